@@ -1,0 +1,41 @@
+//! `rastergi`: the command-line front end. All rendering lives in the `rastergi` library.
+
+mod render;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+#[derive(Parser)]
+#[command(name = "rastergi", version, about = "Global illumination on the GPU with photon maps and a rasterized final gather")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Print the GPU adapter, backend, driver and the limits that matter.
+    Info {
+        #[command(flatten)]
+        gpu: render::GpuArgs,
+    },
+    /// Render a scene progressively and write the image (.exr linear, .png display).
+    Render(render::RenderArgs),
+}
+
+fn main() -> ExitCode {
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Info { gpu } => render::gpu(&gpu).map(|g| println!("{}", g.describe())),
+        Command::Render(args) => render::run(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

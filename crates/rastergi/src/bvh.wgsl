@@ -1,0 +1,106 @@
+// BVH traversal: the twin of Bvh::intersect / Bvh::occluded in bvh.rs.
+
+const NO_TRIANGLE: u32 = 0xffffffffu;
+
+struct RayHit {
+    t: f32,
+    tri: u32,
+    b1: f32,
+    b2: f32,
+}
+
+// Möller–Trumbore; returns (t, b1, b2) or t = -1 when the ray misses the triangle.
+fn intersect_triangle(t: Triangle, o: vec3f, d: vec3f) -> vec3f {
+    let e1 = t.v1 - t.v0;
+    let e2 = t.v2 - t.v0;
+    let p = cross(d, e2);
+    let det = dot(e1, p);
+    if abs(det) < 1e-20 {
+        return vec3f(-1.0, 0.0, 0.0);
+    }
+    let inv_det = 1.0 / det;
+    let s = o - t.v0;
+    let b1 = dot(s, p) * inv_det;
+    if b1 < 0.0 || b1 > 1.0 {
+        return vec3f(-1.0, 0.0, 0.0);
+    }
+    let q = cross(s, e1);
+    let b2 = dot(d, q) * inv_det;
+    if b2 < 0.0 || b1 + b2 > 1.0 {
+        return vec3f(-1.0, 0.0, 0.0);
+    }
+    return vec3f(dot(e2, q) * inv_det, b1, b2);
+}
+
+// Entry distance into a node's box, or -1 when it does not overlap [t_min, t_max].
+fn slab(n: BvhNode, o: vec3f, inv: vec3f, t_min: f32, t_max: f32) -> f32 {
+    let t0 = (n.min - o) * inv;
+    let t1 = (n.max - o) * inv;
+    let tn = min(t0, t1);
+    let tf = max(t0, t1);
+    let near = max(max(max(tn.x, tn.y), tn.z), t_min);
+    let far = min(min(min(tf.x, tf.y), tf.z), t_max);
+    return select(-1.0, near, near <= far);
+}
+
+// Closest hit in (t_min, t_max), skipping triangles skip_a and skip_b (any_hit: stop at the
+// first). Returns tri = NO_TRIANGLE on a miss.
+fn trace(o: vec3f, d: vec3f, t_min: f32, t_max: f32, skip_a: u32, skip_b: u32, any_hit: bool) -> RayHit {
+    var hit = RayHit(t_max, NO_TRIANGLE, 0.0, 0.0);
+    let inv = 1.0 / d;
+    var stack: array<u32, 64>;
+    var sp = 0u;
+    var node = 0u;
+    loop {
+        let n = bvh_nodes[node];
+        var descend = false;
+        if n.count > 0u {
+            for (var i = n.offset; i < n.offset + n.count; i++) {
+                if i == skip_a || i == skip_b {
+                    continue;
+                }
+                let r = intersect_triangle(triangles[i], o, d);
+                if r.x > t_min && r.x < hit.t {
+                    hit = RayHit(r.x, i, r.y, r.z);
+                    if any_hit {
+                        return hit;
+                    }
+                }
+            }
+        } else {
+            let l = node + 1u;
+            let r = n.offset;
+            let tl = slab(bvh_nodes[l], o, inv, t_min, hit.t);
+            let tr = slab(bvh_nodes[r], o, inv, t_min, hit.t);
+            if tl >= 0.0 && tr >= 0.0 {
+                if tl <= tr {
+                    stack[sp] = r;
+                    node = l;
+                } else {
+                    stack[sp] = l;
+                    node = r;
+                }
+                sp += 1u;
+                descend = true;
+            } else if tl >= 0.0 {
+                node = l;
+                descend = true;
+            } else if tr >= 0.0 {
+                node = r;
+                descend = true;
+            }
+        }
+        if !descend {
+            if sp == 0u {
+                break;
+            }
+            sp -= 1u;
+            node = stack[sp];
+        }
+    }
+    return hit;
+}
+
+fn occluded(o: vec3f, d: vec3f, t_min: f32, t_max: f32, skip_a: u32, skip_b: u32) -> bool {
+    return trace(o, d, t_min, t_max, skip_a, skip_b, true).tri != NO_TRIANGLE;
+}

@@ -1,0 +1,67 @@
+//! Direct pass: emitted radiance of the visible point plus direct light from the area
+//! lights, with soft shadows from shadow rays traced against the BVH.
+//!
+//! For a visible point x with normal n and albedo ρ, each of the K light samples picks an
+//! emitter point y with density p(y) = pmf(triangle)/area(triangle) and adds
+//!
+//! ```text
+//!   (1/K) · (ρ/π) · Le(y) · V(x,y) · max(0, n·ω) · max(0, n_y·(−ω)) / |y − x|² / p(y)
+//! ```
+//!
+//! (ω = (y − x)/|y − x|), an unbiased estimate of ∫ (ρ/π) Le cos θ_x cos θ_y / r² V dA.
+//! Light samples are fresh every iteration, so penumbrae converge with the image.
+
+use crate::film::Film;
+use crate::frame::FrameBinding;
+use crate::gbuffer::GBufferPass;
+use crate::gpu::{Gpu, compute_pipeline, groups, storage_entry};
+use crate::gpu_scene::GpuScene;
+use crate::shader;
+
+pub struct DirectPass {
+    pipeline: wgpu::ComputePipeline,
+    bind_group: wgpu::BindGroup,
+}
+
+impl DirectPass {
+    pub fn new(gpu: &Gpu, scene: &GpuScene, frame: &FrameBinding, gbuffer: &GBufferPass, film: &Film) -> Self {
+        let device = &gpu.device;
+        let module = shader::module(device, "direct", &shader::with_scene(include_str!("direct.wgsl")));
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("direct"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Uint,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                storage_entry(1, wgpu::ShaderStages::COMPUTE, false),
+            ],
+        });
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("direct"),
+            layout: &layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&gbuffer.view) },
+                wgpu::BindGroupEntry { binding: 1, resource: film.accumulation.as_entire_binding() },
+            ],
+        });
+        let pipeline = compute_pipeline(device, "direct", &module, &[&scene.layout, &frame.layout, &layout]);
+        Self { pipeline, bind_group }
+    }
+
+    /// Reads: scene, frame, G-buffer. Adds to: the film's direct component.
+    pub fn encode(&self, enc: &mut wgpu::CommandEncoder, scene: &GpuScene, frame: &FrameBinding, width: u32, height: u32) {
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("direct"), timestamp_writes: None });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &scene.bind_group, &[]);
+        pass.set_bind_group(1, &frame.bind_group, &[]);
+        pass.set_bind_group(2, &self.bind_group, &[]);
+        pass.dispatch_workgroups(groups(width, 8), groups(height, 8), 1);
+    }
+}

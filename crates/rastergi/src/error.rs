@@ -1,0 +1,28 @@
+//! The library's error type. Every message is one line that says what is wrong and, where
+//! it helps, what to do about it.
+
+use std::path::PathBuf;
+
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    #[error(
+        "no GPU adapter found{0}; install a Vulkan driver (on Debian without a GPU: `apt-get install mesa-vulkan-drivers libvulkan1` for the lavapipe CPU rasterizer) or choose another backend with --backend / WGPU_BACKEND"
+    )]
+    NoAdapter(String),
+    #[error("could not open the GPU device: {0}")]
+    Device(String),
+    #[error("{0}")]
+    Limits(String),
+    #[error("{}: {message}", path.display())]
+    SceneFile { path: PathBuf, message: String },
+    #[error("invalid scene: {0}")]
+    InvalidScene(String),
+    #[error("invalid camera: {0}")]
+    InvalidCamera(String),
+    #[error("{}: {message}", path.display())]
+    ImageFile { path: PathBuf, message: String },
+    #[error("GPU error: {0}")]
+    Gpu(String),
+}

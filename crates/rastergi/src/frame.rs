@@ -1,0 +1,104 @@
+//! Per-iteration uniforms shared by the eye passes (bind group 1, `frame.wgsl`): the jittered
+//! camera, the image size, the iteration index and the seed.
+
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Vec2, Vec3};
+
+use crate::gpu::{Gpu, buffer_bind_group, uniform_entry};
+use crate::sampling::{pcg_hash, radical_inverse};
+use crate::scene::Camera;
+
+/// `Frame` in `frame.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct FrameUniforms {
+    /// World → clip, including this iteration's sub-pixel jitter.
+    pub view_proj: [[f32; 4]; 4],
+    pub eye: [f32; 3],
+    pub iteration: u32,
+    pub resolution: [u32; 2],
+    pub seed: u32,
+    pub light_samples: u32,
+    /// Minimum hit distance and origin offset of secondary rays.
+    pub ray_epsilon: f32,
+    pub _pad: [u32; 3],
+}
+
+/// The sub-pixel offset of iteration `i`, uniform over [-0.5, 0.5)² across iterations:
+/// a Halton (2, 3) sequence with a Cranley–Patterson rotation derived from the seed.
+/// Averaging samples spread uniformly over the pixel is the box pixel filter.
+pub fn pixel_jitter(iteration: u32, seed: u32) -> Vec2 {
+    let shift = Vec2::new(pcg_hash(seed ^ 0x6a09e667) as f32, pcg_hash(seed ^ 0xbb67ae85) as f32) / 4_294_967_296.0;
+    let h = Vec2::new(radical_inverse(iteration + 1, 2), radical_inverse(iteration + 1, 3));
+    (h + shift).fract() - Vec2::splat(0.5)
+}
+
+/// World → clip for `camera` at `width × height`: right-handed view, reversed-Z infinite
+/// perspective (depth 1 at the near plane, 0 at infinity), shifted by `jitter` pixels.
+pub fn view_projection(camera: &Camera, width: u32, height: u32, near: f32, jitter: Vec2) -> Mat4 {
+    let view = Mat4::look_at_rh(camera.eye, camera.target, camera.up);
+    let aspect = width as f32 / height as f32;
+    let proj = Mat4::perspective_infinite_reverse_rh(camera.fov_y_deg.to_radians(), aspect, near);
+    // NDC spans 2 units per image side; +y is up in NDC and down in pixel rows.
+    let shift = Mat4::from_translation(Vec3::new(2.0 * jitter.x / width as f32, -2.0 * jitter.y / height as f32, 0.0));
+    shift * proj * view
+}
+
+/// The uniform buffer and its bind group.
+pub struct FrameBinding {
+    pub buffer: wgpu::Buffer,
+    pub layout: wgpu::BindGroupLayout,
+    pub bind_group: wgpu::BindGroup,
+}
+
+impl FrameBinding {
+    pub fn new(gpu: &Gpu) -> Self {
+        let buffer = gpu.zeroed_buffer(
+            "frame uniforms",
+            std::mem::size_of::<FrameUniforms>() as u64,
+            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        );
+        let vis = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
+        let layout = gpu
+            .device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("frame"), entries: &[uniform_entry(0, vis)] });
+        let bind_group = buffer_bind_group(&gpu.device, "frame", &layout, &[&buffer]);
+        Self { buffer, layout, bind_group }
+    }
+
+    pub fn write(&self, gpu: &Gpu, u: &FrameUniforms) {
+        gpu.queue.write_buffer(&self.buffer, 0, bytemuck::bytes_of(u));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn jitter_covers_the_pixel_uniformly() {
+        // Mean of a uniform variable on [-0.5, 0.5) is 0, its variance 1/12; the low
+        // discrepancy sequence must reach both far closer than random sampling would.
+        let n = 1024;
+        let js: Vec<Vec2> = (0..n).map(|i| pixel_jitter(i, 17)).collect();
+        let mean = js.iter().copied().sum::<Vec2>() / n as f32;
+        let var = js.iter().map(|j| (*j - mean) * (*j - mean)).sum::<Vec2>() / n as f32;
+        assert!(mean.abs().max_element() < 5e-3, "{mean}");
+        assert!((var - Vec2::splat(1.0 / 12.0)).abs().max_element() < 2e-3, "{var}");
+        assert!(js.iter().all(|j| j.cmpge(Vec2::splat(-0.5)).all() && j.cmplt(Vec2::splat(0.5)).all()));
+    }
+
+    #[test]
+    fn centre_of_view_projects_to_the_image_centre_and_red_wall_side_to_the_left() {
+        let cam = Camera { eye: Vec3::new(0.0, 0.0, 3.9), target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 39.3077 };
+        let m = view_projection(&cam, 64, 64, 0.01, Vec2::ZERO);
+        let c = m.project_point3(Vec3::ZERO);
+        assert!(c.x.abs() < 1e-6 && c.y.abs() < 1e-6 && c.z > 0.0 && c.z < 1.0);
+        assert!(m.project_point3(Vec3::new(-1.0, 0.0, 0.0)).x < 0.0, "-x must be on the left");
+        assert!(m.project_point3(Vec3::new(0.0, 1.0, 0.0)).y > 0.0, "+y must be up");
+        // The front edge of the side walls (z = 1) is at the edge of the 39.3° view at z = 1:
+        // tan(19.65°) · 2.9 ≈ 1.036, so x = -1 projects just inside the left border.
+        let edge = m.project_point3(Vec3::new(-1.0, 0.0, 1.0)).x;
+        assert!((edge - (-1.0 / (2.9 * (39.3077f32 / 2.0).to_radians().tan()))).abs() < 1e-4);
+    }
+}

@@ -1,0 +1,108 @@
+//! Eye pass: rasterizes the scene from the camera (jittered per iteration) into a visibility
+//! G-buffer. Each pixel stores `(triangle + 1, b1, b2)` — 0 where nothing is seen — from
+//! which later passes reconstruct the visible point exactly (`surface_at` in WGSL): position
+//! by barycentric interpolation, geometric normal, material.
+
+use crate::frame::FrameBinding;
+use crate::gpu::Gpu;
+use crate::gpu_scene::GpuScene;
+use crate::shader;
+
+pub const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;
+const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+pub struct GBufferPass {
+    pipeline: wgpu::RenderPipeline,
+    pub texture: wgpu::Texture,
+    pub view: wgpu::TextureView,
+    depth_view: wgpu::TextureView,
+}
+
+impl GBufferPass {
+    pub fn new(gpu: &Gpu, scene: &GpuScene, frame: &FrameBinding, width: u32, height: u32) -> Self {
+        let device = &gpu.device;
+        let module = shader::module(device, "gbuffer", &shader::with_scene(include_str!("gbuffer.wgsl")));
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("gbuffer"),
+            bind_group_layouts: &[Some(&scene.layout), Some(&frame.layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("gbuffer"),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                // Reversed Z: nearer is larger.
+                depth_compare: Some(wgpu::CompareFunction::Greater),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[Some(FORMAT.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let size = wgpu::Extent3d { width, height, depth_or_array_layers: 1 };
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("gbuffer"),
+            size,
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let depth = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("gbuffer depth"),
+            size,
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: DEPTH_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&Default::default());
+        let depth_view = depth.create_view(&Default::default());
+        Self { pipeline, texture, view, depth_view }
+    }
+
+    /// Reads: scene, frame. Writes: the G-buffer.
+    pub fn encode(&self, enc: &mut wgpu::CommandEncoder, scene: &GpuScene, frame: &FrameBinding) {
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("gbuffer"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &self.view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &self.depth_view,
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(0.0), store: wgpu::StoreOp::Discard }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &scene.bind_group, &[]);
+        pass.set_bind_group(1, &frame.bind_group, &[]);
+        pass.draw(0..3 * scene.triangle_count, 0..1);
+    }
+}

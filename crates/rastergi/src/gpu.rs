@@ -1,0 +1,233 @@
+//! The GPU context: adapter choice, device, and small helpers every pass uses.
+
+use std::fmt::Write as _;
+
+use crate::error::{Error, Result};
+
+/// What the user asked for when choosing a GPU.
+#[derive(Clone, Debug, Default)]
+pub struct GpuOptions {
+    /// Backends to consider; `None` means `WGPU_BACKEND` if set, else Vulkan/Metal/DX12.
+    pub backends: Option<wgpu::Backends>,
+}
+
+/// Re-exported so front ends need no direct wgpu dependency.
+pub use wgpu::Backends;
+
+/// Parses a backend name as accepted by `--backend` (and `WGPU_BACKEND`).
+pub fn parse_backend(name: &str) -> Result<wgpu::Backends, String> {
+    match name.to_ascii_lowercase().as_str() {
+        "vulkan" | "vk" => Ok(wgpu::Backends::VULKAN),
+        "metal" | "mtl" => Ok(wgpu::Backends::METAL),
+        "dx12" | "d3d12" => Ok(wgpu::Backends::DX12),
+        "gl" | "gles" | "opengl" => Ok(wgpu::Backends::GL),
+        "primary" => Ok(wgpu::Backends::PRIMARY),
+        "all" => Ok(wgpu::Backends::all()),
+        other => Err(format!("unknown backend '{other}' (expected vulkan, metal, dx12, gl, primary or all)")),
+    }
+}
+
+/// An opened device. Cloning is cheap (wgpu handles are reference counted).
+#[derive(Clone, Debug)]
+pub struct Gpu {
+    pub adapter: wgpu::Adapter,
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub info: wgpu::AdapterInfo,
+}
+
+fn device_rank(t: wgpu::DeviceType) -> u32 {
+    match t {
+        wgpu::DeviceType::DiscreteGpu => 0,
+        wgpu::DeviceType::IntegratedGpu => 1,
+        wgpu::DeviceType::VirtualGpu => 2,
+        wgpu::DeviceType::Cpu => 3,
+        wgpu::DeviceType::Other => 4,
+    }
+}
+
+impl Gpu {
+    /// Opens the best adapter: a discrete GPU if there is one, then integrated, virtual, CPU.
+    pub fn new(options: &GpuOptions) -> Result<Gpu> {
+        let backends = options.backends.or_else(wgpu::Backends::from_env).unwrap_or(wgpu::Backends::PRIMARY);
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+        desc.backends = backends;
+        let instance = wgpu::Instance::new(desc);
+        let mut adapters = pollster::block_on(instance.enumerate_adapters(backends));
+        adapters.sort_by_key(|a| device_rank(a.get_info().device_type));
+        let adapter = adapters
+            .into_iter()
+            .next()
+            .ok_or_else(|| Error::NoAdapter(format!(" for backends {backends:?}")))?;
+        let info = adapter.get_info();
+        let limits = adapter.limits();
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("rastergi device"),
+            required_features: wgpu::Features::empty(),
+            required_limits: limits,
+            experimental_features: wgpu::ExperimentalFeatures::disabled(),
+            memory_hints: wgpu::MemoryHints::Performance,
+            trace: wgpu::Trace::Off,
+        }))
+        .map_err(|e| Error::Device(e.to_string()))?;
+        log::info!("using {} ({:?}, {:?})", info.name, info.backend, info.device_type);
+        Ok(Gpu { adapter, device, queue, info })
+    }
+
+    /// A multi-line description of the adapter and the limits that matter to rastergi.
+    pub fn describe(&self) -> String {
+        let i = &self.info;
+        let l = self.device.limits();
+        let mut s = String::new();
+        let _ = writeln!(s, "adapter:  {}", i.name);
+        let _ = writeln!(s, "backend:  {:?}", i.backend);
+        let _ = writeln!(s, "type:     {:?}", i.device_type);
+        let _ = writeln!(s, "driver:   {} {}", i.driver, i.driver_info);
+        let _ = writeln!(s, "vendor:   {:#06x}  device: {:#06x}", i.vendor, i.device);
+        let _ = writeln!(s, "max texture 2D:            {}", l.max_texture_dimension_2d);
+        let _ = writeln!(s, "max texture 3D:            {}", l.max_texture_dimension_3d);
+        let _ = writeln!(s, "max storage buffer binding: {} MiB", l.max_storage_buffer_binding_size >> 20);
+        let _ = writeln!(s, "max buffer size:           {} MiB", l.max_buffer_size >> 20);
+        let _ = writeln!(s, "max compute workgroup:     {} invocations", l.max_compute_invocations_per_workgroup);
+        let _ = write!(s, "max storage buffers/stage: {}", l.max_storage_buffers_per_shader_stage);
+        s
+    }
+
+    /// Checks that a `width × height` image with `bytes_per_pixel` of storage fits this device.
+    pub fn check_image_size(&self, width: u32, height: u32, bytes_per_pixel: u64) -> Result<()> {
+        let l = self.device.limits();
+        if width == 0 || height == 0 {
+            return Err(Error::Limits(format!("image size {width}x{height} is empty; give a width and height of at least 1")));
+        }
+        let max = l.max_texture_dimension_2d;
+        if width > max || height > max {
+            return Err(Error::Limits(format!(
+                "image size {width}x{height} exceeds this GPU's limit of {max} pixels per side; choose a smaller --width/--height"
+            )));
+        }
+        let bytes = width as u64 * height as u64 * bytes_per_pixel;
+        let max_binding = l.max_storage_buffer_binding_size.min(l.max_buffer_size);
+        if bytes > max_binding {
+            return Err(Error::Limits(format!(
+                "image size {width}x{height} needs a {} MiB buffer but this GPU allows {} MiB; choose a smaller --width/--height",
+                bytes >> 20,
+                max_binding >> 20
+            )));
+        }
+        Ok(())
+    }
+
+    /// A storage buffer initialised with `data`.
+    pub fn storage_buffer(&self, label: &str, data: &[u8], extra: wgpu::BufferUsages) -> wgpu::Buffer {
+        // Zero-sized bindings are invalid: keep at least 16 bytes.
+        let size = (data.len() as u64).max(16).next_multiple_of(4);
+        let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | extra,
+            mapped_at_creation: true,
+        });
+        {
+            let mut view = buffer.get_mapped_range_mut(..).expect("a buffer mapped at creation is mappable");
+            view.slice(..data.len()).copy_from_slice(data);
+        }
+        buffer.unmap();
+        buffer
+    }
+
+    /// A zero-initialised buffer.
+    pub fn zeroed_buffer(&self, label: &str, size: u64, usage: wgpu::BufferUsages) -> wgpu::Buffer {
+        self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: size.max(16).next_multiple_of(4),
+            usage,
+            mapped_at_creation: false,
+        })
+    }
+
+    /// Copies `size` bytes from the start of `buffer` (which needs COPY_SRC) back to the CPU.
+    pub fn read_buffer(&self, buffer: &wgpu::Buffer, size: u64) -> Result<Vec<u8>> {
+        let staging = self.zeroed_buffer("readback", size, wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST);
+        let mut enc = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback") });
+        enc.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
+        self.queue.submit([enc.finish()]);
+        let (tx, rx) = std::sync::mpsc::channel();
+        staging.map_async(wgpu::MapMode::Read, ..size, move |r| {
+            let _ = tx.send(r);
+        });
+        self.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| Error::Gpu(e.to_string()))?;
+        rx.recv()
+            .map_err(|e| Error::Gpu(e.to_string()))?
+            .map_err(|e| Error::Gpu(format!("mapping a readback buffer failed: {e}")))?;
+        let data = staging.get_mapped_range(..size).map_err(|e| Error::Gpu(e.to_string()))?.to_vec();
+        staging.unmap();
+        Ok(data)
+    }
+
+    /// Blocks until all submitted work has finished.
+    pub fn wait(&self) -> Result<()> {
+        self.device.poll(wgpu::PollType::wait_indefinitely()).map(|_| ()).map_err(|e| Error::Gpu(e.to_string()))
+    }
+}
+
+/// Bind-group-layout entry for a storage buffer.
+pub fn storage_entry(binding: u32, visibility: wgpu::ShaderStages, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+/// Bind-group-layout entry for a uniform buffer.
+pub fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None },
+        count: None,
+    }
+}
+
+/// Bind group whose entries are `buffers` bound whole, at bindings 0, 1, 2, …
+pub fn buffer_bind_group(device: &wgpu::Device, label: &str, layout: &wgpu::BindGroupLayout, buffers: &[&wgpu::Buffer]) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry> = buffers
+        .iter()
+        .enumerate()
+        .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout, entries: &entries })
+}
+
+/// A compute pipeline for `module`'s `main` entry point.
+pub fn compute_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    layouts: &[&wgpu::BindGroupLayout],
+) -> wgpu::ComputePipeline {
+    let layouts: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().map(|&l| Some(l)).collect();
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: &layouts,
+        immediate_size: 0,
+    });
+    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(label),
+        layout: Some(&layout),
+        module,
+        entry_point: Some("main"),
+        compilation_options: Default::default(),
+        cache: None,
+    })
+}
+
+/// Number of workgroups of `size` needed to cover `n` items.
+pub fn groups(n: u32, size: u32) -> u32 {
+    n.div_ceil(size)
+}

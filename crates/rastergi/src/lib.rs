@@ -1,0 +1,26 @@
+//! rastergi: global illumination on the GPU with photon maps and a rasterized final gather.
+//!
+//! The modules follow the data flow of a render:
+//!
+//! scene → [`bvh`] → [`gpu_scene`] → (photon map) → per iteration
+//! ([`gbuffer`] → [`direct`] → (final gather)) → [`film`] (accumulate, resolve) → [`image_io`].
+//!
+//! [`renderer::Renderer::iterate`] is the one place that shows the order of the passes.
+
+pub mod bvh;
+pub mod direct;
+pub mod error;
+pub mod film;
+pub mod frame;
+pub mod gbuffer;
+pub mod gpu;
+pub mod gpu_scene;
+pub mod image_io;
+pub mod lights;
+pub mod metrics;
+pub mod renderer;
+pub mod sampling;
+pub mod scene;
+mod shader;
+
+pub use error::{Error, Result};

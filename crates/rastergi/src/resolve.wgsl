@@ -1,0 +1,45 @@
+// Resolve (film.rs): mean of the accumulated sums → linear RGB and display RGBA8.
+
+struct Resolve {
+    resolution: vec2u,
+    samples: u32,
+    // 0 full, 1 direct, 2 indirect.
+    show: u32,
+    scale: f32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}
+
+@group(0) @binding(0) var<uniform> params: Resolve;
+@group(0) @binding(1) var<storage, read> film: array<vec4f>;
+@group(0) @binding(2) var<storage, read_write> linear_out: array<vec4f>;
+@group(0) @binding(3) var<storage, read_write> display_out: array<u32>;
+
+// The sRGB transfer function (IEC 61966-2-1).
+fn srgb_encode(c: vec3f) -> vec3f {
+    let lo = c * 12.92;
+    let hi = 1.055 * pow(c, vec3f(1.0 / 2.4)) - 0.055;
+    return select(hi, lo, c <= vec3f(0.0031308));
+}
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) gid: vec3u) {
+    if any(gid.xy >= params.resolution) {
+        return;
+    }
+    let pixel = gid.y * params.resolution.x + gid.x;
+    let n = params.resolution.x * params.resolution.y;
+    let direct = film[pixel].rgb;
+    let indirect = film[n + pixel].rgb;
+    var sum = direct + indirect;
+    if params.show == 1u {
+        sum = direct;
+    } else if params.show == 2u {
+        sum = indirect;
+    }
+    let mean = sum / f32(max(params.samples, 1u));
+    linear_out[pixel] = vec4f(mean, 1.0);
+    let display = srgb_encode(clamp(mean * params.scale, vec3f(0.0), vec3f(1.0)));
+    display_out[pixel] = pack4x8unorm(vec4f(display, 1.0));
+}

@@ -1,0 +1,53 @@
+// Random numbers and sampling: bit-for-bit twins of sampling.rs.
+
+const PI: f32 = 3.14159265358979;
+
+fn pcg_hash(v: u32) -> u32 {
+    let state = v * 747796405u + 2891336453u;
+    let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
+}
+
+// The stream for key (seed, a, b); mirrors Rng::new.
+fn rng_new(seed: u32, a: u32, b: u32) -> u32 {
+    return pcg_hash(a ^ pcg_hash(b ^ pcg_hash(seed)));
+}
+
+fn rng_next(state: ptr<function, u32>) -> u32 {
+    let s = *state;
+    *state = s * 747796405u + 2891336453u;
+    let word = ((s >> ((s >> 28u) + 4u)) ^ s) * 277803737u;
+    return (word >> 22u) ^ word;
+}
+
+// Uniform in [0, 1) with 24 bits.
+fn rng_f32(state: ptr<function, u32>) -> f32 {
+    return f32(rng_next(state) >> 8u) * (1.0 / 16777216.0);
+}
+
+// Orthonormal basis completing the unit normal n (Duff et al. 2017): returns (t, b).
+fn orthonormal_basis(n: vec3f) -> array<vec3f, 2> {
+    let sign = select(-1.0, 1.0, n.z >= 0.0);
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    return array<vec3f, 2>(
+        vec3f(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
+        vec3f(b, sign + n.y * n.y * a, -n.y),
+    );
+}
+
+// Direction about n with pdf cos θ / π.
+fn cosine_hemisphere(n: vec3f, u1: f32, u2: f32) -> vec3f {
+    let r = sqrt(u1);
+    let phi = 2.0 * PI * u2;
+    let tb = orthonormal_basis(n);
+    return normalize(tb[0] * (r * cos(phi)) + tb[1] * (r * sin(phi)) + n * sqrt(max(1.0 - u1, 0.0)));
+}
+
+// Barycentrics (b0, b1, b2) of a uniform point on a triangle (pdf 1/area).
+fn uniform_triangle_bary(u1: f32, u2: f32) -> vec3f {
+    let su = sqrt(u1);
+    let b0 = 1.0 - su;
+    let b1 = u2 * su;
+    return vec3f(b0, b1, 1.0 - b0 - b1);
+}

@@ -1,0 +1,220 @@
+//! The scene model: triangles with Lambertian materials, area emitters and a pinhole camera.
+//!
+//! Every surface is Lambertian with albedo ρ (linear RGB) and may emit a constant radiance
+//! `Le` from its front face. The front face of a triangle `(v0, v1, v2)` is the one its
+//! counter-clockwise winding faces: its geometric normal is `normalize((v1-v0) × (v2-v0))`.
+//! Emitters are one-sided. Reflection is one-sided too unless the material is `two_sided`
+//! (a ray reaching the back of a one-sided surface is absorbed, as in Mitsuba 3's `diffuse`).
+
+mod cornell;
+mod obj;
+
+pub use cornell::cornell_box;
+pub use obj::load_obj;
+
+use glam::Vec3;
+
+use crate::error::{Error, Result};
+
+/// A Lambertian material with optional one-sided emission.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    pub name: String,
+    /// Diffuse albedo ρ in linear RGB; the BRDF is ρ/π.
+    pub albedo: Vec3,
+    /// Radiance emitted from the front face, linear RGB.
+    pub emission: Vec3,
+    /// Whether the back face reflects too (it never emits).
+    pub two_sided: bool,
+}
+
+impl Material {
+    pub fn diffuse(name: &str, albedo: Vec3) -> Self {
+        Self { name: name.to_owned(), albedo, emission: Vec3::ZERO, two_sided: false }
+    }
+
+    pub fn is_emitter(&self) -> bool {
+        self.emission.max_element() > 0.0
+    }
+}
+
+/// A pinhole camera. `fov_y_deg` is the full vertical field of view.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    pub eye: Vec3,
+    pub target: Vec3,
+    pub up: Vec3,
+    pub fov_y_deg: f32,
+}
+
+impl Camera {
+    /// The camera's orthonormal frame: (right, up, forward), right-handed, looking along forward.
+    pub fn frame(&self) -> (Vec3, Vec3, Vec3) {
+        let forward = (self.target - self.eye).normalize();
+        let right = forward.cross(self.up).normalize();
+        let up = right.cross(forward);
+        (right, up, forward)
+    }
+
+    /// Rejects cameras that define no view: coincident eye and target, an up vector along the
+    /// view direction, non-finite values or a field of view outside (0, 180) degrees.
+    pub fn validate(&self) -> Result<()> {
+        let finite = self.eye.is_finite() && self.target.is_finite() && self.up.is_finite();
+        let forward = self.target - self.eye;
+        if !finite || forward.length_squared() <= 0.0 {
+            return Err(Error::InvalidCamera("eye and target must be distinct finite points".into()));
+        }
+        if forward.normalize().cross(self.up).length_squared() < 1e-12 {
+            return Err(Error::InvalidCamera("the up vector must not be parallel to the view direction".into()));
+        }
+        if !(self.fov_y_deg > 0.0 && self.fov_y_deg < 180.0) {
+            return Err(Error::InvalidCamera(format!(
+                "the field of view must lie strictly between 0 and 180 degrees, got {}",
+                self.fov_y_deg
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// Axis-aligned bounding box.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    pub min: Vec3,
+    pub max: Vec3,
+}
+
+impl Aabb {
+    pub const EMPTY: Aabb = Aabb { min: Vec3::splat(f32::INFINITY), max: Vec3::splat(f32::NEG_INFINITY) };
+
+    pub fn grow(&mut self, p: Vec3) {
+        self.min = self.min.min(p);
+        self.max = self.max.max(p);
+    }
+
+    pub fn union(self, o: Aabb) -> Aabb {
+        Aabb { min: self.min.min(o.min), max: self.max.max(o.max) }
+    }
+
+    pub fn extent(&self) -> Vec3 {
+        (self.max - self.min).max(Vec3::ZERO)
+    }
+
+    pub fn center(&self) -> Vec3 {
+        0.5 * (self.min + self.max)
+    }
+
+    /// Surface area (0 for an empty box).
+    pub fn area(&self) -> f32 {
+        let e = self.extent();
+        2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
+    }
+}
+
+/// A triangle soup with one material per triangle.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// Triangle corners, counter-clockwise about the front face.
+    pub triangles: Vec<[Vec3; 3]>,
+    /// Index into `materials` for each triangle.
+    pub material_ids: Vec<u32>,
+    pub materials: Vec<Material>,
+    pub camera: Camera,
+}
+
+impl Scene {
+    pub fn new(camera: Camera) -> Self {
+        Self { triangles: Vec::new(), material_ids: Vec::new(), materials: Vec::new(), camera }
+    }
+
+    /// Adds a material and returns its index.
+    pub fn add_material(&mut self, material: Material) -> u32 {
+        self.materials.push(material);
+        (self.materials.len() - 1) as u32
+    }
+
+    pub fn add_triangle(&mut self, tri: [Vec3; 3], material: u32) {
+        self.triangles.push(tri);
+        self.material_ids.push(material);
+    }
+
+    /// Adds the quad `a, b, c, d` (counter-clockwise about its front face) as two triangles.
+    pub fn add_quad(&mut self, [a, b, c, d]: [Vec3; 4], material: u32) {
+        self.add_triangle([a, b, c], material);
+        self.add_triangle([a, c, d], material);
+    }
+
+    pub fn bounds(&self) -> Aabb {
+        let mut b = Aabb::EMPTY;
+        for t in &self.triangles {
+            t.iter().for_each(|&p| b.grow(p));
+        }
+        b
+    }
+
+    pub fn material_of(&self, tri: usize) -> &Material {
+        &self.materials[self.material_ids[tri] as usize]
+    }
+
+    /// Indices of the triangles that emit light and have a non-zero area.
+    pub fn emissive_triangles(&self) -> Vec<u32> {
+        (0..self.triangles.len())
+            .filter(|&i| self.material_of(i).is_emitter() && triangle_area(&self.triangles[i]) > 0.0)
+            .map(|i| i as u32)
+            .collect()
+    }
+
+    /// Total emitted power Φ = Σ π · Le · A over the emitters (one-sided Lambertian emission).
+    pub fn emitted_power(&self) -> Vec3 {
+        self.emissive_triangles()
+            .iter()
+            .map(|&i| std::f32::consts::PI * self.material_of(i as usize).emission * triangle_area(&self.triangles[i as usize]))
+            .sum()
+    }
+
+    /// Checks what every pass relies on: at least one triangle, finite coordinates, valid
+    /// material indices, finite non-negative albedo and emission, a valid camera.
+    pub fn validate(&self) -> Result<()> {
+        if self.triangles.is_empty() {
+            return Err(Error::InvalidScene("the scene has no triangles".into()));
+        }
+        if self.material_ids.len() != self.triangles.len() {
+            return Err(Error::InvalidScene("one material index per triangle is required".into()));
+        }
+        if let Some(i) = self.triangles.iter().position(|t| !t.iter().all(|p| p.is_finite())) {
+            return Err(Error::InvalidScene(format!("triangle {i} has a non-finite coordinate")));
+        }
+        if let Some(&m) = self.material_ids.iter().find(|&&m| m as usize >= self.materials.len()) {
+            return Err(Error::InvalidScene(format!("material index {m} is out of range")));
+        }
+        for m in &self.materials {
+            let ok = |v: Vec3| v.is_finite() && v.min_element() >= 0.0;
+            if !ok(m.albedo) || !ok(m.emission) {
+                return Err(Error::InvalidScene(format!(
+                    "material '{}' has a negative or non-finite albedo or emission",
+                    m.name
+                )));
+            }
+        }
+        self.camera.validate()
+    }
+
+    /// A camera that frames the whole scene from its +z side, looking at the centre of its
+    /// bounds with a 45° vertical field of view (used when a file gives no camera).
+    pub fn framing_camera(bounds: &Aabb) -> Camera {
+        let fov_y_deg = 45.0f32;
+        let radius = 0.5 * bounds.extent().length().max(1e-6);
+        let distance = radius / (0.5 * fov_y_deg.to_radians()).sin();
+        Camera { eye: bounds.center() + Vec3::Z * distance, target: bounds.center(), up: Vec3::Y, fov_y_deg }
+    }
+}
+
+/// Area of a triangle.
+pub fn triangle_area(t: &[Vec3; 3]) -> f32 {
+    0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length()
+}
+
+/// Geometric (front-face) normal of a triangle; zero for a degenerate one.
+pub fn triangle_normal(t: &[Vec3; 3]) -> Vec3 {
+    (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero()
+}

@@ -7,7 +7,11 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 #[derive(Parser)]
-#[command(name = "rastergi", version, about = "Global illumination on the GPU with photon maps and a rasterized final gather")]
+#[command(
+    name = "rastergi",
+    version,
+    about = "Global illumination on the GPU with photon maps and a rasterized final gather"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

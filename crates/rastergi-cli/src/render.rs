@@ -117,7 +117,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         anyhow::bail!("--iterations must be at least 1");
     }
     let gpu = gpu(&args.gpu)?;
-    let settings = RenderSettings { width: args.width, height: args.height, seed: args.seed, light_samples: args.light_samples };
+    let settings =
+        RenderSettings { width: args.width, height: args.height, seed: args.seed, light_samples: args.light_samples };
     let mut renderer = Renderer::new(&gpu, &scene, settings)?;
 
     let progress = if std::io::stderr().is_terminal() {

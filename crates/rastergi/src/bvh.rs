@@ -81,7 +81,15 @@ impl Bvh {
 
     /// Closest hit with t in (t_min, t_max), skipping triangle `skip` (BVH order; `u32::MAX`
     /// skips none). `triangles` must be in BVH order.
-    pub fn intersect(&self, triangles: &[[Vec3; 3]], o: Vec3, d: Vec3, t_min: f32, t_max: f32, skip: u32) -> Option<Hit> {
+    pub fn intersect(
+        &self,
+        triangles: &[[Vec3; 3]],
+        o: Vec3,
+        d: Vec3,
+        t_min: f32,
+        t_max: f32,
+        skip: u32,
+    ) -> Option<Hit> {
         let mut best: Option<Hit> = None;
         let mut t_far = t_max;
         self.traverse(o, d, t_min, &mut t_far, |i, t_far| {

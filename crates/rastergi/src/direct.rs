@@ -56,8 +56,16 @@ impl DirectPass {
     }
 
     /// Reads: scene, frame, G-buffer. Adds to: the film's direct component.
-    pub fn encode(&self, enc: &mut wgpu::CommandEncoder, scene: &GpuScene, frame: &FrameBinding, width: u32, height: u32) {
-        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("direct"), timestamp_writes: None });
+    pub fn encode(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        frame: &FrameBinding,
+        width: u32,
+        height: u32,
+    ) {
+        let mut pass =
+            enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("direct"), timestamp_writes: None });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &scene.bind_group, &[]);
         pass.set_bind_group(1, &frame.bind_group, &[]);

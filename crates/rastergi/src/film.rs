@@ -84,7 +84,12 @@ impl Film {
         let c = wgpu::ShaderStages::COMPUTE;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("resolve"),
-            entries: &[uniform_entry(0, c), storage_entry(1, c, true), storage_entry(2, c, false), storage_entry(3, c, false)],
+            entries: &[
+                uniform_entry(0, c),
+                storage_entry(1, c, true),
+                storage_entry(2, c, false),
+                storage_entry(3, c, false),
+            ],
         });
         let bind_group = buffer_bind_group(device, "resolve", &layout, &[&uniforms, &accumulation, &linear, &display]);
         let module = shader::module(device, "resolve", include_str!("resolve.wgsl"));
@@ -108,7 +113,8 @@ impl Film {
             _pad: [0; 3],
         };
         gpu.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
-        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("resolve"), timestamp_writes: None });
+        let mut pass =
+            enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("resolve"), timestamp_writes: None });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &self.bind_group, &[]);
         pass.dispatch_workgroups(groups(self.width, 8), groups(self.height, 8), 1);
@@ -122,7 +128,11 @@ impl Film {
         let bytes = gpu.read_buffer(&self.linear, self.linear.size())?;
         let texels: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
         let n = (self.width * self.height) as usize;
-        Ok(LinearImage { width: self.width, height: self.height, pixels: texels[..n].iter().map(|t| [t[0], t[1], t[2]]).collect() })
+        Ok(LinearImage {
+            width: self.width,
+            height: self.height,
+            pixels: texels[..n].iter().map(|t| [t[0], t[1], t[2]]).collect(),
+        })
     }
 
     /// The display encoding of `show`: 2^exposure · mean, clamped to [0,1], sRGB, 8 bits.

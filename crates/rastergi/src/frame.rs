@@ -59,9 +59,10 @@ impl FrameBinding {
             wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         );
         let vis = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
-        let layout = gpu
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("frame"), entries: &[uniform_entry(0, vis)] });
+        let layout = gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("frame"),
+            entries: &[uniform_entry(0, vis)],
+        });
         let bind_group = buffer_bind_group(&gpu.device, "frame", &layout, &[&buffer]);
         Self { buffer, layout, bind_group }
     }

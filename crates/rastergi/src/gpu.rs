@@ -55,10 +55,8 @@ impl Gpu {
         let instance = wgpu::Instance::new(desc);
         let mut adapters = pollster::block_on(instance.enumerate_adapters(backends));
         adapters.sort_by_key(|a| device_rank(a.get_info().device_type));
-        let adapter = adapters
-            .into_iter()
-            .next()
-            .ok_or_else(|| Error::NoAdapter(format!(" for backends {backends:?}")))?;
+        let adapter =
+            adapters.into_iter().next().ok_or_else(|| Error::NoAdapter(format!(" for backends {backends:?}")))?;
         let info = adapter.get_info();
         let limits = adapter.limits();
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
@@ -97,7 +95,9 @@ impl Gpu {
     pub fn check_image_size(&self, width: u32, height: u32, bytes_per_pixel: u64) -> Result<()> {
         let l = self.device.limits();
         if width == 0 || height == 0 {
-            return Err(Error::Limits(format!("image size {width}x{height} is empty; give a width and height of at least 1")));
+            return Err(Error::Limits(format!(
+                "image size {width}x{height} is empty; give a width and height of at least 1"
+            )));
         }
         let max = l.max_texture_dimension_2d;
         if width > max || height > max {
@@ -189,13 +189,22 @@ pub fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::Bind
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility,
-        ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None },
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
         count: None,
     }
 }
 
 /// Bind group whose entries are `buffers` bound whole, at bindings 0, 1, 2, …
-pub fn buffer_bind_group(device: &wgpu::Device, label: &str, layout: &wgpu::BindGroupLayout, buffers: &[&wgpu::Buffer]) -> wgpu::BindGroup {
+pub fn buffer_bind_group(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    buffers: &[&wgpu::Buffer],
+) -> wgpu::BindGroup {
     let entries: Vec<wgpu::BindGroupEntry> = buffers
         .iter()
         .enumerate()

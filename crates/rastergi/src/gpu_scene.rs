@@ -112,7 +112,12 @@ impl GpuScene {
         let vis = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
         let layout = gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("scene"),
-            entries: &[storage_entry(0, vis, true), storage_entry(1, vis, true), storage_entry(2, vis, true), storage_entry(3, vis, true)],
+            entries: &[
+                storage_entry(0, vis, true),
+                storage_entry(1, vis, true),
+                storage_entry(2, vis, true),
+                storage_entry(3, vis, true),
+            ],
         });
         let refs: Vec<&wgpu::Buffer> = buffers.iter().collect();
         let bind_group = buffer_bind_group(&gpu.device, "scene", &layout, &refs);

@@ -96,9 +96,19 @@ pub fn write_exr(path: &Path, image: &LinearImage) -> Result<()> {
 }
 
 pub fn write_png(path: &Path, image: &DisplayImage) -> Result<()> {
+    if image.rgba.len() != 4 * (image.width * image.height) as usize {
+        return Err(image_error(path, "pixel count does not match the image size"));
+    }
     write_atomically(path, |tmp| {
-        image::save_buffer_with_format(tmp, &image.rgba, image.width, image.height, image::ExtendedColorType::Rgba8, image::ImageFormat::Png)
-            .map_err(|e| e.to_string())
+        image::save_buffer_with_format(
+            tmp,
+            &image.rgba,
+            image.width,
+            image.height,
+            image::ExtendedColorType::Rgba8,
+            image::ImageFormat::Png,
+        )
+        .map_err(|e| e.to_string())
     })
 }
 
@@ -112,7 +122,11 @@ pub fn read_exr(path: &Path) -> Result<LinearImage> {
     )
     .map_err(|e| image_error(path, format!("cannot read EXR: {e}")))?;
     let size = img.layer_data.size;
-    Ok(LinearImage { width: size.width() as u32, height: size.height() as u32, pixels: img.layer_data.channel_data.pixels.1 })
+    Ok(LinearImage {
+        width: size.width() as u32,
+        height: size.height() as u32,
+        pixels: img.layer_data.channel_data.pixels.1,
+    })
 }
 
 #[cfg(test)]
@@ -133,11 +147,18 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("keep.png");
         std::fs::write(&path, b"good").unwrap();
-        // A pixel buffer shorter than the image: the encoder fails.
+        // An encoder that fails half-way through its output.
+        let result = write_atomically(&path, |tmp| {
+            std::fs::write(tmp, b"half").unwrap();
+            Err("disk full".into())
+        });
+        assert!(result.unwrap_err().to_string().contains("disk full"));
+        assert_eq!(std::fs::read(&path).unwrap(), b"good");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+        // A pixel buffer that does not match the size is refused before anything is written.
         let bad = DisplayImage { width: 4, height: 4, rgba: vec![0; 3] };
         assert!(write_png(&path, &bad).is_err());
         assert_eq!(std::fs::read(&path).unwrap(), b"good");
-        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
     }
 
     #[test]

@@ -100,6 +100,18 @@ pub fn compare(image: &LinearImage, reference: &LinearImage, mask: Option<&[bool
     }
 }
 
+/// Mean over the kept pixels and all channels.
+pub fn masked_mean(image: &LinearImage, mask: Option<&[bool]>) -> f64 {
+    let (mut s, mut n) = (0.0f64, 0usize);
+    for (i, p) in image.pixels.iter().enumerate() {
+        if mask.is_none_or(|m| m[i]) {
+            n += 3;
+            s += p.iter().map(|&v| v as f64).sum::<f64>();
+        }
+    }
+    s / n.max(1) as f64
+}
+
 /// Root-mean-square difference of two images over the kept pixels (absolute units).
 pub fn rmse(a: &LinearImage, b: &LinearImage, mask: Option<&[bool]>) -> f64 {
     let (mut s, mut n) = (0.0f64, 0usize);

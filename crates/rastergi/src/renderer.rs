@@ -51,7 +51,16 @@ impl Renderer {
         let frame = FrameBinding::new(gpu);
         let gbuffer = GBufferPass::new(gpu, &gpu_scene, &frame, width, height);
         let direct = DirectPass::new(gpu, &gpu_scene, &frame, &gbuffer, &film);
-        Ok(Renderer { gpu: gpu.clone(), settings, camera: scene.camera, scene: gpu_scene, frame, gbuffer, direct, film })
+        Ok(Renderer {
+            gpu: gpu.clone(),
+            settings,
+            camera: scene.camera,
+            scene: gpu_scene,
+            frame,
+            gbuffer,
+            direct,
+            film,
+        })
     }
 
     pub fn settings(&self) -> &RenderSettings {
@@ -104,7 +113,8 @@ impl Renderer {
         let (w, h) = (self.settings.width, self.settings.height);
         let iteration = self.film.samples;
         self.frame.write(&self.gpu, &self.frame_uniforms(iteration));
-        let mut enc = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("iteration") });
+        let mut enc =
+            self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("iteration") });
         // 1. Eye pass: the visible point of each pixel, at this iteration's jitter.
         self.gbuffer.encode(&mut enc, &self.scene, &self.frame);
         // 2. Emission + direct light with soft shadows → film (direct component).
@@ -132,7 +142,11 @@ impl Renderer {
     pub fn read_gbuffer(&self) -> Result<Vec<[u32; 4]>> {
         let (w, h) = (self.settings.width, self.settings.height);
         let row = (w * 16).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
-        let buffer = self.gpu.zeroed_buffer("gbuffer readback", (row * h) as u64, wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC);
+        let buffer = self.gpu.zeroed_buffer(
+            "gbuffer readback",
+            (row * h) as u64,
+            wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+        );
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
         enc.copy_texture_to_buffer(
             self.gbuffer.texture.as_image_copy(),

@@ -168,7 +168,11 @@ impl Scene {
     pub fn emitted_power(&self) -> Vec3 {
         self.emissive_triangles()
             .iter()
-            .map(|&i| std::f32::consts::PI * self.material_of(i as usize).emission * triangle_area(&self.triangles[i as usize]))
+            .map(|&i| {
+                std::f32::consts::PI
+                    * self.material_of(i as usize).emission
+                    * triangle_area(&self.triangles[i as usize])
+            })
             .sum()
     }
 

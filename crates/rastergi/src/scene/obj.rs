@@ -5,6 +5,7 @@
 //! emit from the counter-clockwise front face only. Faces without a material get a grey
 //! albedo of 0.5 (Mitsuba's default). OBJ carries no camera: the scene is framed from +z.
 
+use std::cell::RefCell;
 use std::path::Path;
 
 use glam::Vec3;
@@ -22,12 +23,30 @@ fn file_error(path: &Path, message: impl Into<String>) -> Error {
 pub fn load_obj(path: &Path) -> Result<Scene> {
     if !path.is_file() {
         let what = if path.exists() { "is not a file" } else { "no such file" };
-        return Err(file_error(path, format!("{what}; give the path of a .obj file or the built-in scene name 'cornell'")));
+        return Err(file_error(
+            path,
+            format!("{what}; give the path of a .obj file or the built-in scene name 'cornell'"),
+        ));
     }
-    let options = tobj::LoadOptions { triangulate: true, ignore_points: true, ignore_lines: true, ..Default::default() };
-    let (models, materials) =
-        tobj::load_obj(path, &options).map_err(|e| file_error(path, format!("not a valid OBJ file: {e}")))?;
-    let materials = materials.map_err(|e| file_error(path, format!("its material library (mtllib) could not be loaded: {e}")))?;
+    let mut text = std::fs::read(path).map_err(|e| file_error(path, format!("cannot be read: {e}")))?;
+    comment_out_texcoords_and_normals(&mut text);
+    let options =
+        tobj::LoadOptions { triangulate: true, ignore_points: true, ignore_lines: true, ..Default::default() };
+    // tobj keeps only the last MTL error, and none at all once one library loaded; the first
+    // failure, with the library's path, is kept here.
+    let mtl_error = RefCell::new(None);
+    let (models, materials) = tobj::load_obj_buf(&mut text.as_slice(), &options, |mtl| load_mtl(path, mtl, &mtl_error))
+        .map_err(|e| file_error(path, obj_error_message(e)))?;
+    let mtl_failure = mtl_error.into_inner().or_else(|| materials.as_ref().err().map(|e| e.to_string()));
+    if let Some(message) = mtl_failure {
+        return Err(file_error(
+            path,
+            format!(
+                "its material library (mtllib) could not be loaded: {message}; fix the .mtl file, put it beside the .obj or remove the mtllib line"
+            ),
+        ));
+    }
+    let materials = materials.unwrap_or_default();
 
     let mut scene = Scene::new(super::Camera { eye: Vec3::Z, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 45.0 });
     for m in &materials {
@@ -53,7 +72,10 @@ pub fn load_obj(path: &Path) -> Result<Scene> {
             for (k, &i) in face.iter().enumerate() {
                 let i = i as usize;
                 if i >= vertex_count {
-                    return Err(file_error(path, format!("face {f} of '{}' refers to a vertex that does not exist", model.name)));
+                    return Err(file_error(
+                        path,
+                        format!("face {f} of '{}' refers to a vertex that does not exist", model.name),
+                    ));
                 }
                 tri[k] = Vec3::new(mesh.positions[3 * i], mesh.positions[3 * i + 1], mesh.positions[3 * i + 2]);
             }
@@ -66,4 +88,70 @@ pub fn load_obj(path: &Path) -> Result<Scene> {
     scene.camera = Scene::framing_camera(&scene.bounds());
     scene.validate().map_err(|e| file_error(path, e.to_string()))?;
     Ok(scene)
+}
+
+/// What is wrong with an OBJ file tobj refused, and what to do about it.
+fn obj_error_message(e: tobj::LoadError) -> String {
+    use tobj::LoadError as E;
+    let what = match e {
+        E::ReadError => "it is not a UTF-8 text file",
+        E::PositionParseError => "a 'v' line does not hold three numbers",
+        E::ScalingByZeroError => "a 'v' line has a weight w of 0",
+        E::ColorParseError => "a 'v' line has a vertex colour with too many or too few numbers",
+        E::FaceParseError => "an 'f' line holds something other than vertex indices",
+        E::InvalidPolygon => "an 'f' line has fewer than three vertices",
+        E::FaceVertexOutOfBounds => "a face ('f' line) refers to a vertex that does not exist",
+        E::FaceColorOutOfBounds => "some vertices have colours and others do not",
+        E::MaterialParseError => "a 'usemtl' line names no material",
+        _ => return format!("not a valid OBJ file ({e}); check it or export it again as Wavefront OBJ"),
+    };
+    format!("not a valid OBJ file: {what}; fix that line or export the file again as Wavefront OBJ")
+}
+
+/// Turns `vt` and `vn` lines into comments in place: a scene needs positions only, and tobj
+/// rejects (in debug builds: panics on) texture and normal indices out of range.
+fn comment_out_texcoords_and_normals(text: &mut [u8]) {
+    for line in text.split_mut(|&b| b == b'\n') {
+        let indent = line.iter().take_while(|b| b.is_ascii_whitespace()).count();
+        let line = &mut line[indent..];
+        let keyword = line.iter().position(u8::is_ascii_whitespace).unwrap_or(line.len());
+        if matches!(&line[..keyword], b"vt" | b"vn") {
+            line[0] = b'#';
+        }
+    }
+}
+
+/// Loads the MTL library `name`, found relative to the OBJ file `obj` as tobj does. MTL lets
+/// a colour be one number (`Kd 0.5` means `Kd 0.5 0.5 0.5`) but tobj panics on fewer than
+/// three: such lines are completed here first. The first failure is recorded in `error`.
+fn load_mtl(obj: &Path, name: &Path, error: &RefCell<Option<String>>) -> tobj::MTLLoadResult {
+    let mtl_path = obj.parent().unwrap_or(Path::new("")).join(name);
+    let fail = |message: String, e: tobj::LoadError| {
+        error.borrow_mut().get_or_insert(format!("{}: {message}", mtl_path.display()));
+        Err(e)
+    };
+    let text = match std::fs::read_to_string(&mtl_path) {
+        Ok(text) => text,
+        Err(e) => return fail(e.to_string(), tobj::LoadError::OpenFileFailed),
+    };
+    let mut completed = String::with_capacity(text.len());
+    for (n, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        if let Some(key @ ("Ka" | "Kd" | "Ks" | "Ke")) = words.next() {
+            match words.collect::<Vec<_>>().as_slice() {
+                [r] => {
+                    completed.push_str(&format!("{key} {r} {r} {r}\n"));
+                    continue;
+                }
+                [_, _, _, ..] => {}
+                _ => {
+                    let message = format!("line {}: '{key}' needs three numbers (r g b) or one", n + 1);
+                    return fail(message, tobj::LoadError::MaterialParseError);
+                }
+            }
+        }
+        completed.push_str(line);
+        completed.push('\n');
+    }
+    tobj::load_mtl_buf(&mut completed.as_bytes()).or_else(|e| fail(format!("not a valid MTL file ({e})"), e))
 }

@@ -1,0 +1,199 @@
+//! Direct lighting against independent computations: a closed form for a rectangular
+//! emitter over a plane, and Mitsuba 3 for the Cornell box.
+
+mod common;
+
+use std::f64::consts::PI;
+
+use glam::{DVec3, Vec3};
+use rastergi::film::Show;
+use rastergi::metrics::{compare, emitter_mask, masked_mean, rmse};
+use rastergi::renderer::RenderSettings;
+use rastergi::scene::{Camera, Material, Scene, cornell_box};
+
+/// Form factor from a point to the rectangle [0,X]×[0,Z] parallel to its plane at height h,
+/// with the point under the corner (Howell's catalogue, C-11), signed by the corner's quadrant.
+fn corner_form_factor(x: f64, z: f64, h: f64) -> f64 {
+    let (a, b) = (x.abs() / h, z.abs() / h);
+    let (sa, sb) = ((1.0 + a * a).sqrt(), (1.0 + b * b).sqrt());
+    x.signum() * z.signum() * (a / sa * (b / sa).atan() + b / sb * (a / sb).atan()) / (2.0 * PI)
+}
+
+/// Form factor from a point at (px, 0, pz) facing +y to the rectangle [x0,x1]×[z0,z1] at y = h.
+fn rect_form_factor(px: f64, pz: f64, [x0, x1, z0, z1]: [f64; 4], h: f64) -> f64 {
+    let g = |x: f64, z: f64| corner_form_factor(x - px, z - pz, h);
+    g(x1, z1) - g(x0, z1) - g(x1, z0) + g(x0, z0)
+}
+
+const RECT: [f64; 4] = [-0.5, 0.5, -0.3, 0.3];
+const H: f64 = 1.0;
+const ALBEDO: f64 = 0.5;
+const LE: [f32; 3] = [2.0, 3.0, 4.0];
+
+/// A white floor at y = 0 under a 1 × 0.6 emitter facing down at y = 1, seen from above.
+fn emitter_over_plane() -> Scene {
+    let camera = Camera { eye: Vec3::new(0.0, 0.9, 0.0), target: Vec3::ZERO, up: Vec3::NEG_Z, fov_y_deg: 60.0 };
+    let mut s = Scene::new(camera);
+    let floor = s.add_material(Material::diffuse("floor", Vec3::splat(ALBEDO as f32)));
+    let light = s.add_material(Material { emission: Vec3::from(LE), ..Material::diffuse("light", Vec3::ZERO) });
+    s.add_quad(
+        [
+            Vec3::new(-10.0, 0.0, -10.0),
+            Vec3::new(-10.0, 0.0, 10.0),
+            Vec3::new(10.0, 0.0, 10.0),
+            Vec3::new(10.0, 0.0, -10.0),
+        ],
+        floor,
+    );
+    let [x0, x1, z0, z1] = RECT.map(|v| v as f32);
+    let y = H as f32;
+    s.add_quad([Vec3::new(x0, y, z0), Vec3::new(x1, y, z0), Vec3::new(x1, y, z1), Vec3::new(x0, y, z1)], light);
+    s
+}
+
+/// Floor point seen through image position (u, v) ∈ [0,1]² (v down) of `camera`.
+fn floor_point(camera: &Camera, w: u32, h: u32, u: f64, v: f64) -> (f64, f64) {
+    let (right, up, forward) = camera.frame();
+    let t = (0.5 * camera.fov_y_deg as f64).to_radians().tan();
+    let (x, y) = ((2.0 * u - 1.0) * t * w as f64 / h as f64, (1.0 - 2.0 * v) * t);
+    let d = forward.as_dvec3() + right.as_dvec3() * x + up.as_dvec3() * y;
+    let e = camera.eye.as_dvec3();
+    let s = -e.y / d.y;
+    (e.x + s * d.x, e.z + s * d.z)
+}
+
+/// Mean and variance of the one-sample estimator (ρ/π)·Le·cosθ·cosθ'/r²·A (uniform area
+/// sampling of the rectangle) at (px, pz), by midpoint quadrature over the rectangle.
+fn estimator_moments(px: f64, pz: f64) -> (f64, f64) {
+    let [x0, x1, z0, z1] = RECT;
+    let area = (x1 - x0) * (z1 - z0);
+    let n = 120;
+    let (mut m1, mut m2) = (0.0, 0.0);
+    for i in 0..n {
+        for j in 0..n {
+            let y = DVec3::new(
+                x0 + (i as f64 + 0.5) / n as f64 * (x1 - x0),
+                H,
+                z0 + (j as f64 + 0.5) / n as f64 * (z1 - z0),
+            );
+            let d = y - DVec3::new(px, 0.0, pz);
+            let r2 = d.length_squared();
+            let cos = d.y / r2.sqrt();
+            let f = ALBEDO / PI * cos * cos / r2 * area;
+            m1 += f;
+            m2 += f * f;
+        }
+    }
+    let k = (n * n) as f64;
+    (m1 / k, m2 / k - (m1 / k).powi(2))
+}
+
+#[test]
+fn direct_light_under_a_rectangular_emitter_matches_the_closed_form_within_predicted_noise() {
+    let gpu = common::gpu();
+    let scene = emitter_over_plane();
+    let (w, h, n) = (40u32, 40u32, 64u32);
+    let img =
+        common::render(&gpu, &scene, RenderSettings { width: w, height: h, seed: 3, light_samples: 1 }, n, Show::Full);
+
+    // Per pixel: the closed form averaged over the pixel (box filter, 4×4 points) and the
+    // standard deviation of an n-sample mean of the light-sampling estimator (unit Le).
+    let (mut sum_z, mut sum_z2, mut max_z, mut count) = (0.0, 0.0, 0.0f64, 0);
+    for py in 0..h {
+        for px in 0..w {
+            let (mut expected, mut var) = (0.0, 0.0);
+            for sy in 0..4 {
+                for sx in 0..4 {
+                    let u = (px as f64 + (sx as f64 + 0.5) / 4.0) / w as f64;
+                    let v = (py as f64 + (sy as f64 + 0.5) / 4.0) / h as f64;
+                    let (x, z) = floor_point(&scene.camera, w, h, u, v);
+                    expected += ALBEDO * rect_form_factor(x, z, RECT, H) / 16.0;
+                    if sx == 1 && sy == 1 {
+                        var = estimator_moments(x, z).1;
+                    }
+                }
+            }
+            let got = img.at(px, py);
+            for c in 0..3 {
+                // Channels scale one light sample by Le_c: they are not independent, but
+                // each must agree; the statistics below use the green channel alone.
+                let rel = got[c] as f64 / LE[c] as f64 / expected;
+                assert!((rel - 1.0).abs() < 0.5, "pixel ({px},{py}) channel {c}: {rel}");
+            }
+            let sigma = (var / n as f64).sqrt();
+            let z = (img.at(px, py)[1] as f64 / LE[1] as f64 - expected) / sigma;
+            sum_z += z;
+            sum_z2 += z * z;
+            max_z = max_z.max(z.abs());
+            count += 1;
+        }
+    }
+    let (mean_z, mean_z2) = (sum_z / count as f64, sum_z2 / count as f64);
+    // Unbiased: the mean of 1600 standardised errors has standard deviation 1/40 = 0.025.
+    assert!(mean_z.abs() < 0.125, "bias: mean standardised error {mean_z}");
+    // Noise as predicted: mean z² of 1600 values is 1 ± sqrt(2/1600) = 0.035 (5σ bounds).
+    assert!((mean_z2 - 1.0).abs() < 0.18, "noise differs from the prediction: mean z² = {mean_z2}");
+    assert!(max_z < 6.0, "an outlier pixel: |z| = {max_z}");
+}
+
+#[test]
+fn direct_only_cornell_box_matches_mitsuba_within_the_combined_noise() {
+    let gpu = common::gpu();
+    let scene = cornell_box();
+    let n = 256;
+    let settings = |seed| RenderSettings { width: 128, height: 128, seed, light_samples: 1 };
+    let a = common::render(&gpu, &scene, settings(1), n, Show::Direct);
+    let b = common::render(&gpu, &scene, settings(2), n, Show::Direct);
+    let ours = common::average(&a, &b);
+
+    let probe = rastergi::image_io::read_exr(&common::data("cornell_direct_128_a.exr")).unwrap();
+    let mask = emitter_mask(&probe, 3.0);
+    let (reference, ref_noise) = common::reference_pair("cornell_direct_128", Some(&mask));
+    let our_noise = rmse(&a, &b, Some(&mask)) / 2.0;
+    let c = compare(&ours, &reference, Some(&mask));
+
+    // Both images are unbiased estimates of the same integral: their RMS difference is
+    // the root sum of squares of their noises. 10 % margin for the noise estimates' own error.
+    let mean_ref = masked_mean(&reference, Some(&mask));
+    let expected_rmse = (our_noise.powi(2) + ref_noise.powi(2)).sqrt() / mean_ref;
+    println!(
+        "relative RMSE {:.4} (noise predicts {expected_rmse:.4}), block-mean error {:.5}",
+        c.relative_rmse, c.block_mean_error
+    );
+    println!("mean ratio {:?}", c.mean_ratio);
+    assert!(c.relative_rmse < 1.1 * expected_rmse, "relative RMSE {} vs noise {expected_rmse}", c.relative_rmse);
+    // Block means of 256 pixels: noise shrinks 16×; |N(0,σ)| averages σ·sqrt(2/π).
+    let expected_block = expected_rmse / 16.0 * (2.0 / PI).sqrt();
+    assert!(
+        c.block_mean_error < 2.0 * expected_block,
+        "block-mean error {} vs noise {expected_block}",
+        c.block_mean_error
+    );
+    for ratio in c.mean_ratio {
+        assert!((ratio - 1.0).abs() < 0.005, "channel means differ: {:?}", c.mean_ratio);
+    }
+}
+
+#[test]
+fn red_wall_is_on_the_left_of_the_cornell_box_image() {
+    let gpu = common::gpu();
+    let img = common::render(
+        &gpu,
+        &cornell_box(),
+        RenderSettings { width: 64, height: 64, seed: 0, light_samples: 1 },
+        8,
+        Show::Full,
+    );
+    let ratio = |x0: u32, x1: u32| {
+        let (mut r, mut g) = (0.0, 0.0);
+        for y in 16..48 {
+            for x in x0..x1 {
+                r += img.at(x, y)[0] as f64;
+                g += img.at(x, y)[1] as f64;
+            }
+        }
+        r / g
+    };
+    assert!(ratio(0, 6) > 5.0, "left edge is not red: r/g = {}", ratio(0, 6));
+    assert!(ratio(58, 64) < 0.5, "right edge is not green: r/g = {}", ratio(58, 64));
+}

@@ -14,7 +14,8 @@
 use crate::film::Film;
 use crate::frame::FrameBinding;
 use crate::gbuffer::GBufferPass;
-use crate::gpu::{Gpu, compute_pipeline, groups, storage_entry};
+use crate::gpu::{Gpu, compute_pipeline, groups};
+use crate::photon_view::{gbuffer_film_bind_group, gbuffer_film_layout};
 use crate::gpu_scene::GpuScene;
 use crate::shader;
 
@@ -27,30 +28,8 @@ impl DirectPass {
     pub fn new(gpu: &Gpu, scene: &GpuScene, frame: &FrameBinding, gbuffer: &GBufferPass, film: &Film) -> Self {
         let device = &gpu.device;
         let module = shader::module(device, "direct", &shader::with_scene(include_str!("direct.wgsl")));
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("direct"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Uint,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                storage_entry(1, wgpu::ShaderStages::COMPUTE, false),
-            ],
-        });
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("direct"),
-            layout: &layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&gbuffer.view) },
-                wgpu::BindGroupEntry { binding: 1, resource: film.accumulation.as_entire_binding() },
-            ],
-        });
+        let layout = gbuffer_film_layout(device, "direct");
+        let bind_group = gbuffer_film_bind_group(device, "direct", &layout, gbuffer, film);
         let pipeline = compute_pipeline(device, "direct", &module, &[&scene.layout, &frame.layout, &layout]);
         Self { pipeline, bind_group }
     }

@@ -1,7 +1,7 @@
 // Direct pass (direct.rs): emission + next-event estimation with BVH shadow rays.
 
 @group(2) @binding(0) var gbuffer: texture_2d<u32>;
-// Film: component 0 (direct, incl. emission) at [0, W·H), component 1 (indirect) after it.
+// Film: component c of pixel p at c·W·H + p; 0 direct (incl. emission), 1 indirect, 2 photon view.
 @group(2) @binding(1) var<storage, read_write> film: array<vec4f>;
 
 const STREAM_DIRECT: u32 = 0x0d1ec7u;

@@ -1,4 +1,5 @@
-//! The film: per-pixel sums of the iterations' estimates, kept as separate components so the
+//! The film: per-pixel sums of the iterations' estimates, kept as separate components
+//! (direct incl. emission, indirect, photon-map view) so the
 //! display can show any of them without restarting, and the resolve pass that turns the sums
 //! into the mean (linear, for EXR) and a display encoding (exposure, clamp, sRGB, for PNG and
 //! the window).
@@ -15,7 +16,7 @@ use crate::image_io::{DisplayImage, LinearImage};
 use crate::shader;
 
 /// Components accumulated per pixel.
-pub const COMPONENTS: u64 = 2;
+pub const COMPONENTS: u64 = 3;
 /// Bytes per pixel of the film's GPU storage (accumulation + resolved copies).
 pub const BYTES_PER_PIXEL: u64 = COMPONENTS * 16 + 16 + 4;
 
@@ -29,6 +30,8 @@ pub enum Show {
     Direct,
     /// Indirect light only.
     Indirect,
+    /// ρ/π · E from the photon map at the visible points.
+    PhotonMap,
 }
 
 impl Show {
@@ -37,6 +40,7 @@ impl Show {
             Show::Full => 0,
             Show::Direct => 1,
             Show::Indirect => 2,
+            Show::PhotonMap => 3,
         }
     }
 }

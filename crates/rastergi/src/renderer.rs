@@ -11,6 +11,9 @@ use crate::gbuffer::GBufferPass;
 use crate::gpu::Gpu;
 use crate::gpu_scene::{GpuScene, PreparedScene};
 use crate::image_io::{DisplayImage, LinearImage};
+use crate::photon_view::PhotonViewPass;
+use crate::photons::PhotonSettings;
+use crate::photons::gpu::GpuPhotonMap;
 use crate::scene::{Camera, Scene};
 
 /// Settings of a render.
@@ -21,11 +24,26 @@ pub struct RenderSettings {
     pub seed: u32,
     /// Light samples per pixel per iteration in the direct pass.
     pub light_samples: u32,
+    /// Photons traced into the photon map (0: no photon map, no indirect light).
+    pub photons: u32,
+    /// Photon grid cells along the scene's longest axis.
+    pub grid_resolution: u32,
+    /// Also accumulate the photon-map view (`Show::PhotonMap`).
+    pub show_photon_map: bool,
 }
 
 impl Default for RenderSettings {
     fn default() -> Self {
-        Self { width: 256, height: 256, seed: 0, light_samples: 1 }
+        let p = PhotonSettings::default();
+        Self {
+            width: 256,
+            height: 256,
+            seed: 0,
+            light_samples: 1,
+            photons: p.count,
+            grid_resolution: p.grid_resolution,
+            show_photon_map: false,
+        }
     }
 }
 
@@ -37,6 +55,8 @@ pub struct Renderer {
     frame: FrameBinding,
     gbuffer: GBufferPass,
     direct: DirectPass,
+    photon_map: Option<GpuPhotonMap>,
+    photon_view: Option<PhotonViewPass>,
     film: Film,
 }
 
@@ -51,6 +71,17 @@ impl Renderer {
         let frame = FrameBinding::new(gpu);
         let gbuffer = GBufferPass::new(gpu, &gpu_scene, &frame, width, height);
         let direct = DirectPass::new(gpu, &gpu_scene, &frame, &gbuffer, &film);
+        let photon_settings =
+            PhotonSettings { count: settings.photons, seed: settings.seed, grid_resolution: settings.grid_resolution };
+        let photon_map = (settings.photons > 0)
+            .then(|| GpuPhotonMap::build(gpu, &gpu_scene, &prepared, &photon_settings))
+            .transpose()?;
+        let photon_view = match &photon_map {
+            Some(map) if settings.show_photon_map => {
+                Some(PhotonViewPass::new(gpu, &gpu_scene, &frame, &gbuffer, &film, map))
+            }
+            _ => None,
+        };
         Ok(Renderer {
             gpu: gpu.clone(),
             settings,
@@ -59,6 +90,8 @@ impl Renderer {
             frame,
             gbuffer,
             direct,
+            photon_map,
+            photon_view,
             film,
         })
     }
@@ -121,6 +154,10 @@ impl Renderer {
         self.direct.encode(&mut enc, &self.scene, &self.frame, w, h);
         // 3. Indirect light plugs in here: the final gather reads the photon map (built once
         //    per scene) and adds one gather sample per visible point → film (indirect).
+        // Debug view: the photon map's radiance at the visible points → film (photon view).
+        if let (Some(view), Some(map)) = (&self.photon_view, &self.photon_map) {
+            view.encode(&mut enc, &self.scene, &self.frame, map, w, h);
+        }
         self.gpu.queue.submit([enc.finish()]);
         self.film.samples += 1;
     }
@@ -128,6 +165,11 @@ impl Renderer {
     /// Blocks until the submitted iterations have finished on the GPU.
     pub fn wait(&self) -> Result<()> {
         self.gpu.wait()
+    }
+
+    /// The photon map, if the render has one.
+    pub fn photon_map(&self) -> Option<&GpuPhotonMap> {
+        self.photon_map.as_ref()
     }
 
     pub fn read_linear(&self, show: Show) -> Result<LinearImage> {

@@ -3,7 +3,7 @@
 struct Resolve {
     resolution: vec2u,
     samples: u32,
-    // 0 full, 1 direct, 2 indirect.
+    // 0 full, 1 direct, 2 indirect, 3 photon-map view.
     show: u32,
     scale: f32,
     _pad0: u32,
@@ -37,6 +37,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         sum = direct;
     } else if params.show == 2u {
         sum = indirect;
+    } else if params.show == 3u {
+        sum = film[2u * n + pixel].rgb;
     }
     let mean = sum / f32(max(params.samples, 1u));
     linear_out[pixel] = vec4f(mean, 1.0);

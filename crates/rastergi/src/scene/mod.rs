@@ -199,6 +199,12 @@ impl Scene {
                     m.name
                 )));
             }
+            if m.albedo.max_element() > 1.0 {
+                return Err(Error::InvalidScene(format!(
+                    "material '{}' has an albedo above 1 ({}), which would create energy; scale it into [0, 1]",
+                    m.name, m.albedo
+                )));
+            }
         }
         self.camera.validate()
     }

@@ -1,0 +1,70 @@
+//! Photon-map view (`--show photon-map`): the radiance the photon map predicts at each
+//! visible point, L = ρ/π · E(x) (no emission), for debugging the map and for comparing it
+//! with a full reference: it is what the final gather reads at its secondary points.
+
+use crate::film::Film;
+use crate::frame::FrameBinding;
+use crate::gbuffer::GBufferPass;
+use crate::gpu::{Gpu, compute_pipeline, groups, storage_entry};
+use crate::gpu_scene::GpuScene;
+use crate::photons::gpu::GpuPhotonMap;
+use crate::shader;
+
+pub struct PhotonViewPass {
+    pipeline: wgpu::ComputePipeline,
+    bind_group: wgpu::BindGroup,
+}
+
+impl PhotonViewPass {
+    pub fn new(gpu: &Gpu, scene: &GpuScene, frame: &FrameBinding, gbuffer: &GBufferPass, film: &Film, map: &GpuPhotonMap) -> Self {
+        let device = &gpu.device;
+        let source = shader::with_scene(&[include_str!("photon_map.wgsl"), include_str!("photon_view.wgsl")].join("\n"));
+        let module = shader::module(device, "photon view", &source);
+        let layout = gbuffer_film_layout(device, "photon view");
+        let bind_group = gbuffer_film_bind_group(device, "photon view", &layout, gbuffer, film);
+        let pipeline = compute_pipeline(device, "photon view", &module, &[&scene.layout, &frame.layout, &layout, &map.layout]);
+        Self { pipeline, bind_group }
+    }
+
+    /// Reads: scene, frame, G-buffer, photon map. Adds to: the film's photon-map component.
+    pub fn encode(&self, enc: &mut wgpu::CommandEncoder, scene: &GpuScene, frame: &FrameBinding, map: &GpuPhotonMap, width: u32, height: u32) {
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("photon view"), timestamp_writes: None });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &scene.bind_group, &[]);
+        pass.set_bind_group(1, &frame.bind_group, &[]);
+        pass.set_bind_group(2, &self.bind_group, &[]);
+        pass.set_bind_group(3, &map.bind_group, &[]);
+        pass.dispatch_workgroups(groups(width, 8), groups(height, 8), 1);
+    }
+}
+
+/// Layout of a per-pixel pass's own group: the G-buffer (binding 0) and the film (binding 1).
+pub fn gbuffer_film_layout(device: &wgpu::Device, label: &str) -> wgpu::BindGroupLayout {
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(label),
+        entries: &[
+            wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Uint,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                },
+                count: None,
+            },
+            storage_entry(1, wgpu::ShaderStages::COMPUTE, false),
+        ],
+    })
+}
+
+pub fn gbuffer_film_bind_group(device: &wgpu::Device, label: &str, layout: &wgpu::BindGroupLayout, gbuffer: &GBufferPass, film: &Film) -> wgpu::BindGroup {
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &[
+            wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&gbuffer.view) },
+            wgpu::BindGroupEntry { binding: 1, resource: film.accumulation.as_entire_binding() },
+        ],
+    })
+}

@@ -1,0 +1,111 @@
+//! The CPU twin of the photon tracer: the same photons, the same map, in f64 with rayon.
+//! Reference in tests, baseline in `rastergi bench photons`.
+
+use rayon::prelude::*;
+
+use super::{MAX_BOUNCES, PhotonSettings, STREAM_PHOTON};
+use crate::gpu_scene::PreparedScene;
+use crate::photon_map::{GridSpec, PhotonMap, orientation_bin, surface_areas};
+use crate::sampling::{Rng, cosine_hemisphere, uniform_triangle};
+use crate::scene::triangle_normal;
+
+/// Flux deposited per slot, with the squares and counts used for noise estimates.
+pub struct Tally {
+    pub flux: Vec<[f64; 3]>,
+    pub flux_sq: Vec<f64>,
+    pub deposits: Vec<u32>,
+}
+
+impl Tally {
+    fn new(n: usize) -> Self {
+        Self { flux: vec![[0.0; 3]; n], flux_sq: vec![0.0; n], deposits: vec![0; n] }
+    }
+
+    fn merge(mut self, o: Tally) -> Tally {
+        for i in 0..self.flux.len() {
+            for c in 0..3 {
+                self.flux[i][c] += o.flux[i][c];
+            }
+            self.flux_sq[i] += o.flux_sq[i];
+            self.deposits[i] += o.deposits[i];
+        }
+        self
+    }
+}
+
+/// Traces `settings.count` photons on all CPU cores into a photon map over `grid`.
+pub fn trace(prepared: &PreparedScene, grid: &GridSpec, settings: &PhotonSettings) -> PhotonMap {
+    let area = surface_areas(&prepared.scene, grid);
+    let tally = trace_flux(prepared, grid, settings);
+    PhotonMap { grid: *grid, flux: tally.flux, area, flux_sq: tally.flux_sq, deposits: tally.deposits }
+}
+
+/// The photon tracing alone (what `rastergi bench photons` times).
+pub fn trace_flux(prepared: &PreparedScene, grid: &GridSpec, settings: &PhotonSettings) -> Tally {
+    let slots = grid.slot_count();
+    if prepared.lights.is_empty() || settings.count == 0 {
+        return Tally::new(slots);
+    }
+    const CHUNK: u32 = 4096;
+    let chunks = settings.count.div_ceil(CHUNK);
+    (0..chunks)
+        .into_par_iter()
+        .with_min_len(16)
+        .fold(
+            || Tally::new(slots),
+            |mut t, chunk| {
+                for i in chunk * CHUNK..((chunk + 1) * CHUNK).min(settings.count) {
+                    trace_photon(prepared, grid, settings, i, &mut t);
+                }
+                t
+            },
+        )
+        .reduce(|| Tally::new(slots), Tally::merge)
+}
+
+/// One photon's path (`trace_photon` in `trace.wgsl`, draw for draw).
+fn trace_photon(prepared: &PreparedScene, grid: &GridSpec, settings: &PhotonSettings, index: u32, t: &mut Tally) {
+    let scene = &prepared.scene;
+    let eps = prepared.ray_epsilon();
+    let mut rng = Rng::new(settings.seed ^ STREAM_PHOTON, index, 0);
+    let (u0, u1, u2) = (rng.next_f32(), rng.next_f32(), rng.next_f32());
+    let light = prepared.lights.pick(u0);
+    let tri = &scene.triangles[light.triangle as usize];
+    let ln = triangle_normal(tri);
+    let le = scene.material_of(light.triangle as usize).emission;
+    let mut flux = le * (std::f32::consts::PI * light.area / light.pmf / settings.count as f32);
+    let pos = uniform_triangle(tri, u1, u2);
+    let (u3, u4) = (rng.next_f32(), rng.next_f32());
+    let mut dir = cosine_hemisphere(ln, u3, u4);
+    let mut origin = pos + ln * eps;
+    let mut skip = light.triangle;
+    for _ in 0..MAX_BOUNCES {
+        let Some(hit) = prepared.bvh.intersect(&scene.triangles, origin, dir, eps, f32::INFINITY, skip) else {
+            break;
+        };
+        let tri = &scene.triangles[hit.triangle as usize];
+        let material = scene.material_of(hit.triangle as usize);
+        let n = triangle_normal(tri);
+        let front = n.dot(dir) < 0.0;
+        if !front && !material.two_sided {
+            break;
+        }
+        let n = if front { n } else { -n };
+        let p = tri[0] * (1.0 - hit.b1 - hit.b2) + tri[1] * hit.b1 + tri[2] * hit.b2;
+        let slot = grid.slot(grid.cell_of(p), orientation_bin(n));
+        for c in 0..3 {
+            t.flux[slot][c] += flux[c] as f64;
+        }
+        t.flux_sq[slot] += (flux.y as f64).powi(2);
+        t.deposits[slot] += 1;
+        let survive = material.albedo.max_element();
+        if rng.next_f32() >= survive {
+            break;
+        }
+        flux *= material.albedo / survive;
+        let (u1, u2) = (rng.next_f32(), rng.next_f32());
+        dir = cosine_hemisphere(n, u1, u2);
+        origin = p + n * eps;
+        skip = hit.triangle;
+    }
+}

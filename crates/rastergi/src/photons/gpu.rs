@@ -1,0 +1,327 @@
+//! The GPU photon tracer (`trace.wgsl`) and the photon map's GPU form.
+//!
+//! Accumulation: each deposit adds round(Φ_c · 2²⁴ / Φ_max) to a 64-bit fixed-point counter
+//! per slot and channel, kept as two u32 words (low, high) with an explicit carry: the thread
+//! whose `atomicAdd` wraps the low word adds 1 to the high word. Since a photon's flux never
+//! exceeds Φ_max (see [`super`]), a deposit is at most 2²⁴ units; a counter holds 2⁶⁴ units,
+//! i.e. 2⁴⁰ ≈ 10¹² full-flux deposits per slot, and each deposit is exact to 2⁻²⁵ Φ_max.
+//! No float atomics, no lost flux, the same totals whatever the scheduling order.
+//!
+//! A resolve kernel turns the counters into the lookup texture: a 3D `rgba32float` texture
+//! of size (nx, ny, 6·nz) whose texel at (x, y, z + bin·nz) holds (Φ_rgb/h², A/h²), h the cell
+//! side; `photon_map.wgsl` samples it.
+
+use bytemuck::{Pod, Zeroable};
+use glam::UVec3;
+
+use super::{MAX_BOUNCES, PhotonSettings};
+use crate::error::{Error, Result};
+use crate::gpu::{Gpu, storage_entry, uniform_entry};
+use crate::gpu_scene::{GpuScene, PreparedScene};
+use crate::photon_map::{BINS, GridSpec, PhotonMap, surface_areas};
+use crate::shader;
+
+/// Fixed-point units per Φ_max.
+const QUANTUM_BITS: u32 = 24;
+/// Photons per dispatch: keeps each submission short (no GPU watchdog, steady progress).
+const BATCH: u32 = 1 << 20;
+const WORKGROUP: u32 = 64;
+
+/// `PhotonParams` in `trace.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct PhotonParams {
+    origin: [f32; 3],
+    cell: f32,
+    dims: [u32; 3],
+    first_photon: u32,
+    batch_size: u32,
+    seed: u32,
+    inv_photon_count: f32,
+    /// Fixed-point units per watt: 2²⁴ / Φ_max.
+    quantum: f32,
+    ray_epsilon: f32,
+    max_bounces: u32,
+    groups_x: u32,
+    _pad: u32,
+}
+
+/// `PhotonGrid` in `photon_map.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct PhotonGridUniforms {
+    pub origin: [f32; 3],
+    pub cell: f32,
+    pub dims: [u32; 3],
+    pub _pad: u32,
+}
+
+/// The photon map on the GPU, ready for lookups (bind group 3 of the passes that read it).
+pub struct GpuPhotonMap {
+    pub grid: GridSpec,
+    pub settings: PhotonSettings,
+    pub texture: wgpu::Texture,
+    pub layout: wgpu::BindGroupLayout,
+    pub bind_group: wgpu::BindGroup,
+    tally: wgpu::Buffer,
+    quantum: f64,
+    area: Vec<f64>,
+    params: PhotonParams,
+    params_buffer: wgpu::Buffer,
+    trace_group: wgpu::BindGroup,
+    trace_pipeline: wgpu::ComputePipeline,
+    resolve_pipeline: wgpu::ComputePipeline,
+    has_lights: bool,
+}
+
+/// Bytes of GPU memory the photon map of `grid` takes (tally + area + texture).
+pub fn memory_bytes(grid: &GridSpec) -> u64 {
+    grid.slot_count() as u64 * (6 * 4 + 4 + 16)
+}
+
+impl GpuPhotonMap {
+    /// Traces `settings.count` photons on the GPU into a fresh map over the scene.
+    pub fn build(gpu: &Gpu, scene: &GpuScene, prepared: &PreparedScene, settings: &PhotonSettings) -> Result<GpuPhotonMap> {
+        let map = Self::new(gpu, scene, prepared, settings)?;
+        map.trace(gpu, scene);
+        Ok(map)
+    }
+
+    /// Allocates the map and its pipelines (the geometry's cell areas are computed here).
+    pub fn new(gpu: &Gpu, scene: &GpuScene, prepared: &PreparedScene, settings: &PhotonSettings) -> Result<GpuPhotonMap> {
+        let grid = GridSpec::new(&prepared.bounds, settings.grid_resolution);
+        let limits = gpu.device.limits();
+        let slots = grid.slot_count() as u64;
+        if grid.dims.max_element() > limits.max_texture_dimension_3d || BINS as u32 * grid.dims.z > limits.max_texture_dimension_3d {
+            return Err(Error::Limits(format!(
+                "a photon grid of {}x{}x{} cells needs a 3D texture deeper than this GPU's {} texels; choose a smaller --grid",
+                grid.dims.x, grid.dims.y, grid.dims.z, limits.max_texture_dimension_3d
+            )));
+        }
+        if slots * 24 > limits.max_storage_buffer_binding_size.min(limits.max_buffer_size) {
+            return Err(Error::Limits(format!(
+                "a photon grid of {}x{}x{} cells needs {} MiB of counters, more than this GPU binds ({} MiB); choose a smaller --grid",
+                grid.dims.x,
+                grid.dims.y,
+                grid.dims.z,
+                (slots * 24) >> 20,
+                limits.max_storage_buffer_binding_size >> 20
+            )));
+        }
+        let area = surface_areas(&prepared.scene, &grid);
+        let max_flux = settings.max_photon_flux(prepared);
+        let quantum = if max_flux > 0.0 { (1u64 << QUANTUM_BITS) as f64 / max_flux } else { 1.0 };
+        let device = &gpu.device;
+
+        let tally = gpu.zeroed_buffer(
+            "photon tally",
+            slots * 24,
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+        );
+        let h2 = (grid.cell as f64).powi(2);
+        let area_scaled: Vec<f32> = area.iter().map(|&a| (a / h2) as f32).collect();
+        let area_buffer = gpu.storage_buffer("photon cell areas", bytemuck::cast_slice(&area_scaled), wgpu::BufferUsages::empty());
+        let params_buffer = gpu.zeroed_buffer(
+            "photon params",
+            std::mem::size_of::<PhotonParams>() as u64,
+            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        );
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("photon map"),
+            size: wgpu::Extent3d { width: grid.dims.x, height: grid.dims.y, depth_or_array_layers: BINS as u32 * grid.dims.z },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D3,
+            format: wgpu::TextureFormat::Rgba32Float,
+            usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&Default::default());
+
+        let c = wgpu::ShaderStages::COMPUTE;
+        let trace_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("photon trace"),
+            entries: &[
+                uniform_entry(0, c),
+                storage_entry(1, c, false),
+                storage_entry(2, c, true),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 3,
+                    visibility: c,
+                    ty: wgpu::BindingType::StorageTexture {
+                        access: wgpu::StorageTextureAccess::WriteOnly,
+                        format: wgpu::TextureFormat::Rgba32Float,
+                        view_dimension: wgpu::TextureViewDimension::D3,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let trace_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("photon trace"),
+            layout: &trace_layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: params_buffer.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: tally.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: area_buffer.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&view) },
+            ],
+        });
+        let source = [shader::SAMPLING, shader::SCENE, shader::BVH, include_str!("trace.wgsl")].join("\n");
+        let module = shader::module(device, "photon trace", &source);
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("photon trace"),
+            bind_group_layouts: &[Some(&scene.layout), Some(&trace_layout)],
+            immediate_size: 0,
+        });
+        let pipeline = |entry: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: Some(&layout),
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        let trace_pipeline = pipeline("trace_photons");
+        let resolve_pipeline = pipeline("resolve_map");
+        let params = PhotonParams {
+            origin: grid.origin.into(),
+            cell: grid.cell,
+            dims: grid.dims.into(),
+            first_photon: 0,
+            batch_size: 0,
+            seed: settings.seed,
+            inv_photon_count: 1.0 / settings.count.max(1) as f32,
+            quantum: quantum as f32,
+            ray_epsilon: prepared.ray_epsilon(),
+            max_bounces: MAX_BOUNCES,
+            groups_x: 0,
+            _pad: 0,
+        };
+        let (layout, bind_group) = lookup_binding(gpu, &grid, &texture);
+        Ok(GpuPhotonMap {
+            grid,
+            settings: *settings,
+            texture,
+            layout,
+            bind_group,
+            tally,
+            quantum,
+            area,
+            params,
+            params_buffer,
+            trace_group,
+            trace_pipeline,
+            resolve_pipeline,
+            has_lights: scene.light_count > 0,
+        })
+    }
+
+    /// Clears the counters, traces the photons in batches and resolves the lookup texture.
+    /// Returns once the work is submitted; `Gpu::wait` waits for it.
+    pub fn trace(&self, gpu: &Gpu, scene: &GpuScene) {
+        let (device, grid) = (&gpu.device, &self.grid);
+        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("photon clear") });
+        enc.clear_buffer(&self.tally, 0, None);
+        gpu.queue.submit([enc.finish()]);
+        let mut params = self.params;
+        let count = self.settings.count;
+        if self.has_lights {
+            let mut first = 0u32;
+            while first < count {
+                let batch = BATCH.min(count - first);
+                let groups = batch.div_ceil(WORKGROUP);
+                let (gx, gy) = (groups.min(65535), groups.div_ceil(65535));
+                params.first_photon = first;
+                params.batch_size = batch;
+                params.groups_x = gx;
+                gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&params));
+                let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("photon batch") });
+                {
+                    let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                        label: Some("trace photons"),
+                        timestamp_writes: None,
+                    });
+                    pass.set_pipeline(&self.trace_pipeline);
+                    pass.set_bind_group(0, &scene.bind_group, &[]);
+                    pass.set_bind_group(1, &self.trace_group, &[]);
+                    pass.dispatch_workgroups(gx, gy, 1);
+                }
+                gpu.queue.submit([enc.finish()]);
+                first += batch;
+            }
+        }
+        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("photon map resolve") });
+        {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("resolve photon map"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&self.resolve_pipeline);
+            pass.set_bind_group(0, &scene.bind_group, &[]);
+            pass.set_bind_group(1, &self.trace_group, &[]);
+            pass.dispatch_workgroups(grid.dims.x.div_ceil(4), grid.dims.y.div_ceil(4), (BINS as u32 * grid.dims.z).div_ceil(4));
+        }
+        gpu.queue.submit([enc.finish()]);
+    }
+
+    /// Reads the map back from the counters (exact fixed-point sums) for tests and tools.
+    pub fn read(&self, gpu: &Gpu) -> Result<PhotonMap> {
+        let bytes = gpu.read_buffer(&self.tally, self.tally.size())?;
+        let words: &[u32] = bytemuck::cast_slice(&bytes);
+        let n = self.grid.slot_count();
+        let flux = (0..n)
+            .map(|s| {
+                [0, 1, 2].map(|c| {
+                    let (lo, hi) = (words[6 * s + 2 * c] as u64, words[6 * s + 2 * c + 1] as u64);
+                    ((hi << 32) | lo) as f64 / self.quantum
+                })
+            })
+            .collect();
+        Ok(PhotonMap { grid: self.grid, flux, area: self.area.clone(), flux_sq: vec![0.0; n], deposits: vec![0; n] })
+    }
+
+    pub fn cells(&self) -> UVec3 {
+        self.grid.dims
+    }
+}
+
+/// The lookup bind group: the map texture and its grid placement.
+fn lookup_binding(gpu: &Gpu, grid: &GridSpec, texture: &wgpu::Texture) -> (wgpu::BindGroupLayout, wgpu::BindGroup) {
+    let u = PhotonGridUniforms { origin: grid.origin.into(), cell: grid.cell, dims: grid.dims.into(), _pad: 0 };
+    let uniforms = gpu.zeroed_buffer(
+        "photon grid",
+        std::mem::size_of::<PhotonGridUniforms>() as u64,
+        wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+    );
+    gpu.queue.write_buffer(&uniforms, 0, bytemuck::bytes_of(&u));
+    let vis = wgpu::ShaderStages::COMPUTE | wgpu::ShaderStages::FRAGMENT;
+    let layout = gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("photon map lookup"),
+        entries: &[
+            wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: vis,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                    view_dimension: wgpu::TextureViewDimension::D3,
+                    multisampled: false,
+                },
+                count: None,
+            },
+            uniform_entry(1, vis),
+        ],
+    });
+    let view = texture.create_view(&Default::default());
+    let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("photon map lookup"),
+        layout: &layout,
+        entries: &[
+            wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&view) },
+            wgpu::BindGroupEntry { binding: 1, resource: uniforms.as_entire_binding() },
+        ],
+    });
+    (layout, bind_group)
+}

@@ -1,0 +1,62 @@
+//! Photon pass: photons leave the area lights and deposit their flux into the grid photon map
+//! ([`crate::photon_map`]) at every diffuse hit.
+//!
+//! Emission: a light triangle is chosen with probability pmf ∝ its power, a point uniformly on
+//! it (pdf 1/A) and a direction with pdf cos θ/π, so a photon carries
+//!
+//! ```text
+//!   Φ = Le · cos θ / (pmf/A · cos θ/π) / N = π · Le · A / pmf / N
+//! ```
+//!
+//! (= total emitted power / N when all lights share one colour). At each hit of a side that
+//! reflects, Φ is deposited in the slot (cell of the hit, bin of the side's normal); the photon
+//! then survives with probability p = max(ρ) (Russian roulette) carrying Φ·ρ/p, in a cosine
+//! direction about the side's normal. There is no depth limit, only a safety cap
+//! ([`MAX_BOUNCES`]). Hitting the back of a one-sided surface absorbs the photon.
+//!
+//! Every random number comes from the stream (seed ⊕ [`STREAM_PHOTON`], photon index), so the
+//! GPU tracer ([`gpu`]) and its CPU twin ([`cpu`]) draw identical samples for a photon.
+//!
+//! Since ρ_c/max(ρ) ≤ 1, a photon's flux per channel never exceeds its initial flux, which is
+//! at most [`PhotonSettings::max_photon_flux`]: the GPU's fixed-point tally relies on this.
+
+pub mod cpu;
+pub mod gpu;
+
+use crate::gpu_scene::PreparedScene;
+
+/// Safety cap on bounces (Russian roulette ends almost every path long before).
+pub const MAX_BOUNCES: u32 = 256;
+/// Stream constant of the photon pass's random numbers (`STREAM_PHOTON` in WGSL).
+pub const STREAM_PHOTON: u32 = 0x9e3779b9;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PhotonSettings {
+    /// Photons emitted in total.
+    pub count: u32,
+    pub seed: u32,
+    /// Grid cells along the scene's longest axis.
+    pub grid_resolution: u32,
+}
+
+impl Default for PhotonSettings {
+    fn default() -> Self {
+        Self { count: 1 << 20, seed: 0, grid_resolution: 64 }
+    }
+}
+
+impl PhotonSettings {
+    /// The largest flux, over lights and channels, that a photon starts with: π·Le·A/pmf/N.
+    pub fn max_photon_flux(&self, prepared: &PreparedScene) -> f64 {
+        let s = &prepared.scene;
+        prepared
+            .lights
+            .entries
+            .iter()
+            .map(|e| {
+                let le = s.material_of(e.triangle as usize).emission.max_element() as f64;
+                std::f64::consts::PI * le * e.area as f64 / e.pmf as f64 / self.count.max(1) as f64
+            })
+            .fold(0.0, f64::max)
+    }
+}

@@ -1,0 +1,123 @@
+// Photon pass (photons/gpu.rs): trace photons from the lights, deposit into 64-bit
+// fixed-point counters per (cell, bin, channel); then resolve the counters into the
+// lookup texture. Draw for draw the twin of photons/cpu.rs.
+
+struct PhotonParams {
+    origin: vec3f,
+    cell: f32,
+    dims: vec3u,
+    first_photon: u32,
+    batch_size: u32,
+    seed: u32,
+    inv_photon_count: f32,
+    quantum: f32,
+    ray_epsilon: f32,
+    max_bounces: u32,
+    groups_x: u32,
+    _pad: u32,
+}
+
+@group(1) @binding(0) var<uniform> params: PhotonParams;
+// Per slot 6 words: (low, high) for red, green, blue.
+@group(1) @binding(1) var<storage, read_write> tally: array<atomic<u32>>;
+// Surface area per slot, in units of cell side².
+@group(1) @binding(2) var<storage, read> cell_area: array<f32>;
+@group(1) @binding(3) var map_out: texture_storage_3d<rgba32float, write>;
+
+const STREAM_PHOTON: u32 = 0x9e3779b9u;
+
+// Dominant axis and sign of n: 0 +x, 1 -x, 2 +y, 3 -y, 4 +z, 5 -z (photon_map::orientation_bin).
+fn orientation_bin(n: vec3f) -> u32 {
+    let a = abs(n);
+    var axis = 2u;
+    if a.x >= a.y && a.x >= a.z {
+        axis = 0u;
+    } else if a.y >= a.z {
+        axis = 1u;
+    }
+    return 2u * axis + select(0u, 1u, n[axis] < 0.0);
+}
+
+fn slot_of(p: vec3f, n: vec3f) -> u32 {
+    let c = vec3u(clamp(vec3i(floor((p - params.origin) / params.cell)), vec3i(0), vec3i(params.dims) - 1));
+    let z = orientation_bin(n) * params.dims.z + c.z;
+    return (z * params.dims.y + c.y) * params.dims.x + c.x;
+}
+
+// 64-bit add on (low, high) words: whoever wraps the low word carries into the high word.
+fn add64(i: u32, v: u32) {
+    if v == 0u {
+        return;
+    }
+    let old = atomicAdd(&tally[i], v);
+    if old > 0xffffffffu - v {
+        atomicAdd(&tally[i + 1u], 1u);
+    }
+}
+
+fn deposit(p: vec3f, n: vec3f, flux: vec3f) {
+    let s = slot_of(p, n);
+    let q = vec3u(round(flux * params.quantum));
+    add64(6u * s, q.x);
+    add64(6u * s + 2u, q.y);
+    add64(6u * s + 4u, q.z);
+}
+
+@compute @workgroup_size(64)
+fn trace_photons(@builtin(global_invocation_id) gid: vec3u) {
+    let local = gid.x + gid.y * params.groups_x * 64u;
+    if local >= params.batch_size {
+        return;
+    }
+    var rng = rng_new(params.seed ^ STREAM_PHOTON, params.first_photon + local, 0u);
+    let u0 = rng_f32(&rng);
+    let u1 = rng_f32(&rng);
+    let u2 = rng_f32(&rng);
+    let light = sample_light(u0, u1, u2);
+    // Φ = π·Le·A/pmf/N.
+    var flux = light.radiance * (PI / light.pdf_area * params.inv_photon_count);
+    let u3 = rng_f32(&rng);
+    let u4 = rng_f32(&rng);
+    var dir = cosine_hemisphere(light.normal, u3, u4);
+    var origin = light.pos + light.normal * params.ray_epsilon;
+    var skip = light.tri;
+    for (var bounce = 0u; bounce < params.max_bounces; bounce++) {
+        let hit = trace(origin, dir, params.ray_epsilon, 3.0e38, skip, NO_TRIANGLE, false);
+        if hit.tri == NO_TRIANGLE {
+            break;
+        }
+        let s = surface_at(hit.tri, hit.b1, hit.b2);
+        let front = dot(s.normal, dir) < 0.0;
+        if !front && (s.flags & MATERIAL_TWO_SIDED) == 0u {
+            break;
+        }
+        let n = select(-s.normal, s.normal, front);
+        deposit(s.pos, n, flux);
+        let survive = max(s.albedo.x, max(s.albedo.y, s.albedo.z));
+        if rng_f32(&rng) >= survive {
+            break;
+        }
+        flux *= s.albedo / survive;
+        let v1 = rng_f32(&rng);
+        let v2 = rng_f32(&rng);
+        dir = cosine_hemisphere(n, v1, v2);
+        origin = s.pos + n * params.ray_epsilon;
+        skip = hit.tri;
+    }
+}
+
+@compute @workgroup_size(4, 4, 4)
+fn resolve_map(@builtin(global_invocation_id) gid: vec3u) {
+    if gid.x >= params.dims.x || gid.y >= params.dims.y || gid.z >= 6u * params.dims.z {
+        return;
+    }
+    let s = (gid.z * params.dims.y + gid.y) * params.dims.x + gid.x;
+    var flux = vec3f(0.0);
+    for (var c = 0u; c < 3u; c++) {
+        let lo = atomicLoad(&tally[6u * s + 2u * c]);
+        let hi = atomicLoad(&tally[6u * s + 2u * c + 1u]);
+        flux[c] = (f32(hi) * 4294967296.0 + f32(lo)) / params.quantum;
+    }
+    let h2 = params.cell * params.cell;
+    textureStore(map_out, gid, vec4f(flux / h2, cell_area[s]));
+}

@@ -29,6 +29,8 @@ enum ShowArg {
     Direct,
     /// Indirect light only.
     Indirect,
+    /// The photon map's radiance ρ/π·E at the visible points.
+    PhotonMap,
 }
 
 #[derive(Args, Debug)]
@@ -63,6 +65,15 @@ pub struct RenderArgs {
     /// Light samples per pixel per iteration.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=64))]
     light_samples: u32,
+    /// Photons traced into the photon map.
+    #[arg(long, default_value_t = 1 << 20, value_parser = clap::value_parser!(u32).range(1..))]
+    photons: u32,
+    /// Photon grid cells along the scene's longest axis.
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    grid: u32,
+    /// Ray-view resolution of the final gather, texels per side (default: twice the image's larger side, 128 to 2048).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    bundle: Option<u32>,
     /// What the image shows.
     #[arg(long, value_enum, default_value_t = ShowArg::Full)]
     show: ShowArg,
@@ -104,8 +115,28 @@ pub fn load_scene(name: &str) -> Result<Scene> {
     }
 }
 
+/// Refuses, before any rendering, an output path the image could never be written to.
+fn check_output_path(out: &Path) -> Result<()> {
+    if out.is_dir() {
+        anyhow::bail!("{}: is a directory; give --out a file name ending in .exr or .png", out.display());
+    }
+    let dir = match out.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => dir,
+        _ => Path::new("."),
+    };
+    if !dir.is_dir() {
+        anyhow::bail!(
+            "{}: the directory {} does not exist; create it first or choose another --out",
+            out.display(),
+            dir.display()
+        );
+    }
+    Ok(())
+}
+
 pub fn run(args: &RenderArgs) -> Result<()> {
     let format = ImageFormat::from_path(&args.out)?;
+    check_output_path(&args.out)?;
     let mut scene = load_scene(&args.scene)?;
     let c = &mut scene.camera;
     c.eye = args.eye.unwrap_or(c.eye);
@@ -117,8 +148,16 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         anyhow::bail!("--iterations must be at least 1");
     }
     let gpu = gpu(&args.gpu)?;
-    let settings =
-        RenderSettings { width: args.width, height: args.height, seed: args.seed, light_samples: args.light_samples };
+    let settings = RenderSettings {
+        width: args.width,
+        height: args.height,
+        seed: args.seed,
+        light_samples: args.light_samples,
+        photons: args.photons,
+        grid_resolution: args.grid,
+        show_photon_map: matches!(args.show, ShowArg::PhotonMap),
+        bundle: args.bundle.unwrap_or(0),
+    };
     let mut renderer = Renderer::new(&gpu, &scene, settings)?;
 
     let progress = if std::io::stderr().is_terminal() {
@@ -133,7 +172,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         ProgressBar::hidden()
     };
     for i in 0..args.iterations {
-        renderer.iterate();
+        renderer.iterate()?;
         // Keep the GPU queue short so the progress bar tells the truth.
         if i % 8 == 7 {
             renderer.wait()?;
@@ -147,6 +186,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         ShowArg::Full => Show::Full,
         ShowArg::Direct => Show::Direct,
         ShowArg::Indirect => Show::Indirect,
+        ShowArg::PhotonMap => Show::PhotonMap,
     };
     match format {
         ImageFormat::Exr => write_exr(&args.out, &renderer.read_linear(show)?)?,

@@ -15,8 +15,8 @@ use crate::film::Film;
 use crate::frame::FrameBinding;
 use crate::gbuffer::GBufferPass;
 use crate::gpu::{Gpu, compute_pipeline, groups};
-use crate::photon_view::{gbuffer_film_bind_group, gbuffer_film_layout};
 use crate::gpu_scene::GpuScene;
+use crate::photon_view::{gbuffer_film_bind_group, gbuffer_film_layout};
 use crate::shader;
 
 pub struct DirectPass {

@@ -12,6 +12,7 @@ pub mod direct;
 pub mod error;
 pub mod film;
 pub mod frame;
+pub mod gather;
 pub mod gbuffer;
 pub mod gpu;
 pub mod gpu_scene;

@@ -16,19 +16,37 @@ pub struct PhotonViewPass {
 }
 
 impl PhotonViewPass {
-    pub fn new(gpu: &Gpu, scene: &GpuScene, frame: &FrameBinding, gbuffer: &GBufferPass, film: &Film, map: &GpuPhotonMap) -> Self {
+    pub fn new(
+        gpu: &Gpu,
+        scene: &GpuScene,
+        frame: &FrameBinding,
+        gbuffer: &GBufferPass,
+        film: &Film,
+        map: &GpuPhotonMap,
+    ) -> Self {
         let device = &gpu.device;
-        let source = shader::with_scene(&[include_str!("photon_map.wgsl"), include_str!("photon_view.wgsl")].join("\n"));
+        let source =
+            shader::with_scene(&[include_str!("photon_map.wgsl"), include_str!("photon_view.wgsl")].join("\n"));
         let module = shader::module(device, "photon view", &source);
         let layout = gbuffer_film_layout(device, "photon view");
         let bind_group = gbuffer_film_bind_group(device, "photon view", &layout, gbuffer, film);
-        let pipeline = compute_pipeline(device, "photon view", &module, &[&scene.layout, &frame.layout, &layout, &map.layout]);
+        let pipeline =
+            compute_pipeline(device, "photon view", &module, &[&scene.layout, &frame.layout, &layout, &map.layout]);
         Self { pipeline, bind_group }
     }
 
     /// Reads: scene, frame, G-buffer, photon map. Adds to: the film's photon-map component.
-    pub fn encode(&self, enc: &mut wgpu::CommandEncoder, scene: &GpuScene, frame: &FrameBinding, map: &GpuPhotonMap, width: u32, height: u32) {
-        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("photon view"), timestamp_writes: None });
+    pub fn encode(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        frame: &FrameBinding,
+        map: &GpuPhotonMap,
+        width: u32,
+        height: u32,
+    ) {
+        let mut pass =
+            enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("photon view"), timestamp_writes: None });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &scene.bind_group, &[]);
         pass.set_bind_group(1, &frame.bind_group, &[]);
@@ -58,7 +76,13 @@ pub fn gbuffer_film_layout(device: &wgpu::Device, label: &str) -> wgpu::BindGrou
     })
 }
 
-pub fn gbuffer_film_bind_group(device: &wgpu::Device, label: &str, layout: &wgpu::BindGroupLayout, gbuffer: &GBufferPass, film: &Film) -> wgpu::BindGroup {
+pub fn gbuffer_film_bind_group(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    gbuffer: &GBufferPass,
+    film: &Film,
+) -> wgpu::BindGroup {
     device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some(label),
         layout,

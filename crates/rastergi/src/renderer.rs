@@ -1,12 +1,13 @@
 //! The progressive renderer: owns the passes and runs one iteration at a time.
 //! [`Renderer::iterate`] is the pipeline, top to bottom.
 
-use glam::Vec2;
+use glam::{Quat, Vec2, Vec3};
 
 use crate::direct::DirectPass;
 use crate::error::Result;
 use crate::film::{Film, Show};
 use crate::frame::{FrameBinding, FrameUniforms, pixel_jitter, view_projection};
+use crate::gather::{GatherPass, gather_direction, random_rotation};
 use crate::gbuffer::GBufferPass;
 use crate::gpu::Gpu;
 use crate::gpu_scene::{GpuScene, PreparedScene};
@@ -14,6 +15,7 @@ use crate::image_io::{DisplayImage, LinearImage};
 use crate::photon_view::PhotonViewPass;
 use crate::photons::PhotonSettings;
 use crate::photons::gpu::GpuPhotonMap;
+use crate::sampling::Rng;
 use crate::scene::{Camera, Scene};
 
 /// Settings of a render.
@@ -30,6 +32,27 @@ pub struct RenderSettings {
     pub grid_resolution: u32,
     /// Also accumulate the photon-map view (`Show::PhotonMap`).
     pub show_photon_map: bool,
+    /// Ray-view resolution of the final gather (texels per side); 0 picks
+    /// [`default_bundle`] for the image size.
+    pub bundle: u32,
+}
+
+/// The default ray-view resolution: twice the image's larger side, within [128, 2048], so a
+/// ray-view texel is about as wide as an eye pixel's footprint on a scene seen whole.
+pub fn default_bundle(width: u32, height: u32) -> u32 {
+    (2 * width.max(height)).clamp(128, 2048)
+}
+
+/// Fixed values for one iteration's random choices, so tests can compare the passes with
+/// other estimators for the same samples.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Overrides {
+    /// Gather direction ω instead of the sequence's.
+    pub direction: Option<Vec3>,
+    /// Sub-pixel offset in [-0.5, 0.5)² instead of the sequence's.
+    pub pixel_jitter: Option<Vec2>,
+    /// Ray-view sub-texel offset instead of a random one.
+    pub texel_jitter: Option<Vec2>,
 }
 
 impl Default for RenderSettings {
@@ -43,6 +66,7 @@ impl Default for RenderSettings {
             photons: p.count,
             grid_resolution: p.grid_resolution,
             show_photon_map: false,
+            bundle: 0,
         }
     }
 }
@@ -57,7 +81,11 @@ pub struct Renderer {
     direct: DirectPass,
     photon_map: Option<GpuPhotonMap>,
     photon_view: Option<PhotonViewPass>,
+    gather: Option<GatherPass>,
     film: Film,
+    /// Restarts so far (camera moves): each draws a new rotation of the gather directions.
+    restart: u32,
+    rotation: Quat,
 }
 
 impl Renderer {
@@ -82,6 +110,12 @@ impl Renderer {
             }
             _ => None,
         };
+        let bundle = if settings.bundle == 0 { default_bundle(width, height) } else { settings.bundle };
+        let gather = match &photon_map {
+            Some(map) => Some(GatherPass::new(gpu, &gpu_scene, &frame, &gbuffer, &film, map, bundle)?),
+            None => None,
+        };
+        let rotation = random_rotation(settings.seed, 0);
         Ok(Renderer {
             gpu: gpu.clone(),
             settings,
@@ -92,7 +126,10 @@ impl Renderer {
             direct,
             photon_map,
             photon_view,
+            gather,
             film,
+            restart: 0,
+            rotation,
         })
     }
 
@@ -122,13 +159,14 @@ impl Renderer {
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
         self.film.clear(&mut enc);
         self.gpu.queue.submit([enc.finish()]);
+        self.restart += 1;
+        self.rotation = random_rotation(self.settings.seed, self.restart);
     }
 
-    fn frame_uniforms(&self, iteration: u32) -> FrameUniforms {
+    fn frame_uniforms(&self, iteration: u32, jitter: Vec2) -> FrameUniforms {
         let (w, h) = (self.settings.width, self.settings.height);
         let b = self.scene.bounds;
         let near = 1e-4 * b.extent().length().max(1e-3);
-        let jitter: Vec2 = pixel_jitter(iteration, self.settings.seed);
         FrameUniforms {
             view_proj: view_projection(&self.camera, w, h, near, jitter).to_cols_array_2d(),
             eye: self.camera.eye.into(),
@@ -142,24 +180,49 @@ impl Renderer {
     }
 
     /// One progressive iteration: one new estimate per pixel, added to the film.
-    pub fn iterate(&mut self) {
+    pub fn iterate(&mut self) -> Result<()> {
+        self.iterate_with(&Overrides::default())
+    }
+
+    /// One iteration with some random choices fixed (see [`Overrides`]).
+    pub fn iterate_with(&mut self, o: &Overrides) -> Result<()> {
         let (w, h) = (self.settings.width, self.settings.height);
         let iteration = self.film.samples;
-        self.frame.write(&self.gpu, &self.frame_uniforms(iteration));
+        let seed = self.settings.seed;
+        let jitter = o.pixel_jitter.unwrap_or_else(|| pixel_jitter(iteration, seed));
+        self.frame.write(&self.gpu, &self.frame_uniforms(iteration, jitter));
         let mut enc =
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("iteration") });
         // 1. Eye pass: the visible point of each pixel, at this iteration's jitter.
         self.gbuffer.encode(&mut enc, &self.scene, &self.frame);
         // 2. Emission + direct light with soft shadows → film (direct component).
         self.direct.encode(&mut enc, &self.scene, &self.frame, w, h);
-        // 3. Indirect light plugs in here: the final gather reads the photon map (built once
-        //    per scene) and adds one gather sample per visible point → film (indirect).
         // Debug view: the photon map's radiance at the visible points → film (photon view).
         if let (Some(view), Some(map)) = (&self.photon_view, &self.photon_map) {
             view.encode(&mut enc, &self.scene, &self.frame, map, w, h);
         }
+        // 3. Final gather along one direction for every visible point → film (indirect).
+        //    The ray view's depth complexity is counted first: that many layers are peeled.
+        if let (Some(gather), Some(map)) = (&self.gather, &self.photon_map) {
+            let direction = o.direction.unwrap_or_else(|| gather_direction(iteration, self.rotation));
+            let texel_jitter = o.texel_jitter.unwrap_or_else(|| {
+                let mut rng = Rng::new(seed ^ 0x7e1a5, iteration, self.restart);
+                Vec2::new(rng.next_f32(), rng.next_f32()) - 0.5
+            });
+            gather.set_direction(&self.gpu, &self.scene.bounds, direction.normalize(), texel_jitter);
+            gather.encode_count(&mut enc, &self.scene);
+            self.gpu.queue.submit([enc.finish()]);
+            let layers = gather.read_layer_count(&self.gpu)?;
+            enc = self
+                .gpu
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("gather layers") });
+            gather.encode_layers(&mut enc, &self.scene, &self.frame, map, w, h, layers);
+        }
+        // 4. Accumulate: every pass above added its estimate to the film's sums.
         self.gpu.queue.submit([enc.finish()]);
         self.film.samples += 1;
+        Ok(())
     }
 
     /// Blocks until the submitted iterations have finished on the GPU.

@@ -93,8 +93,13 @@ fn direct_light_under_a_rectangular_emitter_matches_the_closed_form_within_predi
     let gpu = common::gpu();
     let scene = emitter_over_plane();
     let (w, h, n) = (40u32, 40u32, 64u32);
-    let img =
-        common::render(&gpu, &scene, RenderSettings { width: w, height: h, seed: 3, light_samples: 1, photons: 0, ..Default::default() }, n, Show::Full);
+    let img = common::render(
+        &gpu,
+        &scene,
+        RenderSettings { width: w, height: h, seed: 3, light_samples: 1, photons: 0, ..Default::default() },
+        n,
+        Show::Full,
+    );
 
     // Per pixel: the closed form averaged over the pixel (box filter, 4×4 points) and the
     // standard deviation of an n-sample mean of the light-sampling estimator (unit Le).
@@ -141,7 +146,8 @@ fn direct_only_cornell_box_matches_mitsuba_within_the_combined_noise() {
     let gpu = common::gpu();
     let scene = cornell_box();
     let n = 256;
-    let settings = |seed| RenderSettings { width: 128, height: 128, seed, light_samples: 1, photons: 0, ..Default::default() };
+    let settings =
+        |seed| RenderSettings { width: 128, height: 128, seed, light_samples: 1, photons: 0, ..Default::default() };
     let a = common::render(&gpu, &scene, settings(1), n, Show::Direct);
     let b = common::render(&gpu, &scene, settings(2), n, Show::Direct);
     let ours = common::average(&a, &b);

@@ -28,16 +28,29 @@ fn closed_box(a: f32) -> Scene {
     let camera = Camera { eye: Vec3::new(0.0, 0.0, 0.9), target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 60.0 };
     let mut s = Scene::new(camera);
     let wall = s.add_material(Material::diffuse("wall", Vec3::splat(a)));
-    let light = s.add_material(Material { emission: Vec3::new(1.0, 2.0, 3.0), two_sided: true, ..Material::diffuse("light", Vec3::splat(a)) });
+    let light = s.add_material(Material {
+        emission: Vec3::new(1.0, 2.0, 3.0),
+        two_sided: true,
+        ..Material::diffuse("light", Vec3::splat(a))
+    });
     add_room(&mut s, Vec3::splat(-1.0), Vec3::splat(1.0), wall);
     let y = 0.9;
-    s.add_quad([Vec3::new(-0.2, y, -0.2), Vec3::new(0.2, y, -0.2), Vec3::new(0.2, y, 0.2), Vec3::new(-0.2, y, 0.2)], light);
+    s.add_quad(
+        [Vec3::new(-0.2, y, -0.2), Vec3::new(0.2, y, -0.2), Vec3::new(0.2, y, 0.2), Vec3::new(-0.2, y, 0.2)],
+        light,
+    );
     s
 }
 
 /// The six walls of the box [lo, hi], facing in.
 fn add_room(s: &mut Scene, lo: Vec3, hi: Vec3, m: u32) {
-    let c = |x: f32, y: f32, z: f32| Vec3::new(if x < 0.5 { lo.x } else { hi.x }, if y < 0.5 { lo.y } else { hi.y }, if z < 0.5 { lo.z } else { hi.z });
+    let c = |x: f32, y: f32, z: f32| {
+        Vec3::new(
+            if x < 0.5 { lo.x } else { hi.x },
+            if y < 0.5 { lo.y } else { hi.y },
+            if z < 0.5 { lo.z } else { hi.z },
+        )
+    };
     s.add_quad([c(0., 0., 0.), c(0., 0., 1.), c(1., 0., 1.), c(1., 0., 0.)], m); // floor, +y
     s.add_quad([c(0., 1., 0.), c(1., 1., 0.), c(1., 1., 1.), c(0., 1., 1.)], m); // ceiling, -y
     s.add_quad([c(0., 0., 0.), c(1., 0., 0.), c(1., 1., 0.), c(0., 1., 0.)], m); // back, +z
@@ -68,7 +81,10 @@ fn closed_box_average_irradiance_matches_power_over_area_times_one_minus_albedo(
             let expected = power[c] / (area * (1.0 - a));
             let got = flux[c] / total_area(&map);
             println!("{name} channel {c}: average irradiance {got:.5} expected {expected:.5}");
-            assert!((got / expected - 1.0).abs() < 4.0 * sigma, "{name} channel {c}: {got} vs {expected} (σ = {sigma})");
+            assert!(
+                (got / expected - 1.0).abs() < 4.0 * sigma,
+                "{name} channel {c}: {got} vs {expected} (σ = {sigma})"
+            );
         }
     }
 }
@@ -79,7 +95,8 @@ fn gpu_and_cpu_photon_maps_agree_cell_by_cell_within_noise() {
     let scene = cornell_box();
     let n = 1u32 << 19;
     let g = gpu_map(&gpu, &scene, &PhotonSettings { count: n, seed: 11, grid_resolution: 16 });
-    let c = cpu::trace(&PreparedScene::new(&scene), &g.grid, &PhotonSettings { count: n, seed: 12, grid_resolution: 16 });
+    let c =
+        cpu::trace(&PreparedScene::new(&scene), &g.grid, &PhotonSettings { count: n, seed: 12, grid_resolution: 16 });
     assert_eq!(g.area, c.area);
     // Independent seeds: per well-populated slot the difference of the two sums has variance
     // ≈ 2·Σφ² (compound Poisson), estimated from the CPU map's squared deposits.
@@ -109,17 +126,24 @@ fn gpu_and_cpu_photon_maps_agree_cell_by_cell_within_noise() {
 fn thin_wall_keeps_the_dark_room_dark_beyond_one_and_a_half_cells() {
     // Two rooms along x, [-1,-0.01] lit and [0.01,1] dark, split by a wall 0.02 thick — a
     // sixth of a cell at grid resolution 16 (cell ≈ 0.125).
-    let camera = Camera { eye: Vec3::new(-0.5, 0.0, 0.9), target: Vec3::new(-0.5, 0.0, 0.0), up: Vec3::Y, fov_y_deg: 60.0 };
+    let camera =
+        Camera { eye: Vec3::new(-0.5, 0.0, 0.9), target: Vec3::new(-0.5, 0.0, 0.0), up: Vec3::Y, fov_y_deg: 60.0 };
     let mut s = Scene::new(camera);
     let white = s.add_material(Material::diffuse("white", Vec3::splat(0.8)));
     let light = s.add_material(Material { emission: Vec3::splat(5.0), ..Material::diffuse("light", Vec3::splat(0.8)) });
     add_room(&mut s, Vec3::new(-1.0, -1.0, -1.0), Vec3::new(-0.01, 1.0, 1.0), white);
     add_room(&mut s, Vec3::new(0.01, -1.0, -1.0), Vec3::new(1.0, 1.0, 1.0), white);
     let y = 0.95;
-    s.add_quad([Vec3::new(-0.7, y, -0.2), Vec3::new(-0.3, y, -0.2), Vec3::new(-0.3, y, 0.2), Vec3::new(-0.7, y, 0.2)], light);
+    s.add_quad(
+        [Vec3::new(-0.7, y, -0.2), Vec3::new(-0.3, y, -0.2), Vec3::new(-0.3, y, 0.2), Vec3::new(-0.7, y, 0.2)],
+        light,
+    );
     let gpu = common::gpu();
     let settings = PhotonSettings { count: 1 << 19, seed: 2, grid_resolution: 16 };
-    let maps = [("gpu", gpu_map(&gpu, &s, &settings)), ("cpu", cpu::trace(&PreparedScene::new(&s), &GridSpec::new(&s.bounds(), 16), &settings))];
+    let maps = [
+        ("gpu", gpu_map(&gpu, &s, &settings)),
+        ("cpu", cpu::trace(&PreparedScene::new(&s), &GridSpec::new(&s.bounds(), 16), &settings)),
+    ];
     for (name, map) in &maps {
         let h = map.grid.cell;
         // The lookup reads cells whose centres lie within one cell of p; a cell holding lit
@@ -162,7 +186,7 @@ fn photon_view_lookup_on_the_gpu_equals_the_cpu_lookup() {
         ..Default::default()
     };
     let mut r = Renderer::new(&gpu, &scene, settings).unwrap();
-    r.iterate();
+    r.iterate().unwrap();
     let img = r.read_linear(Show::PhotonMap).unwrap();
     let gbuffer = r.read_gbuffer().unwrap();
     let map = r.photon_map().unwrap().read(&gpu).unwrap();
@@ -184,7 +208,11 @@ fn photon_view_lookup_on_the_gpu_equals_the_cpu_lookup() {
         let e = map.irradiance(p, n);
         for c in 0..3 {
             let expected = albedo[c] as f64 / std::f64::consts::PI * e[c];
-            assert!((img.pixels[i][c] as f64 - expected).abs() <= 1e-4 * expected.max(1e-3), "pixel {i} channel {c}: {} vs {expected}", img.pixels[i][c]);
+            assert!(
+                (img.pixels[i][c] as f64 - expected).abs() <= 1e-4 * expected.max(1e-3),
+                "pixel {i} channel {c}: {} vs {expected}",
+                img.pixels[i][c]
+            );
         }
         checked += 1;
     }

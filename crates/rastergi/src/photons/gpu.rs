@@ -81,18 +81,30 @@ pub fn memory_bytes(grid: &GridSpec) -> u64 {
 
 impl GpuPhotonMap {
     /// Traces `settings.count` photons on the GPU into a fresh map over the scene.
-    pub fn build(gpu: &Gpu, scene: &GpuScene, prepared: &PreparedScene, settings: &PhotonSettings) -> Result<GpuPhotonMap> {
+    pub fn build(
+        gpu: &Gpu,
+        scene: &GpuScene,
+        prepared: &PreparedScene,
+        settings: &PhotonSettings,
+    ) -> Result<GpuPhotonMap> {
         let map = Self::new(gpu, scene, prepared, settings)?;
         map.trace(gpu, scene);
         Ok(map)
     }
 
     /// Allocates the map and its pipelines (the geometry's cell areas are computed here).
-    pub fn new(gpu: &Gpu, scene: &GpuScene, prepared: &PreparedScene, settings: &PhotonSettings) -> Result<GpuPhotonMap> {
+    pub fn new(
+        gpu: &Gpu,
+        scene: &GpuScene,
+        prepared: &PreparedScene,
+        settings: &PhotonSettings,
+    ) -> Result<GpuPhotonMap> {
         let grid = GridSpec::new(&prepared.bounds, settings.grid_resolution);
         let limits = gpu.device.limits();
         let slots = grid.slot_count() as u64;
-        if grid.dims.max_element() > limits.max_texture_dimension_3d || BINS as u32 * grid.dims.z > limits.max_texture_dimension_3d {
+        if grid.dims.max_element() > limits.max_texture_dimension_3d
+            || BINS as u32 * grid.dims.z > limits.max_texture_dimension_3d
+        {
             return Err(Error::Limits(format!(
                 "a photon grid of {}x{}x{} cells needs a 3D texture deeper than this GPU's {} texels; choose a smaller --grid",
                 grid.dims.x, grid.dims.y, grid.dims.z, limits.max_texture_dimension_3d
@@ -120,7 +132,8 @@ impl GpuPhotonMap {
         );
         let h2 = (grid.cell as f64).powi(2);
         let area_scaled: Vec<f32> = area.iter().map(|&a| (a / h2) as f32).collect();
-        let area_buffer = gpu.storage_buffer("photon cell areas", bytemuck::cast_slice(&area_scaled), wgpu::BufferUsages::empty());
+        let area_buffer =
+            gpu.storage_buffer("photon cell areas", bytemuck::cast_slice(&area_scaled), wgpu::BufferUsages::empty());
         let params_buffer = gpu.zeroed_buffer(
             "photon params",
             std::mem::size_of::<PhotonParams>() as u64,
@@ -128,12 +141,18 @@ impl GpuPhotonMap {
         );
         let texture = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("photon map"),
-            size: wgpu::Extent3d { width: grid.dims.x, height: grid.dims.y, depth_or_array_layers: BINS as u32 * grid.dims.z },
+            size: wgpu::Extent3d {
+                width: grid.dims.x,
+                height: grid.dims.y,
+                depth_or_array_layers: BINS as u32 * grid.dims.z,
+            },
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D3,
             format: wgpu::TextureFormat::Rgba32Float,
-            usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
+            usage: wgpu::TextureUsages::STORAGE_BINDING
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
             view_formats: &[],
         });
         let view = texture.create_view(&Default::default());
@@ -238,7 +257,8 @@ impl GpuPhotonMap {
                 params.batch_size = batch;
                 params.groups_x = gx;
                 gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&params));
-                let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("photon batch") });
+                let mut enc =
+                    device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("photon batch") });
                 {
                     let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                         label: Some("trace photons"),
@@ -253,7 +273,8 @@ impl GpuPhotonMap {
                 first += batch;
             }
         }
-        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("photon map resolve") });
+        let mut enc =
+            device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("photon map resolve") });
         {
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("resolve photon map"),
@@ -262,7 +283,11 @@ impl GpuPhotonMap {
             pass.set_pipeline(&self.resolve_pipeline);
             pass.set_bind_group(0, &scene.bind_group, &[]);
             pass.set_bind_group(1, &self.trace_group, &[]);
-            pass.dispatch_workgroups(grid.dims.x.div_ceil(4), grid.dims.y.div_ceil(4), (BINS as u32 * grid.dims.z).div_ceil(4));
+            pass.dispatch_workgroups(
+                grid.dims.x.div_ceil(4),
+                grid.dims.y.div_ceil(4),
+                (BINS as u32 * grid.dims.z).div_ceil(4),
+            );
         }
         gpu.queue.submit([enc.finish()]);
     }

@@ -39,12 +39,8 @@ pub fn load_obj(path: &Path) -> Result<Scene> {
         .map_err(|e| file_error(path, obj_error_message(e)))?;
     let mtl_failure = mtl_error.into_inner().or_else(|| materials.as_ref().err().map(|e| e.to_string()));
     if let Some(message) = mtl_failure {
-        return Err(file_error(
-            path,
-            format!(
-                "its material library (mtllib) could not be loaded: {message}; fix the .mtl file, put it beside the .obj or remove the mtllib line"
-            ),
-        ));
+        let hint = "fix the .mtl file, put it beside the .obj or remove the mtllib line";
+        return Err(file_error(path, format!("its material library (mtllib) could not be loaded: {message}; {hint}")));
     }
     let materials = materials.unwrap_or_default();
 
@@ -94,7 +90,7 @@ pub fn load_obj(path: &Path) -> Result<Scene> {
 fn obj_error_message(e: tobj::LoadError) -> String {
     use tobj::LoadError as E;
     let what = match e {
-        E::ReadError => "it is not a UTF-8 text file",
+        E::ReadError => return "not a valid OBJ file: it is not UTF-8 text; export it again as Wavefront OBJ".into(),
         E::PositionParseError => "a 'v' line does not hold three numbers",
         E::ScalingByZeroError => "a 'v' line has a weight w of 0",
         E::ColorParseError => "a 'v' line has a vertex colour with too many or too few numbers",
@@ -130,6 +126,10 @@ fn load_mtl(obj: &Path, name: &Path, error: &RefCell<Option<String>>) -> tobj::M
         error.borrow_mut().get_or_insert(format!("{}: {message}", mtl_path.display()));
         Err(e)
     };
+    if name.as_os_str().is_empty() {
+        error.borrow_mut().get_or_insert("an mtllib line names no file".into());
+        return Err(tobj::LoadError::OpenFileFailed);
+    }
     let text = match std::fs::read_to_string(&mtl_path) {
         Ok(text) => text,
         Err(e) => return fail(e.to_string(), tobj::LoadError::OpenFileFailed),

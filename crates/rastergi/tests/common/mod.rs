@@ -17,7 +17,7 @@ pub fn gpu() -> Gpu {
 pub fn render(gpu: &Gpu, scene: &Scene, settings: RenderSettings, iterations: u32, show: Show) -> LinearImage {
     let mut r = Renderer::new(gpu, scene, settings).expect("renderer");
     for i in 0..iterations {
-        r.iterate();
+        r.iterate().expect("iteration");
         if i % 16 == 15 {
             r.wait().unwrap();
         }

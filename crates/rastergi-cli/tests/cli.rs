@@ -1,0 +1,193 @@
+//! The `rastergi` binary as a user meets it: its help, its one-line errors (never a panic),
+//! the files it writes and the ones it must leave alone.
+
+use std::fs::File;
+use std::path::Path;
+use std::process::{Command, ExitStatus, Stdio};
+use std::time::{Duration, Instant};
+
+/// Longer than any of these runs takes on lavapipe; a run past it is killed and fails the test.
+const TIMEOUT: Duration = Duration::from_secs(300);
+
+struct Run {
+    status: ExitStatus,
+    stdout: String,
+    stderr: String,
+}
+
+impl Run {
+    /// stderr without the lines Mesa prints on its own when XDG_RUNTIME_DIR is not set
+    /// ("error: XDG_RUNTIME_DIR is invalid or not set in the environment.").
+    fn our_stderr(&self) -> Vec<&str> {
+        self.stderr.lines().filter(|l| !l.contains("XDG_RUNTIME_DIR") && !l.trim().is_empty()).collect()
+    }
+
+    /// The one `error: ` line of a failed run, after checking that the run failed, printed
+    /// exactly one such line and did not panic.
+    fn error_line(&self) -> &str {
+        assert!(!self.status.success(), "the run succeeded; stderr:\n{}", self.stderr);
+        assert!(!self.stderr.contains("panicked"), "the run panicked:\n{}", self.stderr);
+        let errors: Vec<&str> = self.our_stderr().into_iter().filter(|l| l.starts_with("error:")).collect();
+        assert_eq!(errors.len(), 1, "expected one error line, got:\n{}", self.stderr);
+        errors[0]
+    }
+}
+
+/// Runs the binary with `args` in the directory `dir`.
+fn rastergi(dir: &Path, args: &[&str]) -> Run {
+    let out = tempfile::tempdir().unwrap();
+    let (stdout_path, stderr_path) = (out.path().join("stdout"), out.path().join("stderr"));
+    let mut child = Command::new(env!("CARGO_BIN_EXE_rastergi"))
+        .args(args)
+        .current_dir(dir)
+        .stdin(Stdio::null())
+        .stdout(File::create(&stdout_path).unwrap())
+        .stderr(File::create(&stderr_path).unwrap())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break status;
+        }
+        if start.elapsed() > TIMEOUT {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("rastergi {args:?} ran longer than {TIMEOUT:?}");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let read = |p: &Path| String::from_utf8_lossy(&std::fs::read(p).unwrap()).into_owned();
+    Run { status, stdout: read(&stdout_path), stderr: read(&stderr_path) }
+}
+
+/// The names of the files in `dir`, sorted.
+fn files_in(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> =
+        std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    names.sort();
+    names
+}
+
+#[test]
+fn help_lists_the_render_and_info_commands() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = rastergi(dir.path(), &["--help"]);
+    assert!(run.status.success(), "{}", run.stderr);
+    let commands: Vec<&str> = run.stdout.lines().filter_map(|l| l.split_whitespace().next()).collect();
+    assert!(commands.contains(&"render") && commands.contains(&"info"), "{}", run.stdout);
+}
+
+#[test]
+fn unknown_option_is_a_usage_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = rastergi(dir.path(), &["render", "cornell", "--out", "x.png", "--no-such-option"]);
+    assert_eq!(run.status.code(), Some(2), "clap's usage errors exit with 2:\n{}", run.stderr);
+    assert!(run.stderr.contains("--no-such-option") && run.stderr.contains("Usage:"), "{}", run.stderr);
+    assert!(files_in(dir.path()).is_empty());
+}
+
+#[test]
+fn missing_scene_file_is_one_error_line_naming_it_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = rastergi(dir.path(), &["render", "missing.obj", "--out", "x.png"]);
+    let line = run.error_line();
+    assert!(line.contains("missing.obj"), "{line}");
+    assert_eq!(run.our_stderr(), vec![line], "nothing but the error line");
+    assert!(files_in(dir.path()).is_empty(), "{:?}", files_in(dir.path()));
+}
+
+#[test]
+fn unsupported_output_format_fails_before_rendering() {
+    let dir = tempfile::tempdir().unwrap();
+    // Billions of iterations: had it started rendering, the run would hit the timeout.
+    let run = rastergi(dir.path(), &["render", "cornell", "--iterations", "4000000000", "--out", "x.jpg"]);
+    let line = run.error_line();
+    assert!(line.contains("x.jpg") && line.contains(".png") && line.contains(".exr"), "{line}");
+    assert!(files_in(dir.path()).is_empty());
+}
+
+#[test]
+fn missing_output_directory_fails_before_rendering() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = rastergi(dir.path(), &["render", "cornell", "--iterations", "4000000000", "--out", "no/such/dir/x.png"]);
+    let line = run.error_line();
+    assert!(line.contains("no/such/dir") && line.contains("does not exist"), "{line}");
+    assert!(files_in(dir.path()).is_empty());
+}
+
+#[test]
+fn width_beyond_the_gpu_limit_is_a_clear_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = rastergi(dir.path(), &["render", "cornell", "--width", "100000", "--iterations", "1", "--out", "x.png"]);
+    let line = run.error_line();
+    assert!(line.contains("100000") && line.contains("limit"), "{line}");
+    assert!(files_in(dir.path()).is_empty());
+}
+
+#[test]
+fn zero_field_of_view_is_a_camera_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = rastergi(dir.path(), &["render", "cornell", "--fov", "0", "--out", "x.png"]);
+    let line = run.error_line();
+    assert!(line.contains("camera") && line.contains("field of view"), "{line}");
+}
+
+#[test]
+fn eye_at_the_target_is_a_camera_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = rastergi(dir.path(), &["render", "cornell", "--eye", "0,0,0", "--target", "0,0,0", "--out", "x.png"]);
+    let line = run.error_line();
+    assert!(line.contains("camera") && line.contains("eye and target"), "{line}");
+}
+
+#[test]
+fn failed_renders_leave_an_existing_image_untouched() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = b"the bytes of a good image from an earlier render";
+    std::fs::write(dir.path().join("keep.png"), good).unwrap();
+    // One failure before the GPU is touched, one after.
+    for args in [
+        &["render", "no-such-scene", "--out", "keep.png"][..],
+        &["render", "cornell", "--width", "100000", "--iterations", "1", "--out", "keep.png"][..],
+    ] {
+        let run = rastergi(dir.path(), args);
+        run.error_line();
+        assert_eq!(std::fs::read(dir.path().join("keep.png")).unwrap(), good, "after {args:?}");
+        assert_eq!(files_in(dir.path()), ["keep.png"], "after {args:?}");
+    }
+}
+
+/// Width and height from a PNG's IHDR chunk, after checking the signature.
+fn png_size(bytes: &[u8]) -> (u32, u32) {
+    assert!(bytes.len() > 33, "{} bytes is too short for a PNG", bytes.len());
+    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "PNG signature");
+    assert_eq!(&bytes[8..16], b"\0\0\0\x0dIHDR", "the first chunk is a 13-byte IHDR");
+    let be = |i: usize| u32::from_be_bytes(bytes[i..i + 4].try_into().unwrap());
+    (be(16), be(20))
+}
+
+#[test]
+fn tiny_renders_write_a_valid_png_and_exr_and_no_temporary_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = rastergi(
+        dir.path(),
+        &["render", "cornell", "--width", "32", "--height", "32", "--iterations", "4", "--out", "a.png"],
+    );
+    assert!(png.status.success(), "{}", png.stderr);
+    assert!(!png.stderr.contains("panicked"), "{}", png.stderr);
+    assert_eq!(png_size(&std::fs::read(dir.path().join("a.png")).unwrap()), (32, 32));
+
+    // Not square, so that a swapped width and height would show.
+    let exr = rastergi(
+        dir.path(),
+        &["render", "cornell", "--width", "32", "--height", "24", "--iterations", "4", "--out", "b.exr"],
+    );
+    assert!(exr.status.success(), "{}", exr.stderr);
+    let image = rastergi::image_io::read_exr(&dir.path().join("b.exr")).unwrap();
+    assert_eq!((image.width, image.height, image.pixels.len()), (32, 24, 32 * 24));
+    assert!(image.pixels.iter().flatten().all(|c| c.is_finite() && *c >= 0.0), "a pixel is negative or not finite");
+    assert!(image.mean().iter().all(|&m| m > 0.0), "the lit Cornell box is not black: mean {:?}", image.mean());
+
+    assert_eq!(files_in(dir.path()), ["a.png", "b.exr"], "no .rastergi-* temporary files are left");
+}

@@ -1,0 +1,299 @@
+//! The reference path tracer: a progressive GPU compute path tracer over the same scene, BVH,
+//! camera, pixel jitter and film as the rasterizing renderer, the in-project ground truth the
+//! fast passes are measured against.
+//!
+//! Each iteration traces one path per pixel from the eye through the pixel's centre in the
+//! iteration's jittered view ([`pixel_jitter`], [`view_projection`]): the same ray the
+//! G-buffer's pixel sees, so the mean over iterations is the same box-filtered image. Along
+//! the path x₁, x₂, … (x₀ the eye) the estimate is
+//!
+//! ```text
+//!   L = Σₖ Tₖ · [ w_σ,k · Le(xₖ → xₖ₋₁)  +  w_L,k · (ρₖ/π) · Le(yₖ) · V(xₖ,yₖ) · cos θₓ · cos θ_y / (|yₖ − xₖ|² · p_A(yₖ)) ]
+//!   Tₖ = Π_{j<k} ρⱼ / qⱼ
+//! ```
+//!
+//! - BSDF sampling: Lambertian BRDF ρ/π, directions with density p_σ(ω) = cos θ/π, so each
+//!   bounce multiplies the throughput by f·cos θ/p_σ = ρ.
+//! - Next-event estimation: one point yₖ on the emitters per vertex from the light table
+//!   (`sample_light`: a triangle by power, a point uniformly on it), density p_A(y) per
+//!   area, p_L = p_A(y) · |y − x|² / cos θ_y per solid angle at x.
+//! - Multiple importance sampling, power heuristic: for the light sample
+//!   w_L = p_L² / (p_L² + p_σ²); for emission found by the BSDF-sampled direction from xₖ₋₁,
+//!   w_σ = p_σ² / (p_σ² + p_L²) with both densities of that direction at xₖ₋₁. Emission
+//!   seen by the camera ray has w_σ = 1 (no light sample competes for it).
+//! - Russian roulette from the [`RR_START`]-th scattering event on: the path continues with
+//!   probability q = max(ρ) (qⱼ = 1 before), and ends after [`MAX_BOUNCES`] events at the
+//!   latest (a safety cap; the energy left there is ρ_max^1024, nothing for any albedo < 1).
+//! - Emitters are one-sided (the front face, counter-clockwise, emits); a ray reaching the back
+//!   of a one-sided surface is absorbed, a two-sided one reflects on both faces.
+//!
+//! The radiance is accumulated into component 0 of a [`Film`], whose other components stay
+//! zero, so the film's resolve, EXR/PNG output and display work unchanged with [`Show::Full`].
+
+use bytemuck::{Pod, Zeroable};
+use glam::{DMat4, Mat4, Vec2};
+
+use crate::error::Result;
+use crate::film::{Film, Show};
+use crate::frame::{FrameBinding, FrameUniforms, pixel_jitter, view_projection};
+use crate::gpu::{Gpu, buffer_bind_group, groups, storage_entry, uniform_entry};
+use crate::gpu_scene::{GpuScene, PreparedScene};
+use crate::image_io::{DisplayImage, LinearImage};
+use crate::renderer::RenderSettings;
+use crate::scene::{Camera, Scene, triangle_area};
+use crate::shader;
+
+/// Scattering events after which every path ends (a safety cap; roulette ends them first).
+pub const MAX_BOUNCES: u32 = 1024;
+/// Index of the first scattering event (0 = the surface the camera sees) at which Russian
+/// roulette may end the path.
+pub const RR_START: u32 = 1;
+
+/// `PathParams` in `path_tracer.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct PathParams {
+    /// Clip → world for this iteration's jittered camera.
+    pub inv_view_proj: [[f32; 4]; 4],
+    /// Σ over the emissive triangles of area · (Le.r + Le.g + Le.b).
+    pub light_weight: f32,
+    pub light_count: u32,
+    pub max_bounces: u32,
+    pub rr_start: u32,
+}
+
+pub struct PathTracer {
+    gpu: Gpu,
+    settings: RenderSettings,
+    camera: Camera,
+    scene: GpuScene,
+    frame: FrameBinding,
+    film: Film,
+    light_weight: f32,
+    params: wgpu::Buffer,
+    layout: wgpu::BindGroupLayout,
+    bind_group: wgpu::BindGroup,
+    trace: wgpu::ComputePipeline,
+    primary: wgpu::ComputePipeline,
+}
+
+impl PathTracer {
+    pub fn new(gpu: &Gpu, scene: &Scene, settings: RenderSettings) -> Result<PathTracer> {
+        scene.validate()?;
+        let (width, height) = (settings.width, settings.height);
+        let film = Film::new(gpu, width, height)?;
+        let prepared = PreparedScene::new(scene);
+        let light_weight = prepared
+            .lights
+            .entries
+            .iter()
+            .map(|e| {
+                let t = e.triangle as usize;
+                let le = prepared.scene.material_of(t).emission.as_dvec3();
+                triangle_area(&prepared.scene.triangles[t]) as f64 * (le.x + le.y + le.z)
+            })
+            .sum::<f64>() as f32;
+        let gpu_scene = GpuScene::new(gpu, &prepared);
+        let frame = FrameBinding::new(gpu);
+
+        let device = &gpu.device;
+        let c = wgpu::ShaderStages::COMPUTE;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("path tracer"),
+            entries: &[storage_entry(0, c, false), uniform_entry(1, c), storage_entry(2, c, false)],
+        });
+        let params = gpu.zeroed_buffer(
+            "path tracer params",
+            std::mem::size_of::<PathParams>() as u64,
+            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        );
+        // `main` does not write the visibility buffer; a placeholder fills its binding.
+        let placeholder = gpu.zeroed_buffer("path tracer visibility placeholder", 16, wgpu::BufferUsages::STORAGE);
+        let bind_group =
+            buffer_bind_group(device, "path tracer", &layout, &[&film.accumulation, &params, &placeholder]);
+        let module = shader::module(device, "path tracer", &shader::with_scene(include_str!("path_tracer.wgsl")));
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("path tracer"),
+            bind_group_layouts: &[Some(&gpu_scene.layout), Some(&frame.layout), Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = |label: &str, entry: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(label),
+                layout: Some(&pipeline_layout),
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        let trace = pipeline("path tracer", "main");
+        let primary = pipeline("path tracer primary hits", "primary_hits");
+        Ok(PathTracer {
+            gpu: gpu.clone(),
+            settings,
+            camera: scene.camera,
+            scene: gpu_scene,
+            frame,
+            film,
+            light_weight,
+            params,
+            layout,
+            bind_group,
+            trace,
+            primary,
+        })
+    }
+
+    pub fn settings(&self) -> &RenderSettings {
+        &self.settings
+    }
+
+    pub fn camera(&self) -> Camera {
+        self.camera
+    }
+
+    /// Iterations (paths per pixel) accumulated since the last reset.
+    pub fn samples(&self) -> u32 {
+        self.film.samples
+    }
+
+    /// Moves the camera; the image starts converging again.
+    pub fn set_camera(&mut self, camera: Camera) -> Result<()> {
+        camera.validate()?;
+        self.camera = camera;
+        self.reset();
+        Ok(())
+    }
+
+    /// Discards the accumulated iterations.
+    pub fn reset(&mut self) {
+        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
+        self.film.clear(&mut enc);
+        self.gpu.queue.submit([enc.finish()]);
+    }
+
+    /// The uniforms of `iteration`: exactly the rasterizer's jittered view-projection
+    /// (`Renderer`'s near plane, which the rays do not depend on), and its inverse.
+    fn uniforms(&self, iteration: u32) -> (FrameUniforms, PathParams) {
+        let (w, h) = (self.settings.width, self.settings.height);
+        let near = 1e-4 * self.scene.bounds.extent().length().max(1e-3);
+        let jitter: Vec2 = pixel_jitter(iteration, self.settings.seed);
+        let view_proj: Mat4 = view_projection(&self.camera, w, h, near, jitter);
+        let frame = FrameUniforms {
+            view_proj: view_proj.to_cols_array_2d(),
+            eye: self.camera.eye.into(),
+            iteration,
+            resolution: [w, h],
+            seed: self.settings.seed,
+            light_samples: 1,
+            ray_epsilon: self.scene.ray_epsilon,
+            _pad: [0; 3],
+        };
+        // Inverted in f64: the f32 matrix the rasterizer uses, inverted without further loss.
+        let inverse = DMat4::from_cols_array_2d(&view_proj.to_cols_array_2d().map(|c| c.map(f64::from))).inverse();
+        let params = PathParams {
+            inv_view_proj: inverse.to_cols_array_2d().map(|c| c.map(|v| v as f32)),
+            light_weight: self.light_weight,
+            light_count: self.scene.light_count,
+            max_bounces: MAX_BOUNCES,
+            rr_start: RR_START,
+        };
+        (frame, params)
+    }
+
+    fn write_uniforms(&self, iteration: u32) {
+        let (frame, params) = self.uniforms(iteration);
+        self.frame.write(&self.gpu, &frame);
+        self.gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+    }
+
+    /// One progressive iteration: one path per pixel, added to the film.
+    pub fn iterate(&mut self) {
+        let (w, h) = (self.settings.width, self.settings.height);
+        self.write_uniforms(self.film.samples);
+        let mut enc =
+            self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("path tracer") });
+        {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("path tracer"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&self.trace);
+            pass.set_bind_group(0, &self.scene.bind_group, &[]);
+            pass.set_bind_group(1, &self.frame.bind_group, &[]);
+            pass.set_bind_group(2, &self.bind_group, &[]);
+            pass.dispatch_workgroups(groups(w, 8), groups(h, 8), 1);
+        }
+        self.gpu.queue.submit([enc.finish()]);
+        self.film.samples += 1;
+    }
+
+    /// Blocks until the submitted iterations have finished on the GPU.
+    pub fn wait(&self) -> Result<()> {
+        self.gpu.wait()
+    }
+
+    /// The mean radiance so far, linear RGB.
+    pub fn read_linear(&self) -> Result<LinearImage> {
+        self.film.read_linear(&self.gpu, Show::Full)
+    }
+
+    /// The display encoding of the mean: 2^exposure · mean, clamped, sRGB, 8 bits.
+    pub fn read_display(&self, exposure: f32) -> Result<DisplayImage> {
+        self.film.read_display(&self.gpu, Show::Full, exposure)
+    }
+
+    /// The first surface each camera ray of `iteration` hits, in the format of
+    /// `Renderer::read_gbuffer`: `(triangle + 1, b1 bits, b2 bits, 0)` per pixel, row by row,
+    /// 0 where the ray escapes; triangles in BVH order. The ray-traced twin of the G-buffer.
+    pub fn primary_hits(&self, iteration: u32) -> Result<Vec<[u32; 4]>> {
+        let (w, h) = (self.settings.width, self.settings.height);
+        let size = w as u64 * h as u64 * 16;
+        let visibility = self.gpu.zeroed_buffer(
+            "path tracer visibility",
+            size,
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        );
+        let bind_group = buffer_bind_group(
+            &self.gpu.device,
+            "path tracer primary hits",
+            &self.layout,
+            &[&self.film.accumulation, &self.params, &visibility],
+        );
+        self.write_uniforms(iteration);
+        let mut enc = self
+            .gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("path tracer primary hits") });
+        {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("path tracer primary hits"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&self.primary);
+            pass.set_bind_group(0, &self.scene.bind_group, &[]);
+            pass.set_bind_group(1, &self.frame.bind_group, &[]);
+            pass.set_bind_group(2, &bind_group, &[]);
+            pass.dispatch_workgroups(groups(w, 8), groups(h, 8), 1);
+        }
+        self.gpu.queue.submit([enc.finish()]);
+        let bytes = self.gpu.read_buffer(&visibility, size)?;
+        Ok(bytemuck::cast_slice(&bytes).to_vec())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn path_params_layout_matches_wgsl() {
+        // WGSL: mat4x4f at 0 (64 bytes), then four 4-byte scalars; size 80, align 16.
+        assert_eq!(std::mem::size_of::<PathParams>(), 80);
+        assert_eq!(std::mem::offset_of!(PathParams, light_weight), 64);
+        assert_eq!(std::mem::offset_of!(PathParams, light_count), 68);
+        assert_eq!(std::mem::offset_of!(PathParams, max_bounces), 72);
+        assert_eq!(std::mem::offset_of!(PathParams, rr_start), 76);
+    }
+}

@@ -1,0 +1,161 @@
+// Reference path tracer (path_tracer.rs): one path per pixel per iteration, next-event
+// estimation and BSDF sampling combined by multiple importance sampling (power heuristic).
+
+// `PathParams` in path_tracer.rs.
+struct PathParams {
+    // Clip → world for this iteration's jittered camera: the inverse of frame.view_proj.
+    inv_view_proj: mat4x4f,
+    // Σ over the emissive triangles of area · (Le.r + Le.g + Le.b), the light table's
+    // normaliser: an emitter point with radiance Le has density (Le.r + Le.g + Le.b) / this.
+    light_weight: f32,
+    light_count: u32,
+    // Scattering events after which a path ends regardless of Russian roulette.
+    max_bounces: u32,
+    // Russian roulette decides from the scattering event with this index (0 = primary hit) on.
+    rr_start: u32,
+}
+
+// Film: component 0 of the accumulation receives the whole radiance estimate.
+@group(2) @binding(0) var<storage, read_write> film: array<vec4f>;
+@group(2) @binding(1) var<uniform> params: PathParams;
+// (triangle + 1, b1 bits, b2 bits, 0) of the primary hit, written by `primary_hits` only.
+@group(2) @binding(2) var<storage, read_write> visibility: array<vec4u>;
+
+const STREAM_PATH: u32 = 0x9a7b1du;
+const FAR: f32 = 1e30;
+
+// The unit direction of the camera ray through the centre of pixel `xy` of the jittered view.
+// Clip (x, y, 0, 1) is the point at infinity in reversed-Z, so the inverse view-projection maps
+// it to the homogeneous world point (direction, 0), the same ray the rasterizer's pixel sees.
+fn camera_direction(xy: vec2u) -> vec3f {
+    let res = vec2f(frame.resolution);
+    let p = vec2f(xy) + 0.5;
+    let ndc = vec2f(2.0 * p.x / res.x - 1.0, 1.0 - 2.0 * p.y / res.y);
+    return normalize((params.inv_view_proj * vec4f(ndc, 0.0, 1.0)).xyz);
+}
+
+// Density per unit area with which `sample_light` picks a point on an emitter of radiance le.
+fn light_pdf_area(le: vec3f) -> f32 {
+    return (le.r + le.g + le.b) / params.light_weight;
+}
+
+// The power heuristic (β = 2) weight of the strategy with density pa against pb.
+fn power_heuristic(pa: f32, pb: f32) -> f32 {
+    let a = pa * pa;
+    return a / (a + pb * pb);
+}
+
+// One sample of the radiance arriving at `origin` from direction −dir (see path_tracer.rs
+// for the estimator). Random numbers per scattering event: 3 (light), 1 (roulette), 2 (BSDF).
+fn path_radiance(origin: vec3f, dir: vec3f, rng: ptr<function, u32>) -> vec3f {
+    var radiance = vec3f(0.0);
+    var throughput = vec3f(1.0);
+    var o = origin;
+    var d = dir;
+    var t_min = 0.0;
+    var skip = NO_TRIANGLE;
+    // Solid-angle density of d under BSDF sampling; 0 for the camera ray (no light strategy).
+    var bsdf_pdf = 0.0;
+    for (var bounce = 0u; ; bounce++) {
+        let hit = trace(o, d, t_min, FAR, skip, NO_TRIANGLE, false);
+        if hit.tri == NO_TRIANGLE {
+            break;
+        }
+        let s = surface_at(hit.tri, hit.b1, hit.b2);
+        let cos_in = -dot(s.normal, d);
+        let front = cos_in > 0.0;
+        // Emission of the front face, weighted against the light sample taken at the previous
+        // vertex, which could have produced the same point with density p_light.
+        if front && any(s.emission > vec3f(0.0)) {
+            var w = 1.0;
+            if bsdf_pdf > 0.0 {
+                let p_light = light_pdf_area(s.emission) * hit.t * hit.t / cos_in;
+                w = power_heuristic(bsdf_pdf, p_light);
+            }
+            radiance += throughput * s.emission * w;
+        }
+        // The back of a one-sided surface absorbs.
+        if !front && (s.flags & MATERIAL_TWO_SIDED) == 0u {
+            break;
+        }
+        if bounce >= params.max_bounces {
+            break;
+        }
+        let n = select(-s.normal, s.normal, front);
+        let x = s.pos + n * frame.ray_epsilon;
+        let f = s.albedo / PI;
+
+        // Next-event estimation: a point y on the emitters, weighted against BSDF sampling.
+        let u0 = rng_f32(rng);
+        let u1 = rng_f32(rng);
+        let u2 = rng_f32(rng);
+        if params.light_count > 0u {
+            let l = sample_light(u0, u1, u2);
+            let to_light = l.pos - x;
+            let dist2 = dot(to_light, to_light);
+            let dist = sqrt(dist2);
+            let w = to_light / dist;
+            let cos_x = dot(n, w);
+            let cos_y = -dot(l.normal, w);
+            if cos_x > 0.0 && cos_y > 0.0
+                && !occluded(x, w, frame.ray_epsilon, dist * (1.0 - 1e-4), s.tri, l.tri) {
+                // Area density → solid angle at x. The weight takes the density from the same
+                // formula as the emitter hits above, so that the two weights sum to one exactly.
+                let to_solid_angle = dist2 / cos_y;
+                let p_bsdf = cos_x / PI;
+                let mis = power_heuristic(light_pdf_area(l.radiance) * to_solid_angle, p_bsdf);
+                radiance += throughput * f * l.radiance * (cos_x * mis / (l.pdf_area * to_solid_angle));
+            }
+        }
+
+        // Russian roulette: continue with probability q = max(ρ), dividing by q.
+        var q = 1.0;
+        if bounce >= params.rr_start {
+            q = min(max(max(s.albedo.r, s.albedo.g), s.albedo.b), 1.0);
+        }
+        let u_rr = rng_f32(rng);
+        if u_rr >= q {
+            break;
+        }
+        // Cosine sampling: f · cos θ / pdf = ρ.
+        let v1 = rng_f32(rng);
+        let v2 = rng_f32(rng);
+        d = cosine_hemisphere(n, v1, v2);
+        bsdf_pdf = max(dot(n, d), 0.0) / PI;
+        if bsdf_pdf <= 0.0 {
+            break;
+        }
+        throughput *= s.albedo / q;
+        o = x;
+        t_min = frame.ray_epsilon;
+        skip = s.tri;
+    }
+    return radiance;
+}
+
+// One path per pixel through this iteration's jittered pixel position, added to the film.
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) gid: vec3u) {
+    if any(gid.xy >= frame.resolution) {
+        return;
+    }
+    let pixel = gid.y * frame.resolution.x + gid.x;
+    var rng = rng_new(frame.seed ^ STREAM_PATH, pixel, frame.iteration);
+    let radiance = path_radiance(frame.eye, camera_direction(gid.xy), &rng);
+    film[pixel] += vec4f(radiance, 0.0);
+}
+
+// The first surface hit by each camera ray, in the G-buffer's format (gbuffer.wgsl).
+@compute @workgroup_size(8, 8)
+fn primary_hits(@builtin(global_invocation_id) gid: vec3u) {
+    if any(gid.xy >= frame.resolution) {
+        return;
+    }
+    let pixel = gid.y * frame.resolution.x + gid.x;
+    let hit = trace(frame.eye, camera_direction(gid.xy), 0.0, FAR, NO_TRIANGLE, NO_TRIANGLE, false);
+    var v = vec4u(0u);
+    if hit.tri != NO_TRIANGLE {
+        v = vec4u(hit.tri + 1u, bitcast<u32>(hit.b1), bitcast<u32>(hit.b2), 0u);
+    }
+    visibility[pixel] = v;
+}

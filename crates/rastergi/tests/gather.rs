@@ -1,0 +1,209 @@
+//! The final gather against independent computations: a CPU ray cast of the same estimator,
+//! Mitsuba 3 for the converged Cornell box, and the seed's three effects measured.
+
+mod common;
+
+use std::f64::consts::PI;
+
+use glam::{Vec2, Vec3};
+use rastergi::film::Show;
+use rastergi::gpu_scene::PreparedScene;
+use rastergi::image_io::LinearImage;
+use rastergi::metrics::{compare, emitter_mask, masked_mean, rmse};
+use rastergi::renderer::{Overrides, RenderSettings, Renderer};
+use rastergi::sampling::uniform_sphere;
+use rastergi::scene::{Camera, cornell_box, triangle_normal};
+
+#[test]
+fn gather_matches_cpu_raycast_for_same_directions_except_at_ray_view_edges() {
+    let gpu = common::gpu();
+    let scene = cornell_box();
+    let (w, h) = (64u32, 64u32);
+    let settings = RenderSettings {
+        width: w,
+        height: h,
+        photons: 1 << 16,
+        grid_resolution: 16,
+        bundle: 512,
+        ..Default::default()
+    };
+    let mut r = Renderer::new(&gpu, &scene, settings).unwrap();
+    let map = r.photon_map().unwrap().read(&gpu).unwrap();
+    let prepared = PreparedScene::new(&scene);
+    let eps = prepared.ray_epsilon();
+    let s = &prepared.scene;
+    let (mut compared, mut mismatched) = (0usize, 0usize);
+    for k in 0..6 {
+        let direction = uniform_sphere((k as f32 + 0.5) / 6.0, 0.37 * k as f32 + 0.1);
+        r.reset();
+        let o =
+            Overrides { direction: Some(direction), pixel_jitter: Some(Vec2::ZERO), texel_jitter: Some(Vec2::ZERO) };
+        r.iterate_with(&o).unwrap();
+        let img = r.read_linear(Show::Indirect).unwrap();
+        let gbuffer = r.read_gbuffer().unwrap();
+        for (i, g) in gbuffer.iter().enumerate() {
+            if g[0] == 0 {
+                continue;
+            }
+            // The same estimator by ray casting: (ρ_x/π)·(ρ_h/π)·E(h)·max(0, n·ω)·4π.
+            let t = g[0] as usize - 1;
+            let (b1, b2) = (f32::from_bits(g[1]), f32::from_bits(g[2]));
+            let tri = s.triangles[t];
+            let x = tri[0] * (1.0 - b1 - b2) + tri[1] * b1 + tri[2] * b2;
+            let n = triangle_normal(&tri);
+            if n.dot(scene.camera.eye - x) <= 0.0 {
+                continue;
+            }
+            let cos = n.dot(direction);
+            let mut expected = [0.0f64; 3];
+            if cos > 0.0
+                && let Some(hit) = prepared.bvh.intersect(&s.triangles, x, direction, eps, f32::INFINITY, t as u32)
+            {
+                let ht = s.triangles[hit.triangle as usize];
+                let nh = triangle_normal(&ht);
+                if nh.dot(direction) < 0.0 {
+                    let e = map.irradiance(x + direction * hit.t, nh);
+                    let (ax, ah) = (s.material_of(t).albedo, s.material_of(hit.triangle as usize).albedo);
+                    for c in 0..3 {
+                        expected[c] = ax[c] as f64 / PI * ah[c] as f64 / PI * e[c] * cos as f64 * 4.0 * PI;
+                    }
+                }
+            }
+            compared += 1;
+            let got = img.pixels[i];
+            let ok =
+                (0..3).all(|c| (got[c] as f64 - expected[c]).abs() <= 2e-3 * expected[c].max(got[c] as f64) + 1e-6);
+            if !ok {
+                mismatched += 1;
+            }
+        }
+    }
+    let fraction = mismatched as f64 / compared as f64;
+    println!("{mismatched} of {compared} pixel estimates differ from the ray cast ({:.2} %)", 100.0 * fraction);
+    // A rasterized gather samples each ray-view texel at one point: a gather ray passing
+    // within a texel of a silhouette in the ray view may see the other surface. With a
+    // 512² bundle over the scene's bounding sphere (diameter 3.5: texels ≈ 0.007 wide) and
+    // the box's ~14 silhouette edges of length ≈ 1–2 units in any view, the texels next to
+    // an edge cover ≈ 2·14·1.5·0.007/(π·1.75²) ≈ 3 % of the view; eye pixels whose rays pass
+    // there are at most that fraction, so 5 % bounds it with margin.
+    assert!(fraction < 0.05, "{:.2} % of the gather estimates disagree with the ray cast", 100.0 * fraction);
+}
+
+fn cornell_reference() -> (LinearImage, f64, Vec<bool>) {
+    let probe = rastergi::image_io::read_exr(&common::data("cornell_path_128_a.exr")).unwrap();
+    let mask = emitter_mask(&probe, 3.0);
+    let (reference, noise) = common::reference_pair("cornell_path_128", Some(&mask));
+    (reference, noise, mask)
+}
+
+#[test]
+fn converged_cornell_box_matches_mitsuba_within_noise_and_grid_bias() {
+    let gpu = common::gpu();
+    let scene = cornell_box();
+    let settings = |seed| RenderSettings {
+        width: 128,
+        height: 128,
+        seed,
+        photons: 1 << 21,
+        grid_resolution: 32,
+        ..Default::default()
+    };
+    let a = common::render(&gpu, &scene, settings(1), 256, Show::Full);
+    let b = common::render(&gpu, &scene, settings(2), 256, Show::Full);
+    let ours = common::average(&a, &b);
+    let (reference, ref_noise, mask) = cornell_reference();
+    let mean = masked_mean(&reference, Some(&mask));
+    // Two seeds differ in every random choice — gather directions, jitter, light samples and
+    // the photon map itself — so their difference measures all of our noise.
+    let noise = (rmse(&a, &b, Some(&mask)).powi(2) / 4.0 + ref_noise.powi(2)).sqrt() / mean;
+    let c = compare(&ours, &reference, Some(&mask));
+    let bias = (c.relative_rmse.powi(2) - noise.powi(2)).max(0.0).sqrt();
+    println!(
+        "relative RMSE {:.4} = noise {noise:.4} ⊕ bias {bias:.4}; block-mean error {:.4}; mean ratio {:?}",
+        c.relative_rmse, c.block_mean_error, c.mean_ratio
+    );
+    // Targets of the design: 5 % relative RMSE and 1.5 % block-mean error at 128² within a
+    // test-sized run. What is not noise is the photon map's error read at the secondary
+    // points (and the ray view's texel sampling): it cannot exceed the error of the same map
+    // read at the visible points themselves, 3.0 % at grid 32 (photons.rs measures it).
+    assert!(c.relative_rmse < 0.05, "relative RMSE {}", c.relative_rmse);
+    assert!(c.block_mean_error < 0.015, "block-mean error {}", c.block_mean_error);
+    assert!(bias < 0.03, "bias {bias}");
+    for r in c.mean_ratio {
+        assert!((r - 1.0).abs() < 0.01, "mean ratio {:?}", c.mean_ratio);
+    }
+}
+
+/// Mean radiance over the pixels of `rect` = (x0, y0, x1, y1).
+fn region_mean(img: &LinearImage, (x0, y0, x1, y1): (u32, u32, u32, u32)) -> [f64; 3] {
+    let mut m = [0.0; 3];
+    for y in y0..y1 {
+        for x in x0..x1 {
+            for c in 0..3 {
+                m[c] += img.at(x, y)[c] as f64;
+            }
+        }
+    }
+    m.map(|v| v / ((x1 - x0) * (y1 - y0)) as f64)
+}
+
+#[test]
+fn indirect_light_lightens_shadows_darkens_corners_and_bleeds_colour() {
+    let gpu = common::gpu();
+    let scene = cornell_box();
+    let settings = RenderSettings {
+        width: 128,
+        height: 128,
+        seed: 4,
+        photons: 1 << 20,
+        grid_resolution: 32,
+        ..Default::default()
+    };
+    let mut r = Renderer::new(&gpu, &scene, settings.clone()).unwrap();
+    for _ in 0..256 {
+        r.iterate().unwrap();
+    }
+    let (full, direct) = (r.read_linear(Show::Full).unwrap(), r.read_linear(Show::Direct).unwrap());
+    let reference = common::reference_pair("cornell_path_128", None).0;
+    let ref_direct = common::reference_pair("cornell_direct_128", None).0;
+
+    // 1. Shadows: floor pixels behind the small box that the light barely reaches directly.
+    let shadow = (75, 118, 90, 122);
+    let (f, d, rf, rd) = [&full, &direct, &reference, &ref_direct].map(|i| region_mean(i, shadow)).into();
+    println!("shadow: direct {:.4} full {:.4} (Mitsuba {:.4} → {:.4})", d[1], f[1], rd[1], rf[1]);
+    assert!(f[1] > 1.5 * d[1], "indirect light does not lighten the shadow");
+    let (ours_ind, ref_ind) = (f[1] - d[1], rf[1] - rd[1]);
+    assert!((ours_ind / ref_ind - 1.0).abs() < 0.1, "indirect light in the shadow {ours_ind} vs Mitsuba {ref_ind}");
+
+    // 2. Corners: the back wall's upper corners against its centre above the boxes.
+    let corners = [(29, 29, 33, 33), (95, 29, 99, 33)];
+    let centre = (60, 36, 68, 44);
+    for corner in corners {
+        let (oc, occ) = (region_mean(&full, corner)[1], region_mean(&full, centre)[1]);
+        let (rc, rcc) = (region_mean(&reference, corner)[1], region_mean(&reference, centre)[1]);
+        println!("corner/centre: ours {:.3}, Mitsuba {:.3}", oc / occ, rc / rcc);
+        assert!(oc < 0.9 * occ, "corner not darker than the centre");
+        // The grid blurs irradiance over a cell (0.06 here) right where corners need it:
+        // 10 % is the known corner bias of a 32-cell grid, not noise.
+        let rel = (oc / occ) / (rc / rcc);
+        assert!((rel - 1.0).abs() < 0.1, "corner darkening differs from Mitsuba: {rel}");
+    }
+
+    // 3. Colour bleeding: the tall box's side facing the red wall against its side facing
+    //    the green wall, each seen head-on from a camera inside the box.
+    let ratio = |eye: Vec3, target: Vec3| {
+        let mut r = Renderer::new(&gpu, &scene, RenderSettings { width: 48, height: 48, ..settings.clone() }).unwrap();
+        r.set_camera(Camera { eye, target, up: Vec3::Y, fov_y_deg: 20.0 }).unwrap();
+        for _ in 0..128 {
+            r.iterate().unwrap();
+        }
+        let m = region_mean(&r.read_linear(Show::Full).unwrap(), (16, 16, 32, 32));
+        m[0] / m[1]
+    };
+    let face_red = Vec3::new(-0.615, -0.4, -0.186);
+    let face_green = Vec3::new(-0.045, -0.4, -0.374);
+    let red_side = ratio(face_red + Vec3::new(-0.95, 0.0, 0.31) * 0.3, face_red);
+    let green_side = ratio(face_green + Vec3::new(0.95, 0.0, -0.31) * 0.4, face_green);
+    println!("red/green ratio: side facing red {red_side:.3}, side facing green {green_side:.3}");
+    assert!(red_side > 1.2 * green_side, "no colour bleeding: {red_side} vs {green_side}");
+}

@@ -1,0 +1,228 @@
+//! `load_obj` against hand-written OBJ/MTL fixtures in `tests/data/obj/`: the triangles,
+//! materials and emitted power it must produce, and the files it must refuse with an error
+//! (never a panic) that names the file.
+
+use std::f32::consts::PI;
+use std::path::PathBuf;
+
+use glam::Vec3;
+use rastergi::scene::{Material, Scene, load_obj};
+
+fn fixture(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/obj").join(name)
+}
+
+fn v(x: f32, y: f32, z: f32) -> Vec3 {
+    Vec3::new(x, y, z)
+}
+
+/// Whether `a` and `b` are the same triangle with the same winding: equal up to a cyclic
+/// rotation of the corners (a reversed order would flip the front face).
+fn same_winding(a: &[Vec3; 3], b: &[Vec3; 3]) -> bool {
+    (0..3).any(|r| (0..3).all(|k| a[k] == b[(k + r) % 3]))
+}
+
+/// The triangles of the scene that use a material with this name.
+fn triangles_of(scene: &Scene, material: &str) -> Vec<([Vec3; 3], Material)> {
+    (0..scene.triangles.len())
+        .filter(|&i| scene.material_of(i).name == material)
+        .map(|i| (scene.triangles[i], scene.material_of(i).clone()))
+        .collect()
+}
+
+/// The triangles of the scene whose material is none of the named ones.
+fn triangles_not_of(scene: &Scene, materials: &[&str]) -> Vec<([Vec3; 3], Material)> {
+    (0..scene.triangles.len())
+        .filter(|&i| !materials.contains(&scene.material_of(i).name.as_str()))
+        .map(|i| (scene.triangles[i], scene.material_of(i).clone()))
+        .collect()
+}
+
+// The geometry of scene.obj, written out by hand from the file.
+const FLOOR: [[f32; 3]; 4] = [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [2.0, 0.0, -3.0], [0.0, 0.0, -3.0]];
+const LIGHT: [[f32; 3]; 3] = [[0.0, 2.0, 0.0], [0.0, 2.0, -1.0], [1.0, 2.0, 0.0]];
+const WALL: [[f32; 3]; 3] = [[0.0, 0.0, -3.0], [2.0, 0.0, -3.0], [0.0, 1.5, -3.0]];
+
+#[test]
+fn scene_has_the_files_triangles_with_their_winding() {
+    let scene = load_obj(&fixture("scene.obj")).unwrap();
+    assert_eq!(scene.triangles.len(), 4, "a quad and two triangles make four triangles");
+    assert_eq!(scene.material_ids.len(), scene.triangles.len());
+
+    let light = triangles_of(&scene, "light");
+    assert_eq!(light.len(), 1);
+    assert!(same_winding(&light[0].0, &LIGHT.map(Vec3::from)), "light triangle {:?}", light[0].0);
+
+    let wall = triangles_not_of(&scene, &["light", "grey"]);
+    assert_eq!(wall.len(), 1, "the face before any usemtl");
+    assert!(same_winding(&wall[0].0, &WALL.map(Vec3::from)), "wall triangle {:?}", wall[0].0);
+
+    // The quad a b c d splits along either diagonal; both halves keep its winding.
+    let floor: Vec<[Vec3; 3]> = triangles_of(&scene, "grey").into_iter().map(|(t, _)| t).collect();
+    assert_eq!(floor.len(), 2, "the quad becomes two triangles");
+    let [a, b, c, d] = FLOOR.map(Vec3::from);
+    let splits = [[[a, b, c], [a, c, d]], [[a, b, d], [b, c, d]]];
+    let matches = |split: &[[Vec3; 3]; 2]| {
+        (same_winding(&floor[0], &split[0]) && same_winding(&floor[1], &split[1]))
+            || (same_winding(&floor[0], &split[1]) && same_winding(&floor[1], &split[0]))
+    };
+    assert!(splits.iter().any(matches), "floor triangles {floor:?} are not a split of the quad {:?}", [a, b, c, d]);
+}
+
+#[test]
+fn front_faces_follow_the_counter_clockwise_order_of_the_file() {
+    let scene = load_obj(&fixture("scene.obj")).unwrap();
+    let expected = [("grey", v(0.0, 1.0, 0.0)), ("light", v(0.0, -1.0, 0.0))];
+    for (name, normal) in expected {
+        for (t, _) in triangles_of(&scene, name) {
+            assert_eq!(rastergi::scene::triangle_normal(&t), normal, "{name} triangle {t:?}");
+        }
+    }
+    for (t, _) in triangles_not_of(&scene, &["light", "grey"]) {
+        assert_eq!(rastergi::scene::triangle_normal(&t), v(0.0, 0.0, 1.0), "wall triangle {t:?}");
+    }
+}
+
+#[test]
+fn each_group_gets_its_own_material_and_faces_without_one_get_grey() {
+    let scene = load_obj(&fixture("scene.obj")).unwrap();
+    for (t, m) in triangles_of(&scene, "grey") {
+        assert_eq!(m.albedo, v(0.2, 0.4, 0.6), "Kd of 'grey' for {t:?}");
+        assert_eq!(m.emission, Vec3::ZERO);
+        assert!(m.two_sided, "OBJ materials reflect on both sides");
+    }
+    for (_, m) in triangles_of(&scene, "light") {
+        assert_eq!(m.albedo, v(0.8, 0.7, 0.6), "Kd of 'light'");
+        assert_eq!(m.emission, v(10.0, 5.0, 2.0), "Ke of 'light'");
+        assert!(m.two_sided);
+        assert!(m.is_emitter());
+    }
+    for (_, m) in triangles_not_of(&scene, &["light", "grey"]) {
+        assert_eq!(m.albedo, Vec3::splat(0.5), "a face without a material is 0.5 grey");
+        assert_eq!(m.emission, Vec3::ZERO);
+        assert!(m.two_sided);
+    }
+}
+
+#[test]
+fn emitted_power_is_pi_times_radiance_times_area_of_the_light() {
+    let scene = load_obj(&fixture("scene.obj")).unwrap();
+    // The light is a right triangle with legs 1 and 1: area 1/2; Le = (10, 5, 2).
+    let expected = PI * v(10.0, 5.0, 2.0) * 0.5;
+    let power = scene.emitted_power();
+    assert!((power - expected).abs().max_element() < 1e-5, "Φ = {power}, expected {expected}");
+    assert_eq!(scene.emissive_triangles().len(), 1);
+}
+
+#[test]
+fn framing_camera_sees_every_corner_of_the_bounds() {
+    let scene = load_obj(&fixture("scene.obj")).unwrap();
+    let bounds = scene.bounds();
+    assert_eq!((bounds.min, bounds.max), (v(0.0, 0.0, -3.0), v(2.0, 2.0, 0.0)));
+    let camera = scene.camera;
+    camera.validate().unwrap();
+    let (right, up, forward) = camera.frame();
+    let tan_half = (0.5 * camera.fov_y_deg.to_radians()).tan();
+    for i in 0..8 {
+        let corner = v(
+            if i & 1 == 0 { bounds.min.x } else { bounds.max.x },
+            if i & 2 == 0 { bounds.min.y } else { bounds.max.y },
+            if i & 4 == 0 { bounds.min.z } else { bounds.max.z },
+        );
+        let d = corner - camera.eye;
+        let depth = d.dot(forward);
+        assert!(depth > 0.0, "corner {corner} is behind the camera");
+        // A square image: the horizontal half-angle equals the vertical one.
+        assert!(d.dot(up).abs() <= tan_half * depth, "corner {corner} is above or below the view");
+        assert!(d.dot(right).abs() <= tan_half * depth, "corner {corner} is left or right of the view");
+    }
+}
+
+#[test]
+fn single_number_colours_mean_grey_as_in_the_mtl_format() {
+    let scene = load_obj(&fixture("short_colours.obj")).unwrap();
+    let m = scene.material_of(0);
+    assert_eq!(m.albedo, Vec3::splat(0.25), "Kd 0.25 is Kd 0.25 0.25 0.25");
+    assert_eq!(m.emission, Vec3::splat(3.0), "Ke 3 is Ke 3 3 3");
+}
+
+#[test]
+fn texture_and_normal_indices_are_not_needed_and_not_checked() {
+    let scene = load_obj(&fixture("bad_normal_index.obj")).unwrap();
+    assert_eq!(scene.triangles, vec![[v(0.0, 0.0, 0.0), v(1.0, 0.0, 0.0), v(0.0, 1.0, 0.0)]]);
+}
+
+/// Loads a file that must be refused and returns the error's message, after checking that it
+/// is one line naming the file.
+fn refused(path: PathBuf) -> String {
+    let message = match load_obj(&path) {
+        Ok(scene) => panic!("{} was accepted: {} triangles", path.display(), scene.triangles.len()),
+        Err(e) => e.to_string(),
+    };
+    assert!(message.contains(&path.display().to_string()), "the error does not name the file: {message}");
+    assert!(!message.contains('\n'), "the error is not one line: {message}");
+    message
+}
+
+#[test]
+fn missing_file_is_refused() {
+    let message = refused(fixture("no-such-scene.obj"));
+    assert!(message.contains("no such file"), "{message}");
+}
+
+#[test]
+fn directory_is_refused() {
+    let message = refused(fixture(""));
+    assert!(message.contains("not a file"), "{message}");
+}
+
+#[test]
+fn malformed_vertex_line_is_refused() {
+    refused(fixture("malformed.obj"));
+}
+
+#[test]
+fn text_that_is_not_obj_is_refused() {
+    refused(fixture("not_obj.obj"));
+}
+
+#[test]
+fn empty_file_is_refused() {
+    let message = refused(fixture("empty.obj"));
+    assert!(message.contains("no faces"), "{message}");
+}
+
+#[test]
+fn face_with_a_vertex_that_does_not_exist_is_refused() {
+    refused(fixture("bad_index.obj"));
+}
+
+#[test]
+fn missing_material_library_is_refused_and_named() {
+    let message = refused(fixture("missing_mtllib.obj"));
+    assert!(message.contains("no-such-library.mtl"), "{message}");
+}
+
+#[test]
+fn a_missing_second_material_library_is_not_hidden_by_the_first() {
+    let message = refused(fixture("second_mtllib_missing.obj"));
+    assert!(message.contains("also-missing.mtl"), "{message}");
+}
+
+#[test]
+fn nan_coordinate_is_refused() {
+    let message = refused(fixture("nan.obj"));
+    assert!(message.contains("non-finite"), "{message}");
+}
+
+#[test]
+fn negative_albedo_is_refused() {
+    let message = refused(fixture("negative_kd.obj"));
+    assert!(message.contains("negative"), "{message}");
+}
+
+#[test]
+fn colour_without_numbers_is_refused() {
+    let message = refused(fixture("empty_ke.obj"));
+    assert!(message.contains("empty_ke.mtl") && message.contains("Ke"), "{message}");
+}

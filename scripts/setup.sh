@@ -1,0 +1,79 @@
+#!/usr/bin/env bash
+# Installs what rastergi needs on a fresh Debian or Ubuntu machine: a C toolchain and
+# pkg-config, Mesa's Vulkan drivers (lavapipe runs the GPU code on the CPU when there is no
+# GPU) and Rust >= 1.88 with rustfmt and clippy. Safe to run again: it installs only what is
+# missing. Afterwards, in a new shell or after `. ~/.cargo/env`: cargo test --release
+set -euo pipefail
+
+MIN_RUST=1.88
+PACKAGES=(build-essential pkg-config mesa-vulkan-drivers libvulkan1 curl ca-certificates)
+
+say() { echo "setup: $*"; }
+die() {
+    echo "setup: error: $*" >&2
+    exit 1
+}
+
+# Runs a command as root: directly when root, else through sudo when there is one.
+as_root() {
+    if [ "$(id -u)" -eq 0 ]; then
+        "$@"
+    elif command -v sudo >/dev/null 2>&1; then
+        sudo "$@"
+    else
+        die "need root to run '$*'; run this script as root or install sudo"
+    fi
+}
+
+# Whether version $1 (like 1.95.0) is at least $2 (like 1.88).
+version_at_least() {
+    [ "$(printf '%s\n%s\n' "$2" "$1" | sort -V | head -n 1)" = "$2" ]
+}
+
+# System packages.
+if command -v apt-get >/dev/null 2>&1; then
+    missing=()
+    for p in "${PACKAGES[@]}"; do
+        dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+    done
+    if [ ${#missing[@]} -gt 0 ]; then
+        say "installing ${missing[*]}"
+        as_root env DEBIAN_FRONTEND=noninteractive apt-get update -qq
+        as_root env DEBIAN_FRONTEND=noninteractive apt-get install -qq -y --no-install-recommends "${missing[@]}" >/dev/null
+    else
+        say "system packages present: ${PACKAGES[*]}"
+    fi
+else
+    say "no apt-get: install the equivalents of ${PACKAGES[*]} yourself"
+fi
+
+# Rust, through rustup.
+if [ -f "$HOME/.cargo/env" ]; then
+    . "$HOME/.cargo/env"
+fi
+install_rustup() {
+    say "installing Rust with rustup (into ~/.cargo)"
+    curl --proto '=https' --tlsv1.2 https://sh.rustup.rs -sSf | sh -s -- -y --profile minimal
+    . "$HOME/.cargo/env"
+}
+if ! command -v cargo >/dev/null 2>&1; then
+    install_rustup
+fi
+rust_version="$(rustc --version | awk '{print $2}')"
+if ! version_at_least "$rust_version" "$MIN_RUST"; then
+    if command -v rustup >/dev/null 2>&1; then
+        say "rustc $rust_version is older than $MIN_RUST: updating the stable toolchain"
+        rustup update stable
+    else
+        # A distribution's Rust without rustup: rustup's toolchain goes first on PATH.
+        say "rustc $rust_version is older than $MIN_RUST and there is no rustup"
+        install_rustup
+    fi
+    rust_version="$(rustc --version | awk '{print $2}')"
+    version_at_least "$rust_version" "$MIN_RUST" ||
+        die "rustc $rust_version is still older than $MIN_RUST; run 'rustup default stable' (or remove the override that pins an older toolchain)"
+fi
+if command -v rustup >/dev/null 2>&1; then
+    rustup -q component add rustfmt clippy
+fi
+say "ready: $(rustc --version), $(cargo --version)"

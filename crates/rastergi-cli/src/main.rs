@@ -1,5 +1,6 @@
 //! `rastergi`: the command-line front end. All rendering lives in the `rastergi` library.
 
+mod bench;
 mod render;
 
 use std::process::ExitCode;
@@ -26,6 +27,9 @@ enum Command {
     },
     /// Render a scene progressively and write the image (.exr linear, .png display).
     Render(render::RenderArgs),
+    /// Measure throughput: `bench photons`, `bench gather`.
+    #[command(subcommand)]
+    Bench(bench::BenchCommand),
 }
 
 fn main() -> ExitCode {
@@ -34,6 +38,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Info { gpu } => render::gpu(&gpu).map(|g| println!("{}", g.describe())),
         Command::Render(args) => render::run(&args),
+        Command::Bench(command) => bench::run(&command),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

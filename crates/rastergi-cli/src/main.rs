@@ -1,6 +1,7 @@
 //! `rastergi`: the command-line front end. All rendering lives in the `rastergi` library.
 
 mod bench;
+mod compare;
 mod render;
 
 use std::process::ExitCode;
@@ -30,15 +31,46 @@ enum Command {
     /// Measure throughput: `bench photons`, `bench gather`.
     #[command(subcommand)]
     Bench(bench::BenchCommand),
+    /// Compare an image with a reference: relative RMSE, block-mean error, PSNR, mean ratios.
+    Compare(compare::CompareArgs),
+}
+
+/// Mesa's Vulkan drivers probe Wayland when they start and, where `XDG_RUNTIME_DIR` is unset
+/// (root shells, CI, containers), print "error: XDG_RUNTIME_DIR is invalid" lines that look
+/// like rastergi's own errors. Commands that open no window point the variable at a private
+/// directory first; the window of `view` needs the real environment, so it is left alone.
+fn quiet_wayland_probe() {
+    if std::env::var_os("XDG_RUNTIME_DIR").is_some() {
+        return;
+    }
+    let dir = std::env::temp_dir().join("rastergi-runtime");
+    let created = std::fs::create_dir_all(&dir).is_ok();
+    #[cfg(unix)]
+    let created =
+        created && std::fs::set_permissions(&dir, std::os::unix::fs::PermissionsExt::from_mode(0o700)).is_ok();
+    if created {
+        // SAFETY: called at the start of main, before any other thread exists.
+        unsafe { std::env::set_var("XDG_RUNTIME_DIR", &dir) };
+    }
+}
+
+impl Command {
+    fn opens_window(&self) -> bool {
+        false
+    }
 }
 
 fn main() -> ExitCode {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();
+    if !cli.command.opens_window() {
+        quiet_wayland_probe();
+    }
     let result = match cli.command {
         Command::Info { gpu } => render::gpu(&gpu).map(|g| println!("{}", g.describe())),
         Command::Render(args) => render::run(&args),
         Command::Bench(command) => bench::run(&command),
+        Command::Compare(args) => compare::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -9,7 +9,7 @@ use anyhow::{Context, Result};
 use clap::{Args, Subcommand};
 use rastergi::film::Show;
 use rastergi::gpu_scene::{GpuScene, PreparedScene};
-use rastergi::image_io::read_exr;
+use rastergi::image_io::{LinearImage, read_exr};
 use rastergi::metrics::{compare, emitter_mask};
 use rastergi::photon_map::GridSpec;
 use rastergi::photons::{PhotonSettings, cpu, gpu::GpuPhotonMap};
@@ -59,9 +59,10 @@ pub struct GatherArgs {
     #[arg(long, default_value_t = 64)]
     grid: u32,
     /// A converged reference (linear EXR) of the scene's camera view: also measure the time
-    /// to reach each target error at its resolution.
-    #[arg(long)]
-    reference: Option<PathBuf>,
+    /// to reach each target error at its resolution. Several comma-separated independent
+    /// renders are averaged (less reference noise).
+    #[arg(long, value_delimiter = ',')]
+    reference: Vec<PathBuf>,
     /// Target relative RMSEs in percent (emitter pixels masked).
     #[arg(long, value_delimiter = ',', default_values_t = [5.0f64, 2.0])]
     targets: Vec<f64>,
@@ -168,21 +169,27 @@ fn gather(a: &GatherArgs) -> Result<()> {
             1e3 * dt / a.iterations as f64
         );
     }
-    if let Some(path) = &a.reference {
-        time_to_error(a, &gpu, &scene, path)?;
+    if !a.reference.is_empty() {
+        time_to_error(a, &gpu, &scene, &a.reference)?;
     }
     Ok(())
 }
 
 /// Renders at the reference's size, checking the error at growing iteration counts, and
 /// reports the render time (readbacks excluded) at which each target was first met.
-fn time_to_error(a: &GatherArgs, gpu: &rastergi::gpu::Gpu, scene: &rastergi::scene::Scene, path: &Path) -> Result<()> {
-    let reference = read_exr(path)?;
+fn time_to_error(
+    a: &GatherArgs,
+    gpu: &rastergi::gpu::Gpu,
+    scene: &rastergi::scene::Scene,
+    paths: &[PathBuf],
+) -> Result<()> {
+    let reference = average_references(paths)?;
     let mask = emitter_mask(&reference, 3.0);
     let (w, h) = (reference.width, reference.height);
     let mut targets: Vec<f64> = a.targets.iter().map(|t| t / 100.0).collect();
     targets.sort_by(|x, y| y.total_cmp(x));
-    println!("time to error against {} ({w}x{h}, emitter pixels masked):", path.display());
+    let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+    println!("time to error against the mean of {} ({w}x{h}, emitter pixels masked):", names.join(", "));
     let t_setup = Instant::now();
     let mut r = Renderer::new(gpu, scene, settings(a, w, h, rastergi::renderer::default_bundle(w, h)))?;
     gpu.wait()?;
@@ -219,6 +226,31 @@ fn time_to_error(a: &GatherArgs, gpu: &rastergi::gpu::Gpu, scene: &rastergi::sce
         mitsuba_time_to_error(a, &reference, &mask, &targets)?;
     }
     Ok(())
+}
+
+/// The mean of equally sized reference renders.
+fn average_references(paths: &[PathBuf]) -> Result<LinearImage> {
+    let mut mean = read_exr(&paths[0])?;
+    for p in &paths[1..] {
+        let other = read_exr(p)?;
+        anyhow::ensure!(
+            (other.width, other.height) == (mean.width, mean.height),
+            "{}: {}x{} differs from the first reference's {}x{}",
+            p.display(),
+            other.width,
+            other.height,
+            mean.width,
+            mean.height
+        );
+        for (m, o) in mean.pixels.iter_mut().zip(&other.pixels) {
+            for c in 0..3 {
+                m[c] += o[c];
+            }
+        }
+    }
+    let k = paths.len() as f32;
+    mean.pixels.iter_mut().for_each(|m| m.iter_mut().for_each(|v| *v /= k));
+    Ok(mean)
 }
 
 /// Mitsuba 3's `path` integrator through scripts/mitsuba_reference.py at doubling sample

@@ -71,18 +71,48 @@ impl Default for RenderSettings {
     }
 }
 
+/// The passes whose resources depend on the image size.
+struct ImagePasses {
+    gbuffer: GBufferPass,
+    direct: DirectPass,
+    photon_view: Option<PhotonViewPass>,
+    gather: Option<GatherPass>,
+    film: Film,
+}
+
+impl ImagePasses {
+    fn new(
+        gpu: &Gpu,
+        scene: &GpuScene,
+        frame: &FrameBinding,
+        map: Option<&GpuPhotonMap>,
+        settings: &RenderSettings,
+    ) -> Result<ImagePasses> {
+        let (width, height) = (settings.width, settings.height);
+        let film = Film::new(gpu, width, height)?;
+        let gbuffer = GBufferPass::new(gpu, scene, frame, width, height);
+        let direct = DirectPass::new(gpu, scene, frame, &gbuffer, &film);
+        let photon_view = match map {
+            Some(map) if settings.show_photon_map => Some(PhotonViewPass::new(gpu, scene, frame, &gbuffer, &film, map)),
+            _ => None,
+        };
+        let bundle = if settings.bundle == 0 { default_bundle(width, height) } else { settings.bundle };
+        let gather = match map {
+            Some(map) => Some(GatherPass::new(gpu, scene, frame, &gbuffer, &film, map, bundle)?),
+            None => None,
+        };
+        Ok(ImagePasses { gbuffer, direct, photon_view, gather, film })
+    }
+}
+
 pub struct Renderer {
     gpu: Gpu,
     settings: RenderSettings,
     camera: Camera,
     scene: GpuScene,
     frame: FrameBinding,
-    gbuffer: GBufferPass,
-    direct: DirectPass,
     photon_map: Option<GpuPhotonMap>,
-    photon_view: Option<PhotonViewPass>,
-    gather: Option<GatherPass>,
-    film: Film,
+    passes: ImagePasses,
     /// Restarts so far (camera moves): each draws a new rotation of the gather directions.
     restart: u32,
     rotation: Quat,
@@ -91,30 +121,17 @@ pub struct Renderer {
 impl Renderer {
     pub fn new(gpu: &Gpu, scene: &Scene, settings: RenderSettings) -> Result<Renderer> {
         scene.validate()?;
-        let (width, height) = (settings.width, settings.height);
-        gpu.check_image_size(width, height, crate::film::COMPONENTS * 16)?;
+        // Fail on an impossible image size before the BVH and the photon map are built.
+        gpu.check_image_size(settings.width, settings.height, crate::film::COMPONENTS * 16)?;
         let prepared = PreparedScene::new(scene);
-        let film = Film::new(gpu, width, height)?;
         let gpu_scene = GpuScene::new(gpu, &prepared);
         let frame = FrameBinding::new(gpu);
-        let gbuffer = GBufferPass::new(gpu, &gpu_scene, &frame, width, height);
-        let direct = DirectPass::new(gpu, &gpu_scene, &frame, &gbuffer, &film);
         let photon_settings =
             PhotonSettings { count: settings.photons, seed: settings.seed, grid_resolution: settings.grid_resolution };
         let photon_map = (settings.photons > 0)
             .then(|| GpuPhotonMap::build(gpu, &gpu_scene, &prepared, &photon_settings))
             .transpose()?;
-        let photon_view = match &photon_map {
-            Some(map) if settings.show_photon_map => {
-                Some(PhotonViewPass::new(gpu, &gpu_scene, &frame, &gbuffer, &film, map))
-            }
-            _ => None,
-        };
-        let bundle = if settings.bundle == 0 { default_bundle(width, height) } else { settings.bundle };
-        let gather = match &photon_map {
-            Some(map) => Some(GatherPass::new(gpu, &gpu_scene, &frame, &gbuffer, &film, map, bundle)?),
-            None => None,
-        };
+        let passes = ImagePasses::new(gpu, &gpu_scene, &frame, photon_map.as_ref(), &settings)?;
         let rotation = random_rotation(settings.seed, 0);
         Ok(Renderer {
             gpu: gpu.clone(),
@@ -122,15 +139,21 @@ impl Renderer {
             camera: scene.camera,
             scene: gpu_scene,
             frame,
-            gbuffer,
-            direct,
             photon_map,
-            photon_view,
-            gather,
-            film,
+            passes,
             restart: 0,
             rotation,
         })
+    }
+
+    /// Changes the image size: the passes that depend on it are rebuilt and the image
+    /// restarts; the scene, its BVH and the photon map are kept.
+    pub fn resize(&mut self, width: u32, height: u32) -> Result<()> {
+        let settings = RenderSettings { width, height, ..self.settings.clone() };
+        self.passes = ImagePasses::new(&self.gpu, &self.scene, &self.frame, self.photon_map.as_ref(), &settings)?;
+        self.settings = settings;
+        self.reset();
+        Ok(())
     }
 
     pub fn settings(&self) -> &RenderSettings {
@@ -143,7 +166,7 @@ impl Renderer {
 
     /// Iterations accumulated since the last reset.
     pub fn samples(&self) -> u32 {
-        self.film.samples
+        self.passes.film.samples
     }
 
     /// Moves the camera; the image starts converging again.
@@ -157,7 +180,7 @@ impl Renderer {
     /// Discards the accumulated iterations.
     pub fn reset(&mut self) {
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
-        self.film.clear(&mut enc);
+        self.passes.film.clear(&mut enc);
         self.gpu.queue.submit([enc.finish()]);
         self.restart += 1;
         self.rotation = random_rotation(self.settings.seed, self.restart);
@@ -187,23 +210,23 @@ impl Renderer {
     /// One iteration with some random choices fixed (see [`Overrides`]).
     pub fn iterate_with(&mut self, o: &Overrides) -> Result<()> {
         let (w, h) = (self.settings.width, self.settings.height);
-        let iteration = self.film.samples;
+        let iteration = self.passes.film.samples;
         let seed = self.settings.seed;
         let jitter = o.pixel_jitter.unwrap_or_else(|| pixel_jitter(iteration, seed));
         self.frame.write(&self.gpu, &self.frame_uniforms(iteration, jitter));
         let mut enc =
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("iteration") });
         // 1. Eye pass: the visible point of each pixel, at this iteration's jitter.
-        self.gbuffer.encode(&mut enc, &self.scene, &self.frame);
+        self.passes.gbuffer.encode(&mut enc, &self.scene, &self.frame);
         // 2. Emission + direct light with soft shadows → film (direct component).
-        self.direct.encode(&mut enc, &self.scene, &self.frame, w, h);
+        self.passes.direct.encode(&mut enc, &self.scene, &self.frame, w, h);
         // Debug view: the photon map's radiance at the visible points → film (photon view).
-        if let (Some(view), Some(map)) = (&self.photon_view, &self.photon_map) {
+        if let (Some(view), Some(map)) = (&self.passes.photon_view, &self.photon_map) {
             view.encode(&mut enc, &self.scene, &self.frame, map, w, h);
         }
         // 3. Final gather along one direction for every visible point → film (indirect).
         //    The ray view's depth complexity is counted first: that many layers are peeled.
-        if let (Some(gather), Some(map)) = (&self.gather, &self.photon_map) {
+        if let (Some(gather), Some(map)) = (&self.passes.gather, &self.photon_map) {
             let direction = o.direction.unwrap_or_else(|| gather_direction(iteration, self.rotation));
             let texel_jitter = o.texel_jitter.unwrap_or_else(|| {
                 let mut rng = Rng::new(seed ^ 0x7e1a5, iteration, self.restart);
@@ -221,7 +244,7 @@ impl Renderer {
         }
         // 4. Accumulate: every pass above added its estimate to the film's sums.
         self.gpu.queue.submit([enc.finish()]);
-        self.film.samples += 1;
+        self.passes.film.samples += 1;
         Ok(())
     }
 
@@ -235,12 +258,23 @@ impl Renderer {
         self.photon_map.as_ref()
     }
 
+    /// The film: accumulated sums and the resolved images (for drawing it in a window).
+    pub fn film(&self) -> &Film {
+        &self.passes.film
+    }
+
+    /// Encodes the resolve of `show` at `exposure` into the film's linear and display
+    /// buffers (what [`read_display`](Self::read_display) reads, without the readback).
+    pub fn encode_resolve(&self, enc: &mut wgpu::CommandEncoder, show: Show, exposure: f32) {
+        self.passes.film.encode_resolve(&self.gpu, enc, show, exposure);
+    }
+
     pub fn read_linear(&self, show: Show) -> Result<LinearImage> {
-        self.film.read_linear(&self.gpu, show)
+        self.passes.film.read_linear(&self.gpu, show)
     }
 
     pub fn read_display(&self, show: Show, exposure: f32) -> Result<DisplayImage> {
-        self.film.read_display(&self.gpu, show, exposure)
+        self.passes.film.read_display(&self.gpu, show, exposure)
     }
 
     /// Raw G-buffer texels `(triangle + 1, b1 bits, b2 bits, 0)`, row by row (for tests and tools).
@@ -254,7 +288,7 @@ impl Renderer {
         );
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
         enc.copy_texture_to_buffer(
-            self.gbuffer.texture.as_image_copy(),
+            self.passes.gbuffer.texture.as_image_copy(),
             wgpu::TexelCopyBufferInfo {
                 buffer: &buffer,
                 layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: Some(h) },

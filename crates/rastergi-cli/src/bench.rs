@@ -274,6 +274,7 @@ fn mitsuba_time_to_error(
             .args(["--spp", &spp.to_string(), "--seed", "7", "--quiet", "--chunk-spp", "100000"])
             .arg("--out")
             .arg(&out)
+            .stdout(std::process::Stdio::null())
             .status()
             .context("cannot run python3 for --mitsuba")?;
         anyhow::ensure!(status.success(), "the Mitsuba script failed (pip install mitsuba numpy?)");

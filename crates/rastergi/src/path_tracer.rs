@@ -78,6 +78,8 @@ pub struct PathTracer {
 }
 
 impl PathTracer {
+    /// Uploads `scene` and builds the pipeline. Of `settings`, the size and seed are used:
+    /// every vertex takes one light sample, and no photon map is involved.
     pub fn new(gpu: &Gpu, scene: &Scene, settings: RenderSettings) -> Result<PathTracer> {
         scene.validate()?;
         let (width, height) = (settings.width, settings.height);

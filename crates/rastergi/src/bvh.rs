@@ -16,7 +16,7 @@ const MAX_LEAF: usize = 8;
 const COST_TRAVERSAL: f32 = 1.0;
 const COST_TRIANGLE: f32 = 1.0;
 
-/// A flattened node (`BvhNode` in `scene.wgsl`). Interior nodes (`count == 0`) have their
+/// A flattened node (`BvhNode` in `gpu_scene.wgsl`). Interior nodes (`count == 0`) have their
 /// left child right after them and their right child at `offset`; leaves hold the triangles
 /// `offset .. offset + count` (in the BVH's triangle order).
 #[repr(C)]

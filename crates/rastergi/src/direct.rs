@@ -30,7 +30,7 @@ impl DirectPass {
         let module = shader::module(device, "direct", &shader::with_scene(include_str!("direct.wgsl")));
         let layout = gbuffer_film_layout(device, "direct");
         let bind_group = gbuffer_film_bind_group(device, "direct", &layout, gbuffer, film);
-        let pipeline = compute_pipeline(device, "direct", &module, &[&scene.layout, &frame.layout, &layout]);
+        let pipeline = compute_pipeline(device, "direct", &module, "main", &[&scene.layout, &frame.layout, &layout]);
         Self { pipeline, bind_group }
     }
 

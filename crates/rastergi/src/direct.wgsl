@@ -14,13 +14,13 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let pixel = gid.y * frame.resolution.x + gid.x;
     let g = textureLoad(gbuffer, gid.xy, 0);
     var radiance = vec3f(0.0);
-    if g.x != 0u && arrayLength(&lights) > 0u {
+    if g.x != 0u {
         let s = surface_at(g.x - 1u, bitcast<f32>(g.y), bitcast<f32>(g.z));
         let front = dot(s.normal, frame.eye - s.pos) > 0.0;
         if front {
             radiance = s.emission;
         }
-        if front || (s.flags & MATERIAL_TWO_SIDED) != 0u {
+        if has_lights() && (front || (s.flags & MATERIAL_TWO_SIDED) != 0u) {
             let n = select(-s.normal, s.normal, front);
             let origin = s.pos + n * frame.ray_epsilon;
             var rng = rng_new(frame.seed ^ STREAM_DIRECT, pixel, frame.iteration);

@@ -6,7 +6,7 @@ use glam::{Mat4, Vec2, Vec3};
 
 use crate::gpu::{Gpu, buffer_bind_group, uniform_entry};
 use crate::sampling::{pcg_hash, radical_inverse};
-use crate::scene::Camera;
+use crate::scene::{Aabb, Camera};
 
 /// `Frame` in `frame.wgsl`.
 #[repr(C)]
@@ -33,14 +33,22 @@ pub fn pixel_jitter(iteration: u32, seed: u32) -> Vec2 {
     (h + shift).fract() - Vec2::splat(0.5)
 }
 
+/// Distance of the near plane for a scene with these bounds: small against the scene, and
+/// harmless with reversed-Z depth.
+pub fn near_plane(bounds: &Aabb) -> f32 {
+    1e-4 * bounds.extent().length().max(1e-3)
+}
+
 /// World → clip for `camera` at `width × height`: right-handed view, reversed-Z infinite
-/// perspective (depth 1 at the near plane, 0 at infinity), shifted by `jitter` pixels.
+/// perspective (depth 1 at the near plane, 0 at infinity). With it, pixel (x, y) (row 0 at
+/// the top) samples the image plane at (x + 0.5 + jitter.x, y + 0.5 + jitter.y) pixels.
 pub fn view_projection(camera: &Camera, width: u32, height: u32, near: f32, jitter: Vec2) -> Mat4 {
     let view = Mat4::look_at_rh(camera.eye, camera.target, camera.up);
     let aspect = width as f32 / height as f32;
     let proj = Mat4::perspective_infinite_reverse_rh(camera.fov_y_deg.to_radians(), aspect, near);
-    // NDC spans 2 units per image side; +y is up in NDC and down in pixel rows.
-    let shift = Mat4::from_translation(Vec3::new(2.0 * jitter.x / width as f32, -2.0 * jitter.y / height as f32, 0.0));
+    // NDC spans 2 units per image side; +y is up in NDC and down in pixel rows. Moving the
+    // scene by −jitter puts the sample at +jitter relative to the pixel centre.
+    let shift = Mat4::from_translation(Vec3::new(-2.0 * jitter.x / width as f32, 2.0 * jitter.y / height as f32, 0.0));
     shift * proj * view
 }
 

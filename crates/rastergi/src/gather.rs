@@ -266,6 +266,7 @@ impl GatherPass {
             device,
             "gather project",
             &project_module,
+            "main",
             &[&scene.layout, &frame.layout, &project_layout, &map.layout],
         );
         Ok(GatherPass {

@@ -213,11 +213,12 @@ pub fn buffer_bind_group(
     device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout, entries: &entries })
 }
 
-/// A compute pipeline for `module`'s `main` entry point.
+/// A compute pipeline for `module`'s entry point `entry`, with bind groups `layouts`.
 pub fn compute_pipeline(
     device: &wgpu::Device,
     label: &str,
     module: &wgpu::ShaderModule,
+    entry: &str,
     layouts: &[&wgpu::BindGroupLayout],
 ) -> wgpu::ComputePipeline {
     let layouts: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().map(|&l| Some(l)).collect();
@@ -230,7 +231,7 @@ pub fn compute_pipeline(
         label: Some(label),
         layout: Some(&layout),
         module,
-        entry_point: Some("main"),
+        entry_point: Some(entry),
         compilation_options: Default::default(),
         cache: None,
     })

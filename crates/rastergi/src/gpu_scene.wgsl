@@ -66,6 +66,12 @@ fn surface_at(tri: u32, b1: f32, b2: f32) -> Surface {
     return s;
 }
 
+// Whether the scene has emitters: an empty light table is stored as one zero entry (a
+// binding cannot be empty), whose pmf is 0.
+fn has_lights() -> bool {
+    return lights[0].pmf > 0.0;
+}
+
 // The light entry whose cdf interval holds u: the first with u < cdf (LightTable::pick).
 fn light_pick(u: f32) -> u32 {
     var lo = 0u;

@@ -7,7 +7,7 @@ use glam::Vec3;
 
 use crate::scene::{Scene, triangle_area};
 
-/// One emissive triangle, as stored on the GPU (`LightEntry` in `scene.wgsl`).
+/// One emissive triangle, as stored on the GPU (`LightEntry` in `gpu_scene.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
 pub struct LightEntry {
@@ -64,7 +64,7 @@ impl LightTable {
     }
 
     /// The entry whose cdf interval holds u ∈ [0,1): the first with `u < cdf`.
-    /// Mirrors `light_pick` in `scene.wgsl`.
+    /// Mirrors `light_pick` in `gpu_scene.wgsl`.
     pub fn pick(&self, u: f32) -> &LightEntry {
         let i = self.entries.partition_point(|e| e.cdf <= u);
         &self.entries[i.min(self.entries.len() - 1)]

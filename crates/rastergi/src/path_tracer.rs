@@ -35,8 +35,8 @@ use glam::{DMat4, Mat4, Vec2};
 
 use crate::error::Result;
 use crate::film::{Film, Show};
-use crate::frame::{FrameBinding, FrameUniforms, pixel_jitter, view_projection};
-use crate::gpu::{Gpu, buffer_bind_group, groups, storage_entry, uniform_entry};
+use crate::frame::{FrameBinding, FrameUniforms, near_plane, pixel_jitter, view_projection};
+use crate::gpu::{Gpu, buffer_bind_group, compute_pipeline, groups, storage_entry, uniform_entry};
 use crate::gpu_scene::{GpuScene, PreparedScene};
 use crate::image_io::{DisplayImage, LinearImage};
 use crate::renderer::RenderSettings;
@@ -114,23 +114,9 @@ impl PathTracer {
         let bind_group =
             buffer_bind_group(device, "path tracer", &layout, &[&film.accumulation, &params, &placeholder]);
         let module = shader::module(device, "path tracer", &shader::with_scene(include_str!("path_tracer.wgsl")));
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("path tracer"),
-            bind_group_layouts: &[Some(&gpu_scene.layout), Some(&frame.layout), Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = |label: &str, entry: &str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(label),
-                layout: Some(&pipeline_layout),
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
-        let trace = pipeline("path tracer", "main");
-        let primary = pipeline("path tracer primary hits", "primary_hits");
+        let layouts = [&gpu_scene.layout, &frame.layout, &layout];
+        let trace = compute_pipeline(device, "path tracer", &module, "main", &layouts);
+        let primary = compute_pipeline(device, "path tracer primary hits", &module, "primary_hits", &layouts);
         Ok(PathTracer {
             gpu: gpu.clone(),
             settings,
@@ -179,7 +165,7 @@ impl PathTracer {
     /// (`Renderer`'s near plane, which the rays do not depend on), and its inverse.
     fn uniforms(&self, iteration: u32) -> (FrameUniforms, PathParams) {
         let (w, h) = (self.settings.width, self.settings.height);
-        let near = 1e-4 * self.scene.bounds.extent().length().max(1e-3);
+        let near = near_plane(&self.scene.bounds);
         let jitter: Vec2 = pixel_jitter(iteration, self.settings.seed);
         let view_proj: Mat4 = view_projection(&self.camera, w, h, near, jitter);
         let frame = FrameUniforms {

@@ -30,8 +30,13 @@ impl PhotonViewPass {
         let module = shader::module(device, "photon view", &source);
         let layout = gbuffer_film_layout(device, "photon view");
         let bind_group = gbuffer_film_bind_group(device, "photon view", &layout, gbuffer, film);
-        let pipeline =
-            compute_pipeline(device, "photon view", &module, &[&scene.layout, &frame.layout, &layout, &map.layout]);
+        let pipeline = compute_pipeline(
+            device,
+            "photon view",
+            &module,
+            "main",
+            &[&scene.layout, &frame.layout, &layout, &map.layout],
+        );
         Self { pipeline, bind_group }
     }
 

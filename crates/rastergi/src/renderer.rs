@@ -6,7 +6,7 @@ use glam::{Quat, Vec2, Vec3};
 use crate::direct::DirectPass;
 use crate::error::Result;
 use crate::film::{Film, Show};
-use crate::frame::{FrameBinding, FrameUniforms, pixel_jitter, view_projection};
+use crate::frame::{FrameBinding, FrameUniforms, near_plane, pixel_jitter, view_projection};
 use crate::gather::{GatherPass, gather_direction, random_rotation};
 use crate::gbuffer::GBufferPass;
 use crate::gpu::Gpu;
@@ -188,8 +188,7 @@ impl Renderer {
 
     fn frame_uniforms(&self, iteration: u32, jitter: Vec2) -> FrameUniforms {
         let (w, h) = (self.settings.width, self.settings.height);
-        let b = self.scene.bounds;
-        let near = 1e-4 * b.extent().length().max(1e-3);
+        let near = near_plane(&self.scene.bounds);
         FrameUniforms {
             view_proj: view_projection(&self.camera, w, h, near, jitter).to_cols_array_2d(),
             eye: self.camera.eye.into(),

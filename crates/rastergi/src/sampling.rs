@@ -1,4 +1,4 @@
-//! Random numbers and sampling routines, bit-for-bit twins of `shaders/sampling.wgsl`.
+//! Random numbers and sampling routines, bit-for-bit twins of `sampling.wgsl`.
 //!
 //! The generator is PCG-RXS-M-XS on 32 bits (O'Neill 2014). Streams are keyed by a hash of
 //! (seed, a, b) — e.g. (seed, pixel, iteration) or (seed, photon, batch) — so every sample

@@ -16,7 +16,7 @@ use glam::UVec3;
 
 use super::{MAX_BOUNCES, PhotonSettings};
 use crate::error::{Error, Result};
-use crate::gpu::{Gpu, storage_entry, uniform_entry};
+use crate::gpu::{Gpu, compute_pipeline, storage_entry, uniform_entry};
 use crate::gpu_scene::{GpuScene, PreparedScene};
 use crate::photon_map::{BINS, GridSpec, PhotonMap, surface_areas};
 use crate::shader;
@@ -188,23 +188,9 @@ impl GpuPhotonMap {
         });
         let source = [shader::SAMPLING, shader::SCENE, shader::BVH, include_str!("trace.wgsl")].join("\n");
         let module = shader::module(device, "photon trace", &source);
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("photon trace"),
-            bind_group_layouts: &[Some(&scene.layout), Some(&trace_layout)],
-            immediate_size: 0,
-        });
-        let pipeline = |entry: &str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: Some(&layout),
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
-        let trace_pipeline = pipeline("trace_photons");
-        let resolve_pipeline = pipeline("resolve_map");
+        let layouts = [&scene.layout, &trace_layout];
+        let trace_pipeline = compute_pipeline(device, "trace photons", &module, "trace_photons", &layouts);
+        let resolve_pipeline = compute_pipeline(device, "resolve photon map", &module, "resolve_map", &layouts);
         let params = PhotonParams {
             origin: grid.origin.into(),
             cell: grid.cell,

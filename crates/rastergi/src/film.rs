@@ -97,8 +97,14 @@ impl Film {
         });
         let bind_group = buffer_bind_group(device, "resolve", &layout, &[&uniforms, &accumulation, &linear, &display]);
         let module = shader::module(device, "resolve", include_str!("resolve.wgsl"));
-        let pipeline = compute_pipeline(device, "resolve", &module, &[&layout]);
+        let pipeline = compute_pipeline(device, "resolve", &module, "main", &[&layout]);
         Ok(Film { width, height, samples: 0, accumulation, linear, display, uniforms, pipeline, bind_group })
+    }
+
+    /// The display encoding written by [`encode_resolve`](Self::encode_resolve): one packed
+    /// RGBA8 sRGB pixel (`pack4x8unorm`) per `u32`, row-major, row 0 at the top.
+    pub fn display_buffer(&self) -> &wgpu::Buffer {
+        &self.display
     }
 
     /// Clears the sums (camera moved, scene changed).

@@ -11,9 +11,10 @@ use rastergi::film::Show;
 use rastergi::gpu_scene::{GpuScene, PreparedScene};
 use rastergi::image_io::{LinearImage, read_exr};
 use rastergi::metrics::{compare, emitter_mask};
+use rastergi::path_tracer::PathTracer;
 use rastergi::photon_map::GridSpec;
 use rastergi::photons::{PhotonSettings, cpu, gpu::GpuPhotonMap};
-use rastergi::renderer::{RenderSettings, Renderer};
+use rastergi::renderer::{RenderSettings, Renderer, default_bundle};
 
 use crate::render::{GpuArgs, gpu, load_scene};
 
@@ -23,6 +24,8 @@ pub enum BenchCommand {
     Photons(PhotonArgs),
     /// Gather directions per second, and the time to reach a target error against a reference.
     Gather(GatherArgs),
+    /// Relative RMSE against time for the photon/gather pipeline and the path tracer: CSV and plot.
+    Converge(ConvergeArgs),
 }
 
 #[derive(Args, Debug)]
@@ -80,6 +83,7 @@ pub fn run(command: &BenchCommand) -> Result<()> {
     match command {
         BenchCommand::Photons(a) => photons(a),
         BenchCommand::Gather(a) => gather(a),
+        BenchCommand::Converge(a) => converge(a),
     }
 }
 
@@ -175,57 +179,139 @@ fn gather(a: &GatherArgs) -> Result<()> {
     Ok(())
 }
 
-/// Renders at the reference's size, checking the error at growing iteration counts, and
-/// reports the render time (readbacks excluded) at which each target was first met.
+/// One point of a convergence curve: rendering time (readbacks excluded), samples per pixel
+/// so far, and relative RMSE against the reference (emitter pixels masked).
+#[derive(Clone, Copy, Debug)]
+struct Point {
+    seconds: f64,
+    samples: u32,
+    error: f64,
+}
+
+/// The renderers whose convergence is measured.
+enum Method {
+    Gather(Box<Renderer>),
+    Path(Box<PathTracer>),
+}
+
+impl Method {
+    fn name(&self) -> &'static str {
+        match self {
+            Method::Gather(_) => "rastergi photon map + final gather",
+            Method::Path(_) => "rastergi path tracer",
+        }
+    }
+    fn iterate(&mut self) -> Result<()> {
+        match self {
+            Method::Gather(r) => r.iterate()?,
+            Method::Path(p) => p.iterate(),
+        }
+        Ok(())
+    }
+    fn wait(&self) -> Result<()> {
+        Ok(match self {
+            Method::Gather(r) => r.wait()?,
+            Method::Path(p) => p.wait()?,
+        })
+    }
+    fn samples(&self) -> u32 {
+        match self {
+            Method::Gather(r) => r.samples(),
+            Method::Path(p) => p.samples(),
+        }
+    }
+    fn image(&self) -> Result<LinearImage> {
+        Ok(match self {
+            Method::Gather(r) => r.read_linear(Show::Full)?,
+            Method::Path(p) => p.read_linear()?,
+        })
+    }
+}
+
+/// Renders, measuring the error at iteration counts growing by 25 %, until `max_seconds` of
+/// rendering or an error at or under `stop_at`.
+fn curve(m: &mut Method, reference: &LinearImage, mask: &[bool], max_seconds: f64, stop_at: f64) -> Result<Vec<Point>> {
+    let mut points = Vec::new();
+    let mut rendering = Duration::ZERO;
+    let mut next = 4u32;
+    m.wait()?;
+    while rendering.as_secs_f64() < max_seconds {
+        let t = Instant::now();
+        while m.samples() < next {
+            m.iterate()?;
+        }
+        m.wait()?;
+        rendering += t.elapsed();
+        let error = compare(&m.image()?, reference, Some(mask)).relative_rmse;
+        points.push(Point { seconds: rendering.as_secs_f64(), samples: m.samples(), error });
+        if error <= stop_at {
+            break;
+        }
+        next = (next as f64 * 1.25).ceil() as u32;
+    }
+    Ok(points)
+}
+
+fn first_below(points: &[Point], target: f64) -> Option<Point> {
+    points.iter().copied().find(|p| p.error <= target)
+}
+
+fn print_targets(name: &str, points: &[Point], targets: &[f64], setup: f64, unit: &str) {
+    for &target in targets {
+        match first_below(points, target) {
+            Some(p) => println!(
+                "  {name:<36} {:>4.1} %: {:>8.2} s ({} {unit}, error {:.2} %; set-up {setup:.2} s)",
+                100.0 * target,
+                p.seconds,
+                p.samples,
+                100.0 * p.error
+            ),
+            None => println!(
+                "  {name:<36} {:>4.1} %: not reached in {:.1} s",
+                100.0 * target,
+                points.last().map_or(0.0, |p| p.seconds)
+            ),
+        }
+    }
+}
+
+/// The reference (mean of `paths`) and its emitter mask.
+fn load_reference(paths: &[PathBuf]) -> Result<(LinearImage, Vec<bool>)> {
+    let reference = average_references(paths)?;
+    let mask = emitter_mask(&reference, 3.0);
+    Ok((reference, mask))
+}
+
+/// Renders at the reference's size and reports the rendering time at which each target was
+/// first met (the photon map and set-up are reported separately).
 fn time_to_error(
     a: &GatherArgs,
     gpu: &rastergi::gpu::Gpu,
     scene: &rastergi::scene::Scene,
     paths: &[PathBuf],
 ) -> Result<()> {
-    let reference = average_references(paths)?;
-    let mask = emitter_mask(&reference, 3.0);
+    let (reference, mask) = load_reference(paths)?;
     let (w, h) = (reference.width, reference.height);
-    let mut targets: Vec<f64> = a.targets.iter().map(|t| t / 100.0).collect();
-    targets.sort_by(|x, y| y.total_cmp(x));
+    let targets = sorted_targets(&a.targets);
     let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
     println!("time to error against the mean of {} ({w}x{h}, emitter pixels masked):", names.join(", "));
-    let t_setup = Instant::now();
-    let mut r = Renderer::new(gpu, scene, settings(a, w, h, rastergi::renderer::default_bundle(w, h)))?;
-    gpu.wait()?;
-    let setup = t_setup.elapsed().as_secs_f64();
-    let mut rendering = Duration::ZERO;
-    let mut next = 8u32;
-    let mut reached = vec![None; targets.len()];
-    while reached.iter().any(Option::is_none) && rendering.as_secs_f64() < a.max_seconds {
-        let t = Instant::now();
-        while r.samples() < next {
-            r.iterate()?;
-        }
-        r.wait()?;
-        rendering += t.elapsed();
-        let err = compare(&r.read_linear(Show::Full)?, &reference, Some(&mask)).relative_rmse;
-        for (i, &target) in targets.iter().enumerate() {
-            if reached[i].is_none() && err <= target {
-                reached[i] = Some((rendering.as_secs_f64(), r.samples(), err));
-            }
-        }
-        next = (next as f64 * 1.25).ceil() as u32;
-    }
-    for (target, result) in targets.iter().zip(&reached) {
-        match result {
-            Some((s, n, e)) => println!(
-                "  rastergi {:>4.1} %: {s:>8.2} s ({n} iterations, error {:.2} %; plus {setup:.2} s photon map + setup)",
-                100.0 * target,
-                100.0 * e
-            ),
-            None => println!("  rastergi {:>4.1} %: not reached in {:.0} s", 100.0 * target, a.max_seconds),
-        }
-    }
+    let t = Instant::now();
+    let mut m = Method::Gather(Box::new(Renderer::new(gpu, scene, settings(a, w, h, default_bundle(w, h)))?));
+    m.wait()?;
+    let setup = t.elapsed().as_secs_f64();
+    let points = curve(&mut m, &reference, &mask, a.max_seconds, *targets.last().unwrap_or(&0.0))?;
+    print_targets(m.name(), &points, &targets, setup, "iterations");
     if a.mitsuba {
-        mitsuba_time_to_error(a, &reference, &mask, &targets)?;
+        let points = mitsuba_curve(&a.scene, &reference, &mask, a.max_seconds, *targets.last().unwrap_or(&0.0))?;
+        print_targets("Mitsuba 3 path (llvm_ad_rgb)", &points, &targets, 0.0, "spp");
     }
     Ok(())
+}
+
+fn sorted_targets(percent: &[f64]) -> Vec<f64> {
+    let mut t: Vec<f64> = percent.iter().map(|t| t / 100.0).collect();
+    t.sort_by(|x, y| y.total_cmp(x));
+    t
 }
 
 /// The mean of equally sized reference renders.
@@ -255,13 +341,14 @@ fn average_references(paths: &[PathBuf]) -> Result<LinearImage> {
 
 /// Mitsuba 3's `path` integrator through scripts/mitsuba_reference.py at doubling sample
 /// counts; process start-up (measured with 1 spp) is subtracted.
-fn mitsuba_time_to_error(
-    a: &GatherArgs,
-    reference: &rastergi::image_io::LinearImage,
+fn mitsuba_curve(
+    scene: &str,
+    reference: &LinearImage,
     mask: &[bool],
-    targets: &[f64],
-) -> Result<()> {
-    anyhow::ensure!(a.scene == "cornell", "--mitsuba supports the built-in cornell scene only");
+    max_seconds: f64,
+    stop_at: f64,
+) -> Result<Vec<Point>> {
+    anyhow::ensure!(scene == "cornell", "--mitsuba supports the built-in cornell scene only");
     let script = Path::new("scripts/mitsuba_reference.py");
     anyhow::ensure!(script.is_file(), "--mitsuba needs scripts/mitsuba_reference.py: run from the repository root");
     let dir = tempfile::tempdir()?;
@@ -281,28 +368,166 @@ fn mitsuba_time_to_error(
         Ok(t.elapsed().as_secs_f64())
     };
     let startup = run(1)?;
-    let mut reached = vec![None; targets.len()];
-    let mut spp = 16u32;
+    let mut points = Vec::new();
+    let mut spp = 4u32;
     loop {
-        let t = run(spp)? - startup;
-        let err = compare(&read_exr(&out)?, reference, Some(mask)).relative_rmse;
-        for (i, &target) in targets.iter().enumerate() {
-            if reached[i].is_none() && err <= target {
-                reached[i] = Some((t, spp, err));
-            }
-        }
-        if reached.iter().all(Option::is_some) || t > a.max_seconds {
+        let seconds = (run(spp)? - startup).max(0.0);
+        let error = compare(&read_exr(&out)?, reference, Some(mask)).relative_rmse;
+        points.push(Point { seconds, samples: spp, error });
+        if error <= stop_at || seconds > max_seconds {
             break;
         }
         spp *= 2;
     }
-    for (target, result) in targets.iter().zip(&reached) {
-        match result {
-            Some((s, n, e)) => {
-                println!("  Mitsuba  {:>4.1} %: {s:>8.2} s ({n} spp, error {:.2} %)", 100.0 * target, 100.0 * e)
-            }
-            None => println!("  Mitsuba  {:>4.1} %: not reached in {:.0} s", 100.0 * target, a.max_seconds),
+    Ok(points)
+}
+
+#[derive(Args, Debug)]
+pub struct ConvergeArgs {
+    #[arg(default_value = "cornell")]
+    scene: String,
+    /// Converged reference render(s) of the scene's camera view (linear EXR); several
+    /// comma-separated independent renders are averaged.
+    #[arg(long, value_delimiter = ',', required = true)]
+    reference: Vec<PathBuf>,
+    /// Rendering time per method.
+    #[arg(long, default_value_t = 60.0)]
+    seconds: f64,
+    #[arg(long, default_value_t = 1 << 20)]
+    photons: u32,
+    #[arg(long, default_value_t = 64)]
+    grid: u32,
+    /// Also measure Mitsuba 3 (built-in cornell only; needs python3 with mitsuba).
+    #[arg(long)]
+    mitsuba: bool,
+    /// CSV output: method, seconds, samples, relative RMSE.
+    #[arg(long, default_value = "converge.csv")]
+    csv: PathBuf,
+    /// Plot of relative RMSE against time (log-log), PNG.
+    #[arg(long, default_value = "converge.png")]
+    plot: PathBuf,
+    #[command(flatten)]
+    gpu: GpuArgs,
+}
+
+fn converge(a: &ConvergeArgs) -> Result<()> {
+    anyhow::ensure!(
+        a.plot.extension().is_some_and(|e| e.eq_ignore_ascii_case("png")),
+        "{}: the plot is written as PNG; give a .png file name",
+        a.plot.display()
+    );
+    let scene = load_scene(&a.scene)?;
+    scene.validate()?;
+    let gpu = gpu(&a.gpu)?;
+    let (reference, mask) = load_reference(&a.reference)?;
+    let (w, h) = (reference.width, reference.height);
+    println!(
+        "convergence: {} at {w}x{h} on {} ({:?}), {:.0} s per method",
+        a.scene, gpu.info.name, gpu.info.backend, a.seconds
+    );
+    let base = RenderSettings {
+        width: w,
+        height: h,
+        photons: a.photons,
+        grid_resolution: a.grid,
+        seed: 1,
+        ..Default::default()
+    };
+    let mut curves: Vec<(String, Vec<Point>)> = Vec::new();
+    let t = Instant::now();
+    let mut gather = Method::Gather(Box::new(Renderer::new(&gpu, &scene, base.clone())?));
+    gather.wait()?;
+    let setup = t.elapsed().as_secs_f64();
+    let points = curve(&mut gather, &reference, &mask, a.seconds, 0.0)?;
+    print_targets(gather.name(), &points, &[0.05, 0.02], setup, "iterations");
+    curves.push((gather.name().to_string(), points));
+    let t = Instant::now();
+    let mut path = Method::Path(Box::new(PathTracer::new(&gpu, &scene, base)?));
+    path.wait()?;
+    let setup = t.elapsed().as_secs_f64();
+    let points = curve(&mut path, &reference, &mask, a.seconds, 0.0)?;
+    print_targets(path.name(), &points, &[0.05, 0.02], setup, "spp");
+    curves.push((path.name().to_string(), points));
+    if a.mitsuba {
+        let points = mitsuba_curve(&a.scene, &reference, &mask, a.seconds, 0.0)?;
+        print_targets("Mitsuba 3 path (llvm_ad_rgb)", &points, &[0.05, 0.02], 0.0, "spp");
+        curves.push(("Mitsuba 3 path (llvm_ad_rgb)".to_string(), points));
+    }
+    let mut csv = String::from("method,seconds,samples,relative_rmse\n");
+    for (name, points) in &curves {
+        for p in points {
+            csv += &format!("{name},{:.4},{},{:.6}\n", p.seconds, p.samples, p.error);
         }
     }
+    write_file(&a.csv, csv.as_bytes())?;
+    plot(&a.plot, &curves, &format!("{} {w}x{h}, {}", a.scene, gpu.info.name))?;
+    println!("wrote {} and {}", a.csv.display(), a.plot.display());
+    Ok(())
+}
+
+/// Writes `bytes` via a temporary file renamed into place.
+fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let mut tmp =
+        tempfile::NamedTempFile::new_in(dir).with_context(|| format!("{}: cannot write here", path.display()))?;
+    std::io::Write::write_all(&mut tmp, bytes)?;
+    tmp.persist(path).with_context(|| format!("{}: cannot write", path.display()))?;
+    Ok(())
+}
+
+/// Relative RMSE against time, log-log, one line per method.
+fn plot(path: &Path, curves: &[(String, Vec<Point>)], title: &str) -> Result<()> {
+    use plotters::prelude::*;
+    static FONT: std::sync::Once = std::sync::Once::new();
+    FONT.call_once(|| {
+        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular());
+    });
+    let all: Vec<&Point> = curves.iter().flat_map(|(_, p)| p).filter(|p| p.seconds > 0.0).collect();
+    anyhow::ensure!(!all.is_empty(), "no measurement to plot");
+    let (t0, t1) = all.iter().fold((f64::MAX, 0.0f64), |(a, b), p| (a.min(p.seconds), b.max(p.seconds)));
+    let (e0, e1) = all.iter().fold((f64::MAX, 0.0f64), |(a, b), p| (a.min(p.error), b.max(p.error)));
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let tmp = tempfile::Builder::new().suffix(".png").tempfile_in(dir)?;
+    {
+        let root = BitMapBackend::new(tmp.path(), (800, 560)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 20))
+            .margin(16)
+            .x_label_area_size(44)
+            .y_label_area_size(64)
+            .build_cartesian_2d((t0 * 0.8..t1 * 1.25).log_scale(), (e0 * 0.8..e1 * 1.25).log_scale())
+            .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+        chart
+            .configure_mesh()
+            .x_desc("rendering time (s)")
+            .y_desc("relative RMSE")
+            .y_label_formatter(&|v| format!("{:.1} %", 100.0 * v))
+            .draw()
+            .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+        let colours = [RGBColor(200, 60, 40), RGBColor(40, 90, 200), RGBColor(40, 150, 70)];
+        for (i, (name, points)) in curves.iter().enumerate() {
+            let c = colours[i % colours.len()];
+            let series: Vec<(f64, f64)> =
+                points.iter().filter(|p| p.seconds > 0.0).map(|p| (p.seconds, p.error)).collect();
+            chart
+                .draw_series(LineSeries::new(series.clone(), c.stroke_width(2)))
+                .map_err(|e| anyhow::anyhow!("plot: {e}"))?
+                .label(name.as_str())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
+            chart
+                .draw_series(series.iter().map(|&p| Circle::new(p, 3, c.filled())))
+                .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+        root.present().map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+    }
+    tmp.persist(path).with_context(|| format!("{}: cannot write", path.display()))?;
     Ok(())
 }

@@ -1,11 +1,47 @@
 #!/usr/bin/env python3
-"""Render Mitsuba 3 reference images of rastergi's built-in Cornell box.
+"""Render Mitsuba 3 reference images of rastergi scenes.
+
+Any scene rastergi renders: the built-in Cornell box (`--scene cornell`, the
+default) or a Wavefront OBJ + MTL file (`--scene PATH.obj`), seen by rastergi's
+camera (or the one given by --eye/--target/--up/--fov), rendered with
+Mitsuba's `path` integrator and a box pixel filter, and written as a linear
+float32 RGB OpenEXR (3 channels R, G, B, no alpha; row 0 of the image is the
+top; PIZ lossless compression) that `rastergi compare` reads.
 
 The scene `cornell` is built here explicitly from the numbers in
 cornell-box.md (it is Mitsuba's `mi.cornell_box()` geometry and materials, but
-with a box pixel filter and a vertical field of view), rendered with Mitsuba's
-`path` integrator and written as a linear float32 RGB OpenEXR (3 channels R, G,
-B, no alpha; row 0 of the image is the top; PIZ lossless compression).
+with a box pixel filter and a vertical field of view).
+
+OBJ scenes are read here, not by Mitsuba (whose `obj` loader ignores MTL), the
+way rastergi reads them (crates/rastergi/src/scene/obj.rs, through tobj):
+`v` and `f` lines (`l` lines of three or more vertices count as faces, as in
+tobj), relative (negative) indices, polygons triangulated as fans (v0, vi,
+vi+1), `mtllib` and `usemtl`; `vt`, `vn`, `o`, `g`, `s` and the rest are
+ignored. From the MTL, `Kd` is the diffuse reflectance (default 0.5, as for
+faces without a material) and `Ke` the emitted radiance (a single number means
+grey); albedo textures (`map_Kd`) are not reproduced (a warning says so). The triangles of each material are written to a binary PLY file in a
+temporary directory and loaded as one `ply` shape with face normals (no
+smoothing), its BSDF `twosided(diffuse(Kd))` (OBJ surfaces reflect on both
+sides in rastergi) and, where Ke > 0, an `area` emitter, which Mitsuba makes
+one-sided: it emits from the front face, the side the counter-clockwise
+winding faces (normal (v1-v0) x (v2-v0)), as rastergi does. The conventions
+were checked with crates/rastergi/tests/data/obj/emitter_sides.obj: a CCW
+quad facing the camera shows its Ke in both renderers, a CW one is black.
+
+Camera: as in rastergi, the built-in Cornell box has its own camera and an
+OBJ file is framed by rastergi's default camera (Scene::framing_camera): it
+looks at the centre of the triangles' bounds from +z, at a distance
+radius / sin(fov/2) with radius half the bounds' diagonal, up +y, vertical
+fov 45 degrees. --eye, --target, --up and --fov (vertical, degrees) replace
+the corresponding parts, exactly as `rastergi render` does; give the same
+values to both. The near clip is 1e-4 of the bounds' diagonal (rastergi's;
+0.001 for the Cornell box, as the committed references were made).
+
+Make a reference for an OBJ scene and compare a rastergi render with it:
+
+    python3 scripts/mitsuba_reference.py --scene room.obj --width 128 --height 128 --spp 4096 --out room_ref.exr
+    rastergi render room.obj --width 128 --height 128 --iterations 1024 --out room.exr
+    rastergi compare room.exr room_ref.exr --mask-emitters --diff room_diff.png
 
 Setup (Debian 12, Python 3):
 
@@ -34,7 +70,7 @@ estimates; RMSE(a, b) / 2 is the noise of their mean.
 
 Other commands:
 
-    python3 scripts/mitsuba_reference.py --check-scene    # compare with mi.cornell_box()
+    python3 scripts/mitsuba_reference.py --check-scene    # compare cornell with mi.cornell_box()
     python3 scripts/mitsuba_reference.py --stats A.exr [B.exr]   # mean RGB, rel. RMSE
 
 Depth convention (Mitsuba's): max_depth 1 = only directly visible emitters,
@@ -51,7 +87,9 @@ the plain per-pixel mean of the samples.
 
 import argparse
 import math
+import os
 import sys
+import tempfile
 import time
 
 import numpy as np
@@ -108,12 +146,47 @@ def _transform(mi, m34):
     return mi.ScalarTransform4f(rows)
 
 
-def cornell_scene_dict(mi, width, height, max_depth, spp=1):
-    """The built-in `cornell` scene as a Mitsuba scene dict."""
-    T = mi.ScalarTransform4f
+CORNELL_CAMERA = {"eye": CAMERA_EYE, "target": CAMERA_TARGET, "up": CAMERA_UP,
+                  "fov": CAMERA_VFOV_DEG}
 
-    def rgb(v):
-        return {"type": "rgb", "value": list(v)}
+
+def rgb(v):
+    return {"type": "rgb", "value": [float(x) for x in v]}
+
+
+def sensor_dict(mi, camera, width, height, spp, near_clip, far_clip):
+    """rastergi's pinhole camera: vertical fov, box filter, linear RGB film."""
+    return {
+        "type": "perspective",
+        "fov_axis": "y",  # vertical field of view, as rastergi
+        "fov": camera["fov"],
+        "near_clip": near_clip,
+        "far_clip": far_clip,
+        "to_world": mi.ScalarTransform4f().look_at(
+            origin=camera["eye"], target=camera["target"], up=camera["up"]),
+        "sampler": {"type": "independent", "sample_count": int(spp)},
+        "film": {
+            "type": "hdrfilm",
+            "width": int(width),
+            "height": int(height),
+            "rfilter": {"type": "box"},
+            "pixel_format": "rgb",
+            "component_format": "float32",
+        },
+    }
+
+
+def far_clip_for(camera, lo, hi):
+    """A far clip beyond every point of the bounds [lo, hi] (at least 100)."""
+    eye = np.asarray(camera["eye"], dtype=np.float64)
+    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1])
+                        for z in (lo[2], hi[2])], dtype=np.float64)
+    return float(max(100.0, 2.0 * np.linalg.norm(corners - eye, axis=1).max()))
+
+
+def cornell_scene_dict(mi, width, height, max_depth, spp=1, camera=None):
+    """The built-in `cornell` scene as a Mitsuba scene dict."""
+    camera = camera or CORNELL_CAMERA
 
     def ref(name):
         return {"type": "ref", "id": name}
@@ -121,24 +194,8 @@ def cornell_scene_dict(mi, width, height, max_depth, spp=1):
     scene = {
         "type": "scene",
         "integrator": {"type": "path", "max_depth": int(max_depth)},
-        "sensor": {
-            "type": "perspective",
-            "fov_axis": "y",  # vertical field of view, as rastergi
-            "fov": CAMERA_VFOV_DEG,
-            "near_clip": 0.001,
-            "far_clip": 100.0,
-            "to_world": T().look_at(origin=CAMERA_EYE, target=CAMERA_TARGET,
-                                    up=CAMERA_UP),
-            "sampler": {"type": "independent", "sample_count": int(spp)},
-            "film": {
-                "type": "hdrfilm",
-                "width": int(width),
-                "height": int(height),
-                "rfilter": {"type": "box"},
-                "pixel_format": "rgb",
-                "component_format": "float32",
-            },
-        },
+        "sensor": sensor_dict(mi, camera, width, height, spp, 0.001,
+                              far_clip_for(camera, [-1, -1, -1], [1, 1, 1])),
         "white": {"type": "diffuse", "reflectance": rgb(WHITE)},
         "red": {"type": "diffuse", "reflectance": rgb(RED)},
         "green": {"type": "diffuse", "reflectance": rgb(GREEN)},
@@ -159,6 +216,237 @@ def cornell_scene_dict(mi, width, height, max_depth, spp=1):
                           "to_world": _transform(mi, LARGE_BOX_MATRIX),
                           "bsdf": ref("white")}
     return scene
+
+
+# OBJ + MTL scenes, read as rastergi reads them ------------------------------
+
+OBJ_DEFAULT_ALBEDO = 0.5  # faces without a material, materials without Kd
+
+
+class SceneError(Exception):
+    pass
+
+
+def _rest_of_line(line, keyword_len):
+    return line[keyword_len:].strip()
+
+
+def _colour(words, path, n):
+    """`Kd r g b` or `Kd v` (grey), as rastergi completes it for tobj."""
+    vals = words[1:]
+    if len(vals) == 1:
+        vals = vals * 3
+    if len(vals) < 3:
+        raise SceneError(f"{path}: line {n}: '{words[0]}' needs three numbers (r g b) or one")
+    try:
+        return [float(np.float32(v)) for v in vals[:3]]
+    except ValueError:
+        raise SceneError(f"{path}: line {n}: '{words[0]}' holds something other than numbers")
+
+
+def load_mtl(path):
+    """Materials of an MTL file: name -> {"kd": [r,g,b] or None, "ke": [r,g,b] or None}."""
+    try:
+        text = open(path, encoding="utf-8").read()
+    except (OSError, UnicodeDecodeError) as e:
+        raise SceneError(f"{path}: the material library (mtllib) cannot be read: "
+                         f"{getattr(e, 'strerror', None) or e}")
+    materials, current = {}, None
+    for n, raw in enumerate(text.splitlines(), 1):
+        line = raw.strip()
+        words = line.split()
+        if not words:
+            continue
+        if words[0] == "newmtl":
+            name = _rest_of_line(line, 6)
+            if not name:
+                raise SceneError(f"{path}: line {n}: 'newmtl' names no material")
+            current = materials[name] = {"kd": None, "ke": None}
+        elif words[0] in ("Kd", "Ke") and current is not None:
+            current[words[0].lower()] = _colour(words, path, n)
+        elif words[0] == "map_Kd" and current is not None:
+            # Albedo textures are not reproduced here (see the module docstring).
+            print(f"warning: {path}: line {n}: map_Kd is ignored; the reference uses Kd "
+                  "alone and differs from rastergi where the texture shows", file=sys.stderr)
+    return materials
+
+
+def load_obj(path):
+    """The triangles of an OBJ file grouped by material, as rastergi loads them.
+
+    Returns a list of (material, triangles): material is {"name", "kd", "ke"},
+    triangles a float32 array (n, 3, 3) of counter-clockwise corners.
+    """
+    try:
+        text = open(path, encoding="utf-8").read()
+    except (OSError, UnicodeDecodeError) as e:
+        raise SceneError(f"{path}: cannot be read: {e}")
+    directory = os.path.dirname(path)
+    positions = []
+    library = {}  # material name -> material, from the mtllib lines so far
+    groups = {}  # material name (None: no material) -> list of index triples
+    current = None
+    for n, raw in enumerate(text.splitlines(), 1):
+        line = raw.strip()
+        words = line.split()
+        if not words:
+            continue
+        key = words[0]
+        if key == "v":
+            try:
+                vals = [np.float32(w) for w in words[1:]]
+            except ValueError:
+                raise SceneError(f"{path}: line {n}: a 'v' line does not hold numbers")
+            if len(vals) < 3 or len(vals) == 5 or len(vals) > 6:
+                raise SceneError(f"{path}: line {n}: a 'v' line needs x y z [w] or x y z r g b")
+            p = np.array(vals[:3], dtype=np.float32)
+            if len(vals) == 4:  # homogeneous weight, as tobj
+                if vals[3] == 0:
+                    raise SceneError(f"{path}: line {n}: a 'v' line has a weight w of 0")
+                p = p / vals[3]
+            positions.append(p)
+        elif key in ("f", "l"):
+            # tobj reads `l` lines as faces too; fewer than three vertices are
+            # points and lines, which rastergi ignores.
+            if len(words) < 4:
+                continue
+            idx = []
+            for w in words[1:]:
+                try:
+                    i = int(w.split("/")[0])
+                except ValueError:
+                    raise SceneError(f"{path}: line {n}: an '{key}' line holds something "
+                                     "other than vertex indices")
+                i = i - 1 if i > 0 else len(positions) + i
+                if not 0 <= i < len(positions):
+                    raise SceneError(f"{path}: line {n}: a face refers to a vertex that "
+                                     "does not exist")
+                idx.append(i)
+            tris = groups.setdefault(current, [])
+            for k in range(1, len(idx) - 1):  # fan, as tobj
+                tris.append((idx[0], idx[k], idx[k + 1]))
+        elif key == "usemtl":
+            name = _rest_of_line(line, 6)
+            if not name:
+                raise SceneError(f"{path}: line {n}: a 'usemtl' line names no material")
+            current = name if name in library else None
+        elif key == "mtllib":
+            name = _rest_of_line(line, 6)
+            if not name:
+                raise SceneError(f"{path}: line {n}: an mtllib line names no file")
+            library.update(load_mtl(os.path.join(directory, name)))
+    pos = np.array(positions, dtype=np.float32).reshape(-1, 3)
+    # Every material of the libraries, used or not, is checked, as rastergi does.
+    for name, m in library.items():
+        kd = m["kd"] or [OBJ_DEFAULT_ALBEDO] * 3
+        ke = m["ke"] or [0.0] * 3
+        if not all(math.isfinite(v) and v >= 0 for v in kd + ke):
+            raise SceneError(f"{path}: material '{name}' has a negative or non-finite "
+                             "albedo or emission")
+        if max(kd) > 1:
+            raise SceneError(f"{path}: material '{name}' has an albedo above 1 ({kd}), "
+                             "which would create energy")
+    result = []
+    for name, tris in groups.items():
+        if not tris:
+            continue
+        m = library.get(name) if name is not None else None
+        kd = (m or {}).get("kd") or [OBJ_DEFAULT_ALBEDO] * 3
+        ke = (m or {}).get("ke") or [0.0] * 3
+        label = name if m is not None else "default"
+        triangles = pos[np.array(tris, dtype=np.int64)]
+        if not np.isfinite(triangles).all():
+            raise SceneError(f"{path}: a triangle has a non-finite coordinate")
+        result.append(({"name": label, "kd": kd, "ke": ke}, triangles))
+    if not result:
+        raise SceneError(f"{path}: contains no faces; an OBJ scene needs at least one "
+                         "triangle ('f' lines)")
+    return result
+
+
+def bounds(groups):
+    pts = np.concatenate([t.reshape(-1, 3) for _, t in groups]).astype(np.float32)
+    return pts.min(0), pts.max(0)
+
+
+def framing_camera(lo, hi):
+    """rastergi's Scene::framing_camera: the bounds' centre from +z, 45 degrees."""
+    fov = 45.0
+    extent = np.maximum(hi.astype(np.float64) - lo, 0.0)
+    radius = 0.5 * max(float(np.linalg.norm(extent)), 1e-6)
+    distance = radius / math.sin(0.5 * math.radians(fov))
+    centre = 0.5 * (lo.astype(np.float64) + hi)
+    return {"eye": [float(centre[0]), float(centre[1]), float(centre[2] + distance)],
+            "target": [float(c) for c in centre], "up": [0.0, 1.0, 0.0], "fov": fov}
+
+
+def check_camera(camera):
+    """rastergi's Camera::validate."""
+    eye, target, up = (np.asarray(camera[k], dtype=np.float64)
+                       for k in ("eye", "target", "up"))
+    forward = target - eye
+    if not (np.isfinite(eye).all() and np.isfinite(target).all()
+            and np.isfinite(up).all()) or forward @ forward <= 0:
+        raise SceneError("invalid camera: eye and target must be distinct finite points")
+    c = np.cross(forward / np.linalg.norm(forward), up)
+    if c @ c < 1e-12:
+        raise SceneError("invalid camera: the up vector must not be parallel to the "
+                         "view direction")
+    if not 0 < camera["fov"] < 180:
+        raise SceneError("invalid camera: the field of view must lie strictly between 0 "
+                         f"and 180 degrees, got {camera['fov']}")
+
+
+def write_ply(path, triangles):
+    """Triangles (n, 3, 3) as a binary PLY mesh, three vertices per triangle."""
+    n = len(triangles)
+    header = ("ply\nformat binary_little_endian 1.0\n"
+              f"element vertex {3 * n}\nproperty float x\nproperty float y\nproperty float z\n"
+              f"element face {n}\nproperty list uchar int vertex_indices\nend_header\n")
+    faces = np.zeros(n, dtype=[("count", "u1"), ("idx", "<i4", 3)])
+    faces["count"] = 3
+    faces["idx"] = np.arange(3 * n, dtype=np.int32).reshape(n, 3)
+    with open(path, "wb") as f:
+        f.write(header.encode("ascii"))
+        f.write(np.ascontiguousarray(triangles, dtype="<f4").tobytes())
+        f.write(faces.tobytes())
+
+
+def obj_scene_dict(mi, groups, camera, width, height, max_depth, spp, mesh_dir):
+    """An OBJ scene (from load_obj) as a Mitsuba scene dict; meshes go to mesh_dir."""
+    lo, hi = bounds(groups)
+    diagonal = float(np.linalg.norm(np.maximum(hi.astype(np.float64) - lo, 0.0)))
+    scene = {
+        "type": "scene",
+        "integrator": {"type": "path", "max_depth": int(max_depth)},
+        "sensor": sensor_dict(mi, camera, width, height, spp,
+                              1e-4 * max(diagonal, 1e-3), far_clip_for(camera, lo, hi)),
+    }
+    for i, (material, triangles) in enumerate(groups):
+        filename = os.path.join(mesh_dir, f"material_{i}.ply")
+        write_ply(filename, triangles)
+        shape = {
+            "type": "ply",
+            "filename": filename,
+            "face_normals": True,
+            "bsdf": {"type": "twosided",
+                     "bsdf": {"type": "diffuse", "reflectance": rgb(material["kd"])}},
+        }
+        if max(material["ke"]) > 0:
+            # One-sided: emits from the front (counter-clockwise) face only.
+            shape["emitter"] = {"type": "area", "radiance": rgb(material["ke"])}
+        scene[f"material-{i}"] = shape
+    return scene
+
+
+def scene_camera(args, default):
+    """The default camera with the command line's --eye/--target/--up/--fov in place."""
+    camera = dict(default)
+    for key in ("eye", "target", "up", "fov"):
+        if getattr(args, key) is not None:
+            camera[key] = getattr(args, key)
+    check_camera(camera)
+    return camera
 
 
 def check_scene(mi):
@@ -211,11 +499,36 @@ def check_scene(mi):
     return ok and worst < 1e-6
 
 
+def load_scene(mi, args, spp):
+    """The Mitsuba scene of --scene with the camera options applied."""
+    if args.scene == "cornell":
+        camera = scene_camera(args, CORNELL_CAMERA)
+        return mi.load_dict(cornell_scene_dict(mi, args.width, args.height,
+                                               args.max_depth, spp, camera))
+    if not args.scene.lower().endswith(".obj"):
+        raise SceneError(f"unknown scene '{args.scene}': use the built-in 'cornell' "
+                         "or a path to a .obj file")
+    if not os.path.isfile(args.scene):
+        raise SceneError(f"{args.scene}: no such file")
+    groups = load_obj(args.scene)
+    camera = scene_camera(args, framing_camera(*bounds(groups)))
+    if not args.quiet:
+        for material, triangles in groups:
+            kd, ke = (", ".join(f"{v:.7g}" for v in material[k]) for k in ("kd", "ke"))
+            print(f"  {material['name']}: {len(triangles)} triangles, Kd ({kd}), Ke ({ke})",
+                  file=sys.stderr)
+        print(f"  camera: eye {camera['eye']}, target {camera['target']}, up "
+              f"{camera['up']}, fov {camera['fov']}", file=sys.stderr)
+    with tempfile.TemporaryDirectory(prefix="rastergi-mitsuba-") as mesh_dir:
+        # Mitsuba reads the meshes while loading; the files can go afterwards.
+        return mi.load_dict(obj_scene_dict(mi, groups, camera, args.width, args.height,
+                                           args.max_depth, spp, mesh_dir))
+
+
 def render(mi, args):
     spp_total = int(args.spp)
     chunk = max(1, min(int(args.chunk_spp), spp_total))
-    scene = mi.load_dict(cornell_scene_dict(mi, args.width, args.height,
-                                            args.max_depth, chunk))
+    scene = load_scene(mi, args, chunk)
     acc = np.zeros((args.height, args.width, 3), dtype=np.float64)
     done = 0
     i = 0
@@ -283,9 +596,42 @@ def stats(a, b=None):
     return out
 
 
+def parse_vec3(s):
+    """`x,y,z` as three finite floats (the format of rastergi's camera options)."""
+    parts = s.split(",")
+    try:
+        v = [float(x) for x in parts]
+    except ValueError:
+        v = []
+    if len(v) != 3 or not all(math.isfinite(x) for x in v):
+        raise argparse.ArgumentTypeError(
+            f"expected three comma-separated finite numbers like 0,1,3.5, got '{s}'")
+    return v
+
+
+def _join_camera_values(argv):
+    """`--target -1,0,2` as `--target=-1,0,2`: argparse takes a value starting with
+    '-' for an option, rastergi's command line does not; the same options work in both."""
+    out, i = [], 0
+    while i < len(argv):
+        if argv[i] in ("--eye", "--target", "--up", "--fov") and i + 1 < len(argv):
+            out.append(f"{argv[i]}={argv[i + 1]}")
+            i += 2
+        else:
+            out.append(argv[i])
+            i += 1
+    return out
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--scene", default="cornell",
+                   help="the built-in 'cornell' (default) or a Wavefront .obj file (+ .mtl)")
+    p.add_argument("--eye", type=parse_vec3, help="camera position x,y,z (as rastergi's --eye)")
+    p.add_argument("--target", type=parse_vec3, help="point looked at, x,y,z")
+    p.add_argument("--up", type=parse_vec3, help="camera up vector x,y,z")
+    p.add_argument("--fov", type=float, help="vertical field of view in degrees")
     p.add_argument("--width", type=int, default=128)
     p.add_argument("--height", type=int, default=128)
     p.add_argument("--spp", type=int, default=1024)
@@ -302,7 +648,7 @@ def main():
     p.add_argument("--stats", nargs="+", metavar="EXR",
                    help="print mean RGB (and rel. RMSE of a pair) and exit")
     p.add_argument("--quiet", action="store_true")
-    args = p.parse_args()
+    args = p.parse_args(_join_camera_values(sys.argv[1:]))
 
     import mitsuba as mi
     if args.variant:
@@ -316,6 +662,8 @@ def main():
     print(f"mitsuba {mi.__version__}, variant {mi.variant()}", file=sys.stderr)
 
     if args.check_scene:
+        if args.scene != "cornell":
+            p.error("--check-scene compares the built-in cornell scene with mi.cornell_box()")
         sys.exit(0 if check_scene(mi) else 1)
     if args.stats:
         imgs = [read_exr(mi, f) for f in args.stats[:2]]
@@ -326,10 +674,13 @@ def main():
     if not args.out:
         p.error("--out is required")
 
-    img, secs = render(mi, args)
+    try:
+        img, secs = render(mi, args)
+    except SceneError as e:
+        sys.exit(f"error: {e}")
     write_exr(mi, args.out, img)
     mean = img.reshape(-1, 3).mean(0)
-    print(f"{args.out}: {args.width}x{args.height}, {args.spp} spp, max_depth "
+    print(f"{args.out}: {args.scene}, {args.width}x{args.height}, {args.spp} spp, max_depth "
           f"{args.max_depth}, seed {args.seed}, {secs:.1f} s, mean RGB "
           f"({mean[0]:.5f}, {mean[1]:.5f}, {mean[2]:.5f}), mitsuba "
           f"{mi.__version__} {mi.variant()}")

@@ -82,6 +82,10 @@ fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> std::result::Resul
 }
 
 pub fn write_exr(path: &Path, image: &LinearImage) -> Result<()> {
+    // The exr crate panics on an empty image.
+    if image.width == 0 || image.height == 0 {
+        return Err(image_error(path, "cannot write an empty image (0 pixels wide or high)"));
+    }
     if image.pixels.len() != (image.width * image.height) as usize {
         return Err(image_error(path, "pixel count does not match the image size"));
     }
@@ -129,6 +133,81 @@ pub fn read_exr(path: &Path) -> Result<LinearImage> {
     })
 }
 
+/// The sRGB transfer function's inverse (IEC 61966-2-1): display value in [0, 1] → linear.
+pub fn srgb_to_linear(v: f32) -> f32 {
+    if v <= 0.04045 { v / 12.92 } else { ((v + 0.055) / 1.055).powf(2.4) }
+}
+
+/// Reads a PNG as linear RGB: the 8- or 16-bit sRGB values are decoded by the sRGB transfer
+/// function (grey images are spread over R, G, B; alpha is ignored). A PNG holds display values,
+/// clamped to [0, 1] and quantised, so it only approximates the radiance it was made from.
+pub fn read_png(path: &Path) -> Result<LinearImage> {
+    let mut reader = image::ImageReader::open(path).map_err(|e| image_error(path, format!("cannot be opened: {e}")))?;
+    reader.set_format(image::ImageFormat::Png);
+    let decoded = reader.decode().map_err(|e| image_error(path, format!("cannot read PNG: {e}")))?;
+    let rgb = decoded.to_rgb32f();
+    Ok(LinearImage {
+        width: rgb.width(),
+        height: rgb.height(),
+        pixels: rgb.pixels().map(|p| p.0.map(srgb_to_linear)).collect(),
+    })
+}
+
+/// Reads an image for comparison, by its extension: `.exr` as linear radiance
+/// ([`read_exr`]), `.png` as display values decoded to linear ([`read_png`]). Refuses a missing
+/// file, another extension and an image without pixels.
+pub fn read_image(path: &Path) -> Result<LinearImage> {
+    if !path.exists() {
+        return Err(image_error(path, "no such file"));
+    }
+    if path.is_dir() {
+        return Err(image_error(path, "is a directory, not an image"));
+    }
+    let image = match path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).as_deref() {
+        Some("exr") => read_exr(path)?,
+        Some("png") => read_png(path)?,
+        _ => return Err(image_error(path, "unsupported image format; use a .exr (linear) or .png (display) file")),
+    };
+    non_empty(path, image)
+}
+
+fn non_empty(path: &Path, image: LinearImage) -> Result<LinearImage> {
+    if image.width == 0 || image.height == 0 || image.pixels.is_empty() {
+        return Err(image_error(path, format!("the image is empty ({} x {} pixels)", image.width, image.height)));
+    }
+    Ok(image)
+}
+
+/// Pixels of an image that are NaN or infinite in some channel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct NonFinitePixels {
+    /// How many pixels have a NaN or infinite channel.
+    pub count: usize,
+    /// Column and row (0-based, row 0 at the top) of the first, in row-major order.
+    pub first: (u32, u32),
+}
+
+impl std::fmt::Display for NonFinitePixels {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let (x, y) = self.first;
+        let pixels = if self.count == 1 { "pixel is" } else { "pixels are" };
+        write!(f, "{} {pixels} NaN or infinite, the first at x = {x}, y = {y} (0-based, row 0 at the top)", self.count)
+    }
+}
+
+impl std::error::Error for NonFinitePixels {}
+
+/// Checks that every channel of every pixel is a finite number.
+pub fn validate_finite(image: &LinearImage) -> std::result::Result<(), NonFinitePixels> {
+    let bad = |p: &[f32; 3]| !p.iter().all(|c| c.is_finite());
+    let Some(first) = image.pixels.iter().position(bad) else { return Ok(()) };
+    let width = image.width.max(1) as usize;
+    Err(NonFinitePixels {
+        count: image.pixels.iter().filter(|p| bad(p)).count(),
+        first: ((first % width) as u32, (first / width) as u32),
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -165,5 +244,63 @@ mod tests {
     fn unknown_extension_is_refused() {
         assert!(ImageFormat::from_path(Path::new("x.jpg")).is_err());
         assert_eq!(ImageFormat::from_path(Path::new("x.EXR")).unwrap(), ImageFormat::Exr);
+    }
+
+    #[test]
+    fn png_is_decoded_from_srgb_to_linear() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.png");
+        // Two pixels: sRGB 0, 10, 128 and 255, 200, 188 (alpha ignored).
+        let rgba = vec![0, 10, 128, 255, 255, 200, 188, 7];
+        write_png(&path, &DisplayImage { width: 2, height: 1, rgba: rgba.clone() }).unwrap();
+        let img = read_image(&path).unwrap();
+        assert_eq!((img.width, img.height), (2, 1));
+        // IEC 61966-2-1, written out: linear = v/12.92 below 0.04045, else ((v+0.055)/1.055)^2.4.
+        let expected = |v: u8| {
+            let v = v as f64 / 255.0;
+            if v <= 0.04045 { v / 12.92 } else { ((v + 0.055) / 1.055).powf(2.4) }
+        };
+        for (i, p) in img.pixels.iter().enumerate() {
+            for c in 0..3 {
+                assert!((p[c] as f64 - expected(rgba[4 * i + c])).abs() < 1e-6, "pixel {i} channel {c}: {}", p[c]);
+            }
+        }
+        assert!((img.pixels[0][2] - 0.2158605).abs() < 1e-6, "sRGB 128 is linear 0.2158605");
+    }
+
+    #[test]
+    fn read_image_refuses_missing_unknown_corrupt_and_empty_files() {
+        let dir = tempfile::tempdir().unwrap();
+        let missing = read_image(&dir.path().join("nope.exr")).unwrap_err().to_string();
+        assert!(missing.contains("nope.exr") && missing.contains("no such file"), "{missing}");
+        let tif = dir.path().join("a.tif");
+        std::fs::write(&tif, b"II*\0").unwrap();
+        assert!(read_image(&tif).unwrap_err().to_string().contains("unsupported image format"));
+        for name in ["bad.exr", "bad.png"] {
+            let path = dir.path().join(name);
+            std::fs::write(&path, b"not an image at all").unwrap();
+            let e = read_image(&path).unwrap_err().to_string();
+            assert!(e.contains(name) && e.contains("cannot read"), "{e}");
+        }
+        let e = read_image(dir.path()).unwrap_err().to_string();
+        assert!(e.contains("directory"), "{e}");
+        // EXR and PNG files cannot hold an empty image; the check behind read_image still says so.
+        let empty = non_empty(&tif, LinearImage { width: 0, height: 4, pixels: vec![] }).unwrap_err().to_string();
+        assert!(empty.contains("a.tif") && empty.contains("empty (0 x 4 pixels)"), "{empty}");
+        assert!(
+            write_exr(&dir.path().join("empty.exr"), &LinearImage { width: 0, height: 4, pixels: vec![] }).is_err()
+        );
+    }
+
+    #[test]
+    fn non_finite_pixels_are_counted_and_the_first_located() {
+        let mut img = LinearImage { width: 4, height: 3, pixels: vec![[0.5; 3]; 12] };
+        assert_eq!(validate_finite(&img), Ok(()));
+        img.pixels[2 * 4 + 1][1] = f32::NAN; // x 1, y 2
+        img.pixels[2 * 4 + 3][0] = f32::INFINITY;
+        img.pixels[4 + 2][2] = f32::NEG_INFINITY; // x 2, y 1: the first in row-major order
+        let e = validate_finite(&img).unwrap_err();
+        assert_eq!(e, NonFinitePixels { count: 3, first: (2, 1) });
+        assert!(e.to_string().starts_with("3 pixels are NaN or infinite, the first at x = 2, y = 1"), "{e}");
     }
 }

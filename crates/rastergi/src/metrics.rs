@@ -1,7 +1,8 @@
 //! Image error metrics of DESIGN.md ("Validation"): relative RMSE over pixels and channels,
-//! and the error of 16×16 block means, where Monte Carlo noise averages out and bias remains.
+//! and the error of 16×16 block means, where Monte Carlo noise averages out and bias remains;
+//! and a false-colour picture of where two images differ.
 
-use crate::image_io::LinearImage;
+use crate::image_io::{DisplayImage, LinearImage};
 
 /// Block side of [`Comparison::block_mean_error`].
 pub const BLOCK: u32 = 16;
@@ -16,7 +17,8 @@ pub struct Comparison {
     pub block_mean_error: f64,
     /// mean(a_c) / mean(r_c) per channel.
     pub mean_ratio: [f64; 3],
-    /// 10·log10(max(r)² / mean((a − r)²)).
+    /// 10·log10(max(r)² / mean((a − r)²)) in dB, the peak max(r) taken over the kept pixels
+    /// and channels; infinite when the images are equal there.
     pub psnr: f64,
     /// Pixels kept by the mask.
     pub pixels: usize,
@@ -95,7 +97,7 @@ pub fn compare(image: &LinearImage, reference: &LinearImage, mask: Option<&[bool
         relative_rmse: mse.sqrt() / mean_r,
         block_mean_error: block_err / blocks.max(1) as f64 / mean_r,
         mean_ratio: [0, 1, 2].map(|c| sum_a[c] / sum_r[c].max(f64::MIN_POSITIVE)),
-        psnr: 10.0 * (max_r * max_r / mse.max(f64::MIN_POSITIVE)).log10(),
+        psnr: if mse > 0.0 { 10.0 * (max_r * max_r / mse).log10() } else { f64::INFINITY },
         pixels: n,
     }
 }
@@ -122,6 +124,49 @@ pub fn rmse(a: &LinearImage, b: &LinearImage, mask: Option<&[bool]>) -> f64 {
         }
     }
     (s / n.max(1) as f64).sqrt()
+}
+
+/// Colour of [`difference_image`] where the image is darker than the reference by the full
+/// scale or more (sRGB; the blue end of ColorBrewer's RdBu).
+pub const DIFF_DARKER: [u8; 3] = [33, 102, 172];
+/// Colour where the image equals the reference.
+pub const DIFF_EQUAL: [u8; 3] = [247, 247, 247];
+/// Colour where the image is brighter than the reference by the full scale or more (RdBu's red).
+pub const DIFF_BRIGHTER: [u8; 3] = [178, 24, 43];
+/// Colour of pixels the mask leaves out.
+pub const DIFF_MASKED: [u8; 3] = [0, 0, 0];
+
+/// A false-colour picture of `image − reference` on a diverging colour map. Each pixel's
+/// relative difference is
+///
+/// d = (mean_c a_c − mean_c r_c) / mean(r),
+///
+/// the pixel's error in units of the reference mean over the kept pixels and channels (the
+/// normalisation of [`Comparison::relative_rmse`]). Its colour runs linearly in sRGB from
+/// [`DIFF_EQUAL`] at d = 0 to [`DIFF_DARKER`] at d ≤ −`scale` and to [`DIFF_BRIGHTER`] at
+/// d ≥ `scale`; pixels the mask leaves out are [`DIFF_MASKED`]. Panics if the sizes differ.
+pub fn difference_image(
+    image: &LinearImage,
+    reference: &LinearImage,
+    mask: Option<&[bool]>,
+    scale: f64,
+) -> DisplayImage {
+    assert_eq!((image.width, image.height), (reference.width, reference.height), "image sizes differ");
+    let norm = masked_mean(reference, mask).max(f64::MIN_POSITIVE) * scale.max(f64::MIN_POSITIVE);
+    let mut rgba = Vec::with_capacity(4 * image.pixels.len());
+    for (i, (a, r)) in image.pixels.iter().zip(&reference.pixels).enumerate() {
+        let colour = if mask.is_none_or(|m| m[i]) {
+            let d = (0..3).map(|c| a[c] as f64 - r[c] as f64).sum::<f64>() / 3.0;
+            let t = (d / norm).clamp(-1.0, 1.0);
+            let end = if t < 0.0 { DIFF_DARKER } else { DIFF_BRIGHTER };
+            [0, 1, 2].map(|c| (DIFF_EQUAL[c] as f64 + t.abs() * (end[c] as f64 - DIFF_EQUAL[c] as f64)).round() as u8)
+        } else {
+            DIFF_MASKED
+        };
+        rgba.extend_from_slice(&colour);
+        rgba.push(255);
+    }
+    DisplayImage { width: image.width, height: image.height, rgba }
 }
 
 #[cfg(test)]
@@ -164,5 +209,138 @@ mod tests {
         let keep = emitter_mask(&r, 1.0);
         assert_eq!(keep.iter().filter(|&&k| !k).count(), 9);
         assert!(!keep[2 * 8 + 2] && keep[0]);
+    }
+
+    /// r(x, y, c) = k_c · (i + 1) / n for the pixel index i = y·w + x of n = w·h pixels: channel
+    /// means k_c · (n + 1) / (2n), peak k_0 = 1.
+    const K: [f32; 3] = [1.0, 0.5, 0.25];
+    fn ramp(w: u32, h: u32) -> LinearImage {
+        let n = (w * h) as f32;
+        LinearImage { width: w, height: h, pixels: (0..w * h).map(|i| K.map(|k| k * (i as f32 + 1.0) / n)).collect() }
+    }
+
+    fn ramp_mean(w: u32, h: u32) -> f64 {
+        let n = (w * h) as f64;
+        K.iter().map(|&k| k as f64).sum::<f64>() / 3.0 * (n + 1.0) / (2.0 * n)
+    }
+
+    fn map(image: &LinearImage, f: impl FnMut(&[f32; 3]) -> [f32; 3]) -> LinearImage {
+        LinearImage { width: image.width, height: image.height, pixels: image.pixels.iter().map(f).collect() }
+    }
+
+    #[test]
+    fn identical_images_have_zero_error_unit_ratio_and_infinite_psnr() {
+        let r = ramp(40, 24);
+        let c = compare(&r, &r, None);
+        assert_eq!((c.relative_rmse, c.block_mean_error, c.mean_ratio), (0.0, 0.0, [1.0; 3]));
+        assert_eq!(c.psnr, f64::INFINITY);
+        assert_eq!(c.pixels, 40 * 24);
+    }
+
+    #[test]
+    fn constant_offset_gives_the_closed_form_errors() {
+        // 40 x 24: partial blocks at the right and bottom edges.
+        let (w, h, delta) = (40, 24, 0.05f32);
+        let r = ramp(w, h);
+        let a = map(&r, |p| p.map(|v| v + delta));
+        let c = compare(&a, &r, None);
+        let mean = ramp_mean(w, h);
+        let d = delta as f64;
+        assert!((c.relative_rmse - d / mean).abs() < 1e-5 * d / mean, "{c:?}");
+        // Every block mean is off by exactly delta.
+        assert!((c.block_mean_error - d / mean).abs() < 1e-5 * d / mean, "{c:?}");
+        let n = (w * h) as f64;
+        for ch in 0..3 {
+            let mean_c = K[ch] as f64 * (n + 1.0) / (2.0 * n);
+            assert!((c.mean_ratio[ch] - (mean_c + d) / mean_c).abs() < 1e-5, "channel {ch}: {c:?}");
+        }
+        // PSNR = 20·log10(peak / delta) with peak 1.
+        assert!((c.psnr - 20.0 * (1.0 / d).log10()).abs() < 1e-4, "{c:?}");
+        assert!((rmse(&a, &r, None) - d).abs() < 1e-6);
+    }
+
+    /// Standard normal deviates: splitmix64 and the Box–Muller transform.
+    fn gaussians(seed: u64) -> impl FnMut() -> f64 {
+        let mut state = seed;
+        let mut uniform = move || {
+            state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = state;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+        };
+        move || {
+            let (u1, u2) = (1.0 - uniform(), uniform());
+            (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+        }
+    }
+
+    #[test]
+    fn gaussian_noise_of_known_level_is_measured_within_sampling_error() {
+        let (w, h, sigma) = (64u32, 64u32, 0.05f64);
+        let r = ramp(w, h);
+        let mut normal = gaussians(7);
+        let a = map(&r, |p| p.map(|v| v + (sigma * normal()) as f32));
+        let c = compare(&a, &r, None);
+        let mean = ramp_mean(w, h);
+        let samples = (3 * w * h) as f64;
+
+        // The RMS of N deviates of std σ has standard deviation ≈ σ/√(2N).
+        let rms_sd = sigma / (2.0 * samples).sqrt();
+        assert!((c.relative_rmse * mean - sigma).abs() < 4.0 * rms_sd, "rmse {} vs σ {sigma}", c.relative_rmse * mean);
+        // PSNR = 20·log10(peak/σ), peak 1; its sd is (20/ln 10)·rms_sd/σ.
+        let psnr_sd = 20.0 / std::f64::consts::LN_10 * rms_sd / sigma;
+        assert!((c.psnr - 20.0 * (1.0 / sigma).log10()).abs() < 4.0 * psnr_sd, "psnr {}", c.psnr);
+
+        // A block mean of 256 pixels has sd σ_b = σ/16; |N(0, σ_b²)| has mean σ_b·√(2/π) and sd
+        // σ_b·√(1 − 2/π), and the error averages 16 blocks × 3 channels of them.
+        let sigma_b = sigma / 16.0;
+        let expected = sigma_b * (2.0 / std::f64::consts::PI).sqrt();
+        let sd = sigma_b * (1.0 - 2.0 / std::f64::consts::PI).sqrt() / 48f64.sqrt();
+        let block = c.block_mean_error * mean;
+        assert!((block - expected).abs() < 4.0 * sd, "block error {block} vs {expected} ± {sd}");
+        assert!(block < 0.1 * sigma, "noise averages out in block means");
+
+        // A channel mean of 4096 pixels has sd σ/64.
+        let n = (w * h) as f64;
+        for ch in 0..3 {
+            let mean_c = K[ch] as f64 * (n + 1.0) / (2.0 * n);
+            assert!((c.mean_ratio[ch] - 1.0).abs() < 4.0 * sigma / 64.0 / mean_c, "channel {ch}: {c:?}");
+        }
+    }
+
+    #[test]
+    fn masked_pixels_do_not_count() {
+        let r = ramp(32, 32);
+        let mut a = r.clone();
+        a.pixels[5] = [100.0; 3];
+        let mut keep = vec![true; 32 * 32];
+        keep[5] = false;
+        let c = compare(&a, &r, Some(&keep));
+        assert_eq!((c.relative_rmse, c.block_mean_error, c.pixels), (0.0, 0.0, 32 * 32 - 1));
+        assert!(compare(&a, &r, None).relative_rmse > 0.0);
+    }
+
+    #[test]
+    fn difference_image_is_blue_where_darker_red_where_brighter_white_where_equal() {
+        // Reference mean 0.5; scale 0.1, so full colour at a difference of 0.05.
+        let r = constant(6, 1, 0.5);
+        let mut a = r.clone();
+        a.pixels[1] = [0.40; 3]; // d = −0.2: saturated blue
+        a.pixels[2] = [0.60; 3]; // d = +0.2: saturated red
+        a.pixels[3] = [0.525; 3]; // d = +0.05, half the scale: half-way to red
+        a.pixels[4] = [0.6, 0.5, 0.4]; // channel differences cancel: white
+        let keep = [true, true, true, true, true, false];
+        let diff = difference_image(&a, &r, Some(&keep), 0.1);
+        let px = |i: usize| [diff.rgba[4 * i], diff.rgba[4 * i + 1], diff.rgba[4 * i + 2]];
+        assert_eq!((diff.width, diff.height, diff.rgba.len()), (6, 1, 24));
+        assert_eq!(px(0), DIFF_EQUAL);
+        assert_eq!(px(1), DIFF_DARKER);
+        assert_eq!(px(2), DIFF_BRIGHTER);
+        let half = [0, 1, 2].map(|c| ((DIFF_EQUAL[c] as f64 + DIFF_BRIGHTER[c] as f64) / 2.0).round() as u8);
+        assert_eq!(px(3), half);
+        assert_eq!(px(4), DIFF_EQUAL);
+        assert_eq!(px(5), DIFF_MASKED);
+        assert!(diff.rgba.chunks(4).all(|p| p[3] == 255));
     }
 }

@@ -113,12 +113,14 @@ pub fn surface_areas(scene: &Scene, grid: &GridSpec) -> Vec<f64> {
     area
 }
 
-/// Sutherland–Hodgman clipping of a convex polygon to an axis-aligned box.
+/// Sutherland–Hodgman clipping of a convex polygon to the half-open box [min, max), the
+/// same cells `GridSpec::cell_of` assigns points to: a polygon lying exactly on a cell
+/// boundary counts in the cell above it only, where its photons land.
 fn clip_to_box(poly: &[DVec3], min: DVec3, max: DVec3) -> Vec<DVec3> {
     let mut out = poly.to_vec();
     for axis in 0..3 {
         for (bound, keep_below) in [(min[axis], false), (max[axis], true)] {
-            let inside = |p: &DVec3| if keep_below { p[axis] <= bound } else { p[axis] >= bound };
+            let inside = |p: &DVec3| if keep_below { p[axis] < bound } else { p[axis] >= bound };
             let input = std::mem::take(&mut out);
             for (k, p) in input.iter().enumerate() {
                 let q = &input[(k + 1) % input.len()];
@@ -271,6 +273,20 @@ mod tests {
                 assert!((a - 0.0625).abs() < 1e-9, "cell ({x},{y}): {a}");
             }
         }
+    }
+
+    #[test]
+    fn a_square_exactly_on_a_cell_boundary_counts_once_in_the_cell_its_photons_land_in() {
+        let cam = Camera { eye: Vec3::Z, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 40.0 };
+        let mut s = Scene::new(cam);
+        let m = s.add_material(Material::diffuse("m", Vec3::ONE));
+        s.add_quad([Vec3::new(0.0, 0.0, 0.5), Vec3::new(1.0, 0.0, 0.5), Vec3::new(1.0, 1.0, 0.5), Vec3::new(0.0, 1.0, 0.5)], m);
+        let grid = GridSpec { origin: Vec3::ZERO, cell: 0.25, dims: UVec3::new(4, 4, 4) };
+        let areas = surface_areas(&s, &grid);
+        let total: f64 = areas.iter().sum();
+        assert!((total - 1.0).abs() < 1e-9, "area counted {total} times");
+        assert_eq!(grid.cell_of(Vec3::new(0.3, 0.3, 0.5)).z, 2);
+        assert!((areas[grid.slot(UVec3::new(1, 1, 2), 4)] - 0.0625).abs() < 1e-9);
     }
 
     #[test]

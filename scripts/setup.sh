@@ -1,12 +1,16 @@
 #!/usr/bin/env bash
 # Installs what rastergi needs on a fresh Debian or Ubuntu machine: a C toolchain and
 # pkg-config, Mesa's Vulkan drivers (lavapipe runs the GPU code on the CPU when there is no
-# GPU) and Rust >= 1.88 with rustfmt and clippy. Safe to run again: it installs only what is
-# missing. Afterwards, in a new shell or after `. ~/.cargo/env`: cargo test --release
+# GPU), the X11 libraries of the viewer's window and Xvfb for its tests, and Rust >= 1.88
+# with rustfmt and clippy. Safe to run again: it installs only what is missing. Afterwards,
+# in a new shell or after `. ~/.cargo/env`: cargo test --release
 set -euo pipefail
 
 MIN_RUST=1.88
-PACKAGES=(build-essential pkg-config mesa-vulkan-drivers libvulkan1 curl ca-certificates)
+PACKAGES=(build-essential pkg-config mesa-vulkan-drivers libvulkan1 curl ca-certificates
+    # The viewer's window (`rastergi view`): the X11 libraries winit loads at run time, and
+    # Xvfb + xauth (for xvfb-run) so its tests run without a display.
+    libx11-6 libx11-xcb1 libxcursor1 libxrandr2 libxi6 libxkbcommon-x11-0 xvfb xauth)
 
 say() { echo "setup: $*"; }
 die() {

@@ -98,7 +98,7 @@ fn photons(a: &PhotonArgs) -> Result<()> {
     let gpu = gpu(&a.gpu)?;
     let prepared = PreparedScene::new(&scene);
     let settings = PhotonSettings { count: a.photons, seed: 1, grid_resolution: a.grid };
-    let gs = GpuScene::new(&gpu, &prepared);
+    let gs = GpuScene::new(&gpu, &prepared)?;
     let map = GpuPhotonMap::new(&gpu, &gs, &prepared, &settings)?;
     map.trace(&gpu, &gs);
     gpu.wait()?;
@@ -209,10 +209,11 @@ impl Method {
         Ok(())
     }
     fn wait(&self) -> Result<()> {
-        Ok(match self {
+        match self {
             Method::Gather(r) => r.wait()?,
             Method::Path(p) => p.wait()?,
-        })
+        }
+        Ok(())
     }
     fn samples(&self) -> u32 {
         match self {

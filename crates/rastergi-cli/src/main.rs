@@ -2,7 +2,10 @@
 
 mod bench;
 mod compare;
+mod export;
 mod render;
+mod script;
+mod view;
 
 use std::process::ExitCode;
 
@@ -33,6 +36,11 @@ enum Command {
     Bench(bench::BenchCommand),
     /// Compare an image with a reference: relative RMSE, block-mean error, PSNR, mean ratios.
     Compare(compare::CompareArgs),
+    /// Write a scene (built in, e.g. `atrium` or `spheres:1000000`, or a file) as Wavefront OBJ + MTL.
+    Export(export::ExportArgs),
+    /// Open a window that shows the image converging; fly or orbit through the scene.
+    #[command(after_help = view::AFTER_HELP)]
+    View(view::ViewArgs),
 }
 
 /// Mesa's Vulkan drivers probe Wayland when they start and, where `XDG_RUNTIME_DIR` is unset
@@ -56,7 +64,7 @@ fn quiet_wayland_probe() {
 
 impl Command {
     fn opens_window(&self) -> bool {
-        false
+        matches!(self, Command::View(_))
     }
 }
 
@@ -71,6 +79,8 @@ fn main() -> ExitCode {
         Command::Render(args) => render::run(&args),
         Command::Bench(command) => bench::run(&command),
         Command::Compare(args) => compare::run(&args),
+        Command::Export(args) => export::run(&args),
+        Command::View(args) => view::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -2,17 +2,20 @@
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use anyhow::Result;
 use clap::{Args, ValueEnum};
 use glam::Vec3;
 use indicatif::{ProgressBar, ProgressStyle};
 use rastergi::film::Show;
+use rastergi::fit;
 use rastergi::gpu::{Backends, Gpu, GpuOptions, parse_backend};
 use rastergi::image_io::{ImageFormat, write_exr, write_png};
+use rastergi::path_tracer::PathTracer;
 use rastergi::renderer::{RenderSettings, Renderer};
-use rastergi::scene::{Scene, cornell_box, load_obj};
+use rastergi::scene::generate::BUILTIN_NAMES;
+use rastergi::scene::{GltfOptions, Scene, load_gltf_with, load_obj};
 
 #[derive(Args, Clone, Debug)]
 pub struct GpuArgs {
@@ -22,7 +25,7 @@ pub struct GpuArgs {
 }
 
 #[derive(Copy, Clone, Debug, ValueEnum)]
-enum ShowArg {
+pub enum ShowArg {
     /// Emission + direct + indirect light.
     Full,
     /// Emission + direct light.
@@ -33,55 +36,153 @@ enum ShowArg {
     PhotonMap,
 }
 
+impl ShowArg {
+    pub fn show(self) -> Show {
+        match self {
+            ShowArg::Full => Show::Full,
+            ShowArg::Direct => Show::Direct,
+            ShowArg::Indirect => Show::Indirect,
+            ShowArg::PhotonMap => Show::PhotonMap,
+        }
+    }
+}
+
+/// The options `render` and `view` share: the scene and its camera, the renderer's settings,
+/// what is shown and the GPU.
+#[derive(Args, Debug)]
+pub struct SceneArgs {
+    /// The scene: built in (`cornell`, `atrium`, `spheres:N` for about N triangles), a Wavefront .obj file or a glTF 2.0 .gltf/.glb file.
+    pub scene: String,
+    /// Image width in pixels (`view`: the window's initial width).
+    #[arg(long, default_value_t = 256)]
+    pub width: u32,
+    /// Image height in pixels (`view`: the window's initial height).
+    #[arg(long, default_value_t = 256)]
+    pub height: u32,
+    /// Camera position, overriding the scene's (x,y,z).
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub eye: Option<Vec3>,
+    /// Point the camera looks at (x,y,z).
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub target: Option<Vec3>,
+    /// Camera up vector (x,y,z).
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub up: Option<Vec3>,
+    /// Vertical field of view in degrees.
+    #[arg(long)]
+    pub fov: Option<f32>,
+    /// glTF scenes: the camera to use, by its index in the file's cameras (default: the first).
+    #[arg(long)]
+    pub camera: Option<usize>,
+    /// Seed of every random decision; the same seed gives the same image.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u32,
+    /// Light samples per pixel per iteration.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub light_samples: u32,
+    /// Photons traced into the photon map (default: fitted to the scene: about 40 per
+    /// cell-sized patch of surface, a power of two from 2^18 to 2^24; 2^20 for cornell).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    pub photons: Option<u32>,
+    /// Photon grid cells along the scene's longest axis (default: fitted to the scene: as many
+    /// cubic cells as 64³, so 64 for a cube like cornell and more for long or flat scenes).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub grid: Option<u32>,
+    /// Ray-view resolution of the final gather, texels per side (default: twice the image's larger side, 128 to 2048).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    pub bundle: Option<u32>,
+    /// What the image shows.
+    #[arg(long, value_enum, default_value_t = ShowArg::Full)]
+    pub show: ShowArg,
+    /// Exposure in stops for PNG output and the window (the image is scaled by 2^exposure).
+    /// Default: 0, except for a PNG whose median luminance is more than two stops from
+    /// middle grey (0.18): then the whole stops that bring it there.
+    #[arg(long, allow_hyphen_values = true)]
+    pub exposure: Option<f32>,
+    #[command(flatten)]
+    pub gpu: GpuArgs,
+}
+
+impl SceneArgs {
+    /// The scene with the camera options applied, its camera validated.
+    pub fn load_scene(&self) -> Result<Scene> {
+        let mut scene = load_scene_with_camera(&self.scene, self.camera)?;
+        let c = &mut scene.camera;
+        c.eye = self.eye.unwrap_or(c.eye);
+        c.target = self.target.unwrap_or(c.target);
+        c.up = self.up.unwrap_or(c.up);
+        c.fov_y_deg = self.fov.unwrap_or(c.fov_y_deg);
+        scene.camera.validate()?;
+        Ok(scene)
+    }
+
+    /// The renderer's settings for `scene` at the given image size: the photon grid and count
+    /// as given, else fitted to the scene ([`rastergi::fit`]).
+    pub fn settings(&self, scene: &Scene, width: u32, height: u32, show_photon_map: bool) -> RenderSettings {
+        let grid = self.grid.unwrap_or_else(|| fit::grid_resolution(&scene.bounds()));
+        let photons = self.photons.unwrap_or_else(|| fit::photon_count(scene, grid));
+        log::info!(
+            "photons {photons}{}, grid {grid}{}",
+            if self.photons.is_some() { "" } else { " (fitted)" },
+            if self.grid.is_some() { "" } else { " (fitted)" }
+        );
+        RenderSettings {
+            width,
+            height,
+            seed: self.seed,
+            light_samples: self.light_samples,
+            photons,
+            grid_resolution: grid,
+            show_photon_map,
+            bundle: self.bundle.unwrap_or(0),
+        }
+    }
+}
+
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    /// The scene: `cornell` (built in) or a Wavefront .obj file.
-    scene: String,
-    #[arg(long, default_value_t = 256)]
-    width: u32,
-    #[arg(long, default_value_t = 256)]
-    height: u32,
+    #[command(flatten)]
+    scene: SceneArgs,
     /// Progressive iterations (one sample per pixel each).
     #[arg(long, default_value_t = 256)]
     iterations: u32,
     /// Output image: .exr (linear radiance, f32 RGB) or .png (exposure, sRGB).
     #[arg(long)]
     out: PathBuf,
-    /// Camera position, overriding the scene's (x,y,z).
-    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
-    eye: Option<Vec3>,
-    /// Point the camera looks at (x,y,z).
-    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
-    target: Option<Vec3>,
-    /// Camera up vector (x,y,z).
-    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
-    up: Option<Vec3>,
-    /// Vertical field of view in degrees.
-    #[arg(long)]
-    fov: Option<f32>,
-    /// Seed of every random decision; the same seed gives the same image.
-    #[arg(long, default_value_t = 0)]
-    seed: u32,
-    /// Light samples per pixel per iteration.
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=64))]
-    light_samples: u32,
-    /// Photons traced into the photon map.
-    #[arg(long, default_value_t = 1 << 20, value_parser = clap::value_parser!(u32).range(1..))]
-    photons: u32,
-    /// Photon grid cells along the scene's longest axis.
-    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=1024))]
-    grid: u32,
-    /// Ray-view resolution of the final gather, texels per side (default: twice the image's larger side, 128 to 2048).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
-    bundle: Option<u32>,
-    /// What the image shows.
-    #[arg(long, value_enum, default_value_t = ShowArg::Full)]
-    show: ShowArg,
-    /// Exposure in stops for PNG output (the image is scaled by 2^exposure).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
-    exposure: f32,
-    #[command(flatten)]
-    gpu: GpuArgs,
+    /// `gather`: photon map + rasterized final gather; `path`: the reference path tracer
+    /// (same scene, camera and pixel filter; unlimited depth, next-event estimation + MIS).
+    #[arg(long, value_enum, default_value_t = Method::Gather)]
+    method: Method,
+}
+
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
+enum Method {
+    Gather,
+    Path,
+}
+
+/// The two progressive renderers behind one loop.
+enum Progressive {
+    Gather(Box<Renderer>),
+    Path(Box<PathTracer>),
+}
+
+impl Progressive {
+    fn iterate(&mut self) -> Result<()> {
+        match self {
+            Progressive::Gather(r) => r.iterate()?,
+            Progressive::Path(p) => p.iterate(),
+        }
+        Ok(())
+    }
+
+    fn wait(&self) -> Result<()> {
+        match self {
+            Progressive::Gather(r) => r.wait()?,
+            Progressive::Path(p) => p.wait()?,
+        }
+        Ok(())
+    }
 }
 
 fn parse_vec3(s: &str) -> Result<Vec3, String> {
@@ -99,19 +200,38 @@ fn parse_vec3(s: &str) -> Result<Vec3, String> {
     Ok(Vec3::from(v))
 }
 
+impl GpuArgs {
+    /// The backends asked for (`None`: the default choice).
+    pub fn backend(&self) -> Option<Backends> {
+        self.backend
+    }
+}
+
 pub fn gpu(args: &GpuArgs) -> Result<Gpu> {
     Ok(Gpu::new(&GpuOptions { backends: args.backend })?)
 }
 
 /// The built-in scene of that name, or the scene file at that path.
 pub fn load_scene(name: &str) -> Result<Scene> {
-    if name == "cornell" {
-        return Ok(cornell_box());
-    }
+    load_scene_with_camera(name, None)
+}
+
+/// [`load_scene`] with the camera of a glTF file chosen by its index.
+pub fn load_scene_with_camera(name: &str, camera: Option<usize>) -> Result<Scene> {
     let path = Path::new(name);
-    match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+    let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    if camera.is_some() && !matches!(extension.as_deref(), Some("gltf" | "glb")) {
+        anyhow::bail!("--camera chooses among a glTF file's cameras; '{name}' is not a .gltf or .glb file");
+    }
+    if let Some(scene) = rastergi::scene::generate::builtin(name)? {
+        return Ok(scene);
+    }
+    match extension.as_deref() {
         Some("obj") => Ok(load_obj(path)?),
-        _ => anyhow::bail!("unknown scene '{name}': use the built-in 'cornell' or a path to a .obj file"),
+        Some("gltf" | "glb") => Ok(load_gltf_with(path, &GltfOptions { camera })?),
+        _ => anyhow::bail!(
+            "unknown scene '{name}': use a built-in scene ({BUILTIN_NAMES}) or a path to a .obj, .gltf or .glb file"
+        ),
     }
 }
 
@@ -137,28 +257,26 @@ fn check_output_path(out: &Path) -> Result<()> {
 pub fn run(args: &RenderArgs) -> Result<()> {
     let format = ImageFormat::from_path(&args.out)?;
     check_output_path(&args.out)?;
-    let mut scene = load_scene(&args.scene)?;
-    let c = &mut scene.camera;
-    c.eye = args.eye.unwrap_or(c.eye);
-    c.target = args.target.unwrap_or(c.target);
-    c.up = args.up.unwrap_or(c.up);
-    c.fov_y_deg = args.fov.unwrap_or(c.fov_y_deg);
-    scene.camera.validate()?;
+    let a = &args.scene;
+    let start = Instant::now();
+    let scene = a.load_scene()?;
+    log::info!("{}: {} triangles loaded in {:.2} s", a.scene, scene.triangles.len(), start.elapsed().as_secs_f64());
     if args.iterations == 0 {
         anyhow::bail!("--iterations must be at least 1");
     }
-    let gpu = gpu(&args.gpu)?;
-    let settings = RenderSettings {
-        width: args.width,
-        height: args.height,
-        seed: args.seed,
-        light_samples: args.light_samples,
-        photons: args.photons,
-        grid_resolution: args.grid,
-        show_photon_map: matches!(args.show, ShowArg::PhotonMap),
-        bundle: args.bundle.unwrap_or(0),
+    let gpu = gpu(&a.gpu)?;
+    if args.method == Method::Path && !matches!(a.show, ShowArg::Full) {
+        anyhow::bail!("--method path renders the full image only; drop --show or use --method gather");
+    }
+    let settings = a.settings(&scene, a.width, a.height, matches!(a.show, ShowArg::PhotonMap));
+    let start = Instant::now();
+    let mut renderer = match args.method {
+        Method::Gather => Progressive::Gather(Box::new(Renderer::new(&gpu, &scene, settings)?)),
+        Method::Path => Progressive::Path(Box::new(PathTracer::new(&gpu, &scene, settings)?)),
     };
-    let mut renderer = Renderer::new(&gpu, &scene, settings)?;
+    renderer.wait()?;
+    log::info!("set-up (BVH, upload, photon map) in {:.2} s", start.elapsed().as_secs_f64());
+    let start = Instant::now();
 
     let progress = if std::io::stderr().is_terminal() {
         let bar = ProgressBar::new(args.iterations as u64);
@@ -181,16 +299,29 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     renderer.wait()?;
     progress.finish_and_clear();
+    log::info!("{} iterations in {:.2} s", args.iterations, start.elapsed().as_secs_f64());
 
-    let show = match args.show {
-        ShowArg::Full => Show::Full,
-        ShowArg::Direct => Show::Direct,
-        ShowArg::Indirect => Show::Indirect,
-        ShowArg::PhotonMap => Show::PhotonMap,
+    let show = a.show.show();
+    let linear = match &renderer {
+        Progressive::Gather(r) => r.read_linear(show)?,
+        Progressive::Path(p) => p.read_linear()?,
     };
-    match format {
-        ImageFormat::Exr => write_exr(&args.out, &renderer.read_linear(show)?)?,
-        ImageFormat::Png => write_png(&args.out, &renderer.read_display(show, args.exposure)?)?,
+    if format == ImageFormat::Exr {
+        return Ok(write_exr(&args.out, &linear)?);
     }
+    let exposure = a.exposure.unwrap_or_else(|| {
+        let fitted = fit::exposure(&linear);
+        if fitted != 0.0 {
+            eprintln!(
+                "note: exposure {fitted:+} EV fitted to the image (its median luminance is far from middle grey); give --exposure to choose"
+            );
+        }
+        fitted
+    });
+    let display = match &renderer {
+        Progressive::Gather(r) => r.read_display(show, exposure)?,
+        Progressive::Path(p) => p.read_display(exposure)?,
+    };
+    write_png(&args.out, &display)?;
     Ok(())
 }

@@ -21,7 +21,7 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Quat, Vec2, Vec3};
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::film::Film;
 use crate::frame::FrameBinding;
 use crate::gbuffer::GBufferPass;
@@ -100,12 +100,7 @@ impl GatherPass {
         bundle: u32,
     ) -> Result<GatherPass> {
         let device = &gpu.device;
-        let max = device.limits().max_texture_dimension_2d;
-        if bundle == 0 || bundle > max {
-            return Err(Error::Limits(format!(
-                "a ray-view bundle of {bundle}x{bundle} texels exceeds this GPU's limit of {max}; choose a smaller --bundle"
-            )));
-        }
+        crate::limits::check_bundle(&device.limits(), bundle)?;
         let uniforms = gpu.zeroed_buffer(
             "gather uniforms",
             std::mem::size_of::<GatherUniforms>() as u64,

@@ -28,7 +28,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         found[pixel] = 1u;
         return;
     }
-    let x = surface_at(g.x - 1u, bitcast<f32>(g.y), bitcast<f32>(g.z));
+    let x = surface_at(g.x - 1u, bitcast<f32>(g.y), bitcast<f32>(g.z), bitcast<f32>(g.w));
     let front = dot(x.normal, frame.eye - x.pos) > 0.0;
     let w = gather.direction;
     let n = select(-x.normal, x.normal, front);
@@ -69,7 +69,10 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         return;
     }
     let hit = x.pos + w * dist;
-    let radiance_h = m.albedo / PI * photon_irradiance(hit, select(-n_h, n_h, front_h));
+    // ρ_h at the hit point itself, unfiltered (level 0), like every secondary point.
+    let b = plane_barycentrics(t, hit);
+    let albedo_h = surface_at(tri, b.x, b.y, 0.0).albedo;
+    let radiance_h = albedo_h / PI * photon_irradiance(hit, select(-n_h, n_h, front_h));
     let n_pixels = frame.resolution.x * frame.resolution.y;
     film[n_pixels + pixel] += vec4f(x.albedo / PI * radiance_h * (cos_x * 4.0 * PI), 0.0);
 }

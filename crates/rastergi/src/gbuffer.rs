@@ -1,7 +1,10 @@
 //! Eye pass: rasterizes the scene from the camera (jittered per iteration) into a visibility
-//! G-buffer. Each pixel stores `(triangle + 1, b1, b2)` — 0 where nothing is seen — from
+//! G-buffer. Each pixel stores `(triangle + 1, b1, b2, λ)` — 0 where nothing is seen — from
 //! which later passes reconstruct the visible point exactly (`surface_at` in WGSL): position
-//! by barycentric interpolation, geometric normal, material.
+//! by barycentric interpolation, geometric normal, material. λ is the albedo texture's level
+//! of detail over the pixel's footprint, log2 of the texture coordinates' screen-space change
+//! in texels (`texture_lod`), so that the passes read the texture filtered like a fragment
+//! shader would.
 
 use crate::frame::FrameBinding;
 use crate::gpu::Gpu;

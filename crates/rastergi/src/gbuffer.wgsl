@@ -1,10 +1,12 @@
 // Eye pass (gbuffer.rs): vertices pulled from the scene's triangle buffer; each fragment
-// stores (triangle + 1, b1, b2) of the nearest surface.
+// stores (triangle + 1, b1, b2, texture level of detail) of the nearest surface.
 
 struct VertexOut {
     @builtin(position) clip: vec4f,
     @location(0) bary: vec2f,
     @location(1) @interpolate(flat) tri: u32,
+    // Texture coordinates, interpolated for their screen-space derivatives.
+    @location(2) uv: vec2f,
 }
 
 @vertex
@@ -25,10 +27,16 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> VertexOut {
     out.clip = frame.view_proj * vec4f(p, 1.0);
     out.bary = b;
     out.tri = tri;
+    out.uv = surface_uv(tri, b.x, b.y);
     return out;
 }
 
+// The level of detail comes from the texture coordinates' change to the neighbouring pixels
+// (screen-space derivatives), as a fragment shader's implicit texture sampling would do. They
+// are taken of an interpolated input, not of values loaded in the fragment shader: helper
+// invocations outside the triangle may not load memory (lavapipe's read zeros).
 @fragment
 fn fs_main(in: VertexOut) -> @location(0) vec4u {
-    return vec4u(in.tri + 1u, bitcast<u32>(in.bary.x), bitcast<u32>(in.bary.y), 0u);
+    let lod = texture_lod(dpdx(in.uv), dpdy(in.uv));
+    return vec4u(in.tri + 1u, bitcast<u32>(in.bary.x), bitcast<u32>(in.bary.y), bitcast<u32>(lod));
 }

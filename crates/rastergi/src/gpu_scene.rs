@@ -1,13 +1,16 @@
-//! The scene on the GPU: triangles in BVH order, materials, BVH nodes and the light table,
-//! bound together as bind group 0 of every pass that reads the scene (`gpu_scene.wgsl`).
+//! The scene on the GPU: triangles in BVH order, materials, BVH nodes, the light table and the
+//! albedo textures with the triangles' texture coordinates, bound together as bind group 0 of
+//! every pass that reads the scene (`gpu_scene.wgsl`).
 
 use bytemuck::{Pod, Zeroable};
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 use crate::bvh::{Bvh, BvhNode};
-use crate::gpu::{Gpu, buffer_bind_group, storage_entry};
+use crate::error::Result;
+use crate::gpu::{Gpu, storage_entry};
 use crate::lights::{LightEntry, LightTable};
 use crate::scene::{Aabb, Scene};
+use crate::textures::TextureArray;
 
 /// `Triangle` in `gpu_scene.wgsl`.
 #[repr(C)]
@@ -21,26 +24,30 @@ pub struct GpuTriangle {
     pub _pad1: u32,
 }
 
-/// `Material` in `gpu_scene.wgsl`. Bit 0 of `flags`: the back face reflects too.
+/// `Material` in `gpu_scene.wgsl`. Bit 0 of `flags`: the back face reflects too. `texture`:
+/// the layer of the albedo texture in the texture array, [`NO_TEXTURE`] for none.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuMaterial {
     pub albedo: [f32; 3],
     pub flags: u32,
     pub emission: [f32; 3],
-    pub _pad: u32,
+    pub texture: u32,
 }
 
 pub const MATERIAL_TWO_SIDED: u32 = 1;
+pub const NO_TEXTURE: u32 = u32::MAX;
 
 /// A scene prepared for rendering: triangles permuted into BVH order, with the BVH and the
-/// light table over them. CPU twins use this directly; [`GpuScene`] uploads it.
+/// light table over them and the textures as the GPU samples them. CPU twins use this
+/// directly; [`GpuScene`] uploads it.
 #[derive(Clone, Debug)]
 pub struct PreparedScene {
     pub scene: Scene,
     pub bvh: Bvh,
     pub lights: LightTable,
     pub bounds: Aabb,
+    pub textures: TextureArray,
 }
 
 impl PreparedScene {
@@ -49,10 +56,32 @@ impl PreparedScene {
         let mut scene = scene.clone();
         scene.triangles = bvh.permute(&scene.triangles);
         scene.material_ids = bvh.permute(&scene.material_ids);
+        if !scene.uvs.is_empty() {
+            scene.uvs = bvh.permute(&scene.uvs);
+        }
         let bvh = Bvh { order: (0..scene.triangles.len() as u32).collect(), ..bvh };
         let lights = LightTable::new(&scene);
         let bounds = scene.bounds();
-        PreparedScene { scene, bvh, lights, bounds }
+        let textures = TextureArray::new(&scene.textures);
+        PreparedScene { scene, bvh, lights, bounds, textures }
+    }
+
+    /// Texture coordinates at barycentrics (b1, b2) of triangle `tri` (`surface_uv` in WGSL).
+    pub fn uv_at(&self, tri: usize, b1: f32, b2: f32) -> Vec2 {
+        match self.scene.uvs.get(tri) {
+            Some(uv) => uv[0] * (1.0 - b1 - b2) + uv[1] * b1 + uv[2] * b2,
+            None => Vec2::ZERO,
+        }
+    }
+
+    /// The albedo at barycentrics (b1, b2) of triangle `tri`, its texture read at level of
+    /// detail `lod`: the twin of `surface_at(…).albedo` in WGSL.
+    pub fn albedo_at(&self, tri: usize, b1: f32, b2: f32, lod: f32) -> Vec3 {
+        let m = self.scene.material_of(tri);
+        match m.albedo_texture {
+            Some(layer) => m.albedo * self.textures.sample(layer as u32, self.uv_at(tri, b1, b2), lod),
+            None => m.albedo,
+        }
     }
 
     /// Distance used to offset ray origins and as the minimum hit distance: a small multiple
@@ -75,7 +104,11 @@ pub struct GpuScene {
 }
 
 impl GpuScene {
-    pub fn new(gpu: &Gpu, prepared: &PreparedScene) -> GpuScene {
+    /// Uploads `prepared`, after checking that its buffers fit the device (see [`crate::limits`]).
+    pub fn new(gpu: &Gpu, prepared: &PreparedScene) -> Result<GpuScene> {
+        let limits = gpu.device.limits();
+        crate::limits::check_scene(&limits, &prepared.scene)?;
+        crate::limits::check_bvh_nodes(&limits, prepared.bvh.nodes.len())?;
         let s = &prepared.scene;
         let triangles: Vec<GpuTriangle> = s
             .triangles
@@ -97,9 +130,17 @@ impl GpuScene {
                 albedo: m.albedo.into(),
                 flags: if m.two_sided { MATERIAL_TWO_SIDED } else { 0 },
                 emission: m.emission.into(),
-                _pad: 0,
+                texture: m.albedo_texture.map_or(NO_TEXTURE, |t| t as u32),
             })
             .collect();
+        // One triangle's worth of zeros when the scene has no texture coordinates: a binding
+        // cannot be empty, and `surface_uv` clamps its index into the buffer.
+        let uvs: Vec<[f32; 2]> = if s.uvs.is_empty() {
+            vec![[0.0; 2]; 3]
+        } else {
+            s.uvs.iter().flat_map(|t| t.map(|uv| uv.to_array())).collect()
+        };
+        let (texture_view, sampler) = prepared.textures.upload(gpu);
         let lights: Vec<LightEntry> = prepared.lights.entries.clone();
         let nodes: &[BvhNode] = &prepared.bvh.nodes;
         let none = wgpu::BufferUsages::empty();
@@ -108,6 +149,7 @@ impl GpuScene {
             gpu.storage_buffer("scene materials", bytemuck::cast_slice(&materials), none),
             gpu.storage_buffer("scene bvh nodes", bytemuck::cast_slice(nodes), none),
             gpu.storage_buffer("scene lights", bytemuck::cast_slice(&lights), none),
+            gpu.storage_buffer("scene texture coordinates", bytemuck::cast_slice(&uvs), none),
         ];
         let vis = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
         let layout = gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -117,11 +159,38 @@ impl GpuScene {
                 storage_entry(1, vis, true),
                 storage_entry(2, vis, true),
                 storage_entry(3, vis, true),
+                storage_entry(4, vis, true),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 5,
+                    visibility: vis,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                        view_dimension: wgpu::TextureViewDimension::D2Array,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 6,
+                    visibility: vis,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                    count: None,
+                },
             ],
         });
-        let refs: Vec<&wgpu::Buffer> = buffers.iter().collect();
-        let bind_group = buffer_bind_group(&gpu.device, "scene", &layout, &refs);
-        GpuScene {
+        let mut entries: Vec<wgpu::BindGroupEntry> = buffers
+            .iter()
+            .enumerate()
+            .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
+            .collect();
+        entries.push(wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&texture_view) });
+        entries.push(wgpu::BindGroupEntry { binding: 6, resource: wgpu::BindingResource::Sampler(&sampler) });
+        let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("scene"),
+            layout: &layout,
+            entries: &entries,
+        });
+        Ok(GpuScene {
             layout,
             bind_group,
             triangle_count: triangles.len() as u32,
@@ -129,6 +198,21 @@ impl GpuScene {
             bounds: prepared.bounds,
             ray_epsilon: prepared.ray_epsilon(),
             emitted_power: prepared.lights.power,
-        }
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn material_layout_matches_wgsl() {
+        // WGSL `Material`: vec3f albedo at 0, u32 flags at 12, vec3f emission at 16, u32
+        // texture at 28; size 32.
+        assert_eq!(std::mem::size_of::<GpuMaterial>(), 32);
+        assert_eq!(std::mem::offset_of!(GpuMaterial, flags), 12);
+        assert_eq!(std::mem::offset_of!(GpuMaterial, emission), 16);
+        assert_eq!(std::mem::offset_of!(GpuMaterial, texture), 28);
     }
 }

@@ -9,12 +9,13 @@ struct Triangle {
     _pad1: u32,
 }
 
-// Bit 0 of flags: the back face reflects too.
+// Bit 0 of flags: the back face reflects too. texture: layer of the albedo texture in
+// `textures`, NO_TEXTURE for none.
 struct Material {
     albedo: vec3f,
     flags: u32,
     emission: vec3f,
-    _pad: u32,
+    texture: u32,
 }
 
 struct BvhNode {
@@ -35,8 +36,16 @@ struct LightEntry {
 @group(0) @binding(1) var<storage, read> materials: array<Material>;
 @group(0) @binding(2) var<storage, read> bvh_nodes: array<BvhNode>;
 @group(0) @binding(3) var<storage, read> lights: array<LightEntry>;
+// Texture coordinates of the triangles' corners, three per triangle (one zero triangle when
+// the scene has none).
+@group(0) @binding(4) var<storage, read> uvs: array<vec2f>;
+// Every albedo texture, one layer each, with its mip chain (sRGB, read as linear RGB).
+@group(0) @binding(5) var textures: texture_2d_array<f32>;
+// Trilinear filtering, repeat addressing.
+@group(0) @binding(6) var texture_sampler: sampler;
 
 const MATERIAL_TWO_SIDED: u32 = 1u;
+const NO_TEXTURE: u32 = 0xffffffffu;
 
 // A point on a surface: position, front-face geometric normal and material.
 struct Surface {
@@ -52,14 +61,51 @@ fn triangle_normal(t: Triangle) -> vec3f {
     return normalize(cross(t.v1 - t.v0, t.v2 - t.v0));
 }
 
-// The surface at barycentrics (b1, b2) of triangle `tri`.
-fn surface_at(tri: u32, b1: f32, b2: f32) -> Surface {
+// Texture coordinates at barycentrics (b1, b2) of triangle `tri` (PreparedScene::uv_at).
+fn surface_uv(tri: u32, b1: f32, b2: f32) -> vec2f {
+    let i = 3u * min(tri, arrayLength(&uvs) / 3u - 1u);
+    return uvs[i] * (1.0 - b1 - b2) + uvs[i + 1u] * b1 + uvs[i + 2u] * b2;
+}
+
+// Level of detail of a footprint whose texture coordinates change by dx and dy across one
+// pixel: log2 of the longer change in texels of level 0, 0 under magnification
+// (TextureArray::lod).
+fn texture_lod(dx: vec2f, dy: vec2f) -> f32 {
+    let size = vec2f(textureDimensions(textures));
+    let rho = max(length(dx * size), length(dy * size));
+    return min(log2(max(rho, 1.0)), 32.0);
+}
+
+// Barycentrics (b1, b2) of the point p of triangle t's plane.
+fn plane_barycentrics(t: Triangle, p: vec3f) -> vec2f {
+    let e1 = t.v1 - t.v0;
+    let e2 = t.v2 - t.v0;
+    let d = p - t.v0;
+    let d11 = dot(e1, e1);
+    let d12 = dot(e1, e2);
+    let d22 = dot(e2, e2);
+    let det = d11 * d22 - d12 * d12;
+    if det == 0.0 {
+        return vec2f(0.0);
+    }
+    let p1 = dot(d, e1);
+    let p2 = dot(d, e2);
+    return vec2f(d22 * p1 - d12 * p2, d11 * p2 - d12 * p1) / det;
+}
+
+// The surface at barycentrics (b1, b2) of triangle `tri`, its albedo texture (if any) read at
+// level of detail `lod` (PreparedScene::albedo_at).
+fn surface_at(tri: u32, b1: f32, b2: f32, lod: f32) -> Surface {
     let t = triangles[tri];
     let m = materials[t.material];
     var s: Surface;
     s.pos = t.v0 * (1.0 - b1 - b2) + t.v1 * b1 + t.v2 * b2;
     s.normal = triangle_normal(t);
     s.albedo = m.albedo;
+    if m.texture != NO_TEXTURE {
+        let uv = surface_uv(tri, b1, b2);
+        s.albedo *= textureSampleLevel(textures, texture_sampler, uv, m.texture, lod).rgb;
+    }
     s.emission = m.emission;
     s.flags = m.flags;
     s.tri = tri;

@@ -8,9 +8,12 @@
 //! [`renderer::Renderer::iterate`] is the one place that shows the order of the passes.
 
 pub mod bvh;
+pub mod camera_control;
 pub mod direct;
+pub mod display;
 pub mod error;
 pub mod film;
+pub mod fit;
 pub mod frame;
 pub mod gather;
 pub mod gbuffer;
@@ -18,6 +21,7 @@ pub mod gpu;
 pub mod gpu_scene;
 pub mod image_io;
 pub mod lights;
+pub mod limits;
 pub mod metrics;
 pub mod path_tracer;
 pub mod photon_map;
@@ -27,5 +31,6 @@ pub mod renderer;
 pub mod sampling;
 pub mod scene;
 mod shader;
+pub mod textures;
 
 pub use error::{Error, Result};

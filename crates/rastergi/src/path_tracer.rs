@@ -26,6 +26,11 @@
 //!   latest (a safety cap; the energy left there is ρ_max^1024, nothing for any albedo < 1).
 //! - Emitters are one-sided (the front face, counter-clockwise, emits); a ray reaching the back
 //!   of a one-sided surface is absorbed, a two-sided one reflects on both faces.
+//! - Textured albedo: at x₁ the texture is read filtered over the pixel's footprint, its level
+//!   of detail from ray differentials (the rays through the neighbouring pixels meet x₁'s plane
+//!   where the G-buffer's screen-space derivatives would put them), so the reference sees the
+//!   same filtered texture as the rasterizer's visible points; at x₂, x₃, … unfiltered
+//!   (level 0), the exact albedo at the point, as the renderer's secondary points read it.
 //!
 //! The radiance is accumulated into component 0 of a [`Film`], whose other components stay
 //! zero, so the film's resolve, EXR/PNG output and display work unchanged with [`Show::Full`].
@@ -84,7 +89,9 @@ impl PathTracer {
         scene.validate()?;
         let (width, height) = (settings.width, settings.height);
         let film = Film::new(gpu, width, height)?;
+        crate::limits::check_scene(&gpu.device.limits(), scene)?;
         let prepared = PreparedScene::new(scene);
+        prepared.textures.check_limits(gpu)?;
         let light_weight = prepared
             .lights
             .entries
@@ -95,7 +102,7 @@ impl PathTracer {
                 triangle_area(&prepared.scene.triangles[t]) as f64 * (le.x + le.y + le.z)
             })
             .sum::<f64>() as f32;
-        let gpu_scene = GpuScene::new(gpu, &prepared);
+        let gpu_scene = GpuScene::new(gpu, &prepared)?;
         let frame = FrameBinding::new(gpu);
 
         let device = &gpu.device;
@@ -233,8 +240,9 @@ impl PathTracer {
     }
 
     /// The first surface each camera ray of `iteration` hits, in the format of
-    /// `Renderer::read_gbuffer`: `(triangle + 1, b1 bits, b2 bits, 0)` per pixel, row by row,
-    /// 0 where the ray escapes; triangles in BVH order. The ray-traced twin of the G-buffer.
+    /// `Renderer::read_gbuffer` without the level of detail: `(triangle + 1, b1 bits, b2 bits,
+    /// 0)` per pixel, row by row, 0 where the ray escapes; triangles in BVH order. The
+    /// ray-traced twin of the G-buffer.
     pub fn primary_hits(&self, iteration: u32) -> Result<Vec<[u32; 4]>> {
         let (w, h) = (self.settings.width, self.settings.height);
         let size = w as u64 * h as u64 * 16;

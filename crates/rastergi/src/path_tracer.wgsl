@@ -24,14 +24,40 @@ struct PathParams {
 const STREAM_PATH: u32 = 0x9a7b1du;
 const FAR: f32 = 1e30;
 
-// The unit direction of the camera ray through the centre of pixel `xy` of the jittered view.
-// Clip (x, y, 0, 1) is the point at infinity in reversed-Z, so the inverse view-projection maps
-// it to the homogeneous world point (direction, 0), the same ray the rasterizer's pixel sees.
-fn camera_direction(xy: vec2u) -> vec3f {
+// The unit direction of the camera ray through the point p (in pixels, from the top-left
+// corner) of the jittered view. Clip (x, y, 0, 1) is the point at infinity in reversed-Z, so
+// the inverse view-projection maps it to the homogeneous world point (direction, 0), the same
+// ray the rasterizer's pixel sees.
+fn camera_ray(p: vec2f) -> vec3f {
     let res = vec2f(frame.resolution);
-    let p = vec2f(xy) + 0.5;
     let ndc = vec2f(2.0 * p.x / res.x - 1.0, 1.0 - 2.0 * p.y / res.y);
     return normalize((params.inv_view_proj * vec4f(ndc, 0.0, 1.0)).xyz);
+}
+
+// The camera ray through the centre of pixel `xy`.
+fn camera_direction(xy: vec2u) -> vec3f {
+    return camera_ray(vec2f(xy) + 0.5);
+}
+
+// Texture coordinates where the ray (o, d) meets the plane of triangle `tri`.
+fn plane_uv(tri: u32, o: vec3f, d: vec3f) -> vec2f {
+    let t = triangles[tri];
+    let n = cross(t.v1 - t.v0, t.v2 - t.v0);
+    let b = plane_barycentrics(t, o + d * (dot(t.v0 - o, n) / dot(d, n)));
+    return surface_uv(tri, b.x, b.y);
+}
+
+// The texture level of detail at the camera ray's hit on `tri` through pixel `xy`: the rays
+// through the next pixel to the right and below meet the triangle's plane at texture
+// coordinates that differ by what the G-buffer's screen-space derivatives measure (ray
+// differentials, Igehy 1999).
+fn primary_lod(tri: u32, xy: vec2u) -> f32 {
+    let p = vec2f(xy) + 0.5;
+    let uv = plane_uv(tri, frame.eye, camera_ray(p));
+    let dx = plane_uv(tri, frame.eye, camera_ray(p + vec2f(1.0, 0.0))) - uv;
+    let dy = plane_uv(tri, frame.eye, camera_ray(p + vec2f(0.0, 1.0))) - uv;
+    let lod = texture_lod(dx, dy);
+    return select(lod, 32.0, lod != lod);
 }
 
 // Density per unit area with which `sample_light` picks a point on an emitter of radiance le.
@@ -46,8 +72,10 @@ fn power_heuristic(pa: f32, pb: f32) -> f32 {
 }
 
 // One sample of the radiance arriving at `origin` from direction −dir (see path_tracer.rs
-// for the estimator). Random numbers per scattering event: 3 (light), 1 (roulette), 2 (BSDF).
-fn path_radiance(origin: vec3f, dir: vec3f, rng: ptr<function, u32>) -> vec3f {
+// for the estimator), for the camera ray through pixel `xy`. Textures are read filtered over
+// the pixel's footprint at the first hit and unfiltered (level 0) at every later one. Random
+// numbers per scattering event: 3 (light), 1 (roulette), 2 (BSDF).
+fn path_radiance(origin: vec3f, dir: vec3f, xy: vec2u, rng: ptr<function, u32>) -> vec3f {
     var radiance = vec3f(0.0);
     var throughput = vec3f(1.0);
     var o = origin;
@@ -61,7 +89,11 @@ fn path_radiance(origin: vec3f, dir: vec3f, rng: ptr<function, u32>) -> vec3f {
         if hit.tri == NO_TRIANGLE {
             break;
         }
-        let s = surface_at(hit.tri, hit.b1, hit.b2);
+        var lod = 0.0;
+        if bounce == 0u && materials[triangles[hit.tri].material].texture != NO_TEXTURE {
+            lod = primary_lod(hit.tri, xy);
+        }
+        let s = surface_at(hit.tri, hit.b1, hit.b2, lod);
         let cos_in = -dot(s.normal, d);
         let front = cos_in > 0.0;
         // Emission of the front face, weighted against the light sample taken at the previous
@@ -141,7 +173,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     }
     let pixel = gid.y * frame.resolution.x + gid.x;
     var rng = rng_new(frame.seed ^ STREAM_PATH, pixel, frame.iteration);
-    let radiance = path_radiance(frame.eye, camera_direction(gid.xy), &rng);
+    let radiance = path_radiance(frame.eye, camera_direction(gid.xy), gid.xy, &rng);
     film[pixel] += vec4f(radiance, 0.0);
 }
 

@@ -280,7 +280,10 @@ mod tests {
         let cam = Camera { eye: Vec3::Z, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 40.0 };
         let mut s = Scene::new(cam);
         let m = s.add_material(Material::diffuse("m", Vec3::ONE));
-        s.add_quad([Vec3::new(0.0, 0.0, 0.5), Vec3::new(1.0, 0.0, 0.5), Vec3::new(1.0, 1.0, 0.5), Vec3::new(0.0, 1.0, 0.5)], m);
+        s.add_quad(
+            [Vec3::new(0.0, 0.0, 0.5), Vec3::new(1.0, 0.0, 0.5), Vec3::new(1.0, 1.0, 0.5), Vec3::new(0.0, 1.0, 0.5)],
+            m,
+        );
         let grid = GridSpec { origin: Vec3::ZERO, cell: 0.25, dims: UVec3::new(4, 4, 4) };
         let areas = surface_areas(&s, &grid);
         let total: f64 = areas.iter().sum();

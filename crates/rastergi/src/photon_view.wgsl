@@ -12,7 +12,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let g = textureLoad(gbuffer, gid.xy, 0);
     var radiance = vec3f(0.0);
     if g.x != 0u {
-        let s = surface_at(g.x - 1u, bitcast<f32>(g.y), bitcast<f32>(g.z));
+        let s = surface_at(g.x - 1u, bitcast<f32>(g.y), bitcast<f32>(g.z), bitcast<f32>(g.w));
         let front = dot(s.normal, frame.eye - s.pos) > 0.0;
         if front || (s.flags & MATERIAL_TWO_SIDED) != 0u {
             let n = select(-s.normal, s.normal, front);

@@ -12,6 +12,7 @@ use crate::gbuffer::GBufferPass;
 use crate::gpu::Gpu;
 use crate::gpu_scene::{GpuScene, PreparedScene};
 use crate::image_io::{DisplayImage, LinearImage};
+use crate::photon_map::GridSpec;
 use crate::photon_view::PhotonViewPass;
 use crate::photons::PhotonSettings;
 use crate::photons::gpu::GpuPhotonMap;
@@ -123,8 +124,23 @@ impl Renderer {
         scene.validate()?;
         // Fail on an impossible image size before the BVH and the photon map are built.
         gpu.check_image_size(settings.width, settings.height, crate::film::COMPONENTS * 16)?;
+        // Fail on a scene or photon grid too large for this GPU before the BVH is built.
+        let limits = gpu.device.limits();
+        crate::limits::check_scene(&limits, scene)?;
+        if settings.photons > 0 {
+            crate::limits::check_photon_grid(&limits, &GridSpec::new(&scene.bounds(), settings.grid_resolution))?;
+        }
+        let start = std::time::Instant::now();
         let prepared = PreparedScene::new(scene);
-        let gpu_scene = GpuScene::new(gpu, &prepared);
+        log::info!(
+            "BVH over {} triangles: {} nodes, depth {}, built in {:.2} s",
+            scene.triangles.len(),
+            prepared.bvh.nodes.len(),
+            prepared.bvh.depth(),
+            start.elapsed().as_secs_f64()
+        );
+        prepared.textures.check_limits(gpu)?;
+        let gpu_scene = GpuScene::new(gpu, &prepared)?;
         let frame = FrameBinding::new(gpu);
         let photon_settings =
             PhotonSettings { count: settings.photons, seed: settings.seed, grid_resolution: settings.grid_resolution };
@@ -276,7 +292,8 @@ impl Renderer {
         self.passes.film.read_display(&self.gpu, show, exposure)
     }
 
-    /// Raw G-buffer texels `(triangle + 1, b1 bits, b2 bits, 0)`, row by row (for tests and tools).
+    /// Raw G-buffer texels `(triangle + 1, b1 bits, b2 bits, texture level of detail bits)`,
+    /// row by row (for tests and tools).
     pub fn read_gbuffer(&self) -> Result<Vec<[u32; 4]>> {
         let (w, h) = (self.settings.width, self.settings.height);
         let row = (w * 16).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);

@@ -14,7 +14,7 @@ use rastergi::scene::{Camera, Material, Scene, cornell_box};
 
 fn gpu_map(gpu: &rastergi::gpu::Gpu, scene: &Scene, settings: &PhotonSettings) -> PhotonMap {
     let prepared = PreparedScene::new(scene);
-    let gs = GpuScene::new(gpu, &prepared);
+    let gs = GpuScene::new(gpu, &prepared).expect("scene upload");
     GpuPhotonMap::build(gpu, &gs, &prepared, settings).unwrap().read(gpu).unwrap()
 }
 

@@ -98,11 +98,12 @@ fn trace_photon(prepared: &PreparedScene, grid: &GridSpec, settings: &PhotonSett
         }
         t.flux_sq[slot] += (flux.y as f64).powi(2);
         t.deposits[slot] += 1;
-        let survive = material.albedo.max_element();
+        let albedo = prepared.albedo_at(hit.triangle as usize, hit.b1, hit.b2, 0.0);
+        let survive = albedo.max_element();
         if rng.next_f32() >= survive {
             break;
         }
-        flux *= material.albedo / survive;
+        flux *= albedo / survive;
         let (u1, u2) = (rng.next_f32(), rng.next_f32());
         dir = cosine_hemisphere(n, u1, u2);
         origin = p + n * eps;

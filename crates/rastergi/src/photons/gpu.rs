@@ -15,7 +15,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::UVec3;
 
 use super::{MAX_BOUNCES, PhotonSettings};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::gpu::{Gpu, compute_pipeline, storage_entry, uniform_entry};
 use crate::gpu_scene::{GpuScene, PreparedScene};
 use crate::photon_map::{BINS, GridSpec, PhotonMap, surface_areas};
@@ -100,26 +100,8 @@ impl GpuPhotonMap {
         settings: &PhotonSettings,
     ) -> Result<GpuPhotonMap> {
         let grid = GridSpec::new(&prepared.bounds, settings.grid_resolution);
-        let limits = gpu.device.limits();
+        crate::limits::check_photon_grid(&gpu.device.limits(), &grid)?;
         let slots = grid.slot_count() as u64;
-        if grid.dims.max_element() > limits.max_texture_dimension_3d
-            || BINS as u32 * grid.dims.z > limits.max_texture_dimension_3d
-        {
-            return Err(Error::Limits(format!(
-                "a photon grid of {}x{}x{} cells needs a 3D texture deeper than this GPU's {} texels; choose a smaller --grid",
-                grid.dims.x, grid.dims.y, grid.dims.z, limits.max_texture_dimension_3d
-            )));
-        }
-        if slots * 24 > limits.max_storage_buffer_binding_size.min(limits.max_buffer_size) {
-            return Err(Error::Limits(format!(
-                "a photon grid of {}x{}x{} cells needs {} MiB of counters, more than this GPU binds ({} MiB); choose a smaller --grid",
-                grid.dims.x,
-                grid.dims.y,
-                grid.dims.z,
-                (slots * 24) >> 20,
-                limits.max_storage_buffer_binding_size >> 20
-            )));
-        }
         let area = surface_areas(&prepared.scene, &grid);
         let max_flux = settings.max_photon_flux(prepared);
         let quantum = if max_flux > 0.0 { (1u64 << QUANTUM_BITS) as f64 / max_flux } else { 1.0 };

@@ -11,7 +11,8 @@
 //! (= total emitted power / N when all lights share one colour). At each hit of a side that
 //! reflects, Φ is deposited in the slot (cell of the hit, bin of the side's normal); the photon
 //! then survives with probability p = max(ρ) (Russian roulette) carrying Φ·ρ/p, in a cosine
-//! direction about the side's normal. There is no depth limit, only a safety cap
+//! direction about the side's normal; ρ is the albedo at the hit point, a texture read there
+//! unfiltered (level 0), so each photon takes the colour of the texel it hits. There is no depth limit, only a safety cap
 //! ([`MAX_BOUNCES`]). Hitting the back of a one-sided surface absorbs the photon.
 //!
 //! Every random number comes from the stream (seed ⊕ [`STREAM_PHOTON`], photon index), so the

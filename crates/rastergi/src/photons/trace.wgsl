@@ -86,7 +86,8 @@ fn trace_photons(@builtin(global_invocation_id) gid: vec3u) {
         if hit.tri == NO_TRIANGLE {
             break;
         }
-        let s = surface_at(hit.tri, hit.b1, hit.b2);
+        // The texel's albedo, unfiltered (level 0): photons sample the texture point-wise.
+        let s = surface_at(hit.tri, hit.b1, hit.b2, 0.0);
         let front = dot(s.normal, dir) < 0.0;
         if !front && (s.flags & MATERIAL_TWO_SIDED) == 0u {
             break;

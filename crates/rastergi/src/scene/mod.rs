@@ -5,23 +5,38 @@
 //! counter-clockwise winding faces: its geometric normal is `normalize((v1-v0) × (v2-v0))`.
 //! Emitters are one-sided. Reflection is one-sided too unless the material is `two_sided`
 //! (a ray reaching the back of a one-sided surface is absorbed, as in Mitsuba 3's `diffuse`).
+//! The albedo may vary over a surface: a material's constant albedo times an sRGB texture read
+//! at the triangle's interpolated texture coordinates.
 
 mod cornell;
+pub mod export;
+pub mod generate;
+mod gltf;
 mod obj;
+mod texture;
 
 pub use cornell::cornell_box;
+pub use gltf::{GltfOptions, load_gltf, load_gltf_with};
 pub use obj::load_obj;
+pub use texture::{MAX_DECODED_SIDE, Texture};
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 use crate::error::{Error, Result};
+
+/// Most textures a scene may hold: one texture-array layer each, and 256 layers is what every
+/// WebGPU device supports.
+pub const MAX_TEXTURES: usize = 256;
 
 /// A Lambertian material with optional one-sided emission.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
     pub name: String,
-    /// Diffuse albedo ρ in linear RGB; the BRDF is ρ/π.
+    /// Diffuse albedo ρ in linear RGB; the BRDF is ρ/π. With a texture, ρ = albedo × texel.
     pub albedo: Vec3,
+    /// Index into [`Scene::textures`] of an albedo texture (sRGB, decoded to linear), read at
+    /// the triangle's texture coordinates ([`Scene::uvs`]).
+    pub albedo_texture: Option<usize>,
     /// Radiance emitted from the front face, linear RGB.
     pub emission: Vec3,
     /// Whether the back face reflects too (it never emits).
@@ -30,7 +45,7 @@ pub struct Material {
 
 impl Material {
     pub fn diffuse(name: &str, albedo: Vec3) -> Self {
-        Self { name: name.to_owned(), albedo, emission: Vec3::ZERO, two_sided: false }
+        Self { name: name.to_owned(), albedo, albedo_texture: None, emission: Vec3::ZERO, two_sided: false }
     }
 
     pub fn is_emitter(&self) -> bool {
@@ -119,12 +134,24 @@ pub struct Scene {
     /// Index into `materials` for each triangle.
     pub material_ids: Vec<u32>,
     pub materials: Vec<Material>,
+    /// Texture coordinates of each triangle's corners, in the order of `triangles`: empty when
+    /// no triangle has any, else one entry per triangle (zero where a triangle has none).
+    pub uvs: Vec<[Vec2; 3]>,
+    /// Albedo textures, referred to by [`Material::albedo_texture`].
+    pub textures: Vec<Texture>,
     pub camera: Camera,
 }
 
 impl Scene {
     pub fn new(camera: Camera) -> Self {
-        Self { triangles: Vec::new(), material_ids: Vec::new(), materials: Vec::new(), camera }
+        Self {
+            triangles: Vec::new(),
+            material_ids: Vec::new(),
+            materials: Vec::new(),
+            uvs: Vec::new(),
+            textures: Vec::new(),
+            camera,
+        }
     }
 
     /// Adds a material and returns its index.
@@ -136,6 +163,23 @@ impl Scene {
     pub fn add_triangle(&mut self, tri: [Vec3; 3], material: u32) {
         self.triangles.push(tri);
         self.material_ids.push(material);
+        if !self.uvs.is_empty() {
+            self.uvs.push([Vec2::ZERO; 3]);
+        }
+    }
+
+    /// Adds a triangle with texture coordinates `uv` at its corners.
+    pub fn add_textured_triangle(&mut self, tri: [Vec3; 3], uv: [Vec2; 3], material: u32) {
+        self.uvs.resize(self.triangles.len(), [Vec2::ZERO; 3]);
+        self.triangles.push(tri);
+        self.material_ids.push(material);
+        self.uvs.push(uv);
+    }
+
+    /// Adds a texture and returns its index.
+    pub fn add_texture(&mut self, texture: Texture) -> usize {
+        self.textures.push(texture);
+        self.textures.len() - 1
     }
 
     /// Adds the quad `a, b, c, d` (counter-clockwise about its front face) as two triangles.
@@ -191,12 +235,34 @@ impl Scene {
         if let Some(&m) = self.material_ids.iter().find(|&&m| m as usize >= self.materials.len()) {
             return Err(Error::InvalidScene(format!("material index {m} is out of range")));
         }
+        if !self.uvs.is_empty() && self.uvs.len() != self.triangles.len() {
+            return Err(Error::InvalidScene("texture coordinates must be given for every triangle or none".into()));
+        }
+        if let Some(i) = self.uvs.iter().position(|t| !t.iter().all(|uv| uv.is_finite())) {
+            return Err(Error::InvalidScene(format!("triangle {i} has a non-finite texture coordinate")));
+        }
+        if self.textures.len() > MAX_TEXTURES {
+            return Err(Error::InvalidScene(format!(
+                "the scene has {} textures, more than the {MAX_TEXTURES} supported",
+                self.textures.len()
+            )));
+        }
+        for t in &self.textures {
+            t.validate().map_err(Error::InvalidScene)?;
+        }
         for m in &self.materials {
             let ok = |v: Vec3| v.is_finite() && v.min_element() >= 0.0;
             if !ok(m.albedo) || !ok(m.emission) {
                 return Err(Error::InvalidScene(format!(
                     "material '{}' has a negative or non-finite albedo or emission",
                     m.name
+                )));
+            }
+            if let Some(t) = m.albedo_texture.filter(|&t| t >= self.textures.len()) {
+                return Err(Error::InvalidScene(format!(
+                    "material '{}' refers to texture {t}, but the scene has {}",
+                    m.name,
+                    self.textures.len()
                 )));
             }
             if m.albedo.max_element() > 1.0 {

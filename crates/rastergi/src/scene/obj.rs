@@ -4,13 +4,19 @@
 //! OBJ has no notion of sidedness, so materials loaded from OBJ reflect on both faces; they
 //! emit from the counter-clockwise front face only. Faces without a material get a grey
 //! albedo of 0.5 (Mitsuba's default). OBJ carries no camera: the scene is framed from +z.
+//!
+//! A material's `map_Kd` image (PNG or JPEG, found relative to its .mtl file) multiplies its
+//! `Kd` (1 when `Kd` is absent), read at the faces' `vt` coordinates; OBJ's v points up the
+//! image, so v is flipped into the scene's convention (v down). Texture options (`-o`, `-s`,
+//! …) are skipped with a warning.
 
 use std::cell::RefCell;
-use std::path::Path;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
-use super::{Material, Scene};
+use super::{Material, Scene, Texture};
 use crate::error::{Error, Result};
 
 const DEFAULT_ALBEDO: f32 = 0.5;
@@ -32,23 +38,47 @@ pub fn load_obj(path: &Path) -> Result<Scene> {
     comment_out_texcoords_and_normals(&mut text);
     let options =
         tobj::LoadOptions { triangulate: true, ignore_points: true, ignore_lines: true, ..Default::default() };
-    // tobj keeps only the last MTL error, and none at all once one library loaded; the first
-    // failure, with the library's path, is kept here.
-    let mtl_error = RefCell::new(None);
-    let (models, materials) = tobj::load_obj_buf(&mut text.as_slice(), &options, |mtl| load_mtl(path, mtl, &mtl_error))
-        .map_err(|e| file_error(path, obj_error_message(e)))?;
-    let mtl_failure = mtl_error.into_inner().or_else(|| materials.as_ref().err().map(|e| e.to_string()));
-    if let Some(message) = mtl_failure {
-        let hint = "fix the .mtl file, put it beside the .obj or remove the mtllib line";
-        return Err(file_error(path, format!("its material library (mtllib) could not be loaded: {message}; {hint}")));
+    let (mut models, materials) = load_obj_text(path, &text, &options)?;
+    if models.iter().any(|m| m.mesh.positions.iter().any(|c| !c.is_finite())) {
+        let (line, word) = first_non_finite_vertex(&text).unwrap_or((0, "?".into()));
+        return Err(file_error(
+            path,
+            format!(
+                "line {line}: a vertex has a non-finite coordinate ('{word}' is NaN or beyond ±3.4e38); fix the vertex"
+            ),
+        ));
     }
-    let materials = materials.unwrap_or_default();
+    let textured = materials.iter().any(|m| m.diffuse_texture.is_some());
+    if textured {
+        // Textures need the texture coordinates: load again with them, once every face's
+        // references are known to be in range (tobj overflows on some that are not).
+        let mut text = std::fs::read(path).map_err(|e| file_error(path, format!("cannot be read: {e}")))?;
+        comment_out_normals(&mut text);
+        check_texcoord_references(&text).map_err(|message| file_error(path, message))?;
+        models = load_obj_text(path, &text, &tobj::LoadOptions { single_index: true, ..options })?.0;
+    }
 
     let mut scene = Scene::new(super::Camera { eye: Vec3::Z, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 45.0 });
+    let mut texture_of_file: HashMap<PathBuf, usize> = HashMap::new();
     for m in &materials {
-        let albedo = m.diffuse.map(Vec3::from).unwrap_or(Vec3::splat(DEFAULT_ALBEDO));
+        let albedo_texture = match &m.diffuse_texture {
+            Some(file) => Some(match texture_of_file.get(Path::new(file)) {
+                Some(&t) => t,
+                None => {
+                    let texture = read_texture(Path::new(file)).map_err(|e| {
+                        file_error(path, format!("the texture {file} (map_Kd of material '{}') {e}", m.name))
+                    })?;
+                    let t = scene.add_texture(texture);
+                    texture_of_file.insert(PathBuf::from(file), t);
+                    t
+                }
+            }),
+            None => None,
+        };
+        let default_albedo = if albedo_texture.is_some() { 1.0 } else { DEFAULT_ALBEDO };
+        let albedo = m.diffuse.map(Vec3::from).unwrap_or(Vec3::splat(default_albedo));
         let emission = m.emissive.map(Vec3::from).unwrap_or(Vec3::ZERO);
-        scene.add_material(Material { name: m.name.clone(), albedo, emission, two_sided: true });
+        scene.add_material(Material { name: m.name.clone(), albedo, albedo_texture, emission, two_sided: true });
     }
     let mut default_material = None;
     for model in &models {
@@ -63,6 +93,18 @@ pub fn load_obj(path: &Path) -> Result<Scene> {
             }),
         };
         let vertex_count = mesh.positions.len() / 3;
+        // tobj gives texture coordinates per vertex only when every vertex of the model has one.
+        let has_uvs = !mesh.texcoords.is_empty() && mesh.texcoords.len() / 2 == vertex_count;
+        let needs_uvs = scene.materials[material as usize].albedo_texture.is_some();
+        if needs_uvs && !has_uvs {
+            return Err(file_error(
+                path,
+                format!(
+                    "faces of '{}' use the textured material '{}' but lack texture coordinates (f v/vt)",
+                    model.name, scene.materials[material as usize].name
+                ),
+            ));
+        }
         for (f, face) in mesh.indices.chunks_exact(3).enumerate() {
             let mut tri = [Vec3::ZERO; 3];
             for (k, &i) in face.iter().enumerate() {
@@ -75,7 +117,15 @@ pub fn load_obj(path: &Path) -> Result<Scene> {
                 }
                 tri[k] = Vec3::new(mesh.positions[3 * i], mesh.positions[3 * i + 1], mesh.positions[3 * i + 2]);
             }
-            scene.add_triangle(tri, material);
+            if has_uvs {
+                let uv: [Vec2; 3] = std::array::from_fn(|k| {
+                    let i = face[k] as usize;
+                    Vec2::new(mesh.texcoords[2 * i], 1.0 - mesh.texcoords[2 * i + 1])
+                });
+                scene.add_textured_triangle(tri, uv, material);
+            } else {
+                scene.add_triangle(tri, material);
+            }
         }
     }
     if scene.triangles.is_empty() {
@@ -86,9 +136,121 @@ pub fn load_obj(path: &Path) -> Result<Scene> {
     Ok(scene)
 }
 
-/// What is wrong with an OBJ file tobj refused, and what to do about it.
-fn obj_error_message(e: tobj::LoadError) -> String {
+/// Reads a `map_Kd` image; a device or a pipe (`map_Kd /dev/zero`) would be read forever.
+fn read_texture(file: &Path) -> std::result::Result<Texture, String> {
+    if file.exists() && !file.is_file() {
+        return Err("is not a regular file".into());
+    }
+    Texture::read(file)
+}
+
+/// Parses OBJ text with tobj, loading its MTL libraries relative to `path`.
+fn load_obj_text(
+    path: &Path,
+    text: &[u8],
+    options: &tobj::LoadOptions,
+) -> Result<(Vec<tobj::Model>, Vec<tobj::Material>)> {
+    // tobj keeps only the last MTL error, and none at all once one library loaded; the first
+    // failure, with the library's path, is kept here.
+    let mtl_error = RefCell::new(None);
+    let (models, materials) = tobj::load_obj_buf(&mut &text[..], options, |mtl| load_mtl(path, mtl, &mtl_error))
+        .map_err(|e| file_error(path, obj_error_message(e, text)))?;
+    let mtl_failure = mtl_error.into_inner().or_else(|| materials.as_ref().err().map(|e| e.to_string()));
+    if let Some(message) = mtl_failure {
+        let hint = "fix the .mtl file, put it beside the .obj or remove the mtllib line";
+        return Err(file_error(path, format!("its material library (mtllib) could not be loaded: {message}; {hint}")));
+    }
+    Ok((models, materials.unwrap_or_default()))
+}
+
+/// Turns `vn` lines into comments in place (see [`comment_out_texcoords_and_normals`]).
+fn comment_out_normals(text: &mut [u8]) {
+    for line in text.split_mut(|&b| b == b'\n') {
+        let indent = line.iter().take_while(|b| b.is_ascii_whitespace()).count();
+        let line = &mut line[indent..];
+        let keyword = line.iter().position(u8::is_ascii_whitespace).unwrap_or(line.len());
+        if &line[..keyword] == b"vn" {
+            line[0] = b'#';
+        }
+    }
+}
+
+/// Checks that every texture-coordinate reference of an `f` line names a `vt` line of the file:
+/// 1 to the number of `vt` lines, or −1 back to the first `vt` line before it.
+fn check_texcoord_references(text: &[u8]) -> Result<(), String> {
+    let is_vt = |line: &[u8]| line.split(u8::is_ascii_whitespace).find(|w| !w.is_empty()) == Some(b"vt");
+    let total = text.split(|&b| b == b'\n').filter(|&l| is_vt(l)).count() as i64;
+    let mut seen = 0i64;
+    for (n, line) in text.split(|&b| b == b'\n').enumerate() {
+        let line = String::from_utf8_lossy(line);
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("vt") => seen += 1,
+            Some("f") => {
+                for vertex in words {
+                    let Some(Ok(i)) = vertex.split('/').nth(1).filter(|s| !s.is_empty()).map(str::parse::<i64>) else {
+                        continue;
+                    };
+                    if (i > 0 && i > total) || (i < 0 && seen + i < 0) {
+                        return Err(format!(
+                            "line {}: a face refers to texture coordinate {i}, but there are {} (vt lines); fix the face or export the file again",
+                            n + 1,
+                            if i > 0 { total } else { seen }
+                        ));
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
+/// The file name of a `map_Kd` statement's value, after its options (`-o u v w`, `-s …`,
+/// `-clamp on`, …), which are skipped.
+fn texture_file_name(value: &str) -> std::result::Result<&str, String> {
+    let mut rest = value.trim();
+    while rest.starts_with('-') {
+        let (option, after) = rest.split_once(char::is_whitespace).unwrap_or((rest, ""));
+        let (min, max) = match option {
+            "-blendu" | "-blendv" | "-cc" | "-clamp" | "-texres" | "-bm" | "-boost" | "-imfchan" => (1, 1),
+            "-mm" => (2, 2),
+            "-o" | "-s" | "-t" => (1, 3),
+            _ => return Err(format!("map_Kd has an unknown option '{option}'")),
+        };
+        rest = after.trim_start();
+        // The required values are taken as they come, the optional ones only if numbers.
+        for k in 0..max {
+            let (word, after) = rest.split_once(char::is_whitespace).unwrap_or((rest, ""));
+            if word.is_empty() || (k >= min && word.parse::<f32>().is_err()) {
+                if k < min {
+                    return Err(format!("map_Kd option '{option}' lacks its value"));
+                }
+                break;
+            }
+            rest = after.trim_start();
+        }
+        log::warn!("map_Kd option '{option}' is not supported and is ignored");
+    }
+    if rest.is_empty() {
+        return Err("map_Kd names no file".into());
+    }
+    Ok(rest)
+}
+
+/// What is wrong with an OBJ file tobj refused, where, and what to do about it.
+fn obj_error_message(e: tobj::LoadError, text: &[u8]) -> String {
     use tobj::LoadError as E;
+    let located = match e {
+        E::PositionParseError | E::ScalingByZeroError | E::ColorParseError => first_bad_vertex(text),
+        E::FaceParseError | E::InvalidPolygon | E::FaceVertexOutOfBounds => first_bad_face(text),
+        _ => None,
+    };
+    if let Some((line, what)) = located {
+        return format!(
+            "not a valid OBJ file: line {line}: {what}; fix that line or export the file again as Wavefront OBJ"
+        );
+    }
     let what = match e {
         E::ReadError => return "not a valid OBJ file: it is not UTF-8 text; export it again as Wavefront OBJ".into(),
         E::PositionParseError => "a 'v' line does not hold three numbers",
@@ -102,6 +264,84 @@ fn obj_error_message(e: tobj::LoadError) -> String {
         _ => return format!("not a valid OBJ file ({e}); check it or export it again as Wavefront OBJ"),
     };
     format!("not a valid OBJ file: {what}; fix that line or export the file again as Wavefront OBJ")
+}
+
+/// The OBJ's lines (numbered from 1) split into words, as tobj reads them.
+fn numbered_lines(text: &[u8]) -> impl Iterator<Item = (usize, Vec<&str>)> {
+    text.split(|&b| b == b'\n')
+        .enumerate()
+        .map(|(n, line)| (n + 1, std::str::from_utf8(line).unwrap_or("").split_whitespace().collect()))
+}
+
+/// The first `v` line tobj refuses, and why: three coordinates, then nothing, a weight w ≠ 0
+/// or a colour (r g b).
+fn first_bad_vertex(text: &[u8]) -> Option<(usize, String)> {
+    let number = |w: &str| w.parse::<f32>().is_ok();
+    numbered_lines(text).find_map(|(n, words)| {
+        let values = match words.split_first() {
+            Some((&"v", values)) => values,
+            _ => return None,
+        };
+        let what = match values {
+            [x, y, z, rest @ ..] if number(x) && number(y) && number(z) => match rest {
+                [] => return None,
+                [w] if w.parse::<f32>().is_ok_and(|w| w != 0.0) => return None,
+                [w] if number(w) => "a vertex has a weight w of 0".to_owned(),
+                [r, g, b] if number(r) && number(g) && number(b) => return None,
+                _ => format!(
+                    "a vertex has {} values after its coordinates; expected none, a weight or a colour (r g b)",
+                    rest.len()
+                ),
+            },
+            _ => format!("'{}' does not start with three numbers (x y z)", words.join(" ")),
+        };
+        Some((n, what))
+    })
+}
+
+/// The first `v` line with a coordinate that is not a finite `f32` (tobj reads `nan`, `inf`
+/// and `1e39` as such), and that word.
+fn first_non_finite_vertex(text: &[u8]) -> Option<(usize, String)> {
+    numbered_lines(text).find_map(|(n, words)| match words.split_first() {
+        Some((&"v", values)) => {
+            let bad = values.iter().take(3).find(|w| w.parse::<f32>().is_ok_and(|x| !x.is_finite()))?;
+            Some((n, bad.to_string()))
+        }
+        _ => None,
+    })
+}
+
+/// The first `f` (or `l`) line tobj refuses, and why: a face needs three or more corners
+/// whose vertex indices count from 1 (or back from −1) within the vertices of the file.
+fn first_bad_face(text: &[u8]) -> Option<(usize, String)> {
+    let total = numbered_lines(text).filter(|(_, w)| w.first() == Some(&"v")).count() as i64;
+    let mut seen = 0i64;
+    numbered_lines(text).find_map(|(n, words)| {
+        let (keyword, corners) = words.split_first()?;
+        match *keyword {
+            "v" => seen += 1,
+            "f" | "l" => {
+                if *keyword == "f" && corners.len() < 3 {
+                    return Some((n, format!("a face has {} corners; it needs three or more", corners.len())));
+                }
+                for corner in corners {
+                    let index = corner.split('/').next().unwrap_or("");
+                    let what = match index.parse::<i64>() {
+                        Err(_) => format!("'{corner}' is not a vertex index"),
+                        Ok(0) => "vertex index 0 does not exist (OBJ counts vertices from 1)".to_owned(),
+                        Ok(i) if i > total => format!("vertex {i} does not exist: the file has {total} vertices"),
+                        Ok(i) if i < 0 && seen + i < 0 => {
+                            format!("vertex {i} does not exist: {seen} vertices come before this line")
+                        }
+                        Ok(_) => continue,
+                    };
+                    return Some((n, what));
+                }
+            }
+            _ => {}
+        }
+        None
+    })
 }
 
 /// Turns `vt` and `vn` lines into comments in place: a scene needs positions only, and tobj
@@ -130,6 +370,10 @@ fn load_mtl(obj: &Path, name: &Path, error: &RefCell<Option<String>>) -> tobj::M
         error.borrow_mut().get_or_insert("an mtllib line names no file".into());
         return Err(tobj::LoadError::OpenFileFailed);
     }
+    // A device or a pipe (`mtllib /dev/zero`) would be read forever.
+    if mtl_path.exists() && !mtl_path.is_file() {
+        return fail("is not a regular file".into(), tobj::LoadError::OpenFileFailed);
+    }
     let text = match std::fs::read_to_string(&mtl_path) {
         Ok(text) => text,
         Err(e) => return fail(e.to_string(), tobj::LoadError::OpenFileFailed),
@@ -153,5 +397,21 @@ fn load_mtl(obj: &Path, name: &Path, error: &RefCell<Option<String>>) -> tobj::M
         completed.push_str(line);
         completed.push('\n');
     }
-    tobj::load_mtl_buf(&mut completed.as_bytes()).or_else(|e| fail(format!("not a valid MTL file ({e})"), e))
+    let (mut materials, names) =
+        tobj::load_mtl_buf(&mut completed.as_bytes()).or_else(|e| fail(format!("not a valid MTL file ({e})"), e))?;
+    // Texture files are named relative to the MTL file.
+    for m in &mut materials {
+        if let Some(value) = &m.diffuse_texture {
+            match texture_file_name(value) {
+                Ok(file) => {
+                    let resolved = mtl_path.parent().unwrap_or(Path::new("")).join(file);
+                    m.diffuse_texture = Some(resolved.to_string_lossy().into_owned());
+                }
+                Err(message) => {
+                    return fail(format!("material '{}': {message}", m.name), tobj::LoadError::MaterialParseError);
+                }
+            }
+        }
+    }
+    Ok((materials, names))
 }

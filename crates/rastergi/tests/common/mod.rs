@@ -1,6 +1,8 @@
 //! Shared test harness: the GPU (lavapipe on CI), renders and references.
 #![allow(dead_code)]
 
+pub mod textured_room;
+
 use std::path::PathBuf;
 
 use rastergi::film::Show;

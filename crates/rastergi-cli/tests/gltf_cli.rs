@@ -1,0 +1,110 @@
+//! `rastergi render` with glTF scenes: `.gltf`/`.glb` are recognised, `--camera N` picks a
+//! camera of the file, and a bad camera index or a broken file is one error line, no panic.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+/// Runs the binary with `args` in `dir`.
+fn rastergi(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_rastergi")).args(args).current_dir(dir).output().unwrap()
+}
+
+/// The one `error:` line of a failed run (Mesa's XDG_RUNTIME_DIR notices aside).
+fn error_line(run: &Output) -> String {
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(!run.status.success(), "the run succeeded:\n{stderr}");
+    assert!(!stderr.contains("panicked"), "the run panicked:\n{stderr}");
+    let errors: Vec<&str> =
+        stderr.lines().filter(|l| l.starts_with("error:") && !l.contains("XDG_RUNTIME_DIR")).collect();
+    assert_eq!(errors.len(), 1, "expected one error line:\n{stderr}");
+    errors[0].to_owned()
+}
+
+/// A floor (2 × 2 at y = 0) under a small emitter facing down, seen by two cameras: 0 from the
+/// front, 1 from above. Written as `scene.gltf` + `scene.bin` in `dir`.
+fn write_scene(dir: &Path) {
+    let positions: [[f32; 3]; 8] = [
+        [-1.0, 0.0, 1.0],
+        [1.0, 0.0, 1.0],
+        [1.0, 0.0, -1.0],
+        [-1.0, 0.0, -1.0],
+        [-0.2, 1.5, -0.2],
+        [0.2, 1.5, -0.2],
+        [0.2, 1.5, 0.2],
+        [-0.2, 1.5, 0.2],
+    ];
+    let indices: [u16; 12] = [0, 1, 2, 0, 2, 3, 0, 1, 2, 0, 2, 3];
+    let mut bin: Vec<u8> = positions.iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
+    bin.extend(indices.iter().flat_map(|i| i.to_le_bytes()));
+    std::fs::write(dir.join("scene.bin"), &bin).unwrap();
+    let s = std::f32::consts::FRAC_1_SQRT_2;
+    let json = format!(
+        r#"{{
+  "asset": {{ "version": "2.0" }},
+  "scene": 0,
+  "scenes": [{{ "nodes": [0, 1, 2, 3] }}],
+  "nodes": [
+    {{ "mesh": 0 }},
+    {{ "mesh": 1 }},
+    {{ "camera": 0, "translation": [0, 1, 3] }},
+    {{ "camera": 1, "translation": [0, 3, 0], "rotation": [{r}, 0, 0, {s}] }}
+  ],
+  "cameras": [
+    {{ "type": "perspective", "perspective": {{ "yfov": 0.8, "znear": 0.01 }} }},
+    {{ "type": "perspective", "perspective": {{ "yfov": 0.8, "znear": 0.01 }} }}
+  ],
+  "materials": [
+    {{ "pbrMetallicRoughness": {{ "baseColorFactor": [0.8, 0.8, 0.8, 1] }} }},
+    {{ "emissiveFactor": [1, 1, 1] }}
+  ],
+  "meshes": [
+    {{ "primitives": [{{ "attributes": {{ "POSITION": 0 }}, "indices": 1, "material": 0 }}] }},
+    {{ "primitives": [{{ "attributes": {{ "POSITION": 2 }}, "indices": 3, "material": 1 }}] }}
+  ],
+  "buffers": [{{ "uri": "scene.bin", "byteLength": {len} }}],
+  "bufferViews": [
+    {{ "buffer": 0, "byteOffset": 0, "byteLength": 96 }},
+    {{ "buffer": 0, "byteOffset": 96, "byteLength": 24 }}
+  ],
+  "accessors": [
+    {{ "bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-1, 0, -1], "max": [1, 0, 1] }},
+    {{ "bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR" }},
+    {{ "bufferView": 0, "byteOffset": 48, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-0.2, 1.5, -0.2], "max": [0.2, 1.5, 0.2] }},
+    {{ "bufferView": 1, "byteOffset": 12, "componentType": 5123, "count": 6, "type": "SCALAR" }}
+  ]
+}}"#,
+        r = -s,
+        len = bin.len()
+    );
+    std::fs::write(dir.join("scene.gltf"), json).unwrap();
+}
+
+#[test]
+fn gltf_scenes_render_from_the_camera_chosen_with_camera() {
+    let dir = tempfile::tempdir().unwrap();
+    write_scene(dir.path());
+    let base = ["render", "scene.gltf", "--width", "16", "--height", "16", "--iterations", "2", "--photons", "4096"];
+    for (camera, out) in [("0", "front.png"), ("1", "top.png")] {
+        let run = rastergi(dir.path(), &[&base[..], &["--camera", camera, "--out", out]].concat());
+        assert!(run.status.success(), "--camera {camera}: {}", String::from_utf8_lossy(&run.stderr));
+    }
+    let run = rastergi(dir.path(), &[&base[..], &["--out", "default.png"]].concat());
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let read = |name: &str| std::fs::read(dir.path().join(name)).unwrap();
+    assert_eq!(read("default.png"), read("front.png"), "the first camera is the default");
+    assert_ne!(read("front.png"), read("top.png"), "the two cameras see the same image");
+}
+
+#[test]
+fn a_camera_the_file_lacks_or_a_camera_for_another_scene_is_one_error_line() {
+    let dir = tempfile::tempdir().unwrap();
+    write_scene(dir.path());
+    let line = error_line(&rastergi(dir.path(), &["render", "scene.gltf", "--camera", "2", "--out", "x.png"]));
+    assert!(line.contains("scene.gltf") && line.contains("2 cameras"), "{line}");
+    let line = error_line(&rastergi(dir.path(), &["render", "cornell", "--camera", "0", "--out", "x.png"]));
+    assert!(line.contains("--camera"), "{line}");
+    std::fs::write(dir.path().join("broken.glb"), b"glTF\x02\0\0\0\xff\xff\0\0JSON").unwrap();
+    let line = error_line(&rastergi(dir.path(), &["render", "broken.glb", "--out", "x.png"]));
+    assert!(line.contains("broken.glb") && line.contains("truncated"), "{line}");
+    assert!(!dir.path().join("x.png").exists());
+}

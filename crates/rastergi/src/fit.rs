@@ -1,0 +1,165 @@
+//! Settings that fit the scene, for front ends whose user gave none: the photon grid's
+//! resolution, the photon count and the exposure of a display image. Each rule is calibrated
+//! so the built-in Cornell box keeps the defaults its documented figures were measured with
+//! (grid 64, 2²⁰ photons, exposure 0), and each reduces to a statement a user can check:
+//!
+//! - **Grid**: as many cubic cells as the Cornell box's 64³, whatever the scene's shape. A
+//!   cube gets 64 cells per side; a corridor ten times longer than wide gets about 300 along
+//!   its length and 30 across, where "64 along the longest axis" would give it only 6 across.
+//!   Memory stays that of the 64³ grid (about 70 MB).
+//! - **Photons**: about [`PHOTONS_PER_CELL_AREA`] photons per cell-sized patch of surface
+//!   (total surface area A over the cell's face h²), so a cell's irradiance estimate has
+//!   about the same noise as in the Cornell box; rounded to a power of two, from 2¹⁸ to 2²⁴.
+//! - **Exposure** (PNG): 0 unless the image's median luminance (over pixels that see
+//!   anything) is more than two stops away from middle grey 0.18; then the whole number of
+//!   stops that brings it to 0.18. A guard rail for scenes whose emitters are far too
+//!   strong or weak, not a tone mapper: a reasonably lit image is left as rendered.
+
+use crate::image_io::LinearImage;
+use crate::photon_map::GridSpec;
+use crate::scene::{Aabb, Scene, triangle_area};
+
+/// Grid cells of the Cornell box's default grid, the budget every scene gets.
+pub const GRID_CELL_BUDGET: u64 = 64 * 64 * 64;
+/// Largest fitted resolution (a flat scene gets about 500 × 1 × 500 cells).
+pub const MAX_GRID: u32 = 512;
+/// Photons per h² of surface: the Cornell box's 2²⁰ photons over its ≈ 25 m² of surface in
+/// cells of h = 3.1 cm (≈ 25 000 patches) are ≈ 41 per patch; 40 puts it in the middle of the
+/// band that rounds to 2²⁰.
+pub const PHOTONS_PER_CELL_AREA: f64 = 40.0;
+/// Range of fitted photon counts.
+pub const MIN_PHOTONS: u32 = 1 << 18;
+pub const MAX_PHOTONS: u32 = 1 << 24;
+/// Middle grey, and how far (in stops) an image's median may stray from it unadjusted.
+pub const MIDDLE_GREY: f64 = 0.18;
+pub const EXPOSURE_DEAD_BAND: f64 = 2.0;
+
+/// The largest grid resolution (cells along the longest axis) whose grid over `bounds` has
+/// at most [`GRID_CELL_BUDGET`] cells, within 1 ..= [`MAX_GRID`].
+pub fn grid_resolution(bounds: &Aabb) -> u32 {
+    // The cell count grows with the resolution: bisect for the last one within budget.
+    let cells = |r: u32| GridSpec::new(bounds, r).cell_count() as u64;
+    let (mut lo, mut hi) = (1u32, MAX_GRID);
+    if cells(hi) <= GRID_CELL_BUDGET {
+        return hi;
+    }
+    while hi - lo > 1 {
+        let mid = (lo + hi) / 2;
+        if cells(mid) <= GRID_CELL_BUDGET { lo = mid } else { hi = mid }
+    }
+    lo
+}
+
+/// Photons for `scene` in a grid of `resolution` over its bounds: [`PHOTONS_PER_CELL_AREA`]
+/// per cell-sized patch of its surface, rounded to the nearest power of two and clamped to
+/// [`MIN_PHOTONS`] ..= [`MAX_PHOTONS`].
+pub fn photon_count(scene: &Scene, resolution: u32) -> u32 {
+    let grid = GridSpec::new(&scene.bounds(), resolution);
+    let area: f64 = scene.triangles.iter().map(|t| triangle_area(t) as f64).sum();
+    let patches = area / (grid.cell as f64).powi(2);
+    let wanted = (PHOTONS_PER_CELL_AREA * patches).max(1.0);
+    let exponent = wanted.log2().round().clamp(MIN_PHOTONS.ilog2() as f64, MAX_PHOTONS.ilog2() as f64);
+    1 << exponent as u32
+}
+
+/// Rec. 709 luminance of a linear RGB pixel.
+fn luminance(p: &[f32; 3]) -> f64 {
+    0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64
+}
+
+/// The exposure (stops) for displaying `image`: 0 when the median luminance of its non-black
+/// pixels lies within [`EXPOSURE_DEAD_BAND`] stops of [`MIDDLE_GREY`], else the whole number
+/// of stops that brings the median to middle grey. A black image gets 0.
+pub fn exposure(image: &LinearImage) -> f32 {
+    let mut lit: Vec<f64> = image.pixels.iter().map(luminance).filter(|l| l.is_finite() && *l > 0.0).collect();
+    if lit.is_empty() {
+        return 0.0;
+    }
+    let mid = lit.len() / 2;
+    let median = *lit.select_nth_unstable_by(mid, f64::total_cmp).1;
+    let stops = (MIDDLE_GREY / median).log2();
+    if stops.abs() <= EXPOSURE_DEAD_BAND { 0.0 } else { stops.round().clamp(-64.0, 64.0) as f32 }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+    use crate::scene::{Camera, Material, cornell_box, generate};
+
+    #[test]
+    fn cornell_box_keeps_the_documented_defaults() {
+        let s = cornell_box();
+        let grid = grid_resolution(&s.bounds());
+        assert_eq!(grid, 64);
+        assert_eq!(photon_count(&s, grid), 1 << 20);
+        // Cornell's photon count is not at the edge of its rounding band: ±25 % keeps it.
+        let area: f64 = s.triangles.iter().map(|t| triangle_area(t) as f64).sum();
+        let h = GridSpec::new(&s.bounds(), 64).cell as f64;
+        let exponent = (PHOTONS_PER_CELL_AREA * area / (h * h)).log2();
+        assert!((exponent - 20.0).abs() < 0.5 - 0.32, "log2 of Cornell's photons {exponent}");
+    }
+
+    fn slab(extent: Vec3) -> Scene {
+        let camera = Camera { eye: Vec3::Z * 10.0, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 45.0 };
+        let mut s = Scene::new(camera);
+        let m = s.add_material(Material::diffuse("m", Vec3::splat(0.5)));
+        let e = extent;
+        s.add_triangle([Vec3::ZERO, Vec3::new(e.x, 0.0, 0.0), Vec3::new(0.0, e.y, 0.0)], m);
+        s.add_triangle([Vec3::ZERO, Vec3::new(0.0, 0.0, e.z), Vec3::new(e.x, e.y, e.z)], m);
+        s
+    }
+
+    #[test]
+    fn grid_keeps_the_cell_budget_whatever_the_shape() {
+        for extent in [Vec3::splat(2.0), Vec3::new(20.0, 2.0, 2.0), Vec3::new(8.0, 4.5, 9.0), Vec3::new(5.0, 1.0, 0.1)]
+        {
+            let bounds = slab(extent).bounds();
+            let r = grid_resolution(&bounds);
+            let cells = |r| GridSpec::new(&bounds, r).cell_count() as u64;
+            println!("extent {extent}: resolution {r}, {} cells", cells(r));
+            assert!(cells(r) <= GRID_CELL_BUDGET && (r == MAX_GRID || cells(r + 1) > GRID_CELL_BUDGET));
+            // Within a factor two of the budget, unless the shape is flatter than the cap allows.
+            assert!(r == MAX_GRID || cells(r) * 2 > GRID_CELL_BUDGET);
+        }
+        // A corridor ten times longer than wide: cells along its width, not just its length.
+        let corridor = slab(Vec3::new(20.0, 2.0, 2.0)).bounds();
+        let corridor = GridSpec::new(&corridor, grid_resolution(&corridor));
+        assert!(corridor.dims.y >= 25, "{:?}", corridor.dims);
+        // A flat square: one cell thick (the grid's padding makes it two from 501 on).
+        let flat = slab(Vec3::new(4.0, 0.0, 4.0)).bounds();
+        assert_eq!(GridSpec::new(&flat, grid_resolution(&flat)).dims.y, 1);
+        assert!(grid_resolution(&flat) >= 500);
+    }
+
+    #[test]
+    fn photons_grow_with_surface_per_cell_and_stay_powers_of_two_in_range() {
+        let atrium = generate::atrium();
+        let r = grid_resolution(&atrium.bounds());
+        let n = photon_count(&atrium, r);
+        println!("atrium: grid {r}, {n} photons");
+        assert!(n.is_power_of_two() && (MIN_PHOTONS..=MAX_PHOTONS).contains(&n));
+        // Doubling the resolution quarters the cell face: four times the photons.
+        let s = cornell_box();
+        assert_eq!(photon_count(&s, 128), 4 << 20);
+        assert_eq!(photon_count(&s, 4), MIN_PHOTONS);
+        assert_eq!(photon_count(&s, 1024), MAX_PHOTONS);
+    }
+
+    fn image(values: &[f32]) -> LinearImage {
+        LinearImage { width: values.len() as u32, height: 1, pixels: values.iter().map(|&v| [v; 3]).collect() }
+    }
+
+    #[test]
+    fn exposure_leaves_reasonable_images_alone_and_fixes_far_off_ones() {
+        // Median 0.05 (1.85 stops under grey, as the Cornell box's 0.06) and 0.6: unchanged.
+        assert_eq!(exposure(&image(&[0.0, 0.0, 0.01, 0.05, 100.0])), 0.0);
+        assert_eq!(exposure(&image(&[0.3, 0.6, 0.9])), 0.0);
+        // 100× too bright: 0.18/18 → −6.6 stops → −7; 1000× too dark: +10.
+        assert_eq!(exposure(&image(&[18.0, 18.0, 1e4])), -7.0);
+        assert_eq!(exposure(&image(&[0.00018, 0.0, 0.00018])), 10.0);
+        // Black and non-finite pixels do not count; an all-black image is left alone.
+        assert_eq!(exposure(&image(&[0.0, f32::NAN, 0.0])), 0.0);
+    }
+}

@@ -1,0 +1,423 @@
+//! Procedural scenes, and the built-in scene names every front end accepts:
+//!
+//! - `cornell`: Mitsuba 3's Cornell box ([`super::cornell_box`]);
+//! - `atrium`: a colonnaded hall lit through three windows and a skylight ([`atrium`]), the
+//!   scene beyond the Cornell box (`scenes/atrium.obj` is the same scene as OBJ + MTL);
+//! - `spheres:N`: about N triangles of tessellated spheres on a floor under an area light
+//!   ([`spheres`]), for measuring scale (`spheres:1000000` is a million triangles).
+//!
+//! Every surface here is built from quads oriented by an explicit outward normal, so the
+//! front faces (and the emitters' emitting sides) never depend on the order corners are
+//! listed in.
+
+use glam::Vec3;
+
+use super::{Camera, Material, Scene, cornell_box};
+use crate::error::{Error, Result};
+
+/// The built-in scene names, as shown in help texts and error messages.
+pub const BUILTIN_NAMES: &str = "cornell, atrium, spheres:N (about N triangles)";
+
+/// Largest triangle count `spheres:N` accepts: 2²⁸ triangles are 16 GiB of corners, far
+/// past what any GPU binds as one buffer, so larger requests are typos.
+pub const MAX_GENERATED_TRIANGLES: usize = 1 << 28;
+
+/// The built-in scene called `name`, `Ok(None)` if `name` is not a built-in name (it may be
+/// a file), or an error if it is one with a bad parameter (`spheres:abc`).
+pub fn builtin(name: &str) -> Result<Option<Scene>> {
+    let bad = |message: String| Error::InvalidScene(format!("built-in scene '{name}': {message}"));
+    match name.split_once(':') {
+        None if name == "cornell" => Ok(Some(cornell_box())),
+        None if name == "atrium" => Ok(Some(atrium())),
+        Some(("spheres", count)) => {
+            let n: usize = count
+                .trim()
+                .replace('_', "")
+                .parse()
+                .map_err(|_| bad(format!("'{count}' is not a triangle count; write e.g. spheres:1000000")))?;
+            if !(1..=MAX_GENERATED_TRIANGLES).contains(&n) {
+                return Err(bad(format!("the triangle count must lie in 1..={MAX_GENERATED_TRIANGLES}")));
+            }
+            Ok(Some(spheres(n)))
+        }
+        _ => Ok(None),
+    }
+}
+
+/// Adds the planar quad `q` as two triangles whose front faces look along `outward`.
+fn add_quad_facing(scene: &mut Scene, mut q: [Vec3; 4], outward: Vec3, material: u32) {
+    if (q[1] - q[0]).cross(q[2] - q[0]).dot(outward) < 0.0 {
+        q.reverse();
+    }
+    scene.add_quad(q, material);
+}
+
+/// An axis-aligned box, its faces looking outwards.
+fn add_box(scene: &mut Scene, lo: Vec3, hi: Vec3, material: u32) {
+    for axis in 0..3 {
+        let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+        for (side, at) in [(-1.0f32, lo[axis]), (1.0, hi[axis])] {
+            let corner = |a: f32, b: f32| {
+                let mut p = Vec3::ZERO;
+                p[axis] = at;
+                p[u] = a;
+                p[v] = b;
+                p
+            };
+            let q = [corner(lo[u], lo[v]), corner(hi[u], lo[v]), corner(hi[u], hi[v]), corner(lo[u], hi[v])];
+            add_quad_facing(scene, q, Vec3::AXES[axis] * side, material);
+        }
+    }
+}
+
+/// A UV sphere: `segments` around the axis, `segments / 2` rings from pole to pole;
+/// `2·segments·(rings − 1)` triangles, front faces outwards.
+fn add_sphere(scene: &mut Scene, centre: Vec3, radius: f32, segments: u32, material: u32) {
+    let segments = segments.max(3);
+    let rings = (segments / 2).max(2);
+    let point = |ring: u32, seg: u32| {
+        let theta = std::f32::consts::PI * ring as f32 / rings as f32;
+        let phi = std::f32::consts::TAU * (seg % segments) as f32 / segments as f32;
+        centre + radius * Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin())
+    };
+    for ring in 0..rings {
+        for seg in 0..segments {
+            let (a, b) = (point(ring, seg), point(ring, seg + 1));
+            let (c, d) = (point(ring + 1, seg + 1), point(ring + 1, seg));
+            // Seen from outside, a → b runs along φ and b → c down towards the −y pole, so
+            // (a, b, d) and (b, c, d) wind counter-clockwise; at the poles one is degenerate.
+            if ring > 0 {
+                scene.add_triangle([a, b, d], material);
+            }
+            if ring + 1 < rings {
+                scene.add_triangle([b, c, d], material);
+            }
+        }
+    }
+}
+
+/// Triangles of [`add_sphere`] with `segments` segments.
+fn sphere_triangles(segments: u32) -> usize {
+    let rings = (segments.max(3) / 2).max(2);
+    2 * segments.max(3) as usize * (rings as usize - 1)
+}
+
+/// An open cylinder (no caps) along +y from `base`, `sides` faces, front faces outwards.
+fn add_cylinder(scene: &mut Scene, base: Vec3, radius: f32, height: f32, sides: u32, material: u32) {
+    for k in 0..sides {
+        let angle = |k: u32| std::f32::consts::TAU * k as f32 / sides as f32;
+        let (a0, a1) = (angle(k), angle(k + 1));
+        let p = |a: f32, y: f32| base + Vec3::new(radius * a.cos(), y, radius * a.sin());
+        let mid = 0.5 * (a0 + a1);
+        let outward = Vec3::new(mid.cos(), 0.0, mid.sin());
+        add_quad_facing(scene, [p(a0, 0.0), p(a1, 0.0), p(a1, height), p(a0, height)], outward, material);
+    }
+}
+
+/// A linear-RGB albedo for a hue in [0, 1) at the given saturation and value.
+fn hue(h: f32, saturation: f32, value: f32) -> Vec3 {
+    let k = |n: f32| {
+        let k = (n + h * 6.0) % 6.0;
+        value - value * saturation * k.min(4.0 - k).clamp(0.0, 1.0)
+    };
+    // HSV to sRGB, then sRGB to linear (a gamma of 2.2 is close enough for a test scene).
+    Vec3::new(k(5.0), k(3.0), k(1.0)).powf(2.2)
+}
+
+/// About `triangles` triangles (at least 8): an m × m grid of UV spheres in eight colours on
+/// a grey floor, lit by a square area light overhead, with a camera looking down on them at
+/// an angle. m grows as the fourth root of the count (a million triangles: 16 × 16 spheres
+/// of about 4 000 triangles each), so large scenes have both many objects and fine meshes.
+pub fn spheres(triangles: usize) -> Scene {
+    let fixed = 4; // floor and light
+    let budget = triangles.saturating_sub(fixed).max(8);
+    let m = ((budget as f64 / 4000.0).sqrt().ceil() as usize).clamp(1, 64);
+    let count = m * m;
+    // 2·s·(s/2 − 1) = s² − 2s triangles per sphere of s segments (s even): the finest s that
+    // fits every sphere, then as many spheres as fit at s + 2.
+    let mut segments = ((1.0 + (1.0 + budget as f64 / count as f64).sqrt()).round() as u32).max(4) & !1;
+    while segments > 4 && sphere_triangles(segments) * count > budget {
+        segments -= 2;
+    }
+    let extra = sphere_triangles(segments + 2) - sphere_triangles(segments);
+    let finer = (budget.saturating_sub(sphere_triangles(segments) * count) / extra).min(count);
+
+    let half = 0.5 * m as f32;
+    let camera = Camera {
+        eye: Vec3::new(0.3 * half, 1.2 * half + 1.5, 1.8 * half + 2.5),
+        target: Vec3::new(0.0, 0.0, 0.15 * half),
+        up: Vec3::Y,
+        fov_y_deg: 45.0,
+    };
+    let mut s = Scene::new(camera);
+    let floor = s.add_material(Material::diffuse("floor", Vec3::splat(0.6)));
+    let light =
+        s.add_material(Material { emission: Vec3::new(6.0, 5.6, 5.0), ..Material::diffuse("light", Vec3::ZERO) });
+    let colours: Vec<u32> = (0..8)
+        .map(|k| s.add_material(Material::diffuse(&format!("sphere{k}"), hue(k as f32 / 8.0, 0.65, 0.85))))
+        .collect();
+
+    let extent = half + 1.5;
+    let floor_quad = [
+        Vec3::new(-extent, 0.0, -extent),
+        Vec3::new(extent, 0.0, -extent),
+        Vec3::new(extent, 0.0, extent),
+        Vec3::new(-extent, 0.0, extent),
+    ];
+    add_quad_facing(&mut s, floor_quad, Vec3::Y, floor);
+    let (h, l) = (half + 2.0, 0.4 * half + 0.5);
+    let light_quad = [Vec3::new(-l, h, -l), Vec3::new(l, h, -l), Vec3::new(l, h, l), Vec3::new(-l, h, l)];
+    add_quad_facing(&mut s, light_quad, Vec3::NEG_Y, light);
+
+    let radius = 0.4;
+    for i in 0..m {
+        for j in 0..m {
+            let centre = Vec3::new(i as f32 - half + 0.5, radius, j as f32 - half + 0.5);
+            let segments = if i * m + j < finer { segments + 2 } else { segments };
+            add_sphere(&mut s, centre, radius, segments, colours[(i * 3 + j * 5) % colours.len()]);
+        }
+    }
+    s
+}
+
+/// One arcade: a wall `thickness` thick in the plane x = `x`, from `y_spring` to `y_top`,
+/// pierced by semicircular arches between consecutive column centres `columns` (along z),
+/// each arch `column_width` narrower than its bay.
+fn add_arcade(
+    scene: &mut Scene,
+    x: f32,
+    thickness: f32,
+    columns: &[f32],
+    column_width: f32,
+    (y_spring, y_top): (f32, f32),
+    material: u32,
+) {
+    const ARCH_SEGMENTS: u32 = 16;
+    let (x0, x1) = (x - 0.5 * thickness, x + 0.5 * thickness);
+    let hw = 0.5 * column_width;
+    let (z_first, z_last) = (columns[0] - hw, columns[columns.len() - 1] + hw);
+    let at = |x: f32, y: f32, z: f32| Vec3::new(x, y, z);
+    // Top, ends, and the flat undersides above the columns.
+    add_quad_facing(
+        scene,
+        [at(x0, y_top, z_first), at(x1, y_top, z_first), at(x1, y_top, z_last), at(x0, y_top, z_last)],
+        Vec3::Y,
+        material,
+    );
+    for (z, n) in [(z_first, Vec3::NEG_Z), (z_last, Vec3::Z)] {
+        add_quad_facing(
+            scene,
+            [at(x0, y_spring, z), at(x1, y_spring, z), at(x1, y_top, z), at(x0, y_top, z)],
+            n,
+            material,
+        );
+    }
+    for &c in columns {
+        add_quad_facing(
+            scene,
+            [at(x0, y_spring, c - hw), at(x1, y_spring, c - hw), at(x1, y_spring, c + hw), at(x0, y_spring, c + hw)],
+            Vec3::NEG_Y,
+            material,
+        );
+    }
+    // Each bay: the faces at x0 and x1 between the arch and the bay's rectangle, as quads
+    // between the arch and its radial projection onto the rectangle (the rectangle's upper
+    // corners are among the angles, so every quad is convex and planar), and the vault.
+    for pair in columns.windows(2) {
+        let (zc, half_bay) = (0.5 * (pair[0] + pair[1]), 0.5 * (pair[1] - pair[0]));
+        let radius = half_bay - hw;
+        let height = y_top - y_spring;
+        let corner = height.atan2(half_bay);
+        let mut angles: Vec<f32> =
+            (0..=ARCH_SEGMENTS).map(|k| std::f32::consts::PI * k as f32 / ARCH_SEGMENTS as f32).collect();
+        angles.extend([corner, std::f32::consts::PI - corner]);
+        angles.sort_by(f32::total_cmp);
+        angles.dedup_by(|a, b| (*a - *b).abs() < 1e-4);
+        let arch = |a: f32| (zc + radius * a.cos(), y_spring + radius * a.sin());
+        let rim = |a: f32| {
+            let (c, s) = (a.cos(), a.sin());
+            let t = (half_bay / c.abs().max(1e-6)).min(height / s.abs().max(1e-6));
+            (zc + t * c, y_spring + t * s)
+        };
+        for w in angles.windows(2) {
+            let (a0, a1) = (w[0], w[1]);
+            let (p0, p1, r0, r1) = (arch(a0), arch(a1), rim(a0), rim(a1));
+            for (xf, n) in [(x0, Vec3::NEG_X), (x1, Vec3::X)] {
+                let q = [at(xf, p0.1, p0.0), at(xf, p1.1, p1.0), at(xf, r1.1, r1.0), at(xf, r0.1, r0.0)];
+                add_quad_facing(scene, q, n, material);
+            }
+            // The vault faces the arch's centre.
+            let mid = 0.5 * (a0 + a1);
+            let inward = Vec3::new(0.0, -mid.sin(), -mid.cos());
+            let q = [at(x0, p0.1, p0.0), at(x1, p0.1, p0.0), at(x1, p1.1, p1.0), at(x0, p1.1, p1.0)];
+            add_quad_facing(scene, q, inward, material);
+        }
+    }
+}
+
+/// The hall's camera: standing at the entrance, looking down the nave.
+pub const ATRIUM_CAMERA: Camera =
+    Camera { eye: Vec3::new(0.5, 1.7, 2.85), target: Vec3::new(-0.7, 1.35, -6.0), up: Vec3::Y, fov_y_deg: 60.0 };
+
+/// A closed hall 8 m wide, 9 m deep and 4.5 m high: a nave between two arcades of four
+/// round columns each, three tall warm windows in the terracotta left wall, a cool skylight
+/// over the nave, a teal right wall, a blue back wall, a checkered stone floor, a blue
+/// sphere and a golden block on it. The windows light the left aisle and throw the
+/// columns' soft shadows across the nave; the coloured walls bleed onto the floor, the
+/// columns and the ceiling. About 2 500 triangles; every material is two-sided, as an
+/// OBJ file's would be, so the built-in scene and `scenes/atrium.obj` are the same.
+pub fn atrium() -> Scene {
+    let mut s = Scene::new(ATRIUM_CAMERA);
+    let material = |s: &mut Scene, name: &str, albedo: Vec3, emission: Vec3| {
+        s.add_material(Material { emission, two_sided: true, ..Material::diffuse(name, albedo) })
+    };
+    let none = Vec3::ZERO;
+    let stone_light = material(&mut s, "stone_light", Vec3::new(0.72, 0.66, 0.58), none);
+    let stone_dark = material(&mut s, "stone_dark", Vec3::new(0.32, 0.29, 0.27), none);
+    let plaster = material(&mut s, "plaster", Vec3::new(0.78, 0.77, 0.74), none);
+    let terracotta = material(&mut s, "terracotta", Vec3::new(0.66, 0.24, 0.13), none);
+    let teal = material(&mut s, "teal", Vec3::new(0.10, 0.42, 0.38), none);
+    let blue = material(&mut s, "blue", Vec3::new(0.14, 0.20, 0.58), none);
+    let marble = material(&mut s, "marble", Vec3::new(0.82, 0.80, 0.76), none);
+    let glaze = material(&mut s, "glaze", Vec3::new(0.10, 0.22, 0.70), none);
+    let gold = material(&mut s, "gold", Vec3::new(0.80, 0.56, 0.12), none);
+    let window = material(&mut s, "window", none, Vec3::new(16.0, 12.0, 7.5));
+    let sky = material(&mut s, "sky", none, Vec3::new(0.8, 1.05, 1.5));
+
+    let (x0, x1, y1, z0, z1) = (-4.0f32, 4.0f32, 4.5f32, -6.0f32, 3.0f32);
+    // Floor: 1 m tiles in a checker.
+    for i in 0..8 {
+        for k in 0..9 {
+            let (x, z) = (x0 + i as f32, z0 + k as f32);
+            let q = [
+                Vec3::new(x, 0.0, z),
+                Vec3::new(x + 1.0, 0.0, z),
+                Vec3::new(x + 1.0, 0.0, z + 1.0),
+                Vec3::new(x, 0.0, z + 1.0),
+            ];
+            add_quad_facing(&mut s, q, Vec3::Y, if (i + k) % 2 == 0 { stone_light } else { stone_dark });
+        }
+    }
+    let wall = |s: &mut Scene, q: [Vec3; 4], n: Vec3, m: u32| add_quad_facing(s, q, n, m);
+    let p = Vec3::new;
+    wall(&mut s, [p(x0, y1, z0), p(x1, y1, z0), p(x1, y1, z1), p(x0, y1, z1)], Vec3::NEG_Y, plaster);
+    wall(&mut s, [p(x0, 0.0, z0), p(x1, 0.0, z0), p(x1, y1, z0), p(x0, y1, z0)], Vec3::Z, blue);
+    wall(&mut s, [p(x0, 0.0, z1), p(x1, 0.0, z1), p(x1, y1, z1), p(x0, y1, z1)], Vec3::NEG_Z, plaster);
+    wall(&mut s, [p(x1, 0.0, z0), p(x1, 0.0, z1), p(x1, y1, z1), p(x1, y1, z0)], Vec3::NEG_X, teal);
+    wall(&mut s, [p(x0, 0.0, z0), p(x0, 0.0, z1), p(x0, y1, z1), p(x0, y1, z0)], Vec3::X, terracotta);
+    // Windows: emitters 2 cm in front of the left wall, facing into the hall.
+    for zc in [-3.0f32, -1.0, 1.0] {
+        let x = x0 + 0.02;
+        let q = [p(x, 1.0, zc - 0.5), p(x, 1.0, zc + 0.5), p(x, 3.3, zc + 0.5), p(x, 3.3, zc - 0.5)];
+        wall(&mut s, q, Vec3::X, window);
+    }
+    // Skylight: a strip under the ceiling over the nave, facing down.
+    let y = y1 - 0.02;
+    wall(&mut s, [p(-0.8, y, -4.5), p(0.8, y, -4.5), p(0.8, y, 0.5), p(-0.8, y, 0.5)], Vec3::NEG_Y, sky);
+
+    // Two arcades on round columns.
+    let columns = [-4.0f32, -2.0, 0.0, 2.0];
+    for x in [-2.0f32, 2.0] {
+        for &z in &columns {
+            add_cylinder(&mut s, p(x, 0.0, z), 0.18, 2.6, 16, marble);
+            // Plinths reach 1 cm under the floor: no face coincides with it.
+            add_box(&mut s, p(x - 0.22, -0.01, z - 0.22), p(x + 0.22, 0.12, z + 0.22), marble);
+        }
+        add_arcade(&mut s, x, 0.4, &columns, 0.4, (2.6, 3.5), plaster);
+    }
+    add_sphere(&mut s, p(0.7, 0.55, -2.6), 0.55, 32, glaze);
+    // The block, turned 30° about y, its bottom 1 cm under the floor.
+    let (c, half) = (p(-0.6, 0.395, -0.4), p(0.45, 0.405, 0.3));
+    let first = s.triangles.len();
+    add_box(&mut s, -half, half, gold);
+    let turn = glam::Quat::from_rotation_y(30f32.to_radians());
+    for t in &mut s.triangles[first..] {
+        *t = t.map(|v| c + turn * v);
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{triangle_area, triangle_normal};
+
+    /// Whether every triangle of a closed surface faces away from `inside`, judged by the
+    /// signed volume of the tetrahedron (inside, triangle): positive for outward windings.
+    fn signed_volume(tris: &[[Vec3; 3]], inside: Vec3) -> f32 {
+        tris.iter().map(|t| (t[0] - inside).dot((t[1] - inside).cross(t[2] - inside)) / 6.0).sum()
+    }
+
+    #[test]
+    fn sphere_is_closed_outward_and_has_the_counted_triangles() {
+        for segments in [4, 8, 32, 64] {
+            let mut s = Scene::new(ATRIUM_CAMERA);
+            let m = s.add_material(Material::diffuse("m", Vec3::ONE * 0.5));
+            add_sphere(&mut s, Vec3::new(1.0, 2.0, 3.0), 0.5, segments, m);
+            assert_eq!(s.triangles.len(), sphere_triangles(segments));
+            // Enclosed volume equals the polyhedron's, which approaches 4/3·π·r³ from below.
+            let v = signed_volume(&s.triangles, Vec3::new(1.0, 2.0, 3.0));
+            let sphere = 4.0 / 3.0 * std::f32::consts::PI * 0.125;
+            assert!(v > 0.0 && v <= sphere * 1.0001, "segments {segments}: volume {v} vs {sphere}");
+            if segments >= 32 {
+                assert!(v > 0.97 * sphere, "segments {segments}: volume {v} vs {sphere}");
+            }
+        }
+    }
+
+    #[test]
+    fn spheres_scene_has_about_the_requested_triangles() {
+        for n in [1usize, 100, 10_000, 250_000, 1_000_000] {
+            let s = spheres(n);
+            s.validate().unwrap();
+            let got = s.triangles.len();
+            println!("spheres:{n} → {got} triangles");
+            // Short by at most one step of one sphere's refinement once there are many triangles.
+            assert!(got as f64 <= (n as f64 * 1.01).max(300.0), "spheres:{n} gave {got}");
+            let floor = if n >= 10_000 { 0.97 } else { 0.5 };
+            assert!(got as f64 >= floor * n as f64, "spheres:{n} gave only {got}");
+            assert!(s.emitted_power().min_element() > 0.0);
+        }
+    }
+
+    #[test]
+    fn builtin_names_parse_and_bad_parameters_are_errors() {
+        assert_eq!(builtin("cornell").unwrap().unwrap().triangles.len(), cornell_box().triangles.len());
+        assert!(builtin("atrium").unwrap().is_some());
+        assert!(builtin("spheres:1_000").unwrap().is_some());
+        assert!(builtin("scene.obj").unwrap().is_none());
+        for bad in ["spheres:", "spheres:abc", "spheres:0", "spheres:-5", "spheres:999999999999"] {
+            let e = builtin(bad).unwrap_err().to_string();
+            assert!(e.contains(bad), "'{e}' does not name '{bad}'");
+        }
+    }
+
+    #[test]
+    fn atrium_is_closed_lit_from_inside_and_every_side_faces_as_built() {
+        let s = atrium();
+        s.validate().unwrap();
+        let b = s.bounds();
+        assert_eq!((b.min, b.max), (Vec3::new(-4.0, -0.01, -6.0), Vec3::new(4.0, 4.5, 3.0)));
+        assert!(ATRIUM_CAMERA.eye.cmpgt(b.min).all() && ATRIUM_CAMERA.eye.cmplt(b.max).all());
+        // Emitters face into the hall: the windows +x, the skylight −y.
+        let lights = s.emissive_triangles();
+        assert_eq!(lights.len(), 8);
+        for &i in &lights {
+            let n = triangle_normal(&s.triangles[i as usize]);
+            assert!(n == Vec3::X || n == Vec3::NEG_Y, "emitter {i} faces {n}");
+        }
+        // The room's six sides enclose the hall: their windings give its volume.
+        let walls = ["plaster", "blue", "teal", "terracotta", "stone_light", "stone_dark"];
+        let (lo, hi) = (Vec3::new(-4.0, 0.0, -6.0), Vec3::new(4.0, 4.5, 3.0));
+        let on_side =
+            |t: &[Vec3; 3]| (0..3).any(|a| t.iter().all(|p| p[a] == lo[a]) || t.iter().all(|p| p[a] == hi[a]));
+        let room: Vec<[Vec3; 3]> = (0..s.triangles.len())
+            .filter(|&i| walls.contains(&s.material_of(i).name.as_str()) && on_side(&s.triangles[i]))
+            .map(|i| s.triangles[i])
+            .collect();
+        let inside = -signed_volume(&room, Vec3::new(0.0, 2.0, 0.0));
+        assert!((inside - 8.0 * 4.5 * 9.0).abs() < 1e-2, "room walls enclose {inside} m³");
+        let area: f32 = s.triangles.iter().map(triangle_area).sum();
+        assert!(area > 300.0 && s.triangles.len() < 4000, "area {area}, {} triangles", s.triangles.len());
+    }
+}

@@ -1,0 +1,74 @@
+//! Albedo textures as a scene holds them: decoded images, 8 bits per channel, sRGB-encoded
+//! colour (what PNG and JPEG base-colour images store). Resampling, mip maps and sampling are
+//! the renderer's business ([`crate::textures`]).
+
+use std::io::Cursor;
+use std::path::Path;
+
+/// Largest image side accepted when decoding (a guard against hostile headers; the largest
+/// texture WebGPU guarantees, and the renderer resamples to at most
+/// [`crate::textures::MAX_SIDE`] anyway).
+pub const MAX_DECODED_SIDE: u32 = 8192;
+/// Largest allocation the image decoder may make for one image (8192² texels of 16-bit RGBA).
+const MAX_DECODE_BYTES: u64 = 512 << 20;
+
+/// An image used as an albedo texture. Texture coordinates (u, v) address it with u to the
+/// right and v down the image, (0, 0) the top-left corner of the first row (glTF's and
+/// WebGPU's convention), repeating outside [0, 1].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Texture {
+    pub name: String,
+    pub width: u32,
+    pub height: u32,
+    /// Row by row from the top: sRGB-encoded red, green, blue and a linear alpha (unused).
+    pub texels: Vec<[u8; 4]>,
+}
+
+impl Texture {
+    /// Decodes a PNG or JPEG image (the format is recognised from its bytes).
+    pub fn decode(name: &str, bytes: &[u8]) -> Result<Texture, String> {
+        let mut reader = image::ImageReader::new(Cursor::new(bytes))
+            .with_guessed_format()
+            .map_err(|e| format!("cannot be read: {e}"))?;
+        if reader.format().is_none() {
+            return Err("is not a PNG or JPEG image".into());
+        }
+        let mut limits = image::Limits::default();
+        limits.max_image_width = Some(MAX_DECODED_SIDE);
+        limits.max_image_height = Some(MAX_DECODED_SIDE);
+        limits.max_alloc = Some(MAX_DECODE_BYTES);
+        reader.limits(limits);
+        let image = reader.decode().map_err(|e| format!("is not a valid PNG or JPEG image ({e})"))?;
+        let rgba = image.to_rgba8();
+        let (width, height) = rgba.dimensions();
+        if width == 0 || height == 0 {
+            return Err("is an empty image".into());
+        }
+        let texels = rgba.pixels().map(|p| p.0).collect();
+        Ok(Texture { name: name.to_owned(), width, height, texels })
+    }
+
+    /// Reads and decodes an image file; errors say what is wrong without naming the file.
+    pub fn read(path: &Path) -> Result<Texture, String> {
+        let bytes = std::fs::read(path).map_err(|e| format!("cannot be read ({e})"))?;
+        let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        Texture::decode(&name, &bytes)
+    }
+
+    /// Checks the texel count against the size.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.width == 0 || self.height == 0 {
+            return Err(format!("texture '{}' is empty ({}x{})", self.name, self.width, self.height));
+        }
+        if self.texels.len() as u64 != self.width as u64 * self.height as u64 {
+            return Err(format!(
+                "texture '{}' has {} texels for a size of {}x{}",
+                self.name,
+                self.texels.len(),
+                self.width,
+                self.height
+            ));
+        }
+        Ok(())
+    }
+}

@@ -11,23 +11,12 @@ struct VertexOut {
 
 @vertex
 fn vs_main(@builtin(vertex_index) vi: u32) -> VertexOut {
-    let tri = vi / 3u;
-    let corner = vi % 3u;
-    let t = triangles[tri];
-    var p = t.v0;
-    var b = vec2f(0.0, 0.0);
-    if corner == 1u {
-        p = t.v1;
-        b = vec2f(1.0, 0.0);
-    } else if corner == 2u {
-        p = t.v2;
-        b = vec2f(0.0, 1.0);
-    }
+    let v = triangle_vertex(vi);
     var out: VertexOut;
-    out.clip = frame.view_proj * vec4f(p, 1.0);
-    out.bary = b;
-    out.tri = tri;
-    out.uv = surface_uv(tri, b.x, b.y);
+    out.clip = frame.view_proj * vec4f(v.pos, 1.0);
+    out.bary = v.bary;
+    out.tri = v.tri;
+    out.uv = surface_uv(v.tri, v.bary.x, v.bary.y);
     return out;
 }
 

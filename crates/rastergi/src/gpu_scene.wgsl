@@ -57,6 +57,26 @@ struct Surface {
     tri: u32,
 }
 
+// Vertex `vi` of the scene drawn as one non-indexed triangle list (vertex pulling in the
+// raster passes): its position, its barycentrics (b1, b2) and its triangle.
+struct TriangleVertex {
+    pos: vec3f,
+    bary: vec2f,
+    tri: u32,
+}
+
+fn triangle_vertex(vi: u32) -> TriangleVertex {
+    let tri = vi / 3u;
+    let corner = vi % 3u;
+    let t = triangles[tri];
+    if corner == 1u {
+        return TriangleVertex(t.v1, vec2f(1.0, 0.0), tri);
+    } else if corner == 2u {
+        return TriangleVertex(t.v2, vec2f(0.0, 1.0), tri);
+    }
+    return TriangleVertex(t.v0, vec2f(0.0, 0.0), tri);
+}
+
 fn triangle_normal(t: Triangle) -> vec3f {
     return normalize(cross(t.v1 - t.v0, t.v2 - t.v0));
 }

@@ -88,7 +88,9 @@ pub struct SceneArgs {
     /// cubic cells as 64³, so 64 for a cube like cornell and more for long or flat scenes).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub grid: Option<u32>,
-    /// Ray-view resolution of the final gather, texels per side (default: twice the image's larger side, 128 to 2048).
+    /// Ray-view resolution of the final gather, texels per side (default: fitted: twice the
+    /// image's larger side, raised to 8 texels across the median triangle's shortest edge over
+    /// the scene's bounding sphere; 128 to 2048).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
     pub bundle: Option<u32>,
     /// What the image shows.
@@ -276,6 +278,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     };
     renderer.wait()?;
     log::info!("set-up (BVH, upload, photon map) in {:.2} s", start.elapsed().as_secs_f64());
+    if let Progressive::Gather(r) = &renderer {
+        log::info!("gather ray view: {0}x{0} texels", r.bundle());
+    }
     let start = Instant::now();
 
     let progress = if std::io::stderr().is_terminal() {

@@ -790,7 +790,15 @@ impl App {
     fn overlay_lines(&self) -> Vec<String> {
         let c = &self.controls;
         let s = self.renderer.as_ref().map_or_else(|| self.wanted(), |r| r.settings().clone());
-        let bundle = if s.bundle == 0 { default_bundle(s.width, s.height) } else { s.bundle };
+        // The renderer's own bundle: 0 in the settings is fitted to the scene as well.
+        let fitted = self.renderer.as_ref().map_or(0, |r| r.bundle());
+        let bundle = if fitted > 0 {
+            fitted
+        } else if s.bundle == 0 {
+            default_bundle(s.width, s.height)
+        } else {
+            s.bundle
+        };
         let samples = self.renderer.as_ref().map_or(0, |r| r.samples());
         let size = (s.width, s.height);
         let mut lines = vec![

@@ -23,11 +23,16 @@ pub fn check_storage_buffer(limits: &wgpu::Limits, what: &str, count: u64, strid
     let max = max_storage_buffer(limits);
     match count.checked_mul(stride) {
         Some(bytes) if bytes <= max => Ok(()),
-        bytes => Err(Error::Limits(format!(
-            "{what} need {} ({count} × {stride} bytes), more than the {} this GPU binds as one buffer; {remedy}",
-            bytes.map_or_else(|| "more than 2⁶⁴ bytes".to_owned(), mib),
-            mib(max)
-        ))),
+        bytes => {
+            let (mut need, mut have) = (bytes.map_or_else(|| "more than 2⁶⁴ bytes".to_owned(), mib), mib(max));
+            if need == have {
+                // Just over the limit: the rounded sizes would read the same.
+                (need, have) = (format!("{} bytes", bytes.unwrap_or(u64::MAX)), format!("{max} bytes"));
+            }
+            Err(Error::Limits(format!(
+                "{what} need {need} ({count} × {stride} bytes), more than the {have} this GPU binds as one buffer; {remedy}"
+            )))
+        }
     }
 }
 
@@ -120,11 +125,13 @@ mod tests {
         assert!(check_scene_buffers(&l, 2_796_202, 10, 2).is_ok());
         let e = check_scene_buffers(&l, 2_796_203, 10, 2).unwrap_err().to_string();
         println!("{e}");
-        assert!(e.contains("2796203 triangles") && e.contains("128 MiB") && e.contains("fewer triangles"), "{e}");
+        assert!(e.contains("2796203 triangles") && e.contains("fewer triangles"), "{e}");
+        // One triangle over: the sizes in bytes, since both round to 128 MiB.
+        assert!(e.contains("134217744 bytes") && e.contains("134217728 bytes"), "{e}");
         // 32 bytes per node: 128 MiB hold 4 194 304 nodes.
         assert!(check_bvh_nodes(&l, 4_194_304).is_ok());
         let e = check_bvh_nodes(&l, 4_194_305).unwrap_err().to_string();
-        assert!(e.contains("4194305 BVH nodes") && e.contains("128 MiB"), "{e}");
+        assert!(e.contains("4194305 BVH nodes") && e.contains("134217728 bytes"), "{e}");
     }
 
     #[test]

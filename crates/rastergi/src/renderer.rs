@@ -33,8 +33,8 @@ pub struct RenderSettings {
     pub grid_resolution: u32,
     /// Also accumulate the photon-map view (`Show::PhotonMap`).
     pub show_photon_map: bool,
-    /// Ray-view resolution of the final gather (texels per side); 0 picks
-    /// [`default_bundle`] for the image size.
+    /// Ray-view resolution of the final gather (texels per side); 0 fits it to the scene and
+    /// the image size ([`crate::fit::bundle`]: at least [`default_bundle`]).
     pub bundle: u32,
 }
 
@@ -54,6 +54,13 @@ pub struct Overrides {
     pub pixel_jitter: Option<Vec2>,
     /// Ray-view sub-texel offset instead of a random one.
     pub texel_jitter: Option<Vec2>,
+}
+
+impl RenderSettings {
+    /// The gather's bundle: as set, or (0) fitted to a scene of this [`crate::fit::detail_bundle`].
+    pub fn bundle_for(&self, detail_bundle: u32) -> u32 {
+        if self.bundle == 0 { crate::fit::bundle(detail_bundle, self.width, self.height) } else { self.bundle }
+    }
 }
 
 impl Default for RenderSettings {
@@ -88,6 +95,7 @@ impl ImagePasses {
         frame: &FrameBinding,
         map: Option<&GpuPhotonMap>,
         settings: &RenderSettings,
+        detail_bundle: u32,
     ) -> Result<ImagePasses> {
         let (width, height) = (settings.width, settings.height);
         let film = Film::new(gpu, width, height)?;
@@ -97,7 +105,7 @@ impl ImagePasses {
             Some(map) if settings.show_photon_map => Some(PhotonViewPass::new(gpu, scene, frame, &gbuffer, &film, map)),
             _ => None,
         };
-        let bundle = if settings.bundle == 0 { default_bundle(width, height) } else { settings.bundle };
+        let bundle = settings.bundle_for(detail_bundle);
         let gather = match map {
             Some(map) => Some(GatherPass::new(gpu, scene, frame, &gbuffer, &film, map, bundle)?),
             None => None,
@@ -114,6 +122,8 @@ pub struct Renderer {
     frame: FrameBinding,
     photon_map: Option<GpuPhotonMap>,
     passes: ImagePasses,
+    /// The scene's part of the default bundle ([`crate::fit::detail_bundle`]).
+    detail_bundle: u32,
     /// Restarts so far (camera moves): each draws a new rotation of the gather directions.
     restart: u32,
     rotation: Quat,
@@ -124,11 +134,13 @@ impl Renderer {
         scene.validate()?;
         // Fail on an impossible image size before the BVH and the photon map are built.
         gpu.check_image_size(settings.width, settings.height, crate::film::COMPONENTS * 16)?;
-        // Fail on a scene or photon grid too large for this GPU before the BVH is built.
+        // Fail on a scene, photon grid or bundle too large for this GPU before the BVH is built.
         let limits = gpu.device.limits();
         crate::limits::check_scene(&limits, scene)?;
+        let detail_bundle = crate::fit::detail_bundle(scene);
         if settings.photons > 0 {
             crate::limits::check_photon_grid(&limits, &GridSpec::new(&scene.bounds(), settings.grid_resolution))?;
+            crate::limits::check_bundle(&limits, settings.bundle_for(detail_bundle))?;
         }
         let start = std::time::Instant::now();
         let prepared = PreparedScene::new(scene);
@@ -147,7 +159,7 @@ impl Renderer {
         let photon_map = (settings.photons > 0)
             .then(|| GpuPhotonMap::build(gpu, &gpu_scene, &prepared, &photon_settings))
             .transpose()?;
-        let passes = ImagePasses::new(gpu, &gpu_scene, &frame, photon_map.as_ref(), &settings)?;
+        let passes = ImagePasses::new(gpu, &gpu_scene, &frame, photon_map.as_ref(), &settings, detail_bundle)?;
         let rotation = random_rotation(settings.seed, 0);
         Ok(Renderer {
             gpu: gpu.clone(),
@@ -157,6 +169,7 @@ impl Renderer {
             frame,
             photon_map,
             passes,
+            detail_bundle,
             restart: 0,
             rotation,
         })
@@ -166,7 +179,14 @@ impl Renderer {
     /// restarts; the scene, its BVH and the photon map are kept.
     pub fn resize(&mut self, width: u32, height: u32) -> Result<()> {
         let settings = RenderSettings { width, height, ..self.settings.clone() };
-        self.passes = ImagePasses::new(&self.gpu, &self.scene, &self.frame, self.photon_map.as_ref(), &settings)?;
+        self.passes = ImagePasses::new(
+            &self.gpu,
+            &self.scene,
+            &self.frame,
+            self.photon_map.as_ref(),
+            &settings,
+            self.detail_bundle,
+        )?;
         self.settings = settings;
         self.reset();
         Ok(())
@@ -174,6 +194,11 @@ impl Renderer {
 
     pub fn settings(&self) -> &RenderSettings {
         &self.settings
+    }
+
+    /// The gather's ray-view resolution in use (texels per side; 0 without a photon map).
+    pub fn bundle(&self) -> u32 {
+        self.passes.gather.as_ref().map_or(0, |g| g.bundle)
     }
 
     pub fn camera(&self) -> Camera {

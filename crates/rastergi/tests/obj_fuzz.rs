@@ -6,7 +6,7 @@
 //! `regression_corpus_loads_or_is_refused_by_name`.
 //!
 //! The number of generated cases is bounded so the whole file runs in seconds; set
-//! `PROPTEST_CASES` to fuzz longer.
+//! `RASTERGI_FUZZ_CASES` (or `PROPTEST_CASES`) to fuzz longer.
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU32, Ordering};
@@ -17,7 +17,7 @@ use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
 use rastergi::scene::load_obj;
 
-/// Generated cases per strategy (overridden by `PROPTEST_CASES`).
+/// Generated cases per strategy (overridden by `RASTERGI_FUZZ_CASES` or `PROPTEST_CASES`).
 const CASES: u32 = 2000;
 /// A load that takes longer than this on a few kilobytes of text is a hang.
 const WATCHDOG: Duration = Duration::from_secs(20);
@@ -27,7 +27,10 @@ fn data(name: &str) -> PathBuf {
 }
 
 fn config() -> Config {
-    let cases = std::env::var("PROPTEST_CASES").ok().and_then(|c| c.parse().ok()).unwrap_or(CASES);
+    let cases = ["RASTERGI_FUZZ_CASES", "PROPTEST_CASES"]
+        .iter()
+        .find_map(|v| std::env::var(v).ok().and_then(|c| c.parse().ok()))
+        .unwrap_or(CASES);
     // Failures are reported with the shrunk input; nothing is written beside the sources.
     Config { cases, failure_persistence: None, ..Config::default() }
 }

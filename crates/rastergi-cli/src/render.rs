@@ -10,6 +10,7 @@ use glam::Vec3;
 use indicatif::{ProgressBar, ProgressStyle};
 use rastergi::film::Show;
 use rastergi::fit;
+use rastergi::gather::GatherMethod;
 use rastergi::gpu::{Backends, Gpu, GpuOptions, parse_backend};
 use rastergi::image_io::{ImageFormat, write_exr, write_png};
 use rastergi::path_tracer::PathTracer;
@@ -43,6 +44,27 @@ impl ShowArg {
             ShowArg::Direct => Show::Direct,
             ShowArg::Indirect => Show::Indirect,
             ShowArg::PhotonMap => Show::PhotonMap,
+        }
+    }
+}
+
+/// How the final gather finds the nearest surface along its direction.
+#[derive(Copy, Clone, Debug, ValueEnum)]
+pub enum GatherArg {
+    /// Time both on the first iterations and keep the faster on this GPU.
+    Auto,
+    /// Depth-peeled orthographic ray views (rasterization).
+    Raster,
+    /// BVH ray casting in a compute shader.
+    Trace,
+}
+
+impl GatherArg {
+    pub fn method(self) -> GatherMethod {
+        match self {
+            GatherArg::Auto => GatherMethod::Auto,
+            GatherArg::Raster => GatherMethod::Raster,
+            GatherArg::Trace => GatherMethod::Trace,
         }
     }
 }
@@ -93,6 +115,10 @@ pub struct SceneArgs {
     /// the scene's bounding sphere; 128 to 2048).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
     pub bundle: Option<u32>,
+    /// How the final gather finds the nearest surface along each direction (the same
+    /// estimator either way).
+    #[arg(long, value_enum, default_value_t = GatherArg::Auto)]
+    pub gather: GatherArg,
     /// What the image shows.
     #[arg(long, value_enum, default_value_t = ShowArg::Full)]
     pub show: ShowArg,
@@ -137,6 +163,7 @@ impl SceneArgs {
             grid_resolution: grid,
             show_photon_map,
             bundle: self.bundle.unwrap_or(0),
+            gather: self.gather.method(),
         }
     }
 }
@@ -155,6 +182,9 @@ pub struct RenderArgs {
     /// (same scene, camera and pixel filter; unlimited depth, next-event estimation + MIS).
     #[arg(long, value_enum, default_value_t = Method::Gather)]
     method: Method,
+    /// Print the GPU time of every pass (timestamp queries): the set-up's and the iterations'.
+    #[arg(long)]
+    profile: bool,
 }
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
@@ -210,7 +240,33 @@ impl GpuArgs {
 }
 
 pub fn gpu(args: &GpuArgs) -> Result<Gpu> {
-    Ok(Gpu::new(&GpuOptions { backends: args.backend })?)
+    Ok(Gpu::new(&GpuOptions { backends: args.backend, ..Default::default() })?)
+}
+
+/// A GPU whose passes are timed when `profile` is set (see [`print_profile`]).
+pub fn gpu_profiled(args: &GpuArgs, profile: bool) -> Result<Gpu> {
+    Ok(Gpu::new(&GpuOptions { backends: args.backend, profile })?)
+}
+
+/// Prints the GPU time per pass since the last call under `title` (per `per` `per_name`s),
+/// then starts new sums. Nothing without `--profile`; a note where the adapter has no
+/// timestamp queries.
+pub fn print_profile(gpu: &Gpu, profile: bool, title: &str, per: u64, per_name: &str) -> Result<()> {
+    if !profile {
+        return Ok(());
+    }
+    let Some(p) = &gpu.profiler else {
+        println!("{title}: {} has no timestamp queries; no per-pass GPU times", gpu.info.name);
+        return Ok(());
+    };
+    let (times, dropped) = p.report(&gpu.device, &gpu.queue)?;
+    p.clear(&gpu.device, &gpu.queue)?;
+    println!("{title} (GPU timestamps, {}):", gpu.info.name);
+    println!("{}", rastergi::profile::table(&times, per, per_name));
+    if dropped > 0 {
+        println!("({dropped} passes not timed: the query set was full)");
+    }
+    Ok(())
 }
 
 /// The built-in scene of that name, or the scene file at that path.
@@ -266,7 +322,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if args.iterations == 0 {
         anyhow::bail!("--iterations must be at least 1");
     }
-    let gpu = gpu(&a.gpu)?;
+    let gpu = gpu_profiled(&a.gpu, args.profile)?;
     if args.method == Method::Path && !matches!(a.show, ShowArg::Full) {
         anyhow::bail!("--method path renders the full image only; drop --show or use --method gather");
     }
@@ -278,6 +334,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     };
     renderer.wait()?;
     log::info!("set-up (BVH, upload, photon map) in {:.2} s", start.elapsed().as_secs_f64());
+    print_profile(&gpu, args.profile, "set-up", 1, "set-up")?;
     if let Progressive::Gather(r) = &renderer {
         log::info!("gather ray view: {0}x{0} texels", r.bundle());
     }
@@ -304,7 +361,16 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     renderer.wait()?;
     progress.finish_and_clear();
-    log::info!("{} iterations in {:.2} s", args.iterations, start.elapsed().as_secs_f64());
+    let seconds = start.elapsed().as_secs_f64();
+    log::info!("{} iterations in {seconds:.2} s", args.iterations);
+    if args.profile {
+        println!(
+            "{} iterations in {seconds:.3} s wall clock ({:.3} ms per iteration)",
+            args.iterations,
+            1e3 * seconds / args.iterations as f64
+        );
+    }
+    print_profile(&gpu, args.profile, "iterations", args.iterations as u64, "iteration")?;
 
     let show = a.show.show();
     let linear = match &renderer {

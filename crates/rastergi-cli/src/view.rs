@@ -489,7 +489,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         scene: Arc::new(scene),
         controls: Controls::new(camera, a.show.show(), a.exposure.unwrap_or(0.0), base.photons, base.grid_resolution),
         base,
-        gpu_options: GpuOptions { backends: a.gpu.backend() },
+        gpu_options: GpuOptions { backends: a.gpu.backend(), ..Default::default() },
         proxy: event_loop.create_proxy(),
         window: None,
         gpu: None,

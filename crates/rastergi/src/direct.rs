@@ -17,11 +17,13 @@ use crate::gbuffer::GBufferPass;
 use crate::gpu::{Gpu, compute_pipeline, groups};
 use crate::gpu_scene::GpuScene;
 use crate::photon_view::{gbuffer_film_bind_group, gbuffer_film_layout};
+use crate::profile::{Profiler, compute_pass};
 use crate::shader;
 
 pub struct DirectPass {
     pipeline: wgpu::ComputePipeline,
     bind_group: wgpu::BindGroup,
+    profiler: Option<Profiler>,
 }
 
 impl DirectPass {
@@ -31,7 +33,7 @@ impl DirectPass {
         let layout = gbuffer_film_layout(device, "direct");
         let bind_group = gbuffer_film_bind_group(device, "direct", &layout, gbuffer, film);
         let pipeline = compute_pipeline(device, "direct", &module, "main", &[&scene.layout, &frame.layout, &layout]);
-        Self { pipeline, bind_group }
+        Self { pipeline, bind_group, profiler: gpu.profiler.clone() }
     }
 
     /// Reads: scene, frame, G-buffer. Adds to: the film's direct component.
@@ -43,8 +45,7 @@ impl DirectPass {
         width: u32,
         height: u32,
     ) {
-        let mut pass =
-            enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("direct"), timestamp_writes: None });
+        let mut pass = compute_pass(enc, self.profiler.as_ref(), "direct");
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &scene.bind_group, &[]);
         pass.set_bind_group(1, &frame.bind_group, &[]);

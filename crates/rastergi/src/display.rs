@@ -270,7 +270,7 @@ impl WindowSurface {
         }))
         .map_err(|e| Error::Device(e.to_string()))?;
         log::info!("using {} ({:?}, {:?}) for the window", info.name, info.backend, info.device_type);
-        let gpu = Gpu { adapter, device, queue, info };
+        let gpu = Gpu { adapter, device, queue, info, profiler: None };
 
         let caps = surface.get_capabilities(&gpu.adapter);
         use wgpu::TextureFormat as F;

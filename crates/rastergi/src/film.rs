@@ -123,8 +123,7 @@ impl Film {
             _pad: [0; 3],
         };
         gpu.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
-        let mut pass =
-            enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("resolve"), timestamp_writes: None });
+        let mut pass = crate::profile::compute_pass(enc, gpu.profiler.as_ref(), "resolve");
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &self.bind_group, &[]);
         pass.dispatch_workgroups(groups(self.width, 8), groups(self.height, 8), 1);

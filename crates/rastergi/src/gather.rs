@@ -1,22 +1,21 @@
-//! Final gather by rasterization (Hachisuka, GPU Gems 2, ch. 38): per iteration one direction
-//! ω for all visible points at once.
+//! Final gather: per iteration one direction ω for all visible points at once (Hachisuka,
+//! GPU Gems 2, ch. 38), found by one of two implementations of the same estimator.
 //!
 //! * Direction: ω_i = R · S(i), S a low-discrepancy (Halton 5, 7) sequence mapped uniformly to
 //!   the sphere (pdf 1/4π) and R a random rotation drawn per restart.
-//! * Ray view: an orthographic camera looking along −ω that encloses the scene's bounding
-//!   sphere, shifted by a random sub-texel offset. Ray-view depth grows along −ω, so a gather
-//!   ray leaving x along +ω meets surfaces of decreasing depth.
-//! * Depth peeling, back to front: layer 1 keeps the farthest fragment per texel (reversed
-//!   depth test); layer k+1 the farthest strictly nearer than layer k. A counting pass first
-//!   measures the depth complexity along ω, and exactly that many layers are peeled.
-//! * Projection: after each layer, every visible point x projects into the ray view like a
-//!   shadow-map lookup. The first layer (back to front) whose surface h lies in front of x —
-//!   the plane of h's triangle crosses x's ray at t > ε — is the nearest hit along ω. The plane
-//!   test rejects x's own triangle and coplanar neighbours exactly, at any angle (no acne, no
-//!   slope bias that would lose contact shadows).
-//! * Estimate: L_ind(x, ω) = (ρ_x/π) · L(h → x) · max(0, n_x·ω) · 4π, where L(h → x) = ρ_h/π ·
-//!   E(h) from the photon map on the side of h facing x (zero from the back of a one-sided
-//!   surface; emission is never added: the direct pass owns it).
+//! * Nearest surface h along ω from each visible point x (t > ε, x's own triangle excluded):
+//!   [`GatherMethod::Raster`] depth-peels an orthographic ray view and projects each layer onto
+//!   the visible points ([`crate::gather_raster`]); [`GatherMethod::Trace`] casts the ray
+//!   through the BVH in a compute shader ([`crate::gather_trace`]). They differ only where a
+//!   ray-view texel is crossed by a silhouette (the raster gather takes the texel's surface).
+//! * Estimate (`gather.wgsl`): L_ind(x, ω) = (ρ_x/π) · L(h → x) · max(0, n_x·ω) · 4π, where
+//!   L(h → x) = ρ_h/π · E(h) from the photon map on the side of h facing x (zero from the back
+//!   of a one-sided surface; emission is never added: the direct pass owns it).
+//!
+//! [`GatherMethod::Auto`] lets the first iterations alternate between the two and keeps the
+//! faster on this adapter; every one of those iterations counts towards the image.
+
+use std::time::{Duration, Instant};
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Quat, Vec2, Vec3};
@@ -24,17 +23,14 @@ use glam::{Mat4, Quat, Vec2, Vec3};
 use crate::error::Result;
 use crate::film::Film;
 use crate::frame::FrameBinding;
+use crate::gather_raster::RasterGather;
+use crate::gather_trace::TraceGather;
 use crate::gbuffer::GBufferPass;
-use crate::gpu::{Gpu, compute_pipeline, groups, storage_entry, uniform_entry};
+use crate::gpu::Gpu;
 use crate::gpu_scene::GpuScene;
 use crate::photons::gpu::GpuPhotonMap;
 use crate::sampling::{Rng, orthonormal_basis, radical_inverse, uniform_sphere};
 use crate::scene::Aabb;
-use crate::shader;
-
-/// Ray-view texel: (triangle + 1, b1 bits, b2 bits, depth bits); 0 where empty.
-const LAYER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;
-const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
 /// `Gather` in `gather.wgsl`.
 #[repr(C)]
@@ -44,6 +40,21 @@ pub struct GatherUniforms {
     pub direction: [f32; 3],
     pub bundle: u32,
 }
+
+/// How the nearest surface along the gather direction is found.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum GatherMethod {
+    /// Time both on the first iterations and keep the faster.
+    #[default]
+    Auto,
+    /// Depth-peeled orthographic ray view (rasterization).
+    Raster,
+    /// BVH ray casting in a compute shader.
+    Trace,
+}
+
+/// Iterations of each method timed by [`GatherMethod::Auto`] before it chooses.
+pub const AUTO_TRIALS: u32 = 3;
 
 /// The gather direction of iteration `i` for a restart whose rotation is `rotation`.
 pub fn gather_direction(i: u32, rotation: Quat) -> Vec3 {
@@ -71,25 +82,20 @@ pub fn ray_view_projection(bounds: &Aabb, direction: Vec3, bundle: u32, jitter: 
     shift * proj * view
 }
 
+/// The final gather pass: one or both implementations behind one interface.
 pub struct GatherPass {
     pub bundle: u32,
     uniforms: wgpu::Buffer,
-    count_pipeline: wgpu::RenderPipeline,
-    peel_pipeline: wgpu::RenderPipeline,
-    project_pipeline: wgpu::ComputePipeline,
-    layers: [wgpu::TextureView; 2],
-    depth: wgpu::TextureView,
-    counts: wgpu::Buffer,
-    max_count: wgpu::Buffer,
-    found: wgpu::Buffer,
-    count_group: wgpu::BindGroup,
-    /// peel_groups[k]: reads layer texture 1−k (the previous layer).
-    peel_groups: [wgpu::BindGroup; 2],
-    /// project_groups[k]: reads layer texture k (the layer just peeled).
-    project_groups: [wgpu::BindGroup; 2],
+    raster: Option<RasterGather>,
+    trace: Option<TraceGather>,
+    /// The implementation in use, once chosen.
+    chosen: Option<GatherMethod>,
+    /// Auto: wall-clock times of the trial iterations so far (raster, trace).
+    trials: [Vec<Duration>; 2],
 }
 
 impl GatherPass {
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         gpu: &Gpu,
         scene: &GpuScene,
@@ -98,187 +104,25 @@ impl GatherPass {
         film: &Film,
         map: &GpuPhotonMap,
         bundle: u32,
+        method: GatherMethod,
     ) -> Result<GatherPass> {
-        let device = &gpu.device;
-        crate::limits::check_bundle(&device.limits(), bundle)?;
         let uniforms = gpu.zeroed_buffer(
             "gather uniforms",
             std::mem::size_of::<GatherUniforms>() as u64,
             wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         );
-        let texture = |label: &str, format: wgpu::TextureFormat, usage: wgpu::TextureUsages| {
-            device
-                .create_texture(&wgpu::TextureDescriptor {
-                    label: Some(label),
-                    size: wgpu::Extent3d { width: bundle, height: bundle, depth_or_array_layers: 1 },
-                    mip_level_count: 1,
-                    sample_count: 1,
-                    dimension: wgpu::TextureDimension::D2,
-                    format,
-                    usage,
-                    view_formats: &[],
-                })
-                .create_view(&Default::default())
-        };
-        let layer_usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
-        let layers = [
-            texture("gather layer 0", LAYER_FORMAT, layer_usage),
-            texture("gather layer 1", LAYER_FORMAT, layer_usage),
-        ];
-        let depth = texture("gather depth", DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT);
-        let counts = gpu.zeroed_buffer(
-            "gather depth complexity",
-            bundle as u64 * bundle as u64 * 4,
-            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-        );
-        let max_count = gpu.zeroed_buffer(
-            "gather max depth complexity",
-            4,
-            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
-        );
-        let pixels = film.width as u64 * film.height as u64;
-        let found =
-            gpu.zeroed_buffer("gather found", pixels * 4, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST);
+        let raster = (method != GatherMethod::Trace)
+            .then(|| RasterGather::new(gpu, scene, frame, gbuffer, film, map, &uniforms, bundle))
+            .transpose()?;
+        let trace = (method != GatherMethod::Raster)
+            .then(|| TraceGather::new(gpu, scene, frame, gbuffer, film, map, &uniforms));
+        let chosen = (method != GatherMethod::Auto).then_some(method);
+        Ok(GatherPass { bundle, uniforms, raster, trace, chosen, trials: [Vec::new(), Vec::new()] })
+    }
 
-        let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
-        let c = wgpu::ShaderStages::COMPUTE;
-        let tex_entry = |binding, visibility| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Uint,
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
-            },
-            count: None,
-        };
-        let count_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("gather count"),
-            entries: &[
-                uniform_entry(0, vf),
-                storage_entry(1, wgpu::ShaderStages::FRAGMENT, false),
-                storage_entry(2, wgpu::ShaderStages::FRAGMENT, false),
-            ],
-        });
-        let peel_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("gather peel"),
-            entries: &[uniform_entry(0, vf), tex_entry(1, wgpu::ShaderStages::FRAGMENT)],
-        });
-        let project_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("gather project"),
-            entries: &[
-                uniform_entry(0, c),
-                tex_entry(1, c),
-                tex_entry(2, c),
-                storage_entry(3, c, false),
-                storage_entry(4, c, false),
-            ],
-        });
-        let count_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("gather count"),
-            layout: &count_layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: counts.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: max_count.as_entire_binding() },
-            ],
-        });
-        let peel_group = |prev: &wgpu::TextureView| {
-            device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("gather peel"),
-                layout: &peel_layout,
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(prev) },
-                ],
-            })
-        };
-        let project_group = |layer: &wgpu::TextureView| {
-            device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("gather project"),
-                layout: &project_layout,
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&gbuffer.view) },
-                    wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(layer) },
-                    wgpu::BindGroupEntry { binding: 3, resource: found.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 4, resource: film.accumulation.as_entire_binding() },
-                ],
-            })
-        };
-        let peel_groups = [peel_group(&layers[1]), peel_group(&layers[0])];
-        let project_groups = [project_group(&layers[0]), project_group(&layers[1])];
-
-        let raster_source = [shader::SAMPLING, shader::SCENE, include_str!("gather_peel.wgsl")].join("\n");
-        let raster = shader::module(device, "gather peel", &raster_source);
-        let raster_pipeline = |label: &str,
-                               layout: &wgpu::BindGroupLayout,
-                               fs: &str,
-                               write: wgpu::ColorWrites,
-                               depth: bool| {
-            let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some(label),
-                bind_group_layouts: &[Some(&scene.layout), Some(layout)],
-                immediate_size: 0,
-            });
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(label),
-                layout: Some(&pl),
-                vertex: wgpu::VertexState {
-                    module: &raster,
-                    entry_point: Some("vs_main"),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-                depth_stencil: depth.then(|| wgpu::DepthStencilState {
-                    format: DEPTH_FORMAT,
-                    depth_write_enabled: Some(true),
-                    // Back to front: keep the farthest fragment.
-                    depth_compare: Some(wgpu::CompareFunction::Greater),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &raster,
-                    entry_point: Some(fs),
-                    compilation_options: Default::default(),
-                    targets: &[Some(wgpu::ColorTargetState { format: LAYER_FORMAT, blend: None, write_mask: write })],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
-        };
-        let count_pipeline =
-            raster_pipeline("gather count", &count_layout, "fs_count", wgpu::ColorWrites::empty(), false);
-        let peel_pipeline = raster_pipeline("gather peel", &peel_layout, "fs_peel", wgpu::ColorWrites::ALL, true);
-
-        let project_source =
-            shader::with_scene(&[include_str!("photon_map.wgsl"), include_str!("gather.wgsl")].join("\n"));
-        let project_module = shader::module(device, "gather project", &project_source);
-        let project_pipeline = compute_pipeline(
-            device,
-            "gather project",
-            &project_module,
-            "main",
-            &[&scene.layout, &frame.layout, &project_layout, &map.layout],
-        );
-        Ok(GatherPass {
-            bundle,
-            uniforms,
-            count_pipeline,
-            peel_pipeline,
-            project_pipeline,
-            layers,
-            depth,
-            counts,
-            max_count,
-            found,
-            count_group,
-            peel_groups,
-            project_groups,
-        })
+    /// The implementation in use (`Auto` while the trials run).
+    pub fn method(&self) -> GatherMethod {
+        self.chosen.unwrap_or(GatherMethod::Auto)
     }
 
     /// Sets the direction and ray view of the next gather (written before the next submit).
@@ -291,111 +135,85 @@ impl GatherPass {
         gpu.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
     }
 
-    /// Encodes the depth-complexity count of the ray view; its result is read by
-    /// [`GatherPass::read_layer_count`] after the encoder is submitted.
-    pub fn encode_count(&self, enc: &mut wgpu::CommandEncoder, scene: &GpuScene) {
-        enc.clear_buffer(&self.counts, 0, None);
-        enc.clear_buffer(&self.max_count, 0, None);
-        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("gather count"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &self.layers[0],
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
-            })],
-            depth_stencil_attachment: None,
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_pipeline(&self.count_pipeline);
-        pass.set_bind_group(0, &scene.bind_group, &[]);
-        pass.set_bind_group(1, &self.count_group, &[]);
-        pass.draw(0..3 * scene.triangle_count, 0..1);
-    }
-
-    /// The depth complexity along the current direction: the number of layers to peel.
-    pub fn read_layer_count(&self, gpu: &Gpu) -> Result<u32> {
-        let bytes = gpu.read_buffer(&self.max_count, 4)?;
-        Ok(u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]))
-    }
-
-    /// Peels `layers` layers back to front, projecting each onto the visible points.
-    /// Reads: scene, frame, G-buffer, photon map. Adds to: the film's indirect component.
+    /// Encodes the gather along the direction last set, after the work already in `enc`, and
+    /// returns the encoder to go on with (the raster gather submits `enc` to read the depth
+    /// complexity back). Reads: scene, frame, G-buffer, photon map. Adds to: the film's
+    /// indirect component.
     #[allow(clippy::too_many_arguments)]
-    pub fn encode_layers(
-        &self,
-        enc: &mut wgpu::CommandEncoder,
+    pub fn encode(
+        &mut self,
+        gpu: &Gpu,
+        enc: wgpu::CommandEncoder,
         scene: &GpuScene,
         frame: &FrameBinding,
         map: &GpuPhotonMap,
         width: u32,
         height: u32,
-        layers: u32,
-    ) {
-        enc.clear_buffer(&self.found, 0, None);
-        // "Layer −1" (read by the first peel) is empty with depth bits above any depth.
-        let beyond = f64::from(2.0f32.to_bits());
-        {
-            let _ = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("gather layer init"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &self.layers[1],
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color { r: 0.0, g: 0.0, b: 0.0, a: beyond }),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-        }
-        for k in 0..layers as usize {
-            let cur = k % 2;
-            {
-                let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("gather peel"),
-                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                        view: &self.layers[cur],
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                            store: wgpu::StoreOp::Store,
-                        },
-                    })],
-                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                        view: &self.depth,
-                        depth_ops: Some(wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(0.0),
-                            store: wgpu::StoreOp::Discard,
-                        }),
-                        stencil_ops: None,
-                    }),
-                    timestamp_writes: None,
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
-                pass.set_pipeline(&self.peel_pipeline);
-                pass.set_bind_group(0, &scene.bind_group, &[]);
-                pass.set_bind_group(1, &self.peel_groups[cur], &[]);
-                pass.draw(0..3 * scene.triangle_count, 0..1);
+    ) -> Result<wgpu::CommandEncoder> {
+        let method = match self.chosen {
+            Some(m) => m,
+            None => return self.encode_trial(gpu, enc, scene, frame, map, width, height),
+        };
+        match method {
+            GatherMethod::Raster => {
+                let raster = self.raster.as_ref().expect("the raster gather exists when chosen");
+                raster.encode(gpu, enc, scene, frame, map, width, height)
             }
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("gather project"),
-                timestamp_writes: None,
-            });
-            pass.set_pipeline(&self.project_pipeline);
-            pass.set_bind_group(0, &scene.bind_group, &[]);
-            pass.set_bind_group(1, &frame.bind_group, &[]);
-            pass.set_bind_group(2, &self.project_groups[cur], &[]);
-            pass.set_bind_group(3, &map.bind_group, &[]);
-            pass.dispatch_workgroups(groups(width, 8), groups(height, 8), 1);
+            _ => {
+                let mut enc = enc;
+                let trace = self.trace.as_ref().expect("the traced gather exists when chosen");
+                trace.encode(&mut enc, scene, frame, map, width, height);
+                Ok(enc)
+            }
         }
+    }
+
+    /// One timed trial iteration of `Auto`: the work before the gather is finished first so the
+    /// gather alone is timed; after [`AUTO_TRIALS`] of each, the faster (median) is kept.
+    #[allow(clippy::too_many_arguments)]
+    fn encode_trial(
+        &mut self,
+        gpu: &Gpu,
+        enc: wgpu::CommandEncoder,
+        scene: &GpuScene,
+        frame: &FrameBinding,
+        map: &GpuPhotonMap,
+        width: u32,
+        height: u32,
+    ) -> Result<wgpu::CommandEncoder> {
+        let k = if self.trials[0].len() <= self.trials[1].len() { 0 } else { 1 };
+        gpu.queue.submit([enc.finish()]);
+        gpu.wait()?;
+        let start = Instant::now();
+        let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("gather") });
+        if k == 0 {
+            let raster = self.raster.as_ref().expect("auto builds both");
+            enc = raster.encode(gpu, enc, scene, frame, map, width, height)?;
+        } else {
+            self.trace.as_ref().expect("auto builds both").encode(&mut enc, scene, frame, map, width, height);
+        }
+        gpu.queue.submit([enc.finish()]);
+        gpu.wait()?;
+        self.trials[k].push(start.elapsed());
+        if self.trials[1].len() as u32 >= AUTO_TRIALS {
+            let median = |v: &mut Vec<Duration>| {
+                v.sort();
+                v[v.len() / 2]
+            };
+            let (raster, trace) = (median(&mut self.trials[0]), median(&mut self.trials[1]));
+            let method = if raster < trace { GatherMethod::Raster } else { GatherMethod::Trace };
+            log::info!(
+                "gather: raster {:.2} ms, trace {:.2} ms per direction on {}: using {method:?}",
+                raster.as_secs_f64() * 1e3,
+                trace.as_secs_f64() * 1e3,
+                gpu.info.name
+            );
+            self.chosen = Some(method);
+            match method {
+                GatherMethod::Raster => self.trace = None,
+                _ => self.raster = None,
+            }
+        }
+        Ok(gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("iteration") }))
     }
 }

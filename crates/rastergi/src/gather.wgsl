@@ -1,4 +1,5 @@
-// Final gather projection (gather.rs): each layer projected onto the eye's visible points.
+// Final gather estimator (gather.rs), shared by the raster projection (gather_project.wgsl)
+// and the traced gather (gather_trace.wgsl).
 
 struct Gather {
     view_proj: mat4x4f,
@@ -6,73 +7,40 @@ struct Gather {
     bundle: u32,
 }
 
-@group(2) @binding(0) var<uniform> gather: Gather;
-@group(2) @binding(1) var gbuffer: texture_2d<u32>;
-@group(2) @binding(2) var layer: texture_2d<u32>;
-// Per eye pixel: 1 once its gather ray for this direction is resolved (hit, miss or no
-// contribution), so nearer layers no longer count.
-@group(2) @binding(3) var<storage, read_write> found: array<u32>;
-@group(2) @binding(4) var<storage, read_write> film: array<vec4f>;
+// A visible point that gathers along ω: the surface, seen from the side facing the eye, and
+// cos θ_x = n_x·ω on that side.
+struct GatherPoint {
+    x: Surface,
+    cos_x: f32,
+    // False where nothing is gathered: no surface, the back of a one-sided surface, or ω
+    // below x's horizon.
+    ok: bool,
+}
 
-@compute @workgroup_size(8, 8)
-fn main(@builtin(global_invocation_id) gid: vec3u) {
-    if any(gid.xy >= frame.resolution) {
-        return;
-    }
-    let pixel = gid.y * frame.resolution.x + gid.x;
-    if found[pixel] != 0u {
-        return;
-    }
-    let g = textureLoad(gbuffer, gid.xy, 0);
+fn gather_point(g: vec4u, w: vec3f) -> GatherPoint {
+    var p: GatherPoint;
+    p.ok = false;
     if g.x == 0u {
-        found[pixel] = 1u;
-        return;
+        return p;
     }
-    let x = surface_at(g.x - 1u, bitcast<f32>(g.y), bitcast<f32>(g.z), bitcast<f32>(g.w));
-    let front = dot(x.normal, frame.eye - x.pos) > 0.0;
-    let w = gather.direction;
-    let n = select(-x.normal, x.normal, front);
-    let cos_x = dot(n, w);
-    if (!front && (x.flags & MATERIAL_TWO_SIDED) == 0u) || cos_x <= 0.0 {
-        found[pixel] = 1u;
-        return;
-    }
-    // Shadow-map style projection of x into the ray view.
-    let clip = gather.view_proj * vec4f(x.pos, 1.0);
-    let uv = vec2f(0.5 * clip.x + 0.5, 0.5 - 0.5 * clip.y) * f32(gather.bundle);
-    let texel = vec2u(clamp(vec2i(floor(uv)), vec2i(0), vec2i(i32(gather.bundle) - 1)));
-    let l = textureLoad(layer, texel, 0);
-    if l.x == 0u {
-        // Nothing at this texel in this layer, hence in no nearer layer: the ray escapes.
-        found[pixel] = 1u;
-        return;
-    }
-    let tri = l.x - 1u;
-    if tri == x.tri {
-        return;
-    }
+    p.x = surface_at(g.x - 1u, bitcast<f32>(g.y), bitcast<f32>(g.z), bitcast<f32>(g.w));
+    let front = dot(p.x.normal, frame.eye - p.x.pos) > 0.0;
+    p.cos_x = dot(select(-p.x.normal, p.x.normal, front), w);
+    p.ok = (front || (p.x.flags & MATERIAL_TWO_SIDED) != 0u) && p.cos_x > 0.0;
+    return p;
+}
+
+// (ρ_x/π) · L(h → x) · cos θ_x · 4π for the hit point h on triangle tri at barycentrics b:
+// L(h → x) = ρ_h/π · E(h) on the side of h facing x, zero from the back of a one-sided h.
+fn gather_estimate(p: GatherPoint, w: vec3f, tri: u32, hit: vec3f, b: vec2f) -> vec3f {
     let t = triangles[tri];
     let n_h = triangle_normal(t);
-    let denom = dot(w, n_h);
-    if abs(denom) < 1e-8 {
-        return;
+    let front_h = dot(w, n_h) < 0.0;
+    if !front_h && (materials[t.material].flags & MATERIAL_TWO_SIDED) == 0u {
+        return vec3f(0.0);
     }
-    // Where x's ray meets the plane of the layer's triangle: in front of x, or not a hit.
-    let dist = dot(t.v0 - x.pos, n_h) / denom;
-    if dist <= frame.ray_epsilon {
-        return;
-    }
-    found[pixel] = 1u;
-    let m = materials[t.material];
-    let front_h = denom < 0.0;
-    if !front_h && (m.flags & MATERIAL_TWO_SIDED) == 0u {
-        return;
-    }
-    let hit = x.pos + w * dist;
     // ρ_h at the hit point itself, unfiltered (level 0), like every secondary point.
-    let b = plane_barycentrics(t, hit);
     let albedo_h = surface_at(tri, b.x, b.y, 0.0).albedo;
     let radiance_h = albedo_h / PI * photon_irradiance(hit, select(-n_h, n_h, front_h));
-    let n_pixels = frame.resolution.x * frame.resolution.y;
-    film[n_pixels + pixel] += vec4f(x.albedo / PI * radiance_h * (cos_x * 4.0 * PI), 0.0);
+    return p.x.albedo / PI * radiance_h * (p.cos_x * 4.0 * PI);
 }

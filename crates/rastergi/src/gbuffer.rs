@@ -19,6 +19,7 @@ pub struct GBufferPass {
     pub texture: wgpu::Texture,
     pub view: wgpu::TextureView,
     depth_view: wgpu::TextureView,
+    profiler: Option<crate::profile::Profiler>,
 }
 
 impl GBufferPass {
@@ -83,7 +84,7 @@ impl GBufferPass {
         });
         let view = texture.create_view(&Default::default());
         let depth_view = depth.create_view(&Default::default());
-        Self { pipeline, texture, view, depth_view }
+        Self { pipeline, texture, view, depth_view, profiler: gpu.profiler.clone() }
     }
 
     /// Reads: scene, frame. Writes: the G-buffer.
@@ -104,7 +105,7 @@ impl GBufferPass {
                 depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(0.0), store: wgpu::StoreOp::Discard }),
                 stencil_ops: None,
             }),
-            timestamp_writes: None,
+            timestamp_writes: self.profiler.as_ref().and_then(|p| p.render("gbuffer")),
             occlusion_query_set: None,
             multiview_mask: None,
         });

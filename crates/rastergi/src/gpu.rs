@@ -3,12 +3,15 @@
 use std::fmt::Write as _;
 
 use crate::error::{Error, Result};
+use crate::profile::Profiler;
 
 /// What the user asked for when choosing a GPU.
 #[derive(Clone, Debug, Default)]
 pub struct GpuOptions {
     /// Backends to consider; `None` means `WGPU_BACKEND` if set, else Vulkan/Metal/DX12.
     pub backends: Option<wgpu::Backends>,
+    /// Time every pass with GPU timestamps ([`crate::profile`]), where the adapter can.
+    pub profile: bool,
 }
 
 /// Re-exported so front ends need no direct wgpu dependency.
@@ -34,6 +37,8 @@ pub struct Gpu {
     pub device: wgpu::Device,
     pub queue: wgpu::Queue,
     pub info: wgpu::AdapterInfo,
+    /// Pass timings, when profiling was asked for and the adapter supports timestamps.
+    pub profiler: Option<Profiler>,
 }
 
 fn device_rank(t: wgpu::DeviceType) -> u32 {
@@ -59,9 +64,14 @@ impl Gpu {
             adapters.into_iter().next().ok_or_else(|| Error::NoAdapter(format!(" for backends {backends:?}")))?;
         let info = adapter.get_info();
         let limits = adapter.limits();
+        let timestamps = wgpu::Features::TIMESTAMP_QUERY;
+        let required_features = if options.profile { adapter.features() & timestamps } else { wgpu::Features::empty() };
+        if options.profile && required_features.is_empty() {
+            log::warn!("{} has no timestamp queries: --profile reports wall-clock time only", info.name);
+        }
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("rastergi device"),
-            required_features: wgpu::Features::empty(),
+            required_features,
             required_limits: limits,
             experimental_features: wgpu::ExperimentalFeatures::disabled(),
             memory_hints: wgpu::MemoryHints::Performance,
@@ -69,7 +79,8 @@ impl Gpu {
         }))
         .map_err(|e| Error::Device(e.to_string()))?;
         log::info!("using {} ({:?}, {:?})", info.name, info.backend, info.device_type);
-        Ok(Gpu { adapter, device, queue, info })
+        let profiler = if options.profile { Profiler::new(&device, &queue) } else { None };
+        Ok(Gpu { adapter, device, queue, info, profiler })
     }
 
     /// A multi-line description of the adapter and the limits that matter to rastergi.

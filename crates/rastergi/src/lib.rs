@@ -3,7 +3,8 @@
 //! The modules follow the data flow of a render:
 //!
 //! scene → [`bvh`] → [`gpu_scene`] → (photon map) → per iteration
-//! ([`gbuffer`] → [`direct`] → (final gather)) → [`film`] (accumulate, resolve) → [`image_io`].
+//! ([`gbuffer`] → [`direct`] → [`gather`] ([`gather_raster`] or [`gather_trace`])) → [`film`]
+//! (accumulate, resolve) → [`image_io`]. [`profile`] times the passes.
 //!
 //! [`renderer::Renderer::iterate`] is the one place that shows the order of the passes.
 
@@ -16,6 +17,8 @@ pub mod film;
 pub mod fit;
 pub mod frame;
 pub mod gather;
+pub mod gather_raster;
+pub mod gather_trace;
 pub mod gbuffer;
 pub mod gpu;
 pub mod gpu_scene;
@@ -27,6 +30,7 @@ pub mod path_tracer;
 pub mod photon_map;
 pub mod photon_view;
 pub mod photons;
+pub mod profile;
 pub mod renderer;
 pub mod sampling;
 pub mod scene;

@@ -210,10 +210,7 @@ impl PathTracer {
         let mut enc =
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("path tracer") });
         {
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("path tracer"),
-                timestamp_writes: None,
-            });
+            let mut pass = crate::profile::compute_pass(&mut enc, self.gpu.profiler.as_ref(), "path tracer");
             pass.set_pipeline(&self.trace);
             pass.set_bind_group(0, &self.scene.bind_group, &[]);
             pass.set_bind_group(1, &self.frame.bind_group, &[]);

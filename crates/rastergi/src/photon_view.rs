@@ -8,11 +8,13 @@ use crate::gbuffer::GBufferPass;
 use crate::gpu::{Gpu, compute_pipeline, groups, storage_entry};
 use crate::gpu_scene::GpuScene;
 use crate::photons::gpu::GpuPhotonMap;
+use crate::profile::{Profiler, compute_pass};
 use crate::shader;
 
 pub struct PhotonViewPass {
     pipeline: wgpu::ComputePipeline,
     bind_group: wgpu::BindGroup,
+    profiler: Option<Profiler>,
 }
 
 impl PhotonViewPass {
@@ -37,7 +39,7 @@ impl PhotonViewPass {
             "main",
             &[&scene.layout, &frame.layout, &layout, &map.layout],
         );
-        Self { pipeline, bind_group }
+        Self { pipeline, bind_group, profiler: gpu.profiler.clone() }
     }
 
     /// Reads: scene, frame, G-buffer, photon map. Adds to: the film's photon-map component.
@@ -50,8 +52,7 @@ impl PhotonViewPass {
         width: u32,
         height: u32,
     ) {
-        let mut pass =
-            enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("photon view"), timestamp_writes: None });
+        let mut pass = compute_pass(enc, self.profiler.as_ref(), "photon view");
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &scene.bind_group, &[]);
         pass.set_bind_group(1, &frame.bind_group, &[]);

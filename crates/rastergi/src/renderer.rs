@@ -7,7 +7,7 @@ use crate::direct::DirectPass;
 use crate::error::Result;
 use crate::film::{Film, Show};
 use crate::frame::{FrameBinding, FrameUniforms, near_plane, pixel_jitter, view_projection};
-use crate::gather::{GatherPass, gather_direction, random_rotation};
+use crate::gather::{GatherMethod, GatherPass, gather_direction, random_rotation};
 use crate::gbuffer::GBufferPass;
 use crate::gpu::Gpu;
 use crate::gpu_scene::{GpuScene, PreparedScene};
@@ -36,6 +36,8 @@ pub struct RenderSettings {
     /// Ray-view resolution of the final gather (texels per side); 0 fits it to the scene and
     /// the image size ([`crate::fit::bundle`]: at least [`default_bundle`]).
     pub bundle: u32,
+    /// How the final gather finds the nearest surface along its direction.
+    pub gather: GatherMethod,
 }
 
 /// The default ray-view resolution: twice the image's larger side, within [128, 2048], so a
@@ -75,6 +77,7 @@ impl Default for RenderSettings {
             grid_resolution: p.grid_resolution,
             show_photon_map: false,
             bundle: 0,
+            gather: GatherMethod::Auto,
         }
     }
 }
@@ -107,7 +110,7 @@ impl ImagePasses {
         };
         let bundle = settings.bundle_for(detail_bundle);
         let gather = match map {
-            Some(map) => Some(GatherPass::new(gpu, scene, frame, &gbuffer, &film, map, bundle)?),
+            Some(map) => Some(GatherPass::new(gpu, scene, frame, &gbuffer, &film, map, bundle, settings.gather)?),
             None => None,
         };
         Ok(ImagePasses { gbuffer, direct, photon_view, gather, film })
@@ -140,7 +143,9 @@ impl Renderer {
         let detail_bundle = crate::fit::detail_bundle(scene);
         if settings.photons > 0 {
             crate::limits::check_photon_grid(&limits, &GridSpec::new(&scene.bounds(), settings.grid_resolution))?;
-            crate::limits::check_bundle(&limits, settings.bundle_for(detail_bundle))?;
+            if settings.gather != GatherMethod::Trace {
+                crate::limits::check_bundle(&limits, settings.bundle_for(detail_bundle))?;
+            }
         }
         let start = std::time::Instant::now();
         let prepared = PreparedScene::new(scene);
@@ -199,6 +204,11 @@ impl Renderer {
     /// The gather's ray-view resolution in use (texels per side; 0 without a photon map).
     pub fn bundle(&self) -> u32 {
         self.passes.gather.as_ref().map_or(0, |g| g.bundle)
+    }
+
+    /// The gather implementation in use (`Auto` until its trials have chosen).
+    pub fn gather_method(&self) -> GatherMethod {
+        self.passes.gather.as_ref().map_or(self.settings.gather, |g| g.method())
     }
 
     pub fn camera(&self) -> Camera {
@@ -265,26 +275,21 @@ impl Renderer {
             view.encode(&mut enc, &self.scene, &self.frame, map, w, h);
         }
         // 3. Final gather along one direction for every visible point → film (indirect).
-        //    The ray view's depth complexity is counted first: that many layers are peeled.
-        if let (Some(gather), Some(map)) = (&self.passes.gather, &self.photon_map) {
+        if let (Some(gather), Some(map)) = (&mut self.passes.gather, &self.photon_map) {
             let direction = o.direction.unwrap_or_else(|| gather_direction(iteration, self.rotation));
             let texel_jitter = o.texel_jitter.unwrap_or_else(|| {
                 let mut rng = Rng::new(seed ^ 0x7e1a5, iteration, self.restart);
                 Vec2::new(rng.next_f32(), rng.next_f32()) - 0.5
             });
             gather.set_direction(&self.gpu, &self.scene.bounds, direction.normalize(), texel_jitter);
-            gather.encode_count(&mut enc, &self.scene);
-            self.gpu.queue.submit([enc.finish()]);
-            let layers = gather.read_layer_count(&self.gpu)?;
-            enc = self
-                .gpu
-                .device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("gather layers") });
-            gather.encode_layers(&mut enc, &self.scene, &self.frame, map, w, h, layers);
+            enc = gather.encode(&self.gpu, enc, &self.scene, &self.frame, map, w, h)?;
         }
         // 4. Accumulate: every pass above added its estimate to the film's sums.
         self.gpu.queue.submit([enc.finish()]);
         self.passes.film.samples += 1;
+        if let Some(p) = self.gpu.profiler.as_ref().filter(|p| p.half_full()) {
+            p.collect(&self.gpu.device, &self.gpu.queue)?;
+        }
         Ok(())
     }
 

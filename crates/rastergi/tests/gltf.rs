@@ -208,6 +208,7 @@ fn the_room_as_obj_with_map_kd_renders_the_same_image_within_noise() {
         seed,
         photons: 1 << 19,
         grid_resolution: 32,
+        gather: rastergi::gather::GatherMethod::Trace,
         ..Default::default()
     };
     let n = 256;

@@ -19,6 +19,7 @@ use crate::error::Result;
 use crate::gpu::{Gpu, compute_pipeline, storage_entry, uniform_entry};
 use crate::gpu_scene::{GpuScene, PreparedScene};
 use crate::photon_map::{BINS, GridSpec, PhotonMap, surface_areas};
+use crate::profile::compute_pass;
 use crate::shader;
 
 /// Fixed-point units per Φ_max.
@@ -228,10 +229,7 @@ impl GpuPhotonMap {
                 let mut enc =
                     device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("photon batch") });
                 {
-                    let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                        label: Some("trace photons"),
-                        timestamp_writes: None,
-                    });
+                    let mut pass = compute_pass(&mut enc, gpu.profiler.as_ref(), "photon trace");
                     pass.set_pipeline(&self.trace_pipeline);
                     pass.set_bind_group(0, &scene.bind_group, &[]);
                     pass.set_bind_group(1, &self.trace_group, &[]);
@@ -244,10 +242,7 @@ impl GpuPhotonMap {
         let mut enc =
             device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("photon map resolve") });
         {
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("resolve photon map"),
-                timestamp_writes: None,
-            });
+            let mut pass = compute_pass(&mut enc, gpu.profiler.as_ref(), "photon map resolve");
             pass.set_pipeline(&self.resolve_pipeline);
             pass.set_bind_group(0, &scene.bind_group, &[]);
             pass.set_bind_group(1, &self.trace_group, &[]);

@@ -1,0 +1,56 @@
+// Final gather projection (gather_raster.rs): each peeled layer projected onto the eye's
+// visible points; the estimate is gather_estimate (gather.wgsl).
+
+@group(2) @binding(0) var<uniform> gather: Gather;
+@group(2) @binding(1) var gbuffer: texture_2d<u32>;
+@group(2) @binding(2) var layer: texture_2d<u32>;
+// Per eye pixel: 1 once its gather ray for this direction is resolved (hit, miss or no
+// contribution), so nearer layers no longer count.
+@group(2) @binding(3) var<storage, read_write> found: array<u32>;
+@group(2) @binding(4) var<storage, read_write> film: array<vec4f>;
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) gid: vec3u) {
+    if any(gid.xy >= frame.resolution) {
+        return;
+    }
+    let pixel = gid.y * frame.resolution.x + gid.x;
+    if found[pixel] != 0u {
+        return;
+    }
+    let w = gather.direction;
+    let p = gather_point(textureLoad(gbuffer, gid.xy, 0), w);
+    if !p.ok {
+        found[pixel] = 1u;
+        return;
+    }
+    // Shadow-map style projection of x into the ray view.
+    let clip = gather.view_proj * vec4f(p.x.pos, 1.0);
+    let uv = vec2f(0.5 * clip.x + 0.5, 0.5 - 0.5 * clip.y) * f32(gather.bundle);
+    let texel = vec2u(clamp(vec2i(floor(uv)), vec2i(0), vec2i(i32(gather.bundle) - 1)));
+    let l = textureLoad(layer, texel, 0);
+    if l.x == 0u {
+        // Nothing at this texel in this layer, hence in no nearer layer: the ray escapes.
+        found[pixel] = 1u;
+        return;
+    }
+    let tri = l.x - 1u;
+    if tri == p.x.tri {
+        return;
+    }
+    let t = triangles[tri];
+    let n_h = triangle_normal(t);
+    let denom = dot(w, n_h);
+    if abs(denom) < 1e-8 {
+        return;
+    }
+    // Where x's ray meets the plane of the layer's triangle: in front of x, or not a hit.
+    let dist = dot(t.v0 - p.x.pos, n_h) / denom;
+    if dist <= frame.ray_epsilon {
+        return;
+    }
+    found[pixel] = 1u;
+    let hit = p.x.pos + w * dist;
+    let n_pixels = frame.resolution.x * frame.resolution.y;
+    film[n_pixels + pixel] += vec4f(gather_estimate(p, w, tri, hit, plane_barycentrics(t, hit)), 0.0);
+}

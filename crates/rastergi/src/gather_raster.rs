@@ -1,0 +1,371 @@
+//! Final gather by rasterization (Hachisuka, GPU Gems 2, ch. 38): the nearest surface along ω
+//! for all visible points at once, by depth peeling the ray view. The estimator is the one in
+//! [`crate::gather`].
+//!
+//! * Ray view: an orthographic camera looking along −ω that encloses the scene's bounding
+//!   sphere, shifted by a random sub-texel offset. Ray-view depth grows along −ω, so a gather
+//!   ray leaving x along +ω meets surfaces of decreasing depth.
+//! * Depth peeling, back to front: layer 1 keeps the farthest fragment per texel (reversed
+//!   depth test); layer k+1 the farthest strictly nearer than layer k. A counting pass first
+//!   measures the depth complexity along ω, and exactly that many layers are peeled: its
+//!   result is read back before the layers are encoded (one GPU→CPU synchronisation per
+//!   direction).
+//! * Projection: after each layer, every visible point x projects into the ray view like a
+//!   shadow-map lookup. The first layer (back to front) whose surface h lies in front of x —
+//!   the plane of h's triangle crosses x's ray at t > ε — is the nearest hit along ω. The plane
+//!   test rejects x's own triangle and coplanar neighbours exactly, at any angle (no acne, no
+//!   slope bias that would lose contact shadows).
+
+use crate::error::Result;
+use crate::film::Film;
+use crate::frame::FrameBinding;
+use crate::gather::GatherUniforms;
+use crate::gbuffer::GBufferPass;
+use crate::gpu::{Gpu, compute_pipeline, groups, storage_entry, uniform_entry};
+use crate::gpu_scene::GpuScene;
+use crate::photons::gpu::GpuPhotonMap;
+use crate::profile::{Profiler, compute_pass};
+use crate::shader;
+
+/// Ray-view texel: (triangle + 1, b1 bits, b2 bits, depth bits); 0 where empty.
+const LAYER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;
+const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+pub struct RasterGather {
+    count_pipeline: wgpu::RenderPipeline,
+    peel_pipeline: wgpu::RenderPipeline,
+    project_pipeline: wgpu::ComputePipeline,
+    layers: [wgpu::TextureView; 2],
+    depth: wgpu::TextureView,
+    counts: wgpu::Buffer,
+    max_count: wgpu::Buffer,
+    found: wgpu::Buffer,
+    count_group: wgpu::BindGroup,
+    /// peel_groups[k]: reads layer texture 1−k (the previous layer).
+    peel_groups: [wgpu::BindGroup; 2],
+    /// project_groups[k]: reads layer texture k (the layer just peeled).
+    project_groups: [wgpu::BindGroup; 2],
+    profiler: Option<Profiler>,
+}
+
+impl RasterGather {
+    /// The passes and ray-view textures for a `bundle`² ray view; `uniforms` holds
+    /// [`GatherUniforms`].
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        gpu: &Gpu,
+        scene: &GpuScene,
+        frame: &FrameBinding,
+        gbuffer: &GBufferPass,
+        film: &Film,
+        map: &GpuPhotonMap,
+        uniforms: &wgpu::Buffer,
+        bundle: u32,
+    ) -> Result<RasterGather> {
+        let device = &gpu.device;
+        crate::limits::check_bundle(&device.limits(), bundle)?;
+        debug_assert_eq!(uniforms.size(), std::mem::size_of::<GatherUniforms>() as u64);
+        let texture = |label: &str, format: wgpu::TextureFormat, usage: wgpu::TextureUsages| {
+            device
+                .create_texture(&wgpu::TextureDescriptor {
+                    label: Some(label),
+                    size: wgpu::Extent3d { width: bundle, height: bundle, depth_or_array_layers: 1 },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format,
+                    usage,
+                    view_formats: &[],
+                })
+                .create_view(&Default::default())
+        };
+        let layer_usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+        let layers = [
+            texture("gather layer 0", LAYER_FORMAT, layer_usage),
+            texture("gather layer 1", LAYER_FORMAT, layer_usage),
+        ];
+        let depth = texture("gather depth", DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT);
+        let counts = gpu.zeroed_buffer(
+            "gather depth complexity",
+            bundle as u64 * bundle as u64 * 4,
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        );
+        let max_count = gpu.zeroed_buffer(
+            "gather max depth complexity",
+            4,
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+        );
+        let pixels = film.width as u64 * film.height as u64;
+        let found =
+            gpu.zeroed_buffer("gather found", pixels * 4, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST);
+
+        let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
+        let c = wgpu::ShaderStages::COMPUTE;
+        let tex_entry = |binding, visibility| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Uint,
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            },
+            count: None,
+        };
+        let count_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("gather count"),
+            entries: &[
+                uniform_entry(0, vf),
+                storage_entry(1, wgpu::ShaderStages::FRAGMENT, false),
+                storage_entry(2, wgpu::ShaderStages::FRAGMENT, false),
+            ],
+        });
+        let peel_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("gather peel"),
+            entries: &[uniform_entry(0, vf), tex_entry(1, wgpu::ShaderStages::FRAGMENT)],
+        });
+        let project_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("gather project"),
+            entries: &[
+                uniform_entry(0, c),
+                tex_entry(1, c),
+                tex_entry(2, c),
+                storage_entry(3, c, false),
+                storage_entry(4, c, false),
+            ],
+        });
+        let count_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("gather count"),
+            layout: &count_layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: counts.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: max_count.as_entire_binding() },
+            ],
+        });
+        let peel_group = |prev: &wgpu::TextureView| {
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("gather peel"),
+                layout: &peel_layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(prev) },
+                ],
+            })
+        };
+        let project_group = |layer: &wgpu::TextureView| {
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("gather project"),
+                layout: &project_layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&gbuffer.view) },
+                    wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(layer) },
+                    wgpu::BindGroupEntry { binding: 3, resource: found.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 4, resource: film.accumulation.as_entire_binding() },
+                ],
+            })
+        };
+        let peel_groups = [peel_group(&layers[1]), peel_group(&layers[0])];
+        let project_groups = [project_group(&layers[0]), project_group(&layers[1])];
+
+        let raster_source = [shader::SAMPLING, shader::SCENE, include_str!("gather_peel.wgsl")].join("\n");
+        let raster = shader::module(device, "gather peel", &raster_source);
+        let raster_pipeline = |label: &str,
+                               layout: &wgpu::BindGroupLayout,
+                               fs: &str,
+                               write: wgpu::ColorWrites,
+                               depth: bool| {
+            let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(label),
+                bind_group_layouts: &[Some(&scene.layout), Some(layout)],
+                immediate_size: 0,
+            });
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(&pl),
+                vertex: wgpu::VertexState {
+                    module: &raster,
+                    entry_point: Some("vs_main"),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+                depth_stencil: depth.then(|| wgpu::DepthStencilState {
+                    format: DEPTH_FORMAT,
+                    depth_write_enabled: Some(true),
+                    // Back to front: keep the farthest fragment.
+                    depth_compare: Some(wgpu::CompareFunction::Greater),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &raster,
+                    entry_point: Some(fs),
+                    compilation_options: Default::default(),
+                    targets: &[Some(wgpu::ColorTargetState { format: LAYER_FORMAT, blend: None, write_mask: write })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let count_pipeline =
+            raster_pipeline("gather count", &count_layout, "fs_count", wgpu::ColorWrites::empty(), false);
+        let peel_pipeline = raster_pipeline("gather peel", &peel_layout, "fs_peel", wgpu::ColorWrites::ALL, true);
+
+        let project_source = shader::with_scene(
+            &[include_str!("photon_map.wgsl"), include_str!("gather.wgsl"), include_str!("gather_project.wgsl")]
+                .join("\n"),
+        );
+        let project_module = shader::module(device, "gather project", &project_source);
+        let project_pipeline = compute_pipeline(
+            device,
+            "gather project",
+            &project_module,
+            "main",
+            &[&scene.layout, &frame.layout, &project_layout, &map.layout],
+        );
+        Ok(RasterGather {
+            count_pipeline,
+            peel_pipeline,
+            project_pipeline,
+            layers,
+            depth,
+            counts,
+            max_count,
+            found,
+            count_group,
+            peel_groups,
+            project_groups,
+            profiler: gpu.profiler.clone(),
+        })
+    }
+
+    /// Counts the depth complexity along the direction in the uniforms, submits `enc` and
+    /// reads the count back, then encodes that many peeled layers with their projections into
+    /// a new encoder, which it returns.
+    #[allow(clippy::too_many_arguments)]
+    pub fn encode(
+        &self,
+        gpu: &Gpu,
+        mut enc: wgpu::CommandEncoder,
+        scene: &GpuScene,
+        frame: &FrameBinding,
+        map: &GpuPhotonMap,
+        width: u32,
+        height: u32,
+    ) -> Result<wgpu::CommandEncoder> {
+        self.encode_count(&mut enc, scene);
+        gpu.queue.submit([enc.finish()]);
+        let layers = self.read_layer_count(gpu)?;
+        let mut enc =
+            gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("gather layers") });
+        self.encode_layers(&mut enc, scene, frame, map, width, height, layers);
+        Ok(enc)
+    }
+
+    /// Encodes the depth-complexity count of the ray view; its result is read by
+    /// [`RasterGather::read_layer_count`] after the encoder is submitted.
+    fn encode_count(&self, enc: &mut wgpu::CommandEncoder, scene: &GpuScene) {
+        enc.clear_buffer(&self.counts, 0, None);
+        enc.clear_buffer(&self.max_count, 0, None);
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("gather count"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &self.layers[0],
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: self.profiler.as_ref().and_then(|p| p.render("gather count")),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.count_pipeline);
+        pass.set_bind_group(0, &scene.bind_group, &[]);
+        pass.set_bind_group(1, &self.count_group, &[]);
+        pass.draw(0..3 * scene.triangle_count, 0..1);
+    }
+
+    /// The depth complexity along the current direction: the number of layers to peel.
+    fn read_layer_count(&self, gpu: &Gpu) -> Result<u32> {
+        let bytes = gpu.read_buffer(&self.max_count, 4)?;
+        Ok(u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]))
+    }
+
+    /// Peels `layers` layers back to front, projecting each onto the visible points.
+    /// Reads: scene, frame, G-buffer, photon map. Adds to: the film's indirect component.
+    #[allow(clippy::too_many_arguments)]
+    fn encode_layers(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        frame: &FrameBinding,
+        map: &GpuPhotonMap,
+        width: u32,
+        height: u32,
+        layers: u32,
+    ) {
+        enc.clear_buffer(&self.found, 0, None);
+        // "Layer −1" (read by the first peel) is empty with depth bits above any depth.
+        let beyond = f64::from(2.0f32.to_bits());
+        {
+            let _ = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("gather layer init"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &self.layers[1],
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color { r: 0.0, g: 0.0, b: 0.0, a: beyond }),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+        }
+        for k in 0..layers as usize {
+            let cur = k % 2;
+            {
+                let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("gather peel"),
+                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                        view: &self.layers[cur],
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                            store: wgpu::StoreOp::Store,
+                        },
+                    })],
+                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                        view: &self.depth,
+                        depth_ops: Some(wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(0.0),
+                            store: wgpu::StoreOp::Discard,
+                        }),
+                        stencil_ops: None,
+                    }),
+                    timestamp_writes: self.profiler.as_ref().and_then(|p| p.render("gather peel")),
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                pass.set_pipeline(&self.peel_pipeline);
+                pass.set_bind_group(0, &scene.bind_group, &[]);
+                pass.set_bind_group(1, &self.peel_groups[cur], &[]);
+                pass.draw(0..3 * scene.triangle_count, 0..1);
+            }
+            let mut pass = compute_pass(enc, self.profiler.as_ref(), "gather project");
+            pass.set_pipeline(&self.project_pipeline);
+            pass.set_bind_group(0, &scene.bind_group, &[]);
+            pass.set_bind_group(1, &frame.bind_group, &[]);
+            pass.set_bind_group(2, &self.project_groups[cur], &[]);
+            pass.set_bind_group(3, &map.bind_group, &[]);
+            pass.dispatch_workgroups(groups(width, 8), groups(height, 8), 1);
+        }
+    }
+}

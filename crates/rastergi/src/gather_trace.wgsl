@@ -1,0 +1,27 @@
+// Final gather by ray casting (gather_trace.rs): the nearest surface along ω from each visible
+// point by BVH traversal; the estimate is gather_estimate (gather.wgsl).
+
+@group(2) @binding(0) var<uniform> gather: Gather;
+@group(2) @binding(1) var gbuffer: texture_2d<u32>;
+@group(2) @binding(2) var<storage, read_write> film: array<vec4f>;
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) gid: vec3u) {
+    if any(gid.xy >= frame.resolution) {
+        return;
+    }
+    let w = gather.direction;
+    let p = gather_point(textureLoad(gbuffer, gid.xy, 0), w);
+    if !p.ok {
+        return;
+    }
+    // Nearest hit at t > ε, x's own triangle excluded (the raster gather's plane test).
+    let h = trace(p.x.pos, w, frame.ray_epsilon, 3.0e38, p.x.tri, NO_TRIANGLE, false);
+    if h.tri == NO_TRIANGLE {
+        return;
+    }
+    let pixel = gid.y * frame.resolution.x + gid.x;
+    let n_pixels = frame.resolution.x * frame.resolution.y;
+    let e = gather_estimate(p, w, h.tri, p.x.pos + w * h.t, vec2f(h.b1, h.b2));
+    film[n_pixels + pixel] += vec4f(e, 0.0);
+}

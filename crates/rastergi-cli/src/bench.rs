@@ -16,7 +16,8 @@ use rastergi::photon_map::GridSpec;
 use rastergi::photons::{PhotonSettings, cpu, gpu::GpuPhotonMap};
 use rastergi::renderer::{RenderSettings, Renderer, default_bundle};
 
-use crate::render::{GpuArgs, gpu, load_scene};
+use crate::render::{GatherArg, GpuArgs, gpu, gpu_profiled, load_scene, print_profile};
+use rastergi::gather::GatherMethod;
 
 #[derive(Subcommand, Debug)]
 pub enum BenchCommand {
@@ -28,6 +29,32 @@ pub enum BenchCommand {
     Converge(ConvergeArgs),
     /// Scene loading and BVH build times (e.g. `bench bvh spheres:1000000`), with the BVH's shape.
     Bvh(BvhArgs),
+    /// GPU memory of a render (the device allocator's report), by resource.
+    Memory(MemoryArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct MemoryArgs {
+    #[arg(default_value = "cornell")]
+    scene: String,
+    #[arg(long, default_value_t = 1920)]
+    width: u32,
+    #[arg(long, default_value_t = 1080)]
+    height: u32,
+    /// Photon grid cells along the scene's longest axis.
+    #[arg(long, default_value_t = 128)]
+    grid: u32,
+    /// Ray-view resolution of the raster gather.
+    #[arg(long, default_value_t = 2048)]
+    bundle: u32,
+    /// Photons traced (the count does not change the memory).
+    #[arg(long, default_value_t = 1 << 16)]
+    photons: u32,
+    /// The gather implementation: auto (both exist until the faster is chosen), raster, trace.
+    #[arg(long, value_enum, default_value_t = GatherArg::Auto)]
+    gather: GatherArg,
+    #[command(flatten)]
+    gpu: GpuArgs,
 }
 
 #[derive(Args, Debug)]
@@ -87,6 +114,12 @@ pub struct GatherArgs {
     /// Also time Mitsuba 3's path tracer (scripts/mitsuba_reference.py; built-in cornell only).
     #[arg(long)]
     mitsuba: bool,
+    /// Gather directions per iteration.
+    #[arg(long, default_value_t = rastergi::renderer::DEFAULT_DIRECTIONS, value_parser = clap::value_parser!(u32).range(1..=16))]
+    directions: u32,
+    /// Print the GPU time of every pass (timestamp queries) for each size and method.
+    #[arg(long)]
+    profile: bool,
     #[command(flatten)]
     gpu: GpuArgs,
 }
@@ -97,7 +130,76 @@ pub fn run(command: &BenchCommand) -> Result<()> {
         BenchCommand::Gather(a) => gather(a),
         BenchCommand::Converge(a) => converge(a),
         BenchCommand::Bvh(a) => bvh(a),
+        BenchCommand::Memory(a) => memory(a),
     }
+}
+
+/// The device allocator's live allocations summed by label, largest first, and the totals.
+fn print_allocations(gpu: &rastergi::gpu::Gpu, title: &str) {
+    let Some(report) = gpu.device.generate_allocator_report() else {
+        println!("{title}: this backend ({:?}) gives no allocator report", gpu.info.backend);
+        return;
+    };
+    let mut by_name: Vec<(String, u64, usize)> = Vec::new();
+    for a in &report.allocations {
+        match by_name.iter_mut().find(|(n, _, _)| *n == a.name) {
+            Some(e) => {
+                e.1 += a.size;
+                e.2 += 1;
+            }
+            None => by_name.push((a.name.clone(), a.size, 1)),
+        }
+    }
+    by_name.sort_by_key(|e| std::cmp::Reverse(e.1));
+    let mib = |b: u64| b as f64 / (1024.0 * 1024.0);
+    println!("{title}:");
+    for (name, bytes, n) in by_name.iter().filter(|e| e.1 >= 1 << 20) {
+        let name = if name.is_empty() { "(unlabelled)" } else { name };
+        println!(
+            "  {name:<34} {:>9.1} MiB{}",
+            mib(*bytes),
+            if *n > 1 { format!(" ({n} allocations)") } else { String::new() }
+        );
+    }
+    let small: u64 = by_name.iter().filter(|e| e.1 < 1 << 20).map(|e| e.1).sum();
+    println!("  {:<34} {:>9.1} MiB", "everything under 1 MiB", mib(small));
+    println!(
+        "  {:<34} {:>9.1} MiB allocated ({:.3} GB), {:.1} MiB reserved in {} blocks",
+        "total",
+        mib(report.total_allocated_bytes),
+        report.total_allocated_bytes as f64 / 1e9,
+        mib(report.total_reserved_bytes),
+        report.blocks.len()
+    );
+}
+
+fn memory(a: &MemoryArgs) -> Result<()> {
+    let scene = load_scene(&a.scene)?;
+    scene.validate()?;
+    let gpu = gpu(&a.gpu)?;
+    println!(
+        "GPU memory: {} at {}x{}, grid {}, bundle {}², gather {:?}, on {} ({:?})",
+        a.scene, a.width, a.height, a.grid, a.bundle, a.gather, gpu.info.name, gpu.info.backend
+    );
+    let settings = RenderSettings {
+        width: a.width,
+        height: a.height,
+        photons: a.photons,
+        grid_resolution: a.grid,
+        bundle: a.bundle,
+        gather: a.gather.method(),
+        seed: 1,
+        ..Default::default()
+    };
+    let mut r = Renderer::new(&gpu, &scene, settings)?;
+    r.wait()?;
+    print_allocations(&gpu, "after set-up (scene, BVH, photon map, passes)");
+    for _ in 0..2 * rastergi::gather::AUTO_TRIALS + 1 {
+        r.iterate()?;
+    }
+    r.wait()?;
+    print_allocations(&gpu, &format!("while rendering (gather: {:?})", r.gather_method()));
+    Ok(())
 }
 
 /// Load time, then the median BVH build time over the repeats (single-threaded binned SAH)
@@ -190,34 +292,55 @@ fn rayon_threads() -> usize {
 }
 
 fn settings(a: &GatherArgs, width: u32, height: u32, bundle: u32) -> RenderSettings {
-    RenderSettings { width, height, photons: a.photons, grid_resolution: a.grid, bundle, seed: 1, ..Default::default() }
+    RenderSettings {
+        width,
+        height,
+        photons: a.photons,
+        grid_resolution: a.grid,
+        bundle,
+        seed: 1,
+        directions: a.directions,
+        ..Default::default()
+    }
 }
 
 fn gather(a: &GatherArgs) -> Result<()> {
     let scene = load_scene(&a.scene)?;
     scene.validate()?;
-    let gpu = gpu(&a.gpu)?;
+    let gpu = gpu_profiled(&a.gpu, a.profile)?;
     println!(
         "final gather: {} on {} ({:?}), bundle {}², {} photons, grid {}",
         a.scene, gpu.info.name, gpu.info.backend, a.bundle, a.photons, a.grid
     );
+    println!("  {} gather directions per iteration (G-buffer and direct light shared by them)", a.directions);
     for &size in &a.sizes {
-        let mut r = Renderer::new(&gpu, &scene, settings(a, size, size, a.bundle))?;
-        for _ in 0..2 {
-            r.iterate()?;
+        for method in [GatherMethod::Raster, GatherMethod::Trace] {
+            let s = RenderSettings { gather: method, ..settings(a, size, size, a.bundle) };
+            let mut r = Renderer::new(&gpu, &scene, s)?;
+            for _ in 0..2 {
+                r.iterate()?;
+            }
+            r.wait()?;
+            if let Some(p) = &gpu.profiler {
+                p.clear(&gpu.device, &gpu.queue)?;
+            }
+            let t = Instant::now();
+            for _ in 0..a.iterations {
+                r.iterate()?;
+            }
+            r.wait()?;
+            let dt = t.elapsed().as_secs_f64();
+            let what = match method {
+                GatherMethod::Raster => "raster (count, read-back, peel + project per layer)",
+                _ => "trace (BVH ray casting, one dispatch)",
+            };
+            println!(
+                "  eye {size}², {what}: {:>8.2} directions/s, {:.1} ms per iteration",
+                (a.iterations * a.directions) as f64 / dt,
+                1e3 * dt / a.iterations as f64
+            );
+            print_profile(&gpu, a.profile, &format!("  eye {size}², {method:?}"), a.iterations as u64, "iteration")?;
         }
-        r.wait()?;
-        let t = Instant::now();
-        for _ in 0..a.iterations {
-            r.iterate()?;
-        }
-        r.wait()?;
-        let dt = t.elapsed().as_secs_f64();
-        println!(
-            "  eye {size}²: {:>8.2} directions/s ({:.1} ms per iteration: G-buffer, direct, count, peel + project per layer)",
-            a.iterations as f64 / dt,
-            1e3 * dt / a.iterations as f64
-        );
     }
     if !a.reference.is_empty() {
         time_to_error(a, &gpu, &scene, &a.reference)?;

@@ -119,6 +119,10 @@ pub struct SceneArgs {
     /// estimator either way).
     #[arg(long, value_enum, default_value_t = GatherArg::Auto)]
     pub gather: GatherArg,
+    /// Gather directions per iteration (1–16): they share the iteration's G-buffer and direct
+    /// light, so the noisier indirect light gets more samples per second.
+    #[arg(long, default_value_t = rastergi::renderer::DEFAULT_DIRECTIONS, value_parser = clap::value_parser!(u32).range(1..=16))]
+    pub directions: u32,
     /// What the image shows.
     #[arg(long, value_enum, default_value_t = ShowArg::Full)]
     pub show: ShowArg,
@@ -164,6 +168,7 @@ impl SceneArgs {
             show_photon_map,
             bundle: self.bundle.unwrap_or(0),
             gather: self.gather.method(),
+            directions: self.directions,
         }
     }
 }

@@ -12,6 +12,9 @@
 //!   L(h → x) = ρ_h/π · E(h) from the photon map on the side of h facing x (zero from the back
 //!   of a one-sided surface; emission is never added: the direct pass owns it).
 //!
+//! Several directions per iteration share one G-buffer and direct pass (`--directions`): the
+//! indirect estimate, by far the noisier, gets more samples per unit of time.
+//!
 //! [`GatherMethod::Auto`] lets the first iterations alternate between the two and keeps the
 //! faster on this adapter; every one of those iterations counts towards the image.
 
@@ -32,13 +35,30 @@ use crate::photons::gpu::GpuPhotonMap;
 use crate::sampling::{Rng, orthonormal_basis, radical_inverse, uniform_sphere};
 use crate::scene::Aabb;
 
+/// Most gather directions per iteration.
+pub const MAX_DIRECTIONS: u32 = 16;
+
 /// `Gather` in `gather.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GatherUniforms {
+    /// Raster: the ray view of `direction`.
     pub view_proj: [[f32; 4]; 4],
+    /// Raster: the direction being peeled.
     pub direction: [f32; 3],
     pub bundle: u32,
+    /// Directions this iteration: each estimate is weighted 1/count.
+    pub count: u32,
+    pub _pad: [u32; 3],
+    /// Trace: all the iteration's directions (xyz).
+    pub directions: [[f32; 4]; MAX_DIRECTIONS as usize],
+}
+
+/// One gather direction of an iteration: ω and the ray view's sub-texel offset.
+#[derive(Clone, Copy, Debug)]
+pub struct GatherSample {
+    pub direction: Vec3,
+    pub texel_jitter: Vec2,
 }
 
 /// How the nearest surface along the gather direction is found.
@@ -125,20 +145,27 @@ impl GatherPass {
         self.chosen.unwrap_or(GatherMethod::Auto)
     }
 
-    /// Sets the direction and ray view of the next gather (written before the next submit).
-    pub fn set_direction(&self, gpu: &Gpu, bounds: &Aabb, direction: Vec3, jitter: Vec2) {
-        let u = GatherUniforms {
-            view_proj: ray_view_projection(bounds, direction, self.bundle, jitter).to_cols_array_2d(),
-            direction: direction.into(),
+    /// The uniforms for `samples` with sample `current` as the raster gather's ray view.
+    fn uniforms(&self, bounds: &Aabb, samples: &[GatherSample], current: usize) -> GatherUniforms {
+        let s = samples[current];
+        let mut directions = [[0.0; 4]; MAX_DIRECTIONS as usize];
+        for (d, s) in directions.iter_mut().zip(samples) {
+            *d = s.direction.extend(0.0).into();
+        }
+        GatherUniforms {
+            view_proj: ray_view_projection(bounds, s.direction, self.bundle, s.texel_jitter).to_cols_array_2d(),
+            direction: s.direction.into(),
             bundle: self.bundle,
-        };
-        gpu.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
+            count: samples.len() as u32,
+            _pad: [0; 3],
+            directions,
+        }
     }
 
-    /// Encodes the gather along the direction last set, after the work already in `enc`, and
-    /// returns the encoder to go on with (the raster gather submits `enc` to read the depth
-    /// complexity back). Reads: scene, frame, G-buffer, photon map. Adds to: the film's
-    /// indirect component.
+    /// Encodes the gather along each of `samples` (1 to [`MAX_DIRECTIONS`] directions, each
+    /// estimate weighted 1/len) after the work already in `enc`, and returns the encoder to go
+    /// on with (the raster gather submits to read each direction's depth complexity back).
+    /// Reads: scene, frame, G-buffer, photon map. Adds to: the film's indirect component.
     #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &mut self,
@@ -147,25 +174,50 @@ impl GatherPass {
         scene: &GpuScene,
         frame: &FrameBinding,
         map: &GpuPhotonMap,
+        samples: &[GatherSample],
         width: u32,
         height: u32,
     ) -> Result<wgpu::CommandEncoder> {
+        assert!((1..=MAX_DIRECTIONS as usize).contains(&samples.len()), "1 to {MAX_DIRECTIONS} gather directions");
         let method = match self.chosen {
             Some(m) => m,
-            None => return self.encode_trial(gpu, enc, scene, frame, map, width, height),
+            None => return self.encode_trial(gpu, enc, scene, frame, map, samples, width, height),
         };
-        match method {
-            GatherMethod::Raster => {
-                let raster = self.raster.as_ref().expect("the raster gather exists when chosen");
-                raster.encode(gpu, enc, scene, frame, map, width, height)
+        self.encode_with(method, gpu, enc, scene, frame, map, samples, width, height)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn encode_with(
+        &self,
+        method: GatherMethod,
+        gpu: &Gpu,
+        mut enc: wgpu::CommandEncoder,
+        scene: &GpuScene,
+        frame: &FrameBinding,
+        map: &GpuPhotonMap,
+        samples: &[GatherSample],
+        width: u32,
+        height: u32,
+    ) -> Result<wgpu::CommandEncoder> {
+        if method == GatherMethod::Raster {
+            let raster = self.raster.as_ref().expect("the raster gather exists when chosen");
+            for k in 0..samples.len() {
+                if k > 0 {
+                    // The previous direction's layers read the uniforms written before them.
+                    gpu.queue.submit([enc.finish()]);
+                    enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("gather") });
+                }
+                let u = self.uniforms(&scene.bounds, samples, k);
+                gpu.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
+                enc = raster.encode(gpu, enc, scene, frame, map, width, height)?;
             }
-            _ => {
-                let mut enc = enc;
-                let trace = self.trace.as_ref().expect("the traced gather exists when chosen");
-                trace.encode(&mut enc, scene, frame, map, width, height);
-                Ok(enc)
-            }
+        } else {
+            let trace = self.trace.as_ref().expect("the traced gather exists when chosen");
+            let u = self.uniforms(&scene.bounds, samples, 0);
+            gpu.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
+            trace.encode(&mut enc, scene, frame, map, width, height);
         }
+        Ok(enc)
     }
 
     /// One timed trial iteration of `Auto`: the work before the gather is finished first so the
@@ -178,6 +230,7 @@ impl GatherPass {
         scene: &GpuScene,
         frame: &FrameBinding,
         map: &GpuPhotonMap,
+        samples: &[GatherSample],
         width: u32,
         height: u32,
     ) -> Result<wgpu::CommandEncoder> {
@@ -185,13 +238,9 @@ impl GatherPass {
         gpu.queue.submit([enc.finish()]);
         gpu.wait()?;
         let start = Instant::now();
-        let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("gather") });
-        if k == 0 {
-            let raster = self.raster.as_ref().expect("auto builds both");
-            enc = raster.encode(gpu, enc, scene, frame, map, width, height)?;
-        } else {
-            self.trace.as_ref().expect("auto builds both").encode(&mut enc, scene, frame, map, width, height);
-        }
+        let enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("gather") });
+        let method = [GatherMethod::Raster, GatherMethod::Trace][k];
+        let enc = self.encode_with(method, gpu, enc, scene, frame, map, samples, width, height)?;
         gpu.queue.submit([enc.finish()]);
         gpu.wait()?;
         self.trials[k].push(start.elapsed());

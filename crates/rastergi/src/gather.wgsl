@@ -2,22 +2,25 @@
 // and the traced gather (gather_trace.wgsl).
 
 struct Gather {
+    // Raster: the ray view of `direction`, the direction being peeled.
     view_proj: mat4x4f,
     direction: vec3f,
     bundle: u32,
+    // Directions this iteration; each estimate is weighted 1/count.
+    count: u32,
+    // Trace: all of them (xyz).
+    directions: array<vec4f, 16>,
 }
 
-// A visible point that gathers along ω: the surface, seen from the side facing the eye, and
-// cos θ_x = n_x·ω on that side.
+// A visible point that gathers: the surface and its normal on the side facing the eye.
 struct GatherPoint {
     x: Surface,
-    cos_x: f32,
-    // False where nothing is gathered: no surface, the back of a one-sided surface, or ω
-    // below x's horizon.
+    n: vec3f,
+    // False where nothing is gathered: no surface, or the back of a one-sided surface.
     ok: bool,
 }
 
-fn gather_point(g: vec4u, w: vec3f) -> GatherPoint {
+fn gather_point(g: vec4u) -> GatherPoint {
     var p: GatherPoint;
     p.ok = false;
     if g.x == 0u {
@@ -25,14 +28,15 @@ fn gather_point(g: vec4u, w: vec3f) -> GatherPoint {
     }
     p.x = surface_at(g.x - 1u, bitcast<f32>(g.y), bitcast<f32>(g.z), bitcast<f32>(g.w));
     let front = dot(p.x.normal, frame.eye - p.x.pos) > 0.0;
-    p.cos_x = dot(select(-p.x.normal, p.x.normal, front), w);
-    p.ok = (front || (p.x.flags & MATERIAL_TWO_SIDED) != 0u) && p.cos_x > 0.0;
+    p.n = select(-p.x.normal, p.x.normal, front);
+    p.ok = front || (p.x.flags & MATERIAL_TWO_SIDED) != 0u;
     return p;
 }
 
-// (ρ_x/π) · L(h → x) · cos θ_x · 4π for the hit point h on triangle tri at barycentrics b:
-// L(h → x) = ρ_h/π · E(h) on the side of h facing x, zero from the back of a one-sided h.
-fn gather_estimate(p: GatherPoint, w: vec3f, tri: u32, hit: vec3f, b: vec2f) -> vec3f {
+// (ρ_x/π) · L(h → x) · cos θ_x · 4π for the hit point h on triangle tri at barycentrics b,
+// cos θ_x = n·ω > 0: L(h → x) = ρ_h/π · E(h) on the side of h facing x, zero from the back of
+// a one-sided h.
+fn gather_estimate(p: GatherPoint, cos_x: f32, w: vec3f, tri: u32, hit: vec3f, b: vec2f) -> vec3f {
     let t = triangles[tri];
     let n_h = triangle_normal(t);
     let front_h = dot(w, n_h) < 0.0;
@@ -42,5 +46,5 @@ fn gather_estimate(p: GatherPoint, w: vec3f, tri: u32, hit: vec3f, b: vec2f) -> 
     // ρ_h at the hit point itself, unfiltered (level 0), like every secondary point.
     let albedo_h = surface_at(tri, b.x, b.y, 0.0).albedo;
     let radiance_h = albedo_h / PI * photon_irradiance(hit, select(-n_h, n_h, front_h));
-    return p.x.albedo / PI * radiance_h * (p.cos_x * 4.0 * PI);
+    return p.x.albedo / PI * radiance_h * (cos_x * 4.0 * PI);
 }

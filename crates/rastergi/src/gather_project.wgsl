@@ -19,8 +19,9 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         return;
     }
     let w = gather.direction;
-    let p = gather_point(textureLoad(gbuffer, gid.xy, 0), w);
-    if !p.ok {
+    let p = gather_point(textureLoad(gbuffer, gid.xy, 0));
+    let cos_x = dot(p.n, w);
+    if !p.ok || cos_x <= 0.0 {
         found[pixel] = 1u;
         return;
     }
@@ -52,5 +53,6 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     found[pixel] = 1u;
     let hit = p.x.pos + w * dist;
     let n_pixels = frame.resolution.x * frame.resolution.y;
-    film[n_pixels + pixel] += vec4f(gather_estimate(p, w, tri, hit, plane_barycentrics(t, hit)), 0.0);
+    let e = gather_estimate(p, cos_x, w, tri, hit, plane_barycentrics(t, hit)) / f32(gather.count);
+    film[n_pixels + pixel] += vec4f(e, 0.0);
 }

@@ -68,7 +68,8 @@ pub fn check_bvh_nodes(limits: &wgpu::Limits, nodes: usize) -> Result<()> {
 }
 
 /// The photon map of `grid` (`photons/gpu.rs`): a 3D texture of (nx, ny, 6·nz) texels and
-/// 64-bit counters for three channels per slot (24 bytes).
+/// 64-bit counters for three channels per slot (24 bytes, one binding of 8 bytes per slot for
+/// each channel).
 pub fn check_photon_grid(limits: &wgpu::Limits, grid: &GridSpec) -> Result<()> {
     let d = grid.dims;
     let max = limits.max_texture_dimension_3d;
@@ -88,9 +89,18 @@ pub fn check_photon_grid(limits: &wgpu::Limits, grid: &GridSpec) -> Result<()> {
         limits,
         &format!("the counters of {what}"),
         grid.slot_count() as u64,
-        24,
+        8,
         "choose a smaller --grid",
-    )
+    )?;
+    let total = grid.slot_count() as u64 * 24;
+    if total > limits.max_buffer_size {
+        return Err(Error::Limits(format!(
+            "the counters of {what} need {} in one buffer, more than this GPU's {}; choose a smaller --grid",
+            mib(total),
+            mib(limits.max_buffer_size)
+        )));
+    }
+    Ok(())
 }
 
 /// The gather's ray view (`gather.rs`): two layer textures, a depth texture and a
@@ -149,12 +159,16 @@ mod tests {
     #[test]
     fn photon_grid_is_checked_against_texture_depth_and_counter_buffer() {
         let bounds = crate::scene::Aabb { min: glam::Vec3::ZERO, max: glam::Vec3::ONE };
-        let l = wgpu::Limits { max_texture_dimension_3d: 2048, ..limits(128) };
-        // 64³ cells: 6·64 = 384 texels deep, 64³·6·24 bytes = 36 MiB of counters.
-        assert!(check_photon_grid(&l, &GridSpec::new(&bounds, 64)).is_ok());
-        // 128³: 288 MiB of counters.
-        let e = check_photon_grid(&l, &GridSpec::new(&bounds, 128)).unwrap_err().to_string();
-        assert!(e.contains("128x128x128") && e.contains("288 MiB") && e.contains("--grid"), "{e}");
+        let l = wgpu::Limits { max_texture_dimension_3d: 2048, max_buffer_size: 1 << 30, ..limits(128) };
+        // 128³ cells: 6·128 = 768 texels deep, 128³·6·8 bytes = 96 MiB of counters per channel.
+        assert!(check_photon_grid(&l, &GridSpec::new(&bounds, 128)).is_ok());
+        // 160³: 160³·6·8 bytes = 187.5 MiB per channel.
+        let e = check_photon_grid(&l, &GridSpec::new(&bounds, 160)).unwrap_err().to_string();
+        assert!(e.contains("160x160x160") && e.contains("188 MiB") && e.contains("--grid"), "{e}");
+        // All three channels live in one buffer: 288 MiB for 128³.
+        let small = wgpu::Limits { max_buffer_size: 256 << 20, ..l.clone() };
+        let e = check_photon_grid(&small, &GridSpec::new(&bounds, 128)).unwrap_err().to_string();
+        assert!(e.contains("288 MiB") && e.contains("one buffer"), "{e}");
         // 400 cells deep need 2400 texels: deeper than 2048.
         let e = check_photon_grid(&l, &GridSpec::new(&bounds, 400)).unwrap_err().to_string();
         assert!(e.contains("2400") && e.contains("2048"), "{e}");

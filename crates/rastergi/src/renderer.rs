@@ -7,7 +7,7 @@ use crate::direct::DirectPass;
 use crate::error::Result;
 use crate::film::{Film, Show};
 use crate::frame::{FrameBinding, FrameUniforms, near_plane, pixel_jitter, view_projection};
-use crate::gather::{GatherMethod, GatherPass, gather_direction, random_rotation};
+use crate::gather::{GatherMethod, GatherPass, GatherSample, MAX_DIRECTIONS, gather_direction, random_rotation};
 use crate::gbuffer::GBufferPass;
 use crate::gpu::Gpu;
 use crate::gpu_scene::{GpuScene, PreparedScene};
@@ -38,6 +38,9 @@ pub struct RenderSettings {
     pub bundle: u32,
     /// How the final gather finds the nearest surface along its direction.
     pub gather: GatherMethod,
+    /// Gather directions per iteration, 1 to [`MAX_DIRECTIONS`]: they share the iteration's
+    /// G-buffer and direct light.
+    pub directions: u32,
 }
 
 /// The default ray-view resolution: twice the image's larger side, within [128, 2048], so a
@@ -45,6 +48,12 @@ pub struct RenderSettings {
 pub fn default_bundle(width: u32, height: u32) -> u32 {
     (2 * width.max(height)).clamp(128, 2048)
 }
+
+/// Gather directions per iteration by default. On the Cornell box at 256² (lavapipe), the
+/// indirect light carries 97 % of an iteration's variance while the G-buffer and the direct
+/// pass take 60 % of its time: sharing them among 4 directions reaches a given error in about
+/// half the time (README, performance).
+pub const DEFAULT_DIRECTIONS: u32 = 4;
 
 /// Fixed values for one iteration's random choices, so tests can compare the passes with
 /// other estimators for the same samples.
@@ -78,6 +87,7 @@ impl Default for RenderSettings {
             show_photon_map: false,
             bundle: 0,
             gather: GatherMethod::Auto,
+            directions: DEFAULT_DIRECTIONS,
         }
     }
 }
@@ -276,13 +286,21 @@ impl Renderer {
         }
         // 3. Final gather along one direction for every visible point → film (indirect).
         if let (Some(gather), Some(map)) = (&mut self.passes.gather, &self.photon_map) {
-            let direction = o.direction.unwrap_or_else(|| gather_direction(iteration, self.rotation));
-            let texel_jitter = o.texel_jitter.unwrap_or_else(|| {
-                let mut rng = Rng::new(seed ^ 0x7e1a5, iteration, self.restart);
-                Vec2::new(rng.next_f32(), rng.next_f32()) - 0.5
-            });
-            gather.set_direction(&self.gpu, &self.scene.bounds, direction.normalize(), texel_jitter);
-            enc = gather.encode(&self.gpu, enc, &self.scene, &self.frame, map, w, h)?;
+            // Directions i·K … i·K + K − 1 of the sequence: consecutive points keep its
+            // stratification however many an iteration takes.
+            let k = if o.direction.is_some() { 1 } else { self.settings.directions.clamp(1, MAX_DIRECTIONS) };
+            let samples: Vec<GatherSample> = (0..k)
+                .map(|j| {
+                    let index = iteration * k + j;
+                    let direction = o.direction.unwrap_or_else(|| gather_direction(index, self.rotation));
+                    let texel_jitter = o.texel_jitter.unwrap_or_else(|| {
+                        let mut rng = Rng::new(seed ^ 0x7e1a5, index, self.restart);
+                        Vec2::new(rng.next_f32(), rng.next_f32()) - 0.5
+                    });
+                    GatherSample { direction: direction.normalize(), texel_jitter }
+                })
+                .collect();
+            enc = gather.encode(&self.gpu, enc, &self.scene, &self.frame, map, &samples, w, h)?;
         }
         // 4. Accumulate: every pass above added its estimate to the film's sums.
         self.gpu.queue.submit([enc.finish()]);

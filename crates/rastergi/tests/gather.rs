@@ -180,6 +180,7 @@ fn indirect_light_lightens_shadows_darkens_corners_and_bleeds_colour() {
         photons: 1 << 20,
         grid_resolution: 32,
         gather: GatherMethod::Raster,
+        directions: 1,
         ..Default::default()
     };
     let mut r = Renderer::new(&gpu, &scene, settings.clone()).unwrap();

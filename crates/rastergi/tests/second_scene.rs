@@ -49,6 +49,7 @@ fn settings(scene: &Scene, seed: u32, bundle: u32) -> RenderSettings {
         bundle,
         // The texel bias measured here is the raster gather's (the traced gather has none).
         gather: GatherMethod::Raster,
+        directions: 1,
         ..RenderSettings::default()
     }
 }

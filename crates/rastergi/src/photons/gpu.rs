@@ -108,9 +108,12 @@ impl GpuPhotonMap {
         let quantum = if max_flux > 0.0 { (1u64 << QUANTUM_BITS) as f64 / max_flux } else { 1.0 };
         let device = &gpu.device;
 
+        // Channel c's sums at c·region: one binding per channel.
+        let channel_bytes = slots * 8;
+        let region = channel_bytes.next_multiple_of(device.limits().min_storage_buffer_offset_alignment as u64);
         let tally = gpu.zeroed_buffer(
             "photon tally",
-            slots * 24,
+            3 * region,
             wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
         );
         let h2 = (grid.cell as f64).powi(2);
@@ -146,9 +149,11 @@ impl GpuPhotonMap {
             entries: &[
                 uniform_entry(0, c),
                 storage_entry(1, c, false),
-                storage_entry(2, c, true),
+                storage_entry(2, c, false),
+                storage_entry(3, c, false),
+                storage_entry(4, c, true),
                 wgpu::BindGroupLayoutEntry {
-                    binding: 3,
+                    binding: 5,
                     visibility: c,
                     ty: wgpu::BindingType::StorageTexture {
                         access: wgpu::StorageTextureAccess::WriteOnly,
@@ -159,14 +164,23 @@ impl GpuPhotonMap {
                 },
             ],
         });
+        let channel = |c: u64| {
+            wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                buffer: &tally,
+                offset: c * region,
+                size: std::num::NonZeroU64::new(channel_bytes),
+            })
+        };
         let trace_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("photon trace"),
             layout: &trace_layout,
             entries: &[
                 wgpu::BindGroupEntry { binding: 0, resource: params_buffer.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: tally.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: area_buffer.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&view) },
+                wgpu::BindGroupEntry { binding: 1, resource: channel(0) },
+                wgpu::BindGroupEntry { binding: 2, resource: channel(1) },
+                wgpu::BindGroupEntry { binding: 3, resource: channel(2) },
+                wgpu::BindGroupEntry { binding: 4, resource: area_buffer.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&view) },
             ],
         });
         let source = [shader::SAMPLING, shader::SCENE, shader::BVH, include_str!("trace.wgsl")].join("\n");
@@ -260,10 +274,11 @@ impl GpuPhotonMap {
         let bytes = gpu.read_buffer(&self.tally, self.tally.size())?;
         let words: &[u32] = bytemuck::cast_slice(&bytes);
         let n = self.grid.slot_count();
+        let region = words.len() / 3;
         let flux = (0..n)
             .map(|s| {
                 [0, 1, 2].map(|c| {
-                    let (lo, hi) = (words[6 * s + 2 * c] as u64, words[6 * s + 2 * c + 1] as u64);
+                    let (lo, hi) = (words[c * region + 2 * s] as u64, words[c * region + 2 * s + 1] as u64);
                     ((hi << 32) | lo) as f64 / self.quantum
                 })
             })

@@ -18,11 +18,14 @@ struct PhotonParams {
 }
 
 @group(1) @binding(0) var<uniform> params: PhotonParams;
-// Per slot 6 words: (low, high) for red, green, blue.
-@group(1) @binding(1) var<storage, read_write> tally: array<atomic<u32>>;
+// Per channel (one binding each, so a large grid fits the per-binding limit) and slot two
+// words: (low, high) of the 64-bit fixed-point sum.
+@group(1) @binding(1) var<storage, read_write> tally_r: array<atomic<u32>>;
+@group(1) @binding(2) var<storage, read_write> tally_g: array<atomic<u32>>;
+@group(1) @binding(3) var<storage, read_write> tally_b: array<atomic<u32>>;
 // Surface area per slot, in units of cell side².
-@group(1) @binding(2) var<storage, read> cell_area: array<f32>;
-@group(1) @binding(3) var map_out: texture_storage_3d<rgba32float, write>;
+@group(1) @binding(4) var<storage, read> cell_area: array<f32>;
+@group(1) @binding(5) var map_out: texture_storage_3d<rgba32float, write>;
 
 const STREAM_PHOTON: u32 = 0x9e3779b9u;
 
@@ -44,23 +47,47 @@ fn slot_of(p: vec3f, n: vec3f) -> u32 {
     return (z * params.dims.y + c.y) * params.dims.x + c.x;
 }
 
-// 64-bit add on (low, high) words: whoever wraps the low word carries into the high word.
-fn add64(i: u32, v: u32) {
+// 64-bit add on the (low, high) words of slot s in channel c: whoever wraps the low word
+// carries into the high word.
+fn add64(c: u32, s: u32, v: u32) {
     if v == 0u {
         return;
     }
-    let old = atomicAdd(&tally[i], v);
-    if old > 0xffffffffu - v {
-        atomicAdd(&tally[i + 1u], 1u);
+    let i = 2u * s;
+    if c == 0u {
+        if atomicAdd(&tally_r[i], v) > 0xffffffffu - v {
+            atomicAdd(&tally_r[i + 1u], 1u);
+        }
+    } else if c == 1u {
+        if atomicAdd(&tally_g[i], v) > 0xffffffffu - v {
+            atomicAdd(&tally_g[i + 1u], 1u);
+        }
+    } else {
+        if atomicAdd(&tally_b[i], v) > 0xffffffffu - v {
+            atomicAdd(&tally_b[i + 1u], 1u);
+        }
     }
+}
+
+// The 64-bit sum of slot s in channel c, in quanta.
+fn tally64(c: u32, s: u32) -> f32 {
+    var w: vec2u;
+    if c == 0u {
+        w = vec2u(atomicLoad(&tally_r[2u * s]), atomicLoad(&tally_r[2u * s + 1u]));
+    } else if c == 1u {
+        w = vec2u(atomicLoad(&tally_g[2u * s]), atomicLoad(&tally_g[2u * s + 1u]));
+    } else {
+        w = vec2u(atomicLoad(&tally_b[2u * s]), atomicLoad(&tally_b[2u * s + 1u]));
+    }
+    return f32(w.y) * 4294967296.0 + f32(w.x);
 }
 
 fn deposit(p: vec3f, n: vec3f, flux: vec3f) {
     let s = slot_of(p, n);
     let q = vec3u(round(flux * params.quantum));
-    add64(6u * s, q.x);
-    add64(6u * s + 2u, q.y);
-    add64(6u * s + 4u, q.z);
+    add64(0u, s, q.x);
+    add64(1u, s, q.y);
+    add64(2u, s, q.z);
 }
 
 @compute @workgroup_size(64)
@@ -115,9 +142,7 @@ fn resolve_map(@builtin(global_invocation_id) gid: vec3u) {
     let s = (gid.z * params.dims.y + gid.y) * params.dims.x + gid.x;
     var flux = vec3f(0.0);
     for (var c = 0u; c < 3u; c++) {
-        let lo = atomicLoad(&tally[6u * s + 2u * c]);
-        let hi = atomicLoad(&tally[6u * s + 2u * c + 1u]);
-        flux[c] = (f32(hi) * 4294967296.0 + f32(lo)) / params.quantum;
+        flux[c] = tally64(c, s) / params.quantum;
     }
     let h2 = params.cell * params.cell;
     textureStore(map_out, gid, vec4f(flux / h2, cell_area[s]));

@@ -173,7 +173,12 @@ impl Renderer {
             PhotonSettings { count: settings.photons, seed: settings.seed, grid_resolution: settings.grid_resolution };
         let photon_map = (settings.photons > 0)
             .then(|| GpuPhotonMap::build(gpu, &gpu_scene, &prepared, &photon_settings))
-            .transpose()?;
+            .transpose()?
+            .map(|mut map| {
+                // Rendering reads the lookup texture alone.
+                map.release_build_buffers();
+                map
+            });
         let passes = ImagePasses::new(gpu, &gpu_scene, &frame, photon_map.as_ref(), &settings, detail_bundle)?;
         let rotation = random_rotation(settings.seed, 0);
         Ok(Renderer {

@@ -64,15 +64,21 @@ pub struct GpuPhotonMap {
     pub texture: wgpu::Texture,
     pub layout: wgpu::BindGroupLayout,
     pub bind_group: wgpu::BindGroup,
-    tally: wgpu::Buffer,
+    /// The build's resources: the 64-bit counters and the bind group of the trace and resolve
+    /// passes (which holds the cell areas); `None` once released.
+    build: Option<Build>,
     quantum: f64,
     area: Vec<f64>,
     params: PhotonParams,
     params_buffer: wgpu::Buffer,
-    trace_group: wgpu::BindGroup,
     trace_pipeline: wgpu::ComputePipeline,
     resolve_pipeline: wgpu::ComputePipeline,
     has_lights: bool,
+}
+
+struct Build {
+    tally: wgpu::Buffer,
+    trace_group: wgpu::BindGroup,
 }
 
 /// Bytes of GPU memory the photon map of `grid` takes (tally + area + texture).
@@ -209,12 +215,11 @@ impl GpuPhotonMap {
             texture,
             layout,
             bind_group,
-            tally,
+            build: Some(Build { tally, trace_group }),
             quantum,
             area,
             params,
             params_buffer,
-            trace_group,
             trace_pipeline,
             resolve_pipeline,
             has_lights: scene.light_count > 0,
@@ -226,7 +231,8 @@ impl GpuPhotonMap {
     pub fn trace(&self, gpu: &Gpu, scene: &GpuScene) {
         let (device, grid) = (&gpu.device, &self.grid);
         let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("photon clear") });
-        enc.clear_buffer(&self.tally, 0, None);
+        let build = self.build.as_ref().expect("trace() after release_build_buffers()");
+        enc.clear_buffer(&build.tally, 0, None);
         gpu.queue.submit([enc.finish()]);
         let mut params = self.params;
         let count = self.settings.count;
@@ -246,7 +252,7 @@ impl GpuPhotonMap {
                     let mut pass = compute_pass(&mut enc, gpu.profiler.as_ref(), "photon trace");
                     pass.set_pipeline(&self.trace_pipeline);
                     pass.set_bind_group(0, &scene.bind_group, &[]);
-                    pass.set_bind_group(1, &self.trace_group, &[]);
+                    pass.set_bind_group(1, &build.trace_group, &[]);
                     pass.dispatch_workgroups(gx, gy, 1);
                 }
                 gpu.queue.submit([enc.finish()]);
@@ -259,7 +265,7 @@ impl GpuPhotonMap {
             let mut pass = compute_pass(&mut enc, gpu.profiler.as_ref(), "photon map resolve");
             pass.set_pipeline(&self.resolve_pipeline);
             pass.set_bind_group(0, &scene.bind_group, &[]);
-            pass.set_bind_group(1, &self.trace_group, &[]);
+            pass.set_bind_group(1, &build.trace_group, &[]);
             pass.dispatch_workgroups(
                 grid.dims.x.div_ceil(4),
                 grid.dims.y.div_ceil(4),
@@ -271,7 +277,10 @@ impl GpuPhotonMap {
 
     /// Reads the map back from the counters (exact fixed-point sums) for tests and tools.
     pub fn read(&self, gpu: &Gpu) -> Result<PhotonMap> {
-        let bytes = gpu.read_buffer(&self.tally, self.tally.size())?;
+        let Some(build) = &self.build else {
+            return self.read_texture(gpu);
+        };
+        let bytes = gpu.read_buffer(&build.tally, build.tally.size())?;
         let words: &[u32] = bytemuck::cast_slice(&bytes);
         let n = self.grid.slot_count();
         let region = words.len() / 3;
@@ -283,6 +292,47 @@ impl GpuPhotonMap {
                 })
             })
             .collect();
+        Ok(PhotonMap { grid: self.grid, flux, area: self.area.clone(), flux_sq: vec![0.0; n], deposits: vec![0; n] })
+    }
+
+    /// Frees the counters and cell areas, which only [`trace`](Self::trace) needs (a third of
+    /// the map's memory at 24 + 4 of its 44 bytes per slot); [`read`](Self::read) then reads
+    /// the f32 lookup texture the passes use.
+    pub fn release_build_buffers(&mut self) {
+        self.build = None;
+    }
+
+    /// The map as the passes see it: the lookup texture's Φ/h² per slot, times h².
+    fn read_texture(&self, gpu: &Gpu) -> Result<PhotonMap> {
+        let d = self.grid.dims;
+        let depth = BINS as u32 * d.z;
+        let row = (d.x * 16).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+        let buffer = gpu.zeroed_buffer(
+            "photon map readback",
+            row as u64 * d.y as u64 * depth as u64,
+            wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+        );
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        enc.copy_texture_to_buffer(
+            self.texture.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buffer,
+                layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: Some(d.y) },
+            },
+            wgpu::Extent3d { width: d.x, height: d.y, depth_or_array_layers: depth },
+        );
+        gpu.queue.submit([enc.finish()]);
+        let bytes = gpu.read_buffer(&buffer, buffer.size())?;
+        let h2 = (self.grid.cell as f64).powi(2);
+        let n = self.grid.slot_count();
+        let mut flux = Vec::with_capacity(n);
+        for z in 0..depth as usize {
+            for y in 0..d.y as usize {
+                let start = (z * d.y as usize + y) * row as usize;
+                let texels: &[[f32; 4]] = bytemuck::cast_slice(&bytes[start..start + d.x as usize * 16]);
+                flux.extend(texels.iter().map(|t| [0, 1, 2].map(|c| t[c] as f64 * h2)));
+            }
+        }
         Ok(PhotonMap { grid: self.grid, flux, area: self.area.clone(), flux_sq: vec![0.0; n], deposits: vec![0; n] })
     }
 

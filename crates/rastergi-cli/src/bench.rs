@@ -194,7 +194,7 @@ fn memory(a: &MemoryArgs) -> Result<()> {
     let mut r = Renderer::new(&gpu, &scene, settings)?;
     r.wait()?;
     print_allocations(&gpu, "after set-up (scene, BVH, photon map, passes)");
-    for _ in 0..2 * rastergi::gather::AUTO_TRIALS + 1 {
+    for _ in 0..rastergi::gather::AUTO_ITERATIONS {
         r.iterate()?;
     }
     r.wait()?;
@@ -314,7 +314,7 @@ fn gather(a: &GatherArgs) -> Result<()> {
     );
     println!("  {} gather directions per iteration (G-buffer and direct light shared by them)", a.directions);
     for &size in &a.sizes {
-        for method in [GatherMethod::Raster, GatherMethod::Trace] {
+        for method in [GatherMethod::Raster, GatherMethod::Lists, GatherMethod::Trace] {
             let s = RenderSettings { gather: method, ..settings(a, size, size, a.bundle) };
             let mut r = Renderer::new(&gpu, &scene, s)?;
             for _ in 0..2 {
@@ -332,6 +332,7 @@ fn gather(a: &GatherArgs) -> Result<()> {
             let dt = t.elapsed().as_secs_f64();
             let what = match method {
                 GatherMethod::Raster => "raster (count, read-back, peel + project per layer)",
+                GatherMethod::Lists => "lists (one raster pass into per-texel lists, project)",
                 _ => "trace (BVH ray casting, one dispatch)",
             };
             println!(

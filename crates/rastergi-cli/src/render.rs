@@ -55,6 +55,8 @@ pub enum GatherArg {
     Auto,
     /// Depth-peeled orthographic ray views (rasterization).
     Raster,
+    /// Per-texel fragment lists of the ray view, one raster pass per direction.
+    Lists,
     /// BVH ray casting in a compute shader.
     Trace,
 }
@@ -64,6 +66,7 @@ impl GatherArg {
         match self {
             GatherArg::Auto => GatherMethod::Auto,
             GatherArg::Raster => GatherMethod::Raster,
+            GatherArg::Lists => GatherMethod::Lists,
             GatherArg::Trace => GatherMethod::Trace,
         }
     }

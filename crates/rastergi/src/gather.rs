@@ -5,9 +5,11 @@
 //!   the sphere (pdf 1/4π) and R a random rotation drawn per restart.
 //! * Nearest surface h along ω from each visible point x (t > ε, x's own triangle excluded):
 //!   [`GatherMethod::Raster`] depth-peels an orthographic ray view and projects each layer onto
-//!   the visible points ([`crate::gather_raster`]); [`GatherMethod::Trace`] casts the ray
+//!   the visible points ([`crate::gather_raster`]); [`GatherMethod::Lists`] rasterizes the ray
+//!   view once into per-texel fragment lists that each visible point walks
+//!   ([`crate::gather_lists`]); [`GatherMethod::Trace`] casts the ray
 //!   through the BVH in a compute shader ([`crate::gather_trace`]). They differ only where a
-//!   ray-view texel is crossed by a silhouette (the raster gather takes the texel's surface).
+//!   ray-view texel is crossed by a silhouette (the raster gathers take the texel's surface).
 //! * Estimate (`gather.wgsl`): L_ind(x, ω) = (ρ_x/π) · L(h → x) · max(0, n_x·ω) · 4π, where
 //!   L(h → x) = ρ_h/π · E(h) from the photon map on the side of h facing x (zero from the back
 //!   of a one-sided surface; emission is never added: the direct pass owns it).
@@ -15,8 +17,8 @@
 //! Several directions per iteration share one G-buffer and direct pass (`--directions`): the
 //! indirect estimate, by far the noisier, gets more samples per unit of time.
 //!
-//! [`GatherMethod::Auto`] lets the first iterations alternate between the two and keeps the
-//! faster on this adapter; every one of those iterations counts towards the image.
+//! [`GatherMethod::Auto`] lets the first iterations alternate between them and keeps the
+//! fastest on this adapter; every one of those iterations counts towards the image.
 
 use std::time::{Duration, Instant};
 
@@ -26,6 +28,7 @@ use glam::{Mat4, Quat, Vec2, Vec3};
 use crate::error::Result;
 use crate::film::Film;
 use crate::frame::FrameBinding;
+use crate::gather_lists::ListGather;
 use crate::gather_raster::RasterGather;
 use crate::gather_trace::TraceGather;
 use crate::gbuffer::GBufferPass;
@@ -69,12 +72,20 @@ pub enum GatherMethod {
     Auto,
     /// Depth-peeled orthographic ray view (rasterization).
     Raster,
+    /// Per-texel fragment lists of the ray view in one raster pass (no read-back).
+    Lists,
     /// BVH ray casting in a compute shader.
     Trace,
 }
 
+/// The implementations `Auto` chooses among, in trial order.
+const CANDIDATES: [GatherMethod; 3] = [GatherMethod::Raster, GatherMethod::Lists, GatherMethod::Trace];
+
 /// Iterations of each method timed by [`GatherMethod::Auto`] before it chooses.
 pub const AUTO_TRIALS: u32 = 3;
+
+/// Iterations after which [`GatherMethod::Auto`] has chosen (at most).
+pub const AUTO_ITERATIONS: u32 = CANDIDATES.len() as u32 * AUTO_TRIALS;
 
 /// The gather direction of iteration `i` for a restart whose rotation is `rotation`.
 pub fn gather_direction(i: u32, rotation: Quat) -> Vec3 {
@@ -102,16 +113,17 @@ pub fn ray_view_projection(bounds: &Aabb, direction: Vec3, bundle: u32, jitter: 
     shift * proj * view
 }
 
-/// The final gather pass: one or both implementations behind one interface.
+/// The final gather pass: the implementations behind one interface.
 pub struct GatherPass {
     pub bundle: u32,
     uniforms: wgpu::Buffer,
     raster: Option<RasterGather>,
+    lists: Option<ListGather>,
     trace: Option<TraceGather>,
     /// The implementation in use, once chosen.
     chosen: Option<GatherMethod>,
-    /// Auto: wall-clock times of the trial iterations so far (raster, trace).
-    trials: [Vec<Duration>; 2],
+    /// Auto: wall-clock times of the trial iterations so far, per candidate.
+    trials: Vec<(GatherMethod, Vec<Duration>)>,
 }
 
 impl GatherPass {
@@ -131,13 +143,26 @@ impl GatherPass {
             std::mem::size_of::<GatherUniforms>() as u64,
             wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         );
-        let raster = (method != GatherMethod::Trace)
+        let wants = |m: GatherMethod| method == m || method == GatherMethod::Auto;
+        let raster = wants(GatherMethod::Raster)
             .then(|| RasterGather::new(gpu, scene, frame, gbuffer, film, map, &uniforms, bundle))
             .transpose()?;
-        let trace = (method != GatherMethod::Raster)
-            .then(|| TraceGather::new(gpu, scene, frame, gbuffer, film, map, &uniforms));
+        let lists = match ListGather::new(gpu, scene, frame, gbuffer, film, map, &uniforms, bundle) {
+            _ if !wants(GatherMethod::Lists) => None,
+            Ok(lists) => Some(lists),
+            // Auto does without a candidate that does not fit.
+            Err(e) if method == GatherMethod::Auto => {
+                log::info!("gather: no fragment lists ({e})");
+                None
+            }
+            Err(e) => return Err(e),
+        };
+        let trace =
+            wants(GatherMethod::Trace).then(|| TraceGather::new(gpu, scene, frame, gbuffer, film, map, &uniforms));
         let chosen = (method != GatherMethod::Auto).then_some(method);
-        Ok(GatherPass { bundle, uniforms, raster, trace, chosen, trials: [Vec::new(), Vec::new()] })
+        let present = [raster.is_some(), lists.is_some(), trace.is_some()];
+        let trials = CANDIDATES.iter().zip(present).filter(|(_, p)| *p).map(|(&m, _)| (m, Vec::new())).collect();
+        Ok(GatherPass { bundle, uniforms, raster, lists, trace, chosen, trials })
     }
 
     /// The implementation in use (`Auto` while the trials run).
@@ -199,17 +224,22 @@ impl GatherPass {
         width: u32,
         height: u32,
     ) -> Result<wgpu::CommandEncoder> {
-        if method == GatherMethod::Raster {
-            let raster = self.raster.as_ref().expect("the raster gather exists when chosen");
+        if method == GatherMethod::Raster || method == GatherMethod::Lists {
             for k in 0..samples.len() {
                 if k > 0 {
-                    // The previous direction's layers read the uniforms written before them.
+                    // The previous direction's passes read the uniforms written before them.
                     gpu.queue.submit([enc.finish()]);
                     enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("gather") });
                 }
                 let u = self.uniforms(&scene.bounds, samples, k);
                 gpu.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
-                enc = raster.encode(gpu, enc, scene, frame, map, width, height)?;
+                if method == GatherMethod::Raster {
+                    let raster = self.raster.as_ref().expect("the raster gather exists when chosen");
+                    enc = raster.encode(gpu, enc, scene, frame, map, width, height)?;
+                } else {
+                    let lists = self.lists.as_ref().expect("the list gather exists when chosen");
+                    lists.encode(&mut enc, scene, frame, map, width, height);
+                }
             }
         } else {
             let trace = self.trace.as_ref().expect("the traced gather exists when chosen");
@@ -234,33 +264,37 @@ impl GatherPass {
         width: u32,
         height: u32,
     ) -> Result<wgpu::CommandEncoder> {
-        let k = if self.trials[0].len() <= self.trials[1].len() { 0 } else { 1 };
+        // The candidate with the fewest trials so far, in order.
+        let k = (0..self.trials.len()).min_by_key(|&k| self.trials[k].1.len()).expect("a gather candidate");
+        let method = self.trials[k].0;
         gpu.queue.submit([enc.finish()]);
         gpu.wait()?;
         let start = Instant::now();
         let enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("gather") });
-        let method = [GatherMethod::Raster, GatherMethod::Trace][k];
         let enc = self.encode_with(method, gpu, enc, scene, frame, map, samples, width, height)?;
         gpu.queue.submit([enc.finish()]);
         gpu.wait()?;
-        self.trials[k].push(start.elapsed());
-        if self.trials[1].len() as u32 >= AUTO_TRIALS {
-            let median = |v: &mut Vec<Duration>| {
+        self.trials[k].1.push(start.elapsed());
+        if self.trials.iter().all(|t| t.1.len() as u32 >= AUTO_TRIALS) {
+            let median = |v: &[Duration]| {
+                let mut v = v.to_vec();
                 v.sort();
                 v[v.len() / 2]
             };
-            let (raster, trace) = (median(&mut self.trials[0]), median(&mut self.trials[1]));
-            let method = if raster < trace { GatherMethod::Raster } else { GatherMethod::Trace };
-            log::info!(
-                "gather: raster {:.2} ms, trace {:.2} ms per direction on {}: using {method:?}",
-                raster.as_secs_f64() * 1e3,
-                trace.as_secs_f64() * 1e3,
-                gpu.info.name
-            );
+            let times: Vec<(GatherMethod, Duration)> = self.trials.iter().map(|(m, t)| (*m, median(t))).collect();
+            let (method, _) = *times.iter().min_by_key(|(_, t)| *t).expect("a gather candidate");
+            let list: Vec<String> =
+                times.iter().map(|(m, t)| format!("{m:?} {:.2} ms", t.as_secs_f64() * 1e3)).collect();
+            log::info!("gather per iteration on {}: {}; using {method:?}", gpu.info.name, list.join(", "));
             self.chosen = Some(method);
-            match method {
-                GatherMethod::Raster => self.trace = None,
-                _ => self.raster = None,
+            if method != GatherMethod::Raster {
+                self.raster = None;
+            }
+            if method != GatherMethod::Lists {
+                self.lists = None;
+            }
+            if method != GatherMethod::Trace {
+                self.trace = None;
             }
         }
         Ok(gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("iteration") }))

@@ -1,5 +1,6 @@
-// Ray-view rasterization of the final gather (gather.rs): the depth-complexity count and
-// the back-to-front depth peel.
+// Ray-view rasterization of the final gather: the depth-complexity count and the
+// back-to-front depth peel (gather_raster.rs), and the per-texel fragment lists
+// (gather_lists.rs).
 
 struct Gather {
     view_proj: mat4x4f,
@@ -47,4 +48,22 @@ fn fs_peel(in: VertexOut) -> @location(0) vec4u {
         discard;
     }
     return vec4u(in.tri + 1u, bitcast<u32>(in.bary.x), bitcast<u32>(in.bary.y), bitcast<u32>(in.clip.z));
+}
+
+// Fragment lists: every fragment prepends its triangle to its texel's list. heads[texel] is
+// the first node + 1 (0: empty); node i is (triangle, next node + 1). The pool holds at most
+// arrayLength(&nodes) fragments: gather_lists.rs sizes it to a bound on any view's fragments.
+@group(1) @binding(1) var<storage, read_write> heads: array<atomic<u32>>;
+@group(1) @binding(2) var<storage, read_write> nodes: array<vec2u>;
+@group(1) @binding(3) var<storage, read_write> node_count: atomic<u32>;
+
+@fragment
+fn fs_list(in: VertexOut) -> @location(0) vec4u {
+    let node = atomicAdd(&node_count, 1u);
+    if node < arrayLength(&nodes) {
+        let texel = vec2u(in.clip.xy);
+        let next = atomicExchange(&heads[texel.y * gather.bundle + texel.x], node + 1u);
+        nodes[node] = vec2u(in.tri, next);
+    }
+    return vec4u(0u);
 }

@@ -101,6 +101,9 @@ pub struct GpuScene {
     pub bounds: Aabb,
     pub ray_epsilon: f32,
     pub emitted_power: Vec3,
+    /// Σ area and Σ perimeter of the triangles (bounds on what a projection of them covers).
+    pub total_area: f64,
+    pub total_perimeter: f64,
 }
 
 impl GpuScene {
@@ -198,6 +201,12 @@ impl GpuScene {
             bounds: prepared.bounds,
             ray_epsilon: prepared.ray_epsilon(),
             emitted_power: prepared.lights.power,
+            total_area: s.triangles.iter().map(|t| crate::scene::triangle_area(t) as f64).sum(),
+            total_perimeter: s
+                .triangles
+                .iter()
+                .map(|t| (t[0].distance(t[1]) + t[1].distance(t[2]) + t[2].distance(t[0])) as f64)
+                .sum(),
         })
     }
 }

@@ -3,7 +3,7 @@
 //! The modules follow the data flow of a render:
 //!
 //! scene → [`bvh`] → [`gpu_scene`] → (photon map) → per iteration
-//! ([`gbuffer`] → [`direct`] → [`gather`] ([`gather_raster`] or [`gather_trace`])) → [`film`]
+//! ([`gbuffer`] → [`direct`] → [`gather`] ([`gather_raster`], [`gather_lists`] or [`gather_trace`])) → [`film`]
 //! (accumulate, resolve) → [`image_io`]. [`profile`] times the passes.
 //!
 //! [`renderer::Renderer::iterate`] is the one place that shows the order of the passes.
@@ -17,6 +17,7 @@ pub mod film;
 pub mod fit;
 pub mod frame;
 pub mod gather;
+pub mod gather_lists;
 pub mod gather_raster;
 pub mod gather_trace;
 pub mod gbuffer;

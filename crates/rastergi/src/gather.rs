@@ -84,7 +84,8 @@ const CANDIDATES: [GatherMethod; 3] = [GatherMethod::Raster, GatherMethod::Lists
 /// Iterations of each method timed by [`GatherMethod::Auto`] before it chooses.
 pub const AUTO_TRIALS: u32 = 3;
 
-/// Iterations after which [`GatherMethod::Auto`] has chosen (at most).
+/// Iterations after which [`GatherMethod::Auto`] has chosen, at most (candidates more than
+/// twice as slow as the fastest are dropped after their first run).
 pub const AUTO_ITERATIONS: u32 = CANDIDATES.len() as u32 * AUTO_TRIALS;
 
 /// The gather direction of iteration `i` for a restart whose rotation is `rotation`.
@@ -275,6 +276,13 @@ impl GatherPass {
         gpu.queue.submit([enc.finish()]);
         gpu.wait()?;
         self.trials[k].1.push(start.elapsed());
+        // Once every candidate has run, drop those whose fastest run is slower than twice the
+        // fastest run of all: the trials cost little beyond the winner's time.
+        if self.trials.iter().all(|t| !t.1.is_empty()) {
+            let fastest = |t: &[Duration]| t.iter().min().copied().unwrap_or(Duration::MAX);
+            let best = self.trials.iter().map(|t| fastest(&t.1)).min().unwrap_or(Duration::MAX);
+            self.trials.retain(|t| fastest(&t.1) <= 2 * best);
+        }
         if self.trials.iter().all(|t| t.1.len() as u32 >= AUTO_TRIALS) {
             let median = |v: &[Duration]| {
                 let mut v = v.to_vec();

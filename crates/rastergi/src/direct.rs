@@ -14,7 +14,7 @@
 use crate::film::Film;
 use crate::frame::FrameBinding;
 use crate::gbuffer::GBufferPass;
-use crate::gpu::{Gpu, compute_pipeline, groups};
+use crate::gpu::{Gpu, compute_pipeline, dispatch_pixels};
 use crate::gpu_scene::GpuScene;
 use crate::photon_view::{gbuffer_film_bind_group, gbuffer_film_layout};
 use crate::profile::{Profiler, compute_pass};
@@ -46,10 +46,12 @@ impl DirectPass {
         height: u32,
     ) {
         let mut pass = compute_pass(enc, self.profiler.as_ref(), "direct");
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &scene.bind_group, &[]);
-        pass.set_bind_group(1, &frame.bind_group, &[]);
-        pass.set_bind_group(2, &self.bind_group, &[]);
-        pass.dispatch_workgroups(groups(width, 8), groups(height, 8), 1);
+        dispatch_pixels(
+            &mut pass,
+            &self.pipeline,
+            &[&scene.bind_group, &frame.bind_group, &self.bind_group],
+            width,
+            height,
+        );
     }
 }

@@ -33,6 +33,25 @@ fn gather_point(g: vec4u) -> GatherPoint {
     return p;
 }
 
+// The ray-view texel that x projects to, like a shadow-map lookup (raster gathers).
+fn ray_view_texel(x: vec3f) -> vec2u {
+    let clip = gather.view_proj * vec4f(x, 1.0);
+    let uv = vec2f(0.5 * clip.x + 0.5, 0.5 - 0.5 * clip.y) * f32(gather.bundle);
+    return vec2u(clamp(vec2i(floor(uv)), vec2i(0), vec2i(i32(gather.bundle) - 1)));
+}
+
+// Distance along ω from x to the plane of triangle tri; negative when the ray runs parallel to
+// it (raster gathers: a texel's surface counts where x's ray crosses its plane at t > ε).
+fn plane_distance(tri: u32, x: vec3f, w: vec3f) -> f32 {
+    let t = triangles[tri];
+    let n_h = triangle_normal(t);
+    let denom = dot(w, n_h);
+    if abs(denom) < 1e-8 {
+        return -1.0;
+    }
+    return dot(t.v0 - x, n_h) / denom;
+}
+
 // (ρ_x/π) · L(h → x) · cos θ_x · 4π for the hit point h on triangle tri at barycentrics b,
 // cos θ_x = n·ω > 0: L(h → x) = ρ_h/π · E(h) on the side of h facing x, zero from the back of
 // a one-sided h.

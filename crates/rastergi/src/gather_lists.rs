@@ -17,7 +17,7 @@ use crate::error::{Error, Result};
 use crate::film::Film;
 use crate::frame::FrameBinding;
 use crate::gbuffer::GBufferPass;
-use crate::gpu::{Gpu, compute_pipeline, groups, storage_entry, uniform_entry};
+use crate::gpu::{Gpu, compute_pipeline, dispatch_pixels, storage_entry, uint_texture_entry, uniform_entry};
 use crate::gpu_scene::GpuScene;
 use crate::photons::gpu::GpuPhotonMap;
 use crate::profile::{Profiler, compute_pass};
@@ -113,16 +113,7 @@ impl ListGather {
             label: Some("gather list project"),
             entries: &[
                 uniform_entry(0, c),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: c,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Uint,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
+                uint_texture_entry(1, c),
                 storage_entry(2, c, true),
                 storage_entry(3, c, true),
                 storage_entry(4, c, false),
@@ -230,12 +221,8 @@ impl ListGather {
             pass.draw(0..3 * scene.triangle_count, 0..1);
         }
         let mut pass = compute_pass(enc, self.profiler.as_ref(), "gather list project");
-        pass.set_pipeline(&self.project_pipeline);
-        pass.set_bind_group(0, &scene.bind_group, &[]);
-        pass.set_bind_group(1, &frame.bind_group, &[]);
-        pass.set_bind_group(2, &self.project_group, &[]);
-        pass.set_bind_group(3, &map.bind_group, &[]);
-        pass.dispatch_workgroups(groups(width, 8), groups(height, 8), 1);
+        let bind_groups = [&scene.bind_group, &frame.bind_group, &self.project_group, &map.bind_group];
+        dispatch_pixels(&mut pass, &self.project_pipeline, &bind_groups, width, height);
     }
 }
 

@@ -20,10 +20,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if !p.ok || cos_x <= 0.0 {
         return;
     }
-    // Shadow-map style projection of x into the ray view.
-    let clip = gather.view_proj * vec4f(p.x.pos, 1.0);
-    let uv = vec2f(0.5 * clip.x + 0.5, 0.5 - 0.5 * clip.y) * f32(gather.bundle);
-    let texel = vec2u(clamp(vec2i(floor(uv)), vec2i(0), vec2i(i32(gather.bundle) - 1)));
+    let texel = ray_view_texel(p.x.pos);
     var best = 3.0e38;
     var best_tri = NO_TRIANGLE;
     var node = heads[texel.y * gather.bundle + texel.x];
@@ -34,14 +31,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         if tri == p.x.tri {
             continue;
         }
-        let t = triangles[tri];
-        let n_h = triangle_normal(t);
-        let denom = dot(w, n_h);
-        if abs(denom) < 1e-8 {
-            continue;
-        }
         // Where x's ray meets the plane of the fragment's triangle: in front of x, or not a hit.
-        let dist = dot(t.v0 - p.x.pos, n_h) / denom;
+        let dist = plane_distance(tri, p.x.pos, w);
         if dist > frame.ray_epsilon && dist < best {
             best = dist;
             best_tri = tri;

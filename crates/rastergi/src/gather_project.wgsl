@@ -25,11 +25,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         found[pixel] = 1u;
         return;
     }
-    // Shadow-map style projection of x into the ray view.
-    let clip = gather.view_proj * vec4f(p.x.pos, 1.0);
-    let uv = vec2f(0.5 * clip.x + 0.5, 0.5 - 0.5 * clip.y) * f32(gather.bundle);
-    let texel = vec2u(clamp(vec2i(floor(uv)), vec2i(0), vec2i(i32(gather.bundle) - 1)));
-    let l = textureLoad(layer, texel, 0);
+    let l = textureLoad(layer, ray_view_texel(p.x.pos), 0);
     if l.x == 0u {
         // Nothing at this texel in this layer, hence in no nearer layer: the ray escapes.
         found[pixel] = 1u;
@@ -39,20 +35,14 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if tri == p.x.tri {
         return;
     }
-    let t = triangles[tri];
-    let n_h = triangle_normal(t);
-    let denom = dot(w, n_h);
-    if abs(denom) < 1e-8 {
-        return;
-    }
     // Where x's ray meets the plane of the layer's triangle: in front of x, or not a hit.
-    let dist = dot(t.v0 - p.x.pos, n_h) / denom;
+    let dist = plane_distance(tri, p.x.pos, w);
     if dist <= frame.ray_epsilon {
         return;
     }
     found[pixel] = 1u;
     let hit = p.x.pos + w * dist;
     let n_pixels = frame.resolution.x * frame.resolution.y;
-    let e = gather_estimate(p, cos_x, w, tri, hit, plane_barycentrics(t, hit)) / f32(gather.count);
+    let e = gather_estimate(p, cos_x, w, tri, hit, plane_barycentrics(triangles[tri], hit)) / f32(gather.count);
     film[n_pixels + pixel] += vec4f(e, 0.0);
 }

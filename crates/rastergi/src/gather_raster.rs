@@ -21,7 +21,7 @@ use crate::film::Film;
 use crate::frame::FrameBinding;
 use crate::gather::GatherUniforms;
 use crate::gbuffer::GBufferPass;
-use crate::gpu::{Gpu, compute_pipeline, groups, storage_entry, uniform_entry};
+use crate::gpu::{Gpu, compute_pipeline, dispatch_pixels, storage_entry, uint_texture_entry, uniform_entry};
 use crate::gpu_scene::GpuScene;
 use crate::photons::gpu::GpuPhotonMap;
 use crate::profile::{Profiler, compute_pass};
@@ -101,16 +101,7 @@ impl RasterGather {
 
         let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
         let c = wgpu::ShaderStages::COMPUTE;
-        let tex_entry = |binding, visibility| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Uint,
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
-            },
-            count: None,
-        };
+        let tex_entry = uint_texture_entry;
         let count_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("gather count"),
             entries: &[
@@ -360,12 +351,8 @@ impl RasterGather {
                 pass.draw(0..3 * scene.triangle_count, 0..1);
             }
             let mut pass = compute_pass(enc, self.profiler.as_ref(), "gather project");
-            pass.set_pipeline(&self.project_pipeline);
-            pass.set_bind_group(0, &scene.bind_group, &[]);
-            pass.set_bind_group(1, &frame.bind_group, &[]);
-            pass.set_bind_group(2, &self.project_groups[cur], &[]);
-            pass.set_bind_group(3, &map.bind_group, &[]);
-            pass.dispatch_workgroups(groups(width, 8), groups(height, 8), 1);
+            let bind_groups = [&scene.bind_group, &frame.bind_group, &self.project_groups[cur], &map.bind_group];
+            dispatch_pixels(&mut pass, &self.project_pipeline, &bind_groups, width, height);
         }
     }
 }

@@ -8,7 +8,7 @@
 use crate::film::Film;
 use crate::frame::FrameBinding;
 use crate::gbuffer::GBufferPass;
-use crate::gpu::{Gpu, compute_pipeline, groups, storage_entry, uniform_entry};
+use crate::gpu::{Gpu, compute_pipeline, dispatch_pixels, storage_entry, uint_texture_entry, uniform_entry};
 use crate::gpu_scene::GpuScene;
 use crate::photons::gpu::GpuPhotonMap;
 use crate::profile::{Profiler, compute_pass};
@@ -35,20 +35,7 @@ impl TraceGather {
         let c = wgpu::ShaderStages::COMPUTE;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("gather trace"),
-            entries: &[
-                uniform_entry(0, c),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: c,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Uint,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                storage_entry(2, c, false),
-            ],
+            entries: &[uniform_entry(0, c), uint_texture_entry(1, c), storage_entry(2, c, false)],
         });
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("gather trace"),
@@ -86,11 +73,7 @@ impl TraceGather {
         height: u32,
     ) {
         let mut pass = compute_pass(enc, self.profiler.as_ref(), "gather trace");
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &scene.bind_group, &[]);
-        pass.set_bind_group(1, &frame.bind_group, &[]);
-        pass.set_bind_group(2, &self.bind_group, &[]);
-        pass.set_bind_group(3, &map.bind_group, &[]);
-        pass.dispatch_workgroups(groups(width, 8), groups(height, 8), 1);
+        let bind_groups = [&scene.bind_group, &frame.bind_group, &self.bind_group, &map.bind_group];
+        dispatch_pixels(&mut pass, &self.pipeline, &bind_groups, width, height);
     }
 }

@@ -195,6 +195,36 @@ pub fn storage_entry(binding: u32, visibility: wgpu::ShaderStages, read_only: bo
     }
 }
 
+/// Bind-group-layout entry for a 2D unsigned-integer texture (the G-buffer, ray-view layers).
+pub fn uint_texture_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Uint,
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+/// Runs `pipeline` once per pixel of a `width × height` image (8×8 workgroups) with bind
+/// groups 0, 1, … set to `bind_groups`.
+pub fn dispatch_pixels(
+    pass: &mut wgpu::ComputePass,
+    pipeline: &wgpu::ComputePipeline,
+    bind_groups: &[&wgpu::BindGroup],
+    width: u32,
+    height: u32,
+) {
+    pass.set_pipeline(pipeline);
+    for (i, g) in bind_groups.iter().enumerate() {
+        pass.set_bind_group(i as u32, *g, &[]);
+    }
+    pass.dispatch_workgroups(groups(width, 8), groups(height, 8), 1);
+}
+
 /// Bind-group-layout entry for a uniform buffer.
 pub fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {

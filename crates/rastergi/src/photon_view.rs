@@ -5,7 +5,7 @@
 use crate::film::Film;
 use crate::frame::FrameBinding;
 use crate::gbuffer::GBufferPass;
-use crate::gpu::{Gpu, compute_pipeline, groups, storage_entry};
+use crate::gpu::{Gpu, compute_pipeline, dispatch_pixels, storage_entry, uint_texture_entry};
 use crate::gpu_scene::GpuScene;
 use crate::photons::gpu::GpuPhotonMap;
 use crate::profile::{Profiler, compute_pass};
@@ -53,12 +53,8 @@ impl PhotonViewPass {
         height: u32,
     ) {
         let mut pass = compute_pass(enc, self.profiler.as_ref(), "photon view");
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &scene.bind_group, &[]);
-        pass.set_bind_group(1, &frame.bind_group, &[]);
-        pass.set_bind_group(2, &self.bind_group, &[]);
-        pass.set_bind_group(3, &map.bind_group, &[]);
-        pass.dispatch_workgroups(groups(width, 8), groups(height, 8), 1);
+        let bind_groups = [&scene.bind_group, &frame.bind_group, &self.bind_group, &map.bind_group];
+        dispatch_pixels(&mut pass, &self.pipeline, &bind_groups, width, height);
     }
 }
 
@@ -67,16 +63,7 @@ pub fn gbuffer_film_layout(device: &wgpu::Device, label: &str) -> wgpu::BindGrou
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some(label),
         entries: &[
-            wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::COMPUTE,
-                ty: wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Uint,
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                    multisampled: false,
-                },
-                count: None,
-            },
+            uint_texture_entry(0, wgpu::ShaderStages::COMPUTE),
             storage_entry(1, wgpu::ShaderStages::COMPUTE, false),
         ],
     })

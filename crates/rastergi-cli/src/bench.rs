@@ -79,6 +79,9 @@ pub struct PhotonArgs {
     /// Timed GPU runs (the median is reported), after one warm-up run.
     #[arg(long, default_value_t = 3)]
     repeats: u32,
+    /// Print the GPU time of the photon passes (timestamp queries) over the timed runs.
+    #[arg(long)]
+    profile: bool,
     #[command(flatten)]
     gpu: GpuArgs,
 }
@@ -243,13 +246,16 @@ fn median(mut v: Vec<Duration>) -> Duration {
 fn photons(a: &PhotonArgs) -> Result<()> {
     let scene = load_scene(&a.scene)?;
     scene.validate()?;
-    let gpu = gpu(&a.gpu)?;
+    let gpu = gpu_profiled(&a.gpu, a.profile)?;
     let prepared = PreparedScene::new(&scene);
     let settings = PhotonSettings { count: a.photons, seed: 1, grid_resolution: a.grid };
     let gs = GpuScene::new(&gpu, &prepared)?;
     let map = GpuPhotonMap::new(&gpu, &gs, &prepared, &settings)?;
     map.trace(&gpu, &gs);
     gpu.wait()?;
+    if let Some(p) = &gpu.profiler {
+        p.clear(&gpu.device, &gpu.queue)?;
+    }
     let mut times = Vec::new();
     for _ in 0..a.repeats.max(1) {
         let t = Instant::now();
@@ -284,6 +290,7 @@ fn photons(a: &PhotonArgs) -> Result<()> {
         n / t_cpu / 1e6
     );
     println!("  GPU / CPU: {:.2}x", t_cpu / t_gpu);
+    print_profile(&gpu, a.profile, "GPU passes", a.repeats.max(1) as u64, "run")?;
     Ok(())
 }
 

@@ -191,3 +191,68 @@ fn tiny_renders_write_a_valid_png_and_exr_and_no_temporary_files() {
 
     assert_eq!(files_in(dir.path()), ["a.png", "b.exr"], "no .rastergi-* temporary files are left");
 }
+
+#[test]
+fn profile_prints_the_gpu_time_of_every_pass_that_ran() {
+    let dir = tempfile::tempdir().unwrap();
+    for (gather, passes) in [
+        ("trace", &["gbuffer", "direct", "gather trace"][..]),
+        ("lists", &["gbuffer", "direct", "gather list fill", "gather list project"][..]),
+        ("raster", &["gbuffer", "direct", "gather count", "gather peel", "gather project"][..]),
+    ] {
+        let args = ["render", "cornell", "--width", "32", "--height", "32", "--iterations", "2", "--photons", "4096"];
+        let run = rastergi(
+            dir.path(),
+            &[&args[..], &["--grid", "8", "--gather", gather, "--profile", "--out", "p.exr"]].concat(),
+        );
+        assert!(run.status.success(), "{}", run.stderr);
+        // The set-up's table (the photon passes), then the iterations' with each pass that ran
+        // there, 2 iterations of 4 directions.
+        let (setup, iterations) = run.stdout.split_once("iterations (GPU timestamps").expect("an iterations table");
+        assert!(setup.contains("photon trace") && setup.contains("photon map resolve"), "{}", run.stdout);
+        for pass in passes {
+            let row = iterations
+                .lines()
+                .find(|l| l.starts_with(pass))
+                .unwrap_or_else(|| panic!("no {pass}:\n{}", run.stdout));
+            let count: u32 = row[22..].split_whitespace().next().unwrap().parse().unwrap();
+            let expected = match *pass {
+                "gbuffer" | "direct" => 2,
+                "gather trace" => 2,
+                // One per direction; peeled layers: at least one per direction.
+                "gather peel" | "gather project" => count.max(8),
+                _ => 8,
+            };
+            assert_eq!(count, expected, "{pass}:\n{}", run.stdout);
+        }
+        assert!(iterations.contains("GPU total"), "{}", run.stdout);
+    }
+}
+
+#[test]
+fn unknown_gather_method_is_a_usage_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = rastergi(dir.path(), &["render", "cornell", "--gather", "magic", "--out", "x.png"]);
+    assert!(!run.status.success());
+    assert!(run.stderr.contains("magic") && run.stderr.contains("trace"), "{}", run.stderr);
+    assert!(files_in(dir.path()).is_empty());
+}
+
+#[test]
+fn bench_memory_reports_the_allocations_and_their_total() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = rastergi(
+        dir.path(),
+        &["bench", "memory", "--width", "64", "--height", "64", "--grid", "16", "--bundle", "128", "--photons", "4096"],
+    );
+    assert!(run.status.success(), "{}", run.stderr);
+    // Film: 3 components × 16 bytes per pixel of accumulation = 192 KiB at 64²; it is under
+    // the 1 MiB listing threshold, so only the totals are checked against a floor: the photon
+    // map texture alone is 16³ cells × 6 bins × 16 bytes = 384 KiB.
+    let totals: Vec<&str> = run.stdout.lines().filter(|l| l.trim_start().starts_with("total")).collect();
+    assert_eq!(totals.len(), 2, "{}", run.stdout);
+    for t in totals {
+        let mib: f64 = t.split_whitespace().nth(1).unwrap().parse().unwrap();
+        assert!(mib >= 0.375, "{t}");
+    }
+}

@@ -148,15 +148,17 @@ impl GatherPass {
         let raster = wants(GatherMethod::Raster)
             .then(|| RasterGather::new(gpu, scene, frame, gbuffer, film, map, &uniforms, bundle))
             .transpose()?;
-        let lists = match ListGather::new(gpu, scene, frame, gbuffer, film, map, &uniforms, bundle) {
-            _ if !wants(GatherMethod::Lists) => None,
-            Ok(lists) => Some(lists),
+        let lists = match wants(GatherMethod::Lists)
+            .then(|| ListGather::new(gpu, scene, frame, gbuffer, film, map, &uniforms, bundle))
+        {
+            None => None,
+            Some(Ok(lists)) => Some(lists),
             // Auto does without a candidate that does not fit.
-            Err(e) if method == GatherMethod::Auto => {
+            Some(Err(e)) if method == GatherMethod::Auto => {
                 log::info!("gather: no fragment lists ({e})");
                 None
             }
-            Err(e) => return Err(e),
+            Some(Err(e)) => return Err(e),
         };
         let trace =
             wants(GatherMethod::Trace).then(|| TraceGather::new(gpu, scene, frame, gbuffer, film, map, &uniforms));

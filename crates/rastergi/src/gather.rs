@@ -81,6 +81,9 @@ pub enum GatherMethod {
 /// The implementations `Auto` chooses among, in trial order.
 const CANDIDATES: [GatherMethod; 3] = [GatherMethod::Raster, GatherMethod::Lists, GatherMethod::Trace];
 
+/// [`GatherMethod::Auto`] keeps the traced gather unless another is this many times faster.
+pub const PREFER_TRACE: f64 = 1.25;
+
 /// Iterations of each method timed by [`GatherMethod::Auto`] before it chooses.
 pub const AUTO_TRIALS: u32 = 3;
 
@@ -292,7 +295,15 @@ impl GatherPass {
                 v[v.len() / 2]
             };
             let times: Vec<(GatherMethod, Duration)> = self.trials.iter().map(|(m, t)| (*m, median(t))).collect();
-            let (method, _) = *times.iter().min_by_key(|(_, t)| *t).expect("a gather candidate");
+            let (fastest, t_fastest) = *times.iter().min_by_key(|(_, t)| *t).expect("a gather candidate");
+            // The traced gather is exact and needs no ray-view memory: a raster gather must
+            // win clearly, so that timing noise does not flip the choice between runs.
+            let method = match times.iter().find(|(m, _)| *m == GatherMethod::Trace) {
+                Some(&(_, t_trace)) if t_trace.as_secs_f64() <= PREFER_TRACE * t_fastest.as_secs_f64() => {
+                    GatherMethod::Trace
+                }
+                _ => fastest,
+            };
             let list: Vec<String> =
                 times.iter().map(|(m, t)| format!("{m:?} {:.2} ms", t.as_secs_f64() * 1e3)).collect();
             log::info!("gather per iteration on {}: {}; using {method:?}", gpu.info.name, list.join(", "));

@@ -32,11 +32,12 @@ use crate::gather_lists::ListGather;
 use crate::gather_raster::RasterGather;
 use crate::gather_trace::TraceGather;
 use crate::gbuffer::GBufferPass;
-use crate::gpu::Gpu;
+use crate::gpu::{Gpu, compute_pipeline};
 use crate::gpu_scene::GpuScene;
 use crate::photons::gpu::GpuPhotonMap;
 use crate::sampling::{Rng, orthonormal_basis, radical_inverse, uniform_sphere};
 use crate::scene::Aabb;
+use crate::shader;
 
 /// Most gather directions per iteration.
 pub const MAX_DIRECTIONS: u32 = 16;
@@ -117,6 +118,59 @@ pub fn ray_view_projection(bounds: &Aabb, direction: Vec3, bundle: u32, jitter: 
     shift * proj * view
 }
 
+/// What a gather implementation's passes bind, for building them: the scene, the frame
+/// uniforms, the G-buffer (visible points), the film (indirect component), the photon map and
+/// the [`GatherUniforms`].
+pub struct GatherSetup<'a> {
+    pub scene: &'a GpuScene,
+    pub frame: &'a FrameBinding,
+    pub gbuffer: &'a GBufferPass,
+    pub film: &'a Film,
+    pub map: &'a GpuPhotonMap,
+    pub uniforms: &'a wgpu::Buffer,
+}
+
+impl GatherSetup<'_> {
+    /// A per-pixel compute pipeline ending in the estimator: `source` after the scene prelude,
+    /// the photon-map lookup and `gather.wgsl`; bind groups scene, frame, `own`, photon map.
+    pub fn estimate_pipeline(
+        &self,
+        device: &wgpu::Device,
+        label: &str,
+        source: &str,
+        own: &wgpu::BindGroupLayout,
+    ) -> wgpu::ComputePipeline {
+        let source =
+            shader::with_scene(&[include_str!("photon_map.wgsl"), include_str!("gather.wgsl"), source].join("\n"));
+        let module = shader::module(device, label, &source);
+        compute_pipeline(
+            device,
+            label,
+            &module,
+            "main",
+            &[&self.scene.layout, &self.frame.layout, own, &self.map.layout],
+        )
+    }
+}
+
+/// What a gather reads when it is encoded: the scene, the frame uniforms and the photon map
+/// it was built with, and the image size.
+#[derive(Clone, Copy)]
+pub struct GatherInputs<'a> {
+    pub scene: &'a GpuScene,
+    pub frame: &'a FrameBinding,
+    pub map: &'a GpuPhotonMap,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl<'a> GatherInputs<'a> {
+    /// The per-pixel pipeline's bind groups around `own`: scene, frame, `own`, photon map.
+    pub fn groups(&self, own: &'a wgpu::BindGroup) -> [&'a wgpu::BindGroup; 4] {
+        [&self.scene.bind_group, &self.frame.bind_group, own, &self.map.bind_group]
+    }
+}
+
 /// The final gather pass: the implementations behind one interface.
 pub struct GatherPass {
     pub bundle: u32,
@@ -147,13 +201,10 @@ impl GatherPass {
             std::mem::size_of::<GatherUniforms>() as u64,
             wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         );
+        let setup = GatherSetup { scene, frame, gbuffer, film, map, uniforms: &uniforms };
         let wants = |m: GatherMethod| method == m || method == GatherMethod::Auto;
-        let raster = wants(GatherMethod::Raster)
-            .then(|| RasterGather::new(gpu, scene, frame, gbuffer, film, map, &uniforms, bundle))
-            .transpose()?;
-        let lists = match wants(GatherMethod::Lists)
-            .then(|| ListGather::new(gpu, scene, frame, gbuffer, film, map, &uniforms, bundle))
-        {
+        let raster = wants(GatherMethod::Raster).then(|| RasterGather::new(gpu, &setup, bundle)).transpose()?;
+        let lists = match wants(GatherMethod::Lists).then(|| ListGather::new(gpu, &setup, bundle)) {
             None => None,
             Some(Ok(lists)) => Some(lists),
             // Auto does without a candidate that does not fit.
@@ -163,8 +214,7 @@ impl GatherPass {
             }
             Some(Err(e)) => return Err(e),
         };
-        let trace =
-            wants(GatherMethod::Trace).then(|| TraceGather::new(gpu, scene, frame, gbuffer, film, map, &uniforms));
+        let trace = wants(GatherMethod::Trace).then(|| TraceGather::new(gpu, &setup));
         let chosen = (method != GatherMethod::Auto).then_some(method);
         let present = [raster.is_some(), lists.is_some(), trace.is_some()];
         let trials = CANDIDATES.iter().zip(present).filter(|(_, p)| *p).map(|(&m, _)| (m, Vec::new())).collect();
@@ -197,38 +247,28 @@ impl GatherPass {
     /// estimate weighted 1/len) after the work already in `enc`, and returns the encoder to go
     /// on with (the raster gather submits to read each direction's depth complexity back).
     /// Reads: scene, frame, G-buffer, photon map. Adds to: the film's indirect component.
-    #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &mut self,
         gpu: &Gpu,
         enc: wgpu::CommandEncoder,
-        scene: &GpuScene,
-        frame: &FrameBinding,
-        map: &GpuPhotonMap,
+        inputs: &GatherInputs,
         samples: &[GatherSample],
-        width: u32,
-        height: u32,
     ) -> Result<wgpu::CommandEncoder> {
         assert!((1..=MAX_DIRECTIONS as usize).contains(&samples.len()), "1 to {MAX_DIRECTIONS} gather directions");
         let method = match self.chosen {
             Some(m) => m,
-            None => return self.encode_trial(gpu, enc, scene, frame, map, samples, width, height),
+            None => return self.encode_trial(gpu, enc, inputs, samples),
         };
-        self.encode_with(method, gpu, enc, scene, frame, map, samples, width, height)
+        self.encode_with(method, gpu, enc, inputs, samples)
     }
 
-    #[allow(clippy::too_many_arguments)]
     fn encode_with(
         &self,
         method: GatherMethod,
         gpu: &Gpu,
         mut enc: wgpu::CommandEncoder,
-        scene: &GpuScene,
-        frame: &FrameBinding,
-        map: &GpuPhotonMap,
+        inputs: &GatherInputs,
         samples: &[GatherSample],
-        width: u32,
-        height: u32,
     ) -> Result<wgpu::CommandEncoder> {
         if method == GatherMethod::Raster || method == GatherMethod::Lists {
             for k in 0..samples.len() {
@@ -237,38 +277,33 @@ impl GatherPass {
                     gpu.queue.submit([enc.finish()]);
                     enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("gather") });
                 }
-                let u = self.uniforms(&scene.bounds, samples, k);
+                let u = self.uniforms(&inputs.scene.bounds, samples, k);
                 gpu.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
                 if method == GatherMethod::Raster {
                     let raster = self.raster.as_ref().expect("the raster gather exists when chosen");
-                    enc = raster.encode(gpu, enc, scene, frame, map, width, height)?;
+                    enc = raster.encode(gpu, enc, inputs)?;
                 } else {
                     let lists = self.lists.as_ref().expect("the list gather exists when chosen");
-                    lists.encode(&mut enc, scene, frame, map, width, height);
+                    lists.encode(&mut enc, inputs);
                 }
             }
         } else {
             let trace = self.trace.as_ref().expect("the traced gather exists when chosen");
-            let u = self.uniforms(&scene.bounds, samples, 0);
+            let u = self.uniforms(&inputs.scene.bounds, samples, 0);
             gpu.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
-            trace.encode(&mut enc, scene, frame, map, width, height);
+            trace.encode(&mut enc, inputs);
         }
         Ok(enc)
     }
 
     /// One timed trial iteration of `Auto`: the work before the gather is finished first so the
     /// gather alone is timed; after [`AUTO_TRIALS`] of each, the faster (median) is kept.
-    #[allow(clippy::too_many_arguments)]
     fn encode_trial(
         &mut self,
         gpu: &Gpu,
         enc: wgpu::CommandEncoder,
-        scene: &GpuScene,
-        frame: &FrameBinding,
-        map: &GpuPhotonMap,
+        inputs: &GatherInputs,
         samples: &[GatherSample],
-        width: u32,
-        height: u32,
     ) -> Result<wgpu::CommandEncoder> {
         // The candidate with the fewest trials so far, in order.
         let k = (0..self.trials.len()).min_by_key(|&k| self.trials[k].1.len()).expect("a gather candidate");
@@ -277,7 +312,7 @@ impl GatherPass {
         gpu.wait()?;
         let start = Instant::now();
         let enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("gather") });
-        let enc = self.encode_with(method, gpu, enc, scene, frame, map, samples, width, height)?;
+        let enc = self.encode_with(method, gpu, enc, inputs, samples)?;
         gpu.queue.submit([enc.finish()]);
         gpu.wait()?;
         self.trials[k].1.push(start.elapsed());

@@ -14,14 +14,11 @@
 //!   lattice points, Nosarzewska), so Σ(A/s² + P/s + 1) nodes always suffice.
 
 use crate::error::{Error, Result};
-use crate::film::Film;
-use crate::frame::FrameBinding;
-use crate::gbuffer::GBufferPass;
-use crate::gpu::{Gpu, compute_pipeline, dispatch_pixels, storage_entry, uint_texture_entry, uniform_entry};
+use crate::gather::{GatherInputs, GatherSetup};
+use crate::gather_raster::{ray_view_module, ray_view_pipeline};
+use crate::gpu::{Gpu, dispatch_pixels, storage_entry, uint_texture_entry, uniform_entry};
 use crate::gpu_scene::GpuScene;
-use crate::photons::gpu::GpuPhotonMap;
 use crate::profile::{Profiler, compute_pass};
-use crate::shader;
 
 /// Render target of the list pass (nothing is written to it; a pass needs an attachment).
 const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Uint;
@@ -46,22 +43,12 @@ pub struct ListGather {
 }
 
 impl ListGather {
-    /// The list buffers for a `bundle`² ray view; `uniforms` holds
-    /// [`crate::gather::GatherUniforms`]. Fails where the node pool exceeds a binding.
-    #[allow(clippy::too_many_arguments)]
-    pub fn new(
-        gpu: &Gpu,
-        scene: &GpuScene,
-        frame: &FrameBinding,
-        gbuffer: &GBufferPass,
-        film: &Film,
-        map: &GpuPhotonMap,
-        uniforms: &wgpu::Buffer,
-        bundle: u32,
-    ) -> Result<ListGather> {
+    /// The list buffers for a `bundle`² ray view. Fails where the node pool exceeds a
+    /// binding.
+    pub fn new(gpu: &Gpu, setup: &GatherSetup, bundle: u32) -> Result<ListGather> {
         let device = &gpu.device;
         crate::limits::check_bundle(&device.limits(), bundle)?;
-        let capacity = node_capacity(scene, bundle);
+        let capacity = node_capacity(setup.scene, bundle);
         let max = device.limits().max_storage_buffer_binding_size.min(device.limits().max_buffer_size);
         if capacity.saturating_mul(8) > max {
             return Err(Error::Limits(format!(
@@ -103,7 +90,7 @@ impl ListGather {
             label: Some("gather list fill"),
             layout: &fill_layout,
             entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 0, resource: setup.uniforms.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 1, resource: heads.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 2, resource: nodes.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 3, resource: node_count.as_entire_binding() },
@@ -123,58 +110,26 @@ impl ListGather {
             label: Some("gather list project"),
             layout: &project_layout,
             entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&gbuffer.view) },
+                wgpu::BindGroupEntry { binding: 0, resource: setup.uniforms.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&setup.gbuffer.view) },
                 wgpu::BindGroupEntry { binding: 2, resource: heads.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 3, resource: nodes.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 4, resource: film.accumulation.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 4, resource: setup.film.accumulation.as_entire_binding() },
             ],
         });
 
-        let raster_source = [shader::SAMPLING, shader::SCENE, include_str!("gather_peel.wgsl")].join("\n");
-        let raster = shader::module(device, "gather list fill", &raster_source);
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("gather list fill"),
-            bind_group_layouts: &[Some(&scene.layout), Some(&fill_layout)],
-            immediate_size: 0,
-        });
-        let fill_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("gather list fill"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &raster,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &raster,
-                entry_point: Some("fs_list"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: TARGET_FORMAT,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::empty(),
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
-        let project_source = shader::with_scene(
-            &[include_str!("photon_map.wgsl"), include_str!("gather.wgsl"), include_str!("gather_lists.wgsl")]
-                .join("\n"),
-        );
-        let project_module = shader::module(device, "gather list project", &project_source);
-        let project_pipeline = compute_pipeline(
+        let module = ray_view_module(device);
+        let fill_pipeline = ray_view_pipeline(
             device,
-            "gather list project",
-            &project_module,
-            "main",
-            &[&scene.layout, &frame.layout, &project_layout, &map.layout],
+            "gather list fill",
+            &module,
+            &[&setup.scene.layout, &fill_layout],
+            "fs_list",
+            (TARGET_FORMAT, wgpu::ColorWrites::empty()),
+            false,
         );
+        let project_pipeline =
+            setup.estimate_pipeline(device, "gather list project", include_str!("gather_lists.wgsl"), &project_layout);
         Ok(ListGather {
             fill_pipeline,
             project_pipeline,
@@ -190,15 +145,7 @@ impl ListGather {
     /// Encodes the lists of the direction in the uniforms and their projection onto the
     /// visible points. Reads: scene, frame, G-buffer, photon map. Adds to: the film's indirect
     /// component.
-    pub fn encode(
-        &self,
-        enc: &mut wgpu::CommandEncoder,
-        scene: &GpuScene,
-        frame: &FrameBinding,
-        map: &GpuPhotonMap,
-        width: u32,
-        height: u32,
-    ) {
+    pub fn encode(&self, enc: &mut wgpu::CommandEncoder, inputs: &GatherInputs) {
         enc.clear_buffer(&self.heads, 0, None);
         enc.clear_buffer(&self.node_count, 0, None);
         {
@@ -216,13 +163,13 @@ impl ListGather {
                 multiview_mask: None,
             });
             pass.set_pipeline(&self.fill_pipeline);
-            pass.set_bind_group(0, &scene.bind_group, &[]);
+            pass.set_bind_group(0, &inputs.scene.bind_group, &[]);
             pass.set_bind_group(1, &self.fill_group, &[]);
-            pass.draw(0..3 * scene.triangle_count, 0..1);
+            pass.draw(0..3 * inputs.scene.triangle_count, 0..1);
         }
         let mut pass = compute_pass(enc, self.profiler.as_ref(), "gather list project");
-        let bind_groups = [&scene.bind_group, &frame.bind_group, &self.project_group, &map.bind_group];
-        dispatch_pixels(&mut pass, &self.project_pipeline, &bind_groups, width, height);
+        let groups = inputs.groups(&self.project_group);
+        dispatch_pixels(&mut pass, &self.project_pipeline, &groups, inputs.width, inputs.height);
     }
 }
 

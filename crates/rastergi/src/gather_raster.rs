@@ -17,19 +17,65 @@
 //!   slope bias that would lose contact shadows).
 
 use crate::error::Result;
-use crate::film::Film;
-use crate::frame::FrameBinding;
-use crate::gather::GatherUniforms;
-use crate::gbuffer::GBufferPass;
-use crate::gpu::{Gpu, compute_pipeline, dispatch_pixels, storage_entry, uint_texture_entry, uniform_entry};
+use crate::gather::{GatherInputs, GatherSetup};
+use crate::gpu::{Gpu, dispatch_pixels, pipeline_layout, storage_entry, uint_texture_entry, uniform_entry};
 use crate::gpu_scene::GpuScene;
-use crate::photons::gpu::GpuPhotonMap;
 use crate::profile::{Profiler, compute_pass};
 use crate::shader;
 
 /// Ray-view texel: (triangle + 1, b1 bits, b2 bits, depth bits); 0 where empty.
 const LAYER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;
 const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// The ray-view raster shaders (`gather_peel.wgsl`: the vertex stage and the count, peel and
+/// list fragment stages), shared by the peeled and the fragment-list gathers.
+pub fn ray_view_module(device: &wgpu::Device) -> wgpu::ShaderModule {
+    let source = [shader::SAMPLING, shader::SCENE, include_str!("gather_peel.wgsl")].join("\n");
+    shader::module(device, "gather ray view", &source)
+}
+
+/// A ray-view raster pipeline: every triangle drawn by `vs_main`, no culling, fragment stage
+/// `fs` into a `target` (format, write mask); with `depth`, a Depth32Float test that keeps the
+/// farthest fragment (back to front).
+pub fn ray_view_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    layouts: &[&wgpu::BindGroupLayout],
+    fs: &str,
+    target: (wgpu::TextureFormat, wgpu::ColorWrites),
+    depth: bool,
+) -> wgpu::RenderPipeline {
+    let layout = pipeline_layout(device, label, layouts);
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+        depth_stencil: depth.then(|| wgpu::DepthStencilState {
+            format: DEPTH_FORMAT,
+            depth_write_enabled: Some(true),
+            // Back to front: keep the farthest fragment.
+            depth_compare: Some(wgpu::CompareFunction::Greater),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some(fs),
+            compilation_options: Default::default(),
+            targets: &[Some(wgpu::ColorTargetState { format: target.0, blend: None, write_mask: target.1 })],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
 
 pub struct RasterGather {
     count_pipeline: wgpu::RenderPipeline,
@@ -49,22 +95,11 @@ pub struct RasterGather {
 }
 
 impl RasterGather {
-    /// The passes and ray-view textures for a `bundle`² ray view; `uniforms` holds
-    /// [`GatherUniforms`].
-    #[allow(clippy::too_many_arguments)]
-    pub fn new(
-        gpu: &Gpu,
-        scene: &GpuScene,
-        frame: &FrameBinding,
-        gbuffer: &GBufferPass,
-        film: &Film,
-        map: &GpuPhotonMap,
-        uniforms: &wgpu::Buffer,
-        bundle: u32,
-    ) -> Result<RasterGather> {
+    /// The passes and ray-view textures for a `bundle`² ray view.
+    pub fn new(gpu: &Gpu, setup: &GatherSetup, bundle: u32) -> Result<RasterGather> {
         let device = &gpu.device;
         crate::limits::check_bundle(&device.limits(), bundle)?;
-        debug_assert_eq!(uniforms.size(), std::mem::size_of::<GatherUniforms>() as u64);
+        let (uniforms, gbuffer, film) = (setup.uniforms, setup.gbuffer, setup.film);
         let texture = |label: &str, format: wgpu::TextureFormat, usage: wgpu::TextureUsages| {
             device
                 .create_texture(&wgpu::TextureDescriptor {
@@ -159,63 +194,28 @@ impl RasterGather {
         let peel_groups = [peel_group(&layers[1]), peel_group(&layers[0])];
         let project_groups = [project_group(&layers[0]), project_group(&layers[1])];
 
-        let raster_source = [shader::SAMPLING, shader::SCENE, include_str!("gather_peel.wgsl")].join("\n");
-        let raster = shader::module(device, "gather peel", &raster_source);
-        let raster_pipeline = |label: &str,
-                               layout: &wgpu::BindGroupLayout,
-                               fs: &str,
-                               write: wgpu::ColorWrites,
-                               depth: bool| {
-            let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some(label),
-                bind_group_layouts: &[Some(&scene.layout), Some(layout)],
-                immediate_size: 0,
-            });
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(label),
-                layout: Some(&pl),
-                vertex: wgpu::VertexState {
-                    module: &raster,
-                    entry_point: Some("vs_main"),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-                depth_stencil: depth.then(|| wgpu::DepthStencilState {
-                    format: DEPTH_FORMAT,
-                    depth_write_enabled: Some(true),
-                    // Back to front: keep the farthest fragment.
-                    depth_compare: Some(wgpu::CompareFunction::Greater),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &raster,
-                    entry_point: Some(fs),
-                    compilation_options: Default::default(),
-                    targets: &[Some(wgpu::ColorTargetState { format: LAYER_FORMAT, blend: None, write_mask: write })],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
-        };
-        let count_pipeline =
-            raster_pipeline("gather count", &count_layout, "fs_count", wgpu::ColorWrites::empty(), false);
-        let peel_pipeline = raster_pipeline("gather peel", &peel_layout, "fs_peel", wgpu::ColorWrites::ALL, true);
-
-        let project_source = shader::with_scene(
-            &[include_str!("photon_map.wgsl"), include_str!("gather.wgsl"), include_str!("gather_project.wgsl")]
-                .join("\n"),
-        );
-        let project_module = shader::module(device, "gather project", &project_source);
-        let project_pipeline = compute_pipeline(
+        let module = ray_view_module(device);
+        let scene_layout = &setup.scene.layout;
+        let count_pipeline = ray_view_pipeline(
             device,
-            "gather project",
-            &project_module,
-            "main",
-            &[&scene.layout, &frame.layout, &project_layout, &map.layout],
+            "gather count",
+            &module,
+            &[scene_layout, &count_layout],
+            "fs_count",
+            (LAYER_FORMAT, wgpu::ColorWrites::empty()),
+            false,
         );
+        let peel_pipeline = ray_view_pipeline(
+            device,
+            "gather peel",
+            &module,
+            &[scene_layout, &peel_layout],
+            "fs_peel",
+            (LAYER_FORMAT, wgpu::ColorWrites::ALL),
+            true,
+        );
+        let project_pipeline =
+            setup.estimate_pipeline(device, "gather project", include_str!("gather_project.wgsl"), &project_layout);
         Ok(RasterGather {
             count_pipeline,
             peel_pipeline,
@@ -235,23 +235,18 @@ impl RasterGather {
     /// Counts the depth complexity along the direction in the uniforms, submits `enc` and
     /// reads the count back, then encodes that many peeled layers with their projections into
     /// a new encoder, which it returns.
-    #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &self,
         gpu: &Gpu,
         mut enc: wgpu::CommandEncoder,
-        scene: &GpuScene,
-        frame: &FrameBinding,
-        map: &GpuPhotonMap,
-        width: u32,
-        height: u32,
+        inputs: &GatherInputs,
     ) -> Result<wgpu::CommandEncoder> {
-        self.encode_count(&mut enc, scene);
+        self.encode_count(&mut enc, inputs.scene);
         gpu.queue.submit([enc.finish()]);
         let layers = self.read_layer_count(gpu)?;
         let mut enc =
             gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("gather layers") });
-        self.encode_layers(&mut enc, scene, frame, map, width, height, layers);
+        self.encode_layers(&mut enc, inputs, layers);
         Ok(enc)
     }
 
@@ -287,17 +282,7 @@ impl RasterGather {
 
     /// Peels `layers` layers back to front, projecting each onto the visible points.
     /// Reads: scene, frame, G-buffer, photon map. Adds to: the film's indirect component.
-    #[allow(clippy::too_many_arguments)]
-    fn encode_layers(
-        &self,
-        enc: &mut wgpu::CommandEncoder,
-        scene: &GpuScene,
-        frame: &FrameBinding,
-        map: &GpuPhotonMap,
-        width: u32,
-        height: u32,
-        layers: u32,
-    ) {
+    fn encode_layers(&self, enc: &mut wgpu::CommandEncoder, inputs: &GatherInputs, layers: u32) {
         enc.clear_buffer(&self.found, 0, None);
         // "Layer −1" (read by the first peel) is empty with depth bits above any depth.
         let beyond = f64::from(2.0f32.to_bits());
@@ -346,13 +331,13 @@ impl RasterGather {
                     multiview_mask: None,
                 });
                 pass.set_pipeline(&self.peel_pipeline);
-                pass.set_bind_group(0, &scene.bind_group, &[]);
+                pass.set_bind_group(0, &inputs.scene.bind_group, &[]);
                 pass.set_bind_group(1, &self.peel_groups[cur], &[]);
-                pass.draw(0..3 * scene.triangle_count, 0..1);
+                pass.draw(0..3 * inputs.scene.triangle_count, 0..1);
             }
             let mut pass = compute_pass(enc, self.profiler.as_ref(), "gather project");
-            let bind_groups = [&scene.bind_group, &frame.bind_group, &self.project_groups[cur], &map.bind_group];
-            dispatch_pixels(&mut pass, &self.project_pipeline, &bind_groups, width, height);
+            let groups = inputs.groups(&self.project_groups[cur]);
+            dispatch_pixels(&mut pass, &self.project_pipeline, &groups, inputs.width, inputs.height);
         }
     }
 }

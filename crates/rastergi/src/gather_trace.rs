@@ -5,14 +5,9 @@
 //! gather quantises to ray-view texels, and costs O(log n) per pixel where rasterising costs
 //! O(n) per layer; rasterization wins where fragment work is cheap and the scene shallow.
 
-use crate::film::Film;
-use crate::frame::FrameBinding;
-use crate::gbuffer::GBufferPass;
-use crate::gpu::{Gpu, compute_pipeline, dispatch_pixels, storage_entry, uint_texture_entry, uniform_entry};
-use crate::gpu_scene::GpuScene;
-use crate::photons::gpu::GpuPhotonMap;
+use crate::gather::{GatherInputs, GatherSetup};
+use crate::gpu::{Gpu, dispatch_pixels, storage_entry, uint_texture_entry, uniform_entry};
 use crate::profile::{Profiler, compute_pass};
-use crate::shader;
 
 pub struct TraceGather {
     pipeline: wgpu::ComputePipeline,
@@ -21,16 +16,7 @@ pub struct TraceGather {
 }
 
 impl TraceGather {
-    /// `uniforms` holds [`crate::gather::GatherUniforms`].
-    pub fn new(
-        gpu: &Gpu,
-        scene: &GpuScene,
-        frame: &FrameBinding,
-        gbuffer: &GBufferPass,
-        film: &Film,
-        map: &GpuPhotonMap,
-        uniforms: &wgpu::Buffer,
-    ) -> TraceGather {
+    pub fn new(gpu: &Gpu, setup: &GatherSetup) -> TraceGather {
         let device = &gpu.device;
         let c = wgpu::ShaderStages::COMPUTE;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -41,39 +27,19 @@ impl TraceGather {
             label: Some("gather trace"),
             layout: &layout,
             entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&gbuffer.view) },
-                wgpu::BindGroupEntry { binding: 2, resource: film.accumulation.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 0, resource: setup.uniforms.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&setup.gbuffer.view) },
+                wgpu::BindGroupEntry { binding: 2, resource: setup.film.accumulation.as_entire_binding() },
             ],
         });
-        let source = shader::with_scene(
-            &[include_str!("photon_map.wgsl"), include_str!("gather.wgsl"), include_str!("gather_trace.wgsl")]
-                .join("\n"),
-        );
-        let module = shader::module(device, "gather trace", &source);
-        let pipeline = compute_pipeline(
-            device,
-            "gather trace",
-            &module,
-            "main",
-            &[&scene.layout, &frame.layout, &layout, &map.layout],
-        );
+        let pipeline = setup.estimate_pipeline(device, "gather trace", include_str!("gather_trace.wgsl"), &layout);
         TraceGather { pipeline, bind_group, profiler: gpu.profiler.clone() }
     }
 
     /// Reads: scene, frame, G-buffer, photon map, gather uniforms. Adds to: the film's
     /// indirect component.
-    pub fn encode(
-        &self,
-        enc: &mut wgpu::CommandEncoder,
-        scene: &GpuScene,
-        frame: &FrameBinding,
-        map: &GpuPhotonMap,
-        width: u32,
-        height: u32,
-    ) {
+    pub fn encode(&self, enc: &mut wgpu::CommandEncoder, inputs: &GatherInputs) {
         let mut pass = compute_pass(enc, self.profiler.as_ref(), "gather trace");
-        let bind_groups = [&scene.bind_group, &frame.bind_group, &self.bind_group, &map.bind_group];
-        dispatch_pixels(&mut pass, &self.pipeline, &bind_groups, width, height);
+        dispatch_pixels(&mut pass, &self.pipeline, &inputs.groups(&self.bind_group), inputs.width, inputs.height);
     }
 }

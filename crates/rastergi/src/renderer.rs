@@ -7,7 +7,9 @@ use crate::direct::DirectPass;
 use crate::error::Result;
 use crate::film::{Film, Show};
 use crate::frame::{FrameBinding, FrameUniforms, near_plane, pixel_jitter, view_projection};
-use crate::gather::{GatherMethod, GatherPass, GatherSample, MAX_DIRECTIONS, gather_direction, random_rotation};
+use crate::gather::{
+    GatherInputs, GatherMethod, GatherPass, GatherSample, MAX_DIRECTIONS, gather_direction, random_rotation,
+};
 use crate::gbuffer::GBufferPass;
 use crate::gpu::Gpu;
 use crate::gpu_scene::{GpuScene, PreparedScene};
@@ -305,7 +307,8 @@ impl Renderer {
                     GatherSample { direction: direction.normalize(), texel_jitter }
                 })
                 .collect();
-            enc = gather.encode(&self.gpu, enc, &self.scene, &self.frame, map, &samples, w, h)?;
+            let inputs = GatherInputs { scene: &self.scene, frame: &self.frame, map, width: w, height: h };
+            enc = gather.encode(&self.gpu, enc, &inputs, &samples)?;
         }
         // 4. Accumulate: every pass above added its estimate to the film's sums.
         self.gpu.queue.submit([enc.finish()]);

@@ -81,11 +81,6 @@ struct Build {
     trace_group: wgpu::BindGroup,
 }
 
-/// Bytes of GPU memory the photon map of `grid` takes (tally + area + texture).
-pub fn memory_bytes(grid: &GridSpec) -> u64 {
-    grid.slot_count() as u64 * (6 * 4 + 4 + 16)
-}
-
 impl GpuPhotonMap {
     /// Traces `settings.count` photons on the GPU into a fresh map over the scene.
     pub fn build(

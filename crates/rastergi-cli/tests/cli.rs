@@ -1,27 +1,17 @@
 //! The `rastergi` binary as a user meets it: its help, its one-line errors (never a panic),
 //! the files it writes and the ones it must leave alone.
 
-use std::fs::File;
+mod common;
+
 use std::path::Path;
-use std::process::{Command, ExitStatus, Stdio};
-use std::time::{Duration, Instant};
+use std::time::Duration;
+
+use common::Run;
 
 /// Longer than any of these runs takes on lavapipe; a run past it is killed and fails the test.
 const TIMEOUT: Duration = Duration::from_secs(300);
 
-struct Run {
-    status: ExitStatus,
-    stdout: String,
-    stderr: String,
-}
-
 impl Run {
-    /// stderr without the lines Mesa prints on its own when XDG_RUNTIME_DIR is not set
-    /// ("error: XDG_RUNTIME_DIR is invalid or not set in the environment.").
-    fn our_stderr(&self) -> Vec<&str> {
-        self.stderr.lines().filter(|l| !l.contains("XDG_RUNTIME_DIR") && !l.trim().is_empty()).collect()
-    }
-
     /// The one `error: ` line of a failed run, after checking that the run failed, printed
     /// exactly one such line and did not panic.
     fn error_line(&self) -> &str {
@@ -35,30 +25,7 @@ impl Run {
 
 /// Runs the binary with `args` in the directory `dir`.
 fn rastergi(dir: &Path, args: &[&str]) -> Run {
-    let out = tempfile::tempdir().unwrap();
-    let (stdout_path, stderr_path) = (out.path().join("stdout"), out.path().join("stderr"));
-    let mut child = Command::new(env!("CARGO_BIN_EXE_rastergi"))
-        .args(args)
-        .current_dir(dir)
-        .stdin(Stdio::null())
-        .stdout(File::create(&stdout_path).unwrap())
-        .stderr(File::create(&stderr_path).unwrap())
-        .spawn()
-        .unwrap();
-    let start = Instant::now();
-    let status = loop {
-        if let Some(status) = child.try_wait().unwrap() {
-            break status;
-        }
-        if start.elapsed() > TIMEOUT {
-            let _ = child.kill();
-            let _ = child.wait();
-            panic!("rastergi {args:?} ran longer than {TIMEOUT:?}");
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    };
-    let read = |p: &Path| String::from_utf8_lossy(&std::fs::read(p).unwrap()).into_owned();
-    Run { status, stdout: read(&stdout_path), stderr: read(&stderr_path) }
+    common::rastergi(dir, args, TIMEOUT)
 }
 
 /// The names of the files in `dir`, sorted.

@@ -2,38 +2,29 @@
 //! a constant offset, Gaussian noise of a known level, PNG values), and on the inputs it must
 //! refuse with one clear error line: missing, corrupt, mismatched, non-finite.
 
-use std::path::Path;
-use std::process::{Command, Output};
+mod common;
 
+use std::path::Path;
+use std::time::Duration;
+
+use common::Run;
 use rastergi::image_io::{DisplayImage, LinearImage, read_image, write_exr, write_png};
 use rastergi::metrics::{DIFF_BRIGHTER, DIFF_DARKER, DIFF_EQUAL, DIFF_MASKED};
 
-struct Run {
-    output: Output,
-    stdout: String,
-    stderr: String,
-}
+/// Far longer than a comparison takes; a run past it is killed and fails the test.
+const TIMEOUT: Duration = Duration::from_secs(120);
 
 impl Run {
-    /// stderr without the lines Mesa prints on its own when XDG_RUNTIME_DIR is not set.
-    fn our_stderr(&self) -> Vec<&str> {
-        self.stderr.lines().filter(|l| !l.contains("XDG_RUNTIME_DIR") && !l.trim().is_empty()).collect()
-    }
-
     fn assert_success(&self) {
-        assert!(self.output.status.success(), "the run failed:\n{}", self.stderr);
+        assert!(self.status.success(), "the run failed:\n{}", self.stderr);
         assert!(self.our_stderr().is_empty(), "unexpected stderr:\n{}", self.stderr);
     }
 
     /// The one `error: ` line of a failed run, after checking that the run failed with exit
     /// code 1, printed exactly one such line, nothing else, and did not panic.
     fn error_line(&self) -> &str {
-        assert_eq!(self.output.status.code(), Some(1), "stdout:\n{}\nstderr:\n{}", self.stdout, self.stderr);
-        assert!(!self.stderr.contains("panicked"), "the run panicked:\n{}", self.stderr);
-        let lines = self.our_stderr();
-        assert_eq!(lines.len(), 1, "expected one error line, got:\n{}", self.stderr);
-        assert!(lines[0].starts_with("error: "), "{}", lines[0]);
-        lines[0]
+        assert_eq!(self.status.code(), Some(1), "stdout:\n{}\nstderr:\n{}", self.stdout, self.stderr);
+        self.sole_error_line()
     }
 
     /// The numbers after `key:` on the line of stdout that starts with it, up to the first
@@ -53,10 +44,7 @@ impl Run {
 }
 
 fn rastergi(dir: &Path, args: &[&str]) -> Run {
-    let output = Command::new(env!("CARGO_BIN_EXE_rastergi")).args(args).current_dir(dir).output().unwrap();
-    let stdout = String::from_utf8_lossy(&output.stdout).into_owned();
-    let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
-    Run { output, stdout, stderr }
+    common::rastergi(dir, args, TIMEOUT)
 }
 
 /// r(x, y, c) = k_c · (i + 1) / n for pixel index i of n pixels: channel means

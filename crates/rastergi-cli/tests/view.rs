@@ -3,12 +3,13 @@
 //! resizing rebuilds the image at the window's size, and without a display or with a bad
 //! script it fails with one clear line.
 
-use std::fs::File;
-use std::path::{Path, PathBuf};
-use std::process::{Command, ExitStatus, Stdio};
-use std::sync::Mutex;
-use std::time::{Duration, Instant};
+mod common;
 
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::time::Duration;
+
+use common::{Run, run};
 use rastergi::image_io::{LinearImage, read_exr};
 use rastergi::metrics::{compare, emitter_mask};
 
@@ -19,27 +20,7 @@ const TIMEOUT: Duration = Duration::from_secs(180);
 const SIZE: &[&str] = &["--width", "64", "--height", "64"];
 const PHOTONS: &[&str] = &["--photons", "65536", "--grid", "32"];
 
-struct Run {
-    status: ExitStatus,
-    stdout: String,
-    stderr: String,
-}
-
 impl Run {
-    /// stderr without Mesa's own complaints about XDG_RUNTIME_DIR.
-    fn our_stderr(&self) -> Vec<&str> {
-        self.stderr.lines().filter(|l| !l.contains("XDG_RUNTIME_DIR") && !l.trim().is_empty()).collect()
-    }
-
-    fn error_line(&self) -> &str {
-        assert!(!self.status.success(), "the run succeeded; stderr:\n{}", self.stderr);
-        assert!(!self.stderr.contains("panicked"), "the run panicked:\n{}", self.stderr);
-        let lines = self.our_stderr();
-        assert_eq!(lines.len(), 1, "expected one error line, got:\n{}", self.stderr);
-        assert!(lines[0].starts_with("error: "), "{}", lines[0]);
-        lines[0]
-    }
-
     fn check_success(&self, what: &str) {
         assert!(
             self.status.success() && !self.stderr.contains("panicked"),
@@ -51,48 +32,8 @@ impl Run {
     }
 }
 
-/// Runs `program args` in `dir` with the environment changes `env` (`None` removes).
-fn run(dir: &Path, program: &str, args: &[&str], env: &[(&str, Option<&str>)]) -> Run {
-    let out = tempfile::tempdir().unwrap();
-    let (stdout_path, stderr_path) = (out.path().join("stdout"), out.path().join("stderr"));
-    let mut command = Command::new(program);
-    command
-        .args(args)
-        .current_dir(dir)
-        .stdin(Stdio::null())
-        .stdout(File::create(&stdout_path).unwrap())
-        .stderr(File::create(&stderr_path).unwrap());
-    for (key, value) in env {
-        match value {
-            Some(v) => command.env(key, v),
-            None => command.env_remove(key),
-        };
-    }
-    let mut child = match command.spawn() {
-        Ok(child) => child,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound && program == "xvfb-run" => panic!(
-            "xvfb-run is not installed: the viewer tests need an X server; install it with `apt-get install xvfb xauth` (scripts/setup.sh does)"
-        ),
-        Err(e) => panic!("cannot start {program}: {e}"),
-    };
-    let start = Instant::now();
-    let status = loop {
-        if let Some(status) = child.try_wait().unwrap() {
-            break status;
-        }
-        if start.elapsed() > TIMEOUT {
-            let _ = child.kill();
-            let _ = child.wait();
-            panic!("{program} {args:?} ran longer than {TIMEOUT:?}");
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    };
-    let read = |p: &Path| String::from_utf8_lossy(&std::fs::read(p).unwrap()).into_owned();
-    Run { status, stdout: read(&stdout_path), stderr: read(&stderr_path) }
-}
-
 fn rastergi(dir: &Path, args: &[&str]) -> Run {
-    run(dir, env!("CARGO_BIN_EXE_rastergi"), args, &[])
+    common::rastergi(dir, args, TIMEOUT)
 }
 
 /// `rastergi view` on a virtual X server. Wayland variables are removed so the window opens
@@ -103,7 +44,7 @@ fn view(dir: &Path, args: &[&str]) -> Run {
     let _one_at_a_time = XVFB.lock().unwrap_or_else(|e| e.into_inner());
     let mut all = vec!["-a", "-s", "-screen 0 320x240x24", env!("CARGO_BIN_EXE_rastergi"), "view"];
     all.extend_from_slice(args);
-    run(dir, "xvfb-run", &all, &[("WAYLAND_DISPLAY", None), ("WAYLAND_SOCKET", None)])
+    run(dir, "xvfb-run", &all, &[("WAYLAND_DISPLAY", None), ("WAYLAND_SOCKET", None)], TIMEOUT)
 }
 
 /// A screenshot line of the viewer's stdout: the two files, the iteration count, the size
@@ -258,8 +199,8 @@ fn resizing_and_retracing_rebuild_the_image_at_the_window_size() {
 fn view_without_a_display_fails_with_one_clear_line() {
     let dir = tempfile::tempdir().unwrap();
     let env = [("DISPLAY", None), ("WAYLAND_DISPLAY", None), ("WAYLAND_SOCKET", None)];
-    let run = run(dir.path(), env!("CARGO_BIN_EXE_rastergi"), &["view", "cornell"], &env);
-    let line = run.error_line();
+    let run = run(dir.path(), env!("CARGO_BIN_EXE_rastergi"), &["view", "cornell"], &env, TIMEOUT);
+    let line = run.sole_error_line();
     assert!(line.contains("cannot open a window") && line.contains("DISPLAY"), "{line}");
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0, "nothing written");
 }
@@ -271,11 +212,11 @@ fn a_bad_script_is_one_error_line_naming_the_line_before_any_window_opens() {
         .unwrap();
     // No display either: the script is checked first.
     let env = [("DISPLAY", None), ("WAYLAND_DISPLAY", None), ("WAYLAND_SOCKET", None)];
-    let run = run(dir.path(), env!("CARGO_BIN_EXE_rastergi"), &["view", "cornell", "--script", "s.txt"], &env);
-    let line = run.error_line();
+    let run = run(dir.path(), env!("CARGO_BIN_EXE_rastergi"), &["view", "cornell", "--script", "s.txt"], &env, TIMEOUT);
+    let line = run.sole_error_line();
     assert!(line.contains("s.txt") && line.contains("line 3") && line.contains("unknown action 'jump'"), "{line}");
     let missing = rastergi(dir.path(), &["view", "cornell", "--script", "none.txt"]);
-    let line = missing.error_line();
+    let line = missing.sole_error_line();
     assert!(line.contains("none.txt"), "{line}");
 }
 

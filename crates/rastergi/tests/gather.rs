@@ -45,16 +45,12 @@ fn mismatches_against_cpu_raycast(method: GatherMethod) -> (usize, usize) {
         r.iterate_with(&o).unwrap();
         let img = r.read_linear(Show::Indirect).unwrap();
         let gbuffer = r.read_gbuffer().unwrap();
-        for (i, g) in gbuffer.iter().enumerate() {
-            if g[0] == 0 {
+        for (i, &g) in gbuffer.iter().enumerate() {
+            let Some(v) = common::VisiblePoint::decode(s, g) else {
                 continue;
-            }
+            };
             // The same estimator by ray casting: (ρ_x/π)·(ρ_h/π)·E(h)·max(0, n·ω)·4π.
-            let t = g[0] as usize - 1;
-            let (b1, b2) = (f32::from_bits(g[1]), f32::from_bits(g[2]));
-            let tri = s.triangles[t];
-            let x = tri[0] * (1.0 - b1 - b2) + tri[1] * b1 + tri[2] * b2;
-            let n = triangle_normal(&tri);
+            let (t, x, n) = (v.tri, v.pos, v.normal);
             if n.dot(scene.camera.eye - x) <= 0.0 {
                 continue;
             }

@@ -192,15 +192,11 @@ fn photon_view_lookup_on_the_gpu_equals_the_cpu_lookup() {
     let map = r.photon_map().unwrap().read(&gpu).unwrap();
     let prepared = PreparedScene::new(&scene);
     let mut checked = 0;
-    for (i, g) in gbuffer.iter().enumerate() {
-        if g[0] == 0 {
+    for (i, &g) in gbuffer.iter().enumerate() {
+        let Some(v) = common::VisiblePoint::decode(&prepared.scene, g) else {
             continue;
-        }
-        let t = g[0] as usize - 1;
-        let (b1, b2) = (f32::from_bits(g[1]), f32::from_bits(g[2]));
-        let tri = prepared.scene.triangles[t];
-        let p = tri[0] * (1.0 - b1 - b2) + tri[1] * b1 + tri[2] * b2;
-        let n = rastergi::scene::triangle_normal(&tri);
+        };
+        let (t, p, n) = (v.tri, v.pos, v.normal);
         if n.dot(scene.camera.eye - p) <= 0.0 {
             continue;
         }

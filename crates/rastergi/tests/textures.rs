@@ -211,17 +211,13 @@ fn photon_view_of_the_textured_room_equals_the_cpu_lookup_per_pixel() {
     let map = r.photon_map().unwrap().read(&gpu).unwrap();
     let prepared = PreparedScene::new(&scene);
     let (mut checked, mut textured, mut worst) = (0, 0, 0.0f64);
-    for (i, g) in gbuffer.iter().enumerate() {
-        if g[0] == 0 {
+    for (i, &g) in gbuffer.iter().enumerate() {
+        let Some(v) = common::VisiblePoint::decode(&prepared.scene, g) else {
             continue;
-        }
-        let t = g[0] as usize - 1;
-        let (b1, b2, lod) = (f32::from_bits(g[1]), f32::from_bits(g[2]), f32::from_bits(g[3]));
-        let tri = prepared.scene.triangles[t];
-        let p = tri[0] * (1.0 - b1 - b2) + tri[1] * b1 + tri[2] * b2;
-        let n = rastergi::scene::triangle_normal(&tri);
-        let n = if n.dot(scene.camera.eye - p) > 0.0 { n } else { -n };
-        let albedo = prepared.albedo_at(t, b1, b2, lod);
+        };
+        let (t, p) = (v.tri, v.pos);
+        let n = if v.normal.dot(scene.camera.eye - p) > 0.0 { v.normal } else { -v.normal };
+        let albedo = prepared.albedo_at(t, v.b1, v.b2, v.lod);
         let e = map.irradiance(p, n);
         for c in 0..3 {
             let expected = albedo[c] as f64 / PI * e[c];

@@ -47,3 +47,28 @@ pub fn average(a: &LinearImage, b: &LinearImage) -> LinearImage {
         pixels: a.pixels.iter().zip(&b.pixels).map(|(p, q)| [0, 1, 2].map(|c| 0.5 * (p[c] + q[c]))).collect(),
     }
 }
+
+/// A visible point decoded from a G-buffer texel (`Renderer::read_gbuffer`).
+pub struct VisiblePoint {
+    /// Triangle index in BVH order (`PreparedScene::scene`).
+    pub tri: usize,
+    pub b1: f32,
+    pub b2: f32,
+    /// Texture level of detail.
+    pub lod: f32,
+    pub pos: glam::Vec3,
+    /// The triangle's geometric normal (counter-clockwise front).
+    pub normal: glam::Vec3,
+}
+
+impl VisiblePoint {
+    /// The point of G-buffer texel `g` of `scene` (prepared: triangles in BVH order), or
+    /// `None` where the texel saw nothing.
+    pub fn decode(scene: &Scene, g: [u32; 4]) -> Option<VisiblePoint> {
+        let tri = (g[0] as usize).checked_sub(1)?;
+        let (b1, b2, lod) = (f32::from_bits(g[1]), f32::from_bits(g[2]), f32::from_bits(g[3]));
+        let t = scene.triangles[tri];
+        let pos = t[0] * (1.0 - b1 - b2) + t[1] * b1 + t[2] * b2;
+        Some(VisiblePoint { tri, b1, b2, lod, pos, normal: rastergi::scene::triangle_normal(&t) })
+    }
+}

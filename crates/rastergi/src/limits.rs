@@ -112,7 +112,7 @@ pub fn check_bundle(limits: &wgpu::Limits, bundle: u32) -> Result<()> {
             "a ray-view bundle of {bundle}x{bundle} texels exceeds this GPU's limit of 1 to {max} per side; choose a smaller --bundle"
         )));
     }
-    let what = format!("the gather's {bundle}x{bundle} depth-complexity counters");
+    let what = format!("the gather's {bundle}x{bundle} per-texel counters (depth complexity or list heads)");
     check_storage_buffer(limits, &what, bundle as u64 * bundle as u64, 4, "choose a smaller --bundle")
 }
 

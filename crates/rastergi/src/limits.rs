@@ -103,8 +103,9 @@ pub fn check_photon_grid(limits: &wgpu::Limits, grid: &GridSpec) -> Result<()> {
     Ok(())
 }
 
-/// The gather's ray view (`gather.rs`): two layer textures, a depth texture and a
-/// depth-complexity counter per texel.
+/// The raster gathers' ray view: its side against the texture limit, and one 4-byte counter
+/// per texel (the peel's depth complexity, `gather_raster.rs`; the list heads,
+/// `gather_lists.rs`) against the binding limit.
 pub fn check_bundle(limits: &wgpu::Limits, bundle: u32) -> Result<()> {
     let max = limits.max_texture_dimension_2d;
     if bundle == 0 || bundle > max {

@@ -5,6 +5,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec2, Vec3};
 
 use crate::gpu::{Gpu, buffer_bind_group, uniform_entry};
+use crate::gpu_scene::GpuScene;
 use crate::sampling::{pcg_hash, radical_inverse};
 use crate::scene::{Aabb, Camera};
 
@@ -22,6 +23,33 @@ pub struct FrameUniforms {
     /// Minimum hit distance and origin offset of secondary rays.
     pub ray_epsilon: f32,
     pub _pad: [u32; 3],
+}
+
+impl FrameUniforms {
+    /// The uniforms of `iteration` of a `size` = (width, height) image of `scene` seen by
+    /// `camera` with sub-pixel offset `jitter` ([`pixel_jitter`]): the renderer's and the path
+    /// tracer's, so both see the same jittered view.
+    pub fn new(
+        camera: &Camera,
+        size: (u32, u32),
+        scene: &GpuScene,
+        iteration: u32,
+        jitter: Vec2,
+        seed: u32,
+        light_samples: u32,
+    ) -> FrameUniforms {
+        let (w, h) = size;
+        FrameUniforms {
+            view_proj: view_projection(camera, w, h, near_plane(&scene.bounds), jitter).to_cols_array_2d(),
+            eye: camera.eye.into(),
+            iteration,
+            resolution: [w, h],
+            seed,
+            light_samples: light_samples.max(1),
+            ray_epsilon: scene.ray_epsilon,
+            _pad: [0; 3],
+        }
+    }
 }
 
 /// The sub-pixel offset of iteration `i`, uniform over [-0.5, 0.5)² across iterations:

@@ -32,6 +32,7 @@ pub mod photon_map;
 pub mod photon_view;
 pub mod photons;
 pub mod profile;
+pub mod progressive;
 pub mod renderer;
 pub mod sampling;
 pub mod scene;

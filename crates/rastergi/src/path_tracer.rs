@@ -36,11 +36,11 @@
 //! zero, so the film's resolve, EXR/PNG output and display work unchanged with [`Show::Full`].
 
 use bytemuck::{Pod, Zeroable};
-use glam::{DMat4, Mat4, Vec2};
+use glam::DMat4;
 
 use crate::error::Result;
 use crate::film::{Film, Show};
-use crate::frame::{FrameBinding, FrameUniforms, near_plane, pixel_jitter, view_projection};
+use crate::frame::{FrameBinding, FrameUniforms, pixel_jitter};
 use crate::gpu::{Gpu, buffer_bind_group, compute_pipeline, groups, storage_entry, uniform_entry};
 use crate::gpu_scene::{GpuScene, PreparedScene};
 use crate::image_io::{DisplayImage, LinearImage};
@@ -172,21 +172,11 @@ impl PathTracer {
     /// (`Renderer`'s near plane, which the rays do not depend on), and its inverse.
     fn uniforms(&self, iteration: u32) -> (FrameUniforms, PathParams) {
         let (w, h) = (self.settings.width, self.settings.height);
-        let near = near_plane(&self.scene.bounds);
-        let jitter: Vec2 = pixel_jitter(iteration, self.settings.seed);
-        let view_proj: Mat4 = view_projection(&self.camera, w, h, near, jitter);
-        let frame = FrameUniforms {
-            view_proj: view_proj.to_cols_array_2d(),
-            eye: self.camera.eye.into(),
-            iteration,
-            resolution: [w, h],
-            seed: self.settings.seed,
-            light_samples: 1,
-            ray_epsilon: self.scene.ray_epsilon,
-            _pad: [0; 3],
-        };
+        let jitter = pixel_jitter(iteration, self.settings.seed);
+        // The path tracer takes one light sample per vertex.
+        let frame = FrameUniforms::new(&self.camera, (w, h), &self.scene, iteration, jitter, self.settings.seed, 1);
         // Inverted in f64: the f32 matrix the rasterizer uses, inverted without further loss.
-        let inverse = DMat4::from_cols_array_2d(&view_proj.to_cols_array_2d().map(|c| c.map(f64::from))).inverse();
+        let inverse = DMat4::from_cols_array_2d(&frame.view_proj.map(|c| c.map(f64::from))).inverse();
         let params = PathParams {
             inv_view_proj: inverse.to_cols_array_2d().map(|c| c.map(|v| v as f32)),
             light_weight: self.light_weight,
@@ -224,6 +214,16 @@ impl PathTracer {
     /// Blocks until the submitted iterations have finished on the GPU.
     pub fn wait(&self) -> Result<()> {
         self.gpu.wait()
+    }
+
+    /// The film: the radiance sums in its full component (for drawing it in a window).
+    pub fn film(&self) -> &Film {
+        &self.film
+    }
+
+    /// Encodes the resolve of the image at `exposure` into the film's linear and display buffers.
+    pub fn encode_resolve(&self, enc: &mut wgpu::CommandEncoder, exposure: f32) {
+        self.film.encode_resolve(&self.gpu, enc, Show::Full, exposure);
     }
 
     /// The mean radiance so far, linear RGB.

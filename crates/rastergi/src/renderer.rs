@@ -6,7 +6,7 @@ use glam::{Quat, Vec2, Vec3};
 use crate::direct::DirectPass;
 use crate::error::Result;
 use crate::film::{Film, Show};
-use crate::frame::{FrameBinding, FrameUniforms, near_plane, pixel_jitter, view_projection};
+use crate::frame::{FrameBinding, FrameUniforms, pixel_jitter};
 use crate::gather::{
     GatherInputs, GatherMethod, GatherPass, GatherSample, MAX_DIRECTIONS, gather_direction, random_rotation,
 };
@@ -254,21 +254,6 @@ impl Renderer {
         self.rotation = random_rotation(self.settings.seed, self.restart);
     }
 
-    fn frame_uniforms(&self, iteration: u32, jitter: Vec2) -> FrameUniforms {
-        let (w, h) = (self.settings.width, self.settings.height);
-        let near = near_plane(&self.scene.bounds);
-        FrameUniforms {
-            view_proj: view_projection(&self.camera, w, h, near, jitter).to_cols_array_2d(),
-            eye: self.camera.eye.into(),
-            iteration,
-            resolution: [w, h],
-            seed: self.settings.seed,
-            light_samples: self.settings.light_samples.max(1),
-            ray_epsilon: self.scene.ray_epsilon,
-            _pad: [0; 3],
-        }
-    }
-
     /// One progressive iteration: one new estimate per pixel, added to the film.
     pub fn iterate(&mut self) -> Result<()> {
         self.iterate_with(&Overrides::default())
@@ -280,7 +265,9 @@ impl Renderer {
         let iteration = self.passes.film.samples;
         let seed = self.settings.seed;
         let jitter = o.pixel_jitter.unwrap_or_else(|| pixel_jitter(iteration, seed));
-        self.frame.write(&self.gpu, &self.frame_uniforms(iteration, jitter));
+        let size = (w, h);
+        let uniforms = FrameUniforms::new(&self.camera, size, &self.scene, iteration, jitter, seed, self.settings.light_samples);
+        self.frame.write(&self.gpu, &uniforms);
         let mut enc =
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("iteration") });
         // 1. Eye pass: the visible point of each pixel, at this iteration's jitter.

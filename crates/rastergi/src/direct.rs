@@ -13,12 +13,16 @@
 
 use crate::film::Film;
 use crate::frame::FrameBinding;
-use crate::gbuffer::GBufferPass;
+use crate::gbuffer::{GBufferPass, gbuffer_film_bind_group, gbuffer_film_layout};
 use crate::gpu::{Gpu, compute_pipeline, dispatch_pixels};
 use crate::gpu_scene::GpuScene;
-use crate::photon_view::{gbuffer_film_bind_group, gbuffer_film_layout};
 use crate::profile::{Profiler, compute_pass};
 use crate::shader;
+
+/// The pass's composed shader.
+pub fn source() -> String {
+    shader::per_pixel(&[include_str!("direct.wgsl")])
+}
 
 pub struct DirectPass {
     pipeline: wgpu::ComputePipeline,
@@ -29,7 +33,7 @@ pub struct DirectPass {
 impl DirectPass {
     pub fn new(gpu: &Gpu, scene: &GpuScene, frame: &FrameBinding, gbuffer: &GBufferPass, film: &Film) -> Self {
         let device = &gpu.device;
-        let module = shader::module(device, "direct", &shader::with_scene(include_str!("direct.wgsl")));
+        let module = shader::module(device, "direct", &source());
         let layout = gbuffer_film_layout(device, "direct");
         let bind_group = gbuffer_film_bind_group(device, "direct", &layout, gbuffer, film);
         let pipeline = compute_pipeline(device, "direct", &module, "main", &[&scene.layout, &frame.layout, &layout]);

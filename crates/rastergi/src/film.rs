@@ -15,8 +15,14 @@ use crate::gpu::{Gpu, buffer_bind_group, compute_pipeline, groups, storage_entry
 use crate::image_io::{DisplayImage, LinearImage};
 use crate::shader;
 
-/// Components accumulated per pixel.
+/// Components accumulated per pixel: component c of pixel p at `c·W·H + p` (`film.wgsl`).
 pub const COMPONENTS: u64 = 3;
+/// Emission + direct light (the path tracer's full image).
+pub const FILM_DIRECT: u32 = 0;
+/// Indirect light from the final gather.
+pub const FILM_INDIRECT: u32 = 1;
+/// The photon-map view.
+pub const FILM_PHOTON_VIEW: u32 = 2;
 /// Bytes per pixel of the film's GPU storage (accumulation + resolved copies).
 pub const BYTES_PER_PIXEL: u64 = COMPONENTS * 16 + 16 + 4;
 
@@ -48,13 +54,18 @@ impl Show {
 /// `Resolve` in `resolve.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
-struct ResolveUniforms {
-    resolution: [u32; 2],
-    samples: u32,
-    show: u32,
+pub(crate) struct ResolveUniforms {
+    pub(crate) resolution: [u32; 2],
+    pub(crate) samples: u32,
+    pub(crate) show: u32,
     /// 2^exposure.
-    scale: f32,
-    _pad: [u32; 3],
+    pub(crate) scale: f32,
+    pub(crate) _pad: [u32; 3],
+}
+
+/// The resolve pass's composed shader.
+pub fn resolve_source() -> String {
+    shader::compose(&[include_str!("resolve.wgsl")])
 }
 
 pub struct Film {
@@ -89,14 +100,14 @@ impl Film {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("resolve"),
             entries: &[
-                uniform_entry(0, c),
-                storage_entry(1, c, true),
-                storage_entry(2, c, false),
-                storage_entry(3, c, false),
+                uniform_entry::<ResolveUniforms>(0, c),
+                storage_entry::<[f32; 4]>(1, c, true),
+                storage_entry::<[f32; 4]>(2, c, false),
+                storage_entry::<u32>(3, c, false),
             ],
         });
         let bind_group = buffer_bind_group(device, "resolve", &layout, &[&uniforms, &accumulation, &linear, &display]);
-        let module = shader::module(device, "resolve", include_str!("resolve.wgsl"));
+        let module = shader::module(device, "resolve", &resolve_source());
         let pipeline = compute_pipeline(device, "resolve", &module, "main", &[&layout]);
         Ok(Film { width, height, samples: 0, accumulation, linear, display, uniforms, pipeline, bind_group })
     }

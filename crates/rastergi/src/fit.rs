@@ -26,7 +26,7 @@
 //!   strong or weak, not a tone mapper: a reasonably lit image is left as rendered.
 
 use crate::image_io::LinearImage;
-use crate::photon_map::GridSpec;
+use crate::photons::map::GridSpec;
 use crate::scene::{Aabb, Scene, triangle_area};
 
 /// Grid cells of the Cornell box's default grid, the budget every scene gets.

@@ -6,7 +6,7 @@ use glam::{Mat4, Vec2, Vec3};
 
 use crate::gpu::{Gpu, buffer_bind_group, uniform_entry};
 use crate::gpu_scene::GpuScene;
-use crate::sampling::{pcg_hash, radical_inverse};
+use crate::sampling::{pcg_hash, radical_inverse, stream};
 use crate::scene::{Aabb, Camera};
 
 /// `Frame` in `frame.wgsl`.
@@ -56,7 +56,8 @@ impl FrameUniforms {
 /// a Halton (2, 3) sequence with a Cranley–Patterson rotation derived from the seed.
 /// Averaging samples spread uniformly over the pixel is the box pixel filter.
 pub fn pixel_jitter(iteration: u32, seed: u32) -> Vec2 {
-    let shift = Vec2::new(pcg_hash(seed ^ 0x6a09e667) as f32, pcg_hash(seed ^ 0xbb67ae85) as f32) / 4_294_967_296.0;
+    let shift = Vec2::new(pcg_hash(seed ^ stream::PIXEL_SHIFT_X) as f32, pcg_hash(seed ^ stream::PIXEL_SHIFT_Y) as f32)
+        / 4_294_967_296.0;
     let h = Vec2::new(radical_inverse(iteration + 1, 2), radical_inverse(iteration + 1, 3));
     (h + shift).fract() - Vec2::splat(0.5)
 }
@@ -97,7 +98,7 @@ impl FrameBinding {
         let vis = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
         let layout = gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("frame"),
-            entries: &[uniform_entry(0, vis)],
+            entries: &[uniform_entry::<FrameUniforms>(0, vis)],
         });
         let bind_group = buffer_bind_group(&gpu.device, "frame", &layout, &[&buffer]);
         Self { buffer, layout, bind_group }

@@ -6,10 +6,17 @@
 //! in texels (`texture_lod`), so that the passes read the texture filtered like a fragment
 //! shader would.
 
+use crate::error::Result;
+use crate::film::Film;
 use crate::frame::FrameBinding;
-use crate::gpu::Gpu;
+use crate::gpu::{Gpu, storage_entry, uint_texture_entry};
 use crate::gpu_scene::GpuScene;
 use crate::shader;
+
+/// The pass's composed shader.
+pub fn source() -> String {
+    shader::with_scene(include_str!("gbuffer.wgsl"))
+}
 
 pub const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;
 const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
@@ -25,7 +32,7 @@ pub struct GBufferPass {
 impl GBufferPass {
     pub fn new(gpu: &Gpu, scene: &GpuScene, frame: &FrameBinding, width: u32, height: u32) -> Self {
         let device = &gpu.device;
-        let module = shader::module(device, "gbuffer", &shader::with_scene(include_str!("gbuffer.wgsl")));
+        let module = shader::module(device, "gbuffer", &source());
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("gbuffer"),
             bind_group_layouts: &[Some(&scene.layout), Some(&frame.layout)],
@@ -114,4 +121,62 @@ impl GBufferPass {
         pass.set_bind_group(1, &frame.bind_group, &[]);
         pass.draw(0..3 * scene.triangle_count, 0..1);
     }
+
+    /// Raw texels `(triangle + 1, b1 bits, b2 bits, texture level of detail bits)`, row by row
+    /// (for tests and tools).
+    pub fn read(&self, gpu: &Gpu) -> Result<Vec<[u32; 4]>> {
+        let size = self.texture.size();
+        let (w, h) = (size.width, size.height);
+        let row = (w * 16).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+        let buffer = gpu.zeroed_buffer(
+            "gbuffer readback",
+            (row * h) as u64,
+            wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+        );
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        enc.copy_texture_to_buffer(
+            self.texture.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buffer,
+                layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: Some(h) },
+            },
+            size,
+        );
+        gpu.queue.submit([enc.finish()]);
+        let bytes = gpu.read_buffer(&buffer, buffer.size())?;
+        let mut out = Vec::with_capacity((w * h) as usize);
+        for y in 0..h as usize {
+            let r: &[[u32; 4]] = bytemuck::cast_slice(&bytes[y * row as usize..y * row as usize + w as usize * 16]);
+            out.extend_from_slice(r);
+        }
+        Ok(out)
+    }
+}
+
+/// Layout of a per-pixel pass's own group: the G-buffer (binding 0) and the film (binding 1).
+pub fn gbuffer_film_layout(device: &wgpu::Device, label: &str) -> wgpu::BindGroupLayout {
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(label),
+        entries: &[
+            uint_texture_entry(0, wgpu::ShaderStages::COMPUTE),
+            storage_entry::<[f32; 4]>(1, wgpu::ShaderStages::COMPUTE, false),
+        ],
+    })
+}
+
+pub fn gbuffer_film_bind_group(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    gbuffer: &GBufferPass,
+    film: &Film,
+) -> wgpu::BindGroup {
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &[
+            wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&gbuffer.view) },
+            wgpu::BindGroupEntry { binding: 1, resource: film.accumulation.as_entire_binding() },
+        ],
+    })
 }

@@ -181,18 +181,24 @@ impl Gpu {
     }
 }
 
-/// Bind-group-layout entry for a storage buffer.
-pub fn storage_entry(binding: u32, visibility: wgpu::ShaderStages, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+/// Bind-group-layout entry for a storage buffer holding `T`s (an array of them or one): wgpu
+/// refuses a bound buffer smaller than one `T`, and a shader whose type there is larger.
+pub fn storage_entry<T>(binding: u32, visibility: wgpu::ShaderStages, read_only: bool) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility,
         ty: wgpu::BindingType::Buffer {
             ty: wgpu::BufferBindingType::Storage { read_only },
             has_dynamic_offset: false,
-            min_binding_size: None,
+            min_binding_size: min_size::<T>(),
         },
         count: None,
     }
+}
+
+/// The size of `T` as a binding's minimum size.
+fn min_size<T>() -> Option<std::num::NonZeroU64> {
+    std::num::NonZeroU64::new(std::mem::size_of::<T>() as u64)
 }
 
 /// Bind-group-layout entry for a 2D unsigned-integer texture (the G-buffer, ray-view layers).
@@ -225,15 +231,16 @@ pub fn dispatch_pixels(
     pass.dispatch_workgroups(groups(width, 8), groups(height, 8), 1);
 }
 
-/// Bind-group-layout entry for a uniform buffer.
-pub fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+/// Bind-group-layout entry for a uniform buffer holding a `T`: wgpu refuses a bound buffer
+/// smaller than `T` and a shader whose struct there is larger.
+pub fn uniform_entry<T>(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility,
         ty: wgpu::BindingType::Buffer {
             ty: wgpu::BufferBindingType::Uniform,
             has_dynamic_offset: false,
-            min_binding_size: None,
+            min_binding_size: min_size::<T>(),
         },
         count: None,
     }

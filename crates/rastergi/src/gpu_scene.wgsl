@@ -44,8 +44,7 @@ struct LightEntry {
 // Trilinear filtering, repeat addressing.
 @group(0) @binding(6) var texture_sampler: sampler;
 
-const MATERIAL_TWO_SIDED: u32 = 1u;
-const NO_TEXTURE: u32 = 0xffffffffu;
+// MATERIAL_TWO_SIDED and NO_TEXTURE: shader::constants.
 
 // A point on a surface: position, front-face geometric normal and material.
 struct Surface {

@@ -2,9 +2,11 @@
 //!
 //! The modules follow the data flow of a render:
 //!
-//! scene → [`bvh`] → [`gpu_scene`] → (photon map) → per iteration
-//! ([`gbuffer`] → [`direct`] → [`gather`] ([`gather_raster`], [`gather_lists`] or [`gather_trace`])) → [`film`]
-//! (accumulate, resolve) → [`image_io`]. [`profile`] times the passes.
+//! scene → [`bvh`] → [`gpu_scene`] → [`photons`] (trace into the grid [`photons::map`]) → per
+//! iteration ([`gbuffer`] → [`direct`] → [`gather`] ([`gather::raster`], [`gather::lists`] or
+//! [`gather::trace`])) → [`film`] (accumulate, resolve) → [`image_io`]. [`path_tracer`] is the
+//! reference; both it and the [`renderer`] are [`progressive`] renderers. [`profile`] times the
+//! passes.
 //!
 //! [`renderer::Renderer::iterate`] is the one place that shows the order of the passes.
 
@@ -17,18 +19,16 @@ pub mod film;
 pub mod fit;
 pub mod frame;
 pub mod gather;
-pub mod gather_lists;
-pub mod gather_raster;
-pub mod gather_trace;
 pub mod gbuffer;
 pub mod gpu;
 pub mod gpu_scene;
 pub mod image_io;
+#[cfg(test)]
+mod layout_test;
 pub mod lights;
 pub mod limits;
 pub mod metrics;
 pub mod path_tracer;
-pub mod photon_map;
 pub mod photon_view;
 pub mod photons;
 pub mod profile;

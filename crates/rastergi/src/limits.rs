@@ -5,7 +5,7 @@
 //! validation panic. Pure functions of [`wgpu::Limits`], so they are tested without a GPU.
 
 use crate::error::{Error, Result};
-use crate::photon_map::{BINS, GridSpec};
+use crate::photons::map::{BINS, GridSpec};
 
 /// Largest buffer this device can create and bind whole as a storage buffer.
 pub fn max_storage_buffer(limits: &wgpu::Limits) -> u64 {

@@ -67,6 +67,18 @@ pub struct PathParams {
     pub rr_start: u32,
 }
 
+/// The path tracer's composed shader.
+pub fn source() -> String {
+    shader::compose(&[
+        shader::SAMPLING,
+        shader::SCENE,
+        shader::BVH,
+        shader::FRAME,
+        shader::FILM,
+        include_str!("path_tracer.wgsl"),
+    ])
+}
+
 pub struct PathTracer {
     gpu: Gpu,
     settings: RenderSettings,
@@ -109,7 +121,11 @@ impl PathTracer {
         let c = wgpu::ShaderStages::COMPUTE;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("path tracer"),
-            entries: &[storage_entry(0, c, false), uniform_entry(1, c), storage_entry(2, c, false)],
+            entries: &[
+                storage_entry::<[f32; 4]>(0, c, false),
+                uniform_entry::<PathParams>(1, c),
+                storage_entry::<[u32; 4]>(2, c, false),
+            ],
         });
         let params = gpu.zeroed_buffer(
             "path tracer params",
@@ -120,7 +136,7 @@ impl PathTracer {
         let placeholder = gpu.zeroed_buffer("path tracer visibility placeholder", 16, wgpu::BufferUsages::STORAGE);
         let bind_group =
             buffer_bind_group(device, "path tracer", &layout, &[&film.accumulation, &params, &placeholder]);
-        let module = shader::module(device, "path tracer", &shader::with_scene(include_str!("path_tracer.wgsl")));
+        let module = shader::module(device, "path tracer", &source());
         let layouts = [&gpu_scene.layout, &frame.layout, &layout];
         let trace = compute_pipeline(device, "path tracer", &module, "main", &layouts);
         let primary = compute_pipeline(device, "path tracer primary hits", &module, "primary_hits", &layouts);
@@ -273,20 +289,5 @@ impl PathTracer {
         self.gpu.queue.submit([enc.finish()]);
         let bytes = self.gpu.read_buffer(&visibility, size)?;
         Ok(bytemuck::cast_slice(&bytes).to_vec())
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn path_params_layout_matches_wgsl() {
-        // WGSL: mat4x4f at 0 (64 bytes), then four 4-byte scalars; size 80, align 16.
-        assert_eq!(std::mem::size_of::<PathParams>(), 80);
-        assert_eq!(std::mem::offset_of!(PathParams, light_weight), 64);
-        assert_eq!(std::mem::offset_of!(PathParams, light_count), 68);
-        assert_eq!(std::mem::offset_of!(PathParams, max_bounces), 72);
-        assert_eq!(std::mem::offset_of!(PathParams, rr_start), 76);
     }
 }

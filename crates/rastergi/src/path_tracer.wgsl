@@ -21,7 +21,6 @@ struct PathParams {
 // (triangle + 1, b1 bits, b2 bits, 0) of the primary hit, written by `primary_hits` only.
 @group(2) @binding(2) var<storage, read_write> visibility: array<vec4u>;
 
-const STREAM_PATH: u32 = 0x9a7b1du;
 const FAR: f32 = 1e30;
 
 // The unit direction of the camera ray through the point p (in pixels, from the top-left
@@ -174,7 +173,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let pixel = gid.y * frame.resolution.x + gid.x;
     var rng = rng_new(frame.seed ^ STREAM_PATH, pixel, frame.iteration);
     let radiance = path_radiance(frame.eye, camera_direction(gid.xy), gid.xy, &rng);
-    film[pixel] += vec4f(radiance, 0.0);
+    // The path tracer has one component: the full image (resolved by Show::Full).
+    film_add(FILM_DIRECT, gid.xy, radiance);
 }
 
 // The first surface hit by each camera ray, in the G-buffer's format (gbuffer.wgsl).

@@ -4,12 +4,18 @@
 
 use crate::film::Film;
 use crate::frame::FrameBinding;
-use crate::gbuffer::GBufferPass;
-use crate::gpu::{Gpu, compute_pipeline, dispatch_pixels, storage_entry, uint_texture_entry};
+use crate::gbuffer::{GBufferPass, gbuffer_film_bind_group, gbuffer_film_layout};
+use crate::gpu::{Gpu, compute_pipeline, dispatch_pixels};
 use crate::gpu_scene::GpuScene;
 use crate::photons::gpu::GpuPhotonMap;
+use crate::photons::map::LOOKUP_WGSL;
 use crate::profile::{Profiler, compute_pass};
 use crate::shader;
+
+/// The pass's composed shader.
+pub fn source() -> String {
+    shader::per_pixel(&[LOOKUP_WGSL, include_str!("photon_view.wgsl")])
+}
 
 pub struct PhotonViewPass {
     pipeline: wgpu::ComputePipeline,
@@ -27,9 +33,7 @@ impl PhotonViewPass {
         map: &GpuPhotonMap,
     ) -> Self {
         let device = &gpu.device;
-        let source =
-            shader::with_scene(&[include_str!("photon_map.wgsl"), include_str!("photon_view.wgsl")].join("\n"));
-        let module = shader::module(device, "photon view", &source);
+        let module = shader::module(device, "photon view", &source());
         let layout = gbuffer_film_layout(device, "photon view");
         let bind_group = gbuffer_film_bind_group(device, "photon view", &layout, gbuffer, film);
         let pipeline = compute_pipeline(
@@ -56,32 +60,4 @@ impl PhotonViewPass {
         let bind_groups = [&scene.bind_group, &frame.bind_group, &self.bind_group, &map.bind_group];
         dispatch_pixels(&mut pass, &self.pipeline, &bind_groups, width, height);
     }
-}
-
-/// Layout of a per-pixel pass's own group: the G-buffer (binding 0) and the film (binding 1).
-pub fn gbuffer_film_layout(device: &wgpu::Device, label: &str) -> wgpu::BindGroupLayout {
-    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some(label),
-        entries: &[
-            uint_texture_entry(0, wgpu::ShaderStages::COMPUTE),
-            storage_entry(1, wgpu::ShaderStages::COMPUTE, false),
-        ],
-    })
-}
-
-pub fn gbuffer_film_bind_group(
-    device: &wgpu::Device,
-    label: &str,
-    layout: &wgpu::BindGroupLayout,
-    gbuffer: &GBufferPass,
-    film: &Film,
-) -> wgpu::BindGroup {
-    device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some(label),
-        layout,
-        entries: &[
-            wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&gbuffer.view) },
-            wgpu::BindGroupEntry { binding: 1, resource: film.accumulation.as_entire_binding() },
-        ],
-    })
 }

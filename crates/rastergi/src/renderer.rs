@@ -1,24 +1,21 @@
 //! The progressive renderer: owns the passes and runs one iteration at a time.
 //! [`Renderer::iterate`] is the pipeline, top to bottom.
 
-use glam::{Quat, Vec2, Vec3};
+use glam::{Vec2, Vec3};
 
 use crate::direct::DirectPass;
 use crate::error::Result;
 use crate::film::{Film, Show};
 use crate::frame::{FrameBinding, FrameUniforms, pixel_jitter};
-use crate::gather::{
-    GatherInputs, GatherMethod, GatherPass, GatherSample, MAX_DIRECTIONS, gather_direction, random_rotation,
-};
+use crate::gather::{DirectionSampler, FixedSample, GatherFrame, GatherMethod, GatherPass, GatherSetup};
 use crate::gbuffer::GBufferPass;
 use crate::gpu::Gpu;
 use crate::gpu_scene::{GpuScene, PreparedScene};
 use crate::image_io::{DisplayImage, LinearImage};
-use crate::photon_map::GridSpec;
 use crate::photon_view::PhotonViewPass;
 use crate::photons::PhotonSettings;
 use crate::photons::gpu::GpuPhotonMap;
-use crate::sampling::Rng;
+use crate::photons::map::GridSpec;
 use crate::scene::{Camera, Scene};
 
 /// Settings of a render.
@@ -40,7 +37,7 @@ pub struct RenderSettings {
     pub bundle: u32,
     /// How the final gather finds the nearest surface along its direction.
     pub gather: GatherMethod,
-    /// Gather directions per iteration, 1 to [`MAX_DIRECTIONS`]: they share the iteration's
+    /// Gather directions per iteration, 1 to [`crate::gather::MAX_DIRECTIONS`]: they share the iteration's
     /// G-buffer and direct light.
     pub directions: u32,
 }
@@ -111,6 +108,7 @@ impl ImagePasses {
         map: Option<&GpuPhotonMap>,
         settings: &RenderSettings,
         detail_bundle: u32,
+        sampler: DirectionSampler,
     ) -> Result<ImagePasses> {
         let (width, height) = (settings.width, settings.height);
         let film = Film::new(gpu, width, height)?;
@@ -122,7 +120,10 @@ impl ImagePasses {
         };
         let bundle = settings.bundle_for(detail_bundle);
         let gather = match map {
-            Some(map) => Some(GatherPass::new(gpu, scene, frame, &gbuffer, &film, map, bundle, settings.gather)?),
+            Some(map) => {
+                let setup = GatherSetup { scene, frame, gbuffer: &gbuffer, film: &film, map };
+                Some(GatherPass::new(gpu, &setup, bundle, settings.gather, sampler)?)
+            }
             None => None,
         };
         Ok(ImagePasses { gbuffer, direct, photon_view, gather, film })
@@ -139,9 +140,6 @@ pub struct Renderer {
     passes: ImagePasses,
     /// The scene's part of the default bundle ([`crate::fit::detail_bundle`]).
     detail_bundle: u32,
-    /// Restarts so far (camera moves): each draws a new rotation of the gather directions.
-    restart: u32,
-    rotation: Quat,
 }
 
 impl Renderer {
@@ -181,8 +179,8 @@ impl Renderer {
                 map.release_build_buffers();
                 map
             });
-        let passes = ImagePasses::new(gpu, &gpu_scene, &frame, photon_map.as_ref(), &settings, detail_bundle)?;
-        let rotation = random_rotation(settings.seed, 0);
+        let sampler = DirectionSampler::new(settings.seed);
+        let passes = ImagePasses::new(gpu, &gpu_scene, &frame, photon_map.as_ref(), &settings, detail_bundle, sampler)?;
         Ok(Renderer {
             gpu: gpu.clone(),
             settings,
@@ -192,8 +190,6 @@ impl Renderer {
             photon_map,
             passes,
             detail_bundle,
-            restart: 0,
-            rotation,
         })
     }
 
@@ -201,6 +197,9 @@ impl Renderer {
     /// restarts; the scene, its BVH and the photon map are kept.
     pub fn resize(&mut self, width: u32, height: u32) -> Result<()> {
         let settings = RenderSettings { width, height, ..self.settings.clone() };
+        // The gather's random choices go on where they were.
+        let sampler =
+            self.passes.gather.as_ref().map_or_else(|| DirectionSampler::new(settings.seed), GatherPass::sampler);
         self.passes = ImagePasses::new(
             &self.gpu,
             &self.scene,
@@ -208,6 +207,7 @@ impl Renderer {
             self.photon_map.as_ref(),
             &settings,
             self.detail_bundle,
+            sampler,
         )?;
         self.settings = settings;
         self.reset();
@@ -250,8 +250,9 @@ impl Renderer {
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
         self.passes.film.clear(&mut enc);
         self.gpu.queue.submit([enc.finish()]);
-        self.restart += 1;
-        self.rotation = random_rotation(self.settings.seed, self.restart);
+        if let Some(gather) = &mut self.passes.gather {
+            gather.restart();
+        }
     }
 
     /// One progressive iteration: one new estimate per pixel, added to the film.
@@ -266,7 +267,8 @@ impl Renderer {
         let seed = self.settings.seed;
         let jitter = o.pixel_jitter.unwrap_or_else(|| pixel_jitter(iteration, seed));
         let size = (w, h);
-        let uniforms = FrameUniforms::new(&self.camera, size, &self.scene, iteration, jitter, seed, self.settings.light_samples);
+        let uniforms =
+            FrameUniforms::new(&self.camera, size, &self.scene, iteration, jitter, seed, self.settings.light_samples);
         self.frame.write(&self.gpu, &uniforms);
         let mut enc =
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("iteration") });
@@ -278,24 +280,11 @@ impl Renderer {
         if let (Some(view), Some(map)) = (&self.passes.photon_view, &self.photon_map) {
             view.encode(&mut enc, &self.scene, &self.frame, map, w, h);
         }
-        // 3. Final gather along one direction for every visible point → film (indirect).
+        // 3. Final gather along the iteration's directions for every visible point → film (indirect).
         if let (Some(gather), Some(map)) = (&mut self.passes.gather, &self.photon_map) {
-            // Directions i·K … i·K + K − 1 of the sequence: consecutive points keep its
-            // stratification however many an iteration takes.
-            let k = if o.direction.is_some() { 1 } else { self.settings.directions.clamp(1, MAX_DIRECTIONS) };
-            let samples: Vec<GatherSample> = (0..k)
-                .map(|j| {
-                    let index = iteration * k + j;
-                    let direction = o.direction.unwrap_or_else(|| gather_direction(index, self.rotation));
-                    let texel_jitter = o.texel_jitter.unwrap_or_else(|| {
-                        let mut rng = Rng::new(seed ^ 0x7e1a5, index, self.restart);
-                        Vec2::new(rng.next_f32(), rng.next_f32()) - 0.5
-                    });
-                    GatherSample { direction: direction.normalize(), texel_jitter }
-                })
-                .collect();
-            let inputs = GatherInputs { scene: &self.scene, frame: &self.frame, map, width: w, height: h };
-            enc = gather.encode(&self.gpu, enc, &inputs, &samples)?;
+            let f = GatherFrame { scene: &self.scene, frame: &self.frame, map, width: w, height: h };
+            let fixed = FixedSample { direction: o.direction, texel_jitter: o.texel_jitter };
+            gather.encode(&self.gpu, &mut enc, &f, iteration, self.settings.directions, &fixed)?;
         }
         // 4. Accumulate: every pass above added its estimate to the film's sums.
         self.gpu.queue.submit([enc.finish()]);
@@ -338,29 +327,6 @@ impl Renderer {
     /// Raw G-buffer texels `(triangle + 1, b1 bits, b2 bits, texture level of detail bits)`,
     /// row by row (for tests and tools).
     pub fn read_gbuffer(&self) -> Result<Vec<[u32; 4]>> {
-        let (w, h) = (self.settings.width, self.settings.height);
-        let row = (w * 16).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
-        let buffer = self.gpu.zeroed_buffer(
-            "gbuffer readback",
-            (row * h) as u64,
-            wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
-        );
-        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
-        enc.copy_texture_to_buffer(
-            self.passes.gbuffer.texture.as_image_copy(),
-            wgpu::TexelCopyBufferInfo {
-                buffer: &buffer,
-                layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: Some(h) },
-            },
-            wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
-        );
-        self.gpu.queue.submit([enc.finish()]);
-        let bytes = self.gpu.read_buffer(&buffer, buffer.size())?;
-        let mut out = Vec::with_capacity((w * h) as usize);
-        for y in 0..h as usize {
-            let r: &[[u32; 4]] = bytemuck::cast_slice(&bytes[y * row as usize..y * row as usize + w as usize * 16]);
-            out.extend_from_slice(r);
-        }
-        Ok(out)
+        self.passes.gbuffer.read(&self.gpu)
     }
 }

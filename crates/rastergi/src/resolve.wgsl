@@ -16,6 +16,11 @@ struct Resolve {
 @group(0) @binding(2) var<storage, read_write> linear_out: array<vec4f>;
 @group(0) @binding(3) var<storage, read_write> display_out: array<u32>;
 
+// The film's layout, without the frame: `film_add` is not used here.
+fn film_slot(component: u32, pixel: u32, n_pixels: u32) -> u32 {
+    return component * n_pixels + pixel;
+}
+
 // The sRGB transfer function (IEC 61966-2-1).
 fn srgb_encode(c: vec3f) -> vec3f {
     let lo = c * 12.92;
@@ -30,15 +35,15 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     }
     let pixel = gid.y * params.resolution.x + gid.x;
     let n = params.resolution.x * params.resolution.y;
-    let direct = film[pixel].rgb;
-    let indirect = film[n + pixel].rgb;
+    let direct = film[film_slot(FILM_DIRECT, pixel, n)].rgb;
+    let indirect = film[film_slot(FILM_INDIRECT, pixel, n)].rgb;
     var sum = direct + indirect;
     if params.show == 1u {
         sum = direct;
     } else if params.show == 2u {
         sum = indirect;
     } else if params.show == 3u {
-        sum = film[2u * n + pixel].rgb;
+        sum = film[film_slot(FILM_PHOTON_VIEW, pixel, n)].rgb;
     }
     let mean = sum / f32(max(params.samples, 1u));
     linear_out[pixel] = vec4f(mean, 1.0);

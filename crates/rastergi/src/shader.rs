@@ -1,15 +1,61 @@
-//! WGSL composition: a pass's shader is the shared sources (sampling, scene, BVH traversal,
-//! per-frame uniforms) followed by the pass's own file. WGSL resolves module-scope names in
-//! any order, so the pieces are simply concatenated.
+//! WGSL composition: a pass's shader is the shared sources (constants, sampling, scene, BVH
+//! traversal, per-frame uniforms, visible points, film writes) followed by the pass's own file.
+//! WGSL resolves module-scope names in any order, so the pieces are simply concatenated.
+//!
+//! Constants that Rust and WGSL share are written once, in Rust: [`constants`] generates
+//! their WGSL declarations. Structs shared by both are checked by the layout test
+//! (`layout_test.rs`), which parses every composed shader with naga.
+
+use crate::film::{FILM_DIRECT, FILM_INDIRECT, FILM_PHOTON_VIEW};
+use crate::gather::MAX_DIRECTIONS;
+use crate::gpu_scene::{MATERIAL_TWO_SIDED, NO_TEXTURE};
+use crate::sampling::stream;
 
 pub const SAMPLING: &str = include_str!("sampling.wgsl");
 pub const SCENE: &str = include_str!("gpu_scene.wgsl");
 pub const BVH: &str = include_str!("bvh.wgsl");
 pub const FRAME: &str = include_str!("frame.wgsl");
+/// The G-buffer texel → visible point decode (`visible_point`), for per-pixel passes.
+pub const VISIBLE_POINT: &str = include_str!("visible_point.wgsl");
+/// Film writes by component (`film_add`), for passes that bind `film`.
+pub const FILM: &str = include_str!("film.wgsl");
 
-/// The common prelude of every pass that reads the scene.
+/// WGSL declarations of the constants Rust and WGSL share, from their Rust values.
+pub fn constants() -> String {
+    let u32s = [
+        ("MAX_DIRECTIONS", MAX_DIRECTIONS),
+        ("MATERIAL_TWO_SIDED", MATERIAL_TWO_SIDED),
+        ("NO_TEXTURE", NO_TEXTURE),
+        ("FILM_DIRECT", FILM_DIRECT),
+        ("FILM_INDIRECT", FILM_INDIRECT),
+        ("FILM_PHOTON_VIEW", FILM_PHOTON_VIEW),
+        ("STREAM_DIRECT", stream::DIRECT),
+        ("STREAM_PATH", stream::PATH),
+        ("STREAM_PHOTON", stream::PHOTON),
+    ];
+    let mut s = String::from("// Generated from the Rust constants (shader.rs).\n");
+    for (name, value) in u32s {
+        s += &format!("const {name}: u32 = {value}u;\n");
+    }
+    s
+}
+
+/// `pieces` after the shared constants.
+pub fn compose(pieces: &[&str]) -> String {
+    let constants = constants();
+    std::iter::once(constants.as_str()).chain(pieces.iter().copied()).collect::<Vec<_>>().join("\n")
+}
+
+/// The common prelude of every pass that reads the scene, then `pass`.
 pub fn with_scene(pass: &str) -> String {
-    [SAMPLING, SCENE, BVH, FRAME, pass].join("\n")
+    compose(&[SAMPLING, SCENE, BVH, FRAME, pass])
+}
+
+/// The prelude of a per-pixel pass over the G-buffer that adds to the film, then `pieces`.
+pub fn per_pixel(pieces: &[&str]) -> String {
+    let mut all = vec![SAMPLING, SCENE, BVH, FRAME, VISIBLE_POINT, FILM];
+    all.extend_from_slice(pieces);
+    compose(&all)
 }
 
 pub fn module(device: &wgpu::Device, label: &str, source: &str) -> wgpu::ShaderModule {

@@ -347,8 +347,8 @@ pub fn sample_on_gpu(gpu: &Gpu, array: &TextureArray, queries: &[(u32, Vec2, f32
                 ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
                 count: None,
             },
-            storage_entry(2, c, true),
-            storage_entry(3, c, false),
+            storage_entry::<[f32; 4]>(2, c, true),
+            storage_entry::<[f32; 4]>(3, c, false),
         ],
     });
     let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {

@@ -7,7 +7,7 @@ use glam::Vec3;
 use rastergi::film::Show;
 use rastergi::gpu_scene::{GpuScene, PreparedScene};
 use rastergi::metrics::{compare, emitter_mask, masked_mean, rmse};
-use rastergi::photon_map::{GridSpec, PhotonMap};
+use rastergi::photons::map::{GridSpec, PhotonMap};
 use rastergi::photons::{PhotonSettings, cpu, gpu::GpuPhotonMap};
 use rastergi::renderer::{RenderSettings, Renderer};
 use rastergi::scene::{Camera, Material, Scene, cornell_box};

@@ -16,7 +16,7 @@ use rastergi::gpu_scene::{GpuScene, PreparedScene};
 use rastergi::image_io::LinearImage;
 use rastergi::metrics::{compare, emitter_mask, masked_mean, rmse};
 use rastergi::path_tracer::PathTracer;
-use rastergi::photon_map::PhotonMap;
+use rastergi::photons::map::PhotonMap;
 use rastergi::photons::{PhotonSettings, cpu, gpu::GpuPhotonMap};
 use rastergi::renderer::{RenderSettings, Renderer};
 use rastergi::sampling::Rng;

@@ -5,7 +5,7 @@ use rayon::prelude::*;
 
 use super::{MAX_BOUNCES, PhotonSettings, STREAM_PHOTON};
 use crate::gpu_scene::PreparedScene;
-use crate::photon_map::{GridSpec, PhotonMap, orientation_bin, surface_areas};
+use crate::photons::map::{GridSpec, PhotonMap, orientation_bin, surface_areas};
 use crate::sampling::{Rng, cosine_hemisphere, uniform_triangle};
 use crate::scene::triangle_normal;
 

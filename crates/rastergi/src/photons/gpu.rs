@@ -9,7 +9,7 @@
 //!
 //! A resolve kernel turns the counters into the lookup texture: a 3D `rgba32float` texture
 //! of size (nx, ny, 6·nz) whose texel at (x, y, z + bin·nz) holds (Φ_rgb/h², A/h²), h the cell
-//! side; `photon_map.wgsl` samples it.
+//! side; `map.wgsl` samples it.
 
 use bytemuck::{Pod, Zeroable};
 use glam::UVec3;
@@ -18,7 +18,7 @@ use super::{MAX_BOUNCES, PhotonSettings};
 use crate::error::Result;
 use crate::gpu::{Gpu, compute_pipeline, storage_entry, uniform_entry};
 use crate::gpu_scene::{GpuScene, PreparedScene};
-use crate::photon_map::{BINS, GridSpec, PhotonMap, surface_areas};
+use crate::photons::map::{BINS, GridSpec, PhotonMap, surface_areas};
 use crate::profile::compute_pass;
 use crate::shader;
 
@@ -31,23 +31,23 @@ const WORKGROUP: u32 = 64;
 /// `PhotonParams` in `trace.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
-struct PhotonParams {
-    origin: [f32; 3],
-    cell: f32,
-    dims: [u32; 3],
-    first_photon: u32,
-    batch_size: u32,
-    seed: u32,
-    inv_photon_count: f32,
+pub(crate) struct PhotonParams {
+    pub(crate) origin: [f32; 3],
+    pub(crate) cell: f32,
+    pub(crate) dims: [u32; 3],
+    pub(crate) first_photon: u32,
+    pub(crate) batch_size: u32,
+    pub(crate) seed: u32,
+    pub(crate) inv_photon_count: f32,
     /// Fixed-point units per watt: 2²⁴ / Φ_max.
-    quantum: f32,
-    ray_epsilon: f32,
-    max_bounces: u32,
-    groups_x: u32,
-    _pad: u32,
+    pub(crate) quantum: f32,
+    pub(crate) ray_epsilon: f32,
+    pub(crate) max_bounces: u32,
+    pub(crate) groups_x: u32,
+    pub(crate) _pad: u32,
 }
 
-/// `PhotonGrid` in `photon_map.wgsl`.
+/// `PhotonGrid` in `map.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct PhotonGridUniforms {
@@ -55,6 +55,11 @@ pub struct PhotonGridUniforms {
     pub cell: f32,
     pub dims: [u32; 3],
     pub _pad: u32,
+}
+
+/// The photon tracer's composed shader (`trace.wgsl`: the trace and resolve kernels).
+pub fn trace_source() -> String {
+    shader::compose(&[shader::SAMPLING, shader::SCENE, shader::BVH, super::map::BIN_WGSL, include_str!("trace.wgsl")])
 }
 
 /// The photon map on the GPU, ready for lookups (bind group 3 of the passes that read it).
@@ -148,11 +153,11 @@ impl GpuPhotonMap {
         let trace_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("photon trace"),
             entries: &[
-                uniform_entry(0, c),
-                storage_entry(1, c, false),
-                storage_entry(2, c, false),
-                storage_entry(3, c, false),
-                storage_entry(4, c, true),
+                uniform_entry::<PhotonParams>(0, c),
+                storage_entry::<u32>(1, c, false),
+                storage_entry::<u32>(2, c, false),
+                storage_entry::<u32>(3, c, false),
+                storage_entry::<f32>(4, c, true),
                 wgpu::BindGroupLayoutEntry {
                     binding: 5,
                     visibility: c,
@@ -184,8 +189,7 @@ impl GpuPhotonMap {
                 wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&view) },
             ],
         });
-        let source = [shader::SAMPLING, shader::SCENE, shader::BVH, include_str!("trace.wgsl")].join("\n");
-        let module = shader::module(device, "photon trace", &source);
+        let module = shader::module(device, "photon trace", &trace_source());
         let layouts = [&scene.layout, &trace_layout];
         let trace_pipeline = compute_pipeline(device, "trace photons", &module, "trace_photons", &layouts);
         let resolve_pipeline = compute_pipeline(device, "resolve photon map", &module, "resolve_map", &layouts);
@@ -359,7 +363,7 @@ fn lookup_binding(gpu: &Gpu, grid: &GridSpec, texture: &wgpu::Texture) -> (wgpu:
                 },
                 count: None,
             },
-            uniform_entry(1, vis),
+            uniform_entry::<PhotonGridUniforms>(1, vis),
         ],
     });
     let view = texture.create_view(&Default::default());

@@ -1,5 +1,5 @@
 //! Photon pass: photons leave the area lights and deposit their flux into the grid photon map
-//! ([`crate::photon_map`]) at every diffuse hit.
+//! ([`map`]) at every diffuse hit.
 //!
 //! Emission: a light triangle is chosen with probability pmf ∝ its power, a point uniformly on
 //! it (pdf 1/A) and a direction with pdf cos θ/π, so a photon carries
@@ -23,13 +23,14 @@
 
 pub mod cpu;
 pub mod gpu;
+pub mod map;
 
 use crate::gpu_scene::PreparedScene;
 
 /// Safety cap on bounces (Russian roulette ends almost every path long before).
 pub const MAX_BOUNCES: u32 = 256;
 /// Stream constant of the photon pass's random numbers (`STREAM_PHOTON` in WGSL).
-pub const STREAM_PHOTON: u32 = 0x9e3779b9;
+pub use crate::sampling::stream::PHOTON as STREAM_PHOTON;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PhotonSettings {

@@ -27,20 +27,6 @@ struct PhotonParams {
 @group(1) @binding(4) var<storage, read> cell_area: array<f32>;
 @group(1) @binding(5) var map_out: texture_storage_3d<rgba32float, write>;
 
-const STREAM_PHOTON: u32 = 0x9e3779b9u;
-
-// Dominant axis and sign of n: 0 +x, 1 -x, 2 +y, 3 -y, 4 +z, 5 -z (photon_map::orientation_bin).
-fn orientation_bin(n: vec3f) -> u32 {
-    let a = abs(n);
-    var axis = 2u;
-    if a.x >= a.y && a.x >= a.z {
-        axis = 0u;
-    } else if a.y >= a.z {
-        axis = 1u;
-    }
-    return 2u * axis + select(0u, 1u, n[axis] < 0.0);
-}
-
 fn slot_of(p: vec3f, n: vec3f) -> u32 {
     let c = vec3u(clamp(vec3i(floor((p - params.origin) / params.cell)), vec3i(0), vec3i(params.dims) - 1));
     let z = orientation_bin(n) * params.dims.z + c.z;

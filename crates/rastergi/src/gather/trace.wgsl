@@ -1,6 +1,6 @@
-// Final gather by ray casting (gather_trace.rs): the nearest surface along each of the
+// Final gather by ray casting (gather/trace.rs): the nearest surface along each of the
 // iteration's directions from each visible point, by BVH traversal; the estimate is
-// gather_estimate (gather.wgsl), averaged over the directions.
+// gather_estimate (estimator.wgsl), averaged over the directions.
 
 @group(2) @binding(0) var<uniform> gather: Gather;
 @group(2) @binding(1) var gbuffer: texture_2d<u32>;
@@ -11,7 +11,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if any(gid.xy >= frame.resolution) {
         return;
     }
-    let p = gather_point(textureLoad(gbuffer, gid.xy, 0));
+    let p = visible_point(textureLoad(gbuffer, gid.xy, 0));
     var sum = vec3f(0.0);
     for (var k = 0u; k < gather.count && p.ok; k++) {
         let w = gather.directions[k].xyz;
@@ -25,7 +25,5 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             sum += gather_estimate(p, cos_x, w, h.tri, p.x.pos + w * h.t, vec2f(h.b1, h.b2));
         }
     }
-    let pixel = gid.y * frame.resolution.x + gid.x;
-    let n_pixels = frame.resolution.x * frame.resolution.y;
-    film[n_pixels + pixel] += vec4f(sum / f32(gather.count), 0.0);
+    film_add(FILM_INDIRECT, gid.xy, sum / f32(gather.count));
 }

@@ -1,4 +1,4 @@
-// Photon map lookups (photon_map.rs), bind group 3 of the passes that read the map.
+// Photon map lookups (photons/map.rs), bind group 3 of the passes that read the map.
 // Texel (x, y, z + bin·nz) holds (Φ_rgb/h², A/h²) of cell (x, y, z) in orientation bin `bin`.
 
 struct PhotonGrid {
@@ -11,21 +11,10 @@ struct PhotonGrid {
 @group(3) @binding(0) var photon_texture: texture_3d<f32>;
 @group(3) @binding(1) var<uniform> photon_grid: PhotonGrid;
 
-fn photon_bin(n: vec3f) -> u32 {
-    let a = abs(n);
-    var axis = 2u;
-    if a.x >= a.y && a.x >= a.z {
-        axis = 0u;
-    } else if a.y >= a.z {
-        axis = 1u;
-    }
-    return 2u * axis + select(0u, 1u, n[axis] < 0.0);
-}
-
 // E(p) for the surface side with normal n: Σ w_i Φ_i / Σ w_i A_i over the 8 cells around p
 // in n's bin, w_i trilinear on cell centres (PhotonMap::irradiance).
 fn photon_irradiance(p: vec3f, n: vec3f) -> vec3f {
-    let bin = photon_bin(n);
+    let bin = orientation_bin(n);
     let g = (p - photon_grid.origin) / photon_grid.cell - 0.5;
     let base = floor(g);
     let f = g - base;

@@ -20,6 +20,11 @@ use glam::{DVec3, IVec3, UVec3, Vec3};
 
 use crate::scene::{Aabb, Scene, triangle_normal};
 
+/// The orientation bin in WGSL (`orientation_bin`, the twin of [`orientation_bin`]).
+pub const BIN_WGSL: &str = include_str!("bin.wgsl");
+/// The map's lookup in WGSL (`photon_irradiance`, bind group 3), with the orientation bin.
+pub const LOOKUP_WGSL: &str = concat!(include_str!("bin.wgsl"), "\n", include_str!("map.wgsl"));
+
 /// Orientation bins: 0 +x, 1 −x, 2 +y, 3 −y, 4 +z, 5 −z.
 pub const BINS: usize = 6;
 

@@ -1,5 +1,5 @@
-// Final gather projection (gather_raster.rs): each peeled layer projected onto the eye's
-// visible points; the estimate is gather_estimate (gather.wgsl).
+// Final gather projection (gather/raster.rs): each peeled layer projected onto the eye's
+// visible points; the estimate is gather_estimate (estimator.wgsl).
 
 @group(2) @binding(0) var<uniform> gather: Gather;
 @group(2) @binding(1) var gbuffer: texture_2d<u32>;
@@ -19,7 +19,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         return;
     }
     let w = gather.direction;
-    let p = gather_point(textureLoad(gbuffer, gid.xy, 0));
+    let p = visible_point(textureLoad(gbuffer, gid.xy, 0));
     let cos_x = dot(p.n, w);
     if !p.ok || cos_x <= 0.0 {
         found[pixel] = 1u;
@@ -42,7 +42,6 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     }
     found[pixel] = 1u;
     let hit = p.x.pos + w * dist;
-    let n_pixels = frame.resolution.x * frame.resolution.y;
-    let e = gather_estimate(p, cos_x, w, tri, hit, plane_barycentrics(triangles[tri], hit)) / f32(gather.count);
-    film[n_pixels + pixel] += vec4f(e, 0.0);
+    let e = gather_estimate(p, cos_x, w, tri, hit, plane_barycentrics(triangles[tri], hit));
+    film_add(FILM_INDIRECT, gid.xy, e / f32(gather.count));
 }

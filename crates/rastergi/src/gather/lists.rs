@@ -1,7 +1,7 @@
 //! Final gather from per-texel fragment lists: the single-pass alternative to depth peeling.
-//! The estimator is the one in [`crate::gather`].
+//! The estimator is the one in [`super::estimator`].
 //!
-//! * One raster pass over the ray view (as in [`crate::gather_raster`]) with no depth test:
+//! * One raster pass over the ray view ([`super::ray_view`], as in [`super::raster`]) with no depth test:
 //!   every fragment prepends its triangle to its texel's linked list (an atomic exchange on
 //!   the texel's head, a node from a pool taken by an atomic counter).
 //! * One compute pass: every visible point x projects into the ray view like a shadow-map
@@ -13,9 +13,10 @@
 //!   orthographic projection (projection shrinks both; a convex set holds at most A + P/2 + 1
 //!   lattice points, Nosarzewska), so Σ(A/s² + P/s + 1) nodes always suffice.
 
+use super::Gather;
+use super::estimator::{GatherInputs, GatherSetup, GatherUniforms, RAY_VIEW_LOOKUP};
+use super::ray_view::{ray_view_module, ray_view_pipeline, texel_size};
 use crate::error::{Error, Result};
-use crate::gather::{GatherInputs, GatherSetup};
-use crate::gather_raster::{ray_view_module, ray_view_pipeline};
 use crate::gpu::{Gpu, dispatch_pixels, storage_entry, uint_texture_entry, uniform_entry};
 use crate::gpu_scene::GpuScene;
 use crate::profile::{Profiler, compute_pass};
@@ -26,8 +27,7 @@ const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Uint;
 /// Nodes that hold every fragment of `scene` in any `bundle`² ray view over its bounding
 /// sphere (see the module documentation).
 pub fn node_capacity(scene: &GpuScene, bundle: u32) -> u64 {
-    let radius = (0.5 * scene.bounds.extent().length()).max(1e-6) as f64 * 1.001;
-    let s = 2.0 * radius / bundle as f64;
+    let s = texel_size(&scene.bounds, bundle);
     (scene.total_area / (s * s) + scene.total_perimeter / s + scene.triangle_count as f64).ceil() as u64
 }
 
@@ -45,7 +45,7 @@ pub struct ListGather {
 impl ListGather {
     /// The list buffers for a `bundle`² ray view. Fails where the node pool exceeds a
     /// binding.
-    pub fn new(gpu: &Gpu, setup: &GatherSetup, bundle: u32) -> Result<ListGather> {
+    pub fn new(gpu: &Gpu, setup: &GatherSetup, uniforms: &wgpu::Buffer, bundle: u32) -> Result<ListGather> {
         let device = &gpu.device;
         crate::limits::check_bundle(&device.limits(), bundle)?;
         let capacity = node_capacity(setup.scene, bundle);
@@ -80,17 +80,17 @@ impl ListGather {
         let fill_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("gather list fill"),
             entries: &[
-                uniform_entry(0, vf),
-                storage_entry(1, f, false),
-                storage_entry(2, f, false),
-                storage_entry(3, f, false),
+                uniform_entry::<GatherUniforms>(0, vf),
+                storage_entry::<u32>(1, f, false),
+                storage_entry::<[u32; 2]>(2, f, false),
+                storage_entry::<u32>(3, f, false),
             ],
         });
         let fill_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("gather list fill"),
             layout: &fill_layout,
             entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: setup.uniforms.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 1, resource: heads.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 2, resource: nodes.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 3, resource: node_count.as_entire_binding() },
@@ -99,18 +99,18 @@ impl ListGather {
         let project_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("gather list project"),
             entries: &[
-                uniform_entry(0, c),
+                uniform_entry::<GatherUniforms>(0, c),
                 uint_texture_entry(1, c),
-                storage_entry(2, c, true),
-                storage_entry(3, c, true),
-                storage_entry(4, c, false),
+                storage_entry::<u32>(2, c, true),
+                storage_entry::<[u32; 2]>(3, c, true),
+                storage_entry::<[f32; 4]>(4, c, false),
             ],
         });
         let project_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("gather list project"),
             layout: &project_layout,
             entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: setup.uniforms.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&setup.gbuffer.view) },
                 wgpu::BindGroupEntry { binding: 2, resource: heads.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 3, resource: nodes.as_entire_binding() },
@@ -128,8 +128,12 @@ impl ListGather {
             (TARGET_FORMAT, wgpu::ColorWrites::empty()),
             false,
         );
-        let project_pipeline =
-            setup.estimate_pipeline(device, "gather list project", include_str!("gather_lists.wgsl"), &project_layout);
+        let project_pipeline = setup.estimate_pipeline(
+            device,
+            "gather list project",
+            &[RAY_VIEW_LOOKUP, include_str!("lists.wgsl")],
+            &project_layout,
+        );
         Ok(ListGather {
             fill_pipeline,
             project_pipeline,
@@ -143,9 +147,8 @@ impl ListGather {
     }
 
     /// Encodes the lists of the direction in the uniforms and their projection onto the
-    /// visible points. Reads: scene, frame, G-buffer, photon map. Adds to: the film's indirect
-    /// component.
-    pub fn encode(&self, enc: &mut wgpu::CommandEncoder, inputs: &GatherInputs) {
+    /// visible points.
+    fn encode_direction(&self, enc: &mut wgpu::CommandEncoder, inputs: &GatherInputs) {
         enc.clear_buffer(&self.heads, 0, None);
         enc.clear_buffer(&self.node_count, 0, None);
         {
@@ -170,6 +173,16 @@ impl ListGather {
         let mut pass = compute_pass(enc, self.profiler.as_ref(), "gather list project");
         let groups = inputs.groups(&self.project_group);
         dispatch_pixels(&mut pass, &self.project_pipeline, &groups, inputs.width, inputs.height);
+    }
+}
+
+impl Gather for ListGather {
+    /// One ray view per direction: its lists, then the walk of every visible point.
+    fn encode(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, inputs: &GatherInputs) -> Result<()> {
+        inputs.for_each_direction(gpu, enc, |enc, _| {
+            self.encode_direction(enc, inputs);
+            Ok(())
+        })
     }
 }
 

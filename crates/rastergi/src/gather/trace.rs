@@ -1,11 +1,13 @@
 //! Final gather by ray casting: the nearest surface along ω from every visible point, found by
-//! traversing the BVH in a compute shader (`gather_trace.wgsl`); the estimate is the raster
-//! gather's ([`crate::gather`]). One dispatch per direction, no ray-view textures and no
+//! traversing the BVH in a compute shader (`trace.wgsl`); the estimate is the raster
+//! gathers' ([`super::estimator`]). One dispatch per direction, no ray-view textures and no
 //! read-back, so directions queue up without synchronisation. It is exact where the raster
 //! gather quantises to ray-view texels, and costs O(log n) per pixel where rasterising costs
 //! O(n) per layer; rasterization wins where fragment work is cheap and the scene shallow.
 
-use crate::gather::{GatherInputs, GatherSetup};
+use super::Gather;
+use super::estimator::{GatherInputs, GatherSetup, GatherUniforms};
+use crate::error::Result;
 use crate::gpu::{Gpu, dispatch_pixels, storage_entry, uint_texture_entry, uniform_entry};
 use crate::profile::{Profiler, compute_pass};
 
@@ -16,30 +18,37 @@ pub struct TraceGather {
 }
 
 impl TraceGather {
-    pub fn new(gpu: &Gpu, setup: &GatherSetup) -> TraceGather {
+    pub fn new(gpu: &Gpu, setup: &GatherSetup, uniforms: &wgpu::Buffer) -> TraceGather {
         let device = &gpu.device;
         let c = wgpu::ShaderStages::COMPUTE;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("gather trace"),
-            entries: &[uniform_entry(0, c), uint_texture_entry(1, c), storage_entry(2, c, false)],
+            entries: &[
+                uniform_entry::<GatherUniforms>(0, c),
+                uint_texture_entry(1, c),
+                storage_entry::<[f32; 4]>(2, c, false),
+            ],
         });
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("gather trace"),
             layout: &layout,
             entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: setup.uniforms.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&setup.gbuffer.view) },
                 wgpu::BindGroupEntry { binding: 2, resource: setup.film.accumulation.as_entire_binding() },
             ],
         });
-        let pipeline = setup.estimate_pipeline(device, "gather trace", include_str!("gather_trace.wgsl"), &layout);
+        let pipeline = setup.estimate_pipeline(device, "gather trace", &[include_str!("trace.wgsl")], &layout);
         TraceGather { pipeline, bind_group, profiler: gpu.profiler.clone() }
     }
+}
 
-    /// Reads: scene, frame, G-buffer, photon map, gather uniforms. Adds to: the film's
-    /// indirect component.
-    pub fn encode(&self, enc: &mut wgpu::CommandEncoder, inputs: &GatherInputs) {
+impl Gather for TraceGather {
+    /// All the iteration's directions in one dispatch: the uniforms hold them all.
+    fn encode(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, inputs: &GatherInputs) -> Result<()> {
+        inputs.write_uniforms(gpu, 0);
         let mut pass = compute_pass(enc, self.profiler.as_ref(), "gather trace");
         dispatch_pixels(&mut pass, &self.pipeline, &inputs.groups(&self.bind_group), inputs.width, inputs.height);
+        Ok(())
     }
 }

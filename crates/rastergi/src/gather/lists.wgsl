@@ -1,7 +1,7 @@
-// Final gather from per-texel fragment lists (gather_lists.rs): each visible point projects
+// Final gather from per-texel fragment lists (gather/lists.rs): each visible point projects
 // into the ray view and walks its texel's list; the nearest surface in front of it along ω is
 // the fragment whose triangle's plane x's ray crosses first at t > ε. The estimate is
-// gather_estimate (gather.wgsl).
+// gather_estimate (estimator.wgsl).
 
 @group(2) @binding(0) var<uniform> gather: Gather;
 @group(2) @binding(1) var gbuffer: texture_2d<u32>;
@@ -15,7 +15,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         return;
     }
     let w = gather.direction;
-    let p = gather_point(textureLoad(gbuffer, gid.xy, 0));
+    let p = visible_point(textureLoad(gbuffer, gid.xy, 0));
     let cos_x = dot(p.n, w);
     if !p.ok || cos_x <= 0.0 {
         return;
@@ -43,7 +43,5 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     }
     let hit = p.x.pos + w * best;
     let b = plane_barycentrics(triangles[best_tri], hit);
-    let pixel = gid.y * frame.resolution.x + gid.x;
-    let n_pixels = frame.resolution.x * frame.resolution.y;
-    film[n_pixels + pixel] += vec4f(gather_estimate(p, cos_x, w, best_tri, hit, b) / f32(gather.count), 0.0);
+    film_add(FILM_INDIRECT, gid.xy, gather_estimate(p, cos_x, w, best_tri, hit, b) / f32(gather.count));
 }

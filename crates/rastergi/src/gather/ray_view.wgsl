@@ -1,12 +1,6 @@
-// Ray-view rasterization of the final gather: the depth-complexity count and the
-// back-to-front depth peel (gather_raster.rs), and the per-texel fragment lists
-// (gather_lists.rs).
-
-struct Gather {
-    view_proj: mat4x4f,
-    direction: vec3f,
-    bundle: u32,
-}
+// Ray-view rasterization of the final gather (gather/ray_view.rs): the depth-complexity
+// count and the back-to-front depth peel (raster.rs), and the per-texel fragment lists
+// (lists.rs).
 
 @group(1) @binding(0) var<uniform> gather: Gather;
 
@@ -52,7 +46,7 @@ fn fs_peel(in: VertexOut) -> @location(0) vec4u {
 
 // Fragment lists: every fragment prepends its triangle to its texel's list. heads[texel] is
 // the first node + 1 (0: empty); node i is (triangle, next node + 1). The pool holds at most
-// arrayLength(&nodes) fragments: gather_lists.rs sizes it to a bound on any view's fragments.
+// arrayLength(&nodes) fragments: lists.rs sizes it to a bound on any view's fragments.
 @group(1) @binding(1) var<storage, read_write> heads: array<atomic<u32>>;
 @group(1) @binding(2) var<storage, read_write> nodes: array<vec2u>;
 @group(1) @binding(3) var<storage, read_write> node_count: atomic<u32>;

@@ -1,6 +1,6 @@
 //! Final gather by rasterization (Hachisuka, GPU Gems 2, ch. 38): the nearest surface along ω
 //! for all visible points at once, by depth peeling the ray view. The estimator is the one in
-//! [`crate::gather`].
+//! [`super::estimator`].
 //!
 //! * Ray view: an orthographic camera looking along −ω that encloses the scene's bounding
 //!   sphere, shifted by a random sub-texel offset. Ray-view depth grows along −ω, so a gather
@@ -16,66 +16,16 @@
 //!   test rejects x's own triangle and coplanar neighbours exactly, at any angle (no acne, no
 //!   slope bias that would lose contact shadows).
 
+use super::Gather;
+use super::estimator::{GatherInputs, GatherSetup, GatherUniforms, RAY_VIEW_LOOKUP, submit_and_renew};
+use super::ray_view::{DEPTH_FORMAT, ray_view_module, ray_view_pipeline};
 use crate::error::Result;
-use crate::gather::{GatherInputs, GatherSetup};
-use crate::gpu::{Gpu, dispatch_pixels, pipeline_layout, storage_entry, uint_texture_entry, uniform_entry};
+use crate::gpu::{Gpu, dispatch_pixels, storage_entry, uint_texture_entry, uniform_entry};
 use crate::gpu_scene::GpuScene;
 use crate::profile::{Profiler, compute_pass};
-use crate::shader;
 
 /// Ray-view texel: (triangle + 1, b1 bits, b2 bits, depth bits); 0 where empty.
 const LAYER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;
-const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
-
-/// The ray-view raster shaders (`gather_peel.wgsl`: the vertex stage and the count, peel and
-/// list fragment stages), shared by the peeled and the fragment-list gathers.
-pub fn ray_view_module(device: &wgpu::Device) -> wgpu::ShaderModule {
-    let source = [shader::SAMPLING, shader::SCENE, include_str!("gather_peel.wgsl")].join("\n");
-    shader::module(device, "gather ray view", &source)
-}
-
-/// A ray-view raster pipeline: every triangle drawn by `vs_main`, no culling, fragment stage
-/// `fs` into a `target` (format, write mask); with `depth`, a Depth32Float test that keeps the
-/// farthest fragment (back to front).
-pub fn ray_view_pipeline(
-    device: &wgpu::Device,
-    label: &str,
-    module: &wgpu::ShaderModule,
-    layouts: &[&wgpu::BindGroupLayout],
-    fs: &str,
-    target: (wgpu::TextureFormat, wgpu::ColorWrites),
-    depth: bool,
-) -> wgpu::RenderPipeline {
-    let layout = pipeline_layout(device, label, layouts);
-    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some(label),
-        layout: Some(&layout),
-        vertex: wgpu::VertexState {
-            module,
-            entry_point: Some("vs_main"),
-            compilation_options: Default::default(),
-            buffers: &[],
-        },
-        primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-        depth_stencil: depth.then(|| wgpu::DepthStencilState {
-            format: DEPTH_FORMAT,
-            depth_write_enabled: Some(true),
-            // Back to front: keep the farthest fragment.
-            depth_compare: Some(wgpu::CompareFunction::Greater),
-            stencil: Default::default(),
-            bias: Default::default(),
-        }),
-        multisample: Default::default(),
-        fragment: Some(wgpu::FragmentState {
-            module,
-            entry_point: Some(fs),
-            compilation_options: Default::default(),
-            targets: &[Some(wgpu::ColorTargetState { format: target.0, blend: None, write_mask: target.1 })],
-        }),
-        multiview_mask: None,
-        cache: None,
-    })
-}
 
 pub struct RasterGather {
     count_pipeline: wgpu::RenderPipeline,
@@ -95,11 +45,11 @@ pub struct RasterGather {
 }
 
 impl RasterGather {
-    /// The passes and ray-view textures for a `bundle`² ray view.
-    pub fn new(gpu: &Gpu, setup: &GatherSetup, bundle: u32) -> Result<RasterGather> {
+    /// The passes and ray-view textures for a `bundle`² ray view reading `uniforms`.
+    pub fn new(gpu: &Gpu, setup: &GatherSetup, uniforms: &wgpu::Buffer, bundle: u32) -> Result<RasterGather> {
         let device = &gpu.device;
         crate::limits::check_bundle(&device.limits(), bundle)?;
-        let (uniforms, gbuffer, film) = (setup.uniforms, setup.gbuffer, setup.film);
+        let (gbuffer, film) = (setup.gbuffer, setup.film);
         let texture = |label: &str, format: wgpu::TextureFormat, usage: wgpu::TextureUsages| {
             device
                 .create_texture(&wgpu::TextureDescriptor {
@@ -140,23 +90,23 @@ impl RasterGather {
         let count_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("gather count"),
             entries: &[
-                uniform_entry(0, vf),
-                storage_entry(1, wgpu::ShaderStages::FRAGMENT, false),
-                storage_entry(2, wgpu::ShaderStages::FRAGMENT, false),
+                uniform_entry::<GatherUniforms>(0, vf),
+                storage_entry::<u32>(1, wgpu::ShaderStages::FRAGMENT, false),
+                storage_entry::<u32>(2, wgpu::ShaderStages::FRAGMENT, false),
             ],
         });
         let peel_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("gather peel"),
-            entries: &[uniform_entry(0, vf), tex_entry(1, wgpu::ShaderStages::FRAGMENT)],
+            entries: &[uniform_entry::<GatherUniforms>(0, vf), tex_entry(1, wgpu::ShaderStages::FRAGMENT)],
         });
         let project_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("gather project"),
             entries: &[
-                uniform_entry(0, c),
+                uniform_entry::<GatherUniforms>(0, c),
                 tex_entry(1, c),
                 tex_entry(2, c),
-                storage_entry(3, c, false),
-                storage_entry(4, c, false),
+                storage_entry::<u32>(3, c, false),
+                storage_entry::<[f32; 4]>(4, c, false),
             ],
         });
         let count_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -214,8 +164,12 @@ impl RasterGather {
             (LAYER_FORMAT, wgpu::ColorWrites::ALL),
             true,
         );
-        let project_pipeline =
-            setup.estimate_pipeline(device, "gather project", include_str!("gather_project.wgsl"), &project_layout);
+        let project_pipeline = setup.estimate_pipeline(
+            device,
+            "gather project",
+            &[RAY_VIEW_LOOKUP, include_str!("raster.wgsl")],
+            &project_layout,
+        );
         Ok(RasterGather {
             count_pipeline,
             peel_pipeline,
@@ -234,20 +188,13 @@ impl RasterGather {
 
     /// Counts the depth complexity along the direction in the uniforms, submits `enc` and
     /// reads the count back, then encodes that many peeled layers with their projections into
-    /// a new encoder, which it returns.
-    pub fn encode(
-        &self,
-        gpu: &Gpu,
-        mut enc: wgpu::CommandEncoder,
-        inputs: &GatherInputs,
-    ) -> Result<wgpu::CommandEncoder> {
-        self.encode_count(&mut enc, inputs.scene);
-        gpu.queue.submit([enc.finish()]);
+    /// a new encoder, left in `enc`.
+    fn encode_direction(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, inputs: &GatherInputs) -> Result<()> {
+        self.encode_count(enc, inputs.scene);
+        submit_and_renew(gpu, enc, "gather layers");
         let layers = self.read_layer_count(gpu)?;
-        let mut enc =
-            gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("gather layers") });
-        self.encode_layers(&mut enc, inputs, layers);
-        Ok(enc)
+        self.encode_layers(enc, inputs, layers);
+        Ok(())
     }
 
     /// Encodes the depth-complexity count of the ray view; its result is read by
@@ -339,5 +286,12 @@ impl RasterGather {
             let groups = inputs.groups(&self.project_groups[cur]);
             dispatch_pixels(&mut pass, &self.project_pipeline, &groups, inputs.width, inputs.height);
         }
+    }
+}
+
+impl Gather for RasterGather {
+    /// One ray view per direction: count, read back, peel and project layer by layer.
+    fn encode(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, inputs: &GatherInputs) -> Result<()> {
+        inputs.for_each_direction(gpu, enc, |enc, _| self.encode_direction(gpu, enc, inputs))
     }
 }

@@ -1,0 +1,173 @@
+//! The final gather's estimator and what every implementation shares: the uniforms, the
+//! resources a pass binds, and the per-pixel estimator pipeline.
+//!
+//! For a visible point x (normal n_x facing the eye, albedo ρ_x) and a direction ω drawn
+//! uniformly on the sphere (pdf 1/4π), with h the nearest surface along ω (t > ε, x's own
+//! triangle excluded):
+//!
+//! ```text
+//!   L_ind(x) ≈ (ρ_x/π) · L(h → x) · max(0, n_x·ω) · 4π,   L(h → x) = (ρ_h/π) · E(h)
+//! ```
+//!
+//! with E(h) the photon map's irradiance on the side of h facing x (zero from the back of a
+//! one-sided h; emission is never added: the direct pass owns it). `estimator.wgsl` holds
+//! `gather_estimate`; each of an iteration's K directions adds its estimate weighted 1/K.
+
+use bytemuck::{Pod, Zeroable};
+use glam::{Vec2, Vec3};
+
+use super::MAX_DIRECTIONS;
+use super::ray_view::ray_view_projection;
+use crate::error::Result;
+use crate::film::Film;
+use crate::frame::FrameBinding;
+use crate::gbuffer::GBufferPass;
+use crate::gpu::{Gpu, compute_pipeline};
+use crate::gpu_scene::GpuScene;
+use crate::photons::gpu::GpuPhotonMap;
+use crate::photons::map::LOOKUP_WGSL;
+use crate::scene::Aabb;
+use crate::shader;
+
+/// `struct Gather` in WGSL.
+pub const UNIFORMS: &str = include_str!("uniforms.wgsl");
+/// `ray_view_texel` and `plane_distance` in WGSL, for the raster gathers' estimator passes.
+pub const RAY_VIEW_LOOKUP: &str = include_str!("ray_view_lookup.wgsl");
+
+/// `Gather` in `uniforms.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GatherUniforms {
+    /// Raster: the ray view of `direction`.
+    pub view_proj: [[f32; 4]; 4],
+    /// Raster: the direction being rasterized.
+    pub direction: [f32; 3],
+    pub bundle: u32,
+    /// Directions this iteration: each estimate is weighted 1/count.
+    pub count: u32,
+    pub _pad: [u32; 3],
+    /// Trace: all the iteration's directions (xyz).
+    pub directions: [[f32; 4]; MAX_DIRECTIONS as usize],
+}
+
+impl GatherUniforms {
+    /// The uniforms for `samples` with sample `current` as the raster gathers' ray view of a
+    /// `bundle`² view over `bounds`.
+    pub fn new(bounds: &Aabb, samples: &[GatherSample], current: usize, bundle: u32) -> GatherUniforms {
+        let s = samples[current];
+        let mut directions = [[0.0; 4]; MAX_DIRECTIONS as usize];
+        for (d, s) in directions.iter_mut().zip(samples) {
+            *d = s.direction.extend(0.0).into();
+        }
+        GatherUniforms {
+            view_proj: ray_view_projection(bounds, s.direction, bundle, s.texel_jitter).to_cols_array_2d(),
+            direction: s.direction.into(),
+            bundle,
+            count: samples.len() as u32,
+            _pad: [0; 3],
+            directions,
+        }
+    }
+}
+
+/// One gather direction of an iteration: ω and the ray view's sub-texel offset.
+#[derive(Clone, Copy, Debug)]
+pub struct GatherSample {
+    pub direction: Vec3,
+    pub texel_jitter: Vec2,
+}
+
+/// The composed shader of an estimator pass: the scene prelude, the visible point, the film
+/// writes, the photon-map lookup, the uniforms, the estimator and `pieces`.
+pub fn estimate_source(pieces: &[&str]) -> String {
+    let mut all = vec![LOOKUP_WGSL, UNIFORMS, include_str!("estimator.wgsl")];
+    all.extend_from_slice(pieces);
+    shader::per_pixel(&all)
+}
+
+/// What a gather's passes bind besides the [`GatherUniforms`], for building them: the scene,
+/// the frame uniforms, the G-buffer (visible points), the film (indirect component) and the
+/// photon map.
+#[derive(Clone, Copy)]
+pub struct GatherSetup<'a> {
+    pub scene: &'a GpuScene,
+    pub frame: &'a FrameBinding,
+    pub gbuffer: &'a GBufferPass,
+    pub film: &'a Film,
+    pub map: &'a GpuPhotonMap,
+}
+
+impl GatherSetup<'_> {
+    /// A per-pixel compute pipeline ending in the estimator ([`estimate_source`] of
+    /// `pieces`); bind groups scene, frame, `own`, photon map.
+    pub fn estimate_pipeline(
+        &self,
+        device: &wgpu::Device,
+        label: &str,
+        pieces: &[&str],
+        own: &wgpu::BindGroupLayout,
+    ) -> wgpu::ComputePipeline {
+        let module = shader::module(device, label, &estimate_source(pieces));
+        compute_pipeline(
+            device,
+            label,
+            &module,
+            "main",
+            &[&self.scene.layout, &self.frame.layout, own, &self.map.layout],
+        )
+    }
+}
+
+/// What a gather reads when it is encoded: the scene, the frame uniforms and the photon map
+/// it was built with, the image size, the iteration's directions and the uniform buffer.
+#[derive(Clone, Copy)]
+pub struct GatherInputs<'a> {
+    pub scene: &'a GpuScene,
+    pub frame: &'a FrameBinding,
+    pub map: &'a GpuPhotonMap,
+    pub width: u32,
+    pub height: u32,
+    /// The iteration's directions, 1 to [`MAX_DIRECTIONS`].
+    pub samples: &'a [GatherSample],
+    pub uniforms: &'a wgpu::Buffer,
+    pub bundle: u32,
+}
+
+impl<'a> GatherInputs<'a> {
+    /// The per-pixel pipeline's bind groups around `own`: scene, frame, `own`, photon map.
+    pub fn groups(&self, own: &'a wgpu::BindGroup) -> [&'a wgpu::BindGroup; 4] {
+        [&self.scene.bind_group, &self.frame.bind_group, own, &self.map.bind_group]
+    }
+
+    /// Writes the uniforms with sample `current` as the ray view. The write lands before the
+    /// next submission: work already in an encoder sees it too.
+    pub fn write_uniforms(&self, gpu: &Gpu, current: usize) {
+        let u = GatherUniforms::new(&self.scene.bounds, self.samples, current, self.bundle);
+        gpu.queue.write_buffer(self.uniforms, 0, bytemuck::bytes_of(&u));
+    }
+
+    /// Encodes `each(enc, k)` for every direction k of the iteration, one ray view after the
+    /// other: the uniforms are written with k as the ray view before its work, and the work of
+    /// direction k − 1 is submitted first, since it reads the uniforms written before it.
+    pub fn for_each_direction(
+        &self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        mut each: impl FnMut(&mut wgpu::CommandEncoder, usize) -> Result<()>,
+    ) -> Result<()> {
+        for k in 0..self.samples.len() {
+            if k > 0 {
+                submit_and_renew(gpu, enc, "gather");
+            }
+            self.write_uniforms(gpu, k);
+            each(enc, k)?;
+        }
+        Ok(())
+    }
+}
+
+/// Submits the work in `enc` and replaces it with a new encoder labelled `label`.
+pub fn submit_and_renew(gpu: &Gpu, enc: &mut wgpu::CommandEncoder, label: &str) {
+    let next = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+    gpu.queue.submit([std::mem::replace(enc, next).finish()]);
+}

@@ -1,0 +1,317 @@
+//! Final gather: per iteration a few directions ω, each shared by all visible points at once
+//! (Hachisuka, GPU Gems 2, ch. 38), the nearest surface along each found by one of several
+//! implementations of the same estimator ([`estimator`]).
+//!
+//! * Directions ([`DirectionSampler`]): ω_i = R · S(i), S a low-discrepancy (Halton 5, 7)
+//!   sequence mapped uniformly to the sphere (pdf 1/4π) and R a random rotation drawn per
+//!   restart. Iteration i with K directions takes S(i·K) … S(i·K + K − 1): consecutive points
+//!   keep the sequence's stratification however many an iteration takes.
+//! * Nearest surface h along ω from each visible point x (t > ε, x's own triangle excluded), a
+//!   [`Gather`] implementation: [`GatherMethod::Raster`] depth-peels an orthographic ray view
+//!   ([`ray_view`]) and projects each layer onto the visible points ([`raster`]);
+//!   [`GatherMethod::Lists`] rasterizes the ray view once into per-texel fragment lists that
+//!   each visible point walks ([`lists`]); [`GatherMethod::Trace`] casts the ray through the
+//!   BVH in a compute shader ([`trace`]). They differ only where a ray-view texel is crossed by
+//!   a silhouette (the raster gathers take the texel's surface).
+//! * Estimate ([`estimator`]): L_ind(x, ω) = (ρ_x/π) · L(h → x) · max(0, n_x·ω) · 4π.
+//!
+//! Several directions per iteration share one G-buffer and direct pass (`--directions`): the
+//! indirect estimate, by far the noisier, gets more samples per unit of time.
+//!
+//! [`GatherMethod::Auto`] lets the first iterations alternate between the implementations and
+//! keeps the fastest on this adapter; every one of those iterations counts towards the image.
+//! A new implementation is a module with a type implementing [`Gather`], a [`GatherMethod`]
+//! variant and one arm in [`build`].
+
+pub mod estimator;
+pub mod lists;
+pub mod raster;
+pub mod ray_view;
+pub mod trace;
+
+use std::time::{Duration, Instant};
+
+use glam::{Quat, Vec2, Vec3};
+
+pub use estimator::{GatherInputs, GatherSample, GatherSetup, GatherUniforms};
+
+use crate::error::Result;
+use crate::frame::FrameBinding;
+use crate::gpu::Gpu;
+use crate::gpu_scene::GpuScene;
+use crate::photons::gpu::GpuPhotonMap;
+use crate::sampling::{Rng, radical_inverse, stream, uniform_sphere};
+
+/// Most gather directions per iteration.
+pub const MAX_DIRECTIONS: u32 = 16;
+
+/// How the nearest surface along the gather direction is found.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum GatherMethod {
+    /// Time the implementations on the first iterations and keep the fastest.
+    #[default]
+    Auto,
+    /// Depth-peeled orthographic ray view (rasterization).
+    Raster,
+    /// Per-texel fragment lists of the ray view in one raster pass (no read-back).
+    Lists,
+    /// BVH ray casting in a compute shader.
+    Trace,
+}
+
+/// One way of finding the nearest surface along an iteration's gather directions and adding
+/// the estimate; each implementation owns its loop over the directions.
+pub trait Gather {
+    /// Encodes the gather along every direction of `inputs.samples` (each estimate weighted
+    /// 1/len) after the work already in `enc`. An implementation that reads a result back may
+    /// submit `enc` and go on in a new encoder, which it leaves in `enc`.
+    /// Reads: scene, frame, G-buffer, photon map, gather uniforms. Adds to: the film's
+    /// indirect component.
+    fn encode(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, inputs: &GatherInputs) -> Result<()>;
+}
+
+/// The implementations `Auto` chooses among, in trial order.
+const CANDIDATES: [GatherMethod; 3] = [GatherMethod::Raster, GatherMethod::Lists, GatherMethod::Trace];
+
+/// [`GatherMethod::Auto`] keeps the traced gather unless another is this many times faster.
+pub const PREFER_TRACE: f64 = 1.25;
+
+/// Iterations of each method timed by [`GatherMethod::Auto`] before it chooses.
+pub const AUTO_TRIALS: u32 = 3;
+
+/// Iterations after which [`GatherMethod::Auto`] has chosen, at most (candidates more than
+/// twice as slow as the fastest are dropped after their first run).
+pub const AUTO_ITERATIONS: u32 = CANDIDATES.len() as u32 * AUTO_TRIALS;
+
+/// Builds the implementation `method` (not `Auto`) for a `bundle`² ray view, reading the
+/// gather's `uniforms`.
+fn build(
+    method: GatherMethod,
+    gpu: &Gpu,
+    setup: &GatherSetup,
+    uniforms: &wgpu::Buffer,
+    bundle: u32,
+) -> Result<Box<dyn Gather>> {
+    Ok(match method {
+        GatherMethod::Raster => Box::new(raster::RasterGather::new(gpu, setup, uniforms, bundle)?),
+        GatherMethod::Lists => Box::new(lists::ListGather::new(gpu, setup, uniforms, bundle)?),
+        GatherMethod::Trace => Box::new(trace::TraceGather::new(gpu, setup, uniforms)),
+        GatherMethod::Auto => unreachable!("Auto is a choice among the others"),
+    })
+}
+
+/// The gather direction of index `i` for a restart whose rotation is `rotation`.
+pub fn gather_direction(i: u32, rotation: Quat) -> Vec3 {
+    rotation * uniform_sphere(radical_inverse(i + 1, 5), radical_inverse(i + 1, 7))
+}
+
+/// A uniformly random rotation (Shoemake's method) from the stream (seed, restart).
+pub fn random_rotation(seed: u32, restart: u32) -> Quat {
+    let mut rng = Rng::new(seed ^ stream::GATHER_ROTATION, restart, 0);
+    let (u1, u2, u3) = (rng.next_f32(), rng.next_f32(), rng.next_f32());
+    let tau = std::f32::consts::TAU;
+    let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());
+    Quat::from_xyzw(a * (tau * u2).sin(), a * (tau * u2).cos(), b * (tau * u3).sin(), b * (tau * u3).cos()).normalize()
+}
+
+/// Values that replace the sampler's for one iteration (tests compare the gathers with other
+/// estimators for the same samples).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FixedSample {
+    /// One direction ω instead of the iteration's.
+    pub direction: Option<Vec3>,
+    /// The ray view's sub-texel offset instead of a random one.
+    pub texel_jitter: Option<Vec2>,
+}
+
+/// The gather's random choices: the rotation R of the direction sequence, drawn anew at every
+/// restart, and the ray view's sub-texel offsets, from the streams keyed by the seed.
+#[derive(Clone, Copy, Debug)]
+pub struct DirectionSampler {
+    seed: u32,
+    /// Restarts so far (camera moves, resizes).
+    restart: u32,
+    rotation: Quat,
+}
+
+impl DirectionSampler {
+    pub fn new(seed: u32) -> DirectionSampler {
+        DirectionSampler { seed, restart: 0, rotation: random_rotation(seed, 0) }
+    }
+
+    /// A new image: a new rotation of the sequence.
+    pub fn restart(&mut self) {
+        self.restart += 1;
+        self.rotation = random_rotation(self.seed, self.restart);
+    }
+
+    /// The `count` directions of `iteration` (one where `fixed` gives the direction), each
+    /// with a uniform sub-texel offset in [-½, ½)².
+    pub fn samples(&self, iteration: u32, count: u32, fixed: &FixedSample) -> Vec<GatherSample> {
+        let k = if fixed.direction.is_some() { 1 } else { count.clamp(1, MAX_DIRECTIONS) };
+        (0..k)
+            .map(|j| {
+                let index = iteration * k + j;
+                let direction = fixed.direction.unwrap_or_else(|| gather_direction(index, self.rotation));
+                let texel_jitter = fixed.texel_jitter.unwrap_or_else(|| {
+                    let mut rng = Rng::new(self.seed ^ stream::TEXEL_JITTER, index, self.restart);
+                    Vec2::new(rng.next_f32(), rng.next_f32()) - 0.5
+                });
+                GatherSample { direction: direction.normalize(), texel_jitter }
+            })
+            .collect()
+    }
+}
+
+/// An implementation and, while `Auto` tries it, its trial times.
+struct Candidate {
+    method: GatherMethod,
+    gather: Box<dyn Gather>,
+    trials: Vec<Duration>,
+}
+
+/// The final gather pass: the directions, the implementations behind one interface, and the
+/// choice among them.
+pub struct GatherPass {
+    pub bundle: u32,
+    uniforms: wgpu::Buffer,
+    sampler: DirectionSampler,
+    /// One implementation once chosen; `Auto`'s remaining candidates while it tries them.
+    candidates: Vec<Candidate>,
+    chosen: bool,
+}
+
+/// What the gather pass reads, besides the G-buffer and film it was built with.
+#[derive(Clone, Copy)]
+pub struct GatherFrame<'a> {
+    pub scene: &'a GpuScene,
+    pub frame: &'a FrameBinding,
+    pub map: &'a GpuPhotonMap,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl GatherPass {
+    /// The pass over `setup`'s resources with `method`, for a `bundle`² ray view, drawing
+    /// directions from `sampler`.
+    pub fn new(
+        gpu: &Gpu,
+        setup: &GatherSetup,
+        bundle: u32,
+        method: GatherMethod,
+        sampler: DirectionSampler,
+    ) -> Result<GatherPass> {
+        let uniforms = gpu.zeroed_buffer(
+            "gather uniforms",
+            std::mem::size_of::<GatherUniforms>() as u64,
+            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        );
+        let mut candidates = Vec::new();
+        for m in CANDIDATES.into_iter().filter(|&m| method == m || method == GatherMethod::Auto) {
+            match build(m, gpu, setup, &uniforms, bundle) {
+                Ok(gather) => candidates.push(Candidate { method: m, gather, trials: Vec::new() }),
+                // Auto does without a candidate that does not fit.
+                Err(e) if method == GatherMethod::Auto => log::info!("gather: no {m:?} gather ({e})"),
+                Err(e) => return Err(e),
+            }
+        }
+        Ok(GatherPass { bundle, uniforms, sampler, candidates, chosen: method != GatherMethod::Auto })
+    }
+
+    /// The implementation in use (`Auto` while the trials run).
+    pub fn method(&self) -> GatherMethod {
+        if self.chosen { self.candidates[0].method } else { GatherMethod::Auto }
+    }
+
+    /// The direction sampler (kept when the pass is rebuilt for a new image size).
+    pub fn sampler(&self) -> DirectionSampler {
+        self.sampler
+    }
+
+    /// A new image: new random choices.
+    pub fn restart(&mut self) {
+        self.sampler.restart();
+    }
+
+    /// Encodes the gather of `iteration` along `directions` directions (1 to
+    /// [`MAX_DIRECTIONS`]; one where `fixed` gives it) after the work already in `enc`; the
+    /// encoder to go on with is left in `enc`.
+    pub fn encode(
+        &mut self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        f: &GatherFrame,
+        iteration: u32,
+        directions: u32,
+        fixed: &FixedSample,
+    ) -> Result<()> {
+        let samples = self.sampler.samples(iteration, directions, fixed);
+        // A handle (reference counted): the trials below change `self`.
+        let uniforms = self.uniforms.clone();
+        let inputs = GatherInputs {
+            scene: f.scene,
+            frame: f.frame,
+            map: f.map,
+            width: f.width,
+            height: f.height,
+            samples: &samples,
+            uniforms: &uniforms,
+            bundle: self.bundle,
+        };
+        if self.chosen {
+            return self.candidates[0].gather.encode(gpu, enc, &inputs);
+        }
+        self.encode_trial(gpu, enc, &inputs)
+    }
+
+    /// One timed trial iteration of `Auto`: the work before the gather is finished first so the
+    /// gather alone is timed; after [`AUTO_TRIALS`] of each, the fastest (median) is kept.
+    fn encode_trial(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, inputs: &GatherInputs) -> Result<()> {
+        // The candidate with the fewest trials so far, in order.
+        let k =
+            (0..self.candidates.len()).min_by_key(|&k| self.candidates[k].trials.len()).expect("a gather candidate");
+        estimator::submit_and_renew(gpu, enc, "gather");
+        gpu.wait()?;
+        let start = Instant::now();
+        self.candidates[k].gather.encode(gpu, enc, inputs)?;
+        estimator::submit_and_renew(gpu, enc, "iteration");
+        gpu.wait()?;
+        self.candidates[k].trials.push(start.elapsed());
+        // Once every candidate has run, drop those whose fastest run is slower than twice the
+        // fastest run of all: the trials cost little beyond the winner's time.
+        let fastest = |c: &Candidate| c.trials.iter().min().copied().unwrap_or(Duration::MAX);
+        if self.candidates.iter().all(|c| !c.trials.is_empty()) {
+            let best = self.candidates.iter().map(fastest).min().unwrap_or(Duration::MAX);
+            self.candidates.retain(|c| fastest(c) <= 2 * best);
+        }
+        if self.candidates.iter().all(|c| c.trials.len() as u32 >= AUTO_TRIALS) {
+            self.choose(gpu);
+        }
+        Ok(())
+    }
+
+    /// Keeps the candidate with the fastest median trial; the traced gather unless another is
+    /// more than [`PREFER_TRACE`] times faster.
+    fn choose(&mut self, gpu: &Gpu) {
+        let median = |v: &[Duration]| {
+            let mut v = v.to_vec();
+            v.sort();
+            v[v.len() / 2]
+        };
+        let times: Vec<(GatherMethod, Duration)> =
+            self.candidates.iter().map(|c| (c.method, median(&c.trials))).collect();
+        let (fastest, t_fastest) = *times.iter().min_by_key(|(_, t)| *t).expect("a gather candidate");
+        // The traced gather is exact and needs no ray-view memory: a raster gather must win
+        // clearly, so that timing noise does not flip the choice between runs.
+        let method = match times.iter().find(|(m, _)| *m == GatherMethod::Trace) {
+            Some(&(_, t_trace)) if t_trace.as_secs_f64() <= PREFER_TRACE * t_fastest.as_secs_f64() => {
+                GatherMethod::Trace
+            }
+            _ => fastest,
+        };
+        let list: Vec<String> = times.iter().map(|(m, t)| format!("{m:?} {:.2} ms", t.as_secs_f64() * 1e3)).collect();
+        log::info!("gather per iteration on {}: {}; using {method:?}", gpu.info.name, list.join(", "));
+        self.candidates.retain(|c| c.method == method);
+        self.chosen = true;
+    }
+}

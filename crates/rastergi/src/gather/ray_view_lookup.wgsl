@@ -1,0 +1,21 @@
+// A visible point's lookup in the ray view (gather/ray_view.rs), for the raster gathers'
+// compute passes: the texel it projects to and the plane test of the texel's triangle.
+
+// The ray-view texel that x projects to, like a shadow-map lookup.
+fn ray_view_texel(x: vec3f) -> vec2u {
+    let clip = gather.view_proj * vec4f(x, 1.0);
+    let uv = vec2f(0.5 * clip.x + 0.5, 0.5 - 0.5 * clip.y) * f32(gather.bundle);
+    return vec2u(clamp(vec2i(floor(uv)), vec2i(0), vec2i(i32(gather.bundle) - 1)));
+}
+
+// Distance along ω from x to the plane of triangle tri; negative when the ray runs parallel to
+// it (a texel's surface counts where x's ray crosses its plane at t > ε).
+fn plane_distance(tri: u32, x: vec3f, w: vec3f) -> f32 {
+    let t = triangles[tri];
+    let n_h = triangle_normal(t);
+    let denom = dot(w, n_h);
+    if abs(denom) < 1e-8 {
+        return -1.0;
+    }
+    return dot(t.v0 - x, n_h) / denom;
+}

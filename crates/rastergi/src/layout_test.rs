@@ -1,0 +1,167 @@
+//! The one check of every Rust/WGSL twin: each composed shader is parsed with naga, and every
+//! struct that Rust also lays out must have the Rust size and member offsets (`size_of`,
+//! `offset_of!`), wherever it appears; the constants that [`crate::shader::constants`]
+//! generates must hold the Rust values in every shader. Members whose names start with `_`
+//! are padding on both sides and are matched by size alone.
+
+use std::collections::BTreeMap;
+use std::mem::{offset_of, size_of};
+
+use crate::bvh::BvhNode;
+use crate::display::DisplayUniforms;
+use crate::film::ResolveUniforms;
+use crate::frame::FrameUniforms;
+use crate::gather::GatherUniforms;
+use crate::gpu_scene::{GpuMaterial, GpuTriangle};
+use crate::lights::LightEntry;
+use crate::path_tracer::PathParams;
+use crate::photons::gpu::{PhotonGridUniforms, PhotonParams};
+
+/// A Rust struct and the name of its WGSL twin.
+struct Twin {
+    rust: &'static str,
+    wgsl: &'static str,
+    size: usize,
+    /// The non-padding fields and their offsets.
+    fields: Vec<(&'static str, usize)>,
+}
+
+macro_rules! twin {
+    ($rust:ty, $wgsl:literal, [$($field:ident),* $(,)?]) => {
+        Twin {
+            rust: stringify!($rust),
+            wgsl: $wgsl,
+            size: size_of::<$rust>(),
+            fields: vec![$((stringify!($field), offset_of!($rust, $field))),*],
+        }
+    };
+}
+
+fn twins() -> Vec<Twin> {
+    vec![
+        twin!(FrameUniforms, "Frame", [view_proj, eye, iteration, resolution, seed, light_samples, ray_epsilon]),
+        twin!(GpuTriangle, "Triangle", [v0, material, v1, v2]),
+        twin!(GpuMaterial, "Material", [albedo, flags, emission, texture]),
+        twin!(BvhNode, "BvhNode", [min, offset, max, count]),
+        twin!(LightEntry, "LightEntry", [triangle, cdf, pmf, area]),
+        twin!(GatherUniforms, "Gather", [view_proj, direction, bundle, count, directions]),
+        twin!(
+            PhotonParams,
+            "PhotonParams",
+            [
+                origin,
+                cell,
+                dims,
+                first_photon,
+                batch_size,
+                seed,
+                inv_photon_count,
+                quantum,
+                ray_epsilon,
+                max_bounces,
+                groups_x
+            ]
+        ),
+        twin!(PhotonGridUniforms, "PhotonGrid", [origin, cell, dims]),
+        twin!(ResolveUniforms, "Resolve", [resolution, samples, show, scale]),
+        twin!(DisplayUniforms, "Display", [image_size, target_size, decode_srgb, text_cols, text_rows, text_scale]),
+        twin!(PathParams, "PathParams", [inv_view_proj, light_weight, light_count, max_bounces, rr_start]),
+    ]
+}
+
+/// Every shader rastergi builds, composed as its pass composes it.
+fn shaders() -> Vec<(&'static str, String)> {
+    use crate::gather::estimator::{RAY_VIEW_LOOKUP, estimate_source};
+    vec![
+        ("gbuffer", crate::gbuffer::source()),
+        ("direct", crate::direct::source()),
+        ("photon view", crate::photon_view::source()),
+        ("gather ray view", crate::gather::ray_view::ray_view_source()),
+        ("gather project", estimate_source(&[RAY_VIEW_LOOKUP, include_str!("gather/raster.wgsl")])),
+        ("gather list project", estimate_source(&[RAY_VIEW_LOOKUP, include_str!("gather/lists.wgsl")])),
+        ("gather trace", estimate_source(&[include_str!("gather/trace.wgsl")])),
+        ("photon trace", crate::photons::gpu::trace_source()),
+        ("resolve", crate::film::resolve_source()),
+        ("display", crate::display::SOURCE.to_string()),
+        ("path tracer", crate::path_tracer::source()),
+    ]
+}
+
+/// The structs of `module` by name: size and member (name, offset, size).
+fn structs(module: &naga::Module) -> BTreeMap<String, (u32, Vec<(String, u32, u32)>)> {
+    let mut layouter = naga::proc::Layouter::default();
+    layouter.update(module.to_ctx()).expect("layouts of a parsed module");
+    let mut out = BTreeMap::new();
+    for (_, ty) in module.types.iter() {
+        if let (Some(name), naga::TypeInner::Struct { members, span }) = (&ty.name, &ty.inner) {
+            let members =
+                members.iter().map(|m| (m.name.clone().unwrap_or_default(), m.offset, layouter[m.ty].size)).collect();
+            out.insert(name.clone(), (*span, members));
+        }
+    }
+    out
+}
+
+/// The u32 constants of `module` by name.
+fn u32_constants(module: &naga::Module) -> BTreeMap<String, u32> {
+    let mut out = BTreeMap::new();
+    for (_, c) in module.constants.iter() {
+        if let (Some(name), naga::Expression::Literal(naga::Literal::U32(v))) =
+            (&c.name, &module.global_expressions[c.init])
+        {
+            out.insert(name.clone(), *v);
+        }
+    }
+    out
+}
+
+#[test]
+fn every_rust_wgsl_twin_has_the_same_size_and_offsets_in_every_shader() {
+    let twins = twins();
+    let mut seen: BTreeMap<&str, usize> = BTreeMap::new();
+    for (label, source) in shaders() {
+        let module =
+            naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| panic!("{label}: {}", e.emit_to_string(&source)));
+        let structs = structs(&module);
+        for twin in &twins {
+            let Some((span, members)) = structs.get(twin.wgsl) else { continue };
+            *seen.entry(twin.rust).or_default() += 1;
+            let at = format!("{} ↔ {} in the {label} shader", twin.rust, twin.wgsl);
+            assert_eq!(*span as usize, twin.size, "{at}: size");
+            let named: Vec<&(String, u32, u32)> = members.iter().filter(|m| !m.0.starts_with('_')).collect();
+            for (name, offset, _) in &named {
+                let rust = twin.fields.iter().find(|f| f.0 == name.as_str());
+                let rust = rust.unwrap_or_else(|| panic!("{at}: WGSL member {name} has no Rust field"));
+                assert_eq!(*offset as usize, rust.1, "{at}: offset of {name}");
+            }
+            for (field, _) in &twin.fields {
+                assert!(named.iter().any(|m| m.0 == *field), "{at}: Rust field {field} has no WGSL member");
+            }
+        }
+    }
+    for twin in &twins {
+        assert!(seen.contains_key(twin.rust), "{} ↔ {}: in no shader", twin.rust, twin.wgsl);
+    }
+}
+
+#[test]
+fn every_shader_holds_the_rust_constants() {
+    // The generated declarations, parsed back: what every composed shader must hold.
+    let generated = crate::shader::constants();
+    let expected = u32_constants(&naga::front::wgsl::parse_str(&generated).expect("the generated constants parse"));
+    assert!(expected.len() >= 9, "{expected:?}");
+    assert_eq!(expected["MAX_DIRECTIONS"], crate::gather::MAX_DIRECTIONS);
+    assert_eq!(expected["NO_TEXTURE"], crate::gpu_scene::NO_TEXTURE);
+    assert_eq!(expected["STREAM_PHOTON"], crate::sampling::stream::PHOTON);
+    for (label, source) in shaders() {
+        if label == "display" {
+            continue; // draws an image; no shared constant
+        }
+        let module =
+            naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| panic!("{label}: {}", e.emit_to_string(&source)));
+        let constants = u32_constants(&module);
+        for (name, value) in &expected {
+            assert_eq!(constants.get(name), Some(value), "{label}: {name}");
+        }
+    }
+}

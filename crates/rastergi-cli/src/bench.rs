@@ -16,7 +16,7 @@ use rastergi::photon_map::GridSpec;
 use rastergi::photons::{PhotonSettings, cpu, gpu::GpuPhotonMap};
 use rastergi::renderer::{RenderSettings, Renderer, default_bundle};
 
-use crate::render::{GatherArg, GpuArgs, gpu, gpu_profiled, load_scene, print_profile};
+use crate::args::{GatherArg, GpuArgs, gpu, gpu_profiled, load_scene, print_profile};
 use rastergi::gather::GatherMethod;
 
 #[derive(Subcommand, Debug)]

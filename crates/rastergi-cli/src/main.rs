@@ -1,5 +1,6 @@
 //! `rastergi`: the command-line front end. All rendering lives in the `rastergi` library.
 
+mod args;
 mod bench;
 mod compare;
 mod export;
@@ -27,7 +28,7 @@ enum Command {
     /// Print the GPU adapter, backend, driver and the limits that matter.
     Info {
         #[command(flatten)]
-        gpu: render::GpuArgs,
+        gpu: args::GpuArgs,
     },
     /// Render a scene progressively and write the image (.exr linear, .png display).
     Render(render::RenderArgs),
@@ -75,7 +76,7 @@ fn main() -> ExitCode {
         quiet_wayland_probe();
     }
     let result = match cli.command {
-        Command::Info { gpu } => render::gpu(&gpu).map(|g| println!("{}", g.describe())),
+        Command::Info { gpu } => args::gpu(&gpu).map(|g| println!("{}", g.describe())),
         Command::Render(args) => render::run(&args),
         Command::Bench(command) => bench::run(&command),
         Command::Compare(args) => compare::run(&args),

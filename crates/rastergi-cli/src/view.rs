@@ -39,7 +39,7 @@ use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop, EventLoopProxy}
 use winit::keyboard::{Key as LogicalKey, KeyCode, NamedKey, PhysicalKey};
 use winit::window::{Window, WindowId};
 
-use crate::render::SceneArgs;
+use crate::args::SceneArgs;
 use crate::script::{self, Action, Step, When};
 
 /// The keys and mouse bindings (a macro so that `--help` can join it to the script text).
@@ -489,7 +489,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         scene: Arc::new(scene),
         controls: Controls::new(camera, a.show.show(), a.exposure.unwrap_or(0.0), base.photons, base.grid_resolution),
         base,
-        gpu_options: GpuOptions { backends: a.gpu.backend(), ..Default::default() },
+        gpu_options: a.gpu.options(),
         proxy: event_loop.create_proxy(),
         window: None,
         gpu: None,

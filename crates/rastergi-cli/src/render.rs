@@ -11,6 +11,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use rastergi::fit;
 use rastergi::image_io::{ImageFormat, write_exr, write_png};
 use rastergi::path_tracer::PathTracer;
+use rastergi::progressive::Progressive;
 use rastergi::renderer::Renderer;
 
 use crate::args::{SceneArgs, ShowArg, gpu_profiled, print_profile};
@@ -38,30 +39,6 @@ pub struct RenderArgs {
 enum Method {
     Gather,
     Path,
-}
-
-/// The two progressive renderers behind one loop.
-enum Progressive {
-    Gather(Box<Renderer>),
-    Path(Box<PathTracer>),
-}
-
-impl Progressive {
-    fn iterate(&mut self) -> Result<()> {
-        match self {
-            Progressive::Gather(r) => r.iterate()?,
-            Progressive::Path(p) => p.iterate(),
-        }
-        Ok(())
-    }
-
-    fn wait(&self) -> Result<()> {
-        match self {
-            Progressive::Gather(r) => r.wait()?,
-            Progressive::Path(p) => p.wait()?,
-        }
-        Ok(())
-    }
 }
 
 /// Refuses, before any rendering, an output path the image could never be written to.
@@ -99,15 +76,20 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     let settings = a.settings(&scene, a.width, a.height, matches!(a.show, ShowArg::PhotonMap));
     let start = Instant::now();
-    let mut renderer = match args.method {
-        Method::Gather => Progressive::Gather(Box::new(Renderer::new(&gpu, &scene, settings)?)),
-        Method::Path => Progressive::Path(Box::new(PathTracer::new(&gpu, &scene, settings)?)),
+    // `bundle`: the photon-map renderer's gather ray view, for the log.
+    let (mut renderer, bundle): (Box<dyn Progressive>, Option<u32>) = match args.method {
+        Method::Gather => {
+            let r = Renderer::new(&gpu, &scene, settings)?;
+            let bundle = r.bundle();
+            (Box::new(r), Some(bundle))
+        }
+        Method::Path => (Box::new(PathTracer::new(&gpu, &scene, settings)?), None),
     };
     renderer.wait()?;
     log::info!("set-up (BVH, upload, photon map) in {:.2} s", start.elapsed().as_secs_f64());
     print_profile(&gpu, args.profile, "set-up", 1, "set-up")?;
-    if let Progressive::Gather(r) = &renderer {
-        log::info!("gather ray view: {0}x{0} texels", r.bundle());
+    if let Some(bundle) = bundle {
+        log::info!("gather ray view: {bundle}x{bundle} texels");
     }
     let start = Instant::now();
 
@@ -144,10 +126,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     print_profile(&gpu, args.profile, "iterations", args.iterations as u64, "iteration")?;
 
     let show = a.show.show();
-    let linear = match &renderer {
-        Progressive::Gather(r) => r.read_linear(show)?,
-        Progressive::Path(p) => p.read_linear()?,
-    };
+    let linear = renderer.read_linear(show)?;
     if format == ImageFormat::Exr {
         return Ok(write_exr(&args.out, &linear)?);
     }
@@ -160,10 +139,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         }
         fitted
     });
-    let display = match &renderer {
-        Progressive::Gather(r) => r.read_display(show, exposure)?,
-        Progressive::Path(p) => p.read_display(exposure)?,
-    };
+    let display = renderer.read_display(show, exposure)?;
     write_png(&args.out, &display)?;
     Ok(())
 }

@@ -5,7 +5,6 @@ mod bench;
 mod compare;
 mod export;
 mod render;
-mod script;
 mod view;
 
 use std::process::ExitCode;

@@ -56,7 +56,8 @@ impl ShowArg {
 /// How the final gather finds the nearest surface along its direction.
 #[derive(Copy, Clone, Debug, ValueEnum)]
 pub enum GatherArg {
-    /// Time both on the first iterations and keep the faster on this GPU.
+    /// Time each on the first iterations and keep the fastest on this GPU (trace unless
+    /// another is over 1.25× faster).
     Auto,
     /// Depth-peeled orthographic ray views (rasterization).
     Raster,
@@ -123,8 +124,8 @@ pub struct SceneArgs {
     /// the scene's bounding sphere; 128 to 2048).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
     pub bundle: Option<u32>,
-    /// How the final gather finds the nearest surface along each direction (the same
-    /// estimator either way).
+    /// How the final gather finds the nearest surface along each direction (three
+    /// implementations of the same estimator).
     #[arg(long, value_enum, default_value_t = GatherArg::Auto)]
     pub gather: GatherArg,
     /// Gather directions per iteration (1–16): they share the iteration's G-buffer and direct

@@ -23,7 +23,7 @@ pub struct GatherArgs {
     /// Eye resolutions (square) for the throughput figures.
     #[arg(long, value_delimiter = ',', default_values_t = [512u32, 1024])]
     sizes: Vec<u32>,
-    /// Ray-view resolution.
+    /// Ray-view resolution of the raster gathers (raster, lists).
     #[arg(long, default_value_t = 1024)]
     bundle: u32,
     /// Timed iterations per size (after two warm-up iterations).

@@ -20,13 +20,14 @@ pub struct MemoryArgs {
     /// Photon grid cells along the scene's longest axis.
     #[arg(long, default_value_t = 128)]
     grid: u32,
-    /// Ray-view resolution of the raster gather.
+    /// Ray-view resolution of the raster gathers (raster, lists).
     #[arg(long, default_value_t = 2048)]
     bundle: u32,
     /// Photons traced (the count does not change the memory).
     #[arg(long, default_value_t = 1 << 16)]
     photons: u32,
-    /// The gather implementation: auto (both exist until the faster is chosen), raster, trace.
+    /// The gather implementation: auto (all three exist until the fastest is chosen), raster,
+    /// lists, trace.
     #[arg(long, value_enum, default_value_t = GatherArg::Auto)]
     gather: GatherArg,
     #[command(flatten)]

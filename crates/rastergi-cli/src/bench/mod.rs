@@ -24,7 +24,8 @@ use crate::args::load_scene;
 pub enum BenchCommand {
     /// Photons per second on the GPU and on the CPU twin, same scene and count.
     Photons(photons::PhotonArgs),
-    /// Gather directions per second, and the time to reach a target error against a reference.
+    /// Gather directions per second of each implementation (raster, lists, trace), and the time
+    /// to reach a target error against a reference.
     Gather(gather::GatherArgs),
     /// Relative RMSE against time for the photon/gather pipeline and the path tracer: CSV and plot.
     Converge(converge::ConvergeArgs),

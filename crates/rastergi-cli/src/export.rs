@@ -7,7 +7,7 @@ use anyhow::Result;
 use clap::Args;
 use rastergi::scene::export::write_obj;
 
-use crate::render::load_scene;
+use crate::args::load_scene;
 
 #[derive(Args, Debug)]
 pub struct ExportArgs {

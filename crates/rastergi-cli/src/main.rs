@@ -1,10 +1,10 @@
 //! `rastergi`: the command-line front end. All rendering lives in the `rastergi` library.
 
+mod args;
 mod bench;
 mod compare;
 mod export;
 mod render;
-mod script;
 mod view;
 
 use std::process::ExitCode;
@@ -27,11 +27,11 @@ enum Command {
     /// Print the GPU adapter, backend, driver and the limits that matter.
     Info {
         #[command(flatten)]
-        gpu: render::GpuArgs,
+        gpu: args::GpuArgs,
     },
     /// Render a scene progressively and write the image (.exr linear, .png display).
     Render(render::RenderArgs),
-    /// Measure throughput: `bench photons`, `bench gather`.
+    /// Measure throughput, convergence and memory: `bench photons`, `gather`, `converge`, `bvh`, `memory`.
     #[command(subcommand)]
     Bench(bench::BenchCommand),
     /// Compare an image with a reference: relative RMSE, block-mean error, PSNR, mean ratios.
@@ -75,7 +75,7 @@ fn main() -> ExitCode {
         quiet_wayland_probe();
     }
     let result = match cli.command {
-        Command::Info { gpu } => render::gpu(&gpu).map(|g| println!("{}", g.describe())),
+        Command::Info { gpu } => args::gpu(&gpu).map(|g| println!("{}", g.describe())),
         Command::Render(args) => render::run(&args),
         Command::Bench(command) => bench::run(&command),
         Command::Compare(args) => compare::run(&args),

@@ -1,71 +1,28 @@
-//! `rastergi view`: a window showing the progressive image as it converges; the camera moves
-//! with the keyboard and mouse, and every move restarts the accumulation (the photon map is
-//! kept).
-//!
-//! The loop, per displayed frame: apply held keys and the script's due steps to the camera;
-//! if the camera moved, `Renderer::set_camera` restarts the image; run as many iterations as
-//! fit in [`FRAME_BUDGET`] of GPU time (at least one); resolve the film and draw it with the
-//! overlay ([`rastergi::display`]); present. Building a renderer (photon tracing) runs on a
-//! worker thread so the window stays live meanwhile; a new photon count or grid
-//! builds a new renderer at the window's size (the film is the window's size) and shows the
-//! old image, scaled, until it is ready. A resize alone keeps the scene and photon map and
-//! rebuilds only the size-dependent passes (`Renderer::resize`). While the window is minimised, occluded or zero-sized
-//! the loop waits for events and renders nothing.
-//!
-//! The overlay (top left; H hides it) shows the iterations, iterations per second, photons,
-//! grid and bundle resolution, what is shown, the exposure and the drag mode; the window title
-//! repeats the main figures. It is drawn with a small bitmap font in the display shader: the
-//! egui-wgpu releases built on wgpu 30 require Rust 1.95, above this project's 1.88.
-//!
-//! Scripts (`--script`) are described in [`crate::script`].
+//! The winit application of `rastergi view`: the window and its surface, renderers built on
+//! a worker thread, the frame loop (held keys, script steps, batched iterations, resolve,
+//! overlay, present), resizes and screenshots. Input is interpreted by [`super::controls`].
 
-use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use anyhow::{Context, Result, anyhow, bail};
-use clap::Args;
-use rastergi::camera_control::{CameraControl, Mode, MoveKeys};
+use anyhow::{Result, anyhow};
+use rastergi::camera_control::CameraControl;
 use rastergi::display::{Presented, WindowSurface};
 use rastergi::film::Show;
 use rastergi::gpu::{Gpu, GpuOptions};
-use rastergi::image_io::{write_exr, write_png};
 use rastergi::renderer::{RenderSettings, Renderer, default_bundle};
-use rastergi::scene::{Camera, Scene};
+use rastergi::scene::Scene;
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
 use winit::event::{ElementState, KeyEvent, MouseButton, MouseScrollDelta, WindowEvent};
-use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop, EventLoopProxy};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoopProxy};
 use winit::keyboard::{Key as LogicalKey, KeyCode, NamedKey, PhysicalKey};
 use winit::window::{Window, WindowId};
 
-use crate::render::SceneArgs;
-use crate::script::{self, Action, Step, When};
-
-/// The keys and mouse bindings (a macro so that `--help` can join it to the script text).
-macro_rules! keys_text {
-    () => {
-        "\
-Keys and mouse:
-  W A S D / Q E     fly forward, left, back, right / down, up (Shift: 4x faster)
-  left drag         look around (fly mode) or orbit the target (orbit mode)
-  right drag        pan
-  scroll            zoom toward the target
-  Tab               switch fly / orbit mode
-  Home              back to the starting camera
-  1 2 3 4           show full / direct / indirect / photon map (no restart)
-  + -               exposure up / down by half a stop
-  [ ]               halve / double the photons (re-traces the photon map)
-  , .               halve / double the photon grid resolution (re-traces)
-  P                 screenshot: rastergi-NNNN.png (as shown) and .exr (linear)
-  H                 hide / show the overlay
-  Esc               quit
-Any camera move restarts the accumulation; the photon map is kept.\n"
-    };
-}
-
-/// The keys, for the start-up message.
-pub const KEYS: &str = keys_text!();
+use super::controls::{Controls, Key, Response, camera_options, show_name};
+use super::screenshots::Screenshots;
+use super::script::{Action, Step, When};
+use crate::args::SceneArgs;
 
 /// GPU time aimed at per displayed frame: iterations are batched up to this.
 pub const FRAME_BUDGET: Duration = Duration::from_millis(30);
@@ -75,56 +32,6 @@ const MAX_BATCH: u32 = 64;
 const RESIZE_SETTLE: Duration = Duration::from_millis(150);
 /// How long a script's `resize` may wait for the window to take the new size.
 const RESIZE_TIMEOUT: Duration = Duration::from_secs(10);
-
-#[derive(Args, Debug)]
-pub struct ViewArgs {
-    #[command(flatten)]
-    scene: SceneArgs,
-    /// Timed actions to run, one per line (see `rastergi view --help` for the format).
-    #[arg(long)]
-    script: Option<PathBuf>,
-    /// Directory for screenshots (default: the current directory).
-    #[arg(long)]
-    screenshot_dir: Option<PathBuf>,
-}
-
-/// The `after_help` of `rastergi view`: the keys and the script format.
-pub const AFTER_HELP: &str = concat!(
-    keys_text!(),
-    "
-Script (--script FILE): one action per line, optionally after a condition; # comments.
-  after N iterations: ACTION   once the image holds N iterations since its last restart
-  after T s: ACTION            T seconds after the previous line
-  ACTION                       right after the previous line
-Actions: move R,U,F | look YAW,PITCH | orbit YAW,PITCH | pan X,Y | zoom STEPS |
-  mode fly|orbit | show full|direct|indirect|photon-map | exposure EV | photons N |
-  grid N | resize W,H | screenshot | quit
-Each screenshot prints its files and the camera as render options to stdout."
-);
-
-/// A key that means something to the viewer.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Key {
-    Forward,
-    Back,
-    Left,
-    Right,
-    Up,
-    Down,
-    Fast,
-    ToggleMode,
-    Home,
-    Show(Show),
-    ExposureUp,
-    ExposureDown,
-    FewerPhotons,
-    MorePhotons,
-    CoarserGrid,
-    FinerGrid,
-    Screenshot,
-    ToggleOverlay,
-    Quit,
-}
 
 /// The viewer's meaning of a keyboard event: movement by key position (WASD wherever the
 /// layout puts those letters), the rest by position or by the character typed.
@@ -167,225 +74,6 @@ fn key_of(event: &KeyEvent) -> Option<Key> {
     }
 }
 
-/// What the application must do after an input.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Response {
-    /// The camera moved: restart the accumulation.
-    pub camera_moved: bool,
-    /// The photon settings changed: build a new renderer (new photon map).
-    pub retrace: bool,
-    pub screenshot: bool,
-    pub quit: bool,
-}
-
-/// Exposure step of the + and - keys, in stops.
-pub const EXPOSURE_STEP: f32 = 0.5;
-
-/// The viewer's interactive state, free of any window: the camera controller, held keys,
-/// what is shown and the photon settings. Inputs come in as [`Key`]s, drags and scrolls and
-/// return what the application must do.
-#[derive(Clone, Debug)]
-pub struct Controls {
-    pub camera: CameraControl,
-    home: CameraControl,
-    pub keys: MoveKeys,
-    pub show: Show,
-    pub exposure: f32,
-    pub photons: u32,
-    pub grid: u32,
-    pub overlay: bool,
-}
-
-impl Controls {
-    pub fn new(camera: CameraControl, show: Show, exposure: f32, photons: u32, grid: u32) -> Controls {
-        Controls {
-            home: camera.clone(),
-            camera,
-            keys: MoveKeys::default(),
-            show,
-            exposure,
-            photons,
-            grid,
-            overlay: true,
-        }
-    }
-
-    /// A key went down (`pressed`) or up. Held keys (movement, Shift) act in [`tick`](Self::tick).
-    pub fn key(&mut self, key: Key, pressed: bool, repeat: bool) -> Response {
-        let mut r = Response::default();
-        let held = match key {
-            Key::Forward => Some(&mut self.keys.forward),
-            Key::Back => Some(&mut self.keys.back),
-            Key::Left => Some(&mut self.keys.left),
-            Key::Right => Some(&mut self.keys.right),
-            Key::Up => Some(&mut self.keys.up),
-            Key::Down => Some(&mut self.keys.down),
-            Key::Fast => Some(&mut self.keys.fast),
-            _ => None,
-        };
-        if let Some(state) = held {
-            *state = pressed;
-            return r;
-        }
-        if !pressed {
-            return r;
-        }
-        // Auto-repeat steps the exposure; other keys act once per press.
-        match key {
-            Key::ExposureUp => self.exposure += EXPOSURE_STEP,
-            Key::ExposureDown => self.exposure -= EXPOSURE_STEP,
-            _ if repeat => {}
-            Key::ToggleMode => self.camera.toggle_mode(),
-            Key::Home => {
-                let (mode, speed) = (self.camera.mode, self.camera.speed);
-                r.camera_moved = self.camera.camera() != self.home.camera();
-                self.camera = self.home.clone();
-                (self.camera.mode, self.camera.speed) = (mode, speed);
-            }
-            Key::Show(show) => self.show = show,
-            Key::FewerPhotons => r.retrace = self.set_photons(self.photons / 2),
-            Key::MorePhotons => r.retrace = self.set_photons(self.photons.saturating_mul(2)),
-            Key::CoarserGrid => r.retrace = self.set_grid(self.grid / 2),
-            Key::FinerGrid => r.retrace = self.set_grid(self.grid * 2),
-            Key::Screenshot => r.screenshot = true,
-            Key::ToggleOverlay => self.overlay = !self.overlay,
-            Key::Quit => r.quit = true,
-            _ => {}
-        }
-        r
-    }
-
-    /// Photons for the next photon map (at least 1); whether that is a change.
-    pub fn set_photons(&mut self, photons: u32) -> bool {
-        let photons = photons.max(1);
-        std::mem::replace(&mut self.photons, photons) != photons
-    }
-
-    /// Grid resolution for the next photon map (1 to 1024); whether that is a change.
-    pub fn set_grid(&mut self, grid: u32) -> bool {
-        let grid = grid.clamp(1, 1024);
-        std::mem::replace(&mut self.grid, grid) != grid
-    }
-
-    /// Time passes with the held keys down: fly.
-    pub fn tick(&mut self, dt: f32) -> Response {
-        Response { camera_moved: self.camera.fly(&self.keys, dt), ..Default::default() }
-    }
-
-    /// A drag by `(dx, dy)` pixels with the left (look/orbit) or right (pan) button.
-    pub fn drag(&mut self, dx: f32, dy: f32, pan: bool, viewport_height: f32) -> Response {
-        let moved = if pan { self.camera.pan(dx, dy, viewport_height) } else { self.camera.drag(dx, dy) };
-        Response { camera_moved: moved, ..Default::default() }
-    }
-
-    /// Scroll by `steps` notches (positive: toward the target).
-    pub fn scroll(&mut self, steps: f32) -> Response {
-        Response { camera_moved: self.camera.zoom(steps), ..Default::default() }
-    }
-
-    /// Keys are no longer reported once the window loses focus: release them all.
-    pub fn release_keys(&mut self) {
-        self.keys = MoveKeys::default();
-    }
-
-    /// A script action that the controls handle (camera, show, exposure, photon settings).
-    pub fn action(&mut self, action: &Action, viewport_height: f32) -> Response {
-        let mut r = Response::default();
-        let c = &mut self.camera;
-        match *action {
-            Action::Move { right, up, forward } => r.camera_moved = c.translate(right, up, forward),
-            Action::Look { yaw_deg, pitch_deg } => {
-                r.camera_moved = c.look(yaw_deg.to_radians(), pitch_deg.to_radians())
-            }
-            Action::Orbit { yaw_deg, pitch_deg } => {
-                r.camera_moved = c.orbit(yaw_deg.to_radians(), pitch_deg.to_radians())
-            }
-            Action::Pan { dx, dy } => r.camera_moved = c.pan(dx, dy, viewport_height),
-            Action::Zoom { steps } => r.camera_moved = c.zoom(steps),
-            Action::Mode { orbit } => {
-                if (c.mode == Mode::Orbit) != orbit {
-                    c.toggle_mode();
-                }
-            }
-            Action::Show(show) => self.show = show,
-            Action::Exposure(ev) => self.exposure = ev,
-            Action::Photons(n) => r.retrace = self.set_photons(n),
-            Action::Grid(n) => r.retrace = self.set_grid(n),
-            Action::Screenshot => r.screenshot = true,
-            Action::Quit => r.quit = true,
-            Action::Resize { .. } => {}
-        }
-        r
-    }
-}
-
-/// The camera as `render` options, with every value printed so that it parses back to the
-/// same f32.
-pub fn camera_options(c: &Camera) -> String {
-    let v = |v: glam::Vec3| format!("{},{},{}", v.x, v.y, v.z);
-    format!("--eye {} --target {} --up {} --fov {}", v(c.eye), v(c.target), v(c.up), c.fov_y_deg)
-}
-
-fn show_name(show: Show) -> &'static str {
-    match show {
-        Show::Full => "full",
-        Show::Direct => "direct",
-        Show::Indirect => "indirect",
-        Show::PhotonMap => "photon-map",
-    }
-}
-
-/// Screenshot names `rastergi-NNNN.png` / `.exr` in a directory, counting up.
-struct Screenshots {
-    dir: PathBuf,
-    next: u32,
-}
-
-impl Screenshots {
-    /// Reserves the first `rastergi-NNNN` at or after the counter for which neither the PNG
-    /// nor the EXR exists, by creating both empty (`create_new`): existing files are never
-    /// overwritten, and another viewer saving into the same directory cannot take the name.
-    fn reserve(&mut self) -> Result<(PathBuf, PathBuf)> {
-        for n in self.next..=9999 {
-            let png = self.dir.join(format!("rastergi-{n:04}.png"));
-            let exr = self.dir.join(format!("rastergi-{n:04}.exr"));
-            let create = |p: &Path| std::fs::OpenOptions::new().write(true).create_new(true).open(p);
-            match create(&png) {
-                Ok(_) => {}
-                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
-                Err(e) => return Err(e).with_context(|| format!("{}: cannot create the screenshot", png.display())),
-            }
-            match create(&exr) {
-                Ok(_) => {}
-                Err(e) => {
-                    let _ = std::fs::remove_file(&png);
-                    if e.kind() == std::io::ErrorKind::AlreadyExists {
-                        continue;
-                    }
-                    return Err(e).with_context(|| format!("{}: cannot create the screenshot", exr.display()));
-                }
-            }
-            self.next = n + 1;
-            return Ok((png, exr));
-        }
-        bail!("{}: rastergi-0000 to rastergi-9999 are all taken; choose another --screenshot-dir", self.dir.display())
-    }
-
-    /// Saves the image as shown (PNG) and its linear radiance (EXR); returns the two paths.
-    fn save(&mut self, renderer: &Renderer, show: Show, exposure: f32) -> Result<(PathBuf, PathBuf)> {
-        let display = renderer.read_display(show, exposure)?;
-        let linear = renderer.read_linear(show)?;
-        let (png, exr) = self.reserve()?;
-        let written = write_png(&png, &display).and_then(|()| write_exr(&exr, &linear));
-        if let Err(e) = written {
-            let _ = std::fs::remove_file(&png);
-            let _ = std::fs::remove_file(&exr);
-            return Err(e.into());
-        }
-        Ok((png, exr))
-    }
-}
-
 /// Iterations per second over the last half second or more.
 struct Rate {
     since: Instant,
@@ -406,7 +94,7 @@ impl Rate {
 }
 
 /// A renderer being built on a worker thread.
-enum UserEvent {
+pub enum UserEvent {
     Built { generation: u64, result: Result<Renderer, String> },
 }
 
@@ -420,7 +108,8 @@ struct ScriptRun {
     resizing: Option<((u32, u32), Instant)>,
 }
 
-struct App {
+/// The viewer: its window, GPU, renderer, controls and script.
+pub struct App {
     args_scene: String,
     scene: Arc<Scene>,
     base: RenderSettings,
@@ -453,87 +142,63 @@ struct App {
     error: Option<anyhow::Error>,
 }
 
-pub fn run(args: &ViewArgs) -> Result<()> {
-    // Everything that can be checked without a window is checked first.
-    let steps = args.script.as_deref().map(script::load).transpose()?;
-    // No directory: names relative to the current directory, printed as such.
-    let dir = args.screenshot_dir.clone().unwrap_or_default();
-    if args.screenshot_dir.is_some() && !dir.is_dir() {
-        bail!(
-            "{}: the screenshot directory does not exist; create it first or choose another --screenshot-dir",
-            dir.display()
-        );
-    }
-    let a = &args.scene;
-    let scene = a.load_scene()?;
-    let base = a.settings(&scene, a.width, a.height, true);
-    // Building the first renderer validates the rest; check the size here for a clear error.
-    if a.width == 0 || a.height == 0 {
-        bail!("the window size {}x{} is empty; give a --width and --height of at least 1", a.width, a.height);
-    }
-
-    check_display()?;
-    let event_loop = EventLoop::<UserEvent>::with_user_event().build().map_err(|e| {
-        // winit's OS errors start with the source location that raised them: keep the message.
-        let message = e.to_string();
-        let message = match message.strip_prefix("os error at ") {
-            Some(rest) => rest.split_once(": ").map_or(rest, |(_, m)| m).to_owned(),
-            None => message,
-        };
-        anyhow!("cannot open a window: {message} (DISPLAY={})", std::env::var("DISPLAY").unwrap_or_default())
-    })?;
-    println!("rastergi view: {}\n{KEYS}", a.scene);
-    let camera = CameraControl::new(&scene.camera, &scene.bounds());
-    let mut app = App {
-        args_scene: a.scene.clone(),
-        scene: Arc::new(scene),
-        controls: Controls::new(camera, a.show.show(), a.exposure.unwrap_or(0.0), base.photons, base.grid_resolution),
-        base,
-        gpu_options: GpuOptions { backends: a.gpu.backend(), ..Default::default() },
-        proxy: event_loop.create_proxy(),
-        window: None,
-        gpu: None,
-        surface: None,
-        renderer: None,
-        building: None,
-        generation: 0,
-        size: (a.width, a.height),
-        resized_at: None,
-        occluded: false,
-        retry_at: None,
-        dragging: (false, false),
-        cursor: None,
-        last_frame: Instant::now(),
-        batch: 1,
-        rate: Rate { since: Instant::now(), count: 0, per_second: 0.0 },
-        title_at: Instant::now(),
-        status: String::new(),
-        script: steps.map(|steps| ScriptRun { steps, next: 0, last: Instant::now(), resizing: None }),
-        screenshots: Screenshots { dir, next: 1 },
-        error: None,
-    };
-    event_loop.run_app(&mut app).map_err(|e| anyhow!("the window's event loop failed: {e}"))?;
-    match app.error {
-        Some(e) => Err(e),
-        None => Ok(()),
-    }
-}
-
-/// On X11/Wayland systems, refuses to start without a display to talk to.
-fn check_display() -> Result<()> {
-    if cfg!(all(unix, not(any(target_os = "macos", target_os = "ios", target_os = "android"))))
-        && ["DISPLAY", "WAYLAND_DISPLAY", "WAYLAND_SOCKET"]
-            .iter()
-            .all(|v| std::env::var_os(v).is_none_or(|s| s.is_empty()))
-    {
-        bail!(
-            "cannot open a window: no display (DISPLAY and WAYLAND_DISPLAY are not set); run it in a desktop session, under xvfb-run, or use `rastergi render` for images without a window"
-        );
-    }
-    Ok(())
-}
-
 impl App {
+    /// The viewer of `scene` for the options `a`, before its window opens (that happens once
+    /// the event loop starts): renderers get `base` at the window's size, the script's `steps`
+    /// run as they fall due, and build results come back through `proxy`.
+    pub fn new(
+        a: &SceneArgs,
+        scene: Scene,
+        base: RenderSettings,
+        steps: Option<Vec<Step>>,
+        screenshots: Screenshots,
+        proxy: EventLoopProxy<UserEvent>,
+    ) -> App {
+        let camera = CameraControl::new(&scene.camera, &scene.bounds());
+        App {
+            args_scene: a.scene.clone(),
+            scene: Arc::new(scene),
+            controls: Controls::new(
+                camera,
+                a.show.show(),
+                a.exposure.unwrap_or(0.0),
+                base.photons,
+                base.grid_resolution,
+            ),
+            base,
+            gpu_options: a.gpu.options(),
+            proxy,
+            window: None,
+            gpu: None,
+            surface: None,
+            renderer: None,
+            building: None,
+            generation: 0,
+            size: (a.width, a.height),
+            resized_at: None,
+            occluded: false,
+            retry_at: None,
+            dragging: (false, false),
+            cursor: None,
+            last_frame: Instant::now(),
+            batch: 1,
+            rate: Rate { since: Instant::now(), count: 0, per_second: 0.0 },
+            title_at: Instant::now(),
+            status: String::new(),
+            script: steps.map(|steps| ScriptRun { steps, next: 0, last: Instant::now(), resizing: None }),
+            screenshots,
+            error: None,
+        }
+    }
+
+    /// Once the event loop has returned: the error that stopped the viewer, if any.
+    pub fn finish(self) -> Result<()> {
+        match self.error {
+            Some(e) => Err(e),
+            None => Ok(()),
+        }
+    }
+
     /// Stops with an error (reported once the event loop has returned).
     fn fail(&mut self, event_loop: &ActiveEventLoop, e: anyhow::Error) {
         if self.error.is_none() {
@@ -994,123 +659,5 @@ impl ApplicationHandler<UserEvent> for App {
         }
         event_loop.set_control_flow(ControlFlow::Wait);
         self.redraw();
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use glam::Vec3;
-    use rastergi::scene::Aabb;
-
-    fn controls() -> Controls {
-        let camera = Camera { eye: Vec3::new(0.0, 0.0, 3.9), target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 39.3077 };
-        let bounds = Aabb { min: Vec3::splat(-1.0), max: Vec3::splat(1.0) };
-        Controls::new(CameraControl::new(&camera, &bounds), Show::Full, 0.0, 1 << 20, 64)
-    }
-
-    #[test]
-    fn held_movement_keys_move_the_camera_on_tick_and_restart_the_image() {
-        let mut c = controls();
-        assert_eq!(c.key(Key::Forward, true, false), Response::default(), "pressing alone does nothing yet");
-        let before = c.camera.camera();
-        assert!(c.tick(0.1).camera_moved);
-        assert!(c.camera.camera().eye.z < before.eye.z);
-        c.key(Key::Forward, false, false);
-        assert!(!c.tick(0.1).camera_moved, "released: no move, no restart");
-        c.key(Key::Left, true, false);
-        c.release_keys();
-        assert!(!c.tick(0.1).camera_moved, "focus lost: keys released");
-    }
-
-    #[test]
-    fn show_exposure_mode_and_overlay_keys_do_not_restart() {
-        let mut c = controls();
-        let camera = c.camera.camera();
-        for key in [
-            Key::Show(Show::PhotonMap),
-            Key::ExposureUp,
-            Key::ExposureUp,
-            Key::ExposureDown,
-            Key::ToggleMode,
-            Key::ToggleOverlay,
-            Key::Fast,
-        ] {
-            assert_eq!(c.key(key, true, false), Response::default(), "{key:?}");
-        }
-        assert_eq!((c.show, c.exposure, c.camera.mode, c.overlay), (Show::PhotonMap, 0.5, Mode::Orbit, false));
-        assert_eq!(c.camera.camera(), camera);
-        assert_eq!(c.action(&Action::Show(Show::Direct), 64.0), Response::default());
-        assert_eq!(c.action(&Action::Mode { orbit: false }, 64.0), Response::default());
-    }
-
-    #[test]
-    fn drags_scrolls_and_camera_actions_restart_and_home_returns() {
-        let mut c = controls();
-        let home = c.camera.camera();
-        assert!(c.drag(10.0, 0.0, false, 64.0).camera_moved);
-        assert!(c.drag(3.0, 2.0, true, 64.0).camera_moved);
-        assert!(c.scroll(1.0).camera_moved);
-        for a in [
-            Action::Move { right: 0.1, up: 0.0, forward: 0.0 },
-            Action::Look { yaw_deg: 5.0, pitch_deg: 0.0 },
-            Action::Orbit { yaw_deg: 5.0, pitch_deg: 1.0 },
-            Action::Pan { dx: 1.0, dy: 0.0 },
-            Action::Zoom { steps: -1.0 },
-        ] {
-            assert!(c.action(&a, 64.0).camera_moved, "{a:?}");
-        }
-        assert!(c.key(Key::Home, true, false).camera_moved);
-        assert_eq!(c.camera.camera(), home);
-        assert!(!c.key(Key::Home, true, false).camera_moved, "already home");
-    }
-
-    #[test]
-    fn photon_keys_ask_for_a_retrace_only_when_the_setting_changes() {
-        let mut c = controls();
-        assert!(c.key(Key::FewerPhotons, true, false).retrace);
-        assert_eq!(c.photons, 1 << 19);
-        assert!(!c.key(Key::MorePhotons, true, true).retrace, "auto-repeat does not re-trace again");
-        assert!(c.key(Key::FinerGrid, true, false).retrace && c.grid == 128);
-        c.grid = 1024;
-        assert!(!c.key(Key::FinerGrid, true, false).retrace, "grid capped at 1024");
-        assert!(c.action(&Action::Photons(7), 64.0).retrace && c.photons == 7);
-        assert!(!c.action(&Action::Photons(7), 64.0).retrace);
-        assert!(c.key(Key::Screenshot, true, false).screenshot && c.key(Key::Quit, true, false).quit);
-    }
-
-    #[test]
-    fn camera_options_parse_back_to_the_same_camera() {
-        let c = Camera {
-            eye: Vec3::new(0.1, -2.5e-8, 3.900001),
-            target: Vec3::new(-0.3333333, 0.0, -1.0),
-            up: Vec3::Y,
-            fov_y_deg: 39.3077,
-        };
-        let s = camera_options(&c);
-        let value = |flag: &str| s.split_whitespace().skip_while(|w| *w != flag).nth(1).unwrap().to_owned();
-        let vec3 = |t: String| {
-            let v: Vec<f32> = t.split(',').map(|x| x.parse().unwrap()).collect();
-            Vec3::new(v[0], v[1], v[2])
-        };
-        assert_eq!(vec3(value("--eye")), c.eye);
-        assert_eq!(vec3(value("--target")), c.target);
-        assert_eq!(value("--fov").parse::<f32>().unwrap(), c.fov_y_deg);
-    }
-
-    #[test]
-    fn screenshots_never_overwrite_and_count_on() {
-        let dir = tempfile::tempdir().unwrap();
-        std::fs::write(dir.path().join("rastergi-0001.png"), b"keep").unwrap();
-        std::fs::write(dir.path().join("rastergi-0002.exr"), b"keep").unwrap();
-        let mut s = Screenshots { dir: dir.path().to_path_buf(), next: 1 };
-        let (png, exr) = s.reserve().unwrap();
-        assert_eq!(
-            (png.file_name().unwrap(), exr.file_name().unwrap()),
-            ("rastergi-0003.png".as_ref(), "rastergi-0003.exr".as_ref())
-        );
-        assert_eq!(std::fs::read(dir.path().join("rastergi-0001.png")).unwrap(), b"keep");
-        assert!(!dir.path().join("rastergi-0002.png").exists(), "a half-taken pair is left alone");
-        assert_eq!(s.reserve().unwrap().0.file_name().unwrap(), "rastergi-0004.png");
     }
 }

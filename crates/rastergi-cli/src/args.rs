@@ -1,0 +1,252 @@
+//! The arguments and helpers the subcommands share: the GPU (`--backend`) and its openers,
+//! the scene and renderer options of `render` and `view` ([`SceneArgs`]), what is shown
+//! ([`ShowArg`]), the gather implementation ([`GatherArg`]), scene loading and the per-pass
+//! GPU time report of `--profile`.
+
+use std::path::Path;
+
+use anyhow::Result;
+use clap::{Args, ValueEnum};
+use glam::Vec3;
+use rastergi::film::Show;
+use rastergi::fit;
+use rastergi::gather::GatherMethod;
+use rastergi::gpu::{Backends, Gpu, GpuOptions, parse_backend};
+use rastergi::renderer::RenderSettings;
+use rastergi::scene::generate::BUILTIN_NAMES;
+use rastergi::scene::{GltfOptions, Scene, load_gltf_with, load_obj};
+
+#[derive(Args, Clone, Debug)]
+pub struct GpuArgs {
+    /// Graphics backend: vulkan, metal, dx12, gl (default: WGPU_BACKEND, else the platform's primary).
+    #[arg(long, value_parser = parse_backend)]
+    backend: Option<Backends>,
+}
+
+impl GpuArgs {
+    /// The options of a GPU on the backends asked for (`None`: the default choice), unprofiled.
+    pub fn options(&self) -> GpuOptions {
+        GpuOptions { backends: self.backend, ..Default::default() }
+    }
+}
+
+#[derive(Copy, Clone, Debug, ValueEnum)]
+pub enum ShowArg {
+    /// Emission + direct + indirect light.
+    Full,
+    /// Emission + direct light.
+    Direct,
+    /// Indirect light only.
+    Indirect,
+    /// The photon map's radiance ρ/π·E at the visible points.
+    PhotonMap,
+}
+
+impl ShowArg {
+    pub fn show(self) -> Show {
+        match self {
+            ShowArg::Full => Show::Full,
+            ShowArg::Direct => Show::Direct,
+            ShowArg::Indirect => Show::Indirect,
+            ShowArg::PhotonMap => Show::PhotonMap,
+        }
+    }
+}
+
+/// How the final gather finds the nearest surface along its direction.
+#[derive(Copy, Clone, Debug, ValueEnum)]
+pub enum GatherArg {
+    /// Time each on the first iterations and keep the fastest on this GPU (trace unless
+    /// another is over 1.25× faster).
+    Auto,
+    /// Depth-peeled orthographic ray views (rasterization).
+    Raster,
+    /// Per-texel fragment lists of the ray view, one raster pass per direction.
+    Lists,
+    /// BVH ray casting in a compute shader.
+    Trace,
+}
+
+impl GatherArg {
+    pub fn method(self) -> GatherMethod {
+        match self {
+            GatherArg::Auto => GatherMethod::Auto,
+            GatherArg::Raster => GatherMethod::Raster,
+            GatherArg::Lists => GatherMethod::Lists,
+            GatherArg::Trace => GatherMethod::Trace,
+        }
+    }
+}
+
+/// The options `render` and `view` share: the scene and its camera, the renderer's settings,
+/// what is shown and the GPU.
+#[derive(Args, Debug)]
+pub struct SceneArgs {
+    /// The scene: built in (`cornell`, `atrium`, `spheres:N` for about N triangles), a Wavefront .obj file or a glTF 2.0 .gltf/.glb file.
+    pub scene: String,
+    /// Image width in pixels (`view`: the window's initial width).
+    #[arg(long, default_value_t = 256)]
+    pub width: u32,
+    /// Image height in pixels (`view`: the window's initial height).
+    #[arg(long, default_value_t = 256)]
+    pub height: u32,
+    /// Camera position, overriding the scene's (x,y,z).
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub eye: Option<Vec3>,
+    /// Point the camera looks at (x,y,z).
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub target: Option<Vec3>,
+    /// Camera up vector (x,y,z).
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub up: Option<Vec3>,
+    /// Vertical field of view in degrees.
+    #[arg(long)]
+    pub fov: Option<f32>,
+    /// glTF scenes: the camera to use, by its index in the file's cameras (default: the first).
+    #[arg(long)]
+    pub camera: Option<usize>,
+    /// Seed of every random decision; the same seed gives the same image.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u32,
+    /// Light samples per pixel per iteration.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub light_samples: u32,
+    /// Photons traced into the photon map (default: fitted to the scene: about 40 per
+    /// cell-sized patch of surface, a power of two from 2^18 to 2^24; 2^20 for cornell).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    pub photons: Option<u32>,
+    /// Photon grid cells along the scene's longest axis (default: fitted to the scene: as many
+    /// cubic cells as 64³, so 64 for a cube like cornell and more for long or flat scenes).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub grid: Option<u32>,
+    /// Ray-view resolution of the final gather, texels per side (default: fitted: twice the
+    /// image's larger side, raised to 8 texels across the median triangle's shortest edge over
+    /// the scene's bounding sphere; 128 to 2048).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    pub bundle: Option<u32>,
+    /// How the final gather finds the nearest surface along each direction (three
+    /// implementations of the same estimator).
+    #[arg(long, value_enum, default_value_t = GatherArg::Auto)]
+    pub gather: GatherArg,
+    /// Gather directions per iteration (1–16): they share the iteration's G-buffer and direct
+    /// light, so the noisier indirect light gets more samples per second.
+    #[arg(long, default_value_t = rastergi::renderer::DEFAULT_DIRECTIONS, value_parser = clap::value_parser!(u32).range(1..=16))]
+    pub directions: u32,
+    /// What the image shows.
+    #[arg(long, value_enum, default_value_t = ShowArg::Full)]
+    pub show: ShowArg,
+    /// Exposure in stops for PNG output and the window (the image is scaled by 2^exposure).
+    /// Default: 0, except for a PNG whose median luminance is more than two stops from
+    /// middle grey (0.18): then the whole stops that bring it there.
+    #[arg(long, allow_hyphen_values = true)]
+    pub exposure: Option<f32>,
+    #[command(flatten)]
+    pub gpu: GpuArgs,
+}
+
+impl SceneArgs {
+    /// The scene with the camera options applied, its camera validated.
+    pub fn load_scene(&self) -> Result<Scene> {
+        let mut scene = load_scene_with_camera(&self.scene, self.camera)?;
+        let c = &mut scene.camera;
+        c.eye = self.eye.unwrap_or(c.eye);
+        c.target = self.target.unwrap_or(c.target);
+        c.up = self.up.unwrap_or(c.up);
+        c.fov_y_deg = self.fov.unwrap_or(c.fov_y_deg);
+        scene.camera.validate()?;
+        Ok(scene)
+    }
+
+    /// The renderer's settings for `scene` at the given image size: the photon grid and count
+    /// as given, else fitted to the scene ([`rastergi::fit`]).
+    pub fn settings(&self, scene: &Scene, width: u32, height: u32, show_photon_map: bool) -> RenderSettings {
+        let grid = self.grid.unwrap_or_else(|| fit::grid_resolution(&scene.bounds()));
+        let photons = self.photons.unwrap_or_else(|| fit::photon_count(scene, grid));
+        log::info!(
+            "photons {photons}{}, grid {grid}{}",
+            if self.photons.is_some() { "" } else { " (fitted)" },
+            if self.grid.is_some() { "" } else { " (fitted)" }
+        );
+        RenderSettings {
+            width,
+            height,
+            seed: self.seed,
+            light_samples: self.light_samples,
+            photons,
+            grid_resolution: grid,
+            show_photon_map,
+            bundle: self.bundle.unwrap_or(0),
+            gather: self.gather.method(),
+            directions: self.directions,
+        }
+    }
+}
+
+fn parse_vec3(s: &str) -> Result<Vec3, String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    if parts.len() != 3 {
+        return Err(format!("expected three comma-separated numbers like 0,1,3.5, got '{s}'"));
+    }
+    let mut v = [0.0f32; 3];
+    for (i, p) in parts.iter().enumerate() {
+        v[i] = p.parse().map_err(|_| format!("'{p}' is not a number"))?;
+        if !v[i].is_finite() {
+            return Err(format!("'{p}' is not a finite number"));
+        }
+    }
+    Ok(Vec3::from(v))
+}
+
+pub fn gpu(args: &GpuArgs) -> Result<Gpu> {
+    gpu_profiled(args, false)
+}
+
+/// A GPU whose passes are timed when `profile` is set (see [`print_profile`]).
+pub fn gpu_profiled(args: &GpuArgs, profile: bool) -> Result<Gpu> {
+    Ok(Gpu::new(&GpuOptions { profile, ..args.options() })?)
+}
+
+/// Prints the GPU time per pass since the last call under `title` (per `per` `per_name`s),
+/// then starts new sums. Nothing without `--profile`; a note where the adapter has no
+/// timestamp queries.
+pub fn print_profile(gpu: &Gpu, profile: bool, title: &str, per: u64, per_name: &str) -> Result<()> {
+    if !profile {
+        return Ok(());
+    }
+    let Some(p) = &gpu.profiler else {
+        println!("{title}: {} has no timestamp queries; no per-pass GPU times", gpu.info.name);
+        return Ok(());
+    };
+    let (times, dropped) = p.report(&gpu.device, &gpu.queue)?;
+    p.clear(&gpu.device, &gpu.queue)?;
+    println!("{title} (GPU timestamps, {}):", gpu.info.name);
+    println!("{}", rastergi::profile::table(&times, per, per_name));
+    if dropped > 0 {
+        println!("({dropped} passes not timed: the query set was full)");
+    }
+    Ok(())
+}
+
+/// The built-in scene of that name, or the scene file at that path.
+pub fn load_scene(name: &str) -> Result<Scene> {
+    load_scene_with_camera(name, None)
+}
+
+/// [`load_scene`] with the camera of a glTF file chosen by its index.
+pub fn load_scene_with_camera(name: &str, camera: Option<usize>) -> Result<Scene> {
+    let path = Path::new(name);
+    let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    if camera.is_some() && !matches!(extension.as_deref(), Some("gltf" | "glb")) {
+        anyhow::bail!("--camera chooses among a glTF file's cameras; '{name}' is not a .gltf or .glb file");
+    }
+    if let Some(scene) = rastergi::scene::generate::builtin(name)? {
+        return Ok(scene);
+    }
+    match extension.as_deref() {
+        Some("obj") => Ok(load_obj(path)?),
+        Some("gltf" | "glb") => Ok(load_gltf_with(path, &GltfOptions { camera })?),
+        _ => anyhow::bail!(
+            "unknown scene '{name}': use a built-in scene ({BUILTIN_NAMES}) or a path to a .obj, .gltf or .glb file"
+        ),
+    }
+}

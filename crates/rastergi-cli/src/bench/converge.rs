@@ -1,0 +1,337 @@
+//! Convergence measurements of `rastergi bench converge` and `bench gather --reference`:
+//! the error curve of any [`Progressive`] renderer and of Mitsuba 3 against a reference, the
+//! times to target errors, and the CSV and log-log plot of `converge`.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result};
+use clap::Args;
+use rastergi::film::Show;
+use rastergi::image_io::{LinearImage, read_exr};
+use rastergi::metrics::{compare, emitter_mask};
+use rastergi::path_tracer::PathTracer;
+use rastergi::progressive::Progressive;
+use rastergi::renderer::{RenderSettings, Renderer};
+
+use super::load_valid_scene;
+use crate::args::{GpuArgs, gpu};
+
+#[derive(Args, Debug)]
+pub struct ConvergeArgs {
+    #[arg(default_value = "cornell")]
+    scene: String,
+    /// Converged reference render(s) of the scene's camera view (linear EXR); several
+    /// comma-separated independent renders are averaged.
+    #[arg(long, value_delimiter = ',', required = true)]
+    reference: Vec<PathBuf>,
+    /// Rendering time per method.
+    #[arg(long, default_value_t = 60.0)]
+    seconds: f64,
+    #[arg(long, default_value_t = 1 << 20)]
+    photons: u32,
+    #[arg(long, default_value_t = 64)]
+    grid: u32,
+    /// Also measure Mitsuba 3 (built-in cornell only; needs python3 with mitsuba).
+    #[arg(long)]
+    mitsuba: bool,
+    /// CSV output: method, seconds, samples, relative RMSE.
+    #[arg(long, default_value = "converge.csv")]
+    csv: PathBuf,
+    /// Plot of relative RMSE against time (log-log), PNG.
+    #[arg(long, default_value = "converge.png")]
+    plot: PathBuf,
+    #[command(flatten)]
+    gpu: GpuArgs,
+}
+
+pub fn run(a: &ConvergeArgs) -> Result<()> {
+    anyhow::ensure!(
+        a.plot.extension().is_some_and(|e| e.eq_ignore_ascii_case("png")),
+        "{}: the plot is written as PNG; give a .png file name",
+        a.plot.display()
+    );
+    let scene = load_valid_scene(&a.scene)?;
+    let gpu = gpu(&a.gpu)?;
+    let reference = Reference::load(&a.reference)?;
+    let (w, h) = reference.size();
+    println!(
+        "convergence: {} at {w}x{h} on {} ({:?}), {:.0} s per method",
+        a.scene, gpu.info.name, gpu.info.backend, a.seconds
+    );
+    let base = RenderSettings {
+        width: w,
+        height: h,
+        photons: a.photons,
+        grid_resolution: a.grid,
+        seed: 1,
+        ..Default::default()
+    };
+    let mut curves: Vec<(String, Vec<Point>)> = Vec::new();
+    let (name, points) =
+        measure(|| Renderer::new(&gpu, &scene, base.clone()), &reference, a.seconds, 0.0, &TARGETS, "iterations")?;
+    curves.push((name.to_string(), points));
+    let (name, points) = measure(|| PathTracer::new(&gpu, &scene, base), &reference, a.seconds, 0.0, &TARGETS, "spp")?;
+    curves.push((name.to_string(), points));
+    if a.mitsuba {
+        let points = mitsuba_curve(&a.scene, &reference, a.seconds, 0.0)?;
+        print_targets(MITSUBA, &points, &TARGETS, 0.0, "spp");
+        curves.push((MITSUBA.to_string(), points));
+    }
+    let mut csv = String::from("method,seconds,samples,relative_rmse\n");
+    for (name, points) in &curves {
+        for p in points {
+            csv += &format!("{name},{:.4},{},{:.6}\n", p.seconds, p.samples, p.error);
+        }
+    }
+    write_file(&a.csv, csv.as_bytes())?;
+    plot(&a.plot, &curves, &format!("{} {w}x{h}, {}", a.scene, gpu.info.name))?;
+    println!("wrote {} and {}", a.csv.display(), a.plot.display());
+    Ok(())
+}
+
+/// The target errors whose times `converge` prints.
+const TARGETS: [f64; 2] = [0.05, 0.02];
+
+/// The name of Mitsuba 3's curve.
+pub const MITSUBA: &str = "Mitsuba 3 path (llvm_ad_rgb)";
+
+/// One point of a convergence curve: rendering time (readbacks excluded), samples per pixel
+/// so far, and relative RMSE against the reference (emitter pixels masked).
+#[derive(Clone, Copy, Debug)]
+pub struct Point {
+    seconds: f64,
+    samples: u32,
+    error: f64,
+}
+
+/// A converged reference, the mean of one or more renders, and its emitter pixels (left out
+/// of every error).
+pub struct Reference {
+    image: LinearImage,
+    mask: Vec<bool>,
+}
+
+impl Reference {
+    /// The mean of the renders at `paths` (of one size) and its emitter mask.
+    pub fn load(paths: &[PathBuf]) -> Result<Reference> {
+        let image = average_references(paths)?;
+        let mask = emitter_mask(&image, 3.0);
+        Ok(Reference { image, mask })
+    }
+
+    /// Width and height in pixels.
+    pub fn size(&self) -> (u32, u32) {
+        (self.image.width, self.image.height)
+    }
+
+    /// The relative RMSE of `image` against the reference, emitter pixels masked.
+    fn error(&self, image: &LinearImage) -> f64 {
+        compare(image, &self.image, Some(&self.mask)).relative_rmse
+    }
+}
+
+/// Builds a renderer with `build`, timing its set-up (BVH, upload, photon map), renders its
+/// [`curve`] and prints the time to each of `targets` (samples counted in `unit`). Returns the
+/// renderer's name and the curve.
+pub fn measure<P: Progressive>(
+    build: impl FnOnce() -> rastergi::error::Result<P>,
+    reference: &Reference,
+    max_seconds: f64,
+    stop_at: f64,
+    targets: &[f64],
+    unit: &str,
+) -> Result<(&'static str, Vec<Point>)> {
+    let t = Instant::now();
+    let mut m = build()?;
+    m.wait()?;
+    let setup = t.elapsed().as_secs_f64();
+    let points = curve(&mut m, reference, max_seconds, stop_at)?;
+    print_targets(m.name(), &points, targets, setup, unit);
+    Ok((m.name(), points))
+}
+
+/// Renders, measuring the error at iteration counts growing by 25 %, until `max_seconds` of
+/// rendering or an error at or under `stop_at`.
+fn curve(m: &mut dyn Progressive, reference: &Reference, max_seconds: f64, stop_at: f64) -> Result<Vec<Point>> {
+    let mut points = Vec::new();
+    let mut rendering = Duration::ZERO;
+    let mut next = 4u32;
+    m.wait()?;
+    while rendering.as_secs_f64() < max_seconds {
+        let t = Instant::now();
+        while m.samples() < next {
+            m.iterate()?;
+        }
+        m.wait()?;
+        rendering += t.elapsed();
+        let error = reference.error(&m.read_linear(Show::Full)?);
+        points.push(Point { seconds: rendering.as_secs_f64(), samples: m.samples(), error });
+        if error <= stop_at {
+            break;
+        }
+        next = (next as f64 * 1.25).ceil() as u32;
+    }
+    Ok(points)
+}
+
+fn first_below(points: &[Point], target: f64) -> Option<Point> {
+    points.iter().copied().find(|p| p.error <= target)
+}
+
+/// For each target error, when the curve first met it (or that it did not).
+pub fn print_targets(name: &str, points: &[Point], targets: &[f64], setup: f64, unit: &str) {
+    for &target in targets {
+        match first_below(points, target) {
+            Some(p) => println!(
+                "  {name:<36} {:>4.1} %: {:>8.2} s ({} {unit}, error {:.2} %; set-up {setup:.2} s)",
+                100.0 * target,
+                p.seconds,
+                p.samples,
+                100.0 * p.error
+            ),
+            None => println!(
+                "  {name:<36} {:>4.1} %: not reached in {:.1} s",
+                100.0 * target,
+                points.last().map_or(0.0, |p| p.seconds)
+            ),
+        }
+    }
+}
+
+/// Target errors given in percent, as fractions, largest first.
+pub fn sorted_targets(percent: &[f64]) -> Vec<f64> {
+    let mut t: Vec<f64> = percent.iter().map(|t| t / 100.0).collect();
+    t.sort_by(|x, y| y.total_cmp(x));
+    t
+}
+
+/// The mean of equally sized reference renders.
+fn average_references(paths: &[PathBuf]) -> Result<LinearImage> {
+    let mut mean = read_exr(&paths[0])?;
+    for p in &paths[1..] {
+        let other = read_exr(p)?;
+        anyhow::ensure!(
+            (other.width, other.height) == (mean.width, mean.height),
+            "{}: {}x{} differs from the first reference's {}x{}",
+            p.display(),
+            other.width,
+            other.height,
+            mean.width,
+            mean.height
+        );
+        for (m, o) in mean.pixels.iter_mut().zip(&other.pixels) {
+            for c in 0..3 {
+                m[c] += o[c];
+            }
+        }
+    }
+    let k = paths.len() as f32;
+    mean.pixels.iter_mut().for_each(|m| m.iter_mut().for_each(|v| *v /= k));
+    Ok(mean)
+}
+
+/// Mitsuba 3's `path` integrator through scripts/mitsuba_reference.py at doubling sample
+/// counts; process start-up (measured with 1 spp) is subtracted.
+pub fn mitsuba_curve(scene: &str, reference: &Reference, max_seconds: f64, stop_at: f64) -> Result<Vec<Point>> {
+    anyhow::ensure!(scene == "cornell", "--mitsuba supports the built-in cornell scene only");
+    let script = Path::new("scripts/mitsuba_reference.py");
+    anyhow::ensure!(script.is_file(), "--mitsuba needs scripts/mitsuba_reference.py: run from the repository root");
+    let dir = tempfile::tempdir()?;
+    let out = dir.path().join("mitsuba.exr");
+    let run = |spp: u32| -> Result<f64> {
+        let t = Instant::now();
+        let status = Command::new("python3")
+            .arg(script)
+            .args(["--width", &reference.image.width.to_string(), "--height", &reference.image.height.to_string()])
+            .args(["--spp", &spp.to_string(), "--seed", "7", "--quiet", "--chunk-spp", "100000"])
+            .arg("--out")
+            .arg(&out)
+            .stdout(std::process::Stdio::null())
+            .status()
+            .context("cannot run python3 for --mitsuba")?;
+        anyhow::ensure!(status.success(), "the Mitsuba script failed (pip install mitsuba numpy?)");
+        Ok(t.elapsed().as_secs_f64())
+    };
+    let startup = run(1)?;
+    let mut points = Vec::new();
+    let mut spp = 4u32;
+    loop {
+        let seconds = (run(spp)? - startup).max(0.0);
+        let error = reference.error(&read_exr(&out)?);
+        points.push(Point { seconds, samples: spp, error });
+        if error <= stop_at || seconds > max_seconds {
+            break;
+        }
+        spp *= 2;
+    }
+    Ok(points)
+}
+
+/// Writes `bytes` via a temporary file renamed into place.
+fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let mut tmp =
+        tempfile::NamedTempFile::new_in(dir).with_context(|| format!("{}: cannot write here", path.display()))?;
+    std::io::Write::write_all(&mut tmp, bytes)?;
+    tmp.persist(path).with_context(|| format!("{}: cannot write", path.display()))?;
+    Ok(())
+}
+
+/// Relative RMSE against time, log-log, one line per method.
+fn plot(path: &Path, curves: &[(String, Vec<Point>)], title: &str) -> Result<()> {
+    use plotters::prelude::*;
+    static FONT: std::sync::Once = std::sync::Once::new();
+    FONT.call_once(|| {
+        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular());
+    });
+    let all: Vec<&Point> = curves.iter().flat_map(|(_, p)| p).filter(|p| p.seconds > 0.0).collect();
+    anyhow::ensure!(!all.is_empty(), "no measurement to plot");
+    let (t0, t1) = all.iter().fold((f64::MAX, 0.0f64), |(a, b), p| (a.min(p.seconds), b.max(p.seconds)));
+    let (e0, e1) = all.iter().fold((f64::MAX, 0.0f64), |(a, b), p| (a.min(p.error), b.max(p.error)));
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let tmp = tempfile::Builder::new().suffix(".png").tempfile_in(dir)?;
+    {
+        let root = BitMapBackend::new(tmp.path(), (800, 560)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 20))
+            .margin(16)
+            .x_label_area_size(44)
+            .y_label_area_size(64)
+            .build_cartesian_2d((t0 * 0.8..t1 * 1.25).log_scale(), (e0 * 0.8..e1 * 1.25).log_scale())
+            .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+        chart
+            .configure_mesh()
+            .x_desc("rendering time (s)")
+            .y_desc("relative RMSE")
+            .y_label_formatter(&|v| format!("{:.1} %", 100.0 * v))
+            .draw()
+            .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+        let colours = [RGBColor(200, 60, 40), RGBColor(40, 90, 200), RGBColor(40, 150, 70)];
+        for (i, (name, points)) in curves.iter().enumerate() {
+            let c = colours[i % colours.len()];
+            let series: Vec<(f64, f64)> =
+                points.iter().filter(|p| p.seconds > 0.0).map(|p| (p.seconds, p.error)).collect();
+            chart
+                .draw_series(LineSeries::new(series.clone(), c.stroke_width(2)))
+                .map_err(|e| anyhow::anyhow!("plot: {e}"))?
+                .label(name.as_str())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
+            chart
+                .draw_series(series.iter().map(|&p| Circle::new(p, 3, c.filled())))
+                .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+        root.present().map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+    }
+    tmp.persist(path).with_context(|| format!("{}: cannot write", path.display()))?;
+    Ok(())
+}

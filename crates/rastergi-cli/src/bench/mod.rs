@@ -1,0 +1,59 @@
+//! `rastergi bench`: throughput figures, measured side by side in one run. Benchmarks print
+//! figures; tests never assert wall-clock time.
+//!
+//! One module per subcommand: [`photons`] (GPU against CPU photon tracing), [`gather`] (the
+//! three final-gather implementations, and the time to a target error), [`converge`] (error
+//! against time for the renderer, the path tracer and Mitsuba 3), [`bvh`] (scene loading and
+//! BVH build) and [`memory`] (the GPU memory of a render).
+
+mod bvh;
+mod converge;
+mod gather;
+mod memory;
+mod photons;
+
+use std::time::Duration;
+
+use anyhow::Result;
+use clap::Subcommand;
+use rastergi::scene::Scene;
+
+use crate::args::load_scene;
+
+#[derive(Subcommand, Debug)]
+pub enum BenchCommand {
+    /// Photons per second on the GPU and on the CPU twin, same scene and count.
+    Photons(photons::PhotonArgs),
+    /// Gather directions per second of each implementation (raster, lists, trace), and the time
+    /// to reach a target error against a reference.
+    Gather(gather::GatherArgs),
+    /// Relative RMSE against time for the photon/gather pipeline and the path tracer: CSV and plot.
+    Converge(converge::ConvergeArgs),
+    /// Scene loading and BVH build times (e.g. `bench bvh spheres:1000000`), with the BVH's shape.
+    Bvh(bvh::BvhArgs),
+    /// GPU memory of a render (the device allocator's report), by resource.
+    Memory(memory::MemoryArgs),
+}
+
+pub fn run(command: &BenchCommand) -> Result<()> {
+    match command {
+        BenchCommand::Photons(a) => photons::run(a),
+        BenchCommand::Gather(a) => gather::run(a),
+        BenchCommand::Converge(a) => converge::run(a),
+        BenchCommand::Bvh(a) => bvh::run(a),
+        BenchCommand::Memory(a) => memory::run(a),
+    }
+}
+
+/// The scene of that name (built in or a file), validated.
+fn load_valid_scene(name: &str) -> Result<Scene> {
+    let scene = load_scene(name)?;
+    scene.validate()?;
+    Ok(scene)
+}
+
+/// The median of timed runs (at least one).
+fn median(mut v: Vec<Duration>) -> Duration {
+    v.sort();
+    v[v.len() / 2]
+}

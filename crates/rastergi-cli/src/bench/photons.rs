@@ -1,0 +1,86 @@
+//! `rastergi bench photons`: photon tracing on the GPU and on its CPU twin, same scene,
+//! count and grid.
+
+use std::time::Instant;
+
+use anyhow::Result;
+use clap::Args;
+use rastergi::gpu_scene::{GpuScene, PreparedScene};
+use rastergi::photon_map::GridSpec;
+use rastergi::photons::{PhotonSettings, cpu, gpu::GpuPhotonMap};
+
+use super::{load_valid_scene, median};
+use crate::args::{GpuArgs, gpu_profiled, print_profile};
+
+#[derive(Args, Debug)]
+pub struct PhotonArgs {
+    /// The scene: `cornell` or a .obj file.
+    #[arg(default_value = "cornell")]
+    scene: String,
+    #[arg(long, default_value_t = 1 << 22)]
+    photons: u32,
+    #[arg(long, default_value_t = 64)]
+    grid: u32,
+    /// Timed GPU runs (the median is reported), after one warm-up run.
+    #[arg(long, default_value_t = 3)]
+    repeats: u32,
+    /// Print the GPU time of the photon passes (timestamp queries) over the timed runs.
+    #[arg(long)]
+    profile: bool,
+    #[command(flatten)]
+    gpu: GpuArgs,
+}
+
+pub fn run(a: &PhotonArgs) -> Result<()> {
+    let scene = load_valid_scene(&a.scene)?;
+    let gpu = gpu_profiled(&a.gpu, a.profile)?;
+    let prepared = PreparedScene::new(&scene);
+    let settings = PhotonSettings { count: a.photons, seed: 1, grid_resolution: a.grid };
+    let gs = GpuScene::new(&gpu, &prepared)?;
+    let map = GpuPhotonMap::new(&gpu, &gs, &prepared, &settings)?;
+    map.trace(&gpu, &gs);
+    gpu.wait()?;
+    if let Some(p) = &gpu.profiler {
+        p.clear(&gpu.device, &gpu.queue)?;
+    }
+    let mut times = Vec::new();
+    for _ in 0..a.repeats.max(1) {
+        let t = Instant::now();
+        map.trace(&gpu, &gs);
+        gpu.wait()?;
+        times.push(t.elapsed());
+    }
+    let t_gpu = median(times).as_secs_f64();
+    let grid = GridSpec::new(&prepared.bounds, a.grid);
+    let t = Instant::now();
+    let tally = cpu::trace_flux(&prepared, &grid, &settings);
+    let t_cpu = t.elapsed().as_secs_f64();
+    let deposits: u64 = tally.deposits.iter().map(|&d| d as u64).sum();
+    let n = a.photons as f64;
+    println!(
+        "photon tracing: {}, {} photons, grid {}, {:.2} diffuse hits per photon",
+        a.scene,
+        a.photons,
+        a.grid,
+        deposits as f64 / n
+    );
+    println!(
+        "  GPU  {:<40} {:>9.3} s  {:>10.2} M photons/s",
+        format!("{} ({:?})", gpu.info.name, gpu.info.backend),
+        t_gpu,
+        n / t_gpu / 1e6
+    );
+    println!(
+        "  CPU  {:<40} {:>9.3} s  {:>10.2} M photons/s",
+        format!("{} threads (rayon)", rayon_threads()),
+        t_cpu,
+        n / t_cpu / 1e6
+    );
+    println!("  GPU / CPU: {:.2}x", t_cpu / t_gpu);
+    print_profile(&gpu, a.profile, "GPU passes", a.repeats.max(1) as u64, "run")?;
+    Ok(())
+}
+
+fn rayon_threads() -> usize {
+    std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)
+}

@@ -1,0 +1,305 @@
+//! The viewer's input handling, free of any window so that it is unit-tested: the keys that
+//! mean something ([`Key`]), the interactive state ([`Controls`]: camera controller, held
+//! keys, what is shown, exposure, photon settings, overlay) and what an input asks of the
+//! application ([`Response`]); also the camera and the shown image as text.
+
+use rastergi::camera_control::{CameraControl, Mode, MoveKeys};
+use rastergi::film::Show;
+use rastergi::scene::Camera;
+
+use super::script::Action;
+
+/// A key that means something to the viewer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Key {
+    Forward,
+    Back,
+    Left,
+    Right,
+    Up,
+    Down,
+    Fast,
+    ToggleMode,
+    Home,
+    Show(Show),
+    ExposureUp,
+    ExposureDown,
+    FewerPhotons,
+    MorePhotons,
+    CoarserGrid,
+    FinerGrid,
+    Screenshot,
+    ToggleOverlay,
+    Quit,
+}
+
+/// What the application must do after an input.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Response {
+    /// The camera moved: restart the accumulation.
+    pub camera_moved: bool,
+    /// The photon settings changed: build a new renderer (new photon map).
+    pub retrace: bool,
+    pub screenshot: bool,
+    pub quit: bool,
+}
+
+/// Exposure step of the + and - keys, in stops.
+pub const EXPOSURE_STEP: f32 = 0.5;
+
+/// The viewer's interactive state, free of any window: the camera controller, held keys,
+/// what is shown and the photon settings. Inputs come in as [`Key`]s, drags and scrolls and
+/// return what the application must do.
+#[derive(Clone, Debug)]
+pub struct Controls {
+    pub camera: CameraControl,
+    home: CameraControl,
+    pub keys: MoveKeys,
+    pub show: Show,
+    pub exposure: f32,
+    pub photons: u32,
+    pub grid: u32,
+    pub overlay: bool,
+}
+
+impl Controls {
+    pub fn new(camera: CameraControl, show: Show, exposure: f32, photons: u32, grid: u32) -> Controls {
+        Controls {
+            home: camera.clone(),
+            camera,
+            keys: MoveKeys::default(),
+            show,
+            exposure,
+            photons,
+            grid,
+            overlay: true,
+        }
+    }
+
+    /// A key went down (`pressed`) or up. Held keys (movement, Shift) act in [`tick`](Self::tick).
+    pub fn key(&mut self, key: Key, pressed: bool, repeat: bool) -> Response {
+        let mut r = Response::default();
+        let held = match key {
+            Key::Forward => Some(&mut self.keys.forward),
+            Key::Back => Some(&mut self.keys.back),
+            Key::Left => Some(&mut self.keys.left),
+            Key::Right => Some(&mut self.keys.right),
+            Key::Up => Some(&mut self.keys.up),
+            Key::Down => Some(&mut self.keys.down),
+            Key::Fast => Some(&mut self.keys.fast),
+            _ => None,
+        };
+        if let Some(state) = held {
+            *state = pressed;
+            return r;
+        }
+        if !pressed {
+            return r;
+        }
+        // Auto-repeat steps the exposure; other keys act once per press.
+        match key {
+            Key::ExposureUp => self.exposure += EXPOSURE_STEP,
+            Key::ExposureDown => self.exposure -= EXPOSURE_STEP,
+            _ if repeat => {}
+            Key::ToggleMode => self.camera.toggle_mode(),
+            Key::Home => {
+                let (mode, speed) = (self.camera.mode, self.camera.speed);
+                r.camera_moved = self.camera.camera() != self.home.camera();
+                self.camera = self.home.clone();
+                (self.camera.mode, self.camera.speed) = (mode, speed);
+            }
+            Key::Show(show) => self.show = show,
+            Key::FewerPhotons => r.retrace = self.set_photons(self.photons / 2),
+            Key::MorePhotons => r.retrace = self.set_photons(self.photons.saturating_mul(2)),
+            Key::CoarserGrid => r.retrace = self.set_grid(self.grid / 2),
+            Key::FinerGrid => r.retrace = self.set_grid(self.grid * 2),
+            Key::Screenshot => r.screenshot = true,
+            Key::ToggleOverlay => self.overlay = !self.overlay,
+            Key::Quit => r.quit = true,
+            _ => {}
+        }
+        r
+    }
+
+    /// Photons for the next photon map (at least 1); whether that is a change.
+    pub fn set_photons(&mut self, photons: u32) -> bool {
+        let photons = photons.max(1);
+        std::mem::replace(&mut self.photons, photons) != photons
+    }
+
+    /// Grid resolution for the next photon map (1 to 1024); whether that is a change.
+    pub fn set_grid(&mut self, grid: u32) -> bool {
+        let grid = grid.clamp(1, 1024);
+        std::mem::replace(&mut self.grid, grid) != grid
+    }
+
+    /// Time passes with the held keys down: fly.
+    pub fn tick(&mut self, dt: f32) -> Response {
+        Response { camera_moved: self.camera.fly(&self.keys, dt), ..Default::default() }
+    }
+
+    /// A drag by `(dx, dy)` pixels with the left (look/orbit) or right (pan) button.
+    pub fn drag(&mut self, dx: f32, dy: f32, pan: bool, viewport_height: f32) -> Response {
+        let moved = if pan { self.camera.pan(dx, dy, viewport_height) } else { self.camera.drag(dx, dy) };
+        Response { camera_moved: moved, ..Default::default() }
+    }
+
+    /// Scroll by `steps` notches (positive: toward the target).
+    pub fn scroll(&mut self, steps: f32) -> Response {
+        Response { camera_moved: self.camera.zoom(steps), ..Default::default() }
+    }
+
+    /// Keys are no longer reported once the window loses focus: release them all.
+    pub fn release_keys(&mut self) {
+        self.keys = MoveKeys::default();
+    }
+
+    /// A script action that the controls handle (camera, show, exposure, photon settings).
+    pub fn action(&mut self, action: &Action, viewport_height: f32) -> Response {
+        let mut r = Response::default();
+        let c = &mut self.camera;
+        match *action {
+            Action::Move { right, up, forward } => r.camera_moved = c.translate(right, up, forward),
+            Action::Look { yaw_deg, pitch_deg } => {
+                r.camera_moved = c.look(yaw_deg.to_radians(), pitch_deg.to_radians())
+            }
+            Action::Orbit { yaw_deg, pitch_deg } => {
+                r.camera_moved = c.orbit(yaw_deg.to_radians(), pitch_deg.to_radians())
+            }
+            Action::Pan { dx, dy } => r.camera_moved = c.pan(dx, dy, viewport_height),
+            Action::Zoom { steps } => r.camera_moved = c.zoom(steps),
+            Action::Mode { orbit } => {
+                if (c.mode == Mode::Orbit) != orbit {
+                    c.toggle_mode();
+                }
+            }
+            Action::Show(show) => self.show = show,
+            Action::Exposure(ev) => self.exposure = ev,
+            Action::Photons(n) => r.retrace = self.set_photons(n),
+            Action::Grid(n) => r.retrace = self.set_grid(n),
+            Action::Screenshot => r.screenshot = true,
+            Action::Quit => r.quit = true,
+            Action::Resize { .. } => {}
+        }
+        r
+    }
+}
+
+/// The camera as `render` options, with every value printed so that it parses back to the
+/// same f32.
+pub fn camera_options(c: &Camera) -> String {
+    let v = |v: glam::Vec3| format!("{},{},{}", v.x, v.y, v.z);
+    format!("--eye {} --target {} --up {} --fov {}", v(c.eye), v(c.target), v(c.up), c.fov_y_deg)
+}
+
+/// The name of `show` as `--show` and scripts spell it.
+pub fn show_name(show: Show) -> &'static str {
+    match show {
+        Show::Full => "full",
+        Show::Direct => "direct",
+        Show::Indirect => "indirect",
+        Show::PhotonMap => "photon-map",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+    use rastergi::scene::Aabb;
+
+    fn controls() -> Controls {
+        let camera = Camera { eye: Vec3::new(0.0, 0.0, 3.9), target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 39.3077 };
+        let bounds = Aabb { min: Vec3::splat(-1.0), max: Vec3::splat(1.0) };
+        Controls::new(CameraControl::new(&camera, &bounds), Show::Full, 0.0, 1 << 20, 64)
+    }
+
+    #[test]
+    fn held_movement_keys_move_the_camera_on_tick_and_restart_the_image() {
+        let mut c = controls();
+        assert_eq!(c.key(Key::Forward, true, false), Response::default(), "pressing alone does nothing yet");
+        let before = c.camera.camera();
+        assert!(c.tick(0.1).camera_moved);
+        assert!(c.camera.camera().eye.z < before.eye.z);
+        c.key(Key::Forward, false, false);
+        assert!(!c.tick(0.1).camera_moved, "released: no move, no restart");
+        c.key(Key::Left, true, false);
+        c.release_keys();
+        assert!(!c.tick(0.1).camera_moved, "focus lost: keys released");
+    }
+
+    #[test]
+    fn show_exposure_mode_and_overlay_keys_do_not_restart() {
+        let mut c = controls();
+        let camera = c.camera.camera();
+        for key in [
+            Key::Show(Show::PhotonMap),
+            Key::ExposureUp,
+            Key::ExposureUp,
+            Key::ExposureDown,
+            Key::ToggleMode,
+            Key::ToggleOverlay,
+            Key::Fast,
+        ] {
+            assert_eq!(c.key(key, true, false), Response::default(), "{key:?}");
+        }
+        assert_eq!((c.show, c.exposure, c.camera.mode, c.overlay), (Show::PhotonMap, 0.5, Mode::Orbit, false));
+        assert_eq!(c.camera.camera(), camera);
+        assert_eq!(c.action(&Action::Show(Show::Direct), 64.0), Response::default());
+        assert_eq!(c.action(&Action::Mode { orbit: false }, 64.0), Response::default());
+    }
+
+    #[test]
+    fn drags_scrolls_and_camera_actions_restart_and_home_returns() {
+        let mut c = controls();
+        let home = c.camera.camera();
+        assert!(c.drag(10.0, 0.0, false, 64.0).camera_moved);
+        assert!(c.drag(3.0, 2.0, true, 64.0).camera_moved);
+        assert!(c.scroll(1.0).camera_moved);
+        for a in [
+            Action::Move { right: 0.1, up: 0.0, forward: 0.0 },
+            Action::Look { yaw_deg: 5.0, pitch_deg: 0.0 },
+            Action::Orbit { yaw_deg: 5.0, pitch_deg: 1.0 },
+            Action::Pan { dx: 1.0, dy: 0.0 },
+            Action::Zoom { steps: -1.0 },
+        ] {
+            assert!(c.action(&a, 64.0).camera_moved, "{a:?}");
+        }
+        assert!(c.key(Key::Home, true, false).camera_moved);
+        assert_eq!(c.camera.camera(), home);
+        assert!(!c.key(Key::Home, true, false).camera_moved, "already home");
+    }
+
+    #[test]
+    fn photon_keys_ask_for_a_retrace_only_when_the_setting_changes() {
+        let mut c = controls();
+        assert!(c.key(Key::FewerPhotons, true, false).retrace);
+        assert_eq!(c.photons, 1 << 19);
+        assert!(!c.key(Key::MorePhotons, true, true).retrace, "auto-repeat does not re-trace again");
+        assert!(c.key(Key::FinerGrid, true, false).retrace && c.grid == 128);
+        c.grid = 1024;
+        assert!(!c.key(Key::FinerGrid, true, false).retrace, "grid capped at 1024");
+        assert!(c.action(&Action::Photons(7), 64.0).retrace && c.photons == 7);
+        assert!(!c.action(&Action::Photons(7), 64.0).retrace);
+        assert!(c.key(Key::Screenshot, true, false).screenshot && c.key(Key::Quit, true, false).quit);
+    }
+
+    #[test]
+    fn camera_options_parse_back_to_the_same_camera() {
+        let c = Camera {
+            eye: Vec3::new(0.1, -2.5e-8, 3.900001),
+            target: Vec3::new(-0.3333333, 0.0, -1.0),
+            up: Vec3::Y,
+            fov_y_deg: 39.3077,
+        };
+        let s = camera_options(&c);
+        let value = |flag: &str| s.split_whitespace().skip_while(|w| *w != flag).nth(1).unwrap().to_owned();
+        let vec3 = |t: String| {
+            let v: Vec<f32> = t.split(',').map(|x| x.parse().unwrap()).collect();
+            Vec3::new(v[0], v[1], v[2])
+        };
+        assert_eq!(vec3(value("--eye")), c.eye);
+        assert_eq!(vec3(value("--target")), c.target);
+        assert_eq!(value("--fov").parse::<f32>().unwrap(), c.fov_y_deg);
+    }
+}

@@ -1,0 +1,139 @@
+//! `rastergi view`: a window showing the progressive image as it converges; the camera moves
+//! with the keyboard and mouse, and every move restarts the accumulation (the photon map is
+//! kept).
+//!
+//! The loop, per displayed frame: apply held keys and the script's due steps to the camera;
+//! if the camera moved, `Renderer::set_camera` restarts the image; run as many iterations as
+//! fit in [`app::FRAME_BUDGET`] of GPU time (at least one); resolve the film and draw it with the
+//! overlay ([`rastergi::display`]); present. Building a renderer (photon tracing) runs on a
+//! worker thread so the window stays live meanwhile; a new photon count or grid
+//! builds a new renderer at the window's size (the film is the window's size) and shows the
+//! old image, scaled, until it is ready. A resize alone keeps the scene and photon map and
+//! rebuilds only the size-dependent passes (`Renderer::resize`). While the window is minimised, occluded or zero-sized
+//! the loop waits for events and renders nothing.
+//!
+//! The overlay (top left; H hides it) shows the iterations, iterations per second, photons,
+//! grid and bundle resolution, what is shown, the exposure and the drag mode; the window title
+//! repeats the main figures. It is drawn with a small bitmap font in the display shader: the
+//! egui-wgpu releases built on wgpu 30 require Rust 1.95, above this project's 1.88.
+//!
+//! Scripts (`--script`) are described in [`script`].
+//!
+//! The parts: [`controls`] (window-free input handling: keys, drags, script actions and what
+//! each asks of the application), [`app`] (the winit application: window, renderer builds,
+//! the frame loop), [`screenshots`] and [`script`].
+
+mod app;
+mod controls;
+mod screenshots;
+mod script;
+
+use std::path::PathBuf;
+
+use anyhow::{Result, anyhow, bail};
+use clap::Args;
+use winit::event_loop::EventLoop;
+
+use crate::args::SceneArgs;
+use app::{App, UserEvent};
+use screenshots::Screenshots;
+
+/// The keys and mouse bindings (a macro so that `--help` can join it to the script text).
+macro_rules! keys_text {
+    () => {
+        "\
+Keys and mouse:
+  W A S D / Q E     fly forward, left, back, right / down, up (Shift: 4x faster)
+  left drag         look around (fly mode) or orbit the target (orbit mode)
+  right drag        pan
+  scroll            zoom toward the target
+  Tab               switch fly / orbit mode
+  Home              back to the starting camera
+  1 2 3 4           show full / direct / indirect / photon map (no restart)
+  + -               exposure up / down by half a stop
+  [ ]               halve / double the photons (re-traces the photon map)
+  , .               halve / double the photon grid resolution (re-traces)
+  P                 screenshot: rastergi-NNNN.png (as shown) and .exr (linear)
+  H                 hide / show the overlay
+  Esc               quit
+Any camera move restarts the accumulation; the photon map is kept.\n"
+    };
+}
+
+/// The keys, for the start-up message.
+pub const KEYS: &str = keys_text!();
+
+#[derive(Args, Debug)]
+pub struct ViewArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// Timed actions to run, one per line (see `rastergi view --help` for the format).
+    #[arg(long)]
+    script: Option<PathBuf>,
+    /// Directory for screenshots (default: the current directory).
+    #[arg(long)]
+    screenshot_dir: Option<PathBuf>,
+}
+
+/// The `after_help` of `rastergi view`: the keys and the script format.
+pub const AFTER_HELP: &str = concat!(
+    keys_text!(),
+    "
+Script (--script FILE): one action per line, optionally after a condition; # comments.
+  after N iterations: ACTION   once the image holds N iterations since its last restart
+  after T s: ACTION            T seconds after the previous line
+  ACTION                       right after the previous line
+Actions: move R,U,F | look YAW,PITCH | orbit YAW,PITCH | pan X,Y | zoom STEPS |
+  mode fly|orbit | show full|direct|indirect|photon-map | exposure EV | photons N |
+  grid N | resize W,H | screenshot | quit
+Each screenshot prints its files and the camera as render options to stdout."
+);
+
+pub fn run(args: &ViewArgs) -> Result<()> {
+    // Everything that can be checked without a window is checked first.
+    let steps = args.script.as_deref().map(script::load).transpose()?;
+    // No directory: names relative to the current directory, printed as such.
+    let dir = args.screenshot_dir.clone().unwrap_or_default();
+    if args.screenshot_dir.is_some() && !dir.is_dir() {
+        bail!(
+            "{}: the screenshot directory does not exist; create it first or choose another --screenshot-dir",
+            dir.display()
+        );
+    }
+    let a = &args.scene;
+    let scene = a.load_scene()?;
+    let base = a.settings(&scene, a.width, a.height, true);
+    // Building the first renderer validates the rest; check the size here for a clear error.
+    if a.width == 0 || a.height == 0 {
+        bail!("the window size {}x{} is empty; give a --width and --height of at least 1", a.width, a.height);
+    }
+
+    check_display()?;
+    let event_loop = EventLoop::<UserEvent>::with_user_event().build().map_err(|e| {
+        // winit's OS errors start with the source location that raised them: keep the message.
+        let message = e.to_string();
+        let message = match message.strip_prefix("os error at ") {
+            Some(rest) => rest.split_once(": ").map_or(rest, |(_, m)| m).to_owned(),
+            None => message,
+        };
+        anyhow!("cannot open a window: {message} (DISPLAY={})", std::env::var("DISPLAY").unwrap_or_default())
+    })?;
+    println!("rastergi view: {}\n{KEYS}", a.scene);
+    let mut app = App::new(a, scene, base, steps, Screenshots::new(dir), event_loop.create_proxy());
+    event_loop.run_app(&mut app).map_err(|e| anyhow!("the window's event loop failed: {e}"))?;
+    app.finish()
+}
+
+/// On X11/Wayland systems, refuses to start without a display to talk to.
+fn check_display() -> Result<()> {
+    if cfg!(all(unix, not(any(target_os = "macos", target_os = "ios", target_os = "android"))))
+        && ["DISPLAY", "WAYLAND_DISPLAY", "WAYLAND_SOCKET"]
+            .iter()
+            .all(|v| std::env::var_os(v).is_none_or(|s| s.is_empty()))
+    {
+        bail!(
+            "cannot open a window: no display (DISPLAY and WAYLAND_DISPLAY are not set); run it in a desktop session, under xvfb-run, or use `rastergi render` for images without a window"
+        );
+    }
+    Ok(())
+}

@@ -1,7 +1,6 @@
 // Direct pass (direct.rs): emission + next-event estimation with BVH shadow rays.
 
-@group(2) @binding(0) var gbuffer: texture_2d<u32>;
-@group(2) @binding(1) var<storage, read_write> film: array<vec4f>;
+// Bind group 2: gbuffer_film.wgsl.
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3u) {

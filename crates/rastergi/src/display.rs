@@ -223,16 +223,6 @@ pub struct WindowSurface {
     pass: DisplayPass,
 }
 
-fn device_rank(t: wgpu::DeviceType) -> u32 {
-    match t {
-        wgpu::DeviceType::DiscreteGpu => 0,
-        wgpu::DeviceType::IntegratedGpu => 1,
-        wgpu::DeviceType::VirtualGpu => 2,
-        wgpu::DeviceType::Cpu => 3,
-        wgpu::DeviceType::Other => 4,
-    }
-}
-
 impl WindowSurface {
     /// Creates a surface for `window` on `display` (the window system's connection, which
     /// OpenGL needs at instance creation) and opens the best device that can present to it
@@ -248,32 +238,13 @@ impl WindowSurface {
     where
         D: wgpu::rwh::HasDisplayHandle + std::fmt::Debug + Send + Sync + 'static,
     {
-        let backends = options.backends.or_else(wgpu::Backends::from_env).unwrap_or(wgpu::Backends::PRIMARY);
         let mut desc = wgpu::InstanceDescriptor::new_with_display_handle(Box::new(display));
-        desc.backends = backends;
+        desc.backends = options.backends();
         let instance = wgpu::Instance::new(desc);
         let surface = instance
             .create_surface(window)
             .map_err(|e| Error::Gpu(format!("cannot create a surface for the window: {e}")))?;
-        let mut adapters = pollster::block_on(instance.enumerate_adapters(backends));
-        adapters.retain(|a| a.is_surface_supported(&surface));
-        adapters.sort_by_key(|a| device_rank(a.get_info().device_type));
-        let adapter = adapters
-            .into_iter()
-            .next()
-            .ok_or_else(|| Error::NoAdapter(format!(" that can present to the window with backends {backends:?}")))?;
-        let info = adapter.get_info();
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-            label: Some("rastergi device"),
-            required_features: wgpu::Features::empty(),
-            required_limits: adapter.limits(),
-            experimental_features: wgpu::ExperimentalFeatures::disabled(),
-            memory_hints: wgpu::MemoryHints::Performance,
-            trace: wgpu::Trace::Off,
-        }))
-        .map_err(|e| Error::Device(e.to_string()))?;
-        log::info!("using {} ({:?}, {:?}) for the window", info.name, info.backend, info.device_type);
-        let gpu = Gpu { adapter, device, queue, info, profiler: None };
+        let gpu = Gpu::open(&instance, options, Some(&surface))?;
 
         let caps = surface.get_capabilities(&gpu.adapter);
         use wgpu::TextureFormat as F;

@@ -118,9 +118,11 @@ impl Film {
         &self.display
     }
 
-    /// Clears the sums (camera moved, scene changed).
-    pub fn clear(&mut self, enc: &mut wgpu::CommandEncoder) {
+    /// Clears the sums (camera moved, scene changed): submitted before any later work.
+    pub fn clear(&mut self, gpu: &Gpu) {
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
         enc.clear_buffer(&self.accumulation, 0, None);
+        gpu.queue.submit([enc.finish()]);
         self.samples = 0;
     }
 

@@ -9,7 +9,7 @@
 use crate::error::Result;
 use crate::film::Film;
 use crate::frame::FrameBinding;
-use crate::gpu::{Gpu, storage_entry, uint_texture_entry};
+use crate::gpu::{Gpu, scene_raster_pipeline, storage_entry, uint_texture_entry};
 use crate::gpu_scene::GpuScene;
 use crate::shader;
 
@@ -33,39 +33,10 @@ impl GBufferPass {
     pub fn new(gpu: &Gpu, scene: &GpuScene, frame: &FrameBinding, width: u32, height: u32) -> Self {
         let device = &gpu.device;
         let module = shader::module(device, "gbuffer", &source());
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("gbuffer"),
-            bind_group_layouts: &[Some(&scene.layout), Some(&frame.layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("gbuffer"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                // Reversed Z: nearer is larger.
-                depth_compare: Some(wgpu::CompareFunction::Greater),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(FORMAT.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let layouts = [&scene.layout, &frame.layout];
+        // Reversed Z: the nearest surface has the largest depth.
+        let pipeline =
+            scene_raster_pipeline(device, "gbuffer", (&module, &layouts), "fs_main", FORMAT.into(), Some(DEPTH_FORMAT));
         let size = wgpu::Extent3d { width, height, depth_or_array_layers: 1 };
         let texture = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("gbuffer"),
@@ -125,33 +96,12 @@ impl GBufferPass {
     /// Raw texels `(triangle + 1, b1 bits, b2 bits, texture level of detail bits)`, row by row
     /// (for tests and tools).
     pub fn read(&self, gpu: &Gpu) -> Result<Vec<[u32; 4]>> {
-        let size = self.texture.size();
-        let (w, h) = (size.width, size.height);
-        let row = (w * 16).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
-        let buffer = gpu.zeroed_buffer(
-            "gbuffer readback",
-            (row * h) as u64,
-            wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
-        );
-        let mut enc = gpu.device.create_command_encoder(&Default::default());
-        enc.copy_texture_to_buffer(
-            self.texture.as_image_copy(),
-            wgpu::TexelCopyBufferInfo {
-                buffer: &buffer,
-                layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: Some(h) },
-            },
-            size,
-        );
-        gpu.queue.submit([enc.finish()]);
-        let bytes = gpu.read_buffer(&buffer, buffer.size())?;
-        let mut out = Vec::with_capacity((w * h) as usize);
-        for y in 0..h as usize {
-            let r: &[[u32; 4]] = bytemuck::cast_slice(&bytes[y * row as usize..y * row as usize + w as usize * 16]);
-            out.extend_from_slice(r);
-        }
-        Ok(out)
+        Ok(bytemuck::pod_collect_to_vec(&gpu.read_texture(&self.texture, 16)?))
     }
 }
+
+/// The WGSL of [`gbuffer_film_layout`]'s bindings (`gbuffer`, `film`).
+pub const GBUFFER_FILM_WGSL: &str = include_str!("gbuffer_film.wgsl");
 
 /// Layout of a per-pixel pass's own group: the G-buffer (binding 0) and the film (binding 1).
 pub fn gbuffer_film_layout(device: &wgpu::Device, label: &str) -> wgpu::BindGroupLayout {

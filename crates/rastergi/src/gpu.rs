@@ -51,17 +51,34 @@ fn device_rank(t: wgpu::DeviceType) -> u32 {
     }
 }
 
+impl GpuOptions {
+    /// The backends to consider: as asked, else `WGPU_BACKEND`, else Vulkan/Metal/DX12.
+    pub fn backends(&self) -> wgpu::Backends {
+        self.backends.or_else(wgpu::Backends::from_env).unwrap_or(wgpu::Backends::PRIMARY)
+    }
+}
+
 impl Gpu {
     /// Opens the best adapter: a discrete GPU if there is one, then integrated, virtual, CPU.
     pub fn new(options: &GpuOptions) -> Result<Gpu> {
-        let backends = options.backends.or_else(wgpu::Backends::from_env).unwrap_or(wgpu::Backends::PRIMARY);
         let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
-        desc.backends = backends;
-        let instance = wgpu::Instance::new(desc);
+        desc.backends = options.backends();
+        Gpu::open(&wgpu::Instance::new(desc), options, None)
+    }
+
+    /// Opens the best adapter of `instance` (ranked as in [`Gpu::new`]) among those that can
+    /// present to `surface`, if one is given: the one device opener of headless and window use.
+    pub fn open(instance: &wgpu::Instance, options: &GpuOptions, surface: Option<&wgpu::Surface>) -> Result<Gpu> {
+        let backends = options.backends();
         let mut adapters = pollster::block_on(instance.enumerate_adapters(backends));
+        if let Some(surface) = surface {
+            adapters.retain(|a| a.is_surface_supported(surface));
+        }
         adapters.sort_by_key(|a| device_rank(a.get_info().device_type));
-        let adapter =
-            adapters.into_iter().next().ok_or_else(|| Error::NoAdapter(format!(" for backends {backends:?}")))?;
+        let adapter = adapters.into_iter().next().ok_or_else(|| {
+            let what = if surface.is_some() { " that can present to the window" } else { "" };
+            Error::NoAdapter(format!("{what} for backends {backends:?}"))
+        })?;
         let info = adapter.get_info();
         let limits = adapter.limits();
         let timestamps = wgpu::Features::TIMESTAMP_QUERY;
@@ -175,6 +192,36 @@ impl Gpu {
         Ok(data)
     }
 
+    /// Copies every texel of mip level 0 of `texture` (which needs COPY_SRC) back to the CPU:
+    /// `texel_bytes` per texel, rows and layers tightly packed (the copy's row padding dropped).
+    pub fn read_texture(&self, texture: &wgpu::Texture, texel_bytes: u32) -> Result<Vec<u8>> {
+        let size = texture.size();
+        let (w, rows) = (size.width, size.height * size.depth_or_array_layers);
+        let tight = (w * texel_bytes) as usize;
+        let row = (w * texel_bytes).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+        let buffer = self.zeroed_buffer(
+            "texture readback",
+            row as u64 * rows as u64,
+            wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+        );
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        enc.copy_texture_to_buffer(
+            texture.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(row),
+                    rows_per_image: Some(size.height),
+                },
+            },
+            size,
+        );
+        self.queue.submit([enc.finish()]);
+        let bytes = self.read_buffer(&buffer, buffer.size())?;
+        Ok(bytes.chunks(row as usize).take(rows as usize).flat_map(|r| &r[..tight]).copied().collect())
+    }
+
     /// Blocks until all submitted work has finished.
     pub fn wait(&self) -> Result<()> {
         self.device.poll(wgpu::PollType::wait_indefinitely()).map(|_| ()).map_err(|e| Error::Gpu(e.to_string()))
@@ -268,6 +315,49 @@ pub fn pipeline_layout(device: &wgpu::Device, label: &str, layouts: &[&wgpu::Bin
         label: Some(label),
         bind_group_layouts: &layouts,
         immediate_size: 0,
+    })
+}
+
+/// A render pipeline that draws every triangle of the scene by vertex pulling (`vs_main` of
+/// `shader.0`, no vertex buffers, no culling) with bind groups `shader.1`, fragment stage `fs`
+/// into one colour `target`; with `depth`, a depth test of that format that keeps the larger
+/// depth (the eye's reversed Z; the ray view's back-to-front peel).
+pub fn scene_raster_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    shader: (&wgpu::ShaderModule, &[&wgpu::BindGroupLayout]),
+    fs: &str,
+    target: wgpu::ColorTargetState,
+    depth: Option<wgpu::TextureFormat>,
+) -> wgpu::RenderPipeline {
+    let (module, layouts) = shader;
+    let layout = pipeline_layout(device, label, layouts);
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+        depth_stencil: depth.map(|format| wgpu::DepthStencilState {
+            format,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Greater),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some(fs),
+            compilation_options: Default::default(),
+            targets: &[Some(target)],
+        }),
+        multiview_mask: None,
+        cache: None,
     })
 }
 

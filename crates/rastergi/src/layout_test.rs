@@ -87,8 +87,11 @@ fn shaders() -> Vec<(&'static str, String)> {
     ]
 }
 
-/// The structs of `module` by name: size and member (name, offset, size).
-fn structs(module: &naga::Module) -> BTreeMap<String, (u32, Vec<(String, u32, u32)>)> {
+/// A struct's members: (name, offset, size).
+type Members = Vec<(String, u32, u32)>;
+
+/// The structs of `module` by name: size and members.
+fn structs(module: &naga::Module) -> BTreeMap<String, (u32, Members)> {
     let mut layouter = naga::proc::Layouter::default();
     layouter.update(module.to_ctx()).expect("layouts of a parsed module");
     let mut out = BTreeMap::new();

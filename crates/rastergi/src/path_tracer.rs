@@ -179,9 +179,7 @@ impl PathTracer {
 
     /// Discards the accumulated iterations.
     pub fn reset(&mut self) {
-        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
-        self.film.clear(&mut enc);
-        self.gpu.queue.submit([enc.finish()]);
+        self.film.clear(&self.gpu);
     }
 
     /// The uniforms of `iteration`: exactly the rasterizer's jittered view-projection

@@ -4,7 +4,7 @@
 
 use crate::film::Film;
 use crate::frame::FrameBinding;
-use crate::gbuffer::{GBufferPass, gbuffer_film_bind_group, gbuffer_film_layout};
+use crate::gbuffer::{GBUFFER_FILM_WGSL, GBufferPass, gbuffer_film_bind_group, gbuffer_film_layout};
 use crate::gpu::{Gpu, compute_pipeline, dispatch_pixels};
 use crate::gpu_scene::GpuScene;
 use crate::photons::gpu::GpuPhotonMap;
@@ -14,7 +14,7 @@ use crate::shader;
 
 /// The pass's composed shader.
 pub fn source() -> String {
-    shader::per_pixel(&[LOOKUP_WGSL, include_str!("photon_view.wgsl")])
+    shader::per_pixel(&[GBUFFER_FILM_WGSL, LOOKUP_WGSL, include_str!("photon_view.wgsl")])
 }
 
 pub struct PhotonViewPass {

@@ -1,8 +1,7 @@
 // Photon-map view (photon_view.rs): ρ/π · E(x) at the visible point → film, photon-view
 // component.
 
-@group(2) @binding(0) var gbuffer: texture_2d<u32>;
-@group(2) @binding(1) var<storage, read_write> film: array<vec4f>;
+// Bind group 2: gbuffer_film.wgsl.
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3u) {

@@ -247,9 +247,7 @@ impl Renderer {
 
     /// Discards the accumulated iterations.
     pub fn reset(&mut self) {
-        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
-        self.passes.film.clear(&mut enc);
-        self.gpu.queue.submit([enc.finish()]);
+        self.passes.film.clear(&self.gpu);
         if let Some(gather) = &mut self.passes.gather {
             gather.restart();
         }

@@ -6,7 +6,7 @@ use std::time::Instant;
 use anyhow::Result;
 use clap::Args;
 use rastergi::gpu_scene::{GpuScene, PreparedScene};
-use rastergi::photon_map::GridSpec;
+use rastergi::photons::map::GridSpec;
 use rastergi::photons::{PhotonSettings, cpu, gpu::GpuPhotonMap};
 
 use super::{load_valid_scene, median};

@@ -14,7 +14,7 @@
 
 use glam::{Mat4, Vec2, Vec3};
 
-use crate::gpu::pipeline_layout;
+use crate::gpu::scene_raster_pipeline;
 use crate::sampling::orthonormal_basis;
 use crate::scene::Aabb;
 use crate::shader;
@@ -55,9 +55,9 @@ pub fn ray_view_source() -> String {
     shader::compose(&[shader::SAMPLING, shader::SCENE, super::estimator::UNIFORMS, include_str!("ray_view.wgsl")])
 }
 
-/// A ray-view raster pipeline: every triangle drawn by `vs_main`, no culling, fragment stage
-/// `fs` into a `target` (format, write mask); with `depth`, a Depth32Float test that keeps the
-/// farthest fragment (back to front).
+/// A ray-view raster pipeline ([`scene_raster_pipeline`]): fragment stage `fs` into a
+/// `target` (format, write mask); with `depth`, a Depth32Float test that keeps the farthest
+/// fragment (back to front: ray-view depth grows along −ω).
 pub fn ray_view_pipeline(
     device: &wgpu::Device,
     label: &str,
@@ -67,33 +67,6 @@ pub fn ray_view_pipeline(
     target: (wgpu::TextureFormat, wgpu::ColorWrites),
     depth: bool,
 ) -> wgpu::RenderPipeline {
-    let layout = pipeline_layout(device, label, layouts);
-    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some(label),
-        layout: Some(&layout),
-        vertex: wgpu::VertexState {
-            module,
-            entry_point: Some("vs_main"),
-            compilation_options: Default::default(),
-            buffers: &[],
-        },
-        primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-        depth_stencil: depth.then(|| wgpu::DepthStencilState {
-            format: DEPTH_FORMAT,
-            depth_write_enabled: Some(true),
-            // Back to front: keep the farthest fragment.
-            depth_compare: Some(wgpu::CompareFunction::Greater),
-            stencil: Default::default(),
-            bias: Default::default(),
-        }),
-        multisample: Default::default(),
-        fragment: Some(wgpu::FragmentState {
-            module,
-            entry_point: Some(fs),
-            compilation_options: Default::default(),
-            targets: &[Some(wgpu::ColorTargetState { format: target.0, blend: None, write_mask: target.1 })],
-        }),
-        multiview_mask: None,
-        cache: None,
-    })
+    let target = wgpu::ColorTargetState { format: target.0, blend: None, write_mask: target.1 };
+    scene_raster_pipeline(device, label, (module, layouts), fs, target, depth.then_some(DEPTH_FORMAT))
 }

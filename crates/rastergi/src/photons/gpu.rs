@@ -303,35 +303,10 @@ impl GpuPhotonMap {
 
     /// The map as the passes see it: the lookup texture's Φ/h² per slot, times h².
     fn read_texture(&self, gpu: &Gpu) -> Result<PhotonMap> {
-        let d = self.grid.dims;
-        let depth = BINS as u32 * d.z;
-        let row = (d.x * 16).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
-        let buffer = gpu.zeroed_buffer(
-            "photon map readback",
-            row as u64 * d.y as u64 * depth as u64,
-            wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
-        );
-        let mut enc = gpu.device.create_command_encoder(&Default::default());
-        enc.copy_texture_to_buffer(
-            self.texture.as_image_copy(),
-            wgpu::TexelCopyBufferInfo {
-                buffer: &buffer,
-                layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: Some(d.y) },
-            },
-            wgpu::Extent3d { width: d.x, height: d.y, depth_or_array_layers: depth },
-        );
-        gpu.queue.submit([enc.finish()]);
-        let bytes = gpu.read_buffer(&buffer, buffer.size())?;
+        let texels: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&gpu.read_texture(&self.texture, 16)?);
         let h2 = (self.grid.cell as f64).powi(2);
         let n = self.grid.slot_count();
-        let mut flux = Vec::with_capacity(n);
-        for z in 0..depth as usize {
-            for y in 0..d.y as usize {
-                let start = (z * d.y as usize + y) * row as usize;
-                let texels: &[[f32; 4]] = bytemuck::cast_slice(&bytes[start..start + d.x as usize * 16]);
-                flux.extend(texels.iter().map(|t| [0, 1, 2].map(|c| t[c] as f64 * h2)));
-            }
-        }
+        let flux = texels.iter().map(|t| [0, 1, 2].map(|c| t[c] as f64 * h2)).collect();
         Ok(PhotonMap { grid: self.grid, flux, area: self.area.clone(), flux_sq: vec![0.0; n], deposits: vec![0; n] })
     }
 

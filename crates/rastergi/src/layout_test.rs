@@ -16,6 +16,7 @@ use crate::gpu_scene::{GpuMaterial, GpuTriangle};
 use crate::lights::LightEntry;
 use crate::path_tracer::PathParams;
 use crate::photons::gpu::{PhotonGridUniforms, PhotonParams};
+use crate::photons::map::TrianglePlane;
 
 /// A Rust struct and the name of its WGSL twin.
 struct Twin {
@@ -59,12 +60,16 @@ fn twins() -> Vec<Twin> {
                 quantum,
                 ray_epsilon,
                 max_bounces,
-                groups_x
+                groups_x,
+                mask,
+                max_probe,
+                pass_index
             ]
         ),
-        twin!(PhotonGridUniforms, "PhotonGrid", [origin, cell, dims]),
+        twin!(PhotonGridUniforms, "PhotonGrid", [origin, cell, dims, mask, max_probe]),
         twin!(ResolveUniforms, "Resolve", [resolution, samples, show, scale]),
         twin!(DisplayUniforms, "Display", [image_size, target_size, decode_srgb, text_cols, text_rows, text_scale]),
+        twin!(TrianglePlane, "TrianglePlane", [normal, offset, bins]),
         twin!(PathParams, "PathParams", [inv_view_proj, light_weight, light_count, max_bounces, rr_start]),
     ]
 }

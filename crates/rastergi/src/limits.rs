@@ -5,7 +5,7 @@
 //! validation panic. Pure functions of [`wgpu::Limits`], so they are tested without a GPU.
 
 use crate::error::{Error, Result};
-use crate::photons::map::{BINS, GridSpec};
+use crate::photons::map::{GridSpec, MapLayout};
 
 /// Largest buffer this device can create and bind whole as a storage buffer.
 pub fn max_storage_buffer(limits: &wgpu::Limits) -> u64 {
@@ -67,32 +67,30 @@ pub fn check_bvh_nodes(limits: &wgpu::Limits, nodes: usize) -> Result<()> {
     check_storage_buffer(limits, &format!("the scene's {nodes} BVH nodes"), nodes as u64, stride, FEWER_TRIANGLES)
 }
 
-/// The photon map of `grid` (`photons/gpu.rs`): a 3D texture of (nx, ny, 6·nz) texels and
-/// 64-bit counters for three channels per slot (24 bytes, one binding of 8 bytes per slot for
-/// each channel).
-pub fn check_photon_grid(limits: &wgpu::Limits, grid: &GridSpec) -> Result<()> {
+/// The photon grid: its cells must have 32-bit indices (the first word of a slot's key).
+pub fn check_photon_grid(_limits: &wgpu::Limits, grid: &GridSpec) -> Result<()> {
     let d = grid.dims;
-    let max = limits.max_texture_dimension_3d;
-    if d.max_element() > max || BINS as u64 * d.z as u64 > max as u64 {
+    if grid.cell_count() >= u32::MAX as u64 {
         return Err(Error::Limits(format!(
-            "a photon grid of {}x{}x{} cells needs a 3D texture of {}x{}x{} texels, more than this GPU's {max} per side; choose a smaller --grid",
-            d.x,
-            d.y,
-            d.z,
-            d.x,
-            d.y,
-            BINS as u64 * d.z as u64
+            "a photon grid of {}x{}x{} cells has more than 2^32 cells; choose a smaller --grid",
+            d.x, d.y, d.z
         )));
     }
-    let what = format!("a photon grid of {}x{}x{} cells", d.x, d.y, d.z);
-    check_storage_buffer(
-        limits,
-        &format!("the counters of {what}"),
-        grid.slot_count() as u64,
-        8,
-        "choose a smaller --grid",
-    )?;
-    let total = grid.slot_count() as u64 * 24;
+    Ok(())
+}
+
+/// The photon map's slots (`photons/gpu.rs`): per table entry 64-bit counters for three
+/// channels (one binding of 8 bytes per entry for each), the lookup values (16 bytes), the keys
+/// (8) and the areas (4), each against the binding limit, and all of them against the largest
+/// buffer.
+pub fn check_photon_slots(limits: &wgpu::Limits, layout: &MapLayout) -> Result<()> {
+    let d = layout.grid.dims;
+    let entries = layout.table.capacity() as u64;
+    let what = format!("the {} slots of a photon grid of {}x{}x{} cells", layout.table.len(), d.x, d.y, d.z);
+    for (part, stride) in [("counters", 8), ("lookup values", 16), ("keys", 8)] {
+        check_storage_buffer(limits, &format!("the {part} of {what}"), entries, stride, "choose a smaller --grid")?;
+    }
+    let total = entries * 24;
     if total > limits.max_buffer_size {
         return Err(Error::Limits(format!(
             "the counters of {what} need {} in one buffer, more than this GPU's {}; choose a smaller --grid",
@@ -158,21 +156,30 @@ mod tests {
     }
 
     #[test]
-    fn photon_grid_is_checked_against_texture_depth_and_counter_buffer() {
+    fn photon_cells_need_32_bit_indices_and_the_slots_must_fit_the_bindings() {
         let bounds = crate::scene::Aabb { min: glam::Vec3::ZERO, max: glam::Vec3::ONE };
-        let l = wgpu::Limits { max_texture_dimension_3d: 2048, max_buffer_size: 1 << 30, ..limits(128) };
-        // 128³ cells: 6·128 = 768 texels deep, 128³·6·8 bytes = 96 MiB of counters per channel.
-        assert!(check_photon_grid(&l, &GridSpec::new(&bounds, 128)).is_ok());
-        // 160³: 160³·6·8 bytes = 187.5 MiB per channel.
-        let e = check_photon_grid(&l, &GridSpec::new(&bounds, 160)).unwrap_err().to_string();
-        assert!(e.contains("160x160x160") && e.contains("188 MiB") && e.contains("--grid"), "{e}");
-        // All three channels live in one buffer: 288 MiB for 128³.
-        let small = wgpu::Limits { max_buffer_size: 256 << 20, ..l.clone() };
-        let e = check_photon_grid(&small, &GridSpec::new(&bounds, 128)).unwrap_err().to_string();
-        assert!(e.contains("288 MiB") && e.contains("one buffer"), "{e}");
-        // 400 cells deep need 2400 texels: deeper than 2048.
-        let e = check_photon_grid(&l, &GridSpec::new(&bounds, 400)).unwrap_err().to_string();
-        assert!(e.contains("2400") && e.contains("2048"), "{e}");
+        let l = limits(128);
+        // 1600³ = 4.1·10⁹ cells fit 32 bits, 1700³ = 4.9·10⁹ do not.
+        assert!(check_photon_grid(&l, &GridSpec::new(&bounds, 1600)).is_ok());
+        let e = check_photon_grid(&l, &GridSpec::new(&bounds, 1700)).unwrap_err().to_string();
+        assert!(e.contains("1700x1700x1700") && e.contains("--grid"), "{e}");
+        // The largest per-entry binding is the lookup values' 16 bytes; all counters share a
+        // buffer of 24 bytes per entry.
+        let scene = crate::scene::cornell_box();
+        let layout = MapLayout::new(&scene, &GridSpec::new(&scene.bounds(), 32));
+        let entries = layout.table.capacity() as u64;
+        let fits = wgpu::Limits {
+            max_storage_buffer_binding_size: entries * 16,
+            max_buffer_size: entries * 24,
+            ..Default::default()
+        };
+        assert!(check_photon_slots(&fits, &layout).is_ok());
+        let narrow = wgpu::Limits { max_storage_buffer_binding_size: entries * 16 - 4, ..fits.clone() };
+        let e = check_photon_slots(&narrow, &layout).unwrap_err().to_string();
+        assert!(e.contains("lookup values") && e.contains("32x32x32") && e.contains("--grid"), "{e}");
+        let short = wgpu::Limits { max_buffer_size: entries * 24 - 1, ..fits };
+        let e = check_photon_slots(&short, &layout).unwrap_err().to_string();
+        assert!(e.contains("one buffer"), "{e}");
     }
 
     #[test]

@@ -41,7 +41,7 @@ impl PhotonViewPass {
             "photon view",
             &module,
             "main",
-            &[&scene.layout, &frame.layout, &layout, &map.layout],
+            &[&scene.layout, &frame.layout, &layout, &map.bind_layout],
         );
         Self { pipeline, bind_group, profiler: gpu.profiler.clone() }
     }

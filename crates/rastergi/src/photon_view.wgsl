@@ -11,7 +11,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let p = visible_point(textureLoad(gbuffer, gid.xy, 0));
     var radiance = vec3f(0.0);
     if p.ok {
-        radiance = p.x.albedo / PI * photon_irradiance(p.x.pos, p.n);
+        radiance = p.x.albedo / PI * photon_irradiance(p.x.pos, p.x.tri, !p.front);
     }
     film_add(FILM_PHOTON_VIEW, gid.xy, radiance);
 }

@@ -9,6 +9,7 @@
 use crate::film::{FILM_DIRECT, FILM_INDIRECT, FILM_PHOTON_VIEW};
 use crate::gather::MAX_DIRECTIONS;
 use crate::gpu_scene::{MATERIAL_TWO_SIDED, NO_TEXTURE};
+use crate::photons::map::OFFSET_STEP;
 use crate::sampling::stream;
 
 pub const SAMPLING: &str = include_str!("sampling.wgsl");
@@ -33,9 +34,13 @@ pub fn constants() -> String {
         ("STREAM_PATH", stream::PATH),
         ("STREAM_PHOTON", stream::PHOTON),
     ];
+    let f32s = [("OFFSET_STEP", OFFSET_STEP)];
     let mut s = String::from("// Generated from the Rust constants (shader.rs).\n");
     for (name, value) in u32s {
         s += &format!("const {name}: u32 = {value}u;\n");
+    }
+    for (name, value) in f32s {
+        s += &format!("const {name}: f32 = {value:?};\n");
     }
     s
 }

@@ -62,7 +62,7 @@ fn mismatches_against_cpu_raycast(method: GatherMethod) -> (usize, usize) {
                 let ht = s.triangles[hit.triangle as usize];
                 let nh = triangle_normal(&ht);
                 if nh.dot(direction) < 0.0 {
-                    let e = map.irradiance(x + direction * hit.t, nh);
+                    let e = map.irradiance_on(hit.triangle as usize, false, x + direction * hit.t);
                     let (ax, ah) = (s.material_of(t).albedo, s.material_of(hit.triangle as usize).albedo);
                     for c in 0..3 {
                         expected[c] = ax[c] as f64 / PI * ah[c] as f64 / PI * e[c] * cos as f64 * 4.0 * PI;

@@ -42,11 +42,22 @@ fn a_scene_beyond_the_storage_binding_limit_is_refused_with_its_size() {
 fn a_photon_grid_or_bundle_beyond_the_device_is_refused_with_the_option_to_change() {
     let gpu = common::gpu();
     let scene = cornell_box();
-    // About 1024³ cells: 6 · 1019 texels of depth and 140 GiB of counters.
-    let grid = RenderSettings { grid_resolution: 1024, ..settings() };
-    let e = Renderer::new(&gpu, &scene, grid).err().expect("a 1024³ grid was accepted").to_string();
+    // 2048 cells along the longest axis: 8.5·10⁹ cells, beyond 32-bit cell indices.
+    let grid = RenderSettings { grid_resolution: 2048, ..settings() };
+    let e = Renderer::new(&gpu, &scene, grid).err().expect("a 2048³ grid was accepted").to_string();
     println!("{e}");
-    assert!(e.contains("photon grid of 1019x1024x1019 cells") && e.contains("--grid"), "{e}");
+    assert!(e.contains("photon grid of 2038x2048x2038 cells") && e.contains("--grid"), "{e}");
+    // 1024³ cells hold about 10⁷ surface slots, more than a 128 MiB binding: the map takes a
+    // coarser grid (with a warning) rather than failing or overflowing its table.
+    let grid = RenderSettings { grid_resolution: 1024, ..settings() };
+    let r = Renderer::new(&gpu, &scene, grid).expect("a 1024³ grid degrades to a coarser one");
+    let map = r.photon_map().expect("a photon map");
+    let max = rastergi::limits::max_storage_buffer(&gpu.device.limits());
+    println!("1024 asked, {} used; {} table entries", map.grid().dims.max_element(), map.layout.table.capacity());
+    assert!(map.layout.table.capacity() as u64 * 16 <= max);
+    if max < 1 << 30 {
+        assert!(map.grid().dims.max_element() < 1024);
+    }
     // A bundle past the texture side, or whose counters (4 bytes a texel) exceed a binding.
     let max = gpu.device.limits().max_texture_dimension_2d;
     let bundle = RenderSettings { bundle: max + 1, ..settings() };

@@ -19,7 +19,7 @@ fn gpu_map(gpu: &rastergi::gpu::Gpu, scene: &Scene, settings: &PhotonSettings) -
 }
 
 fn total_area(map: &PhotonMap) -> f64 {
-    map.area.iter().sum()
+    map.area().iter().sum()
 }
 
 /// A closed cube [-1,1]³ (walls facing in, albedo a) with a small two-sided emitter of albedo a
@@ -96,8 +96,8 @@ fn gpu_and_cpu_photon_maps_agree_cell_by_cell_within_noise() {
     let n = 1u32 << 19;
     let g = gpu_map(&gpu, &scene, &PhotonSettings { count: n, seed: 11, grid_resolution: 16 });
     let c =
-        cpu::trace(&PreparedScene::new(&scene), &g.grid, &PhotonSettings { count: n, seed: 12, grid_resolution: 16 });
-    assert_eq!(g.area, c.area);
+        cpu::trace(&PreparedScene::new(&scene), g.grid(), &PhotonSettings { count: n, seed: 12, grid_resolution: 16 });
+    assert_eq!(g.area(), c.area());
     // Independent seeds: per well-populated slot the difference of the two sums has variance
     // ≈ 2·Σφ² (compound Poisson), estimated from the CPU map's squared deposits.
     let (mut sum_z2, mut max_z, mut cells) = (0.0f64, 0.0f64, 0usize);
@@ -145,7 +145,7 @@ fn thin_wall_keeps_the_dark_room_dark_beyond_one_and_a_half_cells() {
         ("cpu", cpu::trace(&PreparedScene::new(&s), &GridSpec::new(&s.bounds(), 16), &settings)),
     ];
     for (name, map) in &maps {
-        let h = map.grid.cell;
+        let h = map.grid().cell;
         // The lookup reads cells whose centres lie within one cell of p; a cell holding lit
         // floor has its centre at x ≤ −0.01 + h/2, so dark-floor points at x ≥ −0.01 + 1.5h
         // read no lit cell, and the dark face of the wall (+x bin) gathers no photon at all.
@@ -201,7 +201,7 @@ fn photon_view_lookup_on_the_gpu_equals_the_cpu_lookup() {
             continue;
         }
         let albedo = prepared.scene.material_of(t).albedo;
-        let e = map.irradiance(p, n);
+        let e = map.irradiance_on(t, false, p);
         for c in 0..3 {
             let expected = albedo[c] as f64 / std::f64::consts::PI * e[c];
             assert!(

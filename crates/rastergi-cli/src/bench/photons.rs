@@ -6,7 +6,6 @@ use std::time::Instant;
 use anyhow::Result;
 use clap::Args;
 use rastergi::gpu_scene::{GpuScene, PreparedScene};
-use rastergi::photons::map::GridSpec;
 use rastergi::photons::{PhotonSettings, cpu, gpu::GpuPhotonMap};
 
 use super::{load_valid_scene, median};
@@ -51,9 +50,10 @@ pub fn run(a: &PhotonArgs) -> Result<()> {
         times.push(t.elapsed());
     }
     let t_gpu = median(times).as_secs_f64();
-    let grid = GridSpec::new(&prepared.bounds, a.grid);
+    // The GPU map's layout (slots and areas, made on the CPU once per grid): the twin traces
+    // into the same slots, and is timed for the tracing alone like the GPU.
     let t = Instant::now();
-    let tally = cpu::trace_flux(&prepared, &grid, &settings);
+    let tally = cpu::trace_flux(&prepared, &map.layout, &settings, 0);
     let t_cpu = t.elapsed().as_secs_f64();
     let deposits: u64 = tally.deposits.iter().map(|&d| d as u64).sum();
     let n = a.photons as f64;

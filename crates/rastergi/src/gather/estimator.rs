@@ -113,7 +113,7 @@ impl GatherSetup<'_> {
             label,
             &module,
             "main",
-            &[&self.scene.layout, &self.frame.layout, own, &self.map.layout],
+            &[&self.scene.layout, &self.frame.layout, own, &self.map.bind_layout],
         )
     }
 }

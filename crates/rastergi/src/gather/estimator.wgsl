@@ -14,6 +14,6 @@ fn gather_estimate(p: VisiblePoint, cos_x: f32, w: vec3f, tri: u32, hit: vec3f, 
     }
     // ρ_h at the hit point itself, unfiltered (level 0), like every secondary point.
     let albedo_h = surface_at(tri, b.x, b.y, 0.0).albedo;
-    let radiance_h = albedo_h / PI * photon_irradiance(hit, select(-n_h, n_h, front_h));
+    let radiance_h = albedo_h / PI * photon_irradiance(hit, tri, !front_h);
     return p.x.albedo / PI * radiance_h * (cos_x * 4.0 * PI);
 }

@@ -5,7 +5,7 @@ use rayon::prelude::*;
 
 use super::{MAX_BOUNCES, PhotonSettings, STREAM_PHOTON};
 use crate::gpu_scene::PreparedScene;
-use crate::photons::map::{GridSpec, PhotonMap, orientation_bin, surface_areas};
+use crate::photons::map::{GridSpec, MapLayout, PhotonMap};
 use crate::sampling::{Rng, cosine_hemisphere, uniform_triangle};
 use crate::scene::triangle_normal;
 
@@ -14,11 +14,13 @@ pub struct Tally {
     pub flux: Vec<[f64; 3]>,
     pub flux_sq: Vec<f64>,
     pub deposits: Vec<u32>,
+    /// Deposits that found no slot ([`MapLayout::deposit_slot`]).
+    pub dropped: u64,
 }
 
 impl Tally {
     fn new(n: usize) -> Self {
-        Self { flux: vec![[0.0; 3]; n], flux_sq: vec![0.0; n], deposits: vec![0; n] }
+        Self { flux: vec![[0.0; 3]; n], flux_sq: vec![0.0; n], deposits: vec![0; n], dropped: 0 }
     }
 
     fn merge(mut self, o: Tally) -> Tally {
@@ -29,20 +31,26 @@ impl Tally {
             self.flux_sq[i] += o.flux_sq[i];
             self.deposits[i] += o.deposits[i];
         }
+        self.dropped += o.dropped;
         self
     }
 }
 
-/// Traces `settings.count` photons on all CPU cores into a photon map over `grid`.
+/// Traces `settings.count` photons (pass 0) on all CPU cores into a photon map over `grid`.
 pub fn trace(prepared: &PreparedScene, grid: &GridSpec, settings: &PhotonSettings) -> PhotonMap {
-    let area = surface_areas(&prepared.scene, grid);
-    let tally = trace_flux(prepared, grid, settings);
-    PhotonMap { grid: *grid, flux: tally.flux, area, flux_sq: tally.flux_sq, deposits: tally.deposits }
+    trace_pass(prepared, grid, settings, 0)
 }
 
-/// The photon tracing alone (what `rastergi bench photons` times).
-pub fn trace_flux(prepared: &PreparedScene, grid: &GridSpec, settings: &PhotonSettings) -> Tally {
-    let slots = grid.slot_count();
+/// [`trace`] with the photons of `pass` (the stream (seed ⊕ photon stream, index, pass)).
+pub fn trace_pass(prepared: &PreparedScene, grid: &GridSpec, settings: &PhotonSettings, pass: u32) -> PhotonMap {
+    let layout = MapLayout::new(&prepared.scene, grid);
+    let tally = trace_flux(prepared, &layout, settings, pass);
+    PhotonMap { layout, flux: tally.flux, flux_sq: tally.flux_sq, deposits: tally.deposits, dropped: tally.dropped }
+}
+
+/// The photon tracing alone into the slots of `layout` (what `rastergi bench photons` times).
+pub fn trace_flux(prepared: &PreparedScene, layout: &MapLayout, settings: &PhotonSettings, pass: u32) -> Tally {
+    let slots = layout.table.capacity();
     if prepared.lights.is_empty() || settings.count == 0 {
         return Tally::new(slots);
     }
@@ -55,7 +63,7 @@ pub fn trace_flux(prepared: &PreparedScene, grid: &GridSpec, settings: &PhotonSe
             || Tally::new(slots),
             |mut t, chunk| {
                 for i in chunk * CHUNK..((chunk + 1) * CHUNK).min(settings.count) {
-                    trace_photon(prepared, grid, settings, i, &mut t);
+                    trace_photon(prepared, layout, settings, (i, pass), &mut t);
                 }
                 t
             },
@@ -64,10 +72,16 @@ pub fn trace_flux(prepared: &PreparedScene, grid: &GridSpec, settings: &PhotonSe
 }
 
 /// One photon's path (`trace_photon` in `trace.wgsl`, draw for draw).
-fn trace_photon(prepared: &PreparedScene, grid: &GridSpec, settings: &PhotonSettings, index: u32, t: &mut Tally) {
+fn trace_photon(
+    prepared: &PreparedScene,
+    layout: &MapLayout,
+    settings: &PhotonSettings,
+    (index, pass): (u32, u32),
+    t: &mut Tally,
+) {
     let scene = &prepared.scene;
     let eps = prepared.ray_epsilon();
-    let mut rng = Rng::new(settings.seed ^ STREAM_PHOTON, index, 0);
+    let mut rng = Rng::new(settings.seed ^ STREAM_PHOTON, index, pass);
     let (u0, u1, u2) = (rng.next_f32(), rng.next_f32(), rng.next_f32());
     let light = prepared.lights.pick(u0);
     let tri = &scene.triangles[light.triangle as usize];
@@ -92,12 +106,16 @@ fn trace_photon(prepared: &PreparedScene, grid: &GridSpec, settings: &PhotonSett
         }
         let n = if front { n } else { -n };
         let p = tri[0] * (1.0 - hit.b1 - hit.b2) + tri[1] * hit.b1 + tri[2] * hit.b2;
-        let slot = grid.slot(grid.cell_of(p), orientation_bin(n));
-        for c in 0..3 {
-            t.flux[slot][c] += flux[c] as f64;
+        match layout.deposit_slot(hit.triangle as usize, !front, p) {
+            Some(slot) => {
+                for c in 0..3 {
+                    t.flux[slot][c] += flux[c] as f64;
+                }
+                t.flux_sq[slot] += (flux.y as f64).powi(2);
+                t.deposits[slot] += 1;
+            }
+            None => t.dropped += 1,
         }
-        t.flux_sq[slot] += (flux.y as f64).powi(2);
-        t.deposits[slot] += 1;
         let albedo = prepared.albedo_at(hit.triangle as usize, hit.b1, hit.b2, 0.0);
         let survive = albedo.max_element();
         if rng.next_f32() >= survive {

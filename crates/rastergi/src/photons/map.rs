@@ -1,34 +1,61 @@
-//! The grid photon map: a uniform 3D grid over the scene holding, per cell and per surface
-//! orientation bin, the photon flux Φ deposited there and the surface area A inside the cell.
+//! The grid photon map, stored sparsely: only the slots that hold surface, in a hash table.
 //!
-//! * Irradiance of a cell is E = Φ / A with A the area of the scene's surfaces *inside the
-//!   cell* (triangles clipped to the cell), so a flat, evenly lit surface is estimated without
-//!   bias however it cuts the cell.
-//! * Bins: the dominant axis and sign of the normal of the side a photon lands on (±x, ±y, ±z).
-//!   The floor and the wall meeting in a corner cell, or the two sides of a thin wall, fall in
-//!   different bins and never mix.
-//! * Lookup at (p, n): trilinear weights w_i over the 8 cells around p, in n's bin, combined as
-//!   E(p) = Σ w_i Φ_i / Σ w_i A_i — the neighbours' irradiances weighted by w_i A_i, so cells
-//!   with little surface count little and empty cells not at all.
-//! * Outgoing radiance of a Lambertian surface of albedo ρ there: L = ρ/π · E.
+//! * A **slot** is a (cell, plane) pair: a cubic cell of the grid and a surface plane key, the
+//!   side's orientation bin and its plane's offset. Photons deposit their flux Φ in the slot of
+//!   the cell they land in and the plane of the side they land on; the slot's area A is the
+//!   part of the scene's surfaces with that plane key inside the cell (triangles clipped to
+//!   the cell). Irradiance of a slot: E = Φ / A.
+//! * **Orientation bins** ([`orientation_bin`]): the cube face of the dominant axis and sign
+//!   of the side's normal, each face divided 3 × 3 by the other two coordinates over the
+//!   dominant one, 54 bins in all; axis-aligned normals lie at the centre of a bin, and normals
+//!   sharing a bin are at most 2·atan(√2/3) ≈ 50.5° apart (across the central bin's diagonal;
+//!   a plain grid's 6 axis bins mix normals up to 109.5° apart).
+//! * **Plane offsets**: the signed distance d = n·(v₀ − c) from the cell's centre c to the
+//!   side's plane, rounded to [`OFFSET_STEP`] cells. Parallel surfaces farther apart than that
+//!   never share a slot (the light's underside and the ceiling above it, 1 cm apart in the
+//!   Cornell box, with 3.1 cm cells), while the facets of a smooth curved surface, whose planes
+//!   pass within a fraction of a step of each other inside a cell, mostly do. Every triangle's
+//!   plane (unit normal, n·v₀, the bins of both sides) is computed once
+//!   ([`MapLayout::planes`]), so a deposit, the area and a lookup on the same triangle compute
+//!   the same key from the same numbers.
+//! * **Lookup** at p on a plane key: trilinear weights w_i over the 8 cells around p, the slots
+//!   of those cells with the same key, E(p) = Σ w_i Φ_i / Σ w_i A_i (cells without such a slot
+//!   count nothing). Outgoing radiance of a Lambertian surface of albedo ρ: L = ρ/π · E.
+//! * **Hash table** ([`SlotTable`]): open addressing with linear probing over a power-of-two
+//!   capacity at most half full, keyed by (cell index, plane key); built once on the CPU from
+//!   the geometry, read by the GPU tracer's deposits and every lookup. The longest probe of any
+//!   slot bounds every search. Memory is per surface slot, not per cell: 24 bytes per table
+//!   entry while rendering.
 //!
-//! Known bias: the estimate is an average over up to 2×2×2 cells. Surfaces of the same bin
-//! sharing a cell mix (e.g. the floor on both sides of a wall thinner than a cell: the leak
-//! reaches at most 1.5 cell widths from the wall), and irradiance gradients blur over a cell.
+//! Known bias: the estimate averages over up to 2×2×2 cells. Surfaces of one plane sharing a
+//! cell mix (e.g. the floor on both sides of a wall thinner than a cell: the leak reaches at
+//! most 1.5 cell widths from the wall), and irradiance gradients blur over a cell.
+
+use std::collections::HashMap;
 
 use glam::{DVec3, IVec3, UVec3, Vec3};
 
+use crate::sampling::pcg_hash;
 use crate::scene::{Aabb, Scene, triangle_normal};
 
-/// The orientation bin in WGSL (`orientation_bin`, the twin of [`orientation_bin`]).
-pub const BIN_WGSL: &str = include_str!("bin.wgsl");
-/// The map's lookup in WGSL (`photon_irradiance`, bind group 3), with the orientation bin.
-pub const LOOKUP_WGSL: &str = concat!(include_str!("bin.wgsl"), "\n", include_str!("map.wgsl"));
+/// The slot table's search in WGSL (`find_slot`, the twin of [`SlotTable::find`]). The GPU
+/// needs no bins: it reads every triangle's plane keys.
+pub const TABLE_WGSL: &str = include_str!("table.wgsl");
+/// The map's lookup in WGSL (`photon_irradiance`, bind group 3), with the table's search.
+pub const LOOKUP_WGSL: &str = concat!(include_str!("table.wgsl"), "\n", include_str!("map.wgsl"));
 
-/// Orientation bins: 0 +x, 1 −x, 2 +y, 3 −y, 4 +z, 5 −z.
-pub const BINS: usize = 6;
+/// Divisions of each cube face along each of its two axes.
+pub const FACE_DIVISIONS: usize = 3;
+/// Orientation bins: 6 cube faces × FACE_DIVISIONS².
+pub const BINS: usize = 6 * FACE_DIVISIONS * FACE_DIVISIONS;
+/// Plane offsets are rounded to this many cell sides.
+pub const OFFSET_STEP: f32 = 0.125;
+/// A table entry without a slot.
+pub const EMPTY: u32 = u32::MAX;
 
-/// The bin of a surface side with normal n: its dominant axis and sign (`orientation_bin` in WGSL).
+/// The bin of a surface side with normal n: face 2·axis + sign of
+/// the dominant axis, then the 3 × 3 cell of the other two coordinates (in axis order after
+/// it) divided by the dominant one's magnitude, each in [−1, 1].
 pub fn orientation_bin(n: Vec3) -> usize {
     let a = n.abs();
     let axis = if a.x >= a.y && a.x >= a.z {
@@ -38,7 +65,46 @@ pub fn orientation_bin(n: Vec3) -> usize {
     } else {
         2
     };
-    2 * axis + usize::from(n[axis] < 0.0)
+    let face = 2 * axis + usize::from(n[axis] < 0.0);
+    let major = a[axis].max(f32::MIN_POSITIVE);
+    let sub = |c: f32| (((c / major + 1.0) * 0.5 * FACE_DIVISIONS as f32) as usize).min(FACE_DIVISIONS - 1);
+    let (u, v) = (sub(n[(axis + 1) % 3]), sub(n[(axis + 2) % 3]));
+    (face * FACE_DIVISIONS + u) * FACE_DIVISIONS + v
+}
+
+/// A triangle's plane as the map keys it (`TrianglePlane` in `map.wgsl` and `trace.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct TrianglePlane {
+    /// The front side's unit normal.
+    pub normal: [f32; 3],
+    /// n·v₀: the plane is {x : n·x = offset}.
+    pub offset: f32,
+    /// The orientation bins of the front and back sides.
+    pub bins: [u32; 2],
+    pub _pad: [u32; 2],
+}
+
+impl TrianglePlane {
+    /// The plane with front normal n through `point` (n zero: a degenerate triangle, which no
+    /// photon lands on).
+    pub fn new(n: Vec3, point: Vec3) -> TrianglePlane {
+        let bins = if n == Vec3::ZERO { [EMPTY; 2] } else { [orientation_bin(n) as u32, orientation_bin(-n) as u32] };
+        TrianglePlane { normal: n.into(), offset: n.dot(point), bins, _pad: [0; 2] }
+    }
+
+    /// The plane key of side `back` in cell c of `grid` (`plane_key` in WGSL): the orientation
+    /// bin in the low 8 bits, above them the signed distance from the cell's centre to the
+    /// plane along the side's normal in steps of [`OFFSET_STEP`] cells, rounded (24-bit two's
+    /// complement).
+    pub fn key(&self, grid: &GridSpec, c: UVec3, back: bool) -> u32 {
+        let centre = grid.origin + (c.as_vec3() + 0.5) * grid.cell;
+        let d = (self.offset - Vec3::from(self.normal).dot(centre)) / (OFFSET_STEP * grid.cell);
+        // floor(d + ½) as in WGSL (whose round() breaks ties to even).
+        let steps = (d + 0.5).floor() as i32;
+        let steps = if back { -steps } else { steps };
+        self.bins[usize::from(back)] | ((steps as u32) << 8)
+    }
 }
 
 /// Placement of the grid: cubic cells of side `cell` from `origin`, `dims` cells per axis.
@@ -62,8 +128,8 @@ impl GridSpec {
         GridSpec { origin, cell, dims }
     }
 
-    pub fn cell_count(&self) -> usize {
-        (self.dims.x * self.dims.y * self.dims.z) as usize
+    pub fn cell_count(&self) -> u64 {
+        self.dims.x as u64 * self.dims.y as u64 * self.dims.z as u64
     }
 
     /// The cell holding p (clamped to the grid).
@@ -71,51 +137,181 @@ impl GridSpec {
         ((p - self.origin) / self.cell).floor().as_ivec3().clamp(IVec3::ZERO, self.dims.as_ivec3() - 1).as_uvec3()
     }
 
-    /// Linear index of (cell, bin): bins are slabs of the z axis, as in the 3D texture whose
-    /// depth is `BINS · dims.z` (`slot` in WGSL).
-    pub fn slot(&self, c: UVec3, bin: usize) -> usize {
-        let z = bin as u32 * self.dims.z + c.z;
-        ((z * self.dims.y + c.y) * self.dims.x + c.x) as usize
-    }
-
-    pub fn slot_count(&self) -> usize {
-        BINS * self.cell_count()
+    /// The linear index of cell c (x fastest), the first word of a slot's key.
+    pub fn cell_index(&self, c: UVec3) -> u32 {
+        (c.z * self.dims.y + c.y) * self.dims.x + c.x
     }
 }
 
-/// Area of the part of each surface side inside each (cell, bin) slot, by clipping every
-/// triangle to every cell its bounding box overlaps. A side is counted where it can reflect
-/// light: the front face, and the back face of two-sided materials.
-pub fn surface_areas(scene: &Scene, grid: &GridSpec) -> Vec<f64> {
-    let mut area = vec![0.0f64; grid.slot_count()];
-    for (i, t) in scene.triangles.iter().enumerate() {
-        let n = triangle_normal(t);
-        if n == Vec3::ZERO {
-            continue;
+/// The hash of a slot key (`slot_hash` in `table.wgsl`).
+fn slot_hash(cell: u32, plane: u32) -> u32 {
+    pcg_hash(cell ^ pcg_hash(plane))
+}
+
+/// The slots of a map: keys (cell index, plane key) in an open-addressing table.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SlotTable {
+    /// `[cell, plane]` per entry, `[EMPTY, EMPTY]` where there is no slot; a power of two long.
+    pub keys: Vec<[u32; 2]>,
+    /// The longest probe sequence of any key: a search stops after this many entries.
+    pub max_probe: u32,
+}
+
+impl SlotTable {
+    /// A table holding `keys` (distinct), at most half full.
+    pub fn new(keys: &[[u32; 2]]) -> SlotTable {
+        let capacity = (2 * keys.len()).next_power_of_two().max(16);
+        let mask = capacity as u32 - 1;
+        let mut table = vec![[EMPTY; 2]; capacity];
+        let mut max_probe = 1;
+        for &k in keys {
+            let mut i = slot_hash(k[0], k[1]) & mask;
+            let mut probe = 1;
+            while table[i as usize][0] != EMPTY {
+                i = (i + 1) & mask;
+                probe += 1;
+            }
+            table[i as usize] = k;
+            max_probe = max_probe.max(probe);
         }
-        let mut bins = vec![orientation_bin(n)];
-        if scene.material_of(i).two_sided {
-            bins.push(orientation_bin(-n));
+        SlotTable { keys: table, max_probe }
+    }
+
+    pub fn capacity(&self) -> usize {
+        self.keys.len()
+    }
+
+    /// The entry of slot (cell, plane), if the map has it (`find_slot` in WGSL).
+    pub fn find(&self, cell: u32, plane: u32) -> Option<usize> {
+        let mask = self.keys.len() as u32 - 1;
+        let mut i = slot_hash(cell, plane) & mask;
+        for _ in 0..self.max_probe {
+            let k = self.keys[i as usize];
+            if k == [cell, plane] {
+                return Some(i as usize);
+            }
+            if k[0] == EMPTY {
+                return None;
+            }
+            i = (i + 1) & mask;
         }
-        let poly: Vec<DVec3> = t.iter().map(|p| p.as_dvec3()).collect();
-        let lo = grid.cell_of(t[0].min(t[1]).min(t[2]));
-        let hi = grid.cell_of(t[0].max(t[1]).max(t[2]));
-        for z in lo.z..=hi.z {
-            for y in lo.y..=hi.y {
-                for x in lo.x..=hi.x {
-                    let c = UVec3::new(x, y, z);
-                    let min = grid.origin.as_dvec3() + c.as_dvec3() * grid.cell as f64;
-                    let a = polygon_area(&clip_to_box(&poly, min, min + DVec3::splat(grid.cell as f64)));
-                    if a > 0.0 {
-                        for &b in &bins {
-                            area[grid.slot(c, b)] += a;
+        None
+    }
+
+    /// Entries holding a slot.
+    pub fn len(&self) -> usize {
+        self.keys.iter().filter(|k| k[0] != EMPTY).count()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+/// Everything about a map that depends on the geometry alone: the grid, every triangle's
+/// plane, the slots and their areas. Shared by the GPU tracer and its CPU twin.
+#[derive(Clone, Debug)]
+pub struct MapLayout {
+    pub grid: GridSpec,
+    /// Per triangle (in the scene's order): its plane.
+    pub planes: Vec<TrianglePlane>,
+    pub table: SlotTable,
+    /// Surface area per table entry (zero where there is no slot).
+    pub area: Vec<f64>,
+}
+
+impl MapLayout {
+    /// The layout of `scene` over `grid`: every triangle clipped to every cell its bounding
+    /// box overlaps, its area added to the slot of each side that reflects light (the front
+    /// face, and the back of two-sided materials).
+    pub fn new(scene: &Scene, grid: &GridSpec) -> MapLayout {
+        let planes: Vec<TrianglePlane> =
+            scene.triangles.iter().map(|t| TrianglePlane::new(triangle_normal(t), t[0])).collect();
+        let mut areas: HashMap<[u32; 2], f64> = HashMap::new();
+        for (i, t) in scene.triangles.iter().enumerate() {
+            if planes[i].bins[0] == EMPTY {
+                continue;
+            }
+            let sides: &[bool] = if scene.material_of(i).two_sided { &[false, true] } else { &[false] };
+            let poly: Vec<DVec3> = t.iter().map(|p| p.as_dvec3()).collect();
+            let lo = grid.cell_of(t[0].min(t[1]).min(t[2]));
+            let hi = grid.cell_of(t[0].max(t[1]).max(t[2]));
+            for z in lo.z..=hi.z {
+                for y in lo.y..=hi.y {
+                    for x in lo.x..=hi.x {
+                        let c = UVec3::new(x, y, z);
+                        let min = grid.origin.as_dvec3() + c.as_dvec3() * grid.cell as f64;
+                        let a = polygon_area(&clip_to_box(&poly, min, min + DVec3::splat(grid.cell as f64)));
+                        if a > 0.0 {
+                            for &back in sides {
+                                *areas.entry([grid.cell_index(c), planes[i].key(grid, c, back)]).or_default() += a;
+                            }
                         }
                     }
                 }
             }
         }
+        let mut keys: Vec<[u32; 2]> = areas.keys().copied().collect();
+        keys.sort_unstable();
+        let table = SlotTable::new(&keys);
+        let mut area = vec![0.0; table.capacity()];
+        for (k, a) in &areas {
+            area[table.find(k[0], k[1]).expect("every slot is in the table")] = *a;
+        }
+        MapLayout { grid: *grid, planes, table, area }
     }
-    area
+
+    /// The layout over a grid of `resolution` cells along the longest axis of `bounds`, or of
+    /// the finest coarser grid (halving the resolution) whose slots fit `limits`, with a
+    /// warning saying so. The slot count is first estimated from the triangles (a planar
+    /// triangle of area A and perimeter P meets at most about √3·A/h² + 3·P/h + 1 cells of side
+    /// h), so an impossible grid costs no clipping; the estimate is then checked against the
+    /// clipped table. Errors only where the grid's cells have no 32-bit index.
+    pub fn within(scene: &Scene, bounds: &Aabb, resolution: u32, limits: &wgpu::Limits) -> crate::Result<MapLayout> {
+        let (area, perimeter, count) = scene.triangles.iter().fold((0.0f64, 0.0f64, 0.0f64), |(a, p, n), t| {
+            let e = [t[1] - t[0], t[2] - t[1], t[0] - t[2]];
+            (a + 0.5 * e[0].cross(-e[2]).length() as f64, p + e.iter().map(|e| e.length() as f64).sum::<f64>(), n + 1.0)
+        });
+        let mut resolution = resolution.max(1);
+        loop {
+            let grid = GridSpec::new(bounds, resolution);
+            crate::limits::check_photon_grid(limits, &grid)?;
+            let h = grid.cell as f64;
+            // Both sides of every triangle, at most.
+            let estimate = 2.0 * (3f64.sqrt() * area / (h * h) + 3.0 * perimeter / h + count);
+            let fits = |slots: f64| {
+                let entries = (2.0 * slots).max(16.0).log2().ceil().exp2() as u64;
+                entries.saturating_mul(16) <= crate::limits::max_storage_buffer(limits)
+                    && entries.saturating_mul(24) <= limits.max_buffer_size
+            };
+            let outcome = if fits(estimate) || resolution == 1 {
+                let layout = MapLayout::new(scene, &grid);
+                crate::limits::check_photon_slots(limits, &layout).map(|()| layout)
+            } else {
+                Err(crate::Error::Limits(format!(
+                    "the photon map of a grid of {resolution} cells would need about {:.0} slots, more than this GPU binds",
+                    estimate
+                )))
+            };
+            match outcome {
+                Ok(layout) => return Ok(layout),
+                // Cells twice as wide hold about a quarter as many slots.
+                Err(e) if resolution > 1 => {
+                    log::warn!("{e}; using a photon grid of {} cells instead of {resolution}", resolution / 2);
+                    resolution /= 2;
+                }
+                Err(e) => return Err(e),
+            }
+        }
+    }
+
+    /// The table entry where a photon landing at p on side `back` of triangle `tri` deposits
+    /// (`None` where the cell holds no area of that plane: a hit point that rounding moved into
+    /// a neighbouring cell).
+    pub fn deposit_slot(&self, tri: usize, back: bool, p: Vec3) -> Option<usize> {
+        let c = self.grid.cell_of(p);
+        self.table.find(self.grid.cell_index(c), self.planes[tri].key(&self.grid, c, back))
+    }
 }
 
 /// Sutherland–Hodgman clipping of a convex polygon to the half-open box [min, max), the
@@ -156,47 +352,68 @@ fn polygon_area(poly: &[DVec3]) -> f64 {
     0.5 * s.length()
 }
 
-/// A photon map on the CPU: flux (RGB) and area per slot. Built by the CPU tracer, or read
-/// back from the GPU; its lookup is the twin of `photon_irradiance` in WGSL.
+/// A photon map on the CPU: flux (RGB) and area per table entry. Built by the CPU tracer, or
+/// read back from the GPU; its lookup is the twin of `photon_irradiance` in WGSL.
 #[derive(Clone, Debug)]
 pub struct PhotonMap {
-    pub grid: GridSpec,
-    /// Φ per slot (watts, RGB).
+    pub layout: MapLayout,
+    /// Φ per table entry (watts, RGB).
     pub flux: Vec<[f64; 3]>,
-    /// Surface area per slot.
-    pub area: Vec<f64>,
-    /// Sum of squared deposits per slot (green channel), for noise estimates (CPU maps only).
+    /// Sum of squared deposits per entry (green channel), for noise estimates (CPU maps only).
     pub flux_sq: Vec<f64>,
-    /// Number of deposits per slot (CPU maps only).
+    /// Number of deposits per entry (CPU maps only).
     pub deposits: Vec<u32>,
+    /// Deposits that found no slot (CPU maps only; see [`MapLayout::deposit_slot`]).
+    pub dropped: u64,
 }
 
 impl PhotonMap {
-    /// Irradiance of one slot, Φ/A (zero where there is no surface).
+    pub fn grid(&self) -> &GridSpec {
+        &self.layout.grid
+    }
+
+    /// Surface area per table entry.
+    pub fn area(&self) -> &[f64] {
+        &self.layout.area
+    }
+
+    /// Irradiance of one entry, Φ/A (zero where there is no surface).
     pub fn cell_irradiance(&self, slot: usize) -> [f64; 3] {
-        let a = self.area[slot];
+        let a = self.layout.area[slot];
         if a > 0.0 { self.flux[slot].map(|f| f / a) } else { [0.0; 3] }
     }
 
-    /// E(p) for the surface side with normal n: Σ w_i Φ_i / Σ w_i A_i over the 8 cells
-    /// around p in n's bin (trilinear weights on cell centres, clamped at the grid's border).
+    /// E(p) for the surface side with unit normal n through p: the lookup on the plane
+    /// through p with normal n (see [`PhotonMap::irradiance_on_plane`]).
     pub fn irradiance(&self, p: Vec3, n: Vec3) -> [f64; 3] {
-        let bin = orientation_bin(n);
-        let g = (p - self.grid.origin) / self.grid.cell - 0.5;
+        self.irradiance_on_plane(p, &TrianglePlane::new(n, p), false)
+    }
+
+    /// E(p) on side `back` of triangle `tri` (its plane, as the passes look it up).
+    pub fn irradiance_on(&self, tri: usize, back: bool, p: Vec3) -> [f64; 3] {
+        self.irradiance_on_plane(p, &self.layout.planes[tri], back)
+    }
+
+    /// Σ w_i Φ_i / Σ w_i A_i over the slots of side `back` of `plane` in the 8 cells around p
+    /// (trilinear weights on cell centres, clamped at the grid's border).
+    pub fn irradiance_on_plane(&self, p: Vec3, plane: &TrianglePlane, back: bool) -> [f64; 3] {
+        let grid = &self.layout.grid;
+        let g = (p - grid.origin) / grid.cell - 0.5;
         let base = g.floor();
         let f = g - base;
-        let max = self.grid.dims.as_ivec3() - 1;
+        let max = grid.dims.as_ivec3() - 1;
         let (mut flux, mut area) = ([0.0f64; 3], 0.0f64);
         for k in 0..8 {
             let o = IVec3::new(k & 1, (k >> 1) & 1, (k >> 2) & 1);
             let w = o.as_vec3() * f + (Vec3::ONE - o.as_vec3()) * (Vec3::ONE - f);
             let w = (w.x * w.y * w.z) as f64;
             let c = (base.as_ivec3() + o).clamp(IVec3::ZERO, max).as_uvec3();
-            let s = self.grid.slot(c, bin);
-            for (acc, f) in flux.iter_mut().zip(self.flux[s]) {
-                *acc += w * f;
+            if let Some(s) = self.layout.table.find(grid.cell_index(c), plane.key(grid, c, back)) {
+                for (acc, f) in flux.iter_mut().zip(self.flux[s]) {
+                    *acc += w * f;
+                }
+                area += w * self.layout.area[s];
             }
-            area += w * self.area[s];
         }
         if area > 0.0 { flux.map(|v| v / area) } else { [0.0; 3] }
     }
@@ -216,102 +433,222 @@ impl PhotonMap {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sampling::{Rng, uniform_sphere};
     use crate::scene::{Camera, Material, cornell_box, triangle_area};
 
-    #[test]
-    fn bins_follow_the_dominant_axis_and_sign() {
-        assert_eq!(orientation_bin(Vec3::X), 0);
-        assert_eq!(orientation_bin(-Vec3::X), 1);
-        assert_eq!(orientation_bin(Vec3::new(0.1, 0.9, -0.3)), 2);
-        assert_eq!(orientation_bin(Vec3::new(0.1, -0.9, -0.3)), 3);
-        assert_eq!(orientation_bin(Vec3::new(0.1, 0.2, 0.9)), 4);
-        assert_eq!(orientation_bin(Vec3::new(0.1, 0.2, -0.9)), 5);
+    fn scene_of_quads(quads: &[[Vec3; 4]]) -> Scene {
+        let cam = Camera { eye: Vec3::Z, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 40.0 };
+        let mut s = Scene::new(cam);
+        let m = s.add_material(Material::diffuse("m", Vec3::ONE));
+        for q in quads {
+            s.add_quad(*q, m);
+        }
+        s
+    }
+
+    /// The angle between two unit vectors, in degrees.
+    fn angle(a: Vec3, b: Vec3) -> f32 {
+        a.dot(b).clamp(-1.0, 1.0).acos().to_degrees()
     }
 
     #[test]
-    fn clipped_areas_sum_to_the_scene_area_per_bin() {
+    fn axis_normals_lie_in_the_central_bin_of_their_face_and_every_bin_is_used() {
+        for (face, n) in [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z].into_iter().enumerate() {
+            assert_eq!(orientation_bin(n), (face * FACE_DIVISIONS + 1) * FACE_DIVISIONS + 1, "{n}");
+        }
+        // Random directions: all 54 bins occur, and within a bin no two are farther apart than
+        // the central bin's diagonal, 2·atan(√2/3) = 50.48°.
+        let mut rng = Rng::new(3, 0, 0);
+        let mut members: Vec<Vec<Vec3>> = vec![Vec::new(); BINS];
+        for _ in 0..20_000 {
+            let n = uniform_sphere(rng.next_f32(), rng.next_f32());
+            members[orientation_bin(n)].push(n);
+        }
+        let widest = 2.0 * (2f32.sqrt() / 3.0).atan().to_degrees();
+        for (b, m) in members.iter().enumerate() {
+            assert!(!m.is_empty(), "bin {b} never used");
+            for x in m.iter().step_by(7) {
+                for y in m.iter().step_by(11) {
+                    assert!(angle(*x, *y) <= widest + 0.01, "bin {b}: {x} and {y} {}° apart", angle(*x, *y));
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn parallel_planes_farther_apart_than_the_offset_step_never_share_a_key() {
+        let grid = GridSpec { origin: Vec3::ZERO, cell: 0.25, dims: UVec3::splat(8) };
+        let step = OFFSET_STEP * grid.cell;
+        let mut rng = Rng::new(5, 0, 0);
+        for _ in 0..2000 {
+            let p = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0;
+            let gap = step * (1.0 + 2.0 * rng.next_f32());
+            let c = grid.cell_of(p);
+            let (a, b) = (TrianglePlane::new(-Vec3::Y, p), TrianglePlane::new(-Vec3::Y, p + Vec3::Y * gap));
+            for back in [false, true] {
+                assert_ne!(a.key(&grid, c, back), b.key(&grid, c, back), "{p} {gap}");
+            }
+        }
+        // The same plane through any of its points: one key per cell.
+        let c = UVec3::new(2, 1, 3);
+        let k = TrianglePlane::new(Vec3::Y, Vec3::new(0.1, 0.37, 0.2)).key(&grid, c, false);
+        assert_eq!(TrianglePlane::new(Vec3::Y, Vec3::new(1.9, 0.37, 1.3)).key(&grid, c, false), k);
+    }
+
+    #[test]
+    fn the_table_finds_every_key_it_holds_and_no_other() {
+        let keys: Vec<[u32; 2]> = (0..5000u32).map(|i| [i * 7919 % 100_003, i % 13]).collect();
+        let table = SlotTable::new(&keys);
+        assert!(table.capacity() >= 2 * keys.len() && table.capacity().is_power_of_two());
+        assert_eq!(table.len(), keys.len());
+        let mut entries: Vec<usize> = keys.iter().map(|k| table.find(k[0], k[1]).expect("an inserted key")).collect();
+        for (k, &e) in keys.iter().zip(&entries) {
+            assert_eq!(table.keys[e], *k);
+        }
+        entries.sort_unstable();
+        entries.dedup();
+        assert_eq!(entries.len(), keys.len(), "two keys share an entry");
+        for i in 0..5000u32 {
+            assert_eq!(table.find(i * 7919 % 100_003, 13 + i % 5), None);
+        }
+    }
+
+    #[test]
+    fn clipped_areas_sum_to_the_scene_area_per_plane_key() {
         let scene = cornell_box();
         for resolution in [1, 7, 32] {
             let grid = GridSpec::new(&scene.bounds(), resolution);
-            let areas = surface_areas(&scene, &grid);
-            let mut expected = [0.0f64; BINS];
-            for t in &scene.triangles {
-                expected[orientation_bin(triangle_normal(t))] += triangle_area(t) as f64;
-            }
-            let mut got = [0.0f64; BINS];
-            for b in 0..BINS {
-                for z in 0..grid.dims.z {
-                    for y in 0..grid.dims.y {
-                        for x in 0..grid.dims.x {
-                            got[b] += areas[grid.slot(UVec3::new(x, y, z), b)];
-                        }
-                    }
+            let layout = MapLayout::new(&scene, &grid);
+            let mut expected: HashMap<u32, f64> = HashMap::new();
+            // Per orientation bin: the bin is the key's low byte.
+            for (i, t) in scene.triangles.iter().enumerate() {
+                *expected.entry(layout.planes[i].bins[0]).or_default() += triangle_area(t) as f64;
+                if scene.material_of(i).two_sided {
+                    *expected.entry(layout.planes[i].bins[1]).or_default() += triangle_area(t) as f64;
                 }
             }
-            for b in 0..BINS {
-                assert!(
-                    (got[b] - expected[b]).abs() < 1e-5 * expected[b].max(1.0),
-                    "bin {b} at {resolution}: {} vs {}",
-                    got[b],
-                    expected[b]
-                );
+            let mut got: HashMap<u32, f64> = HashMap::new();
+            for (k, a) in layout.table.keys.iter().zip(&layout.area) {
+                if k[0] != EMPTY {
+                    *got.entry(k[1] & 0xff).or_default() += a;
+                }
+            }
+            assert_eq!(got.len(), expected.len(), "bins at {resolution}");
+            for (bin, e) in &expected {
+                let g = got.get(bin).copied().unwrap_or(0.0);
+                assert!((g - e).abs() < 1e-5 * e.max(1.0), "bin {bin} at {resolution}: {g} vs {e}");
             }
         }
+    }
+
+    #[test]
+    fn the_cornell_light_and_the_ceiling_above_it_never_share_a_slot() {
+        let scene = cornell_box();
+        let grid = GridSpec::new(&scene.bounds(), 64);
+        let layout = MapLayout::new(&scene, &grid);
+        // The ceiling at y = 1 and the light at y = 0.99 (3.1 cm cells), both facing down:
+        // in every cell holding light, the light's slot holds the light's area alone.
+        let lights = scene.emissive_triangles();
+        let light_area: f64 = lights.iter().map(|&i| triangle_area(&scene.triangles[i as usize]) as f64).sum();
+        let mut slots = std::collections::HashSet::new();
+        let mut ceiling_cells = 0;
+        let mut rng = Rng::new(9, 0, 0);
+        for _ in 0..4000 {
+            let p = Vec3::new(rng.next_f32() * 0.46 - 0.23, 0.99, rng.next_f32() * 0.38 - 0.18);
+            let i = lights[0] as usize;
+            slots.insert(layout.deposit_slot(i, false, p).expect("the light's slot"));
+            let on_ceiling = TrianglePlane::new(-Vec3::Y, Vec3::new(p.x, 1.0, p.z));
+            let c = grid.cell_of(p);
+            if layout.table.find(grid.cell_index(c), on_ceiling.key(&grid, c, false)).is_some() {
+                ceiling_cells += 1;
+            }
+        }
+        let total: f64 = slots.iter().map(|&s| layout.area[s]).sum();
+        assert!((total - light_area).abs() < 1e-6, "light slots hold {total}, the light {light_area}");
+        assert!(ceiling_cells > 0, "the ceiling shares the light's cells");
     }
 
     #[test]
     fn a_unit_square_on_a_cell_boundary_plane_splits_its_area_exactly() {
         // A square in the plane z = 0.3, from (0,0) to (1,1), in a grid of cells 0.25 wide:
-        // every cell it crosses gets exactly 0.0625 (or the clipped fraction at the border).
-        let cam = Camera { eye: Vec3::Z, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 40.0 };
-        let mut s = Scene::new(cam);
-        let m = s.add_material(Material::diffuse("m", Vec3::ONE));
-        s.add_quad(
-            [Vec3::new(0.0, 0.0, 0.3), Vec3::new(1.0, 0.0, 0.3), Vec3::new(1.0, 1.0, 0.3), Vec3::new(0.0, 1.0, 0.3)],
-            m,
-        );
+        // every cell it crosses gets exactly 0.0625.
+        let s = scene_of_quads(&[[
+            Vec3::new(0.0, 0.0, 0.3),
+            Vec3::new(1.0, 0.0, 0.3),
+            Vec3::new(1.0, 1.0, 0.3),
+            Vec3::new(0.0, 1.0, 0.3),
+        ]]);
         let grid = GridSpec { origin: Vec3::ZERO, cell: 0.25, dims: UVec3::new(4, 4, 4) };
-        let areas = surface_areas(&s, &grid);
+        let layout = MapLayout::new(&s, &grid);
         for y in 0..4 {
             for x in 0..4 {
-                let a = areas[grid.slot(UVec3::new(x, y, 1), 4)];
-                assert!((a - 0.0625).abs() < 1e-9, "cell ({x},{y}): {a}");
+                let c = UVec3::new(x, y, 1);
+                let e = layout.table.find(grid.cell_index(c), layout.planes[0].key(&grid, c, false)).expect("a slot");
+                assert!((layout.area[e] - 0.0625).abs() < 1e-9, "cell ({x},{y}): {}", layout.area[e]);
             }
         }
+        assert_eq!(layout.table.len(), 16);
     }
 
     #[test]
     fn a_square_exactly_on_a_cell_boundary_counts_once_in_the_cell_its_photons_land_in() {
-        let cam = Camera { eye: Vec3::Z, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 40.0 };
-        let mut s = Scene::new(cam);
-        let m = s.add_material(Material::diffuse("m", Vec3::ONE));
-        s.add_quad(
-            [Vec3::new(0.0, 0.0, 0.5), Vec3::new(1.0, 0.0, 0.5), Vec3::new(1.0, 1.0, 0.5), Vec3::new(0.0, 1.0, 0.5)],
-            m,
-        );
+        let s = scene_of_quads(&[[
+            Vec3::new(0.0, 0.0, 0.5),
+            Vec3::new(1.0, 0.0, 0.5),
+            Vec3::new(1.0, 1.0, 0.5),
+            Vec3::new(0.0, 1.0, 0.5),
+        ]]);
         let grid = GridSpec { origin: Vec3::ZERO, cell: 0.25, dims: UVec3::new(4, 4, 4) };
-        let areas = surface_areas(&s, &grid);
-        let total: f64 = areas.iter().sum();
+        let layout = MapLayout::new(&s, &grid);
+        let total: f64 = layout.area.iter().sum();
         assert!((total - 1.0).abs() < 1e-9, "area counted {total} times");
         assert_eq!(grid.cell_of(Vec3::new(0.3, 0.3, 0.5)).z, 2);
-        assert!((areas[grid.slot(UVec3::new(1, 1, 2), 4)] - 0.0625).abs() < 1e-9);
+        let e = layout.deposit_slot(0, false, Vec3::new(0.3, 0.3, 0.5)).expect("the slot photons land in");
+        assert!((layout.area[e] - 0.0625).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_grid_whose_slots_exceed_the_binding_limit_degrades_to_coarser_cells() {
+        let scene = cornell_box();
+        let roomy =
+            wgpu::Limits { max_storage_buffer_binding_size: 1 << 30, max_buffer_size: 1 << 32, ..Default::default() };
+        let asked = MapLayout::within(&scene, &scene.bounds(), 32, &roomy).unwrap();
+        assert_eq!(asked.grid, GridSpec::new(&scene.bounds(), 32));
+        // 1 MiB binds 65 536 lookup values; 256³ cells would need millions.
+        let tight =
+            wgpu::Limits { max_storage_buffer_binding_size: 1 << 20, max_buffer_size: 1 << 32, ..Default::default() };
+        let coarse = MapLayout::within(&scene, &scene.bounds(), 256, &tight).unwrap();
+        let used = coarse.grid.dims.max_element();
+        assert!(used < 256 && 256 % used == 0, "{used}");
+        assert!(crate::limits::check_photon_slots(&tight, &coarse).is_ok());
+        assert!(coarse.table.capacity() as u64 * 16 <= 1 << 20);
+        // The coarser map is a whole map: every triangle's area is in it.
+        let total: f64 = coarse.area.iter().sum();
+        let expected: f64 = scene.triangles.iter().map(|t| triangle_area(t) as f64).sum();
+        assert!((total - expected).abs() < 1e-4 * expected, "{total} vs {expected}");
     }
 
     #[test]
     fn lookup_of_a_uniform_map_returns_the_uniform_irradiance_anywhere() {
-        // Φ = 3·A in every slot with surface: E = 3 wherever interpolated, even at borders
-        // and next to empty cells.
+        // Φ = 3·A in every slot: E = 3 wherever interpolated, even at borders and next to
+        // cells without that plane. Three quads of different planes, areas varied by their
+        // cuts through the cells.
+        let s = scene_of_quads(&[
+            [Vec3::new(0.0, 0.0, 0.1), Vec3::new(2.9, 0.0, 0.1), Vec3::new(2.9, 1.7, 0.1), Vec3::new(0.0, 1.7, 0.1)],
+            [Vec3::new(0.2, 0.3, 0.0), Vec3::new(0.2, 2.9, 0.0), Vec3::new(0.2, 2.9, 2.1), Vec3::new(0.2, 0.3, 2.1)],
+            [Vec3::new(0.0, 2.3, 0.0), Vec3::new(0.0, 2.3, 2.9), Vec3::new(1.1, 2.3, 2.9), Vec3::new(1.1, 2.3, 0.0)],
+        ]);
         let grid = GridSpec { origin: Vec3::ZERO, cell: 1.0, dims: UVec3::new(3, 3, 3) };
-        let n = grid.slot_count();
-        // Varied areas, and the whole slab of cells x = 2 without surface.
-        let area: Vec<f64> = (0..n).map(|i| if i % 3 == 2 { 0.0 } else { 0.1 + (i % 7) as f64 }).collect();
-        let flux = area.iter().map(|&a| [3.0 * a; 3]).collect();
-        let map = PhotonMap { grid, flux, area, flux_sq: vec![0.0; n], deposits: vec![0; n] };
-        for p in [Vec3::splat(0.01), Vec3::new(1.3, 2.9, 0.5), Vec3::splat(1.5)] {
-            for normal in [Vec3::X, -Vec3::Y, Vec3::Z] {
-                let e = map.irradiance(p, normal);
-                assert!((e[0] - 3.0).abs() < 1e-9, "{p} {normal}: {e:?}");
-            }
+        let layout = MapLayout::new(&s, &grid);
+        let flux = layout.area.iter().map(|&a| [3.0 * a; 3]).collect();
+        let n = layout.table.capacity();
+        let map = PhotonMap { layout, flux, flux_sq: vec![0.0; n], deposits: vec![0; n], dropped: 0 };
+        for (tri, p) in [(0, Vec3::new(0.01, 0.01, 0.1)), (0, Vec3::new(2.8, 1.6, 0.1)), (2, Vec3::new(0.3, 0.5, 1.5))]
+        {
+            let e = map.irradiance_on(tri, false, p);
+            assert!((e[0] - 3.0).abs() < 1e-9, "{tri} {p}: {e:?}");
         }
+        let e = map.irradiance(Vec3::new(0.5, 2.3, 2.5), triangle_normal(&s.triangles[4]));
+        assert!((e[0] - 3.0).abs() < 1e-9, "{e:?}");
     }
 }

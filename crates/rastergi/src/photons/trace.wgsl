@@ -1,6 +1,6 @@
 // Photon pass (photons/gpu.rs): trace photons from the lights, deposit into 64-bit
-// fixed-point counters per (cell, bin, channel); then resolve the counters into the
-// lookup texture. Draw for draw the twin of photons/cpu.rs.
+// fixed-point counters per (slot, channel); then resolve the counters into the slots' lookup
+// values. Draw for draw the twin of photons/cpu.rs.
 
 struct PhotonParams {
     origin: vec3f,
@@ -14,7 +14,13 @@ struct PhotonParams {
     ray_epsilon: f32,
     max_bounces: u32,
     groups_x: u32,
-    _pad: u32,
+    // Table capacity − 1 and the longest probe of any slot (table.wgsl).
+    mask: u32,
+    max_probe: u32,
+    // The photon pass: the second key of every photon's stream.
+    pass_index: u32,
+    _pad0: u32,
+    _pad1: u32,
 }
 
 @group(1) @binding(0) var<uniform> params: PhotonParams;
@@ -23,14 +29,19 @@ struct PhotonParams {
 @group(1) @binding(1) var<storage, read_write> tally_r: array<atomic<u32>>;
 @group(1) @binding(2) var<storage, read_write> tally_g: array<atomic<u32>>;
 @group(1) @binding(3) var<storage, read_write> tally_b: array<atomic<u32>>;
-// Surface area per slot, in units of cell side².
-@group(1) @binding(4) var<storage, read> cell_area: array<f32>;
-@group(1) @binding(5) var map_out: texture_storage_3d<rgba32float, write>;
+// Surface area per table entry, in units of cell side².
+@group(1) @binding(4) var<storage, read> slot_area: array<f32>;
+// Per table entry: (Φ_rgb/h², A/h²), what the lookups read (map.wgsl).
+@group(1) @binding(5) var<storage, read_write> slots_out: array<vec4f>;
+@group(1) @binding(6) var<storage, read> slot_keys: array<vec2u>;
+@group(1) @binding(7) var<storage, read> planes: array<TrianglePlane>;
 
-fn slot_of(p: vec3f, n: vec3f) -> u32 {
+// The table entry of a deposit at p on side `back` of triangle tri (MapLayout::deposit_slot).
+fn slot_of(p: vec3f, tri: u32, back: bool) -> u32 {
     let c = vec3u(clamp(vec3i(floor((p - params.origin) / params.cell)), vec3i(0), vec3i(params.dims) - 1));
-    let z = orientation_bin(n) * params.dims.z + c.z;
-    return (z * params.dims.y + c.y) * params.dims.x + c.x;
+    let cell = (c.z * params.dims.y + c.y) * params.dims.x + c.x;
+    let key = plane_key(planes[tri], cell_centre(params.origin, params.cell, c), params.cell, back);
+    return find_slot(cell, key, params.mask, params.max_probe);
 }
 
 // 64-bit add on the (low, high) words of slot s in channel c: whoever wraps the low word
@@ -68,8 +79,13 @@ fn tally64(c: u32, s: u32) -> f32 {
     return f32(w.y) * 4294967296.0 + f32(w.x);
 }
 
-fn deposit(p: vec3f, n: vec3f, flux: vec3f) {
-    let s = slot_of(p, n);
+// Adds flux to the slot of p on side `back` of tri; a hit that rounding moved into a cell
+// without area of its plane deposits nothing (counted by the CPU twin).
+fn deposit(p: vec3f, tri: u32, back: bool, flux: vec3f) {
+    let s = slot_of(p, tri, back);
+    if s == NO_SLOT {
+        return;
+    }
     let q = vec3u(round(flux * params.quantum));
     add64(0u, s, q.x);
     add64(1u, s, q.y);
@@ -82,7 +98,7 @@ fn trace_photons(@builtin(global_invocation_id) gid: vec3u) {
     if local >= params.batch_size {
         return;
     }
-    var rng = rng_new(params.seed ^ STREAM_PHOTON, params.first_photon + local, 0u);
+    var rng = rng_new(params.seed ^ STREAM_PHOTON, params.first_photon + local, params.pass_index);
     let u0 = rng_f32(&rng);
     let u1 = rng_f32(&rng);
     let u2 = rng_f32(&rng);
@@ -106,7 +122,7 @@ fn trace_photons(@builtin(global_invocation_id) gid: vec3u) {
             break;
         }
         let n = select(-s.normal, s.normal, front);
-        deposit(s.pos, n, flux);
+        deposit(s.pos, hit.tri, !front, flux);
         let survive = max(s.albedo.x, max(s.albedo.y, s.albedo.z));
         if rng_f32(&rng) >= survive {
             break;
@@ -120,16 +136,16 @@ fn trace_photons(@builtin(global_invocation_id) gid: vec3u) {
     }
 }
 
-@compute @workgroup_size(4, 4, 4)
+@compute @workgroup_size(64)
 fn resolve_map(@builtin(global_invocation_id) gid: vec3u) {
-    if gid.x >= params.dims.x || gid.y >= params.dims.y || gid.z >= 6u * params.dims.z {
+    let s = gid.x + gid.y * params.groups_x * 64u;
+    if s > params.mask {
         return;
     }
-    let s = (gid.z * params.dims.y + gid.y) * params.dims.x + gid.x;
     var flux = vec3f(0.0);
     for (var c = 0u; c < 3u; c++) {
         flux[c] = tally64(c, s) / params.quantum;
     }
     let h2 = params.cell * params.cell;
-    textureStore(map_out, gid, vec4f(flux / h2, cell_area[s]));
+    slots_out[s] = vec4f(flux / h2, slot_area[s]);
 }

@@ -31,7 +31,7 @@ enum Command {
     },
     /// Render a scene progressively and write the image (.exr linear, .png display).
     Render(render::RenderArgs),
-    /// Measure throughput, convergence and memory: `bench photons`, `gather`, `converge`, `bvh`, `memory`.
+    /// Measure throughput, convergence and memory: `bench photons`, `gather`, `converge`, `frames`, `bvh`, `memory`.
     #[command(subcommand)]
     Bench(bench::BenchCommand),
     /// Compare an image with a reference: relative RMSE, block-mean error, PSNR, mean ratios.

@@ -23,6 +23,10 @@ pub struct RenderArgs {
     /// Progressive iterations (one sample per pixel each).
     #[arg(long, default_value_t = 256)]
     iterations: u32,
+    /// Stop after this many seconds of rendering (set-up not counted) if the iterations are
+    /// not done by then; the image holds the iterations done, and a note says how many.
+    #[arg(long, value_name = "SECONDS")]
+    max_seconds: Option<f64>,
     /// Output image: .exr (linear radiance, f32 RGB) or .png (exposure, sRGB).
     #[arg(long)]
     out: PathBuf,
@@ -70,6 +74,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if args.iterations == 0 {
         anyhow::bail!("--iterations must be at least 1");
     }
+    if let Some(s) = args.max_seconds.filter(|s| !(s.is_finite() && *s > 0.0)) {
+        anyhow::bail!("--max-seconds must be a positive number of seconds, got {s}");
+    }
     let gpu = gpu_profiled(&a.gpu, args.profile)?;
     if args.method == Method::Path && !matches!(a.show, ShowArg::Full) {
         anyhow::bail!("--method path renders the full image only; drop --show or use --method gather");
@@ -104,26 +111,37 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     } else {
         ProgressBar::hidden()
     };
-    for i in 0..args.iterations {
+    let mut done = 0;
+    while done < args.iterations {
         renderer.iterate()?;
-        // Keep the GPU queue short so the progress bar tells the truth.
-        if i % 8 == 7 {
+        done += 1;
+        // Keep the GPU queue short so the progress bar (and --max-seconds) tell the truth.
+        if done % 8 == 0 {
             renderer.wait()?;
-            progress.set_position(i as u64 + 1);
+            progress.set_position(done as u64);
+            if args.max_seconds.is_some_and(|s| start.elapsed().as_secs_f64() >= s) {
+                break;
+            }
         }
     }
     renderer.wait()?;
     progress.finish_and_clear();
     let seconds = start.elapsed().as_secs_f64();
-    log::info!("{} iterations in {seconds:.2} s", args.iterations);
-    if args.profile {
-        println!(
-            "{} iterations in {seconds:.3} s wall clock ({:.3} ms per iteration)",
-            args.iterations,
-            1e3 * seconds / args.iterations as f64
+    log::info!("{done} iterations in {seconds:.2} s");
+    if done < args.iterations {
+        eprintln!(
+            "note: --max-seconds {} reached: {done} of {} iterations in {seconds:.2} s",
+            args.max_seconds.unwrap_or_default(),
+            args.iterations
         );
     }
-    print_profile(&gpu, args.profile, "iterations", args.iterations as u64, "iteration")?;
+    if args.profile {
+        println!(
+            "{done} iterations in {seconds:.3} s wall clock ({:.3} ms per iteration)",
+            1e3 * seconds / done as f64
+        );
+    }
+    print_profile(&gpu, args.profile, "iterations", done as u64, "iteration")?;
 
     let show = a.show.show();
     let linear = renderer.read_linear(show)?;

@@ -334,6 +334,43 @@ impl WindowSurface {
     }
 }
 
+/// A window stand-in: the display pass drawing into a texture of a window's size instead of
+/// a swapchain image (nothing is presented, so no vsync). `rastergi bench frames` measures
+/// the viewer's frame loop with it.
+pub struct OffscreenTarget {
+    _texture: wgpu::Texture,
+    view: wgpu::TextureView,
+    size: (u32, u32),
+    pass: DisplayPass,
+}
+
+impl OffscreenTarget {
+    /// A `width × height` RGBA8 target (a plain format, as [`WindowSurface`] prefers).
+    pub fn new(gpu: &Gpu, width: u32, height: u32) -> Result<OffscreenTarget> {
+        gpu.check_image_size(width, height, 4)?;
+        let format = wgpu::TextureFormat::Rgba8Unorm;
+        let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("offscreen display target"),
+            size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&Default::default());
+        Ok(OffscreenTarget { _texture: texture, view, size: (width, height), pass: DisplayPass::new(gpu, format) })
+    }
+
+    /// What [`WindowSurface::present`] does, onto the texture: submits `enc` followed by
+    /// drawing `film` and `overlay`.
+    pub fn draw(&mut self, gpu: &Gpu, mut enc: wgpu::CommandEncoder, film: Option<&Film>, overlay: &[String]) {
+        self.pass.encode(gpu, &mut enc, &self.view, self.size, film, overlay);
+        gpu.queue.submit([enc.finish()]);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

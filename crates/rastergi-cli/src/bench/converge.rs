@@ -36,6 +36,10 @@ pub struct ConvergeArgs {
     /// Also measure Mitsuba 3 (built-in cornell only; needs python3 with mitsuba).
     #[arg(long)]
     mitsuba: bool,
+    /// Mitsuba's variant for --mitsuba, e.g. cuda_ad_rgb (default: the script's, llvm_ad_rgb
+    /// where usable).
+    #[arg(long, value_name = "VARIANT", requires = "mitsuba")]
+    mitsuba_variant: Option<String>,
     /// CSV output: method, seconds, samples, relative RMSE.
     #[arg(long, default_value = "converge.csv")]
     csv: PathBuf,
@@ -75,9 +79,11 @@ pub fn run(a: &ConvergeArgs) -> Result<()> {
     let (name, points) = measure(|| PathTracer::new(&gpu, &scene, base), &reference, a.seconds, 0.0, &TARGETS, "spp")?;
     curves.push((name.to_string(), points));
     if a.mitsuba {
-        let points = mitsuba_curve(&a.scene, &reference, a.seconds, 0.0)?;
-        print_targets(MITSUBA, &points, &TARGETS, 0.0, "spp");
-        curves.push((MITSUBA.to_string(), points));
+        let variant = a.mitsuba_variant.as_deref();
+        let points = mitsuba_curve(&a.scene, &reference, a.seconds, 0.0, variant)?;
+        let name = mitsuba_name(variant);
+        print_targets(&name, &points, &TARGETS, 0.0, "spp");
+        curves.push((name, points));
     }
     let mut csv = String::from("method,seconds,samples,relative_rmse\n");
     for (name, points) in &curves {
@@ -94,8 +100,10 @@ pub fn run(a: &ConvergeArgs) -> Result<()> {
 /// The target errors whose times `converge` prints.
 const TARGETS: [f64; 2] = [0.05, 0.02];
 
-/// The name of Mitsuba 3's curve.
-pub const MITSUBA: &str = "Mitsuba 3 path (llvm_ad_rgb)";
+/// The name of Mitsuba 3's curve for a `--mitsuba-variant` (`None`: the script's default).
+pub fn mitsuba_name(variant: Option<&str>) -> String {
+    format!("Mitsuba 3 path ({})", variant.unwrap_or("llvm_ad_rgb"))
+}
 
 /// One point of a convergence curve: rendering time (readbacks excluded), samples per pixel
 /// so far, and relative RMSE against the reference (emitter pixels masked).
@@ -233,19 +241,39 @@ fn average_references(paths: &[PathBuf]) -> Result<LinearImage> {
 }
 
 /// Mitsuba 3's `path` integrator through scripts/mitsuba_reference.py at doubling sample
-/// counts; process start-up (measured with 1 spp) is subtracted.
-pub fn mitsuba_curve(scene: &str, reference: &Reference, max_seconds: f64, stop_at: f64) -> Result<Vec<Point>> {
+/// counts, in Mitsuba's `variant` (`None`: the script's default); process start-up (measured
+/// with 1 spp) is subtracted. A render call holds at most 2^28 samples (chunks of fewer spp
+/// at large sizes), which bounds the wavefront's memory on the GPU variants.
+pub fn mitsuba_curve(
+    scene: &str,
+    reference: &Reference,
+    max_seconds: f64,
+    stop_at: f64,
+    variant: Option<&str>,
+) -> Result<Vec<Point>> {
     anyhow::ensure!(scene == "cornell", "--mitsuba supports the built-in cornell scene only");
     let script = Path::new("scripts/mitsuba_reference.py");
     anyhow::ensure!(script.is_file(), "--mitsuba needs scripts/mitsuba_reference.py: run from the repository root");
     let dir = tempfile::tempdir()?;
     let out = dir.path().join("mitsuba.exr");
+    let (w, h) = reference.size();
+    let chunk = ((1u64 << 28) / (w as u64 * h as u64)).clamp(1, 100_000);
     let run = |spp: u32| -> Result<f64> {
         let t = Instant::now();
-        let status = Command::new("python3")
-            .arg(script)
-            .args(["--width", &reference.image.width.to_string(), "--height", &reference.image.height.to_string()])
-            .args(["--spp", &spp.to_string(), "--seed", "7", "--quiet", "--chunk-spp", "100000"])
+        let mut command = Command::new("python3");
+        command.arg(script).args(["--width", &w.to_string(), "--height", &h.to_string()]).args([
+            "--spp",
+            &spp.to_string(),
+            "--seed",
+            "7",
+            "--quiet",
+            "--chunk-spp",
+            &chunk.to_string(),
+        ]);
+        if let Some(v) = variant {
+            command.args(["--variant", v]);
+        }
+        let status = command
             .arg("--out")
             .arg(&out)
             .stdout(std::process::Stdio::null())

@@ -12,7 +12,7 @@ use rastergi::gpu::Gpu;
 use rastergi::renderer::{RenderSettings, Renderer, default_bundle};
 use rastergi::scene::Scene;
 
-use super::converge::{MITSUBA, Reference, measure, mitsuba_curve, print_targets, sorted_targets};
+use super::converge::{Reference, measure, mitsuba_curve, mitsuba_name, print_targets, sorted_targets};
 use super::load_valid_scene;
 use crate::args::{GpuArgs, gpu_profiled, print_profile};
 
@@ -47,6 +47,10 @@ pub struct GatherArgs {
     /// Also time Mitsuba 3's path tracer (scripts/mitsuba_reference.py; built-in cornell only).
     #[arg(long)]
     mitsuba: bool,
+    /// Mitsuba's variant for --mitsuba, e.g. cuda_ad_rgb (default: the script's, llvm_ad_rgb
+    /// where usable).
+    #[arg(long, value_name = "VARIANT", requires = "mitsuba")]
+    mitsuba_variant: Option<String>,
     /// Gather directions per iteration.
     #[arg(long, default_value_t = rastergi::renderer::DEFAULT_DIRECTIONS, value_parser = clap::value_parser!(u32).range(1..=16))]
     directions: u32,
@@ -126,8 +130,9 @@ fn time_to_error(a: &GatherArgs, gpu: &Gpu, scene: &Scene, paths: &[PathBuf]) ->
     let settings = settings(a, w, h, default_bundle(w, h));
     measure(|| Renderer::new(gpu, scene, settings), &reference, a.max_seconds, stop_at, &targets, "iterations")?;
     if a.mitsuba {
-        let points = mitsuba_curve(&a.scene, &reference, a.max_seconds, stop_at)?;
-        print_targets(MITSUBA, &points, &targets, 0.0, "spp");
+        let variant = a.mitsuba_variant.as_deref();
+        let points = mitsuba_curve(&a.scene, &reference, a.max_seconds, stop_at, variant)?;
+        print_targets(&mitsuba_name(variant), &points, &targets, 0.0, "spp");
     }
     Ok(())
 }

@@ -3,11 +3,13 @@
 //!
 //! One module per subcommand: [`photons`] (GPU against CPU photon tracing), [`gather`] (the
 //! three final-gather implementations, and the time to a target error), [`converge`] (error
-//! against time for the renderer, the path tracer and Mitsuba 3), [`bvh`] (scene loading and
-//! BVH build) and [`memory`] (the GPU memory of a render).
+//! against time for the renderer, the path tracer and Mitsuba 3), [`frames`] (the viewer's
+//! frame loop without a window), [`bvh`] (scene loading and BVH build) and [`memory`] (the
+//! GPU memory of a render).
 
 mod bvh;
 mod converge;
+mod frames;
 mod gather;
 mod memory;
 mod photons;
@@ -29,6 +31,9 @@ pub enum BenchCommand {
     Gather(gather::GatherArgs),
     /// Relative RMSE against time for the photon/gather pipeline and the path tracer: CSV and plot.
     Converge(converge::ConvergeArgs),
+    /// Frames and iterations per second of the viewer's frame loop at a window size (default
+    /// 1920x1080), without a window: batched iterations, resolve, display pass offscreen.
+    Frames(frames::FramesArgs),
     /// Scene loading and BVH build times (e.g. `bench bvh spheres:1000000`), with the BVH's shape.
     Bvh(bvh::BvhArgs),
     /// GPU memory of a render (the device allocator's report), by resource.
@@ -40,6 +45,7 @@ pub fn run(command: &BenchCommand) -> Result<()> {
         BenchCommand::Photons(a) => photons::run(a),
         BenchCommand::Gather(a) => gather::run(a),
         BenchCommand::Converge(a) => converge::run(a),
+        BenchCommand::Frames(a) => frames::run(a),
         BenchCommand::Bvh(a) => bvh::run(a),
         BenchCommand::Memory(a) => memory::run(a),
     }

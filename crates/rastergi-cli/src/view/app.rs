@@ -27,7 +27,7 @@ use crate::args::SceneArgs;
 /// GPU time aimed at per displayed frame: iterations are batched up to this.
 pub const FRAME_BUDGET: Duration = Duration::from_millis(30);
 /// Most iterations in one frame (keeps a frame short when iterations are very cheap).
-const MAX_BATCH: u32 = 64;
+pub const MAX_BATCH: u32 = 64;
 /// A resize rebuilds the size-dependent passes once the window size has been still this long.
 const RESIZE_SETTLE: Duration = Duration::from_millis(150);
 /// How long a script's `resize` may wait for the window to take the new size.
@@ -91,6 +91,28 @@ impl Rate {
             self.count = 0;
         }
     }
+}
+
+/// One frame's iterations: up to `limit`, stopping once [`FRAME_BUDGET`] has passed (so at
+/// least one where `limit` > 0), then waits for them and sets `batch` (the next frame's
+/// limit) to as many as fit in the budget at this frame's time per iteration, 1 to
+/// [`MAX_BATCH`]. Returns how many ran. `rastergi bench frames` runs the same.
+pub fn iterate_frame(renderer: &mut Renderer, limit: u32, batch: &mut u32) -> Result<u32> {
+    let start = Instant::now();
+    let mut done = 0;
+    while done < limit {
+        renderer.iterate()?;
+        done += 1;
+        if start.elapsed() >= FRAME_BUDGET {
+            break;
+        }
+    }
+    if done > 0 {
+        renderer.wait()?;
+        let per_iteration = start.elapsed().as_secs_f64() / done as f64;
+        *batch = ((FRAME_BUDGET.as_secs_f64() / per_iteration.max(1e-6)) as u32).clamp(1, MAX_BATCH);
+    }
+    Ok(done)
 }
 
 /// A renderer being built on a worker thread.
@@ -385,19 +407,8 @@ impl App {
         let current = self.building.is_none() && self.renderer_matches(&self.wanted());
         let limit = self.batch.min(self.iteration_limit());
         let Some(renderer) = self.renderer.as_mut().filter(|_| current) else { return Ok(()) };
-        let start = Instant::now();
-        let mut done = 0;
-        while done < limit {
-            renderer.iterate()?;
-            done += 1;
-            if start.elapsed() >= FRAME_BUDGET {
-                break;
-            }
-        }
+        let done = iterate_frame(renderer, limit, &mut self.batch)?;
         if done > 0 {
-            renderer.wait()?;
-            let per_iteration = start.elapsed().as_secs_f64() / done as f64;
-            self.batch = ((FRAME_BUDGET.as_secs_f64() / per_iteration.max(1e-6)) as u32).clamp(1, MAX_BATCH);
             self.rate.add(done);
         }
         Ok(())

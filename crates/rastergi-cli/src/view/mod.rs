@@ -36,6 +36,7 @@ use winit::event_loop::EventLoop;
 
 use crate::args::SceneArgs;
 use app::{App, UserEvent};
+pub use app::{FRAME_BUDGET, MAX_BATCH, iterate_frame};
 use screenshots::Screenshots;
 
 /// The keys and mouse bindings (a macro so that `--help` can join it to the script text).

@@ -119,6 +119,14 @@ pub struct SceneArgs {
     /// cubic cells as 64³, so 64 for a cube like cornell and more for long or flat scenes).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub grid: Option<u32>,
+    /// Photon passes: the photon map is re-traced with fresh photons in finer cells every
+    /// --pass-iterations iterations, so its error keeps falling as the render goes on
+    /// (cell area ∝ pass^-1/3). 1: one fixed map traced before the first iteration; 0: no limit.
+    #[arg(long, default_value_t = 0)]
+    pub photon_passes: u32,
+    /// Iterations per photon pass.
+    #[arg(long, default_value_t = rastergi::photons::passes::DEFAULT_PASS_ITERATIONS, value_parser = clap::value_parser!(u32).range(1..))]
+    pub pass_iterations: u32,
     /// Ray-view resolution of the final gather, texels per side (default: fitted: twice the
     /// image's larger side, raised to 8 texels across the median triangle's shortest edge over
     /// the scene's bounding sphere; 128 to 2048).
@@ -178,6 +186,8 @@ impl SceneArgs {
             bundle: self.bundle.unwrap_or(0),
             gather: self.gather.method(),
             directions: self.directions,
+            photon_passes: self.photon_passes,
+            pass_iterations: self.pass_iterations,
         }
     }
 }

@@ -53,7 +53,7 @@ pub const EXPOSURE_DEAD_BAND: f64 = 2.0;
 /// at most [`GRID_CELL_BUDGET`] cells, within 1 ..= [`MAX_GRID`].
 pub fn grid_resolution(bounds: &Aabb) -> u32 {
     // The cell count grows with the resolution: bisect for the last one within budget.
-    let cells = |r: u32| GridSpec::new(bounds, r).cell_count() as u64;
+    let cells = |r: u32| GridSpec::new(bounds, r).cell_count();
     let (mut lo, mut hi) = (1u32, MAX_GRID);
     if cells(hi) <= GRID_CELL_BUDGET {
         return hi;
@@ -158,7 +158,7 @@ mod tests {
         {
             let bounds = slab(extent).bounds();
             let r = grid_resolution(&bounds);
-            let cells = |r| GridSpec::new(&bounds, r).cell_count() as u64;
+            let cells = |r| GridSpec::new(&bounds, r).cell_count();
             println!("extent {extent}: resolution {r}, {} cells", cells(r));
             assert!(cells(r) <= GRID_CELL_BUDGET && (r == MAX_GRID || cells(r + 1) > GRID_CELL_BUDGET));
             // Within a factor two of the budget, unless the shape is flatter than the cap allows.

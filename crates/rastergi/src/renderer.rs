@@ -16,6 +16,7 @@ use crate::photon_view::PhotonViewPass;
 use crate::photons::PhotonSettings;
 use crate::photons::gpu::GpuPhotonMap;
 use crate::photons::map::GridSpec;
+use crate::photons::passes::{DEFAULT_PASS_ITERATIONS, PhotonPasses};
 use crate::scene::{Camera, Scene};
 
 /// Settings of a render.
@@ -37,6 +38,11 @@ pub struct RenderSettings {
     pub bundle: u32,
     /// How the final gather finds the nearest surface along its direction.
     pub gather: GatherMethod,
+    /// Photon passes ([`crate::photons::passes`]): the map is re-traced with fresh photons in
+    /// finer cells every `pass_iterations` iterations; 1: one fixed map; 0: no limit.
+    pub photon_passes: u32,
+    /// Iterations per photon pass.
+    pub pass_iterations: u32,
     /// Gather directions per iteration, 1 to [`crate::gather::MAX_DIRECTIONS`]: they share the iteration's
     /// G-buffer and direct light.
     pub directions: u32,
@@ -87,6 +93,8 @@ impl Default for RenderSettings {
             bundle: 0,
             gather: GatherMethod::Auto,
             directions: DEFAULT_DIRECTIONS,
+            photon_passes: 0,
+            pass_iterations: DEFAULT_PASS_ITERATIONS,
         }
     }
 }
@@ -136,7 +144,8 @@ pub struct Renderer {
     camera: Camera,
     scene: GpuScene,
     frame: FrameBinding,
-    photon_map: Option<GpuPhotonMap>,
+    /// The photon map of the current pass, and what the next pass needs.
+    photons: Option<PhotonPasses>,
     passes: ImagePasses,
     /// The scene's part of the default bundle ([`crate::fit::detail_bundle`]).
     detail_bundle: u32,
@@ -171,23 +180,22 @@ impl Renderer {
         let frame = FrameBinding::new(gpu);
         let photon_settings =
             PhotonSettings { count: settings.photons, seed: settings.seed, grid_resolution: settings.grid_resolution };
-        let photon_map = (settings.photons > 0)
-            .then(|| GpuPhotonMap::build(gpu, &gpu_scene, &prepared, &photon_settings))
-            .transpose()?
-            .map(|mut map| {
-                // Rendering reads the lookup texture alone.
-                map.release_build_buffers();
-                map
-            });
+        let photons = (settings.photons > 0)
+            .then(|| {
+                let (n, k) = (settings.photon_passes, settings.pass_iterations);
+                PhotonPasses::new(gpu, &gpu_scene, prepared, photon_settings, n, k)
+            })
+            .transpose()?;
+        let map = photons.as_ref().map(PhotonPasses::map);
         let sampler = DirectionSampler::new(settings.seed);
-        let passes = ImagePasses::new(gpu, &gpu_scene, &frame, photon_map.as_ref(), &settings, detail_bundle, sampler)?;
+        let passes = ImagePasses::new(gpu, &gpu_scene, &frame, map, &settings, detail_bundle, sampler)?;
         Ok(Renderer {
             gpu: gpu.clone(),
             settings,
             camera: scene.camera,
             scene: gpu_scene,
             frame,
-            photon_map,
+            photons,
             passes,
             detail_bundle,
         })
@@ -204,7 +212,7 @@ impl Renderer {
             &self.gpu,
             &self.scene,
             &self.frame,
-            self.photon_map.as_ref(),
+            self.photons.as_ref().map(PhotonPasses::map),
             &settings,
             self.detail_bundle,
             sampler,
@@ -261,6 +269,10 @@ impl Renderer {
     /// One iteration with some random choices fixed (see [`Overrides`]).
     pub fn iterate_with(&mut self, o: &Overrides) -> Result<()> {
         let (w, h) = (self.settings.width, self.settings.height);
+        // 0. A new photon pass, when the current one has had its iterations.
+        if let Some(photons) = &mut self.photons {
+            photons.advance(&self.gpu, &self.scene)?;
+        }
         let iteration = self.passes.film.samples;
         let seed = self.settings.seed;
         let jitter = o.pixel_jitter.unwrap_or_else(|| pixel_jitter(iteration, seed));
@@ -275,11 +287,12 @@ impl Renderer {
         // 2. Emission + direct light with soft shadows → film (direct component).
         self.passes.direct.encode(&mut enc, &self.scene, &self.frame, w, h);
         // Debug view: the photon map's radiance at the visible points → film (photon view).
-        if let (Some(view), Some(map)) = (&self.passes.photon_view, &self.photon_map) {
+        let map = self.photons.as_ref().map(PhotonPasses::map);
+        if let (Some(view), Some(map)) = (&self.passes.photon_view, map) {
             view.encode(&mut enc, &self.scene, &self.frame, map, w, h);
         }
         // 3. Final gather along the iteration's directions for every visible point → film (indirect).
-        if let (Some(gather), Some(map)) = (&mut self.passes.gather, &self.photon_map) {
+        if let (Some(gather), Some(map)) = (&mut self.passes.gather, map) {
             let f = GatherFrame { scene: &self.scene, frame: &self.frame, map, width: w, height: h };
             let fixed = FixedSample { direction: o.direction, texel_jitter: o.texel_jitter };
             gather.encode(&self.gpu, &mut enc, &f, iteration, self.settings.directions, &fixed)?;
@@ -298,9 +311,14 @@ impl Renderer {
         self.gpu.wait()
     }
 
-    /// The photon map, if the render has one.
+    /// The photon map of the current pass, if the render has one.
     pub fn photon_map(&self) -> Option<&GpuPhotonMap> {
-        self.photon_map.as_ref()
+        self.photons.as_ref().map(PhotonPasses::map)
+    }
+
+    /// The current photon pass (0-based; 0 without a photon map).
+    pub fn photon_pass(&self) -> u32 {
+        self.photons.as_ref().map_or(0, PhotonPasses::pass)
     }
 
     /// The film: accumulated sums and the resolved images (for drawing it in a window).

@@ -9,7 +9,7 @@
 use crate::film::{FILM_DIRECT, FILM_INDIRECT, FILM_PHOTON_VIEW};
 use crate::gather::MAX_DIRECTIONS;
 use crate::gpu_scene::{MATERIAL_TWO_SIDED, NO_TEXTURE};
-use crate::photons::map::OFFSET_STEP;
+use crate::photons::map::{MAX_SEPARATORS, OFFSET_SHIFT, OFFSET_STEP, REGION_SHIFT};
 use crate::sampling::stream;
 
 pub const SAMPLING: &str = include_str!("sampling.wgsl");
@@ -30,6 +30,9 @@ pub fn constants() -> String {
         ("FILM_DIRECT", FILM_DIRECT),
         ("FILM_INDIRECT", FILM_INDIRECT),
         ("FILM_PHOTON_VIEW", FILM_PHOTON_VIEW),
+        ("REGION_SHIFT", REGION_SHIFT),
+        ("OFFSET_SHIFT", OFFSET_SHIFT),
+        ("MAX_SEPARATORS", MAX_SEPARATORS as u32),
         ("STREAM_DIRECT", stream::DIRECT),
         ("STREAM_PATH", stream::PATH),
         ("STREAM_PHOTON", stream::PHOTON),

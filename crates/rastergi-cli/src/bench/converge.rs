@@ -33,6 +33,14 @@ pub struct ConvergeArgs {
     photons: u32,
     #[arg(long, default_value_t = 64)]
     grid: u32,
+    /// Photon passes of the photon-map renderer (see `render --photon-passes`); several
+    /// comma-separated values are measured side by side, e.g. 1,0 for the fixed map and the
+    /// unlimited passes.
+    #[arg(long, value_delimiter = ',', default_value = "0")]
+    photon_passes: Vec<u32>,
+    /// Iterations per photon pass.
+    #[arg(long, default_value_t = rastergi::photons::passes::DEFAULT_PASS_ITERATIONS)]
+    pass_iterations: u32,
     /// Also measure Mitsuba 3 (built-in cornell only; needs python3 with mitsuba).
     #[arg(long)]
     mitsuba: bool,
@@ -73,9 +81,14 @@ pub fn run(a: &ConvergeArgs) -> Result<()> {
         ..Default::default()
     };
     let mut curves: Vec<(String, Vec<Point>)> = Vec::new();
-    let (name, points) =
-        measure(|| Renderer::new(&gpu, &scene, base.clone()), &reference, a.seconds, 0.0, &TARGETS, "iterations")?;
-    curves.push((name.to_string(), points));
+    for &passes in &a.photon_passes {
+        let settings = RenderSettings { photon_passes: passes, pass_iterations: a.pass_iterations, ..base.clone() };
+        println!("photon passes {passes} (0: unlimited), a pass every {} iterations:", a.pass_iterations);
+        let (name, points) =
+            measure(|| Renderer::new(&gpu, &scene, settings), &reference, a.seconds, 0.0, &TARGETS, "iterations")?;
+        let passes = if passes == 0 { "unlimited".to_string() } else { passes.to_string() };
+        curves.push((format!("{name}, photon passes {passes}"), points));
+    }
     let (name, points) = measure(|| PathTracer::new(&gpu, &scene, base), &reference, a.seconds, 0.0, &TARGETS, "spp")?;
     curves.push((name.to_string(), points));
     if a.mitsuba {

@@ -49,6 +49,8 @@ pub fn run(a: &MemoryArgs) -> Result<()> {
         bundle: a.bundle,
         gather: a.gather.method(),
         seed: 1,
+        // Throughput of one fixed map: no photon pass between the timed iterations.
+        photon_passes: 1,
         ..Default::default()
     };
     let mut r = Renderer::new(&gpu, &scene, settings)?;

@@ -17,7 +17,7 @@
 use bytemuck::{Pod, Zeroable};
 use glam::UVec3;
 
-use super::map::{GridSpec, MapLayout, PhotonMap, TABLE_WGSL, TrianglePlane};
+use super::map::{GridSpec, MAX_SEPARATORS, MapLayout, PhotonMap, Separator, TABLE_WGSL, TrianglePlane};
 use super::{MAX_BOUNCES, PhotonSettings};
 use crate::error::Result;
 use crate::gpu::{Gpu, buffer_bind_group, compute_pipeline, storage_entry, uniform_entry};
@@ -52,7 +52,10 @@ pub(crate) struct PhotonParams {
     pub(crate) max_probe: u32,
     /// The photon pass: the second key of every photon's random stream.
     pub(crate) pass_index: u32,
-    pub(crate) _pad: [u32; 2],
+    /// The separators' table: capacity − 1 and the longest probe.
+    pub(crate) sep_mask: u32,
+    pub(crate) sep_max_probe: u32,
+    pub(crate) _pad: [u32; 4],
 }
 
 /// `PhotonGrid` in `map.wgsl`.
@@ -62,10 +65,12 @@ pub struct PhotonGridUniforms {
     pub origin: [f32; 3],
     pub cell: f32,
     pub dims: [u32; 3],
-    /// Table capacity − 1.
+    /// Table capacity − 1, the longest probe, and the same for the separators' table.
     pub mask: u32,
     pub max_probe: u32,
-    pub _pad: [u32; 3],
+    pub sep_mask: u32,
+    pub sep_max_probe: u32,
+    pub _pad: u32,
 }
 
 /// The photon tracer's composed shader (`trace.wgsl`: the trace and resolve kernels).
@@ -166,6 +171,15 @@ impl GpuPhotonMap {
             layout.planes.clone()
         };
         let planes = gpu.storage_buffer("photon planes", bytemuck::cast_slice(&planes), wgpu::BufferUsages::empty());
+        let sep = &layout.separators;
+        let sep_keys = gpu.storage_buffer(
+            "photon separator keys",
+            bytemuck::cast_slice(&sep.table.keys),
+            wgpu::BufferUsages::empty(),
+        );
+        let sep_planes =
+            gpu.storage_buffer("photon separators", bytemuck::cast_slice(&sep.planes), wgpu::BufferUsages::empty());
+        let (sep_mask, sep_max_probe) = (sep.table.capacity() as u32 - 1, sep.table.max_probe);
         let slots = gpu.zeroed_buffer(
             "photon map slots",
             capacity * 16,
@@ -189,6 +203,8 @@ impl GpuPhotonMap {
                 storage_entry::<[f32; 4]>(5, c, false),
                 storage_entry::<[u32; 2]>(6, c, true),
                 storage_entry::<TrianglePlane>(7, c, true),
+                storage_entry::<[u32; 2]>(8, c, true),
+                storage_entry::<[Separator; MAX_SEPARATORS]>(9, c, true),
             ],
         });
         let channel = |c: u64| {
@@ -210,6 +226,8 @@ impl GpuPhotonMap {
                 wgpu::BindGroupEntry { binding: 5, resource: slots.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 6, resource: keys.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 7, resource: planes.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 8, resource: sep_keys.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 9, resource: sep_planes.as_entire_binding() },
             ],
         });
         let module = shader::module(device, "photon trace", &trace_source());
@@ -233,7 +251,9 @@ impl GpuPhotonMap {
             mask,
             max_probe,
             pass_index: 0,
-            _pad: [0; 2],
+            sep_mask,
+            sep_max_probe,
+            _pad: [0; 4],
         };
         let grid_uniforms = PhotonGridUniforms {
             origin: grid.origin.into(),
@@ -241,9 +261,12 @@ impl GpuPhotonMap {
             dims: grid.dims.into(),
             mask,
             max_probe,
-            _pad: [0; 3],
+            sep_mask,
+            sep_max_probe,
+            _pad: 0,
         };
-        let (bind_layout, bind_group) = lookup_binding(gpu, &grid_uniforms, [&slots, &keys, &planes]);
+        let buffers = [&slots, &keys, &planes, &sep_keys, &sep_planes];
+        let (bind_layout, bind_group) = lookup_binding(gpu, &grid_uniforms, buffers);
         Ok(GpuPhotonMap {
             layout,
             settings: *settings,
@@ -353,7 +376,7 @@ impl GpuPhotonMap {
 fn lookup_binding(
     gpu: &Gpu,
     u: &PhotonGridUniforms,
-    [slots, keys, planes]: [&wgpu::Buffer; 3],
+    [slots, keys, planes, sep_keys, sep_planes]: [&wgpu::Buffer; 5],
 ) -> (wgpu::BindGroupLayout, wgpu::BindGroup) {
     let uniforms = gpu.zeroed_buffer(
         "photon grid",
@@ -369,8 +392,15 @@ fn lookup_binding(
             uniform_entry::<PhotonGridUniforms>(1, vis),
             storage_entry::<[u32; 2]>(2, vis, true),
             storage_entry::<TrianglePlane>(3, vis, true),
+            storage_entry::<[u32; 2]>(4, vis, true),
+            storage_entry::<[Separator; MAX_SEPARATORS]>(5, vis, true),
         ],
     });
-    let bind_group = buffer_bind_group(&gpu.device, "photon map lookup", &layout, &[slots, &uniforms, keys, planes]);
+    let bind_group = buffer_bind_group(
+        &gpu.device,
+        "photon map lookup",
+        &layout,
+        &[slots, &uniforms, keys, planes, sep_keys, sep_planes],
+    );
     (layout, bind_group)
 }

@@ -18,18 +18,25 @@
 //!   plane (unit normal, n·v₀, the bins of both sides) is computed once
 //!   ([`MapLayout::planes`]), so a deposit, the area and a lookup on the same triangle compute
 //!   the same key from the same numbers.
-//! * **Lookup** at p on a plane key: trilinear weights w_i over the 8 cells around p, the slots
-//!   of those cells with the same key, E(p) = Σ w_i Φ_i / Σ w_i A_i (cells without such a slot
-//!   count nothing). Outgoing radiance of a Lambertian surface of albedo ρ: L = ρ/π · E.
+//! * **Separators** ([`Separators`]): up to [`MAX_SEPARATORS`] planes of other surfaces in the
+//!   cell split a slot into regions, a point's region being the signs of its distances to
+//!   them. A wall standing on a floor splits the floor's slot into each room's floor and the
+//!   strip under the wall (which no photon reaches, and which no longer dilutes the
+//!   irradiance beside it); planes that only bound the slot (the wall the floor ends at) split
+//!   nothing but fence the lookup.
+//! * **Lookup** at p on a triangle's side: trilinear weights w_i over the 8 cells around p,
+//!   each cell's slot of the same plane and of p's region there, E(p) = Σ w_i Φ_i / Σ w_i A_i
+//!   (cells without such a slot count nothing, nor cells whose centre lies beyond a separator
+//!   of p's own cell). Outgoing radiance of a Lambertian surface of albedo ρ: L = ρ/π · E.
 //! * **Hash table** ([`SlotTable`]): open addressing with linear probing over a power-of-two
 //!   capacity at most half full, keyed by (cell index, plane key); built once on the CPU from
 //!   the geometry, read by the GPU tracer's deposits and every lookup. The longest probe of any
 //!   slot bounds every search. Memory is per surface slot, not per cell: 24 bytes per table
 //!   entry while rendering.
 //!
-//! Known bias: the estimate averages over up to 2×2×2 cells. Surfaces of one plane sharing a
-//! cell mix (e.g. the floor on both sides of a wall thinner than a cell: the leak reaches at
-//! most 1.5 cell widths from the wall), and irradiance gradients blur over a cell.
+//! Known bias: the estimate averages over up to 2×2×2 cells, so irradiance gradients blur over
+//! a cell, and surfaces of one plane and region sharing a cell mix. Progressive passes
+//! ([`super::passes`]) shrink the cells as the render goes on.
 
 use std::collections::HashMap;
 
@@ -94,16 +101,16 @@ impl TrianglePlane {
     }
 
     /// The plane key of side `back` in cell c of `grid` (`plane_key` in WGSL): the orientation
-    /// bin in the low 8 bits, above them the signed distance from the cell's centre to the
-    /// plane along the side's normal in steps of [`OFFSET_STEP`] cells, rounded (24-bit two's
-    /// complement).
+    /// bin in the low 6 bits, the region's bits free above it (zero here), and from
+    /// [`OFFSET_SHIFT`] up the signed distance from the cell's centre to the plane along the
+    /// side's normal in steps of [`OFFSET_STEP`] cells, rounded (two's complement).
     pub fn key(&self, grid: &GridSpec, c: UVec3, back: bool) -> u32 {
         let centre = grid.origin + (c.as_vec3() + 0.5) * grid.cell;
         let d = (self.offset - Vec3::from(self.normal).dot(centre)) / (OFFSET_STEP * grid.cell);
         // floor(d + ½) as in WGSL (whose round() breaks ties to even).
         let steps = (d + 0.5).floor() as i32;
         let steps = if back { -steps } else { steps };
-        self.bins[usize::from(back)] | ((steps as u32) << 8)
+        self.bins[usize::from(back)] | ((steps as u32) << OFFSET_SHIFT)
     }
 }
 
@@ -218,6 +225,109 @@ pub struct MapLayout {
     pub table: SlotTable,
     /// Surface area per table entry (zero where there is no slot).
     pub area: Vec<f64>,
+    /// The planes that split base slots into regions.
+    pub separators: Separators,
+}
+
+/// A surface side's part inside one cell.
+struct Fragment {
+    /// Its base plane key in the cell.
+    key: u32,
+    /// Its plane, (n, d) with n·x = d on it, n the side's normal.
+    plane: (DVec3, f64),
+    poly: Vec<DVec3>,
+    area: f64,
+}
+
+/// A separator plane (n, d), n unit: a point x lies on its negative side where n·x − d < 0.
+pub type Separator = [f32; 4];
+
+/// Most separators of one slot (each doubles its regions).
+pub const MAX_SEPARATORS: usize = 4;
+/// A separator splits a slot only where each side holds at least this fraction of its area.
+pub const MIN_REGION: f64 = 0.02;
+
+/// Bit offset of the region in a slot's plane key (the orientation bin below it, < 64).
+pub const REGION_SHIFT: u32 = 6;
+/// Bit offset of the plane offset in a plane key (the region's [`MAX_SEPARATORS`] bits below
+/// it): 22 bits of signed steps, ±2²¹ eighths of a cell.
+pub const OFFSET_SHIFT: u32 = REGION_SHIFT + MAX_SEPARATORS as u32;
+
+/// The separators of every base slot that has any, in a table keyed like the slots
+/// (`separator_keys`, `separator_planes` in WGSL).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Separators {
+    pub table: SlotTable,
+    /// Per table entry; unused separators are all zero (every point on their positive side).
+    pub planes: Vec<[Separator; MAX_SEPARATORS]>,
+}
+
+/// Bit k set where p lies on the negative side of separator k (`region_of` in WGSL).
+pub fn region_of(planes: &[Separator; MAX_SEPARATORS], p: Vec3) -> u32 {
+    let mut region = 0;
+    for (k, s) in planes.iter().enumerate() {
+        // Unused separators are zero: every point on their non-negative side.
+        if Vec3::new(s[0], s[1], s[2]).dot(p) - s[3] < 0.0 {
+            region |= 1 << k;
+        }
+    }
+    region
+}
+
+/// Up to [`MAX_SEPARATORS`] planes of other surfaces in the cell, the ones with the most
+/// surface in the cell first, leaving out planes the slot's own fragments lie in (all their
+/// vertices within `eps`) and planes that cut off less than [`MIN_REGION`] of their area. A
+/// plane that cuts the fragments splits the slot into regions: a
+/// wall standing on a floor splits the floor's slot into its two rooms and the strip under
+/// the wall, which no photon reaches; a box standing on it, the floor under it from the floor
+/// around it. A plane that bounds them (a wall the floor ends at) splits nothing, but the
+/// lookup reads no neighbouring cell beyond it.
+fn separators_of(own: &[&Fragment], all: &[Fragment], key: u32, eps: f64) -> Vec<(DVec3, f64)> {
+    // (key, plane, area in the cell, splits the slot's fragments)
+    let mut candidates: Vec<(u32, (DVec3, f64), f64, bool)> = Vec::new();
+    for f in all.iter().filter(|f| f.key != key) {
+        match candidates.iter_mut().find(|c| c.0 == f.key) {
+            Some(c) => c.2 += f.area,
+            None => candidates.push((f.key, f.plane, f.area, false)),
+        }
+    }
+    let vertices = || own.iter().flat_map(|f| f.poly.iter());
+    let total: f64 = own.iter().map(|f| f.area).sum();
+    let negative =
+        |(n, d): (DVec3, f64)| own.iter().map(|f| polygon_area(&clip_to_half_space(&f.poly, n, d, true))).sum::<f64>();
+    candidates.retain_mut(|c| {
+        let (n, d) = c.1;
+        if !vertices().any(|v| (n.dot(*v) - d).abs() > eps) {
+            return false; // the slot's own plane
+        }
+        let below = negative(c.1);
+        let least = below.min(total - below);
+        // A plane that cuts off a sliver would make a slot of almost no area, whose few
+        // photons read as a spike: it neither splits nor fences.
+        c.3 = least > MIN_REGION * total;
+        c.3 || least <= 1e-9 * total
+    });
+    // Planes that split first, then by their surface in the cell.
+    candidates.sort_by(|a, b| b.3.cmp(&a.3).then(b.2.total_cmp(&a.2)).then(a.0.cmp(&b.0)));
+    candidates.into_iter().take(MAX_SEPARATORS).map(|c| c.1).collect()
+}
+
+/// The part of the convex polygon on the negative side of plane (n, d) (`negative`), or on
+/// its non-negative side.
+fn clip_to_half_space(poly: &[DVec3], n: DVec3, d: f64, negative: bool) -> Vec<DVec3> {
+    let inside = |p: &DVec3| (n.dot(*p) - d < 0.0) == negative;
+    let mut out = Vec::new();
+    for (k, p) in poly.iter().enumerate() {
+        let q = &poly[(k + 1) % poly.len()];
+        if inside(p) {
+            out.push(*p);
+        }
+        if inside(p) != inside(q) {
+            let (sp, sq) = (n.dot(*p) - d, n.dot(*q) - d);
+            out.push(*p + (*q - *p) * (sp / (sp - sq)));
+        }
+    }
+    if out.len() < 3 { Vec::new() } else { out }
 }
 
 impl MapLayout {
@@ -227,7 +337,8 @@ impl MapLayout {
     pub fn new(scene: &Scene, grid: &GridSpec) -> MapLayout {
         let planes: Vec<TrianglePlane> =
             scene.triangles.iter().map(|t| TrianglePlane::new(triangle_normal(t), t[0])).collect();
-        let mut areas: HashMap<[u32; 2], f64> = HashMap::new();
+        // Every side's fragment in every cell, grouped by cell.
+        let mut cells: HashMap<u32, Vec<Fragment>> = HashMap::new();
         for (i, t) in scene.triangles.iter().enumerate() {
             if planes[i].bins[0] == EMPTY {
                 continue;
@@ -236,17 +347,60 @@ impl MapLayout {
             let poly: Vec<DVec3> = t.iter().map(|p| p.as_dvec3()).collect();
             let lo = grid.cell_of(t[0].min(t[1]).min(t[2]));
             let hi = grid.cell_of(t[0].max(t[1]).max(t[2]));
+            let n = Vec3::from(planes[i].normal).as_dvec3();
             for z in lo.z..=hi.z {
                 for y in lo.y..=hi.y {
                     for x in lo.x..=hi.x {
                         let c = UVec3::new(x, y, z);
                         let min = grid.origin.as_dvec3() + c.as_dvec3() * grid.cell as f64;
-                        let a = polygon_area(&clip_to_box(&poly, min, min + DVec3::splat(grid.cell as f64)));
-                        if a > 0.0 {
+                        let piece = clip_to_box(&poly, min, min + DVec3::splat(grid.cell as f64));
+                        let area = polygon_area(&piece);
+                        if area > 0.0 {
                             for &back in sides {
-                                *areas.entry([grid.cell_index(c), planes[i].key(grid, c, back)]).or_default() += a;
+                                let side = if back { -n } else { n };
+                                cells.entry(grid.cell_index(c)).or_default().push(Fragment {
+                                    key: planes[i].key(grid, c, back),
+                                    plane: (side, side.dot(poly[0])),
+                                    poly: piece.clone(),
+                                    area,
+                                });
                             }
                         }
+                    }
+                }
+            }
+        }
+        let mut areas: HashMap<[u32; 2], f64> = HashMap::new();
+        let mut separated: Vec<([u32; 2], [Separator; MAX_SEPARATORS])> = Vec::new();
+        let eps = 1e-4 * grid.cell as f64;
+        for (&cell, fragments) in &cells {
+            let mut keys: Vec<u32> = fragments.iter().map(|f| f.key).collect();
+            keys.sort_unstable();
+            keys.dedup();
+            for &key in &keys {
+                let own: Vec<&Fragment> = fragments.iter().filter(|f| f.key == key).collect();
+                let separators = separators_of(&own, fragments, key, eps);
+                if separators.is_empty() {
+                    *areas.entry([cell, key]).or_default() += own.iter().map(|f| f.area).sum::<f64>();
+                    continue;
+                }
+                let mut record = [[0.0f32; 4]; MAX_SEPARATORS];
+                for (r, &(n, d)) in record.iter_mut().zip(&separators) {
+                    *r = [n.x as f32, n.y as f32, n.z as f32, d as f32];
+                }
+                separated.push(([cell, key], record));
+                for region in 0..1u32 << separators.len() {
+                    let mut area = 0.0;
+                    for f in &own {
+                        let mut piece = f.poly.clone();
+                        for (k, &(n, d)) in separators.iter().enumerate() {
+                            piece = clip_to_half_space(&piece, n, d, region >> k & 1 == 1);
+                        }
+                        area += polygon_area(&piece);
+                    }
+                    // Regions that only rounding creates (where two cuts nearly meet) get no slot.
+                    if area > 1e-9 * own.iter().map(|f| f.area).sum::<f64>() {
+                        *areas.entry([cell, key | region << REGION_SHIFT]).or_default() += area;
                     }
                 }
             }
@@ -258,7 +412,21 @@ impl MapLayout {
         for (k, a) in &areas {
             area[table.find(k[0], k[1]).expect("every slot is in the table")] = *a;
         }
-        MapLayout { grid: *grid, planes, table, area }
+        separated.sort_unstable_by_key(|s| s.0);
+        let sep_keys: Vec<[u32; 2]> = separated.iter().map(|s| s.0).collect();
+        let sep_table = SlotTable::new(&sep_keys);
+        let mut sep_planes = vec![[[0.0f32; 4]; MAX_SEPARATORS]; sep_table.capacity()];
+        for (k, record) in &separated {
+            sep_planes[sep_table.find(k[0], k[1]).expect("every record is in the table")] = *record;
+        }
+        let separators = Separators { table: sep_table, planes: sep_planes };
+        MapLayout { grid: *grid, planes, table, area, separators }
+    }
+
+    /// The region bits of p among the separators of base slot (cell, key): 0 where it has
+    /// none.
+    pub fn region(&self, cell: u32, key: u32, p: Vec3) -> u32 {
+        self.separators.table.find(cell, key).map_or(0, |e| region_of(&self.separators.planes[e], p))
     }
 
     /// The layout over a grid of `resolution` cells along the longest axis of `bounds`, or of
@@ -310,7 +478,8 @@ impl MapLayout {
     /// a neighbouring cell).
     pub fn deposit_slot(&self, tri: usize, back: bool, p: Vec3) -> Option<usize> {
         let c = self.grid.cell_of(p);
-        self.table.find(self.grid.cell_index(c), self.planes[tri].key(&self.grid, c, back))
+        let (cell, key) = (self.grid.cell_index(c), self.planes[tri].key(&self.grid, c, back));
+        self.table.find(cell, key | self.region(cell, key, p) << REGION_SHIFT)
     }
 }
 
@@ -395,9 +564,15 @@ impl PhotonMap {
     }
 
     /// Σ w_i Φ_i / Σ w_i A_i over the slots of side `back` of `plane` in the 8 cells around p
-    /// (trilinear weights on cell centres, clamped at the grid's border).
+    /// (trilinear weights on cell centres, clamped at the grid's border), each cell's slot of
+    /// p's region among that cell's separators; a cell whose centre lies on the other side of a
+    /// separator of p's own cell is left out.
     pub fn irradiance_on_plane(&self, p: Vec3, plane: &TrianglePlane, back: bool) -> [f64; 3] {
-        let grid = &self.layout.grid;
+        let (grid, layout) = (&self.layout.grid, &self.layout);
+        // The separators of p's own slot: cells beyond them (across a wall) do not count.
+        let home = grid.cell_of(p);
+        let own = layout.separators.table.find(grid.cell_index(home), plane.key(grid, home, back));
+        let own = own.map(|e| &layout.separators.planes[e]);
         let g = (p - grid.origin) / grid.cell - 0.5;
         let base = g.floor();
         let f = g - base;
@@ -408,7 +583,14 @@ impl PhotonMap {
             let w = o.as_vec3() * f + (Vec3::ONE - o.as_vec3()) * (Vec3::ONE - f);
             let w = (w.x * w.y * w.z) as f64;
             let c = (base.as_ivec3() + o).clamp(IVec3::ZERO, max).as_uvec3();
-            if let Some(s) = self.layout.table.find(grid.cell_index(c), plane.key(grid, c, back)) {
+            if let Some(own) = own
+                && c != home
+                && region_of(own, p) != region_of(own, grid.origin + (c.as_vec3() + 0.5) * grid.cell)
+            {
+                continue;
+            }
+            let (cell, key) = (grid.cell_index(c), plane.key(grid, c, back));
+            if let Some(s) = layout.table.find(cell, key | layout.region(cell, key, p) << REGION_SHIFT) {
                 for (acc, f) in flux.iter_mut().zip(self.flux[s]) {
                     *acc += w * f;
                 }
@@ -520,7 +702,7 @@ mod tests {
             let grid = GridSpec::new(&scene.bounds(), resolution);
             let layout = MapLayout::new(&scene, &grid);
             let mut expected: HashMap<u32, f64> = HashMap::new();
-            // Per orientation bin: the bin is the key's low byte.
+            // Per orientation bin: the bin is the key's low bits, below the region.
             for (i, t) in scene.triangles.iter().enumerate() {
                 *expected.entry(layout.planes[i].bins[0]).or_default() += triangle_area(t) as f64;
                 if scene.material_of(i).two_sided {
@@ -530,7 +712,7 @@ mod tests {
             let mut got: HashMap<u32, f64> = HashMap::new();
             for (k, a) in layout.table.keys.iter().zip(&layout.area) {
                 if k[0] != EMPTY {
-                    *got.entry(k[1] & 0xff).or_default() += a;
+                    *got.entry(k[1] & ((1 << REGION_SHIFT) - 1)).or_default() += a;
                 }
             }
             assert_eq!(got.len(), expected.len(), "bins at {resolution}");
@@ -557,9 +739,10 @@ mod tests {
             let p = Vec3::new(rng.next_f32() * 0.46 - 0.23, 0.99, rng.next_f32() * 0.38 - 0.18);
             let i = lights[0] as usize;
             slots.insert(layout.deposit_slot(i, false, p).expect("the light's slot"));
-            let on_ceiling = TrianglePlane::new(-Vec3::Y, Vec3::new(p.x, 1.0, p.z));
-            let c = grid.cell_of(p);
-            if layout.table.find(grid.cell_index(c), on_ceiling.key(&grid, c, false)).is_some() {
+            let q = Vec3::new(p.x, 1.0, p.z);
+            let c = grid.cell_of(q);
+            let (cell, key) = (grid.cell_index(c), TrianglePlane::new(-Vec3::Y, q).key(&grid, c, false));
+            if layout.table.find(cell, key | layout.region(cell, key, q) << REGION_SHIFT).is_some() {
                 ceiling_cells += 1;
             }
         }

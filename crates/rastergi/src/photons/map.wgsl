@@ -5,35 +5,65 @@ struct PhotonGrid {
     origin: vec3f,
     cell: f32,
     dims: vec3u,
-    // Table capacity − 1 (a power of two minus one) and the longest probe of any slot.
+    // Table capacity − 1 (a power of two minus one) and the longest probe of any slot; the
+    // same for the separators' table.
     mask: u32,
     max_probe: u32,
+    sep_mask: u32,
+    sep_max_probe: u32,
     _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
 }
 
 @group(3) @binding(0) var<storage, read> photon_slots: array<vec4f>;
 @group(3) @binding(1) var<uniform> photon_grid: PhotonGrid;
 @group(3) @binding(2) var<storage, read> slot_keys: array<vec2u>;
 @group(3) @binding(3) var<storage, read> planes: array<TrianglePlane>;
+@group(3) @binding(4) var<storage, read> separator_keys: array<vec2u>;
+@group(3) @binding(5) var<storage, read> separator_planes: array<SeparatorRecord>;
+
+// p's region among the separators of base slot (cell, key): 0 where it has none.
+fn photon_region(cell: u32, key: u32, p: vec3f) -> u32 {
+    let sep = find_separators(cell, key, photon_grid.sep_mask, photon_grid.sep_max_probe);
+    if sep == NO_SLOT {
+        return 0u;
+    }
+    return region_of(separator_planes[sep], p);
+}
+
+fn grid_cell_index(c: vec3u) -> u32 {
+    return (c.z * photon_grid.dims.y + c.y) * photon_grid.dims.x + c.x;
+}
 
 // E(p) on side `back` of triangle tri: Σ w_i Φ_i / Σ w_i A_i over the slots of its plane in
 // the 8 cells around p, w_i trilinear on cell centres (PhotonMap::irradiance_on).
 fn photon_irradiance(p: vec3f, tri: u32, back: bool) -> vec3f {
     let plane = planes[tri];
-    let g = (p - photon_grid.origin) / photon_grid.cell - 0.5;
+    let origin = photon_grid.origin;
+    let h = photon_grid.cell;
+    let hi = vec3i(photon_grid.dims) - 1;
+    // The separators of p's own slot: cells beyond them (across a wall) do not count.
+    let home = vec3u(clamp(vec3i(floor((p - origin) / h)), vec3i(0), hi));
+    let home_key = plane_key(plane, cell_centre(origin, h, home), h, back);
+    let own = find_separators(grid_cell_index(home), home_key, photon_grid.sep_mask, photon_grid.sep_max_probe);
+    var own_record: SeparatorRecord;
+    if own != NO_SLOT {
+        own_record = separator_planes[own];
+    }
+    let g = (p - origin) / h - 0.5;
     let base = floor(g);
     let f = g - base;
-    let hi = vec3i(photon_grid.dims) - 1;
     var sum = vec4f(0.0);
     for (var k = 0u; k < 8u; k++) {
         let o = vec3u(k & 1u, (k >> 1u) & 1u, (k >> 2u) & 1u);
         let w3 = select(1.0 - f, f, o == vec3u(1u));
         let c = vec3u(clamp(vec3i(base) + vec3i(o), vec3i(0), hi));
-        let cell = (c.z * photon_grid.dims.y + c.y) * photon_grid.dims.x + c.x;
-        let key = plane_key(plane, cell_centre(photon_grid.origin, photon_grid.cell, c), photon_grid.cell, back);
-        let s = find_slot(cell, key, photon_grid.mask, photon_grid.max_probe);
+        let centre = cell_centre(origin, h, c);
+        if own != NO_SLOT && any(c != home) && region_of(own_record, p) != region_of(own_record, centre) {
+            continue;
+        }
+        let cell = grid_cell_index(c);
+        let key = plane_key(plane, centre, h, back);
+        let s = find_slot(cell, key | (photon_region(cell, key, p) << REGION_SHIFT), photon_grid.mask, photon_grid.max_probe);
         if s != NO_SLOT {
             sum += (w3.x * w3.y * w3.z) * photon_slots[s];
         }

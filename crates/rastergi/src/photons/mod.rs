@@ -24,6 +24,7 @@
 pub mod cpu;
 pub mod gpu;
 pub mod map;
+pub mod passes;
 
 use crate::gpu_scene::PreparedScene;
 

@@ -23,7 +23,7 @@ fn plane_key(plane: TrianglePlane, centre: vec3f, cell: f32, back: bool) -> u32 
     if back {
         steps = -steps;
     }
-    return select(plane.bins.x, plane.bins.y, back) | (bitcast<u32>(steps) << 8u);
+    return select(plane.bins.x, plane.bins.y, back) | (bitcast<u32>(steps) << OFFSET_SHIFT);
 }
 
 // The centre of cell c of a grid at `origin` with cells of side `cell`.
@@ -40,6 +40,39 @@ fn find_slot(cell: u32, plane: u32, mask: u32, max_probe: u32) -> u32 {
     var i = slot_hash(cell, plane) & mask;
     for (var probe = 0u; probe < max_probe; probe++) {
         let k = slot_keys[i];
+        if k.x == cell && k.y == plane {
+            return i;
+        }
+        if k.x == NO_SLOT {
+            return NO_SLOT;
+        }
+        i = (i + 1u) & mask;
+    }
+    return NO_SLOT;
+}
+
+// The separators of a base slot (photons::map::Separators): a point's region has bit k set
+// where it lies on the negative side of plane k, n·x − d < 0 (unused planes are zero).
+struct SeparatorRecord {
+    s: array<vec4f, MAX_SEPARATORS>,
+}
+
+fn region_of(r: SeparatorRecord, p: vec3f) -> u32 {
+    var region = 0u;
+    for (var k = 0u; k < MAX_SEPARATORS; k++) {
+        if dot(r.s[k].xyz, p) - r.s[k].w < 0.0 {
+            region |= 1u << k;
+        }
+    }
+    return region;
+}
+
+// The entry of base slot (cell, plane)'s separators in `separator_keys` (bound by the including
+// shader), NO_SLOT where it has none: find_slot over the separators' table.
+fn find_separators(cell: u32, plane: u32, mask: u32, max_probe: u32) -> u32 {
+    var i = slot_hash(cell, plane) & mask;
+    for (var probe = 0u; probe < max_probe; probe++) {
+        let k = separator_keys[i];
         if k.x == cell && k.y == plane {
             return i;
         }

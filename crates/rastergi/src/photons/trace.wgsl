@@ -19,8 +19,13 @@ struct PhotonParams {
     max_probe: u32,
     // The photon pass: the second key of every photon's stream.
     pass_index: u32,
+    // The separators' table: capacity − 1 and the longest probe.
+    sep_mask: u32,
+    sep_max_probe: u32,
     _pad0: u32,
     _pad1: u32,
+    _pad2: u32,
+    _pad3: u32,
 }
 
 @group(1) @binding(0) var<uniform> params: PhotonParams;
@@ -35,13 +40,20 @@ struct PhotonParams {
 @group(1) @binding(5) var<storage, read_write> slots_out: array<vec4f>;
 @group(1) @binding(6) var<storage, read> slot_keys: array<vec2u>;
 @group(1) @binding(7) var<storage, read> planes: array<TrianglePlane>;
+@group(1) @binding(8) var<storage, read> separator_keys: array<vec2u>;
+@group(1) @binding(9) var<storage, read> separator_planes: array<SeparatorRecord>;
 
 // The table entry of a deposit at p on side `back` of triangle tri (MapLayout::deposit_slot).
 fn slot_of(p: vec3f, tri: u32, back: bool) -> u32 {
     let c = vec3u(clamp(vec3i(floor((p - params.origin) / params.cell)), vec3i(0), vec3i(params.dims) - 1));
     let cell = (c.z * params.dims.y + c.y) * params.dims.x + c.x;
     let key = plane_key(planes[tri], cell_centre(params.origin, params.cell, c), params.cell, back);
-    return find_slot(cell, key, params.mask, params.max_probe);
+    var region = 0u;
+    let sep = find_separators(cell, key, params.sep_mask, params.sep_max_probe);
+    if sep != NO_SLOT {
+        region = region_of(separator_planes[sep], p);
+    }
+    return find_slot(cell, key | (region << REGION_SHIFT), params.mask, params.max_probe);
 }
 
 // 64-bit add on the (low, high) words of slot s in channel c: whoever wraps the low word

@@ -4,7 +4,9 @@
 //! - `atrium`: a colonnaded hall lit through three windows and a skylight ([`atrium`]), the
 //!   scene beyond the Cornell box (`scenes/atrium.obj` is the same scene as OBJ + MTL);
 //! - `spheres:N`: about N triangles of tessellated spheres on a floor under an area light
-//!   ([`spheres`]), for measuring scale (`spheres:1000000` is a million triangles).
+//!   ([`spheres`]), for measuring scale (`spheres:1000000` is a million triangles);
+//! - `rooms`, `rooms:closed`: two rooms split by a wall 2 cm thick, lit in one, seen from the
+//!   other, through a doorway or with none ([`rooms`]): the thin-wall case of the photon map.
 //!
 //! Every surface here is built from quads oriented by an explicit outward normal, so the
 //! front faces (and the emitters' emitting sides) never depend on the order corners are
@@ -16,7 +18,7 @@ use super::{Camera, Material, Scene, cornell_box};
 use crate::error::{Error, Result};
 
 /// The built-in scene names, as shown in help texts and error messages.
-pub const BUILTIN_NAMES: &str = "cornell, atrium, spheres:N (about N triangles)";
+pub const BUILTIN_NAMES: &str = "cornell, atrium, spheres:N (about N triangles), rooms, rooms:closed";
 
 /// Largest triangle count `spheres:N` accepts: 2²⁸ triangles are 16 GiB of corners, far
 /// past what any GPU binds as one buffer, so larger requests are typos.
@@ -29,6 +31,8 @@ pub fn builtin(name: &str) -> Result<Option<Scene>> {
     match name.split_once(':') {
         None if name == "cornell" => Ok(Some(cornell_box())),
         None if name == "atrium" => Ok(Some(atrium())),
+        None if name == "rooms" => Ok(Some(rooms(true))),
+        Some(("rooms", "closed")) => Ok(Some(rooms(false))),
         Some(("spheres", count)) => {
             let n: usize = count
                 .trim()
@@ -68,6 +72,56 @@ fn add_box(scene: &mut Scene, lo: Vec3, hi: Vec3, material: u32) {
             add_quad_facing(scene, q, Vec3::AXES[axis] * side, material);
         }
     }
+}
+
+/// Half the thickness of the wall between the two [`rooms`].
+pub const ROOMS_HALF_WALL: f32 = 0.01;
+
+/// Two rooms side by side along x, each 2 × 2.5 × 3 m (x ∈ [−2, 0] lit, x ∈ [0, 2] dark),
+/// split by a wall 2 cm thick at x = 0 — with a doorway 0.8 × 2 m in it (`doorway`) or
+/// none. A 0.8 × 0.8 m light on the lit room's ceiling; the camera stands in the dark room's
+/// far corner looking at the wall. Closed, the dark room receives no light at all: every
+/// pixel's radiance is exactly zero, so any light seen there is the photon map's leak.
+pub fn rooms(doorway: bool) -> Scene {
+    let camera =
+        Camera { eye: Vec3::new(1.9, 1.4, 1.4), target: Vec3::new(-0.2, 0.7, -0.4), up: Vec3::Y, fov_y_deg: 65.0 };
+    let mut s = Scene::new(camera);
+    let white = s.add_material(Material::diffuse("white", Vec3::splat(0.75)));
+    let light =
+        s.add_material(Material { emission: Vec3::splat(8.0), ..Material::diffuse("light", Vec3::splat(0.75)) });
+    let (lo, hi) = (Vec3::new(-2.0, 0.0, -1.5), Vec3::new(2.0, 2.5, 1.5));
+    // The shell, facing in.
+    for axis in 0..3 {
+        let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+        for (inward, at) in [(1.0f32, lo[axis]), (-1.0, hi[axis])] {
+            let corner = |a: f32, b: f32| {
+                let mut p = Vec3::ZERO;
+                p[axis] = at;
+                p[u] = a;
+                p[v] = b;
+                p
+            };
+            let q = [corner(lo[u], lo[v]), corner(hi[u], lo[v]), corner(hi[u], hi[v]), corner(lo[u], hi[v])];
+            add_quad_facing(&mut s, q, Vec3::AXES[axis] * inward, white);
+        }
+    }
+    // The wall, as boxes around the doorway (z ∈ [−0.4, 0.4], y < 2).
+    let w = ROOMS_HALF_WALL;
+    if doorway {
+        add_box(&mut s, Vec3::new(-w, 0.0, lo.z), Vec3::new(w, hi.y, -0.4), white);
+        add_box(&mut s, Vec3::new(-w, 0.0, 0.4), Vec3::new(w, hi.y, hi.z), white);
+        add_box(&mut s, Vec3::new(-w, 2.0, -0.4), Vec3::new(w, hi.y, 0.4), white);
+    } else {
+        add_box(&mut s, Vec3::new(-w, 0.0, lo.z), Vec3::new(w, hi.y, hi.z), white);
+    }
+    let y = hi.y - 0.02;
+    add_quad_facing(
+        &mut s,
+        [Vec3::new(-1.4, y, -0.4), Vec3::new(-0.6, y, -0.4), Vec3::new(-0.6, y, 0.4), Vec3::new(-1.4, y, 0.4)],
+        -Vec3::Y,
+        light,
+    );
+    s
 }
 
 /// A UV sphere: `segments` around the axis, `segments / 2` rings from pole to pole;

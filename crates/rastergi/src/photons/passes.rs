@@ -1,0 +1,135 @@
+//! Progressive photon passes: the photon map is re-traced during rendering with fresh random
+//! numbers, in cells that shrink with the pass count, so that the map's bias and its noise both
+//! go to zero as the render goes on (a grid version of progressive photon mapping's radius
+//! reduction, Hachisuka et al. 2008; Knaus and Zwicker 2011).
+//!
+//! * Pass k = 0, 1, 2, … traces the same number of photons N from the stream (seed, photon,
+//!   k) and lasts `pass_iterations` iterations of the image; every iteration reads the map of
+//!   its pass, and the image is the mean over all iterations.
+//! * Schedule: pass k uses r_k = round(r₀ · (k + 1)^((1 − α)/2)) cells along the longest axis,
+//!   cell area h_k² ∝ (k + 1)^−(1−α), with α = [`ALPHA`] = 2/3.
+//! * Why it converges: the map's bias at a point is a blur over about a cell, O(h_k), → 0;
+//!   its variance per slot is ∝ 1/(N·h_k²) ∝ (k + 1)^(1−α), and the mean over K passes of
+//!   independent maps has variance ∝ K^−2 Σ (k + 1)^(1−α) ∝ K^−α → 0. The iterations average
+//!   the passes' estimates (a Cesàro mean), so the image's error from the map goes to zero too.
+//! * A grid finer than the GPU binds is not refused: [`MapLayout::within`] keeps the finest
+//!   that fits, and the schedule stops refining there (the map's noise still averages out).
+//! * `passes = 1` is one fixed map, traced before the first iteration, as the seed describes.
+
+use super::PhotonSettings;
+use super::gpu::GpuPhotonMap;
+use super::map::MapLayout;
+use crate::error::Result;
+use crate::gpu::Gpu;
+use crate::gpu_scene::{GpuScene, PreparedScene};
+
+/// The schedule's α: cell area ∝ pass^−(1−α).
+pub const ALPHA: f64 = 2.0 / 3.0;
+/// Iterations per photon pass by default.
+pub const DEFAULT_PASS_ITERATIONS: u32 = 64;
+
+/// Grid resolution of pass `pass` (0-based) for a first pass of `first` cells.
+pub fn pass_resolution(first: u32, pass: u32) -> u32 {
+    ((first as f64) * ((pass + 1) as f64).powf(0.5 * (1.0 - ALPHA))).round() as u32
+}
+
+/// The photon map of the current pass and what the next pass needs.
+pub struct PhotonPasses {
+    prepared: PreparedScene,
+    settings: PhotonSettings,
+    /// Passes in all (0: no limit).
+    passes: u32,
+    pass_iterations: u32,
+    pass: u32,
+    iterations_in_pass: u32,
+    /// The finest resolution the GPU binds, once a pass has hit it.
+    finest: Option<u32>,
+    map: GpuPhotonMap,
+}
+
+impl PhotonPasses {
+    /// Traces pass 0 (`settings.grid_resolution` cells) and keeps what later passes need.
+    pub fn new(
+        gpu: &Gpu,
+        scene: &GpuScene,
+        prepared: PreparedScene,
+        settings: PhotonSettings,
+        passes: u32,
+        pass_iterations: u32,
+    ) -> Result<PhotonPasses> {
+        let mut map = GpuPhotonMap::build(gpu, scene, &prepared, &settings)?;
+        if passes == 1 {
+            // One fixed map: rendering reads the lookup values alone.
+            map.release_build_buffers();
+        }
+        Ok(PhotonPasses {
+            prepared,
+            settings,
+            passes,
+            pass_iterations: pass_iterations.max(1),
+            pass: 0,
+            iterations_in_pass: 0,
+            finest: None,
+            map,
+        })
+    }
+
+    pub fn map(&self) -> &GpuPhotonMap {
+        &self.map
+    }
+
+    /// The current pass (0-based).
+    pub fn pass(&self) -> u32 {
+        self.pass
+    }
+
+    /// Called before each iteration: once the current pass has had its iterations, traces the
+    /// next one (a new layout where the schedule asks for finer cells). Returns whether the map
+    /// changed.
+    pub fn advance(&mut self, gpu: &Gpu, scene: &GpuScene) -> Result<bool> {
+        let more = self.passes == 0 || self.pass + 1 < self.passes;
+        if !(more && self.iterations_in_pass >= self.pass_iterations) {
+            self.iterations_in_pass += 1;
+            return Ok(false);
+        }
+        self.pass += 1;
+        self.iterations_in_pass = 1;
+        let wanted = pass_resolution(self.settings.grid_resolution, self.pass);
+        let wanted = self.finest.map_or(wanted, |f| wanted.min(f));
+        let current = self.map.grid().dims.max_element();
+        if wanted > current {
+            let limits = gpu.device.limits();
+            let layout = MapLayout::within(&self.prepared.scene, &self.prepared.bounds, wanted, &limits)?;
+            let got = layout.grid.dims.max_element();
+            if got < wanted {
+                self.finest = Some(got);
+            }
+            if got > current {
+                let settings = PhotonSettings { grid_resolution: got, ..self.settings };
+                self.map = GpuPhotonMap::with_layout(gpu, scene, &self.prepared, &settings, layout)?;
+                log::info!("photon pass {}: {} cells along the longest axis", self.pass, got);
+            }
+        }
+        self.map.trace_pass(gpu, scene, self.pass);
+        Ok(true)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_schedule_shrinks_cell_area_as_pass_to_the_minus_one_third() {
+        assert_eq!(pass_resolution(64, 0), 64);
+        // (k + 1)^(1/6): 64 passes halve the cell side, 4096 quarter it.
+        assert_eq!(pass_resolution(64, 63), 128);
+        assert_eq!(pass_resolution(64, 4095), 256);
+        let mut last = 0;
+        for k in 0..1000 {
+            let r = pass_resolution(32, k);
+            assert!(r >= last);
+            last = r;
+        }
+    }
+}

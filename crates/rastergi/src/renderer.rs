@@ -16,7 +16,7 @@ use crate::photon_view::PhotonViewPass;
 use crate::photons::PhotonSettings;
 use crate::photons::gpu::GpuPhotonMap;
 use crate::photons::map::GridSpec;
-use crate::photons::passes::{DEFAULT_PASS_ITERATIONS, PhotonPasses};
+use crate::photons::passes::{DEFAULT_PASS_ITERATIONS, PhotonPasses, fitted_pass_iterations};
 use crate::scene::{Camera, Scene};
 
 /// Settings of a render.
@@ -41,7 +41,8 @@ pub struct RenderSettings {
     /// Photon passes ([`crate::photons::passes`]): the map is re-traced with fresh photons in
     /// finer cells every `pass_iterations` iterations; 1: one fixed map; 0: no limit.
     pub photon_passes: u32,
-    /// Iterations per photon pass.
+    /// Iterations per photon pass; 0: fitted to the photon count and the image size
+    /// ([`crate::photons::passes::fitted_pass_iterations`]).
     pub pass_iterations: u32,
     /// Gather directions per iteration, 1 to [`crate::gather::MAX_DIRECTIONS`]: they share the iteration's
     /// G-buffer and direct light.
@@ -182,7 +183,12 @@ impl Renderer {
             PhotonSettings { count: settings.photons, seed: settings.seed, grid_resolution: settings.grid_resolution };
         let photons = (settings.photons > 0)
             .then(|| {
-                let (n, k) = (settings.photon_passes, settings.pass_iterations);
+                let pixels = settings.width as u64 * settings.height as u64;
+                let k = match settings.pass_iterations {
+                    0 => fitted_pass_iterations(settings.photons, pixels),
+                    k => k,
+                };
+                let n = settings.photon_passes;
                 PhotonPasses::new(gpu, &gpu_scene, prepared, photon_settings, n, k)
             })
             .transpose()?;

@@ -38,9 +38,13 @@ pub struct ConvergeArgs {
     /// unlimited passes.
     #[arg(long, value_delimiter = ',', default_value = "0")]
     photon_passes: Vec<u32>,
-    /// Iterations per photon pass.
+    /// Iterations per photon pass (0: fitted to the photons and the image size).
     #[arg(long, default_value_t = rastergi::photons::passes::DEFAULT_PASS_ITERATIONS)]
     pass_iterations: u32,
+    /// The final gather's implementation (auto times them on the first iterations, so two
+    /// curves may end up with different ones: pin it to compare other settings).
+    #[arg(long, value_enum, default_value_t = crate::args::GatherArg::Auto)]
+    gather: crate::args::GatherArg,
     /// Also measure Mitsuba 3 (built-in cornell only; needs python3 with mitsuba).
     #[arg(long)]
     mitsuba: bool,
@@ -78,12 +82,13 @@ pub fn run(a: &ConvergeArgs) -> Result<()> {
         photons: a.photons,
         grid_resolution: a.grid,
         seed: 1,
+        gather: a.gather.method(),
         ..Default::default()
     };
     let mut curves: Vec<(String, Vec<Point>)> = Vec::new();
     for &passes in &a.photon_passes {
         let settings = RenderSettings { photon_passes: passes, pass_iterations: a.pass_iterations, ..base.clone() };
-        println!("photon passes {passes} (0: unlimited), a pass every {} iterations:", a.pass_iterations);
+        println!("photon passes {passes} (0: unlimited), a pass every {} iterations (0: fitted):", a.pass_iterations);
         let (name, points) =
             measure(|| Renderer::new(&gpu, &scene, settings), &reference, a.seconds, 0.0, &TARGETS, "iterations")?;
         let passes = if passes == 0 { "unlimited".to_string() } else { passes.to_string() };

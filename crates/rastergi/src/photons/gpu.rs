@@ -120,6 +120,20 @@ impl GpuPhotonMap {
         Ok(map)
     }
 
+    /// [`build`](Self::build), tracing pass 0 with `count` photons (see
+    /// [`trace_photons`](Self::trace_photons)).
+    pub fn build_with(
+        gpu: &Gpu,
+        scene: &GpuScene,
+        prepared: &PreparedScene,
+        settings: &PhotonSettings,
+        count: u32,
+    ) -> Result<GpuPhotonMap> {
+        let map = Self::new(gpu, scene, prepared, settings)?;
+        map.trace_photons(gpu, scene, 0, count);
+        Ok(map)
+    }
+
     /// Lays the map out over the scene (the slots and their areas, on the CPU) and allocates
     /// it and its pipelines.
     pub fn new(
@@ -293,16 +307,23 @@ impl GpuPhotonMap {
         self.trace_pass(gpu, scene, 0);
     }
 
-    /// [`trace`](Self::trace) with the photons of `pass`: the same count, fresh random numbers
-    /// (the stream (seed ⊕ photon stream, photon index, pass)).
+    /// [`trace`](Self::trace) with the photons of `pass`: fresh random numbers (the stream
+    /// (seed ⊕ photon stream, photon index, pass)), the settings' count of them.
     pub fn trace_pass(&self, gpu: &Gpu, scene: &GpuScene, pass: u32) {
+        self.trace_photons(gpu, scene, pass, self.settings.count);
+    }
+
+    /// Pass `pass` with `count` photons, each carrying 1/count of the emitted power. Fewer
+    /// photons than the settings' carry more flux each than the fixed point's Φ_max: k times
+    /// fewer make deposits of up to k·2²⁴ units, which the 64-bit counters hold as well.
+    pub fn trace_photons(&self, gpu: &Gpu, scene: &GpuScene, pass: u32, count: u32) {
         let device = &gpu.device;
         let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("photon clear") });
         let build = self.build.as_ref().expect("trace() after release_build_buffers()");
         enc.clear_buffer(&build.tally, 0, None);
         gpu.queue.submit([enc.finish()]);
-        let mut params = PhotonParams { pass_index: pass, ..self.params };
-        let count = self.settings.count;
+        let inv_photon_count = 1.0 / count.max(1) as f32;
+        let mut params = PhotonParams { pass_index: pass, inv_photon_count, ..self.params };
         let dispatch =
             |params: &mut PhotonParams, items: u32, pipeline: &wgpu::ComputePipeline, label: &'static str| {
                 let groups = items.div_ceil(WORKGROUP);

@@ -453,7 +453,17 @@ impl MapLayout {
                     && entries.saturating_mul(24) <= limits.max_buffer_size
             };
             let outcome = if fits(estimate) || resolution == 1 {
+                let start = std::time::Instant::now();
                 let layout = MapLayout::new(scene, &grid);
+                log::info!(
+                    "photon map layout: grid {}x{}x{}, {} slots, {} with separators, {:.2} s",
+                    grid.dims.x,
+                    grid.dims.y,
+                    grid.dims.z,
+                    layout.table.len(),
+                    layout.separators.table.len(),
+                    start.elapsed().as_secs_f64()
+                );
                 crate::limits::check_photon_slots(limits, &layout).map(|()| layout)
             } else {
                 Err(crate::Error::Limits(format!(

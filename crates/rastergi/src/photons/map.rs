@@ -42,7 +42,10 @@ use std::collections::HashMap;
 
 use glam::{DVec3, IVec3, UVec3, Vec3};
 
-use crate::sampling::pcg_hash;
+use super::clip::{clip_to_box, clip_to_half_space, polygon_area};
+use super::separators::{Fragment, separators_of};
+pub use super::separators::{MAX_SEPARATORS, MIN_REGION, Separator, Separators, region_of};
+pub use super::table::{EMPTY, SlotTable};
 use crate::scene::{Aabb, Scene, triangle_normal};
 
 /// The slot table's search in WGSL (`find_slot`, the twin of [`SlotTable::find`]). The GPU
@@ -57,8 +60,11 @@ pub const FACE_DIVISIONS: usize = 3;
 pub const BINS: usize = 6 * FACE_DIVISIONS * FACE_DIVISIONS;
 /// Plane offsets are rounded to this many cell sides.
 pub const OFFSET_STEP: f32 = 0.125;
-/// A table entry without a slot.
-pub const EMPTY: u32 = u32::MAX;
+/// Bit offset of the region in a slot's plane key (the orientation bin below it, < 64).
+pub const REGION_SHIFT: u32 = 6;
+/// Bit offset of the plane offset in a plane key (the region's [`MAX_SEPARATORS`] bits below
+/// it): 22 bits of signed steps, ±2²¹ eighths of a cell.
+pub const OFFSET_SHIFT: u32 = REGION_SHIFT + MAX_SEPARATORS as u32;
 
 /// The bin of a surface side with normal n: face 2·axis + sign of
 /// the dominant axis, then the 3 × 3 cell of the other two coordinates (in axis order after
@@ -150,71 +156,6 @@ impl GridSpec {
     }
 }
 
-/// The hash of a slot key (`slot_hash` in `table.wgsl`).
-fn slot_hash(cell: u32, plane: u32) -> u32 {
-    pcg_hash(cell ^ pcg_hash(plane))
-}
-
-/// The slots of a map: keys (cell index, plane key) in an open-addressing table.
-#[derive(Clone, Debug, PartialEq)]
-pub struct SlotTable {
-    /// `[cell, plane]` per entry, `[EMPTY, EMPTY]` where there is no slot; a power of two long.
-    pub keys: Vec<[u32; 2]>,
-    /// The longest probe sequence of any key: a search stops after this many entries.
-    pub max_probe: u32,
-}
-
-impl SlotTable {
-    /// A table holding `keys` (distinct), at most half full.
-    pub fn new(keys: &[[u32; 2]]) -> SlotTable {
-        let capacity = (2 * keys.len()).next_power_of_two().max(16);
-        let mask = capacity as u32 - 1;
-        let mut table = vec![[EMPTY; 2]; capacity];
-        let mut max_probe = 1;
-        for &k in keys {
-            let mut i = slot_hash(k[0], k[1]) & mask;
-            let mut probe = 1;
-            while table[i as usize][0] != EMPTY {
-                i = (i + 1) & mask;
-                probe += 1;
-            }
-            table[i as usize] = k;
-            max_probe = max_probe.max(probe);
-        }
-        SlotTable { keys: table, max_probe }
-    }
-
-    pub fn capacity(&self) -> usize {
-        self.keys.len()
-    }
-
-    /// The entry of slot (cell, plane), if the map has it (`find_slot` in WGSL).
-    pub fn find(&self, cell: u32, plane: u32) -> Option<usize> {
-        let mask = self.keys.len() as u32 - 1;
-        let mut i = slot_hash(cell, plane) & mask;
-        for _ in 0..self.max_probe {
-            let k = self.keys[i as usize];
-            if k == [cell, plane] {
-                return Some(i as usize);
-            }
-            if k[0] == EMPTY {
-                return None;
-            }
-            i = (i + 1) & mask;
-        }
-        None
-    }
-
-    /// Entries holding a slot.
-    pub fn len(&self) -> usize {
-        self.keys.iter().filter(|k| k[0] != EMPTY).count()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-}
-
 /// Everything about a map that depends on the geometry alone: the grid, every triangle's
 /// plane, the slots and their areas. Shared by the GPU tracer and its CPU twin.
 #[derive(Clone, Debug)]
@@ -227,107 +168,6 @@ pub struct MapLayout {
     pub area: Vec<f64>,
     /// The planes that split base slots into regions.
     pub separators: Separators,
-}
-
-/// A surface side's part inside one cell.
-struct Fragment {
-    /// Its base plane key in the cell.
-    key: u32,
-    /// Its plane, (n, d) with n·x = d on it, n the side's normal.
-    plane: (DVec3, f64),
-    poly: Vec<DVec3>,
-    area: f64,
-}
-
-/// A separator plane (n, d), n unit: a point x lies on its negative side where n·x − d < 0.
-pub type Separator = [f32; 4];
-
-/// Most separators of one slot (each doubles its regions).
-pub const MAX_SEPARATORS: usize = 4;
-/// A separator splits a slot only where each side holds at least this fraction of its area.
-pub const MIN_REGION: f64 = 0.02;
-
-/// Bit offset of the region in a slot's plane key (the orientation bin below it, < 64).
-pub const REGION_SHIFT: u32 = 6;
-/// Bit offset of the plane offset in a plane key (the region's [`MAX_SEPARATORS`] bits below
-/// it): 22 bits of signed steps, ±2²¹ eighths of a cell.
-pub const OFFSET_SHIFT: u32 = REGION_SHIFT + MAX_SEPARATORS as u32;
-
-/// The separators of every base slot that has any, in a table keyed like the slots
-/// (`separator_keys`, `separator_planes` in WGSL).
-#[derive(Clone, Debug, PartialEq)]
-pub struct Separators {
-    pub table: SlotTable,
-    /// Per table entry; unused separators are all zero (every point on their positive side).
-    pub planes: Vec<[Separator; MAX_SEPARATORS]>,
-}
-
-/// Bit k set where p lies on the negative side of separator k (`region_of` in WGSL).
-pub fn region_of(planes: &[Separator; MAX_SEPARATORS], p: Vec3) -> u32 {
-    let mut region = 0;
-    for (k, s) in planes.iter().enumerate() {
-        // Unused separators are zero: every point on their non-negative side.
-        if Vec3::new(s[0], s[1], s[2]).dot(p) - s[3] < 0.0 {
-            region |= 1 << k;
-        }
-    }
-    region
-}
-
-/// Up to [`MAX_SEPARATORS`] planes of other surfaces in the cell, the ones with the most
-/// surface in the cell first, leaving out planes the slot's own fragments lie in (all their
-/// vertices within `eps`) and planes that cut off less than [`MIN_REGION`] of their area. A
-/// plane that cuts the fragments splits the slot into regions: a
-/// wall standing on a floor splits the floor's slot into its two rooms and the strip under
-/// the wall, which no photon reaches; a box standing on it, the floor under it from the floor
-/// around it. A plane that bounds them (a wall the floor ends at) splits nothing, but the
-/// lookup reads no neighbouring cell beyond it.
-fn separators_of(own: &[&Fragment], all: &[Fragment], key: u32, eps: f64) -> Vec<(DVec3, f64)> {
-    // (key, plane, area in the cell, splits the slot's fragments)
-    let mut candidates: Vec<(u32, (DVec3, f64), f64, bool)> = Vec::new();
-    for f in all.iter().filter(|f| f.key != key) {
-        match candidates.iter_mut().find(|c| c.0 == f.key) {
-            Some(c) => c.2 += f.area,
-            None => candidates.push((f.key, f.plane, f.area, false)),
-        }
-    }
-    let vertices = || own.iter().flat_map(|f| f.poly.iter());
-    let total: f64 = own.iter().map(|f| f.area).sum();
-    let negative =
-        |(n, d): (DVec3, f64)| own.iter().map(|f| polygon_area(&clip_to_half_space(&f.poly, n, d, true))).sum::<f64>();
-    candidates.retain_mut(|c| {
-        let (n, d) = c.1;
-        if !vertices().any(|v| (n.dot(*v) - d).abs() > eps) {
-            return false; // the slot's own plane
-        }
-        let below = negative(c.1);
-        let least = below.min(total - below);
-        // A plane that cuts off a sliver would make a slot of almost no area, whose few
-        // photons read as a spike: it neither splits nor fences.
-        c.3 = least > MIN_REGION * total;
-        c.3 || least <= 1e-9 * total
-    });
-    // Planes that split first, then by their surface in the cell.
-    candidates.sort_by(|a, b| b.3.cmp(&a.3).then(b.2.total_cmp(&a.2)).then(a.0.cmp(&b.0)));
-    candidates.into_iter().take(MAX_SEPARATORS).map(|c| c.1).collect()
-}
-
-/// The part of the convex polygon on the negative side of plane (n, d) (`negative`), or on
-/// its non-negative side.
-fn clip_to_half_space(poly: &[DVec3], n: DVec3, d: f64, negative: bool) -> Vec<DVec3> {
-    let inside = |p: &DVec3| (n.dot(*p) - d < 0.0) == negative;
-    let mut out = Vec::new();
-    for (k, p) in poly.iter().enumerate() {
-        let q = &poly[(k + 1) % poly.len()];
-        if inside(p) {
-            out.push(*p);
-        }
-        if inside(p) != inside(q) {
-            let (sp, sq) = (n.dot(*p) - d, n.dot(*q) - d);
-            out.push(*p + (*q - *p) * (sp / (sp - sq)));
-        }
-    }
-    if out.len() < 3 { Vec::new() } else { out }
 }
 
 impl MapLayout {
@@ -493,44 +333,6 @@ impl MapLayout {
     }
 }
 
-/// Sutherland–Hodgman clipping of a convex polygon to the half-open box [min, max), the
-/// same cells `GridSpec::cell_of` assigns points to: a polygon lying exactly on a cell
-/// boundary counts in the cell above it only, where its photons land.
-fn clip_to_box(poly: &[DVec3], min: DVec3, max: DVec3) -> Vec<DVec3> {
-    let mut out = poly.to_vec();
-    for axis in 0..3 {
-        for (bound, keep_below) in [(min[axis], false), (max[axis], true)] {
-            let inside = |p: &DVec3| if keep_below { p[axis] < bound } else { p[axis] >= bound };
-            let input = std::mem::take(&mut out);
-            for (k, p) in input.iter().enumerate() {
-                let q = &input[(k + 1) % input.len()];
-                if inside(p) {
-                    out.push(*p);
-                }
-                if inside(p) != inside(q) {
-                    let t = (bound - p[axis]) / (q[axis] - p[axis]);
-                    out.push(*p + (*q - *p) * t);
-                }
-            }
-            if out.len() < 3 {
-                return Vec::new();
-            }
-        }
-    }
-    out
-}
-
-fn polygon_area(poly: &[DVec3]) -> f64 {
-    if poly.len() < 3 {
-        return 0.0;
-    }
-    let mut s = DVec3::ZERO;
-    for k in 1..poly.len() - 1 {
-        s += (poly[k] - poly[0]).cross(poly[k + 1] - poly[0]);
-    }
-    0.5 * s.length()
-}
-
 /// A photon map on the CPU: flux (RGB) and area per table entry. Built by the CPU tracer, or
 /// read back from the GPU; its lookup is the twin of `photon_irradiance` in WGSL.
 #[derive(Clone, Debug)]
@@ -685,24 +487,6 @@ mod tests {
         let c = UVec3::new(2, 1, 3);
         let k = TrianglePlane::new(Vec3::Y, Vec3::new(0.1, 0.37, 0.2)).key(&grid, c, false);
         assert_eq!(TrianglePlane::new(Vec3::Y, Vec3::new(1.9, 0.37, 1.3)).key(&grid, c, false), k);
-    }
-
-    #[test]
-    fn the_table_finds_every_key_it_holds_and_no_other() {
-        let keys: Vec<[u32; 2]> = (0..5000u32).map(|i| [i * 7919 % 100_003, i % 13]).collect();
-        let table = SlotTable::new(&keys);
-        assert!(table.capacity() >= 2 * keys.len() && table.capacity().is_power_of_two());
-        assert_eq!(table.len(), keys.len());
-        let mut entries: Vec<usize> = keys.iter().map(|k| table.find(k[0], k[1]).expect("an inserted key")).collect();
-        for (k, &e) in keys.iter().zip(&entries) {
-            assert_eq!(table.keys[e], *k);
-        }
-        entries.sort_unstable();
-        entries.dedup();
-        assert_eq!(entries.len(), keys.len(), "two keys share an entry");
-        for i in 0..5000u32 {
-            assert_eq!(table.find(i * 7919 % 100_003, 13 + i % 5), None);
-        }
     }
 
     #[test]

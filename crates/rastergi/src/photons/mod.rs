@@ -21,10 +21,13 @@
 //! Since ρ_c/max(ρ) ≤ 1, a photon's flux per channel never exceeds its initial flux, which is
 //! at most [`PhotonSettings::max_photon_flux`]: the GPU's fixed-point tally relies on this.
 
+mod clip;
 pub mod cpu;
 pub mod gpu;
 pub mod map;
 pub mod passes;
+pub mod separators;
+pub mod table;
 
 use crate::gpu_scene::PreparedScene;
 

@@ -17,12 +17,7 @@ use crate::shader;
 
 /// Components accumulated per pixel: component c of pixel p at `c·W·H + p` (`film.wgsl`).
 pub const COMPONENTS: u64 = 3;
-/// Emission + direct light (the path tracer's full image).
-pub const FILM_DIRECT: u32 = 0;
-/// Indirect light from the final gather.
-pub const FILM_INDIRECT: u32 = 1;
-/// The photon-map view.
-pub const FILM_PHOTON_VIEW: u32 = 2;
+pub use crate::consts::{FILM_DIRECT, FILM_INDIRECT, FILM_PHOTON_VIEW};
 /// Bytes per pixel of the film's GPU storage (accumulation + resolved copies).
 pub const BYTES_PER_PIXEL: u64 = COMPONENTS * 16 + 16 + 4;
 

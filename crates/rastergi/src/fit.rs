@@ -13,7 +13,7 @@
 //! - **Bundle** (the gather's ray-view resolution): at least [`TEXELS_PER_EDGE`] texels
 //!   across the median triangle's shortest edge, over the scene's bounding sphere (the ray
 //!   view's width), and never less than twice the image's larger side
-//!   ([`crate::renderer::default_bundle`]); 128 to 2048. A ray-view texel samples one
+//!   ([`default_bundle`]); 128 to 2048. A ray-view texel samples one
 //!   surface: a gather ray from a point on a curved, tessellated surface (a column, a vault)
 //!   can meet the plane of a neighbouring facet that covers the same texel and read its back,
 //!   which darkens such surfaces by about 10 % × texel / facet (measured on `atrium`: −5.4 %,
@@ -28,6 +28,12 @@
 use crate::image_io::LinearImage;
 use crate::photons::map::GridSpec;
 use crate::scene::{Aabb, Scene, triangle_area};
+
+/// The default ray-view resolution: twice the image's larger side, within [128, 2048], so a
+/// ray-view texel is about as wide as an eye pixel's footprint on a scene seen whole.
+pub fn default_bundle(width: u32, height: u32) -> u32 {
+    (2 * width.max(height)).clamp(128, 2048)
+}
 
 /// Grid cells of the Cornell box's default grid, the budget every scene gets.
 pub const GRID_CELL_BUDGET: u64 = 64 * 64 * 64;
@@ -98,9 +104,9 @@ pub fn detail_bundle(scene: &Scene) -> u32 {
 }
 
 /// The bundle for a `width × height` image of a scene whose [`detail_bundle`] is `detail`:
-/// the larger of that and [`crate::renderer::default_bundle`].
+/// the larger of that and [`default_bundle`].
 pub fn bundle(detail: u32, width: u32, height: u32) -> u32 {
-    crate::renderer::default_bundle(width, height).max(detail).clamp(MIN_BUNDLE, MAX_BUNDLE)
+    default_bundle(width, height).max(detail).clamp(MIN_BUNDLE, MAX_BUNDLE)
 }
 
 /// Rec. 709 luminance of a linear RGB pixel.
@@ -194,7 +200,7 @@ mod tests {
         let cornell = detail_bundle(&cornell_box());
         assert_eq!(cornell, MIN_BUNDLE);
         assert_eq!(bundle(cornell, 256, 256), 512);
-        assert_eq!(bundle(cornell, 128, 128), crate::renderer::default_bundle(128, 128));
+        assert_eq!(bundle(cornell, 128, 128), default_bundle(128, 128));
         // Atrium: 10 cm facets over a 12.9 m sphere: 8 · 128.7 ≈ 1030 texels.
         let atrium = detail_bundle(&generate::atrium());
         assert!((1000..1060).contains(&atrium), "{atrium}");

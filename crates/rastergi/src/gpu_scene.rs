@@ -35,8 +35,7 @@ pub struct GpuMaterial {
     pub texture: u32,
 }
 
-pub const MATERIAL_TWO_SIDED: u32 = 1;
-pub const NO_TEXTURE: u32 = u32::MAX;
+pub use crate::consts::{MATERIAL_TWO_SIDED, NO_TEXTURE};
 
 /// A scene prepared for rendering: triangles permuted into BVH order, with the BVH and the
 /// light table over them and the textures as the GPU samples them. CPU twins use this

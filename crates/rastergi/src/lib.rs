@@ -12,6 +12,7 @@
 
 pub mod bvh;
 pub mod camera_control;
+pub mod consts;
 pub mod direct;
 pub mod display;
 pub mod error;

@@ -49,11 +49,7 @@ pub struct RenderSettings {
     pub directions: u32,
 }
 
-/// The default ray-view resolution: twice the image's larger side, within [128, 2048], so a
-/// ray-view texel is about as wide as an eye pixel's footprint on a scene seen whole.
-pub fn default_bundle(width: u32, height: u32) -> u32 {
-    (2 * width.max(height)).clamp(128, 2048)
-}
+pub use crate::fit::default_bundle;
 
 /// Gather directions per iteration by default. On the Cornell box at 256² (lavapipe), the
 /// indirect light carries 97 % of an iteration's variance while the G-buffer and the direct

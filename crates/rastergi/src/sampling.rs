@@ -6,23 +6,7 @@
 
 use glam::Vec3;
 
-/// The random streams: every stream key is `seed ^ id` with one of these ids, so no two
-/// passes draw correlated numbers. WGSL gets the ids it uses from [`crate::shader::constants`].
-pub mod stream {
-    /// Light samples of the direct pass, keyed (pixel, iteration).
-    pub const DIRECT: u32 = 0x0d1ec7;
-    /// Paths of the reference path tracer, keyed (pixel, iteration).
-    pub const PATH: u32 = 0x9a7b1d;
-    /// Photons, keyed (photon index, 0): the GPU tracer and its CPU twin share it.
-    pub const PHOTON: u32 = 0x9e3779b9;
-    /// The rotation of the gather directions, keyed (restart, 0).
-    pub const GATHER_ROTATION: u32 = 0x5bd1e995;
-    /// The ray view's sub-texel offset, keyed (direction index, restart).
-    pub const TEXEL_JITTER: u32 = 0x7e1a5;
-    /// The Cranley–Patterson shift of the pixel jitter, x and y (hashed, not a stream).
-    pub const PIXEL_SHIFT_X: u32 = 0x6a09e667;
-    pub const PIXEL_SHIFT_Y: u32 = 0xbb67ae85;
-}
+pub use crate::consts::stream;
 
 /// One round of the PCG permutation, also used as an integer hash.
 #[inline]

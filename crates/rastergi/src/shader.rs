@@ -6,11 +6,10 @@
 //! their WGSL declarations. Structs shared by both are checked by the layout test
 //! (`layout_test.rs`), which parses every composed shader with naga.
 
-use crate::film::{FILM_DIRECT, FILM_INDIRECT, FILM_PHOTON_VIEW};
-use crate::gather::MAX_DIRECTIONS;
-use crate::gpu_scene::{MATERIAL_TWO_SIDED, NO_TEXTURE};
-use crate::photons::map::{MAX_SEPARATORS, OFFSET_SHIFT, OFFSET_STEP, REGION_SHIFT};
-use crate::sampling::stream;
+use crate::consts::{
+    FILM_DIRECT, FILM_INDIRECT, FILM_PHOTON_VIEW, MATERIAL_TWO_SIDED, MAX_DIRECTIONS, MAX_SEPARATORS, NO_TEXTURE,
+    OFFSET_SHIFT, OFFSET_STEP, REGION_SHIFT, stream,
+};
 
 pub const SAMPLING: &str = include_str!("sampling.wgsl");
 pub const SCENE: &str = include_str!("gpu_scene.wgsl");

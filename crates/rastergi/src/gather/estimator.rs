@@ -17,7 +17,6 @@ use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3};
 
 use super::MAX_DIRECTIONS;
-use super::ray_view::ray_view_projection;
 use crate::error::Result;
 use crate::film::Film;
 use crate::frame::FrameBinding;
@@ -26,7 +25,6 @@ use crate::gpu::{Gpu, compute_pipeline};
 use crate::gpu_scene::GpuScene;
 use crate::photons::gpu::GpuPhotonMap;
 use crate::photons::map::LOOKUP_WGSL;
-use crate::scene::Aabb;
 use crate::shader;
 
 /// `struct Gather` in WGSL.
@@ -48,26 +46,6 @@ pub struct GatherUniforms {
     pub _pad: [u32; 3],
     /// Trace: all the iteration's directions (xyz).
     pub directions: [[f32; 4]; MAX_DIRECTIONS as usize],
-}
-
-impl GatherUniforms {
-    /// The uniforms for `samples` with sample `current` as the raster gathers' ray view of a
-    /// `bundle`² view over `bounds`.
-    pub fn new(bounds: &Aabb, samples: &[GatherSample], current: usize, bundle: u32) -> GatherUniforms {
-        let s = samples[current];
-        let mut directions = [[0.0; 4]; MAX_DIRECTIONS as usize];
-        for (d, s) in directions.iter_mut().zip(samples) {
-            *d = s.direction.extend(0.0).into();
-        }
-        GatherUniforms {
-            view_proj: ray_view_projection(bounds, s.direction, bundle, s.texel_jitter).to_cols_array_2d(),
-            direction: s.direction.into(),
-            bundle,
-            count: samples.len() as u32,
-            _pad: [0; 3],
-            directions,
-        }
-    }
 }
 
 /// One gather direction of an iteration: ω and the ray view's sub-texel offset.

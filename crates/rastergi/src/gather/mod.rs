@@ -42,8 +42,7 @@ use crate::gpu_scene::GpuScene;
 use crate::photons::gpu::GpuPhotonMap;
 use crate::sampling::{Rng, radical_inverse, stream, uniform_sphere};
 
-/// Most gather directions per iteration.
-pub const MAX_DIRECTIONS: u32 = 16;
+pub use crate::consts::MAX_DIRECTIONS;
 
 /// How the nearest surface along the gather direction is found.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

@@ -14,6 +14,8 @@
 
 use glam::{Mat4, Vec2, Vec3};
 
+use super::MAX_DIRECTIONS;
+use super::estimator::{GatherSample, GatherUniforms};
 use crate::gpu::scene_raster_pipeline;
 use crate::sampling::orthonormal_basis;
 use crate::scene::Aabb;
@@ -69,4 +71,25 @@ pub fn ray_view_pipeline(
 ) -> wgpu::RenderPipeline {
     let target = wgpu::ColorTargetState { format: target.0, blend: None, write_mask: target.1 };
     scene_raster_pipeline(device, label, (module, layouts), fs, target, depth.then_some(DEPTH_FORMAT))
+}
+
+/// The uniforms are built here, where the ray view is: the raster gathers read its matrix.
+impl GatherUniforms {
+    /// The uniforms for `samples` with sample `current` as the raster gathers' ray view of a
+    /// `bundle`² view over `bounds`.
+    pub fn new(bounds: &Aabb, samples: &[GatherSample], current: usize, bundle: u32) -> GatherUniforms {
+        let s = samples[current];
+        let mut directions = [[0.0; 4]; MAX_DIRECTIONS as usize];
+        for (d, s) in directions.iter_mut().zip(samples) {
+            *d = s.direction.extend(0.0).into();
+        }
+        GatherUniforms {
+            view_proj: ray_view_projection(bounds, s.direction, bundle, s.texel_jitter).to_cols_array_2d(),
+            direction: s.direction.into(),
+            bundle,
+            count: samples.len() as u32,
+            _pad: [0; 3],
+            directions,
+        }
+    }
 }

@@ -58,13 +58,7 @@ pub const LOOKUP_WGSL: &str = concat!(include_str!("table.wgsl"), "\n", include_
 pub const FACE_DIVISIONS: usize = 3;
 /// Orientation bins: 6 cube faces × FACE_DIVISIONS².
 pub const BINS: usize = 6 * FACE_DIVISIONS * FACE_DIVISIONS;
-/// Plane offsets are rounded to this many cell sides.
-pub const OFFSET_STEP: f32 = 0.125;
-/// Bit offset of the region in a slot's plane key (the orientation bin below it, < 64).
-pub const REGION_SHIFT: u32 = 6;
-/// Bit offset of the plane offset in a plane key (the region's [`MAX_SEPARATORS`] bits below
-/// it): 22 bits of signed steps, ±2²¹ eighths of a cell.
-pub const OFFSET_SHIFT: u32 = REGION_SHIFT + MAX_SEPARATORS as u32;
+pub use crate::consts::{OFFSET_SHIFT, OFFSET_STEP, REGION_SHIFT};
 
 /// The bin of a surface side with normal n: face 2·axis + sign of
 /// the dominant axis, then the 3 × 3 cell of the other two coordinates (in axis order after

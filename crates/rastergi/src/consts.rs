@@ -1,0 +1,47 @@
+//! The constants that Rust and WGSL share, declared once here (a leaf module: it imports
+//! nothing) and re-exported by the modules they belong to; [`crate::shader::constants`]
+//! generates their WGSL declarations, so no shader restates a value.
+
+/// Most gather directions per iteration ([`crate::gather`]).
+pub const MAX_DIRECTIONS: u32 = 16;
+
+/// Material flag: the back face reflects too ([`crate::gpu_scene`]).
+pub const MATERIAL_TWO_SIDED: u32 = 1;
+/// A material without an albedo texture.
+pub const NO_TEXTURE: u32 = u32::MAX;
+
+/// Film component: emission + direct light (the path tracer's full image) ([`crate::film`]).
+pub const FILM_DIRECT: u32 = 0;
+/// Film component: indirect light from the final gather.
+pub const FILM_INDIRECT: u32 = 1;
+/// Film component: the photon-map view.
+pub const FILM_PHOTON_VIEW: u32 = 2;
+
+/// Plane offsets of the photon map's slots are rounded to this many cell sides
+/// ([`crate::photons::map`]).
+pub const OFFSET_STEP: f32 = 0.125;
+/// Most separators of one photon-map slot (each doubles its regions).
+pub const MAX_SEPARATORS: usize = 4;
+/// Bit offset of the region in a slot's plane key (the orientation bin below it, < 64).
+pub const REGION_SHIFT: u32 = 6;
+/// Bit offset of the plane offset in a plane key (the region's [`MAX_SEPARATORS`] bits below
+/// it): 22 bits of signed steps, ±2²¹ eighths of a cell.
+pub const OFFSET_SHIFT: u32 = REGION_SHIFT + MAX_SEPARATORS as u32;
+
+/// The random streams: every stream key is `seed ^ id` with one of these ids, so no two
+/// passes draw correlated numbers. WGSL gets the ids it uses from [`crate::shader::constants`].
+pub mod stream {
+    /// Light samples of the direct pass, keyed (pixel, iteration).
+    pub const DIRECT: u32 = 0x0d1ec7;
+    /// Paths of the reference path tracer, keyed (pixel, iteration).
+    pub const PATH: u32 = 0x9a7b1d;
+    /// Photons, keyed (photon index, pass): the GPU tracer and its CPU twin share it.
+    pub const PHOTON: u32 = 0x9e3779b9;
+    /// The rotation of the gather directions, keyed (restart, 0).
+    pub const GATHER_ROTATION: u32 = 0x5bd1e995;
+    /// The ray view's sub-texel offset, keyed (direction index, restart).
+    pub const TEXEL_JITTER: u32 = 0x7e1a5;
+    /// The Cranley–Patterson shift of the pixel jitter, x and y (hashed, not a stream).
+    pub const PIXEL_SHIFT_X: u32 = 0x6a09e667;
+    pub const PIXEL_SHIFT_Y: u32 = 0xbb67ae85;
+}

@@ -58,6 +58,11 @@ fn add_quad_facing(scene: &mut Scene, mut q: [Vec3; 4], outward: Vec3, material:
 
 /// An axis-aligned box, its faces looking outwards.
 fn add_box(scene: &mut Scene, lo: Vec3, hi: Vec3, material: u32) {
+    add_box_facing(scene, lo, hi, material, 1.0);
+}
+
+/// An axis-aligned box whose faces look outwards (`facing` 1) or inwards (−1: a room's shell).
+fn add_box_facing(scene: &mut Scene, lo: Vec3, hi: Vec3, material: u32, facing: f32) {
     for axis in 0..3 {
         let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
         for (side, at) in [(-1.0f32, lo[axis]), (1.0, hi[axis])] {
@@ -69,7 +74,7 @@ fn add_box(scene: &mut Scene, lo: Vec3, hi: Vec3, material: u32) {
                 p
             };
             let q = [corner(lo[u], lo[v]), corner(hi[u], lo[v]), corner(hi[u], hi[v]), corner(lo[u], hi[v])];
-            add_quad_facing(scene, q, Vec3::AXES[axis] * side, material);
+            add_quad_facing(scene, q, Vec3::AXES[axis] * side * facing, material);
         }
     }
 }
@@ -90,21 +95,7 @@ pub fn rooms(doorway: bool) -> Scene {
     let light =
         s.add_material(Material { emission: Vec3::splat(8.0), ..Material::diffuse("light", Vec3::splat(0.75)) });
     let (lo, hi) = (Vec3::new(-2.0, 0.0, -1.5), Vec3::new(2.0, 2.5, 1.5));
-    // The shell, facing in.
-    for axis in 0..3 {
-        let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
-        for (inward, at) in [(1.0f32, lo[axis]), (-1.0, hi[axis])] {
-            let corner = |a: f32, b: f32| {
-                let mut p = Vec3::ZERO;
-                p[axis] = at;
-                p[u] = a;
-                p[v] = b;
-                p
-            };
-            let q = [corner(lo[u], lo[v]), corner(hi[u], lo[v]), corner(hi[u], hi[v]), corner(lo[u], hi[v])];
-            add_quad_facing(&mut s, q, Vec3::AXES[axis] * inward, white);
-        }
-    }
+    add_box_facing(&mut s, lo, hi, white, -1.0); // the shell, facing in
     // The wall, as boxes around the doorway (z ∈ [−0.4, 0.4], y < 2).
     let w = ROOMS_HALF_WALL;
     if doorway {

@@ -1,6 +1,7 @@
 //! The arguments and helpers the subcommands share: the GPU (`--backend`) and its openers,
 //! the scene and renderer options of `render` and `view` ([`SceneArgs`]), what is shown
-//! ([`ShowArg`]), the gather implementation ([`GatherArg`]), scene loading and the per-pass
+//! ([`ShowArg`]), the gather implementation ([`GatherArg`]) and its directions
+//! ([`GatherDirectionsArg`]), scene loading and the per-pass
 //! GPU time report of `--profile`.
 
 use std::path::Path;
@@ -10,7 +11,7 @@ use clap::{Args, ValueEnum};
 use glam::Vec3;
 use rastergi::film::Show;
 use rastergi::fit;
-use rastergi::gather::GatherMethod;
+use rastergi::gather::{GatherDirections, GatherMethod};
 use rastergi::gpu::{Backends, Gpu, GpuOptions, parse_backend};
 use rastergi::renderer::RenderSettings;
 use rastergi::scene::generate::BUILTIN_NAMES;
@@ -78,6 +79,41 @@ impl GatherArg {
     }
 }
 
+/// Whose directions the traced gather casts.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
+pub enum GatherDirectionsArg {
+    /// Each pixel its own cosine-distributed directions (Owen-scrambled Sobol'): noise
+    /// instead of streaks.
+    PerPixel,
+    /// Each direction shared by every pixel (uniform on the sphere, Halton 5, 7).
+    Shared,
+}
+
+impl GatherDirectionsArg {
+    pub fn directions(self) -> GatherDirections {
+        match self {
+            GatherDirectionsArg::PerPixel => GatherDirections::PerPixel,
+            GatherDirectionsArg::Shared => GatherDirections::Shared,
+        }
+    }
+
+    /// The renderer's default.
+    pub fn default_value() -> GatherDirectionsArg {
+        match GatherDirections::default() {
+            GatherDirections::PerPixel => GatherDirectionsArg::PerPixel,
+            GatherDirections::Shared => GatherDirectionsArg::Shared,
+        }
+    }
+
+    /// The name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            GatherDirectionsArg::PerPixel => "per-pixel",
+            GatherDirectionsArg::Shared => "shared",
+        }
+    }
+}
+
 /// The options `render` and `view` share: the scene and its camera, the renderer's settings,
 /// what is shown and the GPU.
 #[derive(Args, Debug)]
@@ -137,6 +173,10 @@ pub struct SceneArgs {
     /// implementations of the same estimator).
     #[arg(long, value_enum, default_value_t = GatherArg::Auto)]
     pub gather: GatherArg,
+    /// Whose directions the traced gather casts (`--gather trace` only: raster, lists and
+    /// auto always share each direction among all pixels, whatever this says).
+    #[arg(long, value_enum, default_value_t = GatherDirectionsArg::default_value())]
+    pub gather_directions: GatherDirectionsArg,
     /// Gather directions per iteration (1–16): they share the iteration's G-buffer and direct
     /// light, so the noisier indirect light gets more samples per second.
     #[arg(long, default_value_t = rastergi::renderer::DEFAULT_DIRECTIONS, value_parser = clap::value_parser!(u32).range(1..=16))]
@@ -186,6 +226,7 @@ impl SceneArgs {
             show_photon_map,
             bundle: self.bundle.unwrap_or(0),
             gather: self.gather.method(),
+            gather_directions: self.gather_directions.directions(),
             directions: self.directions,
             photon_passes: self.photon_passes,
             pass_iterations: self.pass_iterations,

@@ -9,6 +9,7 @@ use anyhow::Result;
 use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 use rastergi::fit;
+use rastergi::gather::GatherDirections;
 use rastergi::image_io::{ImageFormat, write_exr, write_png};
 use rastergi::path_tracer::PathTracer;
 use rastergi::progressive::Progressive;
@@ -83,20 +84,20 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     let settings = a.settings(&scene, a.width, a.height, matches!(a.show, ShowArg::PhotonMap));
     let start = Instant::now();
-    // `bundle`: the photon-map renderer's gather ray view, for the log.
-    let (mut renderer, bundle): (Box<dyn Progressive>, Option<u32>) = match args.method {
+    // `bundle`: the photon-map renderer's gather ray view and directions, for the log.
+    let (mut renderer, gather_info): (Box<dyn Progressive>, Option<(u32, GatherDirections)>) = match args.method {
         Method::Gather => {
             let r = Renderer::new(&gpu, &scene, settings)?;
-            let bundle = r.bundle();
-            (Box::new(r), Some(bundle))
+            let info = (r.bundle(), r.gather_directions());
+            (Box::new(r), Some(info))
         }
         Method::Path => (Box::new(PathTracer::new(&gpu, &scene, settings)?), None),
     };
     renderer.wait()?;
     log::info!("set-up (BVH, upload, photon map) in {:.2} s", start.elapsed().as_secs_f64());
     print_profile(&gpu, args.profile, "set-up", 1, "set-up")?;
-    if let Some(bundle) = bundle {
-        log::info!("gather ray view: {bundle}x{bundle} texels");
+    if let Some((bundle, directions)) = gather_info {
+        log::info!("gather ray view: {bundle}x{bundle} texels; directions {directions:?}");
     }
     let start = Instant::now();
 

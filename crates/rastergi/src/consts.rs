@@ -39,6 +39,8 @@ pub mod stream {
     pub const PHOTON: u32 = 0x9e3779b9;
     /// The rotation of the gather directions, keyed (restart, 0).
     pub const GATHER_ROTATION: u32 = 0x5bd1e995;
+    /// The key of the per-pixel gather directions' scramble seeds, keyed (restart, 0).
+    pub const GATHER_PIXEL: u32 = 0x3c6ef372;
     /// The ray view's sub-texel offset, keyed (direction index, restart).
     pub const TEXEL_JITTER: u32 = 0x7e1a5;
     /// The Cranley–Patterson shift of the pixel jitter, x and y (hashed, not a stream).

@@ -45,7 +45,11 @@ fn twins() -> Vec<Twin> {
         twin!(GpuMaterial, "Material", [albedo, flags, emission, texture]),
         twin!(BvhNode, "BvhNode", [min, offset, max, count]),
         twin!(LightEntry, "LightEntry", [triangle, cdf, pmf, area]),
-        twin!(GatherUniforms, "Gather", [view_proj, direction, bundle, count, directions]),
+        twin!(
+            GatherUniforms,
+            "Gather",
+            [view_proj, direction, bundle, count, per_pixel, pixel_key, first_index, directions]
+        ),
         twin!(
             PhotonParams,
             "PhotonParams",

@@ -7,7 +7,9 @@ use crate::direct::DirectPass;
 use crate::error::Result;
 use crate::film::{Film, Show};
 use crate::frame::{FrameBinding, FrameUniforms, pixel_jitter};
-use crate::gather::{DirectionSampler, FixedSample, GatherFrame, GatherMethod, GatherPass, GatherSetup};
+use crate::gather::{
+    DirectionSampler, FixedSample, GatherDirections, GatherFrame, GatherMethod, GatherPass, GatherSetup,
+};
 use crate::gbuffer::GBufferPass;
 use crate::gpu::Gpu;
 use crate::gpu_scene::{GpuScene, PreparedScene};
@@ -38,6 +40,9 @@ pub struct RenderSettings {
     pub bundle: u32,
     /// How the final gather finds the nearest surface along its direction.
     pub gather: GatherMethod,
+    /// The traced gather's directions: per pixel or shared by every pixel (applies to
+    /// [`GatherMethod::Trace`] only: the raster gathers and `Auto` always share them).
+    pub gather_directions: GatherDirections,
     /// Photon passes ([`crate::photons::passes`]): the map is re-traced with fresh photons in
     /// finer cells every `pass_iterations` iterations; 1: one fixed map; 0: no limit.
     pub photon_passes: u32,
@@ -61,7 +66,8 @@ pub const DEFAULT_DIRECTIONS: u32 = 4;
 /// other estimators for the same samples.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Overrides {
-    /// Gather direction ω instead of the sequence's.
+    /// One gather direction ω instead of the sequence's, shared by every pixel (in per-pixel
+    /// mode too).
     pub direction: Option<Vec3>,
     /// Sub-pixel offset in [-0.5, 0.5)² instead of the sequence's.
     pub pixel_jitter: Option<Vec2>,
@@ -89,6 +95,7 @@ impl Default for RenderSettings {
             show_photon_map: false,
             bundle: 0,
             gather: GatherMethod::Auto,
+            gather_directions: GatherDirections::default(),
             directions: DEFAULT_DIRECTIONS,
             photon_passes: 0,
             pass_iterations: DEFAULT_PASS_ITERATIONS,
@@ -127,7 +134,7 @@ impl ImagePasses {
         let gather = match map {
             Some(map) => {
                 let setup = GatherSetup { scene, frame, gbuffer: &gbuffer, film: &film, map };
-                Some(GatherPass::new(gpu, &setup, bundle, settings.gather, sampler)?)
+                Some(GatherPass::new(gpu, &setup, bundle, settings.gather, settings.gather_directions, sampler)?)
             }
             None => None,
         };
@@ -231,6 +238,17 @@ impl Renderer {
     /// The gather's ray-view resolution in use (texels per side; 0 without a photon map).
     pub fn bundle(&self) -> u32 {
         self.passes.gather.as_ref().map_or(0, |g| g.bundle)
+    }
+
+    /// The gather's random choices as they stand (for tests: the per-pixel scramble key of
+    /// this restart); `None` without a photon map.
+    pub fn gather_sampler(&self) -> Option<DirectionSampler> {
+        self.passes.gather.as_ref().map(GatherPass::sampler)
+    }
+
+    /// Whose directions the gather casts: per pixel or shared.
+    pub fn gather_directions(&self) -> GatherDirections {
+        self.passes.gather.as_ref().map_or(GatherDirections::Shared, GatherPass::directions)
     }
 
     /// The gather implementation in use (`Auto` until its trials have chosen).

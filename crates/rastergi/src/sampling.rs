@@ -7,6 +7,8 @@
 use glam::Vec3;
 
 pub use crate::consts::stream;
+use crate::error::Result;
+use crate::gpu::{Gpu, compute_pipeline, groups, storage_entry};
 
 /// One round of the PCG permutation, also used as an integer hash.
 #[inline]
@@ -84,6 +86,114 @@ pub fn radical_inverse(mut i: u32, base: u32) -> f32 {
     r as f32
 }
 
+/// The 2D Sobol' sequence (its dimensions 0 and 1) at index `i`, as 32-bit binary fractions
+/// (x / 2³²). Dimension 0 is the van der Corput sequence (the bits of i reversed); dimension 1
+/// has the primitive polynomial x + 1, whose direction numbers are v₀ = ½, v_k = v_{k−1} ⊕
+/// v_{k−1}/2 (Pascal's triangle mod 2). Together a (0, 2)-sequence in base 2: every aligned
+/// block of 2^m points is a (0, m, 2)-net. Mirrors `sobol_2d` in WGSL.
+pub fn sobol_2d(i: u32) -> [u32; 2] {
+    let (mut y, mut v, mut j) = (0u32, 1u32 << 31, i);
+    while j != 0 {
+        if j & 1 != 0 {
+            y ^= v;
+        }
+        j >>= 1;
+        v ^= v >> 1;
+    }
+    [i.reverse_bits(), y]
+}
+
+/// A hash-based nested scramble of the bits of `x` from the least significant up (Laine and
+/// Karras 2011, with the mixing Burley 2020 reports from Vegdahl): each step is a bijection
+/// in which bit k of the result is bit k of its input XOR a function of the bits below k
+/// (adding, multiplying by an odd number, XOR with a multiple by an even number), so every
+/// bit is flipped or not depending on the seed and the lower bits only.
+fn lk_permutation(mut x: u32, seed: u32) -> u32 {
+    x ^= x.wrapping_mul(0x3d20_adea);
+    x = x.wrapping_add(seed);
+    x = x.wrapping_mul((seed >> 16) | 1);
+    x ^= x.wrapping_mul(0x0552_6c56);
+    x ^= x.wrapping_mul(0x53a2_2864);
+    x
+}
+
+/// An Owen scramble of the binary fraction x / 2³² keyed by `seed`: [`lk_permutation`] on the
+/// reversed bits, so each digit (most significant first) is flipped depending on the digits
+/// before it. It maps every elementary interval [j/2^k, (j+1)/2^k) onto one of the same size,
+/// so a scrambled (0, m, 2)-net is one too. Mirrors `owen_scramble` in WGSL.
+pub fn owen_scramble(x: u32, seed: u32) -> u32 {
+    lk_permutation(x.reverse_bits(), seed).reverse_bits()
+}
+
+/// The Owen-scrambled 2D Sobol' point of `index` for `seed` (Burley 2020): the index is
+/// shuffled first by the same scramble (applied to its bits as a fraction, so the first 2^m
+/// indices map onto one aligned block of 2^m Sobol' indices, itself a (0, m, 2)-net), then each
+/// coordinate is scrambled with its own seed. Points as 32-bit fractions; mirrors
+/// `sobol_owen_2d` in WGSL.
+pub fn sobol_owen_2d(index: u32, seed: u32) -> [u32; 2] {
+    let shuffled = owen_scramble(index, pcg_hash(seed ^ 0x0b2f_5a31));
+    let [x, y] = sobol_2d(shuffled);
+    [owen_scramble(x, pcg_hash(seed ^ 0x68e3_1da4)), owen_scramble(y, pcg_hash(seed ^ 0xb5c1_8b27))]
+}
+
+/// A 32-bit fraction as an f32 in [0, 1) (its top 24 bits: exact), as `rng_f32` rounds.
+pub fn unit_f32(x: u32) -> f32 {
+    (x >> 8) as f32 * (1.0 / 16_777_216.0)
+}
+
+/// The scramble seed of pixel (x, y) for a frame's `key`; mirrors `pixel_seed` in WGSL.
+pub fn pixel_seed(key: u32, x: u32, y: u32) -> u32 {
+    pcg_hash(x ^ pcg_hash(y ^ key))
+}
+
+/// [`sobol_owen_2d`] of each (index, seed) evaluated by its WGSL twin in a compute shader (for
+/// tests: the two must agree bit for bit).
+pub fn sobol_owen_on_gpu(gpu: &Gpu, queries: &[(u32, u32)]) -> Result<Vec<[u32; 2]>> {
+    let device = &gpu.device;
+    let input: Vec<[u32; 2]> = queries.iter().map(|&(i, s)| [i, s]).collect();
+    let input = gpu.storage_buffer("sobol queries", bytemuck::cast_slice(&input), wgpu::BufferUsages::empty());
+    let size = (queries.len() as u64 * 8).max(8);
+    let output = gpu.zeroed_buffer("sobol points", size, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
+    let c = wgpu::ShaderStages::COMPUTE;
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("sobol points"),
+        entries: &[storage_entry::<[u32; 2]>(0, c, true), storage_entry::<[u32; 2]>(1, c, false)],
+    });
+    let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("sobol points"),
+        layout: &layout,
+        entries: &[
+            wgpu::BindGroupEntry { binding: 0, resource: input.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 1, resource: output.as_entire_binding() },
+        ],
+    });
+    let main = "
+        @group(0) @binding(0) var<storage, read> queries: array<vec2u>;
+        @group(0) @binding(1) var<storage, read_write> points: array<vec2u>;
+        @compute @workgroup_size(64)
+        fn main(@builtin(global_invocation_id) gid: vec3u) {
+            if gid.x >= arrayLength(&queries) {
+                return;
+            }
+            points[gid.x] = sobol_owen_2d(queries[gid.x].x, queries[gid.x].y);
+        }";
+    let source = crate::shader::compose(&[crate::shader::SAMPLING, main]);
+    let module = crate::shader::module(device, "sobol points", &source);
+    let pipeline = compute_pipeline(device, "sobol points", &module, "main", &[&layout]);
+    let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("sobol points") });
+    {
+        let mut pass = enc
+            .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("sobol points"), timestamp_writes: None });
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &bind_group, &[]);
+        pass.dispatch_workgroups(groups(queries.len() as u32, 64), 1, 1);
+    }
+    gpu.queue.submit([enc.finish()]);
+    let bytes = gpu.read_buffer(&output, size)?;
+    let points: &[[u32; 2]] = bytemuck::cast_slice(&bytes);
+    Ok(points[..queries.len()].to_vec())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -134,5 +244,89 @@ mod tests {
         assert_eq!(radical_inverse(1, 2), 0.5);
         assert_eq!(radical_inverse(3, 2), 0.75);
         assert!((radical_inverse(5, 3) - (2.0 / 3.0 + 1.0 / 9.0)).abs() < 1e-6);
+    }
+
+    #[test]
+    fn sobol_2d_first_points_match_hand_values() {
+        // Dimension 0: 0, ½, ¼, ¾, ⅛, ⅝, ⅜, ⅞ (van der Corput). Dimension 1 by hand from
+        // v₀ = 0.1₂, v₁ = 0.11₂, v₂ = 0.101₂: i = 2 → v₁ = ¾, i = 3 → v₀ ⊕ v₁ = 0.01₂ = ¼,
+        // i = 5 → v₀ ⊕ v₂ = 0.001₂ = ⅛, i = 6 → v₁ ⊕ v₂ = 0.011₂ = ⅜, i = 7 → 0.111₂ = ⅞.
+        let expected = [
+            (0.0, 0.0),
+            (0.5, 0.5),
+            (0.25, 0.75),
+            (0.75, 0.25),
+            (0.125, 0.625),
+            (0.625, 0.125),
+            (0.375, 0.375),
+            (0.875, 0.875),
+        ];
+        for (i, &(x, y)) in expected.iter().enumerate() {
+            let [sx, sy] = sobol_2d(i as u32);
+            assert_eq!((sx as f64 / 4_294_967_296.0, sy as f64 / 4_294_967_296.0), (x, y), "point {i}");
+        }
+        // v₃ = v₂ ⊕ v₂/2 = 0.1111₂: point 8 is (1/16, 15/16).
+        assert_eq!(sobol_2d(8), [1 << 28, 0xf000_0000]);
+    }
+
+    /// Whether `points` (2^m of them, 32-bit fractions) put exactly one point in every
+    /// elementary interval [a/2^j, (a+1)/2^j) × [b/2^(m−j), (b+1)/2^(m−j)), for all j.
+    fn is_net(points: &[[u32; 2]], m: u32) -> bool {
+        (0..=m).all(|j| {
+            let mut seen = vec![false; 1 << m];
+            points.iter().all(|&[x, y]| {
+                let cell = |v: u32, bits: u32| if bits == 0 { 0 } else { (v >> (32 - bits)) as usize };
+                let k = (cell(x, j) << (m - j)) | cell(y, m - j);
+                !std::mem::replace(&mut seen[k], true)
+            })
+        })
+    }
+
+    #[test]
+    fn scrambled_sobol_prefixes_are_02_nets_for_every_seed() {
+        for seed in [0u32, 1, 7, 0xdead_beef, pixel_seed(3, 10, 20)] {
+            for m in [1u32, 2, 4, 6, 8, 10] {
+                let points: Vec<[u32; 2]> = (0..1u32 << m).map(|i| sobol_owen_2d(i, seed)).collect();
+                assert!(is_net(&points, m), "seed {seed:#x}: the first 2^{m} points are not a (0,{m},2)-net");
+                // An iteration of K = 4 directions takes an aligned block: a (0,2,2)-net.
+                let block: Vec<[u32; 2]> = (40..44).map(|i| sobol_owen_2d(i, seed)).collect();
+                assert!(is_net(&block, 2), "seed {seed:#x}: points 40..44 are not a (0,2,2)-net");
+            }
+        }
+        // The check itself rejects a non-net: four points on the diagonal's first half.
+        assert!(!is_net(&[[0, 0], [1 << 29, 1 << 29], [2 << 29, 2 << 29], [3 << 29, 3 << 29]], 2));
+        // And the scramble does change the points.
+        assert_ne!(sobol_owen_2d(1, 1), sobol_owen_2d(1, 2));
+    }
+
+    #[test]
+    fn scrambled_sobol_points_are_uniform_across_seeds() {
+        // For a fixed index, the point over random seeds is uniform on [0,1)²: mean ½ and
+        // variance 1/12 in each coordinate, uncorrelated.
+        let n = 50_000;
+        for index in [0u32, 1, 5, 100, 12_345] {
+            let (mut s, mut s2, mut sxy) = ([0.0f64; 2], [0.0f64; 2], 0.0f64);
+            for seed in 0..n {
+                let p = sobol_owen_2d(index, pcg_hash(seed)).map(|v| unit_f32(v) as f64);
+                for c in 0..2 {
+                    s[c] += p[c];
+                    s2[c] += p[c] * p[c];
+                }
+                sxy += (p[0] - 0.5) * (p[1] - 0.5);
+            }
+            let se = (1.0f64 / 12.0 / n as f64).sqrt();
+            for c in 0..2 {
+                let mean = s[c] / n as f64;
+                let var = s2[c] / n as f64 - mean * mean;
+                assert!((mean - 0.5).abs() < 5.0 * se, "index {index}: mean {mean}");
+                // Var of (u − ½)² is 1/180: its standard error is sqrt(1/180/n).
+                assert!(
+                    (var - 1.0 / 12.0).abs() < 5.0 * (1.0f64 / 180.0 / n as f64).sqrt(),
+                    "index {index}: var {var}"
+                );
+            }
+            // Cov of independent U(0,1): 0 with standard error 1/12/sqrt(n).
+            assert!((sxy / n as f64).abs() < 5.0 / 12.0 / (n as f64).sqrt(), "index {index}: covariance");
+        }
     }
 }

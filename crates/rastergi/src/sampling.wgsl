@@ -51,3 +51,51 @@ fn uniform_triangle_bary(u1: f32, u2: f32) -> vec3f {
     let b1 = u2 * su;
     return vec3f(b0, b1, 1.0 - b0 - b1);
 }
+
+// The 2D Sobol' sequence at index i as 32-bit fractions (dimension 0: bits reversed;
+// dimension 1: polynomial x + 1); mirrors sobol_2d.
+fn sobol_2d(i: u32) -> vec2u {
+    var y = 0u;
+    var v = 1u << 31u;
+    for (var j = i; j != 0u; j >>= 1u) {
+        if (j & 1u) != 0u {
+            y ^= v;
+        }
+        v ^= v >> 1u;
+    }
+    return vec2u(reverseBits(i), y);
+}
+
+// Laine–Karras-style hash: bit k depends on the seed and the bits up to k only.
+fn lk_permutation(x0: u32, seed: u32) -> u32 {
+    var x = x0;
+    x ^= x * 0x3d20adeau;
+    x += seed;
+    x *= (seed >> 16u) | 1u;
+    x ^= x * 0x05526c56u;
+    x ^= x * 0x53a22864u;
+    return x;
+}
+
+// Owen scramble of the fraction x / 2^32; mirrors owen_scramble.
+fn owen_scramble(x: u32, seed: u32) -> u32 {
+    return reverseBits(lk_permutation(reverseBits(x), seed));
+}
+
+// The Owen-scrambled 2D Sobol' point of `index` for `seed` (index shuffled, then each
+// coordinate scrambled); mirrors sobol_owen_2d.
+fn sobol_owen_2d(index: u32, seed: u32) -> vec2u {
+    let shuffled = owen_scramble(index, pcg_hash(seed ^ 0x0b2f5a31u));
+    let p = sobol_2d(shuffled);
+    return vec2u(owen_scramble(p.x, pcg_hash(seed ^ 0x68e31da4u)), owen_scramble(p.y, pcg_hash(seed ^ 0xb5c18b27u)));
+}
+
+// A 32-bit fraction as f32 in [0, 1) (its top 24 bits); mirrors unit_f32.
+fn unit_f32(x: u32) -> f32 {
+    return f32(x >> 8u) * (1.0 / 16777216.0);
+}
+
+// The scramble seed of pixel (x, y) for a frame's key; mirrors pixel_seed.
+fn pixel_seed(key: u32, x: u32, y: u32) -> u32 {
+    return pcg_hash(x ^ pcg_hash(y ^ key));
+}

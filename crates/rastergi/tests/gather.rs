@@ -7,21 +7,26 @@ use std::f64::consts::PI;
 
 use glam::{Vec2, Vec3};
 use rastergi::film::Show;
-use rastergi::gather::GatherMethod;
+use rastergi::gather::{GatherDirections, GatherMethod};
 use rastergi::gpu_scene::PreparedScene;
 use rastergi::image_io::LinearImage;
 use rastergi::metrics::{compare, emitter_mask, masked_mean, rmse};
 use rastergi::renderer::{Overrides, RenderSettings, Renderer};
-use rastergi::sampling::uniform_sphere;
+use rastergi::sampling::{
+    cosine_hemisphere, pcg_hash, pixel_seed, sobol_owen_2d, sobol_owen_on_gpu, uniform_sphere, unit_f32,
+};
 use rastergi::scene::{Camera, cornell_box, triangle_normal};
 
-/// Renders 6 fixed directions with `method` at 64² (fixed jitter, bundle 512) and compares
-/// each pixel's estimate with a CPU ray cast of the same estimator at the same visible point.
-/// Returns (mismatched, compared) pixel estimates.
-fn mismatches_against_cpu_raycast(method: GatherMethod) -> (usize, usize) {
+/// Renders 6 iterations with `method` at 64² (fixed jitter, bundle 512) and compares each
+/// pixel's estimate with a CPU ray cast of the same estimator at the same visible point:
+/// shared, one fixed direction per iteration (`Overrides::direction`); per-pixel, the 4
+/// directions of each pixel from the CPU twin of its scrambled Sobol' points. Returns
+/// (mismatched, compared) pixel estimates.
+fn mismatches_against_cpu_raycast(method: GatherMethod, directions: GatherDirections) -> (usize, usize) {
     let gpu = common::gpu();
     let scene = cornell_box();
     let (w, h) = (64u32, 64u32);
+    let per_pixel = directions == GatherDirections::PerPixel;
     let settings = RenderSettings {
         width: w,
         height: h,
@@ -29,6 +34,8 @@ fn mismatches_against_cpu_raycast(method: GatherMethod) -> (usize, usize) {
         grid_resolution: 16,
         bundle: 512,
         gather: method,
+        gather_directions: directions,
+        directions: 4,
         ..Default::default()
     };
     let mut r = Renderer::new(&gpu, &scene, settings).unwrap();
@@ -36,39 +43,60 @@ fn mismatches_against_cpu_raycast(method: GatherMethod) -> (usize, usize) {
     let prepared = PreparedScene::new(&scene);
     let eps = prepared.ray_epsilon();
     let s = &prepared.scene;
+    // The estimate along ω from x on triangle t with normal n (facing the eye):
+    // shared (pdf 1/4π) (ρ_x/π)·(ρ_h/π)·E(h)·max(0, n·ω)·4π; per-pixel (pdf cos/π) ρ_x·(ρ_h/π)·E(h).
+    let estimate = |t: usize, x: Vec3, n: Vec3, direction: Vec3| -> [f64; 3] {
+        let cos = n.dot(direction);
+        let mut e3 = [0.0f64; 3];
+        if cos > 0.0
+            && let Some(hit) = prepared.bvh.intersect(&s.triangles, x, direction, eps, f32::INFINITY, t as u32)
+        {
+            let ht = s.triangles[hit.triangle as usize];
+            if triangle_normal(&ht).dot(direction) < 0.0 {
+                let e = map.irradiance_on(hit.triangle as usize, false, x + direction * hit.t);
+                let (ax, ah) = (s.material_of(t).albedo, s.material_of(hit.triangle as usize).albedo);
+                let weight = if per_pixel { PI } else { cos as f64 * 4.0 * PI };
+                for c in 0..3 {
+                    e3[c] = ax[c] as f64 / PI * ah[c] as f64 / PI * e[c] * weight;
+                }
+            }
+        }
+        e3
+    };
     let (mut compared, mut mismatched) = (0usize, 0usize);
     for k in 0..6 {
         let direction = uniform_sphere((k as f32 + 0.5) / 6.0, 0.37 * k as f32 + 0.1);
         r.reset();
-        let o =
-            Overrides { direction: Some(direction), pixel_jitter: Some(Vec2::ZERO), texel_jitter: Some(Vec2::ZERO) };
+        let o = Overrides {
+            direction: (!per_pixel).then_some(direction),
+            pixel_jitter: Some(Vec2::ZERO),
+            texel_jitter: Some(Vec2::ZERO),
+        };
         r.iterate_with(&o).unwrap();
         let img = r.read_linear(Show::Indirect).unwrap();
         let gbuffer = r.read_gbuffer().unwrap();
+        let key = r.gather_sampler().unwrap().pixel_key();
         for (i, &g) in gbuffer.iter().enumerate() {
             let Some(v) = common::VisiblePoint::decode(s, g) else {
                 continue;
             };
-            // The same estimator by ray casting: (ρ_x/π)·(ρ_h/π)·E(h)·max(0, n·ω)·4π.
             let (t, x, n) = (v.tri, v.pos, v.normal);
             if n.dot(scene.camera.eye - x) <= 0.0 {
                 continue;
             }
-            let cos = n.dot(direction);
-            let mut expected = [0.0f64; 3];
-            if cos > 0.0
-                && let Some(hit) = prepared.bvh.intersect(&s.triangles, x, direction, eps, f32::INFINITY, t as u32)
-            {
-                let ht = s.triangles[hit.triangle as usize];
-                let nh = triangle_normal(&ht);
-                if nh.dot(direction) < 0.0 {
-                    let e = map.irradiance_on(hit.triangle as usize, false, x + direction * hit.t);
-                    let (ax, ah) = (s.material_of(t).albedo, s.material_of(hit.triangle as usize).albedo);
-                    for c in 0..3 {
-                        expected[c] = ax[c] as f64 / PI * ah[c] as f64 / PI * e[c] * cos as f64 * 4.0 * PI;
-                    }
+            let expected = if per_pixel {
+                // Iteration 0 after the reset: sample indices 0..4 with this pixel's seed.
+                let seed = pixel_seed(key, i as u32 % w, i as u32 / w);
+                let mut sum = [0.0f64; 3];
+                for j in 0..4 {
+                    let [u1, u2] = sobol_owen_2d(j, seed);
+                    let e = estimate(t, x, n, cosine_hemisphere(n, unit_f32(u1), unit_f32(u2)));
+                    (0..3).for_each(|c| sum[c] += e[c] / 4.0);
                 }
-            }
+                sum
+            } else {
+                estimate(t, x, n, direction)
+            };
             compared += 1;
             let got = img.pixels[i];
             let ok =
@@ -83,7 +111,7 @@ fn mismatches_against_cpu_raycast(method: GatherMethod) -> (usize, usize) {
 
 #[test]
 fn raster_gather_matches_cpu_raycast_for_same_directions_except_at_ray_view_edges() {
-    let (mismatched, compared) = mismatches_against_cpu_raycast(GatherMethod::Raster);
+    let (mismatched, compared) = mismatches_against_cpu_raycast(GatherMethod::Raster, GatherDirections::Shared);
     let fraction = mismatched as f64 / compared as f64;
     println!("raster: {mismatched} of {compared} pixel estimates differ from the ray cast ({:.2} %)", 100.0 * fraction);
     // A rasterized gather samples each ray-view texel at one point: a gather ray passing
@@ -97,7 +125,7 @@ fn raster_gather_matches_cpu_raycast_for_same_directions_except_at_ray_view_edge
 
 #[test]
 fn list_gather_matches_cpu_raycast_for_same_directions_except_at_ray_view_edges() {
-    let (mismatched, compared) = mismatches_against_cpu_raycast(GatherMethod::Lists);
+    let (mismatched, compared) = mismatches_against_cpu_raycast(GatherMethod::Lists, GatherDirections::Shared);
     let fraction = mismatched as f64 / compared as f64;
     println!("lists: {mismatched} of {compared} pixel estimates differ from the ray cast ({:.2} %)", 100.0 * fraction);
     // The same texel approximation as the peeled raster gather, hence the same bound; a
@@ -107,13 +135,109 @@ fn list_gather_matches_cpu_raycast_for_same_directions_except_at_ray_view_edges(
 
 #[test]
 fn traced_gather_matches_cpu_raycast_for_same_directions() {
-    let (mismatched, compared) = mismatches_against_cpu_raycast(GatherMethod::Trace);
+    let (mismatched, compared) = mismatches_against_cpu_raycast(GatherMethod::Trace, GatherDirections::Shared);
     let fraction = mismatched as f64 / compared as f64;
     println!("trace: {mismatched} of {compared} pixel estimates differ from the ray cast ({:.3} %)", 100.0 * fraction);
     // The same ray against the same BVH in f32 on both sides: they can only disagree for a
     // ray that passes within rounding error of a triangle edge, where the two Möller–Trumbore
     // evaluations may pick different neighbours — a vanishing fraction of 23 000 rays.
     assert!(fraction < 0.002, "{:.3} % of the traced gather's estimates disagree with the ray cast", 100.0 * fraction);
+}
+
+#[test]
+fn per_pixel_traced_gather_matches_cpu_raycast_of_the_same_sobol_directions() {
+    let (mismatched, compared) = mismatches_against_cpu_raycast(GatherMethod::Trace, GatherDirections::PerPixel);
+    let fraction = mismatched as f64 / compared as f64;
+    println!(
+        "per-pixel: {mismatched} of {compared} pixel estimates differ from the ray cast ({:.3} %)",
+        100.0 * fraction
+    );
+    // The Sobol' points agree bit for bit (tested below); the directions from them may differ
+    // in the last bits (the GPU's sin, cos and sqrt), which moves a ray across a triangle edge
+    // only where it passes within rounding error of one: 4 rays per estimate, so 4× the
+    // shared bound.
+    assert!(fraction < 0.008, "{:.3} % of the per-pixel estimates disagree with the ray cast", 100.0 * fraction);
+}
+
+#[test]
+fn scrambled_sobol_on_the_gpu_agrees_bit_for_bit_with_its_cpu_twin() {
+    let gpu = common::gpu();
+    // Consecutive indices (the gather's), large ones, and seeds from small to all bits set.
+    let mut queries: Vec<(u32, u32)> = (0..4096).map(|i| (i % 64, pcg_hash(i / 64))).collect();
+    queries.extend((0..4096u32).map(|i| (pcg_hash(i ^ 0x55), pcg_hash(i))));
+    queries.extend([(0, 0), (u32::MAX, 0), (0, u32::MAX), (u32::MAX, u32::MAX), (1 << 31, 1)]);
+    let gpu_points = sobol_owen_on_gpu(&gpu, &queries).unwrap();
+    for (&(index, seed), g) in queries.iter().zip(&gpu_points) {
+        assert_eq!(*g, sobol_owen_2d(index, seed), "index {index}, seed {seed:#x}");
+    }
+}
+
+/// Renders `n` iterations, resets (new gather choices: rotation, pixel key) and renders `n`
+/// more: two images whose only difference is the gather's random choices (one fixed photon
+/// map; the jitter and light samples repeat after the reset).
+fn two_gathers(gpu: &rastergi::gpu::Gpu, settings: RenderSettings, n: u32) -> (LinearImage, LinearImage) {
+    let mut r = Renderer::new(gpu, &cornell_box(), settings).unwrap();
+    let mut half = || {
+        for i in 0..n {
+            r.iterate().unwrap();
+            if i % 16 == 15 {
+                r.wait().unwrap();
+            }
+        }
+        let img = r.read_linear(Show::Full).unwrap();
+        r.reset();
+        img
+    };
+    (half(), half())
+}
+
+#[test]
+fn per_pixel_and_shared_traced_gathers_converge_to_the_same_image() {
+    let gpu = common::gpu();
+    let settings = |directions| RenderSettings {
+        width: 64,
+        height: 64,
+        seed: 3,
+        photons: 1 << 18,
+        grid_resolution: 32,
+        photon_passes: 1,
+        gather: GatherMethod::Trace,
+        gather_directions: directions,
+        ..Default::default()
+    };
+    let n = 256;
+    let (pa, pb) = two_gathers(&gpu, settings(GatherDirections::PerPixel), n);
+    let (sa, sb) = two_gathers(&gpu, settings(GatherDirections::Shared), n);
+    let mask = emitter_mask(&sa, 3.0);
+    let mean = masked_mean(&sa, Some(&mask));
+    // The same seed: the same photon map, jitter and light samples in all four, so each
+    // difference is gather noise alone. Per image: σ² = rmse(a, b)²/2.
+    let var_p = rmse(&pa, &pb, Some(&mask)).powi(2) / 2.0;
+    let var_s = rmse(&sa, &sb, Some(&mask)).powi(2) / 2.0;
+    let (p, sh) = (common::average(&pa, &pb), common::average(&sa, &sb));
+    // Unbiased against each other: the means of two images differ by their noise alone,
+    // σ²/2 each.
+    let expected = (var_p / 2.0 + var_s / 2.0).sqrt();
+    let c = compare(&p, &sh, Some(&mask));
+    let diff = rmse(&p, &sh, Some(&mask));
+    println!(
+        "{n} iterations × 4 directions: gather noise per image {:.4} per-pixel, {:.4} shared (relative; variance ratio \
+         shared/per-pixel {:.2}); per-pixel − shared {:.4} against {:.4} expected from the noise; mean ratio {:?}",
+        var_p.sqrt() / mean,
+        var_s.sqrt() / mean,
+        var_s / var_p,
+        diff / mean,
+        expected / mean,
+        c.mean_ratio
+    );
+    assert!(var_p > 0.0 && var_s > 0.0, "no gather noise: the two halves are the same image");
+    // An estimator off by a fraction f of the indirect light (≈ a third of the image here)
+    // adds f·⅓ to the relative difference: within 1.3× the noise, f is below a few percent.
+    assert!(diff < 1.3 * expected, "per-pixel and shared differ by {diff}, beyond the noise {expected}");
+    assert!(diff > 0.7 * expected, "per-pixel and shared differ by {diff}, less than their noise {expected}");
+    for r in c.mean_ratio {
+        assert!((r - 1.0).abs() < 0.01, "mean ratio per-pixel/shared {:?}", c.mean_ratio);
+    }
 }
 
 fn cornell_reference() -> (LinearImage, f64, Vec<bool>) {

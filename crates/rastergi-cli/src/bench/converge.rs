@@ -45,6 +45,11 @@ pub struct ConvergeArgs {
     /// curves may end up with different ones: pin it to compare other settings).
     #[arg(long, value_enum, default_value_t = crate::args::GatherArg::Auto)]
     gather: crate::args::GatherArg,
+    /// Whose directions the traced gather casts (see `render --gather-directions`; `trace`
+    /// only, the others share); several comma-separated values are measured side by side,
+    /// e.g. shared,per-pixel (each with every --photon-passes value).
+    #[arg(long, value_enum, value_delimiter = ',', default_values_t = [crate::args::GatherDirectionsArg::default_value()])]
+    gather_directions: Vec<crate::args::GatherDirectionsArg>,
     /// Also measure Mitsuba 3 (built-in cornell only; needs python3 with mitsuba).
     #[arg(long)]
     mitsuba: bool,
@@ -86,13 +91,28 @@ pub fn run(a: &ConvergeArgs) -> Result<()> {
         ..Default::default()
     };
     let mut curves: Vec<(String, Vec<Point>)> = Vec::new();
-    for &passes in &a.photon_passes {
-        let settings = RenderSettings { photon_passes: passes, pass_iterations: a.pass_iterations, ..base.clone() };
-        println!("photon passes {passes} (0: unlimited), a pass every {} iterations (0: fitted):", a.pass_iterations);
-        let (name, points) =
-            measure(|| Renderer::new(&gpu, &scene, settings), &reference, a.seconds, 0.0, &TARGETS, "iterations")?;
-        let passes = if passes == 0 { "unlimited".to_string() } else { passes.to_string() };
-        curves.push((format!("{name}, photon passes {passes}"), points));
+    for &directions in &a.gather_directions {
+        for &passes in &a.photon_passes {
+            let settings = RenderSettings {
+                photon_passes: passes,
+                pass_iterations: a.pass_iterations,
+                gather_directions: directions.directions(),
+                ..base.clone()
+            };
+            println!(
+                "photon passes {passes} (0: unlimited), a pass every {} iterations (0: fitted), {} directions:",
+                a.pass_iterations,
+                directions.name()
+            );
+            let (name, points) =
+                measure(|| Renderer::new(&gpu, &scene, settings), &reference, a.seconds, 0.0, &TARGETS, "iterations")?;
+            let passes = if passes == 0 { "unlimited".to_string() } else { passes.to_string() };
+            let mut name = format!("{name}, photon passes {passes}");
+            if a.gather_directions.len() > 1 {
+                name += &format!(", {} directions", directions.name());
+            }
+            curves.push((name, points));
+        }
     }
     let (name, points) = measure(|| PathTracer::new(&gpu, &scene, base), &reference, a.seconds, 0.0, &TARGETS, "spp")?;
     curves.push((name.to_string(), points));
@@ -103,6 +123,7 @@ pub fn run(a: &ConvergeArgs) -> Result<()> {
         print_targets(&name, &points, &TARGETS, 0.0, "spp");
         curves.push((name, points));
     }
+    print_equal_time(&curves);
     let mut csv = String::from("method,seconds,samples,relative_rmse\n");
     for (name, points) in &curves {
         for p in points {
@@ -200,6 +221,37 @@ fn curve(m: &mut dyn Progressive, reference: &Reference, max_seconds: f64, stop_
         next = (next as f64 * 1.25).ceil() as u32;
     }
     Ok(points)
+}
+
+/// The error of `points` at `seconds`, interpolated log-log between the measured points
+/// (`None` outside them).
+fn error_at(points: &[Point], seconds: f64) -> Option<f64> {
+    let pairs = points.windows(2).find(|w| w[0].seconds <= seconds && seconds <= w[1].seconds)?;
+    let (p, q) = (pairs[0], pairs[1]);
+    if p.seconds <= 0.0 || q.seconds <= p.seconds {
+        return Some(q.error);
+    }
+    let t = (seconds / p.seconds).ln() / (q.seconds / p.seconds).ln();
+    Some((p.error.ln() + t * (q.error / p.error).ln()).exp())
+}
+
+/// Every curve's error at the latest time all of them reached (rendering time, set-up
+/// excluded), and its error² against the first curve's: the ratio of their variances per
+/// unit of time where noise dominates.
+fn print_equal_time(curves: &[(String, Vec<Point>)]) {
+    let Some(t) = curves.iter().map(|(_, p)| p.last().map_or(0.0, |p| p.seconds)).reduce(f64::min) else {
+        return;
+    };
+    let errors: Vec<Option<f64>> = curves.iter().map(|(_, p)| error_at(p, t)).collect();
+    println!("error at equal time, {t:.1} s of rendering:");
+    for ((name, _), e) in curves.iter().zip(&errors) {
+        match (e, errors[0]) {
+            (Some(e), Some(e0)) => {
+                println!("  {name:<56} {:>6.2} % (error² {:.2}× the first's)", 100.0 * e, (e / e0).powi(2))
+            }
+            _ => println!("  {name:<56} not measured at {t:.1} s"),
+        }
+    }
 }
 
 fn first_below(points: &[Point], target: f64) -> Option<Point> {

@@ -1,17 +1,20 @@
 //! The final gather's estimator and what every implementation shares: the uniforms, the
 //! resources a pass binds, and the per-pixel estimator pipeline.
 //!
-//! For a visible point x (normal n_x facing the eye, albedo ρ_x) and a direction ω drawn
-//! uniformly on the sphere (pdf 1/4π), with h the nearest surface along ω (t > ε, x's own
-//! triangle excluded):
+//! For a visible point x (normal n_x facing the eye, albedo ρ_x) and a direction ω, with h the
+//! nearest surface along ω (t > ε, x's own triangle excluded) and
+//! L(h → x) = (ρ_h/π) · E(h), E(h) the photon map's irradiance on the side of h facing x (zero
+//! from the back of a one-sided h; emission is never added: the direct pass owns it):
 //!
 //! ```text
-//!   L_ind(x) ≈ (ρ_x/π) · L(h → x) · max(0, n_x·ω) · 4π,   L(h → x) = (ρ_h/π) · E(h)
+//!   shared ω, uniform on the sphere (pdf 1/4π):     L_ind(x) ≈ (ρ_x/π) · L(h → x) · max(0, n_x·ω) · 4π
+//!   per-pixel ω, cosine about n_x (pdf cos θ_x/π):  L_ind(x) ≈ ρ_x · L(h → x)
 //! ```
 //!
-//! with E(h) the photon map's irradiance on the side of h facing x (zero from the back of a
-//! one-sided h; emission is never added: the direct pass owns it). `estimator.wgsl` holds
-//! `gather_estimate`; each of an iteration's K directions adds its estimate weighted 1/K.
+//! Both are unbiased for ∫ (ρ_x/π) L(h → x) cos θ_x dω over the hemisphere. `estimator.wgsl`
+//! holds `gather_estimate` (shared: every implementation) and `gather_estimate_cosine`
+//! (per-pixel: the traced gather only); each of an iteration's K directions adds its estimate
+//! weighted 1/K.
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3};
@@ -43,8 +46,13 @@ pub struct GatherUniforms {
     pub bundle: u32,
     /// Directions this iteration: each estimate is weighted 1/count.
     pub count: u32,
-    pub _pad: [u32; 3],
-    /// Trace: all the iteration's directions (xyz).
+    /// Trace: 1 where each pixel draws its own directions ([`PixelSamples`]), else 0.
+    pub per_pixel: u32,
+    /// Trace, per-pixel: [`PixelSamples::key`].
+    pub pixel_key: u32,
+    /// Trace, per-pixel: [`PixelSamples::first_index`].
+    pub first_index: u32,
+    /// Trace, shared directions: all the iteration's directions (xyz).
     pub directions: [[f32; 4]; MAX_DIRECTIONS as usize],
 }
 
@@ -53,6 +61,18 @@ pub struct GatherUniforms {
 pub struct GatherSample {
     pub direction: Vec3,
     pub texel_jitter: Vec2,
+}
+
+/// Per-pixel directions of an iteration (the traced gather): pixel (x, y) takes the
+/// Owen-scrambled Sobol' points `first_index` … `first_index + K − 1` with scramble seed
+/// [`crate::sampling::pixel_seed`]`(key, x, y)`, each mapped to a cosine-distributed direction
+/// about its normal.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PixelSamples {
+    /// Keys the pixels' scramble seeds: one per seed and restart.
+    pub key: u32,
+    /// Sample index of the iteration's first direction: iteration · K.
+    pub first_index: u32,
 }
 
 /// The composed shader of an estimator pass: the scene prelude, the visible point, the film
@@ -107,6 +127,8 @@ pub struct GatherInputs<'a> {
     pub height: u32,
     /// The iteration's directions, 1 to [`MAX_DIRECTIONS`].
     pub samples: &'a [GatherSample],
+    /// Where each pixel draws its own directions instead (then only `samples.len()` counts).
+    pub pixel_samples: Option<PixelSamples>,
     pub uniforms: &'a wgpu::Buffer,
     pub bundle: u32,
 }
@@ -120,7 +142,7 @@ impl<'a> GatherInputs<'a> {
     /// Writes the uniforms with sample `current` as the ray view. The write lands before the
     /// next submission: work already in an encoder sees it too.
     pub fn write_uniforms(&self, gpu: &Gpu, current: usize) {
-        let u = GatherUniforms::new(&self.scene.bounds, self.samples, current, self.bundle);
+        let u = GatherUniforms::new(&self.scene.bounds, self.samples, current, self.bundle, self.pixel_samples);
         gpu.queue.write_buffer(self.uniforms, 0, bytemuck::bytes_of(&u));
     }
 

@@ -1,11 +1,21 @@
-//! Final gather: per iteration a few directions ω, each shared by all visible points at once
-//! (Hachisuka, GPU Gems 2, ch. 38), the nearest surface along each found by one of several
-//! implementations of the same estimator ([`estimator`]).
+//! Final gather: per iteration a few directions ω per visible point, the nearest surface along
+//! each found by one of several implementations of the same estimator ([`estimator`]).
 //!
-//! * Directions ([`DirectionSampler`]): ω_i = R · S(i), S a low-discrepancy (Halton 5, 7)
-//!   sequence mapped uniformly to the sphere (pdf 1/4π) and R a random rotation drawn per
-//!   restart. Iteration i with K directions takes S(i·K) … S(i·K + K − 1): consecutive points
-//!   keep the sequence's stratification however many an iteration takes.
+//! * Shared directions ([`GatherDirections::Shared`], every implementation): each ω is shared
+//!   by all visible points at once (Hachisuka, GPU Gems 2, ch. 38). [`DirectionSampler`]:
+//!   ω_i = R · S(i), S a low-discrepancy (Halton 5, 7) sequence mapped uniformly to the sphere
+//!   (pdf 1/4π) and R a random rotation drawn per restart. Iteration i with K directions takes
+//!   S(i·K) … S(i·K + K − 1): consecutive points keep the sequence's stratification however
+//!   many an iteration takes. Estimate (ρ_x/π) · L(h → x) · max(0, n_x·ω) · 4π.
+//! * Per-pixel directions ([`GatherDirections::PerPixel`], the traced gather only): pixel
+//!   (x, y) takes the Owen-scrambled 2D Sobol' points u_j = P(j; s_xy) of
+//!   [`crate::sampling::sobol_owen_2d`], j = i·K … i·K + K − 1, with its own scramble seed
+//!   s_xy = [`crate::sampling::pixel_seed`]`(key, x, y)` (the key drawn per restart), each mapped
+//!   to a direction about the visible point's normal with pdf cos θ/π (Malley's method).
+//!   Every aligned block of 2^m indices is a (0, m, 2)-net, so an iteration's K = 4 directions
+//!   are stratified 2 × 2 and the iterations keep stratifying; neighbouring pixels are
+//!   uncorrelated, so the image has noise instead of the shared directions' streaks.
+//!   Estimate ρ_x · L(h → x): the cosine and 1/π cancel against the pdf.
 //! * Nearest surface h along ω from each visible point x (t > ε, x's own triangle excluded), a
 //!   [`Gather`] implementation: [`GatherMethod::Raster`] depth-peels an orthographic ray view
 //!   ([`ray_view`]) and projects each layer onto the visible points ([`raster`]);
@@ -13,7 +23,7 @@
 //!   each visible point walks ([`lists`]); [`GatherMethod::Trace`] casts the ray through the
 //!   BVH in a compute shader ([`trace`]). They differ only where a ray-view texel is crossed by
 //!   a silhouette (the raster gathers take the texel's surface).
-//! * Estimate ([`estimator`]): L_ind(x, ω) = (ρ_x/π) · L(h → x) · max(0, n_x·ω) · 4π.
+//! * Estimate ([`estimator`]): as above per mode, L(h → x) = (ρ_h/π) · E(h) from the photon map.
 //!
 //! Several directions per iteration share one G-buffer and direct pass (`--directions`): the
 //! indirect estimate, by far the noisier, gets more samples per unit of time.
@@ -33,14 +43,14 @@ use std::time::{Duration, Instant};
 
 use glam::{Quat, Vec2, Vec3};
 
-pub use estimator::{GatherInputs, GatherSample, GatherSetup, GatherUniforms};
+pub use estimator::{GatherInputs, GatherSample, GatherSetup, GatherUniforms, PixelSamples};
 
 use crate::error::Result;
 use crate::frame::FrameBinding;
 use crate::gpu::Gpu;
 use crate::gpu_scene::GpuScene;
 use crate::photons::gpu::GpuPhotonMap;
-use crate::sampling::{Rng, radical_inverse, stream, uniform_sphere};
+use crate::sampling::{Rng, pcg_hash, radical_inverse, stream, uniform_sphere};
 
 pub use crate::consts::MAX_DIRECTIONS;
 
@@ -56,6 +66,17 @@ pub enum GatherMethod {
     Lists,
     /// BVH ray casting in a compute shader.
     Trace,
+}
+
+/// Whose directions the traced gather casts.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum GatherDirections {
+    /// Each pixel its own K cosine-distributed directions from an Owen-scrambled Sobol'
+    /// sequence (the traced gather; the raster gathers and `Auto` always share).
+    PerPixel,
+    /// The iteration's K directions, uniform on the sphere, shared by every pixel.
+    #[default]
+    Shared,
 }
 
 /// One way of finding the nearest surface along an iteration's gather directions and adding
@@ -113,6 +134,11 @@ pub fn random_rotation(seed: u32, restart: u32) -> Quat {
     Quat::from_xyzw(a * (tau * u2).sin(), a * (tau * u2).cos(), b * (tau * u3).sin(), b * (tau * u3).cos()).normalize()
 }
 
+/// The key of the per-pixel scramble seeds for the stream (seed, restart).
+pub fn pixel_key(seed: u32, restart: u32) -> u32 {
+    pcg_hash(restart ^ pcg_hash(seed ^ stream::GATHER_PIXEL))
+}
+
 /// Values that replace the sampler's for one iteration (tests compare the gathers with other
 /// estimators for the same samples).
 #[derive(Clone, Copy, Debug, Default)]
@@ -136,6 +162,11 @@ pub struct DirectionSampler {
 impl DirectionSampler {
     pub fn new(seed: u32) -> DirectionSampler {
         DirectionSampler { seed, restart: 0, rotation: random_rotation(seed, 0) }
+    }
+
+    /// The key of the per-pixel scramble seeds of this restart ([`PixelSamples::key`]).
+    pub fn pixel_key(&self) -> u32 {
+        pixel_key(self.seed, self.restart)
     }
 
     /// A new image: a new rotation of the sequence.
@@ -175,6 +206,9 @@ pub struct GatherPass {
     pub bundle: u32,
     uniforms: wgpu::Buffer,
     sampler: DirectionSampler,
+    /// Per-pixel directions: the traced gather asked for by name with
+    /// [`GatherDirections::PerPixel`].
+    per_pixel: bool,
     /// One implementation once chosen; `Auto`'s remaining candidates while it tries them.
     candidates: Vec<Candidate>,
     chosen: bool,
@@ -192,12 +226,14 @@ pub struct GatherFrame<'a> {
 
 impl GatherPass {
     /// The pass over `setup`'s resources with `method`, for a `bundle`² ray view, drawing
-    /// directions from `sampler`.
+    /// directions from `sampler`; `directions` applies to [`GatherMethod::Trace`] (the others,
+    /// `Auto` included, share them).
     pub fn new(
         gpu: &Gpu,
         setup: &GatherSetup,
         bundle: u32,
         method: GatherMethod,
+        directions: GatherDirections,
         sampler: DirectionSampler,
     ) -> Result<GatherPass> {
         let uniforms = gpu.zeroed_buffer(
@@ -214,12 +250,18 @@ impl GatherPass {
                 Err(e) => return Err(e),
             }
         }
-        Ok(GatherPass { bundle, uniforms, sampler, candidates, chosen: method != GatherMethod::Auto })
+        let per_pixel = method == GatherMethod::Trace && directions == GatherDirections::PerPixel;
+        Ok(GatherPass { bundle, uniforms, sampler, per_pixel, candidates, chosen: method != GatherMethod::Auto })
     }
 
     /// The implementation in use (`Auto` while the trials run).
     pub fn method(&self) -> GatherMethod {
         if self.chosen { self.candidates[0].method } else { GatherMethod::Auto }
+    }
+
+    /// Whose directions are cast: per pixel, or shared by all.
+    pub fn directions(&self) -> GatherDirections {
+        if self.per_pixel { GatherDirections::PerPixel } else { GatherDirections::Shared }
     }
 
     /// The direction sampler (kept when the pass is rebuilt for a new image size).
@@ -233,8 +275,9 @@ impl GatherPass {
     }
 
     /// Encodes the gather of `iteration` along `directions` directions (1 to
-    /// [`MAX_DIRECTIONS`]; one where `fixed` gives it) after the work already in `enc`; the
-    /// encoder to go on with is left in `enc`.
+    /// [`MAX_DIRECTIONS`]; one where `fixed` gives it, and then shared by every pixel even in
+    /// per-pixel mode) after the work already in `enc`; the encoder to go on with is left in
+    /// `enc`.
     pub fn encode(
         &mut self,
         gpu: &Gpu,
@@ -245,6 +288,10 @@ impl GatherPass {
         fixed: &FixedSample,
     ) -> Result<()> {
         let samples = self.sampler.samples(iteration, directions, fixed);
+        let pixel_samples = (self.per_pixel && fixed.direction.is_none()).then(|| PixelSamples {
+            key: self.sampler.pixel_key(),
+            first_index: iteration.wrapping_mul(samples.len() as u32),
+        });
         // A handle (reference counted): the trials below change `self`.
         let uniforms = self.uniforms.clone();
         let inputs = GatherInputs {
@@ -254,6 +301,7 @@ impl GatherPass {
             width: f.width,
             height: f.height,
             samples: &samples,
+            pixel_samples,
             uniforms: &uniforms,
             bundle: self.bundle,
         };

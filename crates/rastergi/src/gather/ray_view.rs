@@ -15,7 +15,7 @@
 use glam::{Mat4, Vec2, Vec3};
 
 use super::MAX_DIRECTIONS;
-use super::estimator::{GatherSample, GatherUniforms};
+use super::estimator::{GatherSample, GatherUniforms, PixelSamples};
 use crate::gpu::scene_raster_pipeline;
 use crate::sampling::orthonormal_basis;
 use crate::scene::Aabb;
@@ -76,8 +76,14 @@ pub fn ray_view_pipeline(
 /// The uniforms are built here, where the ray view is: the raster gathers read its matrix.
 impl GatherUniforms {
     /// The uniforms for `samples` with sample `current` as the raster gathers' ray view of a
-    /// `bundle`² view over `bounds`.
-    pub fn new(bounds: &Aabb, samples: &[GatherSample], current: usize, bundle: u32) -> GatherUniforms {
+    /// `bundle`² view over `bounds`; with `pixel`, the traced gather's per-pixel directions.
+    pub fn new(
+        bounds: &Aabb,
+        samples: &[GatherSample],
+        current: usize,
+        bundle: u32,
+        pixel: Option<PixelSamples>,
+    ) -> GatherUniforms {
         let s = samples[current];
         let mut directions = [[0.0; 4]; MAX_DIRECTIONS as usize];
         for (d, s) in directions.iter_mut().zip(samples) {
@@ -88,7 +94,9 @@ impl GatherUniforms {
             direction: s.direction.into(),
             bundle,
             count: samples.len() as u32,
-            _pad: [0; 3],
+            per_pixel: pixel.is_some() as u32,
+            pixel_key: pixel.map_or(0, |p| p.key),
+            first_index: pixel.map_or(0, |p| p.first_index),
             directions,
         }
     }

@@ -1,6 +1,9 @@
 // Final gather by ray casting (gather/trace.rs): the nearest surface along each of the
-// iteration's directions from each visible point, by BVH traversal; the estimate is
-// gather_estimate (estimator.wgsl), averaged over the directions.
+// iteration's directions from each visible point, by BVH traversal, averaged over the
+// directions. Shared directions (gather.per_pixel == 0): the uniforms' ω_k, estimate
+// gather_estimate. Per-pixel directions: ω_k cosine-distributed about n_x from the
+// Owen-scrambled Sobol' point of index first_index + k with this pixel's scramble seed,
+// estimate gather_estimate_cosine (estimator.wgsl).
 
 @group(2) @binding(0) var<uniform> gather: Gather;
 @group(2) @binding(1) var gbuffer: texture_2d<u32>;
@@ -12,9 +15,15 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         return;
     }
     let p = visible_point(textureLoad(gbuffer, gid.xy, 0));
+    let per_pixel = gather.per_pixel != 0u;
+    let seed = pixel_seed(gather.pixel_key, gid.x, gid.y);
     var sum = vec3f(0.0);
     for (var k = 0u; k < gather.count && p.ok; k++) {
-        let w = gather.directions[k].xyz;
+        var w = gather.directions[k].xyz;
+        if per_pixel {
+            let u = sobol_owen_2d(gather.first_index + k, seed);
+            w = cosine_hemisphere(p.n, unit_f32(u.x), unit_f32(u.y));
+        }
         let cos_x = dot(p.n, w);
         if cos_x <= 0.0 {
             continue;
@@ -22,7 +31,13 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         // Nearest hit at t > ε, x's own triangle excluded (the raster gather's plane test).
         let h = trace(p.x.pos, w, frame.ray_epsilon, 3.0e38, p.x.tri, NO_TRIANGLE, false);
         if h.tri != NO_TRIANGLE {
-            sum += gather_estimate(p, cos_x, w, h.tri, p.x.pos + w * h.t, vec2f(h.b1, h.b2));
+            let hit = p.x.pos + w * h.t;
+            let b = vec2f(h.b1, h.b2);
+            if per_pixel {
+                sum += gather_estimate_cosine(p, w, h.tri, hit, b);
+            } else {
+                sum += gather_estimate(p, cos_x, w, h.tri, hit, b);
+            }
         }
     }
     film_add(FILM_INDIRECT, gid.xy, sum / f32(gather.count));

@@ -8,6 +8,11 @@ struct Gather {
     bundle: u32,
     // Directions this iteration; each estimate is weighted 1/count.
     count: u32,
-    // Trace: all of them (xyz).
+    // Trace: 1 where each pixel draws its own directions (then `directions` is unused), the
+    // key of the pixels' scramble seeds and the sample index of the iteration's first.
+    per_pixel: u32,
+    pixel_key: u32,
+    first_index: u32,
+    // Trace, shared directions: all of them (xyz).
     directions: array<vec4f, MAX_DIRECTIONS>,
 }

@@ -231,11 +231,15 @@ if [ "$ref_ok" = 1 ]; then
         # converged image.
         awk -F, -v n="${noise:-}" '
             NR > 1 {
-                e = 100 * $4
-                s = sprintf("- %s: %.2f %% after %.2f s of rendering (%d samples per pixel)", $1, e, $2, $3)
+                # The method is quoted and may hold commas: the figures are the last three fields.
+                name = $0
+                sub(/,[^,]*,[^,]*,[^,]*$/, "", name)
+                gsub(/"/, "", name)
+                e = 100 * $NF
+                s = sprintf("- %s: %.2f %% after %.2f s of rendering (%d samples per pixel)", name, e, $(NF - 2), $(NF - 1))
                 if (n != "") s = s sprintf("; %.2f %% once the reference noise is taken out", sqrt(e * e > n * n ? e * e - n * n : 0))
-                last[$1] = s
-                if (!($1 in seen)) { seen[$1] = 1; order[++k] = $1 }
+                last[name] = s
+                if (!(name in seen)) { seen[name] = 1; order[++k] = name }
             }
             END { for (i = 1; i <= k; i++) print last[order[i]] }' "$stem-converge.csv" >>"$out"
         report "" "![relative RMSE against time]($(basename "$stem")-converge.png)" ""

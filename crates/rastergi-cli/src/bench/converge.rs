@@ -127,7 +127,8 @@ pub fn run(a: &ConvergeArgs) -> Result<()> {
     let mut csv = String::from("method,seconds,samples,relative_rmse\n");
     for (name, points) in &curves {
         for p in points {
-            csv += &format!("{name},{:.4},{},{:.6}\n", p.seconds, p.samples, p.error);
+            // Quoted: the names hold commas.
+            csv += &format!("\"{name}\",{:.4},{},{:.6}\n", p.seconds, p.samples, p.error);
         }
     }
     write_file(&a.csv, csv.as_bytes())?;

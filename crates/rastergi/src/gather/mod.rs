@@ -72,10 +72,12 @@ pub enum GatherMethod {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum GatherDirections {
     /// Each pixel its own K cosine-distributed directions from an Owen-scrambled Sobol'
-    /// sequence (the traced gather; the raster gathers and `Auto` always share).
+    /// sequence (the traced gather; the raster gathers and `Auto` always share). The default:
+    /// on the Cornell box at 128² (lavapipe) it reaches 5 % in 0.87–0.97 of shared's time and
+    /// has 0.77–0.86 of its error² at equal time (README, performance).
+    #[default]
     PerPixel,
     /// The iteration's K directions, uniform on the sphere, shared by every pixel.
-    #[default]
     Shared,
 }
 

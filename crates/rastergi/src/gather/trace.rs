@@ -1,9 +1,17 @@
 //! Final gather by ray casting: the nearest surface along ω from every visible point, found by
-//! traversing the BVH in a compute shader (`trace.wgsl`); the estimate is the raster
-//! gathers' ([`super::estimator`]). One dispatch per direction, no ray-view textures and no
-//! read-back, so directions queue up without synchronisation. It is exact where the raster
-//! gather quantises to ray-view texels, and costs O(log n) per pixel where rasterising costs
-//! O(n) per layer; rasterization wins where fragment work is cheap and the scene shallow.
+//! traversing the BVH in a compute shader (`trace.wgsl`). One dispatch per iteration, no
+//! ray-view textures and no read-back, so iterations queue up without synchronisation.
+//!
+//! * Shared directions: the uniforms' ω_k (pdf 1/4π), the raster gathers' estimate
+//!   (ρ_x/π)·L(h→x)·max(0, n·ω)·4π ([`super::estimator`]).
+//! * Per-pixel directions ([`super::GatherDirections::PerPixel`]): pixel (x, y) takes the
+//!   Owen-scrambled Sobol' points u_j = [`crate::sampling::sobol_owen_2d`]`(j, s_xy)`,
+//!   j = first_index + k, s_xy = [`crate::sampling::pixel_seed`]`(key, x, y)`, and casts
+//!   ω = [`crate::sampling::cosine_hemisphere`]`(n_x, u_j)` (pdf cos θ/π): estimate ρ_x·L(h→x).
+//!
+//! It is exact where the raster gather quantises to ray-view texels, and costs O(log n) per
+//! pixel where rasterising costs O(n) per layer; rasterization wins where fragment work is
+//! cheap and the scene shallow.
 
 use super::Gather;
 use super::estimator::{GatherInputs, GatherSetup, GatherUniforms};

@@ -224,6 +224,25 @@ fn unknown_gather_method_is_a_usage_error() {
 }
 
 #[test]
+fn gather_directions_choose_per_pixel_or_shared_and_reject_others() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = ["render", "cornell", "--width", "32", "--height", "32", "--iterations", "2", "--photons", "4096"];
+    let mut images = Vec::new();
+    for directions in ["per-pixel", "shared"] {
+        let out = format!("{directions}.exr");
+        let extra = ["--grid", "8", "--gather", "trace", "--gather-directions", directions, "--out", &out];
+        let run = rastergi(dir.path(), &[&args[..], &extra[..]].concat());
+        assert!(run.status.success(), "{}", run.stderr);
+        images.push(rastergi::image_io::read_exr(&dir.path().join(&out)).unwrap());
+    }
+    // The same seed and photon map: only the gather's directions differ.
+    assert_ne!(images[0].pixels, images[1].pixels, "per-pixel and shared directions gave the same image");
+    let run = rastergi(dir.path(), &["render", "cornell", "--gather-directions", "random", "--out", "x.png"]);
+    assert!(!run.status.success());
+    assert!(run.stderr.contains("random") && run.stderr.contains("per-pixel"), "{}", run.stderr);
+}
+
+#[test]
 fn bench_memory_reports_the_allocations_and_their_total() {
     let dir = tempfile::tempdir().unwrap();
     let run = rastergi(

@@ -85,7 +85,7 @@ pub enum GatherDirectionsArg {
     /// Each pixel its own cosine-distributed directions (Owen-scrambled Sobol'): noise
     /// instead of streaks.
     PerPixel,
-    /// Each direction shared by every pixel (uniform on the sphere, Halton 5, 7).
+    /// Each direction shared by every pixel (uniform on the sphere, scrambled Sobol').
     Shared,
 }
 

@@ -37,9 +37,9 @@ pub mod stream {
     pub const PATH: u32 = 0x9a7b1d;
     /// Photons, keyed (photon index, pass): the GPU tracer and its CPU twin share it.
     pub const PHOTON: u32 = 0x9e3779b9;
-    /// The rotation of the gather directions, keyed (restart, 0).
-    pub const GATHER_ROTATION: u32 = 0x5bd1e995;
-    /// The key of the per-pixel gather directions' scramble seeds, keyed (restart, 0).
+    /// The scramble of the shared gather directions, keyed (restart).
+    pub const GATHER_SHARED: u32 = 0x5bd1e995;
+    /// The key of the per-pixel gather directions' scramble seeds, keyed (restart).
     pub const GATHER_PIXEL: u32 = 0x3c6ef372;
     /// The ray view's sub-texel offset, keyed (direction index, restart).
     pub const TEXEL_JITTER: u32 = 0x7e1a5;

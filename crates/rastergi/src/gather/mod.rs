@@ -3,10 +3,12 @@
 //!
 //! * Shared directions ([`GatherDirections::Shared`], every implementation): each ω is shared
 //!   by all visible points at once (Hachisuka, GPU Gems 2, ch. 38). [`DirectionSampler`]:
-//!   ω_i = R · S(i), S a low-discrepancy (Halton 5, 7) sequence mapped uniformly to the sphere
-//!   (pdf 1/4π) and R a random rotation drawn per restart. Iteration i with K directions takes
-//!   S(i·K) … S(i·K + K − 1): consecutive points keep the sequence's stratification however
-//!   many an iteration takes. Estimate (ρ_x/π) · L(h → x) · max(0, n_x·ω) · 4π.
+//!   ω_j = S(P(j; s)), P the Owen-scrambled 2D Sobol' sequence of
+//!   [`crate::sampling::sobol_owen_2d`] with a scramble seed s drawn per restart and S the
+//!   uniform map to the sphere (pdf 1/4π). Iteration i with K directions takes j = i·K …
+//!   i·K + K − 1: an aligned block, a (0, 2, 2)-net for K = 4 (the Halton (5, 7) points used
+//!   before nearly lie on a line in such a batch), and consecutive blocks keep stratifying.
+//!   Estimate (ρ_x/π) · L(h → x) · max(0, n_x·ω) · 4π.
 //! * Per-pixel directions ([`GatherDirections::PerPixel`], the traced gather only): pixel
 //!   (x, y) takes the Owen-scrambled 2D Sobol' points u_j = P(j; s_xy) of
 //!   [`crate::sampling::sobol_owen_2d`], j = i·K … i·K + K − 1, with its own scramble seed
@@ -41,7 +43,7 @@ pub mod trace;
 
 use std::time::{Duration, Instant};
 
-use glam::{Quat, Vec2, Vec3};
+use glam::{Vec2, Vec3};
 
 pub use estimator::{GatherInputs, GatherSample, GatherSetup, GatherUniforms, PixelSamples};
 
@@ -50,7 +52,7 @@ use crate::frame::FrameBinding;
 use crate::gpu::Gpu;
 use crate::gpu_scene::GpuScene;
 use crate::photons::gpu::GpuPhotonMap;
-use crate::sampling::{Rng, pcg_hash, radical_inverse, stream, uniform_sphere};
+use crate::sampling::{Rng, pcg_hash, sobol_owen_2d, stream, uniform_sphere, unit_f32};
 
 pub use crate::consts::MAX_DIRECTIONS;
 
@@ -122,18 +124,16 @@ fn build(
     })
 }
 
-/// The gather direction of index `i` for a restart whose rotation is `rotation`.
-pub fn gather_direction(i: u32, rotation: Quat) -> Vec3 {
-    rotation * uniform_sphere(radical_inverse(i + 1, 5), radical_inverse(i + 1, 7))
+/// The shared gather direction of index `i` for a restart whose scramble seed is `scramble`
+/// ([`shared_scramble`]): the Owen-scrambled Sobol' point mapped uniformly to the sphere.
+pub fn gather_direction(i: u32, scramble: u32) -> Vec3 {
+    let [u1, u2] = sobol_owen_2d(i, scramble);
+    uniform_sphere(unit_f32(u1), unit_f32(u2))
 }
 
-/// A uniformly random rotation (Shoemake's method) from the stream (seed, restart).
-pub fn random_rotation(seed: u32, restart: u32) -> Quat {
-    let mut rng = Rng::new(seed ^ stream::GATHER_ROTATION, restart, 0);
-    let (u1, u2, u3) = (rng.next_f32(), rng.next_f32(), rng.next_f32());
-    let tau = std::f32::consts::TAU;
-    let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());
-    Quat::from_xyzw(a * (tau * u2).sin(), a * (tau * u2).cos(), b * (tau * u3).sin(), b * (tau * u3).cos()).normalize()
+/// The scramble seed of the shared directions for the stream (seed, restart).
+pub fn shared_scramble(seed: u32, restart: u32) -> u32 {
+    pcg_hash(restart ^ pcg_hash(seed ^ stream::GATHER_SHARED))
 }
 
 /// The key of the per-pixel scramble seeds for the stream (seed, restart).
@@ -151,19 +151,19 @@ pub struct FixedSample {
     pub texel_jitter: Option<Vec2>,
 }
 
-/// The gather's random choices: the rotation R of the direction sequence, drawn anew at every
-/// restart, and the ray view's sub-texel offsets, from the streams keyed by the seed.
+/// The gather's random choices: the scramble of the shared directions and the key of the
+/// per-pixel ones, drawn anew at every restart, and the ray view's sub-texel offsets, from the
+/// streams keyed by the seed.
 #[derive(Clone, Copy, Debug)]
 pub struct DirectionSampler {
     seed: u32,
     /// Restarts so far (camera moves, resizes).
     restart: u32,
-    rotation: Quat,
 }
 
 impl DirectionSampler {
     pub fn new(seed: u32) -> DirectionSampler {
-        DirectionSampler { seed, restart: 0, rotation: random_rotation(seed, 0) }
+        DirectionSampler { seed, restart: 0 }
     }
 
     /// The key of the per-pixel scramble seeds of this restart ([`PixelSamples::key`]).
@@ -171,10 +171,9 @@ impl DirectionSampler {
         pixel_key(self.seed, self.restart)
     }
 
-    /// A new image: a new rotation of the sequence.
+    /// A new image: new scrambles of the sequences.
     pub fn restart(&mut self) {
         self.restart += 1;
-        self.rotation = random_rotation(self.seed, self.restart);
     }
 
     /// The `count` directions of `iteration` (one where `fixed` gives the direction), each
@@ -184,7 +183,9 @@ impl DirectionSampler {
         (0..k)
             .map(|j| {
                 let index = iteration * k + j;
-                let direction = fixed.direction.unwrap_or_else(|| gather_direction(index, self.rotation));
+                let direction = fixed
+                    .direction
+                    .unwrap_or_else(|| gather_direction(index, shared_scramble(self.seed, self.restart)));
                 let texel_jitter = fixed.texel_jitter.unwrap_or_else(|| {
                     let mut rng = Rng::new(self.seed ^ stream::TEXEL_JITTER, index, self.restart);
                     Vec2::new(rng.next_f32(), rng.next_f32()) - 0.5

@@ -39,6 +39,9 @@ pub mod stream {
     pub const PHOTON: u32 = 0x9e3779b9;
     /// The rotation of the gather directions, keyed (restart, 0).
     pub const GATHER_ROTATION: u32 = 0x5bd1e995;
+    /// The light sample at a gather hit (`HitLight::Exact`), keyed (pixel, iteration ⊕ a hash
+    /// of the direction).
+    pub const HIT_LIGHT: u32 = 0x3c6ef372;
     /// The ray view's sub-texel offset, keyed (direction index, restart).
     pub const TEXEL_JITTER: u32 = 0x7e1a5;
     /// The Cranley–Patterson shift of the pixel jitter, x and y (hashed, not a stream).

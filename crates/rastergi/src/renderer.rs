@@ -7,7 +7,7 @@ use crate::direct::DirectPass;
 use crate::error::Result;
 use crate::film::{Film, Show};
 use crate::frame::{FrameBinding, FrameUniforms, pixel_jitter};
-use crate::gather::{DirectionSampler, FixedSample, GatherFrame, GatherMethod, GatherPass, GatherSetup};
+use crate::gather::{DirectionSampler, FixedSample, GatherFrame, GatherMethod, GatherPass, GatherSetup, HitLight};
 use crate::gbuffer::GBufferPass;
 use crate::gpu::Gpu;
 use crate::gpu_scene::{GpuScene, PreparedScene};
@@ -47,6 +47,8 @@ pub struct RenderSettings {
     /// Gather directions per iteration, 1 to [`crate::gather::MAX_DIRECTIONS`]: they share the iteration's
     /// G-buffer and direct light.
     pub directions: u32,
+    /// The light at the gather's hits: all from the photon map, or the direct part exact.
+    pub hit_light: HitLight,
 }
 
 pub use crate::fit::default_bundle;
@@ -92,6 +94,7 @@ impl Default for RenderSettings {
             directions: DEFAULT_DIRECTIONS,
             photon_passes: 0,
             pass_iterations: DEFAULT_PASS_ITERATIONS,
+            hit_light: HitLight::Map,
         }
     }
 }
@@ -175,8 +178,12 @@ impl Renderer {
         prepared.textures.check_limits(gpu)?;
         let gpu_scene = GpuScene::new(gpu, &prepared)?;
         let frame = FrameBinding::new(gpu);
-        let photon_settings =
-            PhotonSettings { count: settings.photons, seed: settings.seed, grid_resolution: settings.grid_resolution };
+        let photon_settings = PhotonSettings {
+            count: settings.photons,
+            seed: settings.seed,
+            grid_resolution: settings.grid_resolution,
+            indirect_only: settings.hit_light == HitLight::Exact,
+        };
         let photons = (settings.photons > 0)
             .then(|| {
                 let pixels = settings.width as u64 * settings.height as u64;

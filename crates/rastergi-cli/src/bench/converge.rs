@@ -45,6 +45,10 @@ pub struct ConvergeArgs {
     /// curves may end up with different ones: pin it to compare other settings).
     #[arg(long, value_enum, default_value_t = crate::args::GatherArg::Auto)]
     gather: crate::args::GatherArg,
+    /// Where the light at gather hits comes from (see `render --hit-light`); several
+    /// comma-separated values are measured side by side, e.g. map,exact.
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "map")]
+    hit_light: Vec<crate::args::HitLightArg>,
     /// Also measure Mitsuba 3 (built-in cornell only; needs python3 with mitsuba).
     #[arg(long)]
     mitsuba: bool,
@@ -87,12 +91,23 @@ pub fn run(a: &ConvergeArgs) -> Result<()> {
     };
     let mut curves: Vec<(String, Vec<Point>)> = Vec::new();
     for &passes in &a.photon_passes {
-        let settings = RenderSettings { photon_passes: passes, pass_iterations: a.pass_iterations, ..base.clone() };
-        println!("photon passes {passes} (0: unlimited), a pass every {} iterations (0: fitted):", a.pass_iterations);
-        let (name, points) =
-            measure(|| Renderer::new(&gpu, &scene, settings), &reference, a.seconds, 0.0, &TARGETS, "iterations")?;
-        let passes = if passes == 0 { "unlimited".to_string() } else { passes.to_string() };
-        curves.push((format!("{name}, photon passes {passes}"), points));
+        for &hit_light in &a.hit_light {
+            let settings = RenderSettings {
+                photon_passes: passes,
+                pass_iterations: a.pass_iterations,
+                hit_light: hit_light.hit_light(),
+                ..base.clone()
+            };
+            println!(
+                "photon passes {passes} (0: unlimited), a pass every {} iterations (0: fitted), hit light {hit_light:?}:",
+                a.pass_iterations
+            );
+            let (name, points) =
+                measure(|| Renderer::new(&gpu, &scene, settings), &reference, a.seconds, 0.0, &TARGETS, "iterations")?;
+            let passes = if passes == 0 { "unlimited".to_string() } else { passes.to_string() };
+            let light = format!("{hit_light:?}").to_lowercase();
+            curves.push((format!("{name}, photon passes {passes}, hit light {light}"), points));
+        }
     }
     let (name, points) = measure(|| PathTracer::new(&gpu, &scene, base), &reference, a.seconds, 0.0, &TARGETS, "spp")?;
     curves.push((name.to_string(), points));

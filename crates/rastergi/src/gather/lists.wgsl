@@ -43,5 +43,5 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     }
     let hit = p.x.pos + w * best;
     let b = plane_barycentrics(triangles[best_tri], hit);
-    film_add(FILM_INDIRECT, gid.xy, gather_estimate(p, cos_x, w, best_tri, hit, b) / f32(gather.count));
+    film_add(FILM_INDIRECT, gid.xy, gather_estimate(p, cos_x, w, best_tri, hit, b, gid.y * frame.resolution.x + gid.x) / f32(gather.count));
 }

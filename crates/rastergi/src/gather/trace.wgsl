@@ -22,7 +22,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         // Nearest hit at t > ε, x's own triangle excluded (the raster gather's plane test).
         let h = trace(p.x.pos, w, frame.ray_epsilon, 3.0e38, p.x.tri, NO_TRIANGLE, false);
         if h.tri != NO_TRIANGLE {
-            sum += gather_estimate(p, cos_x, w, h.tri, p.x.pos + w * h.t, vec2f(h.b1, h.b2));
+            sum += gather_estimate(p, cos_x, w, h.tri, p.x.pos + w * h.t, vec2f(h.b1, h.b2), gid.y * frame.resolution.x + gid.x);
         }
     }
     film_add(FILM_INDIRECT, gid.xy, sum / f32(gather.count));

@@ -168,8 +168,10 @@ fn converged_cornell_box(hit_light: HitLight) {
     assert!(c.relative_rmse < 0.05, "relative RMSE {}", c.relative_rmse);
     assert!(c.block_mean_error < 0.015, "block-mean error {}", c.block_mean_error);
     assert!(bias < 0.03, "bias {bias}");
+    // The bound for the channel means (they were 0.993–0.995 with the dense grid;
+    // measured 0.9993–0.9996 with both kinds of hit light).
     for r in c.mean_ratio {
-        assert!((r - 1.0).abs() < 0.01, "mean ratio {:?}", c.mean_ratio);
+        assert!((r - 1.0).abs() < 0.003, "mean ratio {:?}", c.mean_ratio);
     }
     // The light's own pixels: its radiance plus what its white underside reflects of the
     // box's indirect light (Mitsuba: ≈ 1.3 % more). The map once gave the underside the cell

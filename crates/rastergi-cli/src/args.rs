@@ -11,7 +11,7 @@ use clap::{Args, ValueEnum};
 use glam::Vec3;
 use rastergi::film::Show;
 use rastergi::fit;
-use rastergi::gather::{GatherDirections, GatherMethod};
+use rastergi::gather::{GatherDirections, GatherMethod, HitLight};
 use rastergi::gpu::{Backends, Gpu, GpuOptions, parse_backend};
 use rastergi::renderer::RenderSettings;
 use rastergi::scene::generate::BUILTIN_NAMES;
@@ -66,6 +66,25 @@ pub enum GatherArg {
     Lists,
     /// BVH ray casting in a compute shader.
     Trace,
+}
+
+/// Where the light at a gather ray's hit comes from.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
+pub enum HitLightArg {
+    /// All from the photon map.
+    Map,
+    /// The direct part from one light sample with a shadow ray, the rest from a photon map
+    /// of indirect light only.
+    Exact,
+}
+
+impl HitLightArg {
+    pub fn hit_light(self) -> HitLight {
+        match self {
+            HitLightArg::Map => HitLight::Map,
+            HitLightArg::Exact => HitLight::Exact,
+        }
+    }
 }
 
 impl GatherArg {
@@ -181,6 +200,10 @@ pub struct SceneArgs {
     /// light, so the noisier indirect light gets more samples per second.
     #[arg(long, default_value_t = rastergi::renderer::DEFAULT_DIRECTIONS, value_parser = clap::value_parser!(u32).range(1..=16))]
     pub directions: u32,
+    /// Where the light at a gather ray's hit comes from: the photon map (`map`), or direct
+    /// light by a shadow ray plus a map of indirect light only (`exact`).
+    #[arg(long, value_enum, default_value_t = HitLightArg::Map)]
+    pub hit_light: HitLightArg,
     /// What the image shows.
     #[arg(long, value_enum, default_value_t = ShowArg::Full)]
     pub show: ShowArg,
@@ -230,6 +253,7 @@ impl SceneArgs {
             directions: self.directions,
             photon_passes: self.photon_passes,
             pass_iterations: self.pass_iterations,
+            hit_light: self.hit_light.hit_light(),
         }
     }
 }

@@ -15,11 +15,13 @@
 //!   view's width), and never less than twice the image's larger side
 //!   ([`default_bundle`]); 128 to 2048. A ray-view texel samples one
 //!   surface: a gather ray from a point on a curved, tessellated surface (a column, a vault)
-//!   can meet the plane of a neighbouring facet that covers the same texel and read its back,
-//!   which darkens such surfaces by about 10 % × texel / facet (measured on `atrium`: −5.4 %,
-//!   −3.2 %, −1.6 %, −0.9 % at 192, 384, 768, 1536 texels for its 10 cm facets). Eight
-//!   texels per edge keep that near 1 %. Flat scenes such as the Cornell box get the
-//!   image-size rule unchanged.
+//!   can meet the plane of a neighbouring facet that covers the same texel. The raster
+//!   gathers trace such rays where they cross the plane off the facet; before they did, it
+//!   darkened such surfaces by about 10 % × texel / facet (measured on `atrium`: −5.4 %,
+//!   −3.2 %, −1.6 %, −0.9 % at 192, 384, 768, 1536 texels for its 10 cm facets), and eight
+//!   texels per edge kept that near 1 %. Fewer such rays need tracing at that resolution, and
+//!   silhouettes are sampled finer. Flat scenes such as the Cornell box get the image-size
+//!   rule unchanged.
 //! - **Exposure** (PNG): 0 unless the image's median luminance (over pixels that see
 //!   anything) is more than two stops away from middle grey 0.18; then the whole number of
 //!   stops that brings it to 0.18. A guard rail for scenes whose emitters are far too

@@ -69,10 +69,15 @@ fn twins() -> Vec<Twin> {
                 max_probe,
                 pass_index,
                 sep_mask,
-                sep_max_probe
+                sep_max_probe,
+                first_deposit
             ]
         ),
-        twin!(PhotonGridUniforms, "PhotonGrid", [origin, cell, dims, mask, max_probe, sep_mask, sep_max_probe]),
+        twin!(
+            PhotonGridUniforms,
+            "PhotonGrid",
+            [origin, cell, dims, mask, max_probe, sep_mask, sep_max_probe, indirect_only]
+        ),
         twin!(ResolveUniforms, "Resolve", [resolution, samples, show, scale]),
         twin!(DisplayUniforms, "Display", [image_size, target_size, decode_srgb, text_cols, text_rows, text_scale]),
         twin!(TrianglePlane, "TrianglePlane", [normal, offset, bins]),

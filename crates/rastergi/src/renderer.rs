@@ -8,7 +8,7 @@ use crate::error::Result;
 use crate::film::{Film, Show};
 use crate::frame::{FrameBinding, FrameUniforms, pixel_jitter};
 use crate::gather::{
-    DirectionSampler, FixedSample, GatherDirections, GatherFrame, GatherMethod, GatherPass, GatherSetup,
+    DirectionSampler, FixedSample, GatherDirections, GatherFrame, GatherMethod, GatherPass, GatherSetup, HitLight,
 };
 use crate::gbuffer::GBufferPass;
 use crate::gpu::Gpu;
@@ -52,6 +52,8 @@ pub struct RenderSettings {
     /// Gather directions per iteration, 1 to [`crate::gather::MAX_DIRECTIONS`]: they share the iteration's
     /// G-buffer and direct light.
     pub directions: u32,
+    /// The light at the gather's hits: all from the photon map, or the direct part exact.
+    pub hit_light: HitLight,
 }
 
 pub use crate::fit::default_bundle;
@@ -99,6 +101,7 @@ impl Default for RenderSettings {
             directions: DEFAULT_DIRECTIONS,
             photon_passes: 0,
             pass_iterations: DEFAULT_PASS_ITERATIONS,
+            hit_light: HitLight::Map,
         }
     }
 }
@@ -182,8 +185,12 @@ impl Renderer {
         prepared.textures.check_limits(gpu)?;
         let gpu_scene = GpuScene::new(gpu, &prepared)?;
         let frame = FrameBinding::new(gpu);
-        let photon_settings =
-            PhotonSettings { count: settings.photons, seed: settings.seed, grid_resolution: settings.grid_resolution };
+        let photon_settings = PhotonSettings {
+            count: settings.photons,
+            seed: settings.seed,
+            grid_resolution: settings.grid_resolution,
+            indirect_only: settings.hit_light == HitLight::Exact,
+        };
         let photons = (settings.photons > 0)
             .then(|| {
                 let pixels = settings.width as u64 * settings.height as u64;

@@ -35,6 +35,7 @@ pub fn constants() -> String {
         ("STREAM_DIRECT", stream::DIRECT),
         ("STREAM_PATH", stream::PATH),
         ("STREAM_PHOTON", stream::PHOTON),
+        ("STREAM_HIT_LIGHT", stream::HIT_LIGHT),
     ];
     let f32s = [("OFFSET_STEP", OFFSET_STEP)];
     let mut s = String::from("// Generated from the Rust constants (shader.rs).\n");

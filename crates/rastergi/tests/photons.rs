@@ -65,7 +65,7 @@ fn closed_box_average_irradiance_matches_power_over_area_times_one_minus_albedo(
     let a = 0.5f64;
     let scene = closed_box(a as f32);
     let n = 1u32 << 20;
-    let settings = PhotonSettings { count: n, seed: 5, grid_resolution: 16 };
+    let settings = PhotonSettings { count: n, seed: 5, grid_resolution: 16, ..Default::default() };
     let power = scene.emitted_power().as_dvec3();
     // Every surface side that reflects: 6 walls of area 4, both sides of the 0.4×0.4 light.
     let area = 24.0 + 2.0 * 0.16;
@@ -94,9 +94,12 @@ fn gpu_and_cpu_photon_maps_agree_cell_by_cell_within_noise() {
     let gpu = common::gpu();
     let scene = cornell_box();
     let n = 1u32 << 19;
-    let g = gpu_map(&gpu, &scene, &PhotonSettings { count: n, seed: 11, grid_resolution: 16 });
-    let c =
-        cpu::trace(&PreparedScene::new(&scene), g.grid(), &PhotonSettings { count: n, seed: 12, grid_resolution: 16 });
+    let g = gpu_map(&gpu, &scene, &PhotonSettings { count: n, seed: 11, grid_resolution: 16, ..Default::default() });
+    let c = cpu::trace(
+        &PreparedScene::new(&scene),
+        g.grid(),
+        &PhotonSettings { count: n, seed: 12, grid_resolution: 16, ..Default::default() },
+    );
     assert_eq!(g.area(), c.area());
     // Independent seeds: per well-populated slot the difference of the two sums has variance
     // ≈ 2·Σφ² (compound Poisson), estimated from the CPU map's squared deposits.
@@ -139,7 +142,7 @@ fn a_thin_wall_keeps_the_dark_room_dark_right_up_to_the_wall() {
         light,
     );
     let gpu = common::gpu();
-    let settings = PhotonSettings { count: 1 << 19, seed: 2, grid_resolution: 16 };
+    let settings = PhotonSettings { count: 1 << 19, seed: 2, grid_resolution: 16, ..Default::default() };
     let maps = [
         ("gpu", gpu_map(&gpu, &s, &settings)),
         ("cpu", cpu::trace(&PreparedScene::new(&s), &GridSpec::new(&s.bounds(), 16), &settings)),
@@ -247,5 +250,33 @@ fn photon_map_view_of_the_cornell_box_matches_mitsuba_up_to_the_grid_bias() {
     assert!(c.block_mean_error < 0.015, "block-mean error {}", c.block_mean_error);
     for r in c.mean_ratio {
         assert!((r - 1.0).abs() < 0.01, "mean ratio {:?}", c.mean_ratio);
+    }
+}
+
+#[test]
+fn an_indirect_only_map_holds_the_albedo_times_the_full_maps_energy() {
+    // Deposits from the second surface on (`indirect_only`, for exact direct light at the
+    // gather's hits): in the closed box of albedo a, each photon's hits after the first
+    // number K − 1 with E[K − 1] = a/(1−a), so the map's total is Φ·a/(1−a) — a times the full
+    // map's. Var[K − 1] = a/(1−a)² again: relative standard deviation sqrt(1/(aN)).
+    let gpu = common::gpu();
+    let a = 0.5f64;
+    let scene = closed_box(a as f32);
+    let n = 1u32 << 20;
+    let settings = PhotonSettings { count: n, seed: 6, grid_resolution: 16, indirect_only: true };
+    let power = scene.emitted_power().as_dvec3();
+    let sigma = (1.0 / (a * n as f64)).sqrt();
+    let cpu_map = cpu::trace(&PreparedScene::new(&scene), &GridSpec::new(&scene.bounds(), 16), &settings);
+    for (name, map) in [("gpu", gpu_map(&gpu, &scene, &settings)), ("cpu", cpu_map)] {
+        let flux = map.total_flux();
+        for c in 0..3 {
+            let expected = power[c] * a / (1.0 - a);
+            println!("{name} channel {c}: indirect flux {:.5} expected {expected:.5}", flux[c]);
+            assert!(
+                (flux[c] / expected - 1.0).abs() < 4.0 * sigma,
+                "{name} channel {c}: {} vs {expected} (σ = {sigma})",
+                flux[c]
+            );
+        }
     }
 }

@@ -9,13 +9,14 @@
 //!   correlated noise; it is measured as the spread of the means of 8 independent restarts
 //!   (new direction rotations and ray-view jitters, same photon map). The path tracer's mean
 //!   is an average over independent pixels: its noise is rmse(a, b)/2 over √pixels.
-//! - Texel bias. A ray-view texel holds one surface; a gather ray from a curved, tessellated
-//!   surface (columns, vaults, the sphere) can meet the plane of a neighbouring facet in the
-//!   same texel and read its back: a darkening proportional to the texel size (docs of
-//!   `rastergi::fit`). Renders at the fitted bundle B and at B/4 with the same directions and
-//!   jitters differ by this bias alone, 3/4 of the coarse one's, which gives both the bias
-//!   left at B (a third of the difference) and the image without it (the coarse mean minus
-//!   4/3 of the difference).
+//! - Texel surfaces. A ray-view texel holds one surface per layer; a gather ray from a curved,
+//!   tessellated surface (columns, vaults, the sphere) can meet the plane of a neighbouring
+//!   facet in the same texel off that facet. The raster gathers trace such rays instead
+//!   (`on_triangle` in `ray_view_lookup.wgsl`); before they did, this darkened the atrium by
+//!   about 10 % × texel / facet (−1.0 % at the fitted bundle, −4 % at a quarter of it).
+//!   Renders at the fitted bundle B and at B/4 with the same directions and jitters now differ
+//!   only where a silhouette crosses a texel without its plane being crossed off the triangle:
+//!   their paired difference bounds what the ray view's resolution still changes.
 //! - Grid bias. What remains is the photon map's: read at the secondary points, it moved the
 //!   Cornell box's channel means by less than 1 % and its 16×16 block means by less than
 //!   1.5 % (`tests/gather.rs`); the same allowances apply here.
@@ -117,7 +118,7 @@ const T_99_7: f64 = 3.499;
 const CHUNKS: usize = 8;
 
 #[test]
-fn second_scene_atrium_gather_matches_the_path_tracer_within_noise_grid_and_texel_bias() {
+fn second_scene_atrium_gather_matches_the_path_tracer_whatever_the_ray_view_resolution() {
     let gpu = common::gpu();
     let scene = atrium();
     let fine_bundle = fit::bundle(fit::detail_bundle(&scene), WIDTH, HEIGHT);
@@ -135,30 +136,10 @@ fn second_scene_atrium_gather_matches_the_path_tracer_within_noise_grid_and_texe
 
     let offsets: Vec<[f64; 3]> = coarse.iter().map(|c| mean_offset(c, &reference, &mask)).collect();
     let d_fine = mean_offset(&fine, &reference, &mask);
-    // The image without texel bias: the coarse mean minus 4/3 of the paired difference.
-    let limit = {
-        let avg = mean_image(&coarse);
-        let pixels = avg.pixels.iter().zip(&fine.pixels).zip(&coarse[0].pixels);
-        LinearImage {
-            width: avg.width,
-            height: avg.height,
-            pixels: pixels.map(|((a, f), c0)| [0, 1, 2].map(|k| a[k] + 4.0 / 3.0 * (f[k] - c0[k]))).collect(),
-        }
-    };
-    for ch in 0..3 {
-        let m = offsets.iter().map(|o| o[ch]).sum::<f64>() / CHUNKS as f64;
-        let delta = offsets[0][ch] - d_fine[ch];
-        println!(
-            "channel {ch}: mean offset at bundle {coarse_bundle} {m:+.4}, at {fine_bundle} {:+.4} (paired: {:+.4}), without texel bias {:+.4}",
-            m - delta,
-            -delta,
-            m - 4.0 / 3.0 * delta
-        );
-    }
-    let e = compare(&limit, &reference, Some(&mask));
+    let e = compare(&mean_image(&coarse), &reference, Some(&mask));
     let f = compare(&fine, &reference, Some(&mask));
     println!(
-        "limit image: relative RMSE {:.4}, block-mean error {:.4}; fine chunk: {:.4}, {:.4}",
+        "bundle {coarse_bundle}, {CHUNKS} chunks: relative RMSE {:.4}, block-mean error {:.4}; bundle {fine_bundle}, one chunk: {:.4}, {:.4}",
         e.relative_rmse, e.block_mean_error, f.relative_rmse, f.block_mean_error
     );
     let mut worst_se = 0.0f64;
@@ -169,15 +150,18 @@ fn second_scene_atrium_gather_matches_the_path_tracer_within_noise_grid_and_texe
         // Standard error of the coarse mean, and of the path tracer's mean.
         let se = (sd.powi(2) / CHUNKS as f64 + ref_noise.powi(2) / pixels).sqrt();
         worst_se = worst_se.max(se);
-        let delta = d[0] - d_fine[ch];
-        // The coarse ray view darkens the image, and the fitted bundle leaves little of it.
-        assert!(delta < -0.005, "channel {ch}: a 4× coarser ray view changes the mean by only {delta}");
-        assert!(delta / 3.0 > -0.02, "channel {ch}: the fitted bundle still darkens by {}", delta / 3.0);
-        // Without the texel bias, the means agree within the grid's 1 % and 99 % of the noise
-        // (Student's t for the 8 restarts).
-        let limit = m - 4.0 / 3.0 * delta;
+        // The same directions and jitters at 4× the ray-view resolution: what the texels
+        // still change (−4 % before the off-triangle crossings were traced).
+        let delta = d_fine[ch] - d[0];
+        println!(
+            "channel {ch}: mean offset at bundle {coarse_bundle} {m:+.4}, at {fine_bundle} {:+.4} (paired: {delta:+.4})",
+            m + delta
+        );
+        assert!(delta.abs() < 0.005, "channel {ch}: a 4× finer ray view changes the mean by {delta}");
+        // The means agree within the grid's 1 % and 99 % of the noise (Student's t for the 8
+        // restarts).
         let tolerance = 0.01 + T_99_7 * se;
-        assert!(limit.abs() < tolerance, "channel {ch}: mean offset {limit} without texel bias, tolerance {tolerance}");
+        assert!(m.abs() < tolerance, "channel {ch}: mean offset {m}, tolerance {tolerance}");
     }
     // Block means: the grid's 1.5 % and three standard errors of the mean's correlated noise.
     let tolerance = 0.015 + 3.0 * worst_se;

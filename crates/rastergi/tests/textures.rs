@@ -154,7 +154,7 @@ fn photon_tracer_and_its_cpu_twin_read_the_same_texels() {
     // back wall and the cube, far more than that.
     let gpu = common::gpu();
     let scene = textured_room();
-    let settings = PhotonSettings { count: 1 << 18, seed: 9, grid_resolution: 16 };
+    let settings = PhotonSettings { count: 1 << 18, seed: 9, grid_resolution: 16, ..Default::default() };
     let g = gpu_map(&gpu, &scene, &settings);
     let c = cpu::trace(&PreparedScene::new(&scene), g.grid(), &settings);
     let (mut diff, mut total) = (0.0f64, 0.0f64);

@@ -50,6 +50,10 @@ pub struct ConvergeArgs {
     /// e.g. shared,per-pixel (each with every --photon-passes value).
     #[arg(long, value_enum, value_delimiter = ',', default_values_t = [crate::args::GatherDirectionsArg::default_value()])]
     gather_directions: Vec<crate::args::GatherDirectionsArg>,
+    /// Where the light at gather hits comes from (see `render --hit-light`); several
+    /// comma-separated values are measured side by side, e.g. map,exact.
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "map")]
+    hit_light: Vec<crate::args::HitLightArg>,
     /// Also measure Mitsuba 3 (built-in cornell only; needs python3 with mitsuba).
     #[arg(long)]
     mitsuba: bool,
@@ -93,25 +97,38 @@ pub fn run(a: &ConvergeArgs) -> Result<()> {
     let mut curves: Vec<(String, Vec<Point>)> = Vec::new();
     for &directions in &a.gather_directions {
         for &passes in &a.photon_passes {
-            let settings = RenderSettings {
-                photon_passes: passes,
-                pass_iterations: a.pass_iterations,
-                gather_directions: directions.directions(),
-                ..base.clone()
-            };
-            println!(
-                "photon passes {passes} (0: unlimited), a pass every {} iterations (0: fitted), {} directions:",
-                a.pass_iterations,
-                directions.name()
-            );
-            let (name, points) =
-                measure(|| Renderer::new(&gpu, &scene, settings), &reference, a.seconds, 0.0, &TARGETS, "iterations")?;
-            let passes = if passes == 0 { "unlimited".to_string() } else { passes.to_string() };
-            let mut name = format!("{name}, photon passes {passes}");
-            if a.gather_directions.len() > 1 {
-                name += &format!(", {} directions", directions.name());
+            for &hit_light in &a.hit_light {
+                let settings = RenderSettings {
+                    photon_passes: passes,
+                    pass_iterations: a.pass_iterations,
+                    gather_directions: directions.directions(),
+                    hit_light: hit_light.hit_light(),
+                    ..base.clone()
+                };
+                let light = format!("{hit_light:?}").to_lowercase();
+                println!(
+                    "photon passes {passes} (0: unlimited), a pass every {} iterations (0: fitted), {} directions, hit light {light}:",
+                    a.pass_iterations,
+                    directions.name()
+                );
+                let (name, points) = measure(
+                    || Renderer::new(&gpu, &scene, settings),
+                    &reference,
+                    a.seconds,
+                    0.0,
+                    &TARGETS,
+                    "iterations",
+                )?;
+                let passes = if passes == 0 { "unlimited".to_string() } else { passes.to_string() };
+                let mut name = format!("{name}, photon passes {passes}");
+                if a.gather_directions.len() > 1 {
+                    name += &format!(", {} directions", directions.name());
+                }
+                if a.hit_light.len() > 1 {
+                    name += &format!(", hit light {light}");
+                }
+                curves.push((name, points));
             }
-            curves.push((name, points));
         }
     }
     let (name, points) = measure(|| PathTracer::new(&gpu, &scene, base), &reference, a.seconds, 0.0, &TARGETS, "spp")?;

@@ -34,7 +34,7 @@ pub fn run(a: &PhotonArgs) -> Result<()> {
     let scene = load_valid_scene(&a.scene)?;
     let gpu = gpu_profiled(&a.gpu, a.profile)?;
     let prepared = PreparedScene::new(&scene);
-    let settings = PhotonSettings { count: a.photons, seed: 1, grid_resolution: a.grid };
+    let settings = PhotonSettings { count: a.photons, seed: 1, grid_resolution: a.grid, ..Default::default() };
     let gs = GpuScene::new(&gpu, &prepared)?;
     let map = GpuPhotonMap::new(&gpu, &gs, &prepared, &settings)?;
     map.trace(&gpu, &gs);

@@ -3,8 +3,10 @@
 // point gathers where it is `ok` (visible_point.wgsl).
 
 // L(h → x) for the hit point h on triangle tri at barycentrics b, seen along w from x:
-// ρ_h/π · E(h) on the side of h facing x, zero from the back of a one-sided h.
-fn gather_radiance(w: vec3f, tri: u32, hit: vec3f, b: vec2f) -> vec3f {
+// ρ_h/π · E(h) on the side of h facing x, zero from the back of a one-sided h. E(h) is the
+// photon map's, or — for a map of indirect light only — the map's plus the direct irradiance
+// from one light sample with a shadow ray (hit_direct). `pixel` keys the light sample's stream.
+fn gather_radiance(w: vec3f, tri: u32, hit: vec3f, b: vec2f, pixel: u32) -> vec3f {
     let t = triangles[tri];
     let n_h = triangle_normal(t);
     let front_h = dot(w, n_h) < 0.0;
@@ -13,17 +15,47 @@ fn gather_radiance(w: vec3f, tri: u32, hit: vec3f, b: vec2f) -> vec3f {
     }
     // ρ_h at the hit point itself, unfiltered (level 0), like every secondary point.
     let albedo_h = surface_at(tri, b.x, b.y, 0.0).albedo;
-    return albedo_h / PI * photon_irradiance(hit, tri, !front_h);
+    var e = photon_irradiance(hit, tri, !front_h);
+    if photon_grid.indirect_only != 0u {
+        e += hit_direct(hit, select(-n_h, n_h, front_h), tri, w, pixel);
+    }
+    return albedo_h / PI * e;
 }
 
 // Shared directions, uniform on the sphere (pdf 1/4π): (ρ_x/π) · L(h → x) · cos θ_x · 4π,
 // cos θ_x = n·ω > 0.
-fn gather_estimate(p: VisiblePoint, cos_x: f32, w: vec3f, tri: u32, hit: vec3f, b: vec2f) -> vec3f {
-    return p.x.albedo / PI * gather_radiance(w, tri, hit, b) * (cos_x * 4.0 * PI);
+fn gather_estimate(p: VisiblePoint, cos_x: f32, w: vec3f, tri: u32, hit: vec3f, b: vec2f, pixel: u32) -> vec3f {
+    return p.x.albedo / PI * gather_radiance(w, tri, hit, b, pixel) * (cos_x * 4.0 * PI);
 }
 
 // Per-pixel directions, cosine-distributed about n_x (pdf cos θ_x/π): the cosine and the π
 // cancel, ρ_x · L(h → x).
-fn gather_estimate_cosine(p: VisiblePoint, w: vec3f, tri: u32, hit: vec3f, b: vec2f) -> vec3f {
-    return p.x.albedo * gather_radiance(w, tri, hit, b);
+fn gather_estimate_cosine(p: VisiblePoint, w: vec3f, tri: u32, hit: vec3f, b: vec2f, pixel: u32) -> vec3f {
+    return p.x.albedo * gather_radiance(w, tri, hit, b, pixel);
+}
+
+// Direct irradiance at h (side normal n) from one light sample: Le cos θ_h cos θ_l / (d² p_A),
+// zero where occluded. The stream is keyed by pixel and by iteration ⊕ a hash of ω, so each
+// direction of an iteration draws its own sample.
+fn hit_direct(h: vec3f, n: vec3f, tri: u32, w: vec3f, pixel: u32) -> vec3f {
+    if !has_lights() {
+        return vec3f(0.0);
+    }
+    let wk = pcg_hash(bitcast<u32>(w.x) ^ pcg_hash(bitcast<u32>(w.y) ^ pcg_hash(bitcast<u32>(w.z))));
+    var rng = rng_new(frame.seed ^ STREAM_HIT_LIGHT, pixel, frame.iteration ^ wk);
+    let u0 = rng_f32(&rng);
+    let u1 = rng_f32(&rng);
+    let u2 = rng_f32(&rng);
+    let l = sample_light(u0, u1, u2);
+    let origin = h + n * frame.ray_epsilon;
+    let to_light = l.pos - origin;
+    let dist2 = dot(to_light, to_light);
+    let dist = sqrt(dist2);
+    let d = to_light / dist;
+    let cos_h = dot(n, d);
+    let cos_l = -dot(l.normal, d);
+    if cos_h <= 0.0 || cos_l <= 0.0 || occluded(origin, d, frame.ray_epsilon, dist * (1.0 - 1e-4), tri, l.tri) {
+        return vec3f(0.0);
+    }
+    return l.radiance * (cos_h * cos_l / (dist2 * l.pdf_area));
 }

@@ -84,6 +84,18 @@ pub enum GatherDirections {
     Shared,
 }
 
+/// Where the light reflected at a gather hit h comes from: L(h → x) = ρ_h/π · E(h).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum HitLight {
+    /// E(h) read from the photon map (direct and indirect alike): no ray beyond the gather's.
+    #[default]
+    Map,
+    /// E(h) = the direct irradiance from one light sample with a shadow ray, plus the map's,
+    /// which then holds indirect light only (photons deposit from their second surface on):
+    /// the map's cell-sized blur then touches only light that has bounced twice.
+    Exact,
+}
+
 /// One way of finding the nearest surface along an iteration's gather directions and adding
 /// the estimate; each implementation owns its loop over the directions.
 pub trait Gather: Send {

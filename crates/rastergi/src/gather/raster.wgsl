@@ -42,6 +42,12 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     }
     found[pixel] = 1u;
     let hit = p.x.pos + w * dist;
-    let e = gather_estimate(p, cos_x, w, tri, hit, plane_barycentrics(triangles[tri], hit));
+    let b = plane_barycentrics(triangles[tri], hit);
+    var e: vec3f;
+    if on_triangle(b) {
+        e = gather_estimate(p, cos_x, w, tri, hit, b, pixel);
+    } else {
+        e = traced_estimate(p, cos_x, w, pixel);
+    }
     film_add(FILM_INDIRECT, gid.xy, e / f32(gather.count));
 }

@@ -19,3 +19,21 @@ fn plane_distance(tri: u32, x: vec3f, w: vec3f) -> f32 {
     }
     return dot(t.v0 - x, n_h) / denom;
 }
+
+// Whether barycentrics b (of a plane crossing) lie on the triangle, with a margin of 10⁻⁴
+// for rounding: a crossing off the triangle means the texel's surface is not what x's ray
+// meets (a silhouette crosses the texel), and the gather traces that ray instead.
+fn on_triangle(b: vec2f) -> bool {
+    let m = 1e-4;
+    return b.x >= -m && b.y >= -m && b.x + b.y <= 1.0 + m;
+}
+
+// The exact nearest hit along ω from x (BVH), for the rays a texel cannot answer: the
+// estimate, or zero where the ray escapes.
+fn traced_estimate(p: VisiblePoint, cos_x: f32, w: vec3f, pixel: u32) -> vec3f {
+    let h = trace(p.x.pos, w, frame.ray_epsilon, 3.0e38, p.x.tri, NO_TRIANGLE, false);
+    if h.tri == NO_TRIANGLE {
+        return vec3f(0.0);
+    }
+    return gather_estimate(p, cos_x, w, h.tri, p.x.pos + w * h.t, vec2f(h.b1, h.b2), pixel);
+}

@@ -15,6 +15,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         return;
     }
     let p = visible_point(textureLoad(gbuffer, gid.xy, 0));
+    let pixel = gid.y * frame.resolution.x + gid.x;
     let per_pixel = gather.per_pixel != 0u;
     let seed = pixel_seed(gather.pixel_key, gid.x, gid.y);
     var sum = vec3f(0.0);
@@ -34,9 +35,9 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             let hit = p.x.pos + w * h.t;
             let b = vec2f(h.b1, h.b2);
             if per_pixel {
-                sum += gather_estimate_cosine(p, w, h.tri, hit, b);
+                sum += gather_estimate_cosine(p, w, h.tri, hit, b, pixel);
             } else {
-                sum += gather_estimate(p, cos_x, w, h.tri, hit, b);
+                sum += gather_estimate(p, cos_x, w, h.tri, hit, b, pixel);
             }
         }
     }

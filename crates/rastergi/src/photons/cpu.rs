@@ -93,7 +93,8 @@ fn trace_photon(
     let mut dir = cosine_hemisphere(ln, u3, u4);
     let mut origin = pos + ln * eps;
     let mut skip = light.triangle;
-    for _ in 0..MAX_BOUNCES {
+    let first_deposit = settings.indirect_only as u32;
+    for bounce in 0..MAX_BOUNCES {
         let Some(hit) = prepared.bvh.intersect(&scene.triangles, origin, dir, eps, f32::INFINITY, skip) else {
             break;
         };
@@ -106,15 +107,17 @@ fn trace_photon(
         }
         let n = if front { n } else { -n };
         let p = tri[0] * (1.0 - hit.b1 - hit.b2) + tri[1] * hit.b1 + tri[2] * hit.b2;
-        match layout.deposit_slot(hit.triangle as usize, !front, p) {
-            Some(slot) => {
-                for c in 0..3 {
-                    t.flux[slot][c] += flux[c] as f64;
+        if bounce >= first_deposit {
+            match layout.deposit_slot(hit.triangle as usize, !front, p) {
+                Some(slot) => {
+                    for c in 0..3 {
+                        t.flux[slot][c] += flux[c] as f64;
+                    }
+                    t.flux_sq[slot] += (flux.y as f64).powi(2);
+                    t.deposits[slot] += 1;
                 }
-                t.flux_sq[slot] += (flux.y as f64).powi(2);
-                t.deposits[slot] += 1;
+                None => t.dropped += 1,
             }
-            None => t.dropped += 1,
         }
         let albedo = prepared.albedo_at(hit.triangle as usize, hit.b1, hit.b2, 0.0);
         let survive = albedo.max_element();

@@ -55,7 +55,9 @@ pub(crate) struct PhotonParams {
     /// The separators' table: capacity − 1 and the longest probe.
     pub(crate) sep_mask: u32,
     pub(crate) sep_max_probe: u32,
-    pub(crate) _pad: [u32; 4],
+    /// The first bounce that deposits: 0, or 1 for a map of indirect light only.
+    pub(crate) first_deposit: u32,
+    pub(crate) _pad: [u32; 3],
 }
 
 /// `PhotonGrid` in `map.wgsl`.
@@ -70,7 +72,8 @@ pub struct PhotonGridUniforms {
     pub max_probe: u32,
     pub sep_mask: u32,
     pub sep_max_probe: u32,
-    pub _pad: u32,
+    /// 1 where the map holds indirect irradiance only (deposits from the second surface on).
+    pub indirect_only: u32,
 }
 
 /// The photon tracer's composed shader (`trace.wgsl`: the trace and resolve kernels).
@@ -267,7 +270,8 @@ impl GpuPhotonMap {
             pass_index: 0,
             sep_mask,
             sep_max_probe,
-            _pad: [0; 4],
+            first_deposit: settings.indirect_only as u32,
+            _pad: [0; 3],
         };
         let grid_uniforms = PhotonGridUniforms {
             origin: grid.origin.into(),
@@ -277,7 +281,7 @@ impl GpuPhotonMap {
             max_probe,
             sep_mask,
             sep_max_probe,
-            _pad: 0,
+            indirect_only: settings.indirect_only as u32,
         };
         let buffers = [&slots, &keys, &planes, &sep_keys, &sep_planes];
         let (bind_layout, bind_group) = lookup_binding(gpu, &grid_uniforms, buffers);

@@ -11,7 +11,8 @@ struct PhotonGrid {
     max_probe: u32,
     sep_mask: u32,
     sep_max_probe: u32,
-    _pad0: u32,
+    // 1 where the map holds indirect irradiance only: its readers add the direct part.
+    indirect_only: u32,
 }
 
 @group(3) @binding(0) var<storage, read> photon_slots: array<vec4f>;

@@ -43,11 +43,14 @@ pub struct PhotonSettings {
     pub seed: u32,
     /// Grid cells along the scene's longest axis.
     pub grid_resolution: u32,
+    /// Deposit from a photon's second surface on: the map then holds indirect irradiance only,
+    /// and its readers add the direct part exactly ([`crate::gather::HitLight::Exact`]).
+    pub indirect_only: bool,
 }
 
 impl Default for PhotonSettings {
     fn default() -> Self {
-        Self { count: 1 << 20, seed: 0, grid_resolution: 64 }
+        Self { count: 1 << 20, seed: 0, grid_resolution: 64, indirect_only: false }
     }
 }
 

@@ -22,7 +22,8 @@ struct PhotonParams {
     // The separators' table: capacity − 1 and the longest probe.
     sep_mask: u32,
     sep_max_probe: u32,
-    _pad0: u32,
+    // The first bounce that deposits: 0, or 1 for a map of indirect light only.
+    first_deposit: u32,
     _pad1: u32,
     _pad2: u32,
     _pad3: u32,
@@ -134,7 +135,9 @@ fn trace_photons(@builtin(global_invocation_id) gid: vec3u) {
             break;
         }
         let n = select(-s.normal, s.normal, front);
-        deposit(s.pos, hit.tri, !front, flux);
+        if bounce >= params.first_deposit {
+            deposit(s.pos, hit.tri, !front, flux);
+        }
         let survive = max(s.albedo.x, max(s.albedo.y, s.albedo.z));
         if rng_f32(&rng) >= survive {
             break;

@@ -104,3 +104,20 @@ fn trace(o: vec3f, d: vec3f, t_min: f32, t_max: f32, skip_a: u32, skip_b: u32, a
 fn occluded(o: vec3f, d: vec3f, t_min: f32, t_max: f32, skip_a: u32, skip_b: u32) -> bool {
     return trace(o, d, t_min, t_max, skip_a, skip_b, true).tri != NO_TRIANGLE;
 }
+
+// One sample of next-event estimation: the irradiance at `origin` (just off triangle tri,
+// normal n) from the emitter point y drawn by (u0, u1, u2) with area density p_A,
+// Le · cos θ_x · cos θ_y / (|y − x|² p_A), zero where the segment (from t = eps) is occluded.
+fn light_sample_irradiance(origin: vec3f, n: vec3f, tri: u32, eps: f32, u0: f32, u1: f32, u2: f32) -> vec3f {
+    let l = sample_light(u0, u1, u2);
+    let to_light = l.pos - origin;
+    let dist2 = dot(to_light, to_light);
+    let dist = sqrt(dist2);
+    let w = to_light / dist;
+    let cos_x = dot(n, w);
+    let cos_y = -dot(l.normal, w);
+    if cos_x <= 0.0 || cos_y <= 0.0 || occluded(origin, w, eps, dist * (1.0 - 1e-4), tri, l.tri) {
+        return vec3f(0.0);
+    }
+    return l.radiance * (cos_x * cos_y / (dist2 * l.pdf_area));
+}

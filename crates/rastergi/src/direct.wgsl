@@ -23,16 +23,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             let u0 = rng_f32(&rng);
             let u1 = rng_f32(&rng);
             let u2 = rng_f32(&rng);
-            let l = sample_light(u0, u1, u2);
-            let to_light = l.pos - origin;
-            let dist2 = dot(to_light, to_light);
-            let dist = sqrt(dist2);
-            let w = to_light / dist;
-            let cos_x = dot(n, w);
-            let cos_y = -dot(l.normal, w);
-            if cos_x > 0.0 && cos_y > 0.0 && !occluded(origin, w, frame.ray_epsilon, dist * (1.0 - 1e-4), s.tri, l.tri) {
-                sum += l.radiance * (cos_x * cos_y / (dist2 * l.pdf_area));
-            }
+            sum += light_sample_irradiance(origin, n, s.tri, frame.ray_epsilon, u0, u1, u2);
         }
         radiance += s.albedo / PI * sum / f32(frame.light_samples);
     }

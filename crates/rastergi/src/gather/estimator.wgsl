@@ -34,9 +34,9 @@ fn gather_estimate_cosine(p: VisiblePoint, w: vec3f, tri: u32, hit: vec3f, b: ve
     return p.x.albedo * gather_radiance(w, tri, hit, b, pixel);
 }
 
-// Direct irradiance at h (side normal n) from one light sample: Le cos θ_h cos θ_l / (d² p_A),
-// zero where occluded. The stream is keyed by pixel and by iteration ⊕ a hash of ω, so each
-// direction of an iteration draws its own sample.
+// Direct irradiance at h (side normal n) from one light sample (light_sample_irradiance).
+// The stream is keyed by pixel and by iteration ⊕ a hash of ω, so each direction of an
+// iteration draws its own sample.
 fn hit_direct(h: vec3f, n: vec3f, tri: u32, w: vec3f, pixel: u32) -> vec3f {
     if !has_lights() {
         return vec3f(0.0);
@@ -46,16 +46,5 @@ fn hit_direct(h: vec3f, n: vec3f, tri: u32, w: vec3f, pixel: u32) -> vec3f {
     let u0 = rng_f32(&rng);
     let u1 = rng_f32(&rng);
     let u2 = rng_f32(&rng);
-    let l = sample_light(u0, u1, u2);
-    let origin = h + n * frame.ray_epsilon;
-    let to_light = l.pos - origin;
-    let dist2 = dot(to_light, to_light);
-    let dist = sqrt(dist2);
-    let d = to_light / dist;
-    let cos_h = dot(n, d);
-    let cos_l = -dot(l.normal, d);
-    if cos_h <= 0.0 || cos_l <= 0.0 || occluded(origin, d, frame.ray_epsilon, dist * (1.0 - 1e-4), tri, l.tri) {
-        return vec3f(0.0);
-    }
-    return l.radiance * (cos_h * cos_l / (dist2 * l.pdf_area));
+    return light_sample_irradiance(h + n * frame.ray_epsilon, n, tri, frame.ray_epsilon, u0, u1, u2);
 }

@@ -42,13 +42,5 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         return;
     }
     let pixel = gid.y * frame.resolution.x + gid.x;
-    let hit = p.x.pos + w * best;
-    let b = plane_barycentrics(triangles[best_tri], hit);
-    var e: vec3f;
-    if on_triangle(b) {
-        e = gather_estimate(p, cos_x, w, best_tri, hit, b, pixel);
-    } else {
-        e = traced_estimate(p, cos_x, w, pixel);
-    }
-    film_add(FILM_INDIRECT, gid.xy, e / f32(gather.count));
+    film_add(FILM_INDIRECT, gid.xy, texel_estimate(p, cos_x, w, best_tri, best, pixel) / f32(gather.count));
 }

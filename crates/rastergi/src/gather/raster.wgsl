@@ -41,13 +41,5 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         return;
     }
     found[pixel] = 1u;
-    let hit = p.x.pos + w * dist;
-    let b = plane_barycentrics(triangles[tri], hit);
-    var e: vec3f;
-    if on_triangle(b) {
-        e = gather_estimate(p, cos_x, w, tri, hit, b, pixel);
-    } else {
-        e = traced_estimate(p, cos_x, w, pixel);
-    }
-    film_add(FILM_INDIRECT, gid.xy, e / f32(gather.count));
+    film_add(FILM_INDIRECT, gid.xy, texel_estimate(p, cos_x, w, tri, dist, pixel) / f32(gather.count));
 }

@@ -37,3 +37,14 @@ fn traced_estimate(p: VisiblePoint, cos_x: f32, w: vec3f, pixel: u32) -> vec3f {
     }
     return gather_estimate(p, cos_x, w, h.tri, p.x.pos + w * h.t, vec2f(h.b1, h.b2), pixel);
 }
+
+// The estimate for the texel surface tri whose plane x's ray crosses at distance dist: at
+// that crossing where it lies on the triangle, else by tracing the ray (traced_estimate).
+fn texel_estimate(p: VisiblePoint, cos_x: f32, w: vec3f, tri: u32, dist: f32, pixel: u32) -> vec3f {
+    let hit = p.x.pos + w * dist;
+    let b = plane_barycentrics(triangles[tri], hit);
+    if on_triangle(b) {
+        return gather_estimate(p, cos_x, w, tri, hit, b, pixel);
+    }
+    return traced_estimate(p, cos_x, w, pixel);
+}

@@ -44,8 +44,10 @@ fn mismatches_against_cpu_raycast(method: GatherMethod, directions: GatherDirect
     let eps = prepared.ray_epsilon();
     let s = &prepared.scene;
     // The estimate along ω from x on triangle t with normal n (facing the eye):
-    // shared (pdf 1/4π) (ρ_x/π)·(ρ_h/π)·E(h)·max(0, n·ω)·4π; per-pixel (pdf cos/π) ρ_x·(ρ_h/π)·E(h).
+    // shared, along whichever of ±ω lies above x (pdf 1/2π) (ρ_x/π)·(ρ_h/π)·E(h)·|n·ω|·2π;
+    // per-pixel (pdf cos/π) ρ_x·(ρ_h/π)·E(h).
     let estimate = |t: usize, x: Vec3, n: Vec3, direction: Vec3| -> [f64; 3] {
+        let direction = if n.dot(direction) < 0.0 { -direction } else { direction };
         let cos = n.dot(direction);
         let mut e3 = [0.0f64; 3];
         if cos > 0.0
@@ -55,7 +57,7 @@ fn mismatches_against_cpu_raycast(method: GatherMethod, directions: GatherDirect
             if triangle_normal(&ht).dot(direction) < 0.0 {
                 let e = map.irradiance_on(hit.triangle as usize, false, x + direction * hit.t);
                 let (ax, ah) = (s.material_of(t).albedo, s.material_of(hit.triangle as usize).albedo);
-                let weight = if per_pixel { PI } else { cos as f64 * 4.0 * PI };
+                let weight = if per_pixel { PI } else { cos as f64 * 2.0 * PI };
                 for c in 0..3 {
                     e3[c] = ax[c] as f64 / PI * ah[c] as f64 / PI * e[c] * weight;
                 }

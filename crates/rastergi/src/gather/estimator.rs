@@ -105,14 +105,22 @@ impl GatherSetup<'_> {
         pieces: &[&str],
         own: &wgpu::BindGroupLayout,
     ) -> wgpu::ComputePipeline {
+        let [pipeline] = self.estimate_pipelines(device, label, pieces, own, ["main"]);
+        pipeline
+    }
+
+    /// [`GatherSetup::estimate_pipeline`] for each of `entries`, entry points of one module.
+    pub fn estimate_pipelines<const N: usize>(
+        &self,
+        device: &wgpu::Device,
+        label: &str,
+        pieces: &[&str],
+        own: &wgpu::BindGroupLayout,
+        entries: [&str; N],
+    ) -> [wgpu::ComputePipeline; N] {
         let module = shader::module(device, label, &estimate_source(pieces));
-        compute_pipeline(
-            device,
-            label,
-            &module,
-            "main",
-            &[&self.scene.layout, &self.frame.layout, own, &self.map.bind_layout],
-        )
+        let layouts = [&self.scene.layout, &self.frame.layout, own, &self.map.bind_layout];
+        entries.map(|entry| compute_pipeline(device, label, &module, entry, &layouts))
     }
 }
 

@@ -22,10 +22,16 @@ fn gather_radiance(w: vec3f, tri: u32, hit: vec3f, b: vec2f, pixel: u32) -> vec3
     return albedo_h / PI * e;
 }
 
-// Shared directions, uniform on the sphere (pdf 1/4π): (ρ_x/π) · L(h → x) · cos θ_x · 4π,
-// cos θ_x = n·ω > 0.
+// Shared directions, bidirectional: ω uniform on the sphere, and x gathers along whichever of
+// ±ω lies above its surface (w = sign(n·ω)·ω, uniform on x's hemisphere, pdf 1/2π):
+// (ρ_x/π) · L(h → x) · cos θ_x · 2π, cos θ_x = n·w > 0.
 fn gather_estimate(p: VisiblePoint, cos_x: f32, w: vec3f, tri: u32, hit: vec3f, b: vec2f, pixel: u32) -> vec3f {
-    return p.x.albedo / PI * gather_radiance(w, tri, hit, b, pixel) * (cos_x * 4.0 * PI);
+    return p.x.albedo / PI * gather_radiance(w, tri, hit, b, pixel) * (cos_x * 2.0 * PI);
+}
+
+// The side of shared direction ω that x gathers along: ω, or −ω where ω lies below x's surface.
+fn gather_side(n: vec3f, w: vec3f) -> vec3f {
+    return select(-w, w, dot(n, w) >= 0.0);
 }
 
 // Per-pixel directions, cosine-distributed about n_x (pdf cos θ_x/π): the cosine and the π

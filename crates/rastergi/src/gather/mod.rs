@@ -31,7 +31,9 @@
 //! indirect estimate, by far the noisier, gets more samples per unit of time.
 //!
 //! [`GatherMethod::Auto`] lets the first iterations alternate between the implementations and
-//! keeps the fastest on this adapter; every one of those iterations counts towards the image.
+//! keeps the one that lowers the error fastest on this adapter (see [`Efficiency`]): the
+//! implementations differ in speed, and the traced gather's per-pixel directions also in
+//! variance. Every one of those iterations counts towards the image.
 //! A new implementation is a module with a type implementing [`Gather`], a [`GatherMethod`]
 //! variant and one arm in [`build`].
 
@@ -47,6 +49,7 @@ use glam::{Vec2, Vec3};
 
 pub use estimator::{GatherInputs, GatherSample, GatherSetup, GatherUniforms, PixelSamples};
 
+use crate::consts::{FILM_DIRECT, FILM_INDIRECT};
 use crate::error::Result;
 use crate::frame::FrameBinding;
 use crate::gpu::Gpu;
@@ -59,7 +62,8 @@ pub use crate::consts::MAX_DIRECTIONS;
 /// How the nearest surface along the gather direction is found.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum GatherMethod {
-    /// Time the implementations on the first iterations and keep the fastest.
+    /// Try the implementations on the first iterations and keep the one whose error falls
+    /// fastest: least variance × time per iteration.
     #[default]
     Auto,
     /// Depth-peeled orthographic ray view (rasterization).
@@ -70,17 +74,17 @@ pub enum GatherMethod {
     Trace,
 }
 
-/// Whose directions the traced gather casts.
+/// Whose directions the traced gather casts (the raster gathers always share; `Auto` tries
+/// the traced gather with these directions against them).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum GatherDirections {
     /// Each pixel its own K cosine-distributed directions from an Owen-scrambled Sobol'
-    /// sequence (the traced gather; the raster gathers and `Auto` always share). The default:
-    /// no streaks, and on the Cornell box at 128² (lavapipe) 2.2–2.6× less error² per
-    /// iteration; an iteration costs 2.5× as much (every ray is cast), so in time it leads
-    /// early and is level with shared by 20–27 s (README, performance).
+    /// sequence. The default: no streaks, and less error per iteration than shared
+    /// directions (README, performance).
     #[default]
     PerPixel,
-    /// The iteration's K directions, uniform on the sphere, shared by every pixel.
+    /// The iteration's K directions, uniform on the sphere, shared by every pixel: each
+    /// point gathers along whichever of ±ω lies above its surface.
     Shared,
 }
 
@@ -110,14 +114,19 @@ pub trait Gather: Send {
 /// The implementations `Auto` chooses among, in trial order.
 const CANDIDATES: [GatherMethod; 3] = [GatherMethod::Raster, GatherMethod::Lists, GatherMethod::Trace];
 
-/// [`GatherMethod::Auto`] keeps the traced gather unless another is this many times faster.
+/// [`GatherMethod::Auto`] keeps the traced gather unless another lowers the error this many
+/// times faster (its variance × time per iteration this many times smaller).
 pub const PREFER_TRACE: f64 = 1.25;
+
+/// [`GatherMethod::Auto`] drops a candidate whose first run is this many times slower than the
+/// fastest: no estimator here has that much less variance than another.
+const DROP_SLOWER: u32 = 3;
 
 /// Iterations of each method timed by [`GatherMethod::Auto`] before it chooses.
 pub const AUTO_TRIALS: u32 = 3;
 
 /// Iterations after which [`GatherMethod::Auto`] has chosen, at most (candidates more than
-/// twice as slow as the fastest are dropped after their first run).
+/// [`DROP_SLOWER`] times as slow as the fastest are dropped after their first run).
 pub const AUTO_ITERATIONS: u32 = CANDIDATES.len() as u32 * AUTO_TRIALS;
 
 /// Builds the implementation `method` (not `Auto`) for a `bundle`² ray view, reading the
@@ -209,11 +218,111 @@ impl DirectionSampler {
     }
 }
 
-/// An implementation and, while `Auto` tries it, its trial times.
+/// An implementation with its directions and, while `Auto` tries it, its trial times.
 struct Candidate {
     method: GatherMethod,
+    per_pixel: bool,
     gather: Box<dyn Gather>,
     trials: Vec<Duration>,
+    /// The film's indirect increments of its trials.
+    noise: PixelVariance,
+}
+
+/// Per-pixel running sums of one estimate over iterations, for its variance.
+#[derive(Default)]
+struct PixelVariance {
+    /// The image's width (for the neighbours of a pixel).
+    width: u32,
+    n: u32,
+    sum: Vec<f32>,
+    sum_sq: Vec<f32>,
+}
+
+impl PixelVariance {
+    fn new(width: u32) -> PixelVariance {
+        PixelVariance { width, ..Default::default() }
+    }
+
+    /// Adds one iteration's estimate of every pixel.
+    fn add(&mut self, values: &[f32]) {
+        if self.n == 0 {
+            self.sum = vec![0.0; values.len()];
+            self.sum_sq = vec![0.0; values.len()];
+        }
+        for ((s, q), &v) in self.sum.iter_mut().zip(&mut self.sum_sq).zip(values) {
+            *s += v;
+            *q += v * v;
+        }
+        self.n += 1;
+    }
+
+    /// Σ over the pixels that `keep` keeps of the unbiased variance, (Σv² − (Σv)²/n)/(n − 1),
+    /// and its degrees of freedom n − 1 (none before two iterations).
+    fn total(&self, keep: &[bool]) -> Option<(f64, u32)> {
+        if self.n < 2 {
+            return None;
+        }
+        let n = f64::from(self.n);
+        let ss: f64 = (self.sum.iter().zip(&self.sum_sq).zip(keep))
+            .filter(|(_, k)| **k)
+            .map(|((&s, &q), _)| f64::from(q) - f64::from(s).powi(2) / n)
+            .sum();
+        Some((ss.max(0.0) / (n - 1.0), self.n - 1))
+    }
+
+    /// The pixels to keep: all but those whose mean is over `factor` times the image's mean,
+    /// and their 8 neighbours ([`crate::metrics::emitter_mask`]), or all where there are none.
+    fn keep_all_but_brightest(&self, factor: f32) -> Vec<bool> {
+        let pixels = self.sum.len();
+        if self.n == 0 || pixels == 0 {
+            return vec![true; pixels];
+        }
+        let mean: Vec<f32> = self.sum.iter().map(|&s| s / self.n as f32).collect();
+        let image_mean = mean.iter().map(|&m| f64::from(m)).sum::<f64>() / pixels as f64;
+        let width = self.width.max(1);
+        let image = crate::image_io::LinearImage {
+            width,
+            height: (pixels as u32).div_ceil(width),
+            pixels: mean.iter().map(|&m| [m; 3]).collect(),
+        };
+        crate::metrics::emitter_mask(&image, factor * image_mean as f32)
+    }
+}
+
+/// What `Auto` measures of each candidate while trying it, to compare how fast each lowers
+/// the error. After T seconds an estimator of per-iteration variance σ² (summed over pixels)
+/// whose iterations take t has error² ≈ σ²·t/T: the efficiency to maximise is 1/(σ²·t). With
+/// σ² = σ²_direct + σ²_gather and t = t_rest + t_gather — the direct pass's noise and the
+/// G-buffer and direct passes' time are the same for every candidate — each candidate's cost
+/// is (σ²_direct + σ²_gather)·(t_rest + t_gather). σ² is the per-pixel sample variance of the
+/// film's per-iteration increments, pooled over the candidates with the same directions
+/// (raster, lists and shared trace are one estimator); the pixels' value is the mean of R, G
+/// and B. Emitters are left out, as the error measures of `bench converge` leave them out:
+/// pixels whose mean direct value is over [`EMITTER_FACTOR`] times the image's, and their
+/// neighbours, whose noise (the light's edges under the pixel jitter) no gather changes.
+#[derive(Default)]
+struct Efficiency {
+    /// The film's direct sums at the last trial's gather, while the film has not been cleared
+    /// since (the next trial's minus these are one iteration's direct estimates).
+    last_direct: Option<Vec<f32>>,
+    direct: PixelVariance,
+    /// The time of the work before the gather in each trial iteration.
+    rest: Vec<Duration>,
+}
+
+/// The mean of R, G and B of each pixel of component `c` in film sums read back.
+fn film_component(bytes: &[u8], pixels: usize, c: usize) -> Vec<f32> {
+    let sums: &[[f32; 4]] = bytemuck::cast_slice(bytes);
+    sums[c * pixels..(c + 1) * pixels].iter().map(|v| (v[0] + v[1] + v[2]) / 3.0).collect()
+}
+
+/// [`Efficiency`] leaves out pixels this many times brighter than the image's mean (emitters).
+const EMITTER_FACTOR: f32 = 16.0;
+
+fn median(v: &[Duration]) -> Duration {
+    let mut v = v.to_vec();
+    v.sort();
+    v[v.len() / 2]
 }
 
 /// The final gather pass: the directions, the implementations behind one interface, and the
@@ -228,6 +337,10 @@ pub struct GatherPass {
     /// One implementation once chosen; `Auto`'s remaining candidates while it tries them.
     candidates: Vec<Candidate>,
     chosen: bool,
+    /// `Auto`: the film (its sums are read back after each trial) and the measurements.
+    film: wgpu::Buffer,
+    pixels: usize,
+    efficiency: Efficiency,
 }
 
 /// What the gather pass reads, besides the G-buffer and film it was built with.
@@ -242,8 +355,8 @@ pub struct GatherFrame<'a> {
 
 impl GatherPass {
     /// The pass over `setup`'s resources with `method`, for a `bundle`² ray view, drawing
-    /// directions from `sampler`; `directions` applies to [`GatherMethod::Trace`] (the others,
-    /// `Auto` included, share them).
+    /// directions from `sampler`; `directions` applies to [`GatherMethod::Trace`], and to
+    /// the traced gather that `Auto` tries (the raster gathers share them).
     pub fn new(
         gpu: &Gpu,
         setup: &GatherSetup,
@@ -259,15 +372,33 @@ impl GatherPass {
         );
         let mut candidates = Vec::new();
         for m in CANDIDATES.into_iter().filter(|&m| method == m || method == GatherMethod::Auto) {
+            let per_pixel = m == GatherMethod::Trace && directions == GatherDirections::PerPixel;
             match build(m, gpu, setup, &uniforms, bundle) {
-                Ok(gather) => candidates.push(Candidate { method: m, gather, trials: Vec::new() }),
+                Ok(gather) => candidates.push(Candidate {
+                    method: m,
+                    per_pixel,
+                    gather,
+                    trials: Vec::new(),
+                    noise: PixelVariance::new(setup.film.width),
+                }),
                 // Auto does without a candidate that does not fit.
                 Err(e) if method == GatherMethod::Auto => log::info!("gather: no {m:?} gather ({e})"),
                 Err(e) => return Err(e),
             }
         }
-        let per_pixel = method == GatherMethod::Trace && directions == GatherDirections::PerPixel;
-        Ok(GatherPass { bundle, uniforms, sampler, per_pixel, candidates, chosen: method != GatherMethod::Auto })
+        let chosen = method != GatherMethod::Auto;
+        let per_pixel = chosen && candidates[0].per_pixel;
+        Ok(GatherPass {
+            bundle,
+            uniforms,
+            sampler,
+            per_pixel,
+            candidates,
+            chosen,
+            film: setup.film.accumulation.clone(),
+            pixels: setup.film.width as usize * setup.film.height as usize,
+            efficiency: Efficiency { direct: PixelVariance::new(setup.film.width), ..Default::default() },
+        })
     }
 
     /// The implementation in use (`Auto` while the trials run).
@@ -288,6 +419,8 @@ impl GatherPass {
     /// A new image: new random choices.
     pub fn restart(&mut self) {
         self.sampler.restart();
+        // The film is cleared: the next trial's direct sums start afresh.
+        self.efficiency.last_direct = None;
     }
 
     /// Encodes the gather of `iteration` along `directions` directions (1 to
@@ -304,7 +437,10 @@ impl GatherPass {
         fixed: &FixedSample,
     ) -> Result<()> {
         let samples = self.sampler.samples(iteration, directions, fixed);
-        let pixel_samples = (self.per_pixel && fixed.direction.is_none()).then(|| PixelSamples {
+        // While Auto tries them: the directions of the candidate whose turn it is.
+        let trial = (!self.chosen).then(|| self.next_candidate());
+        let per_pixel = trial.map_or(self.per_pixel, |k| self.candidates[k].per_pixel);
+        let pixel_samples = (per_pixel && fixed.direction.is_none()).then(|| PixelSamples {
             key: self.sampler.pixel_key(),
             first_index: iteration.wrapping_mul(samples.len() as u32),
         });
@@ -321,31 +457,62 @@ impl GatherPass {
             uniforms: &uniforms,
             bundle: self.bundle,
         };
-        if self.chosen {
-            return self.candidates[0].gather.encode(gpu, enc, &inputs);
+        match trial {
+            None => self.candidates[0].gather.encode(gpu, enc, &inputs),
+            Some(k) => self.encode_trial(gpu, enc, &inputs, k),
         }
-        self.encode_trial(gpu, enc, &inputs)
     }
 
-    /// One timed trial iteration of `Auto`: the work before the gather is finished first so the
-    /// gather alone is timed; after [`AUTO_TRIALS`] of each, the fastest (median) is kept.
-    fn encode_trial(&mut self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, inputs: &GatherInputs) -> Result<()> {
-        // The candidate with the fewest trials so far, in order.
-        let k =
-            (0..self.candidates.len()).min_by_key(|&k| self.candidates[k].trials.len()).expect("a gather candidate");
+    /// The candidate `Auto` tries next: the one with the fewest trials so far, in order.
+    fn next_candidate(&self) -> usize {
+        (0..self.candidates.len()).min_by_key(|&k| self.candidates[k].trials.len()).expect("a gather candidate")
+    }
+
+    /// One measured trial iteration of `Auto` with candidate `k`: the work before the gather is
+    /// finished (and timed) first, the film's sums read back, the gather run and timed alone,
+    /// and the sums read again: their differences are this iteration's estimates
+    /// ([`Efficiency`]). After [`AUTO_TRIALS`] of each candidate, the most efficient is kept.
+    fn encode_trial(
+        &mut self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        inputs: &GatherInputs,
+        k: usize,
+    ) -> Result<()> {
+        let start = Instant::now();
         estimator::submit_and_renew(gpu, enc, "gather");
         gpu.wait()?;
+        self.efficiency.rest.push(start.elapsed());
+        let sums = 2 * self.pixels as u64 * 16;
+        let before = gpu.read_buffer(&self.film, sums)?;
         let start = Instant::now();
         self.candidates[k].gather.encode(gpu, enc, inputs)?;
         estimator::submit_and_renew(gpu, enc, "iteration");
         gpu.wait()?;
         self.candidates[k].trials.push(start.elapsed());
-        // Once every candidate has run, drop those whose fastest run is slower than twice the
-        // fastest run of all: the trials cost little beyond the winner's time.
+        let after = gpu.read_buffer(&self.film, sums)?;
+
+        let e = &mut self.efficiency;
+        let direct = film_component(&before, self.pixels, FILM_DIRECT as usize);
+        if let Some(last) = &e.last_direct {
+            let increment: Vec<f32> = direct.iter().zip(last).map(|(a, b)| a - b).collect();
+            e.direct.add(&increment);
+        }
+        e.last_direct = Some(direct);
+        let indirect = film_component(&before, self.pixels, FILM_INDIRECT as usize);
+        let increment: Vec<f32> = film_component(&after, self.pixels, FILM_INDIRECT as usize)
+            .iter()
+            .zip(&indirect)
+            .map(|(a, b)| a - b)
+            .collect();
+        self.candidates[k].noise.add(&increment);
+
+        // Once every candidate has run, drop those whose fastest run is more than DROP_SLOWER
+        // times the fastest run of all.
         let fastest = |c: &Candidate| c.trials.iter().min().copied().unwrap_or(Duration::MAX);
         if self.candidates.iter().all(|c| !c.trials.is_empty()) {
             let best = self.candidates.iter().map(fastest).min().unwrap_or(Duration::MAX);
-            self.candidates.retain(|c| fastest(c) <= 2 * best);
+            self.candidates.retain(|c| fastest(c) <= DROP_SLOWER * best);
         }
         if self.candidates.iter().all(|c| c.trials.len() as u32 >= AUTO_TRIALS) {
             self.choose(gpu);
@@ -353,28 +520,96 @@ impl GatherPass {
         Ok(())
     }
 
-    /// Keeps the candidate with the fastest median trial; the traced gather unless another is
-    /// more than [`PREFER_TRACE`] times faster.
+    /// Keeps the candidate of least cost (σ²_direct + σ²_gather)·(t_rest + t_gather)
+    /// ([`Efficiency`]; median times, pooled variances); the traced gather unless another's
+    /// cost is more than [`PREFER_TRACE`] times lower.
     fn choose(&mut self, gpu: &Gpu) {
-        let median = |v: &[Duration]| {
-            let mut v = v.to_vec();
-            v.sort();
-            v[v.len() / 2]
+        let e = &self.efficiency;
+        let keep = e.direct.keep_all_but_brightest(EMITTER_FACTOR);
+        let direct = e.direct.total(&keep).map_or(0.0, |(v, _)| v);
+        let rest = median(&e.rest).as_secs_f64();
+        // Σ of the squared deviations over Σ of the degrees of freedom, per directions mode.
+        let pooled = |per_pixel: bool| {
+            let (ss, dof) = (self.candidates.iter())
+                .filter(|c| c.per_pixel == per_pixel)
+                .filter_map(|c| c.noise.total(&keep))
+                .fold((0.0, 0), |(ss, dof), (v, n)| (ss + v * f64::from(n), dof + n));
+            if dof > 0 { ss / f64::from(dof) } else { f64::INFINITY }
         };
-        let times: Vec<(GatherMethod, Duration)> =
-            self.candidates.iter().map(|c| (c.method, median(&c.trials))).collect();
-        let (fastest, t_fastest) = *times.iter().min_by_key(|(_, t)| *t).expect("a gather candidate");
+        let costs: Vec<f64> = (self.candidates.iter())
+            .map(|c| (direct + pooled(c.per_pixel)) * (rest + median(&c.trials).as_secs_f64()))
+            .collect();
+        let best = (0..costs.len()).min_by(|&a, &b| costs[a].total_cmp(&costs[b])).expect("a gather candidate");
         // The traced gather is exact and needs no ray-view memory: a raster gather must win
-        // clearly, so that timing noise does not flip the choice between runs.
-        let method = match times.iter().find(|(m, _)| *m == GatherMethod::Trace) {
-            Some(&(_, t_trace)) if t_trace.as_secs_f64() <= PREFER_TRACE * t_fastest.as_secs_f64() => {
-                GatherMethod::Trace
-            }
-            _ => fastest,
-        };
-        let list: Vec<String> = times.iter().map(|(m, t)| format!("{m:?} {:.2} ms", t.as_secs_f64() * 1e3)).collect();
-        log::info!("gather per iteration on {}: {}; using {method:?}", gpu.info.name, list.join(", "));
-        self.candidates.retain(|c| c.method == method);
+        // clearly, so that noise in the measurements does not flip the choice between runs.
+        let k = (0..costs.len())
+            .find(|&k| self.candidates[k].method == GatherMethod::Trace && costs[k] <= PREFER_TRACE * costs[best])
+            .unwrap_or(best);
+        let list: Vec<String> = (self.candidates.iter().zip(&costs))
+            .map(|(c, cost)| {
+                let directions = if c.per_pixel { "per-pixel" } else { "shared" };
+                let t = median(&c.trials).as_secs_f64() * 1e3;
+                let v = pooled(c.per_pixel);
+                format!("{:?} ({directions}) {t:.2} ms, variance {v:.3e}, cost {cost:.3e}", c.method)
+            })
+            .collect();
+        log::info!(
+            "gather on {}: rest of an iteration {:.2} ms, direct variance {direct:.3e}; {}; using {:?}",
+            gpu.info.name,
+            rest * 1e3,
+            list.join("; "),
+            self.candidates[k].method
+        );
+        let chosen = self.candidates.swap_remove(k);
+        self.per_pixel = chosen.per_pixel;
+        self.candidates = vec![chosen];
         self.chosen = true;
+        self.efficiency = Efficiency::default();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pixel_variance_matches_the_two_pass_sample_variance() {
+        let (pixels, n) = (37usize, 5u32);
+        let mut rng = Rng::new(11, 0, 0);
+        let values: Vec<Vec<f32>> =
+            (0..n).map(|_| (0..pixels).map(|p| p as f32 * 0.1 + 3.0 * rng.next_f32()).collect()).collect();
+        let mut v = PixelVariance::new(pixels as u32);
+        assert!(v.total(&vec![true; pixels]).is_none());
+        values.iter().for_each(|it| v.add(it));
+        let keep: Vec<bool> = (0..pixels).map(|p| p % 3 != 0).collect();
+        let mut expected = 0.0f64;
+        for p in (0..pixels).filter(|&p| keep[p]) {
+            let mean = values.iter().map(|it| f64::from(it[p])).sum::<f64>() / f64::from(n);
+            expected += values.iter().map(|it| (f64::from(it[p]) - mean).powi(2)).sum::<f64>() / f64::from(n - 1);
+        }
+        let (total, dof) = v.total(&keep).unwrap();
+        assert_eq!(dof, n - 1);
+        assert!((total - expected).abs() < 1e-4 * expected, "{total} against {expected}");
+    }
+
+    #[test]
+    fn the_brightest_pixels_and_their_neighbours_are_left_out() {
+        // A 6×4 image of ones with one emitter pixel at (4, 1) of 1000.
+        let (w, h) = (6u32, 4u32);
+        let mut image = vec![1.0f32; (w * h) as usize];
+        image[(w + 4) as usize] = 1000.0;
+        let mut v = PixelVariance::new(w);
+        v.add(&image);
+        let keep = v.keep_all_but_brightest(EMITTER_FACTOR);
+        for y in 0..h {
+            for x in 0..w {
+                let near = (x as i32 - 4).abs() <= 1 && (y as i32 - 1).abs() <= 1;
+                assert_eq!(keep[(y * w + x) as usize], !near, "pixel ({x}, {y})");
+            }
+        }
+        // Without an outlier every pixel counts.
+        let mut flat = PixelVariance::new(w);
+        flat.add(&vec![2.0; (w * h) as usize]);
+        assert!(flat.keep_all_but_brightest(EMITTER_FACTOR).iter().all(|&k| k));
     }
 }

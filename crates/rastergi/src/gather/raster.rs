@@ -31,11 +31,13 @@ pub struct RasterGather {
     count_pipeline: wgpu::RenderPipeline,
     peel_pipeline: wgpu::RenderPipeline,
     project_pipeline: wgpu::ComputePipeline,
+    resolve_pipeline: wgpu::ComputePipeline,
     layers: [wgpu::TextureView; 2],
     depth: wgpu::TextureView,
     counts: wgpu::Buffer,
     max_count: wgpu::Buffer,
     found: wgpu::Buffer,
+    behind: wgpu::Buffer,
     count_group: wgpu::BindGroup,
     /// peel_groups[k]: reads layer texture 1−k (the previous layer).
     peel_groups: [wgpu::BindGroup; 2],
@@ -83,6 +85,8 @@ impl RasterGather {
         let pixels = film.width as u64 * film.height as u64;
         let found =
             gpu.zeroed_buffer("gather found", pixels * 4, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST);
+        let behind =
+            gpu.zeroed_buffer("gather behind", pixels * 8, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST);
 
         let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
         let c = wgpu::ShaderStages::COMPUTE;
@@ -107,6 +111,7 @@ impl RasterGather {
                 tex_entry(2, c),
                 storage_entry::<u32>(3, c, false),
                 storage_entry::<[f32; 4]>(4, c, false),
+                storage_entry::<[u32; 2]>(5, c, false),
             ],
         });
         let count_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -138,6 +143,7 @@ impl RasterGather {
                     wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(layer) },
                     wgpu::BindGroupEntry { binding: 3, resource: found.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 4, resource: film.accumulation.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 5, resource: behind.as_entire_binding() },
                 ],
             })
         };
@@ -164,21 +170,24 @@ impl RasterGather {
             (LAYER_FORMAT, wgpu::ColorWrites::ALL),
             true,
         );
-        let project_pipeline = setup.estimate_pipeline(
+        let [project_pipeline, resolve_pipeline] = setup.estimate_pipelines(
             device,
             "gather project",
             &[RAY_VIEW_LOOKUP, include_str!("raster.wgsl")],
             &project_layout,
+            ["main", "resolve_behind"],
         );
         Ok(RasterGather {
             count_pipeline,
             peel_pipeline,
             project_pipeline,
+            resolve_pipeline,
             layers,
             depth,
             counts,
             max_count,
             found,
+            behind,
             count_group,
             peel_groups,
             project_groups,
@@ -227,10 +236,12 @@ impl RasterGather {
         Ok(u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]))
     }
 
-    /// Peels `layers` layers back to front, projecting each onto the visible points.
+    /// Peels `layers` layers back to front, projecting each onto the visible points, then
+    /// resolves the points gathering along −ω from the nearest layer behind them.
     /// Reads: scene, frame, G-buffer, photon map. Adds to: the film's indirect component.
     fn encode_layers(&self, enc: &mut wgpu::CommandEncoder, inputs: &GatherInputs, layers: u32) {
         enc.clear_buffer(&self.found, 0, None);
+        enc.clear_buffer(&self.behind, 0, None);
         // "Layer −1" (read by the first peel) is empty with depth bits above any depth.
         let beyond = f64::from(2.0f32.to_bits());
         {
@@ -286,6 +297,9 @@ impl RasterGather {
             let groups = inputs.groups(&self.project_groups[cur]);
             dispatch_pixels(&mut pass, &self.project_pipeline, &groups, inputs.width, inputs.height);
         }
+        let mut pass = compute_pass(enc, self.profiler.as_ref(), "gather resolve behind");
+        let groups = inputs.groups(&self.project_groups[0]);
+        dispatch_pixels(&mut pass, &self.resolve_pipeline, &groups, inputs.width, inputs.height);
     }
 }
 

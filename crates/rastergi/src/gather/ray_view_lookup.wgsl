@@ -8,14 +8,18 @@ fn ray_view_texel(x: vec3f) -> vec2u {
     return vec2u(clamp(vec2i(floor(uv)), vec2i(0), vec2i(i32(gather.bundle) - 1)));
 }
 
-// Distance along ω from x to the plane of triangle tri; negative when the ray runs parallel to
-// it (a texel's surface counts where x's ray crosses its plane at t > ε).
+// plane_distance where the ray runs parallel to the plane: below any real distance.
+const PLANE_PARALLEL: f32 = -3.0e38;
+
+// Distance along ω from x to the plane of triangle tri (negative: the plane crosses x's line
+// behind x), PLANE_PARALLEL where the ray runs parallel to it (a texel's surface counts where
+// x's ray crosses its plane at t > ε).
 fn plane_distance(tri: u32, x: vec3f, w: vec3f) -> f32 {
     let t = triangles[tri];
     let n_h = triangle_normal(t);
     let denom = dot(w, n_h);
     if abs(denom) < 1e-8 {
-        return -1.0;
+        return PLANE_PARALLEL;
     }
     return dot(t.v0 - x, n_h) / denom;
 }

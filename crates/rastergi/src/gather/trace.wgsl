@@ -1,7 +1,7 @@
 // Final gather by ray casting (gather/trace.rs): the nearest surface along each of the
 // iteration's directions from each visible point, by BVH traversal, averaged over the
-// directions. Shared directions (gather.per_pixel == 0): the uniforms' ω_k, estimate
-// gather_estimate. Per-pixel directions: ω_k cosine-distributed about n_x from the
+// directions. Shared directions (gather.per_pixel == 0): the uniforms' ω_k, each cast along
+// whichever of ±ω_k lies above x's surface (gather_side), estimate gather_estimate. Per-pixel directions: ω_k cosine-distributed about n_x from the
 // Owen-scrambled Sobol' point of index first_index + k with this pixel's scramble seed,
 // estimate gather_estimate_cosine (estimator.wgsl).
 
@@ -20,7 +20,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let seed = pixel_seed(gather.pixel_key, gid.x, gid.y);
     var sum = vec3f(0.0);
     for (var k = 0u; k < gather.count && p.ok; k++) {
-        var w = gather.directions[k].xyz;
+        var w = gather_side(p.n, gather.directions[k].xyz);
         if per_pixel {
             let u = sobol_owen_2d(gather.first_index + k, seed);
             w = cosine_hemisphere(p.n, unit_f32(u.x), unit_f32(u.y));

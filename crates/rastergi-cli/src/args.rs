@@ -57,8 +57,8 @@ impl ShowArg {
 /// How the final gather finds the nearest surface along its direction.
 #[derive(Copy, Clone, Debug, ValueEnum)]
 pub enum GatherArg {
-    /// Time each on the first iterations and keep the fastest on this GPU (trace unless
-    /// another is over 1.25× faster).
+    /// Try each on the first iterations and keep the one whose error falls fastest on this
+    /// GPU: least variance × time per iteration (trace unless another is over 1.25× better).
     Auto,
     /// Depth-peeled orthographic ray views (rasterization).
     Raster,
@@ -104,7 +104,8 @@ pub enum GatherDirectionsArg {
     /// Each pixel its own cosine-distributed directions (Owen-scrambled Sobol'): noise
     /// instead of streaks.
     PerPixel,
-    /// Each direction shared by every pixel (uniform on the sphere, scrambled Sobol').
+    /// Each direction shared by every pixel (uniform on the sphere, scrambled Sobol'; each
+    /// point gathers along whichever of ±ω lies above it).
     Shared,
 }
 
@@ -192,8 +193,8 @@ pub struct SceneArgs {
     /// implementations of the same estimator).
     #[arg(long, value_enum, default_value_t = GatherArg::Auto)]
     pub gather: GatherArg,
-    /// Whose directions the traced gather casts (`--gather trace` only: raster, lists and
-    /// auto always share each direction among all pixels, whatever this says).
+    /// Whose directions the traced gather casts (`--gather trace`, and the traced gather that
+    /// auto tries; raster and lists always share each direction among all pixels).
     #[arg(long, value_enum, default_value_t = GatherDirectionsArg::default_value())]
     pub gather_directions: GatherDirectionsArg,
     /// Gather directions per iteration (1–16): they share the iteration's G-buffer and direct

@@ -41,7 +41,8 @@ pub struct RenderSettings {
     /// How the final gather finds the nearest surface along its direction.
     pub gather: GatherMethod,
     /// The traced gather's directions: per pixel or shared by every pixel (applies to
-    /// [`GatherMethod::Trace`] only: the raster gathers and `Auto` always share them).
+    /// [`GatherMethod::Trace`] and the traced gather that `Auto` tries: the raster gathers
+    /// always share them).
     pub gather_directions: GatherDirections,
     /// Photon passes ([`crate::photons::passes`]): the map is re-traced with fresh photons in
     /// finer cells every `pass_iterations` iterations; 1: one fixed map; 0: no limit.

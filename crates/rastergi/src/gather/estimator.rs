@@ -7,7 +7,8 @@
 //! from the back of a one-sided h; emission is never added: the direct pass owns it):
 //!
 //! ```text
-//!   shared ω, uniform on the sphere (pdf 1/4π):     L_ind(x) ≈ (ρ_x/π) · L(h → x) · max(0, n_x·ω) · 4π
+//!   shared ω, uniform on the sphere; x gathers along w = sign(n_x·ω)·ω, uniform on its
+//!   hemisphere (pdf 1/2π):                           L_ind(x) ≈ (ρ_x/π) · L(h → x) · (n_x·w) · 2π
 //!   per-pixel ω, cosine about n_x (pdf cos θ_x/π):  L_ind(x) ≈ ρ_x · L(h → x)
 //! ```
 //!

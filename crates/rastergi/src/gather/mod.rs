@@ -8,7 +8,9 @@
 //!   uniform map to the sphere (pdf 1/4π). Iteration i with K directions takes j = i·K …
 //!   i·K + K − 1: an aligned block, a (0, 2, 2)-net for K = 4 (the Halton (5, 7) points used
 //!   before nearly lie on a line in such a batch), and consecutive blocks keep stratifying.
-//!   Estimate (ρ_x/π) · L(h → x) · max(0, n_x·ω) · 4π.
+//!   Bidirectional: x gathers along whichever of ±ω lies above its surface, w = sign(n_x·ω)·ω,
+//!   uniform on its hemisphere (pdf 1/2π), so one ray view serves every point.
+//!   Estimate (ρ_x/π) · L(h → x) · (n_x·w) · 2π.
 //! * Per-pixel directions ([`GatherDirections::PerPixel`], the traced gather only): pixel
 //!   (x, y) takes the Owen-scrambled 2D Sobol' points u_j = P(j; s_xy) of
 //!   [`crate::sampling::sobol_owen_2d`], j = i·K … i·K + K − 1, with its own scramble seed
@@ -331,8 +333,8 @@ pub struct GatherPass {
     pub bundle: u32,
     uniforms: wgpu::Buffer,
     sampler: DirectionSampler,
-    /// Per-pixel directions: the traced gather asked for by name with
-    /// [`GatherDirections::PerPixel`].
+    /// Per-pixel directions: the traced gather with [`GatherDirections::PerPixel`], asked
+    /// for by name or chosen by `Auto`.
     per_pixel: bool,
     /// One implementation once chosen; `Auto`'s remaining candidates while it tries them.
     candidates: Vec<Candidate>,
@@ -554,11 +556,12 @@ impl GatherPass {
             })
             .collect();
         log::info!(
-            "gather on {}: rest of an iteration {:.2} ms, direct variance {direct:.3e}; {}; using {:?}",
+            "gather on {}: rest of an iteration {:.2} ms, direct variance {direct:.3e}; {}; using {:?}{}",
             gpu.info.name,
             rest * 1e3,
             list.join("; "),
-            self.candidates[k].method
+            self.candidates[k].method,
+            if self.candidates[k].per_pixel { " with per-pixel directions" } else { "" }
         );
         let chosen = self.candidates.swap_remove(k);
         self.per_pixel = chosen.per_pixel;

@@ -11,10 +11,13 @@
 //!   result is read back before the layers are encoded (one GPU→CPU synchronisation per
 //!   direction).
 //! * Projection: after each layer, every visible point x projects into the ray view like a
-//!   shadow-map lookup. The first layer (back to front) whose surface h lies in front of x —
-//!   the plane of h's triangle crosses x's ray at t > ε — is the nearest hit along ω. The plane
-//!   test rejects x's own triangle and coplanar neighbours exactly, at any angle (no acne, no
-//!   slope bias that would lose contact shadows).
+//!   shadow-map lookup. Where x's surface faces ω, the first layer (back to front) whose
+//!   surface h lies in front of x — the plane of h's triangle crosses x's ray at t > ε — is the
+//!   nearest hit along ω. Where it faces −ω, x gathers along −ω from the same view: it keeps
+//!   the nearest layer behind it (per pixel: triangle and distance) until a layer lies in front
+//!   of it, and one pass after the last layer makes its estimate. The plane test rejects x's
+//!   own triangle and coplanar neighbours exactly, at any angle (no acne, no slope bias that
+//!   would lose contact shadows).
 
 use super::Gather;
 use super::estimator::{GatherInputs, GatherSetup, GatherUniforms, RAY_VIEW_LOOKUP, submit_and_renew};

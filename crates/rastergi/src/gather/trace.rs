@@ -2,8 +2,8 @@
 //! traversing the BVH in a compute shader (`trace.wgsl`). One dispatch per iteration, no
 //! ray-view textures and no read-back, so iterations queue up without synchronisation.
 //!
-//! * Shared directions: the uniforms' ω_k (pdf 1/4π), the raster gathers' estimate
-//!   (ρ_x/π)·L(h→x)·max(0, n·ω)·4π ([`super::estimator`]).
+//! * Shared directions: the uniforms' ω_k, each cast along whichever of ±ω_k lies above x
+//!   (pdf 1/2π), the raster gathers' estimate (ρ_x/π)·L(h→x)·(n·w)·2π ([`super::estimator`]).
 //! * Per-pixel directions ([`super::GatherDirections::PerPixel`]): pixel (x, y) takes the
 //!   Owen-scrambled Sobol' points u_j = [`crate::sampling::sobol_owen_2d`]`(j, s_xy)`,
 //!   j = first_index + k, s_xy = [`crate::sampling::pixel_seed`]`(key, x, y)`, and casts

@@ -46,7 +46,7 @@ pub mod stream {
     pub const HIT_LIGHT: u32 = 0xa54ff53a;
     /// The ray view's sub-texel offset, keyed (direction index, restart).
     pub const TEXEL_JITTER: u32 = 0x7e1a5;
-    /// The Cranley–Patterson shift of the pixel jitter, x and y (hashed, not a stream).
-    pub const PIXEL_SHIFT_X: u32 = 0x6a09e667;
-    pub const PIXEL_SHIFT_Y: u32 = 0xbb67ae85;
+    /// The scramble seed of the pixel jitter's Owen-scrambled Sobol' sequence (hashed, not a
+    /// stream).
+    pub const PIXEL_JITTER: u32 = 0x6a09e667;
 }

@@ -31,7 +31,8 @@ pub const OFFSET_SHIFT: u32 = REGION_SHIFT + MAX_SEPARATORS as u32;
 /// The random streams: every stream key is `seed ^ id` with one of these ids, so no two
 /// passes draw correlated numbers. WGSL gets the ids it uses from [`crate::shader::constants`].
 pub mod stream {
-    /// Light samples of the direct pass, keyed (pixel, iteration).
+    /// The key of the direct pass's per-pixel light-sample scramble seeds (not keyed by the
+    /// restart: an Owen-scrambled Sobol' sequence per pixel, indexed by sample).
     pub const DIRECT: u32 = 0x0d1ec7;
     /// Paths of the reference path tracer, keyed (pixel, iteration).
     pub const PATH: u32 = 0x9a7b1d;

@@ -31,7 +31,8 @@ pub const OFFSET_SHIFT: u32 = REGION_SHIFT + MAX_SEPARATORS as u32;
 /// The random streams: every stream key is `seed ^ id` with one of these ids, so no two
 /// passes draw correlated numbers. WGSL gets the ids it uses from [`crate::shader::constants`].
 pub mod stream {
-    /// Light samples of the direct pass, keyed (pixel, iteration).
+    /// The key of the direct pass's per-pixel light-sample scramble seeds (not keyed by the
+    /// restart: an Owen-scrambled Sobol' sequence per pixel, indexed by sample).
     pub const DIRECT: u32 = 0x0d1ec7;
     /// Paths of the reference path tracer, keyed (pixel, iteration).
     pub const PATH: u32 = 0x9a7b1d;
@@ -46,7 +47,7 @@ pub mod stream {
     pub const HIT_LIGHT: u32 = 0xa54ff53a;
     /// The ray view's sub-texel offset, keyed (direction index, restart).
     pub const TEXEL_JITTER: u32 = 0x7e1a5;
-    /// The Cranley–Patterson shift of the pixel jitter, x and y (hashed, not a stream).
-    pub const PIXEL_SHIFT_X: u32 = 0x6a09e667;
-    pub const PIXEL_SHIFT_Y: u32 = 0xbb67ae85;
+    /// The scramble seed of the pixel jitter's Owen-scrambled Sobol' sequence (hashed, not a
+    /// stream).
+    pub const PIXEL_JITTER: u32 = 0x6a09e667;
 }

@@ -195,7 +195,7 @@ pub fn sobol_owen_on_gpu(gpu: &Gpu, queries: &[(u32, u32)]) -> Result<Vec<[u32; 
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     #[test]
@@ -271,7 +271,7 @@ mod tests {
 
     /// Whether `points` (2^m of them, 32-bit fractions) put exactly one point in every
     /// elementary interval [a/2^j, (a+1)/2^j) × [b/2^(m−j), (b+1)/2^(m−j)), for all j.
-    fn is_net(points: &[[u32; 2]], m: u32) -> bool {
+    pub(crate) fn is_net(points: &[[u32; 2]], m: u32) -> bool {
         (0..=m).all(|j| {
             let mut seen = vec![false; 1 << m];
             points.iter().all(|&[x, y]| {

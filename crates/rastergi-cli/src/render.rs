@@ -97,7 +97,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     log::info!("set-up (BVH, upload, photon map) in {:.2} s", start.elapsed().as_secs_f64());
     print_profile(&gpu, args.profile, "set-up", 1, "set-up")?;
     if let Some((bundle, directions)) = gather_info {
-        if settings.gather == rastergi::gather::GatherMethod::Auto {
+        if a.gather.method() == rastergi::gather::GatherMethod::Auto {
             log::info!("gather ray view: {bundle}x{bundle} texels; auto chooses the gather on the first iterations");
         } else {
             log::info!("gather ray view: {bundle}x{bundle} texels; directions {directions:?}");

@@ -42,8 +42,8 @@ pub mod stream {
     pub const GATHER_SHARED: u32 = 0x5bd1e995;
     /// The key of the per-pixel gather directions' scramble seeds, keyed (restart).
     pub const GATHER_PIXEL: u32 = 0x3c6ef372;
-    /// The light sample at a gather hit (`HitLight::Exact`), keyed (pixel, iteration ⊕ a hash
-    /// of the direction).
+    /// The light samples at gather hits (`HitLight::Exact`): the key of the pixels' Sobol'
+    /// scramble seeds (not the restart's).
     pub const HIT_LIGHT: u32 = 0xa54ff53a;
     /// The ray view's sub-texel offset, keyed (direction index, restart).
     pub const TEXEL_JITTER: u32 = 0x7e1a5;

@@ -48,7 +48,7 @@ pub fn light_sample_key(seed: u32) -> u32 {
 /// The position of the 32-bit fraction `a` (a / 2³²) inside the cdf interval [c₋, c₊) of
 /// light entry `e` of `lights`, rescaled to [0, 1): `(a − c₋)/(c₊ − c₋)` computed on the
 /// 32-bit offset, so it keeps 24 significant bits however small the interval. Mirrors
-/// `remap_in_entry` in `direct.wgsl` (the same operations; the GPU's division may round
+/// `remap_in_entry` in `gpu_scene.wgsl` (the same operations; the GPU's division may round
 /// differently in the last bit).
 pub fn remap_in_entry(a: u32, lights: &LightTable, e: usize) -> f32 {
     let lo = if e > 0 { lights.entries[e - 1].cdf } else { 0.0 };
@@ -61,7 +61,7 @@ pub fn remap_in_entry(a: u32, lights: &LightTable, e: usize) -> f32 {
 /// (x, y) for `seed`: the Owen-scrambled Sobol' point (a, b) = [`sobol_owen_2d`]`(j, s)`
 /// with s = [`pixel_seed`]`(`[`light_sample_key`]`(seed), x, y)`; u0 = a, u1 = a's position
 /// in the picked entry's cdf interval ([`remap_in_entry`]), u2 = b. Mirrors
-/// `direct_light_uniforms` in `direct.wgsl`.
+/// `light_sample_uniforms` in `gpu_scene.wgsl`.
 pub fn light_sample_uniforms(seed: u32, x: u32, y: u32, j: u32, lights: &LightTable) -> [f32; 3] {
     let [a, b] = sobol_owen_2d(j, pixel_seed(light_sample_key(seed), x, y));
     let u0 = unit_f32(a);

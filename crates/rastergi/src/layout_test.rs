@@ -48,7 +48,7 @@ fn twins() -> Vec<Twin> {
         twin!(
             GatherUniforms,
             "Gather",
-            [view_proj, direction, bundle, count, per_pixel, pixel_key, first_index, directions]
+            [view_proj, direction, bundle, count, per_pixel, pixel_key, first_index, current, directions]
         ),
         twin!(
             PhotonParams,

@@ -51,8 +51,12 @@ pub struct GatherUniforms {
     pub per_pixel: u32,
     /// Trace, per-pixel: [`PixelSamples::key`].
     pub pixel_key: u32,
-    /// Trace, per-pixel: [`PixelSamples::first_index`].
+    /// The sample index of the iteration's first direction, i·K: direction k has index
+    /// `first_index + k` (its per-pixel Sobol' point, its light sample at the hit).
     pub first_index: u32,
+    /// Raster: the index among the iteration's directions of the ray view's.
+    pub current: u32,
+    pub _pad: [u32; 3],
     /// Trace, shared directions: all the iteration's directions (xyz).
     pub directions: [[f32; 4]; MAX_DIRECTIONS as usize],
 }
@@ -138,6 +142,8 @@ pub struct GatherInputs<'a> {
     pub samples: &'a [GatherSample],
     /// Where each pixel draws its own directions instead (then only `samples.len()` counts).
     pub pixel_samples: Option<PixelSamples>,
+    /// The sample index of the iteration's first direction: iteration · K.
+    pub first_index: u32,
     pub uniforms: &'a wgpu::Buffer,
     pub bundle: u32,
 }
@@ -151,7 +157,14 @@ impl<'a> GatherInputs<'a> {
     /// Writes the uniforms with sample `current` as the ray view. The write lands before the
     /// next submission: work already in an encoder sees it too.
     pub fn write_uniforms(&self, gpu: &Gpu, current: usize) {
-        let u = GatherUniforms::new(&self.scene.bounds, self.samples, current, self.bundle, self.pixel_samples);
+        let u = GatherUniforms::new(
+            &self.scene.bounds,
+            self.samples,
+            current,
+            self.bundle,
+            self.first_index,
+            self.pixel_samples,
+        );
         gpu.queue.write_buffer(self.uniforms, 0, bytemuck::bytes_of(&u));
     }
 

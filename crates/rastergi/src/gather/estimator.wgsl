@@ -5,8 +5,9 @@
 // L(h → x) for the hit point h on triangle tri at barycentrics b, seen along w from x:
 // ρ_h/π · E(h) on the side of h facing x, zero from the back of a one-sided h. E(h) is the
 // photon map's, or — for a map of indirect light only — the map's plus the direct irradiance
-// from one light sample with a shadow ray (hit_direct). `pixel` keys the light sample's stream.
-fn gather_radiance(w: vec3f, tri: u32, hit: vec3f, b: vec2f, pixel: u32) -> vec3f {
+// from one light sample with a shadow ray (hit_direct): sample j (the gather direction's
+// sample index) of the pixel's sequence.
+fn gather_radiance(w: vec3f, tri: u32, hit: vec3f, b: vec2f, pixel: u32, j: u32) -> vec3f {
     let t = triangles[tri];
     let n_h = triangle_normal(t);
     let front_h = dot(w, n_h) < 0.0;
@@ -17,7 +18,7 @@ fn gather_radiance(w: vec3f, tri: u32, hit: vec3f, b: vec2f, pixel: u32) -> vec3
     let albedo_h = surface_at(tri, b.x, b.y, 0.0).albedo;
     var e = photon_irradiance(hit, tri, !front_h);
     if photon_grid.indirect_only != 0u {
-        e += hit_direct(hit, select(-n_h, n_h, front_h), tri, w, pixel);
+        e += hit_direct(hit, select(-n_h, n_h, front_h), tri, pixel, j);
     }
     return albedo_h / PI * e;
 }
@@ -25,8 +26,8 @@ fn gather_radiance(w: vec3f, tri: u32, hit: vec3f, b: vec2f, pixel: u32) -> vec3
 // Shared directions, bidirectional: ω uniform on the sphere, and x gathers along whichever of
 // ±ω lies above its surface (w = sign(n·ω)·ω, uniform on x's hemisphere, pdf 1/2π):
 // (ρ_x/π) · L(h → x) · cos θ_x · 2π, cos θ_x = n·w > 0.
-fn gather_estimate(p: VisiblePoint, cos_x: f32, w: vec3f, tri: u32, hit: vec3f, b: vec2f, pixel: u32) -> vec3f {
-    return p.x.albedo / PI * gather_radiance(w, tri, hit, b, pixel) * (cos_x * 2.0 * PI);
+fn gather_estimate(p: VisiblePoint, cos_x: f32, w: vec3f, tri: u32, hit: vec3f, b: vec2f, pixel: u32, j: u32) -> vec3f {
+    return p.x.albedo / PI * gather_radiance(w, tri, hit, b, pixel, j) * (cos_x * 2.0 * PI);
 }
 
 // The side of shared direction ω that x gathers along: ω, or −ω where ω lies below x's surface.
@@ -36,21 +37,22 @@ fn gather_side(n: vec3f, w: vec3f) -> vec3f {
 
 // Per-pixel directions, cosine-distributed about n_x (pdf cos θ_x/π): the cosine and the π
 // cancel, ρ_x · L(h → x).
-fn gather_estimate_cosine(p: VisiblePoint, w: vec3f, tri: u32, hit: vec3f, b: vec2f, pixel: u32) -> vec3f {
-    return p.x.albedo * gather_radiance(w, tri, hit, b, pixel);
+fn gather_estimate_cosine(p: VisiblePoint, w: vec3f, tri: u32, hit: vec3f, b: vec2f, pixel: u32, j: u32) -> vec3f {
+    return p.x.albedo * gather_radiance(w, tri, hit, b, pixel, j);
 }
 
-// Direct irradiance at h (side normal n) from one light sample (light_sample_irradiance).
-// The stream is keyed by pixel and by iteration ⊕ a hash of ω, so each direction of an
-// iteration draws its own sample.
-fn hit_direct(h: vec3f, n: vec3f, tri: u32, w: vec3f, pixel: u32) -> vec3f {
+// Direct irradiance at h (side normal n) from one light sample (light_sample_irradiance):
+// sample j of the pixel's own Owen-scrambled Sobol' sequence (light_sample_uniforms, as the
+// direct pass draws them), whose seed depends on (seed, pixel) only. j is the gather
+// direction's sample index i·K + k, so an iteration's K hits take an aligned block of the
+// sequence and the iterations keep stratifying it; the index shuffle of sobol_owen_2d keeps
+// it independent of the per-pixel directions, which use the same indices with other seeds.
+fn hit_direct(h: vec3f, n: vec3f, tri: u32, pixel: u32, j: u32) -> vec3f {
     if !has_lights() {
         return vec3f(0.0);
     }
-    let wk = pcg_hash(bitcast<u32>(w.x) ^ pcg_hash(bitcast<u32>(w.y) ^ pcg_hash(bitcast<u32>(w.z))));
-    var rng = rng_new(frame.seed ^ STREAM_HIT_LIGHT, pixel, frame.iteration ^ wk);
-    let u0 = rng_f32(&rng);
-    let u1 = rng_f32(&rng);
-    let u2 = rng_f32(&rng);
-    return light_sample_irradiance(h + n * frame.ray_epsilon, n, tri, frame.ray_epsilon, u0, u1, u2);
+    let xy = vec2u(pixel % frame.resolution.x, pixel / frame.resolution.x);
+    let seed = pixel_seed(pcg_hash(frame.seed ^ STREAM_HIT_LIGHT), xy.x, xy.y);
+    let u = light_sample_uniforms(j, seed);
+    return light_sample_irradiance(h + n * frame.ray_epsilon, n, tri, frame.ray_epsilon, u.x, u.y, u.z);
 }

@@ -456,6 +456,7 @@ impl GatherPass {
             height: f.height,
             samples: &samples,
             pixel_samples,
+            first_index: iteration.wrapping_mul(samples.len() as u32),
             uniforms: &uniforms,
             bundle: self.bundle,
         };

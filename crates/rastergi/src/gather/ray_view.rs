@@ -75,13 +75,15 @@ pub fn ray_view_pipeline(
 
 /// The uniforms are built here, where the ray view is: the raster gathers read its matrix.
 impl GatherUniforms {
-    /// The uniforms for `samples` with sample `current` as the raster gathers' ray view of a
-    /// `bundle`² view over `bounds`; with `pixel`, the traced gather's per-pixel directions.
+    /// The uniforms for `samples` (sample indices `first_index` on) with sample `current` as
+    /// the raster gathers' ray view of a `bundle`² view over `bounds`; with `pixel`, the
+    /// traced gather's per-pixel directions.
     pub fn new(
         bounds: &Aabb,
         samples: &[GatherSample],
         current: usize,
         bundle: u32,
+        first_index: u32,
         pixel: Option<PixelSamples>,
     ) -> GatherUniforms {
         let s = samples[current];
@@ -96,7 +98,9 @@ impl GatherUniforms {
             count: samples.len() as u32,
             per_pixel: pixel.is_some() as u32,
             pixel_key: pixel.map_or(0, |p| p.key),
-            first_index: pixel.map_or(0, |p| p.first_index),
+            first_index,
+            current: current as u32,
+            _pad: [0; 3],
             directions,
         }
     }

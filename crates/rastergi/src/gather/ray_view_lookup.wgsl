@@ -34,21 +34,23 @@ fn on_triangle(b: vec2f) -> bool {
 
 // The exact nearest hit along ω from x (BVH), for the rays a texel cannot answer: the
 // estimate, or zero where the ray escapes.
-fn traced_estimate(p: VisiblePoint, cos_x: f32, w: vec3f, pixel: u32) -> vec3f {
+fn traced_estimate(p: VisiblePoint, cos_x: f32, w: vec3f, pixel: u32, j: u32) -> vec3f {
     let h = trace(p.x.pos, w, frame.ray_epsilon, 3.0e38, p.x.tri, NO_TRIANGLE, false);
     if h.tri == NO_TRIANGLE {
         return vec3f(0.0);
     }
-    return gather_estimate(p, cos_x, w, h.tri, p.x.pos + w * h.t, vec2f(h.b1, h.b2), pixel);
+    return gather_estimate(p, cos_x, w, h.tri, p.x.pos + w * h.t, vec2f(h.b1, h.b2), pixel, j);
 }
 
 // The estimate for the texel surface tri whose plane x's ray crosses at distance dist: at
 // that crossing where it lies on the triangle, else by tracing the ray (traced_estimate).
+// The ray view's direction has sample index first_index + current (the hit's light sample).
 fn texel_estimate(p: VisiblePoint, cos_x: f32, w: vec3f, tri: u32, dist: f32, pixel: u32) -> vec3f {
     let hit = p.x.pos + w * dist;
     let b = plane_barycentrics(triangles[tri], hit);
+    let j = gather.first_index + gather.current;
     if on_triangle(b) {
-        return gather_estimate(p, cos_x, w, tri, hit, b, pixel);
+        return gather_estimate(p, cos_x, w, tri, hit, b, pixel, j);
     }
-    return traced_estimate(p, cos_x, w, pixel);
+    return traced_estimate(p, cos_x, w, pixel, j);
 }

@@ -34,10 +34,11 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         if h.tri != NO_TRIANGLE {
             let hit = p.x.pos + w * h.t;
             let b = vec2f(h.b1, h.b2);
+            let j = gather.first_index + k;
             if per_pixel {
-                sum += gather_estimate_cosine(p, w, h.tri, hit, b, pixel);
+                sum += gather_estimate_cosine(p, w, h.tri, hit, b, pixel, j);
             } else {
-                sum += gather_estimate(p, cos_x, w, h.tri, hit, b, pixel);
+                sum += gather_estimate(p, cos_x, w, h.tri, hit, b, pixel, j);
             }
         }
     }

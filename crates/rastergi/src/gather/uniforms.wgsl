@@ -8,11 +8,15 @@ struct Gather {
     bundle: u32,
     // Directions this iteration; each estimate is weighted 1/count.
     count: u32,
-    // Trace: 1 where each pixel draws its own directions (then `directions` is unused), the
-    // key of the pixels' scramble seeds and the sample index of the iteration's first.
+    // Trace: 1 where each pixel draws its own directions (then `directions` is unused) and the
+    // key of the pixels' scramble seeds.
     per_pixel: u32,
     pixel_key: u32,
+    // The sample index of the iteration's first direction (i·K), and the index among the
+    // iteration's directions of the ray view's (raster): direction k has sample index
+    // first_index + k.
     first_index: u32,
+    current: u32,
     // Trace, shared directions: all of them (xyz).
     directions: array<vec4f, MAX_DIRECTIONS>,
 }

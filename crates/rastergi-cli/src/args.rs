@@ -164,6 +164,13 @@ pub struct SceneArgs {
     /// Seed of every random decision; the same seed gives the same image.
     #[arg(long, default_value_t = 0)]
     pub seed: u32,
+    /// Adds the sun: AZIMUTH,ELEVATION,IRRADIANCE — degrees from +Z towards +X about the +Y
+    /// axis, degrees above the XZ plane, W/m² on a surface facing it (e.g. 30,45,1000).
+    #[arg(long, value_parser = parse_sun, allow_hyphen_values = true)]
+    pub sun: Option<Vec3>,
+    /// The sun's angular diameter in degrees (its soft shadows; 0 for a sharp one).
+    #[arg(long, default_value_t = 0.53, requires = "sun", value_parser = parse_sun_size)]
+    pub sun_size: f32,
     /// Light samples per pixel per iteration.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=64))]
     pub light_samples: u32,
@@ -227,6 +234,16 @@ impl SceneArgs {
         c.up = self.up.unwrap_or(c.up);
         c.fov_y_deg = self.fov.unwrap_or(c.fov_y_deg);
         scene.camera.validate()?;
+        if let Some(sun) = self.sun {
+            scene.lights.push(sun_light(sun, self.sun_size));
+        }
+        if scene.lights.is_empty() && scene.emissive_triangles().is_empty() {
+            log::warn!(
+                "{}: the scene has no light, so it renders black: give it emission (OBJ Ke, glTF \
+                 emissiveFactor), glTF KHR_lights_punctual lights, or --sun AZIMUTH,ELEVATION,IRRADIANCE",
+                self.scene
+            );
+        }
         Ok(scene)
     }
 
@@ -257,6 +274,37 @@ impl SceneArgs {
             hit_light: self.hit_light.hit_light(),
         }
     }
+}
+
+/// The sun of `--sun` (azimuth, elevation in degrees, irradiance) with angular diameter
+/// `size` degrees: light travelling along −(sin a cos e, sin e, cos a cos e).
+pub fn sun_light(sun: Vec3, size: f32) -> rastergi::scene::Light {
+    let (a, e) = (sun.x.to_radians(), sun.y.to_radians());
+    let towards = Vec3::new(a.sin() * e.cos(), e.sin(), a.cos() * e.cos());
+    rastergi::scene::Light::Distant {
+        direction: -towards.normalize(),
+        irradiance: Vec3::splat(sun.z),
+        angular_radius: 0.5 * size.to_radians(),
+    }
+}
+
+fn parse_sun(s: &str) -> Result<Vec3, String> {
+    let v = parse_vec3(s).map_err(|e| format!("{e} (azimuth°,elevation°,irradiance W/m²)"))?;
+    if !(-90.0..=90.0).contains(&v.y) {
+        return Err(format!("the sun's elevation {}° is not within -90..90", v.y));
+    }
+    if v.z < 0.0 {
+        return Err(format!("the sun's irradiance {} W/m² is negative", v.z));
+    }
+    Ok(v)
+}
+
+fn parse_sun_size(s: &str) -> Result<f32, String> {
+    let d: f32 = s.parse().map_err(|_| format!("'{s}' is not a number of degrees"))?;
+    if !(0.0..=57.0).contains(&d) {
+        return Err(format!("the sun's angular diameter {d}° is not within 0..57"));
+    }
+    Ok(d)
 }
 
 fn parse_vec3(s: &str) -> Result<Vec3, String> {

@@ -260,3 +260,53 @@ fn bench_memory_reports_the_allocations_and_their_total() {
         assert!(mib >= 0.375, "{t}");
     }
 }
+
+/// A 4 m square floor at y = 0 facing up (grey 0.5, no light), as OBJ in `dir`.
+fn floor_obj(dir: &Path) -> &'static str {
+    std::fs::write(dir.join("floor.obj"), "v -2 0 -2\nv 2 0 -2\nv 2 0 2\nv -2 0 2\nf 1 3 2\nf 1 4 3\n").unwrap();
+    "floor.obj"
+}
+
+#[test]
+fn a_scene_without_light_warns_and_the_sun_lights_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let floor = floor_obj(dir.path());
+    let camera = ["--eye", "0,3,0.01", "--target", "0,0,0", "--fov", "40", "--width", "16", "--height", "16"];
+    let dark =
+        rastergi(dir.path(), &[&["render", floor, "--iterations", "1", "--out", "dark.exr"], &camera[..]].concat());
+    assert!(dark.status.success(), "{}", dark.stderr);
+    let warnings: Vec<&str> = dark.our_stderr().into_iter().filter(|l| l.contains("has no light")).collect();
+    assert_eq!(warnings.len(), 1, "one warning line:\n{}", dark.stderr);
+    assert!(warnings[0].contains("--sun") && warnings[0].contains("Ke"), "{}", warnings[0]);
+    // Sun at 30° elevation (azimuth 90°: towards +X), 2 W/m², a point (size 0): the floor gets
+    // E sin 30° = 1, radiance ρ/π · 1 everywhere (nothing shadows it, nothing comes back).
+    let sun = ["--sun", "90,30,2", "--sun-size", "0"];
+    let lit = rastergi(
+        dir.path(),
+        &[&["render", floor, "--iterations", "4", "--out", "lit.exr"], &camera[..], &sun[..]].concat(),
+    );
+    assert!(lit.status.success(), "{}", lit.stderr);
+    assert!(!lit.stderr.contains("has no light"), "{}", lit.stderr);
+    let img = rastergi::image_io::read_exr(&dir.path().join("lit.exr")).unwrap();
+    let expected = 0.5 / std::f32::consts::PI;
+    for p in &img.pixels {
+        assert!(p.iter().all(|&v| (v - expected).abs() < 1e-5 * expected), "{p:?} against {expected}");
+    }
+}
+
+#[test]
+fn sun_options_out_of_range_are_usage_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    for (args, fragment) in [
+        (&["--sun", "0,100,5"][..], "elevation"),
+        (&["--sun", "0,45,-1"][..], "negative"),
+        (&["--sun", "0,45"][..], "three"),
+        (&["--sun", "0,45,1", "--sun-size", "90"][..], "diameter"),
+        (&["--sun-size", "1"][..], "--sun"),
+    ] {
+        let run = rastergi(dir.path(), &[&["render", "cornell", "--out", "x.png"], args].concat());
+        assert_eq!(run.status.code(), Some(2), "{args:?}:\n{}", run.stderr);
+        assert!(run.stderr.contains(fragment), "{args:?}: {}", run.stderr);
+        assert!(files_in(dir.path()).is_empty());
+    }
+}

@@ -10,6 +10,14 @@ pub const MATERIAL_TWO_SIDED: u32 = 1;
 /// A material without an albedo texture.
 pub const NO_TEXTURE: u32 = u32::MAX;
 
+/// Light-table entry bit of a point, spot or distant light ([`crate::lights`]); the other
+/// bits index the punctual lights.
+pub const PUNCTUAL_LIGHT: u32 = 1 << 31;
+/// Punctual light kinds ([`crate::lights::PunctualLight::kind`]).
+pub const LIGHT_POINT: u32 = 0;
+pub const LIGHT_SPOT: u32 = 1;
+pub const LIGHT_DISTANT: u32 = 2;
+
 /// Film component: emission + direct light (the path tracer's full image) ([`crate::film`]).
 pub const FILM_DIRECT: u32 = 0;
 /// Film component: indirect light from the final gather.

@@ -144,6 +144,11 @@ impl GpuScene {
         };
         let (texture_view, sampler) = prepared.textures.upload(gpu);
         let lights: Vec<LightEntry> = prepared.lights.entries.clone();
+        // A binding cannot be empty: one zero light where the scene has none.
+        let mut punctual = prepared.lights.punctual.clone();
+        if punctual.is_empty() {
+            punctual.push(bytemuck::Zeroable::zeroed());
+        }
         let nodes: &[BvhNode] = &prepared.bvh.nodes;
         let none = wgpu::BufferUsages::empty();
         let buffers = [
@@ -152,6 +157,7 @@ impl GpuScene {
             gpu.storage_buffer("scene bvh nodes", bytemuck::cast_slice(nodes), none),
             gpu.storage_buffer("scene lights", bytemuck::cast_slice(&lights), none),
             gpu.storage_buffer("scene texture coordinates", bytemuck::cast_slice(&uvs), none),
+            gpu.storage_buffer("scene punctual lights", bytemuck::cast_slice(&punctual), none),
         ];
         let vis = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
         let layout = gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -178,12 +184,15 @@ impl GpuScene {
                     ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
                     count: None,
                 },
+                storage_entry::<crate::lights::PunctualLight>(7, vis, true),
             ],
         });
+        // The buffers' bindings, in the order of `buffers`.
+        const BUFFER_BINDINGS: [u32; 6] = [0, 1, 2, 3, 4, 7];
         let mut entries: Vec<wgpu::BindGroupEntry> = buffers
             .iter()
-            .enumerate()
-            .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
+            .zip(BUFFER_BINDINGS)
+            .map(|(b, binding)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() })
             .collect();
         entries.push(wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&texture_view) });
         entries.push(wgpu::BindGroupEntry { binding: 6, resource: wgpu::BindingResource::Sampler(&sampler) });

@@ -25,6 +25,8 @@ struct BvhNode {
     count: u32,
 }
 
+// A light of the distribution (lights.rs): `triangle` is the emissive triangle, or
+// PUNCTUAL_LIGHT | the index of a punctual light.
 struct LightEntry {
     triangle: u32,
     cdf: f32,
@@ -32,10 +34,24 @@ struct LightEntry {
     area: f32,
 }
 
+// A point, spot or distant light (lights.rs, PunctualLight).
+struct PunctualLight {
+    position: vec3f,
+    kind: u32,
+    direction: vec3f,
+    cos_outer: f32,
+    intensity: vec3f,
+    cos_inner: f32,
+    disc_centre: vec3f,
+    disc_radius: f32,
+}
+
 @group(0) @binding(0) var<storage, read> triangles: array<Triangle>;
 @group(0) @binding(1) var<storage, read> materials: array<Material>;
 @group(0) @binding(2) var<storage, read> bvh_nodes: array<BvhNode>;
 @group(0) @binding(3) var<storage, read> lights: array<LightEntry>;
+// The point, spot and distant lights (one zero light when the scene has none).
+@group(0) @binding(7) var<storage, read> punctual: array<PunctualLight>;
 // Texture coordinates of the triangles' corners, three per triangle (one zero triangle when
 // the scene has none).
 @group(0) @binding(4) var<storage, read> uvs: array<vec2f>;
@@ -45,6 +61,9 @@ struct LightEntry {
 @group(0) @binding(6) var texture_sampler: sampler;
 
 // MATERIAL_TWO_SIDED and NO_TEXTURE: shader::constants.
+
+// No triangle (a miss; an emitter that is not a triangle; no triangle to skip).
+const NO_TRIANGLE: u32 = 0xffffffffu;
 
 // A point on a surface: position, front-face geometric normal and material.
 struct Surface {
@@ -174,6 +193,112 @@ fn light_sample_uniforms(j: u32, seed: u32) -> vec3f {
     let p = sobol_owen_2d(j, seed);
     let u0 = unit_f32(p.x);
     return vec3f(u0, remap_in_entry(p.x, light_pick(u0)), unit_f32(p.y));
+}
+
+// The spot's falloff s(cos θ) (lights.rs: PunctualLight::falloff); 1 for the other kinds.
+fn spot_falloff(p: PunctualLight, cos_theta: f32) -> f32 {
+    if p.kind != LIGHT_SPOT {
+        return 1.0;
+    }
+    let t = clamp((cos_theta - p.cos_outer) / max(p.cos_inner - p.cos_outer, 1e-3), 0.0, 1.0);
+    return t * t;
+}
+
+// A direction uniform within the cone of half-angle acos(cos_max) about axis (lights.rs:
+// cone_direction).
+fn cone_direction(axis: vec3f, cos_max: f32, u1: f32, u2: f32) -> vec3f {
+    let cos_t = 1.0 - u1 * (1.0 - cos_max);
+    let sin_t = sqrt(max(1.0 - cos_t * cos_t, 0.0));
+    let phi = 2.0 * PI * u2;
+    let tb = orthonormal_basis(axis);
+    return normalize(tb[0] * (sin_t * cos(phi)) + tb[1] * (sin_t * sin(phi)) + axis * cos_t);
+}
+
+// A light sample as seen from a point x: the unit direction from x towards the light, the
+// shadow ray's length (to the light's point; 3e38 for a distant light), e such that the
+// estimate of the irradiance at x on a surface of normal n is e · max(0, n·dir), and the
+// emitter triangle (excluded from the shadow ray; NO_TRIANGLE for a punctual light).
+//   triangle: e = Le cos θ_y / (d² p_A)    point: I / (d² pmf)    spot: I s(cos θ) / (d² pmf)
+//   distant:  e = E / pmf, dir uniform in its cone (E cos θ_x = L Ω cos θ_x for its radiance L)
+struct LightRay {
+    dir: vec3f,
+    dist: f32,
+    e: vec3f,
+    tri: u32,
+}
+
+fn sample_light_at(x: vec3f, u0: f32, u1: f32, u2: f32) -> LightRay {
+    var r: LightRay;
+    let entry = lights[light_pick(u0)];
+    if (entry.triangle & PUNCTUAL_LIGHT) == 0u {
+        let l = sample_light(u0, u1, u2);
+        let to_light = l.pos - x;
+        let dist2 = dot(to_light, to_light);
+        r.dist = sqrt(dist2);
+        r.dir = to_light / r.dist;
+        r.tri = l.tri;
+        let cos_y = -dot(l.normal, r.dir);
+        r.e = select(vec3f(0.0), l.radiance * (cos_y / (dist2 * l.pdf_area)), cos_y > 0.0);
+        return r;
+    }
+    let p = punctual[entry.triangle & ~PUNCTUAL_LIGHT];
+    r.tri = NO_TRIANGLE;
+    if p.kind == LIGHT_DISTANT {
+        r.dir = -cone_direction(p.direction, p.cos_outer, u1, u2);
+        r.dist = 3.0e38;
+        r.e = p.intensity / entry.pmf;
+        return r;
+    }
+    let to_light = p.position - x;
+    let dist2 = dot(to_light, to_light);
+    r.dist = sqrt(dist2);
+    r.dir = to_light / r.dist;
+    r.e = p.intensity * (spot_falloff(p, -dot(p.direction, r.dir)) / (dist2 * entry.pmf));
+    return r;
+}
+
+// A photon leaving the lights (lights.rs: LightTable::emit_photon): origin, direction, flux ×
+// the photon count, and the emitter triangle to skip (NO_TRIANGLE for a punctual light).
+struct PhotonStart {
+    origin: vec3f,
+    skip: u32,
+    dir: vec3f,
+    flux: vec3f,
+}
+
+fn emit_photon(u0: f32, u1: f32, u2: f32, u3: f32, u4: f32, eps: f32) -> PhotonStart {
+    var s: PhotonStart;
+    let entry = lights[light_pick(u0)];
+    if (entry.triangle & PUNCTUAL_LIGHT) == 0u {
+        let l = sample_light(u0, u1, u2);
+        // Φ = π·Le·A/pmf.
+        s.flux = l.radiance * (PI / l.pdf_area);
+        s.dir = cosine_hemisphere(l.normal, u3, u4);
+        s.origin = l.pos + l.normal * eps;
+        s.skip = l.tri;
+        return s;
+    }
+    let p = punctual[entry.triangle & ~PUNCTUAL_LIGHT];
+    s.skip = NO_TRIANGLE;
+    if p.kind == LIGHT_POINT {
+        s.origin = p.position;
+        s.dir = uniform_sphere(u3, u4);
+        s.flux = p.intensity * (4.0 * PI / entry.pmf);
+    } else if p.kind == LIGHT_SPOT {
+        s.origin = p.position;
+        s.dir = cone_direction(p.direction, p.cos_outer, u3, u4);
+        let solid = 2.0 * PI * (1.0 - p.cos_outer);
+        s.flux = p.intensity * (spot_falloff(p, dot(p.direction, s.dir)) * solid / entry.pmf);
+    } else {
+        let tb = orthonormal_basis(p.direction);
+        let r = p.disc_radius * sqrt(u1);
+        let phi = 2.0 * PI * u2;
+        let centre = p.disc_centre - p.direction * p.disc_radius;
+        s.origin = centre + (tb[0] * cos(phi) + tb[1] * sin(phi)) * r;
+        s.dir = cone_direction(p.direction, p.cos_outer, u3, u4);
+        s.flux = p.intensity * (PI * p.disc_radius * p.disc_radius / entry.pmf);
+    }
+    return s;
 }
 
 struct LightSample {

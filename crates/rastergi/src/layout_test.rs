@@ -13,7 +13,7 @@ use crate::film::ResolveUniforms;
 use crate::frame::FrameUniforms;
 use crate::gather::GatherUniforms;
 use crate::gpu_scene::{GpuMaterial, GpuTriangle};
-use crate::lights::LightEntry;
+use crate::lights::{LightEntry, PunctualLight};
 use crate::path_tracer::PathParams;
 use crate::photons::gpu::{PhotonGridUniforms, PhotonParams};
 use crate::photons::map::TrianglePlane;
@@ -45,6 +45,11 @@ fn twins() -> Vec<Twin> {
         twin!(GpuMaterial, "Material", [albedo, flags, emission, texture]),
         twin!(BvhNode, "BvhNode", [min, offset, max, count]),
         twin!(LightEntry, "LightEntry", [triangle, cdf, pmf, area]),
+        twin!(
+            PunctualLight,
+            "PunctualLight",
+            [position, kind, direction, cos_outer, intensity, cos_inner, disc_centre, disc_radius]
+        ),
         twin!(
             GatherUniforms,
             "Gather",

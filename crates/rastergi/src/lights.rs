@@ -1,62 +1,167 @@
-//! The emitters of a scene as a discrete distribution: a triangle is chosen with probability
-//! proportional to its emitted power π·A·(Le.r + Le.g + Le.b), then a point uniformly on it.
-//! The same table drives the photon pass (emission) and the direct pass (light samples).
+//! The lights of a scene as one discrete distribution by power: an emissive triangle (then a
+//! point uniformly on it), a point or spot light, or a distant light (the sun). Entry weights
+//! are Φ/π summed over R, G and B: A·ΣLe for a triangle (Φ = π·A·Le), 4·ΣI for a point light
+//! (Φ = 4π·I), 2(1 − cos θ_o)·ΣI for a spot (its outer cone's solid angle times I, over π),
+//! R²·ΣE for a distant light (Φ = E·πR² through a disc covering the scene's bounding sphere
+//! of radius R). The same table drives the photon pass (emission), the direct pass and the
+//! gather's exact hit light (light samples) and the path tracer.
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
-use crate::scene::{Scene, triangle_area};
+use crate::sampling::{cosine_hemisphere, orthonormal_basis, uniform_sphere, uniform_triangle};
+use crate::scene::{Light, Scene, triangle_area, triangle_normal};
 
-/// One emissive triangle, as stored on the GPU (`LightEntry` in `gpu_scene.wgsl`).
+/// [`LightEntry::triangle`] bit of an entry that is a [`PunctualLight`] (the other bits: its
+/// index in [`LightTable::punctual`]); [`PunctualLight::kind`] values.
+pub use crate::consts::{LIGHT_DISTANT, LIGHT_POINT, LIGHT_SPOT, PUNCTUAL_LIGHT};
+
+/// One light of the distribution, as stored on the GPU (`LightEntry` in `gpu_scene.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
 pub struct LightEntry {
-    /// Index of the triangle in the scene.
+    /// Index of the triangle in the scene, or [`PUNCTUAL_LIGHT`] | index of the punctual light.
     pub triangle: u32,
     /// Cumulative probability up to and including this entry.
     pub cdf: f32,
     /// Probability of choosing this entry.
     pub pmf: f32,
-    /// Area of the triangle.
+    /// Area of the triangle (1 for a punctual light).
     pub area: f32,
+}
+
+/// A point, spot or distant light as stored on the GPU (`PunctualLight` in `gpu_scene.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct PunctualLight {
+    /// Point and spot: where the light is.
+    pub position: [f32; 3],
+    /// [`LIGHT_POINT`], [`LIGHT_SPOT`] or [`LIGHT_DISTANT`].
+    pub kind: u32,
+    /// Spot: where it shines; distant: the way the light travels (unit).
+    pub direction: [f32; 3],
+    /// Spot: cos θ_o; distant: the cosine of its angular radius (1: one direction).
+    pub cos_outer: f32,
+    /// Intensity I (W/sr) or, distant, irradiance E (W/m²).
+    pub intensity: [f32; 3],
+    /// Spot: cos θ_i.
+    pub cos_inner: f32,
+    /// Distant: the centre of the scene's bounding sphere, which photons cross from a disc.
+    pub disc_centre: [f32; 3],
+    /// Distant: the photon disc's radius (the bounding sphere's, enlarged by 1 %).
+    pub disc_radius: f32,
+}
+
+impl PunctualLight {
+    /// The GPU form of `light` for a scene whose bounding sphere is (centre, radius).
+    pub fn new(light: &Light, centre: Vec3, radius: f32) -> PunctualLight {
+        let disc = |p: PunctualLight| PunctualLight { disc_centre: centre.into(), disc_radius: 1.01 * radius, ..p };
+        let zero = PunctualLight::zeroed();
+        match *light {
+            Light::Point { position, intensity } => PunctualLight {
+                position: position.into(),
+                kind: LIGHT_POINT,
+                intensity: intensity.into(),
+                cos_outer: -1.0,
+                cos_inner: -1.0,
+                ..zero
+            },
+            Light::Spot { position, direction, intensity, inner, outer } => PunctualLight {
+                position: position.into(),
+                kind: LIGHT_SPOT,
+                direction: direction.normalize().into(),
+                cos_outer: outer.cos(),
+                intensity: intensity.into(),
+                cos_inner: inner.cos(),
+                ..zero
+            },
+            Light::Distant { direction, irradiance, angular_radius } => disc(PunctualLight {
+                kind: LIGHT_DISTANT,
+                direction: direction.normalize().into(),
+                cos_outer: angular_radius.cos(),
+                intensity: irradiance.into(),
+                ..zero
+            }),
+        }
+    }
+
+    /// The spot's falloff s(cos θ) (glTF's: squared linear ramp between the cones; 1 for the
+    /// others). Mirrors `spot_falloff` in WGSL.
+    pub fn falloff(&self, cos_theta: f32) -> f32 {
+        if self.kind != LIGHT_SPOT {
+            return 1.0;
+        }
+        let t = ((cos_theta - self.cos_outer) / (self.cos_inner - self.cos_outer).max(1e-3)).clamp(0.0, 1.0);
+        t * t
+    }
+
+    /// Φ (RGB, W): 4π·I, I·∫s dω = 2π·I·((cos θ_i − cos θ_o)/3 + 1 − cos θ_i), E·πR².
+    pub fn power(&self) -> Vec3 {
+        let i = Vec3::from(self.intensity);
+        match self.kind {
+            LIGHT_POINT => 4.0 * std::f32::consts::PI * i,
+            LIGHT_SPOT => {
+                let ramp = (self.cos_inner - self.cos_outer) / 3.0 + (1.0 - self.cos_inner);
+                2.0 * std::f32::consts::PI * ramp * i
+            }
+            _ => std::f32::consts::PI * self.disc_radius * self.disc_radius * i,
+        }
+    }
+
+    /// The entry weight (module docs): Φ/π of the sampling density's support, summed over R, G, B.
+    fn weight(&self) -> f64 {
+        let i = Vec3::from(self.intensity);
+        let sum = (i.x + i.y + i.z) as f64;
+        match self.kind {
+            LIGHT_POINT => 4.0 * sum,
+            LIGHT_SPOT => 2.0 * (1.0 - self.cos_outer as f64) * sum,
+            _ => (self.disc_radius as f64).powi(2) * sum,
+        }
+    }
 }
 
 #[derive(Clone, Debug, Default)]
 pub struct LightTable {
     pub entries: Vec<LightEntry>,
+    /// The point, spot and distant lights that entries refer to.
+    pub punctual: Vec<PunctualLight>,
     /// Total emitted power Φ (RGB), in watts of the scene's units.
     pub power: Vec3,
+    /// Σ of the entries' weights (module docs): an emitter of radiance Le is picked with area
+    /// density ΣLe / weight.
+    pub weight: f64,
 }
 
 impl LightTable {
     pub fn new(scene: &Scene) -> Self {
         let tris = scene.emissive_triangles();
-        let weights: Vec<f64> = tris
+        let bounds = scene.bounds();
+        let (centre, radius) = (bounds.center(), 0.5 * bounds.extent().length());
+        let punctual: Vec<PunctualLight> = scene.lights.iter().map(|l| PunctualLight::new(l, centre, radius)).collect();
+        let mut weights: Vec<(u32, f64, f32)> = tris
             .iter()
             .map(|&i| {
                 let le = scene.material_of(i as usize).emission;
-                (triangle_area(&scene.triangles[i as usize]) * (le.x + le.y + le.z)) as f64
+                let area = triangle_area(&scene.triangles[i as usize]);
+                (i, (area * (le.x + le.y + le.z)) as f64, area)
             })
             .collect();
-        let total: f64 = weights.iter().sum();
+        weights.extend(punctual.iter().enumerate().map(|(k, p)| (PUNCTUAL_LIGHT | k as u32, p.weight(), 1.0)));
+        weights.retain(|w| w.1 > 0.0);
+        let total: f64 = weights.iter().map(|w| w.1).sum();
         let mut acc = 0.0f64;
-        let mut entries: Vec<LightEntry> = tris
+        let mut entries: Vec<LightEntry> = weights
             .iter()
-            .zip(&weights)
-            .map(|(&i, &w)| {
+            .map(|&(triangle, w, area)| {
                 acc += w;
-                LightEntry {
-                    triangle: i,
-                    cdf: (acc / total) as f32,
-                    pmf: (w / total) as f32,
-                    area: triangle_area(&scene.triangles[i as usize]),
-                }
+                LightEntry { triangle, cdf: (acc / total) as f32, pmf: (w / total) as f32, area }
             })
             .collect();
         if let Some(last) = entries.last_mut() {
             last.cdf = 1.0;
         }
-        Self { entries, power: scene.emitted_power() }
+        let power = scene.emitted_power() + punctual.iter().map(PunctualLight::power).sum::<Vec3>();
+        Self { entries, punctual, power, weight: total }
     }
 
     pub fn is_empty(&self) -> bool {
@@ -69,6 +174,82 @@ impl LightTable {
         let i = self.entries.partition_point(|e| e.cdf <= u);
         &self.entries[i.min(self.entries.len() - 1)]
     }
+
+    /// The largest flux × N, over entries and channels, that a photon starts with
+    /// ([`LightTable::emit_photon`]; a spot's falloff at most 1).
+    pub fn max_photon_flux(&self, scene: &Scene) -> f64 {
+        (self.entries.iter())
+            .map(|e| {
+                let per_pmf = if e.triangle & PUNCTUAL_LIGHT == 0 {
+                    let le = scene.material_of(e.triangle as usize).emission;
+                    std::f64::consts::PI * le.max_element() as f64 * e.area as f64
+                } else {
+                    let p = &self.punctual[(e.triangle & !PUNCTUAL_LIGHT) as usize];
+                    let i = Vec3::from(p.intensity).max_element() as f64;
+                    let support = match p.kind {
+                        LIGHT_POINT => 4.0 * std::f64::consts::PI,
+                        LIGHT_SPOT => 2.0 * std::f64::consts::PI * (1.0 - p.cos_outer as f64),
+                        _ => std::f64::consts::PI * (p.disc_radius as f64).powi(2),
+                    };
+                    i * support
+                };
+                per_pmf / e.pmf as f64
+            })
+            .fold(0.0, f64::max)
+    }
+
+    /// A photon leaving the lights, from uniforms (u0 … u4): (origin, direction, flux × N,
+    /// the emitter triangle or `None`), `eps` the ray offset. Mirrors `emit_photon` in
+    /// `gpu_scene.wgsl`: a triangle's point uniformly (u1, u2) and direction cos θ/π (u3, u4),
+    /// flux π·Le·A/pmf; a point light's direction uniform on the sphere, 4π·I/pmf; a spot's
+    /// uniform in its outer cone, I·s(cos θ)·2π(1 − cos θ_o)/pmf; a distant light's origin
+    /// uniform on a disc of radius R across the bounding sphere (u1, u2) and direction uniform
+    /// in its cone (u3, u4), E·πR²/pmf.
+    pub fn emit_photon(&self, scene: &Scene, u: [f32; 5], eps: f32) -> (Vec3, Vec3, Vec3, Option<u32>) {
+        let e = self.pick(u[0]);
+        if e.triangle & PUNCTUAL_LIGHT == 0 {
+            let tri = &scene.triangles[e.triangle as usize];
+            let n = triangle_normal(tri);
+            let le = scene.material_of(e.triangle as usize).emission;
+            let flux = le * (std::f32::consts::PI * e.area / e.pmf);
+            let pos = uniform_triangle(tri, u[1], u[2]);
+            return (pos + n * eps, cosine_hemisphere(n, u[3], u[4]), flux, Some(e.triangle));
+        }
+        let p = &self.punctual[(e.triangle & !PUNCTUAL_LIGHT) as usize];
+        let i = Vec3::from(p.intensity);
+        let axis = Vec3::from(p.direction);
+        match p.kind {
+            LIGHT_POINT => {
+                let flux = i * (4.0 * std::f32::consts::PI / e.pmf);
+                (Vec3::from(p.position), uniform_sphere(u[3], u[4]), flux, None)
+            }
+            LIGHT_SPOT => {
+                let d = cone_direction(axis, p.cos_outer, u[3], u[4]);
+                let solid = 2.0 * std::f32::consts::PI * (1.0 - p.cos_outer);
+                let flux = i * (p.falloff(axis.dot(d)) * solid / e.pmf);
+                (Vec3::from(p.position), d, flux, None)
+            }
+            _ => {
+                let (t, b) = orthonormal_basis(axis);
+                let r = p.disc_radius * u[1].sqrt();
+                let phi = 2.0 * std::f32::consts::PI * u[2];
+                let centre = Vec3::from(p.disc_centre) - axis * p.disc_radius;
+                let origin = centre + (t * phi.cos() + b * phi.sin()) * r;
+                let flux = i * (std::f32::consts::PI * p.disc_radius * p.disc_radius / e.pmf);
+                (origin, cone_direction(axis, p.cos_outer, u[3], u[4]), flux, None)
+            }
+        }
+    }
+}
+
+/// A direction uniform within the cone of half-angle cos⁻¹(cos_max) about `axis` (pdf
+/// 1/(2π(1 − cos_max))); `axis` itself where cos_max = 1. Mirrors `cone_direction` in WGSL.
+pub fn cone_direction(axis: Vec3, cos_max: f32, u1: f32, u2: f32) -> Vec3 {
+    let cos_t = 1.0 - u1 * (1.0 - cos_max);
+    let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
+    let phi = 2.0 * std::f32::consts::PI * u2;
+    let (t, b) = orthonormal_basis(axis);
+    (t * (sin_t * phi.cos()) + b * (sin_t * phi.sin()) + axis * cos_t).normalize()
 }
 
 #[cfg(test)]

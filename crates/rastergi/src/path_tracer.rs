@@ -14,9 +14,11 @@
 //!
 //! - BSDF sampling: Lambertian BRDF ρ/π, directions with density p_σ(ω) = cos θ/π, so each
 //!   bounce multiplies the throughput by f·cos θ/p_σ = ρ.
-//! - Next-event estimation: one point yₖ on the emitters per vertex from the light table
-//!   (`sample_light`: a triangle by power, a point uniformly on it), density p_A(y) per
-//!   area, p_L = p_A(y) · |y − x|² / cos θ_y per solid angle at x.
+//! - Next-event estimation: one light sample per vertex from the light table
+//!   (`sample_light_at`: a light by power; on an emissive triangle a point uniformly, density
+//!   p_A(y) per area, p_L = p_A(y) · |y − x|² / cos θ_y per solid angle at x). Point, spot
+//!   and distant lights (`crate::lights`) are reached by light samples only: their term is
+//!   (ρₖ/π) · V · e · cos θₓ with weight 1 (e: I·s/(d²·pmf) or E/pmf, `sample_light_at`).
 //! - Multiple importance sampling, power heuristic: for the light sample
 //!   w_L = p_L² / (p_L² + p_σ²); for emission found by the BSDF-sampled direction from xₖ₋₁,
 //!   w_σ = p_σ² / (p_σ² + p_L²) with both densities of that direction at xₖ₋₁. Emission
@@ -45,7 +47,7 @@ use crate::gpu::{Gpu, buffer_bind_group, compute_pipeline, groups, storage_entry
 use crate::gpu_scene::{GpuScene, PreparedScene};
 use crate::image_io::{DisplayImage, LinearImage};
 use crate::renderer::RenderSettings;
-use crate::scene::{Camera, Scene, triangle_area};
+use crate::scene::{Camera, Scene};
 use crate::shader;
 
 /// Scattering events after which every path ends (a safety cap; roulette ends them first).
@@ -104,16 +106,7 @@ impl PathTracer {
         crate::limits::check_scene(&gpu.device.limits(), scene)?;
         let prepared = PreparedScene::new(scene);
         prepared.textures.check_limits(gpu)?;
-        let light_weight = prepared
-            .lights
-            .entries
-            .iter()
-            .map(|e| {
-                let t = e.triangle as usize;
-                let le = prepared.scene.material_of(t).emission.as_dvec3();
-                triangle_area(&prepared.scene.triangles[t]) as f64 * (le.x + le.y + le.z)
-            })
-            .sum::<f64>() as f32;
+        let light_weight = prepared.lights.weight as f32;
         let gpu_scene = GpuScene::new(gpu, &prepared)?;
         let frame = FrameBinding::new(gpu);
 

@@ -121,21 +121,22 @@ fn path_radiance(origin: vec3f, dir: vec3f, xy: vec2u, rng: ptr<function, u32>) 
         let u1 = rng_f32(rng);
         let u2 = rng_f32(rng);
         if params.light_count > 0u {
-            let l = sample_light(u0, u1, u2);
-            let to_light = l.pos - x;
-            let dist2 = dot(to_light, to_light);
-            let dist = sqrt(dist2);
-            let w = to_light / dist;
-            let cos_x = dot(n, w);
-            let cos_y = -dot(l.normal, w);
-            if cos_x > 0.0 && cos_y > 0.0
-                && !occluded(x, w, frame.ray_epsilon, dist * (1.0 - 1e-4), s.tri, l.tri) {
-                // Area density → solid angle at x. The weight takes the density from the same
-                // formula as the emitter hits above, so that the two weights sum to one exactly.
-                let to_solid_angle = dist2 / cos_y;
-                let p_bsdf = cos_x / PI;
-                let mis = power_heuristic(light_pdf_area(l.radiance) * to_solid_angle, p_bsdf);
-                radiance += throughput * f * l.radiance * (cos_x * mis / (l.pdf_area * to_solid_angle));
+            let l = sample_light_at(x, u0, u1, u2);
+            let cos_x = dot(n, l.dir);
+            if cos_x > 0.0 && any(l.e > vec3f(0.0))
+                && !occluded(x, l.dir, frame.ray_epsilon, l.dist * (1.0 - 1e-4), s.tri, l.tri) {
+                // Against BSDF sampling where it could have found the same point: an emissive
+                // triangle, its area density → solid angle at x, from the same formula as the
+                // emitter hits above so that the two weights sum to one exactly. A punctual or
+                // distant light is found by light samples only (weight 1).
+                var mis = 1.0;
+                if l.tri != NO_TRIANGLE {
+                    let t = triangles[l.tri];
+                    let cos_y = -dot(triangle_normal(t), l.dir);
+                    let to_solid_angle = l.dist * l.dist / cos_y;
+                    mis = power_heuristic(light_pdf_area(materials[t.material].emission) * to_solid_angle, cos_x / PI);
+                }
+                radiance += throughput * f * l.e * (cos_x * mis);
             }
         }
 

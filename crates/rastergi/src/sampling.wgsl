@@ -26,6 +26,14 @@ fn rng_f32(state: ptr<function, u32>) -> f32 {
 }
 
 // Orthonormal basis completing the unit normal n (Duff et al. 2017): returns (t, b).
+// A direction uniformly distributed over the unit sphere (pdf 1/4π); mirrors uniform_sphere.
+fn uniform_sphere(u1: f32, u2: f32) -> vec3f {
+    let z = 1.0 - 2.0 * u1;
+    let r = sqrt(max(1.0 - z * z, 0.0));
+    let phi = 2.0 * PI * u2;
+    return vec3f(r * cos(phi), r * sin(phi), z);
+}
+
 fn orthonormal_basis(n: vec3f) -> array<vec3f, 2> {
     let sign = select(-1.0, 1.0, n.z >= 0.0);
     let a = -1.0 / (sign + n.z);

@@ -7,8 +7,8 @@
 //! (`layout_test.rs`), which parses every composed shader with naga.
 
 use crate::consts::{
-    FILM_DIRECT, FILM_INDIRECT, FILM_PHOTON_VIEW, MATERIAL_TWO_SIDED, MAX_DIRECTIONS, MAX_SEPARATORS, NO_TEXTURE,
-    OFFSET_SHIFT, OFFSET_STEP, REGION_SHIFT, stream,
+    FILM_DIRECT, FILM_INDIRECT, FILM_PHOTON_VIEW, LIGHT_DISTANT, LIGHT_POINT, LIGHT_SPOT, MATERIAL_TWO_SIDED,
+    MAX_DIRECTIONS, MAX_SEPARATORS, NO_TEXTURE, OFFSET_SHIFT, OFFSET_STEP, PUNCTUAL_LIGHT, REGION_SHIFT, stream,
 };
 
 pub const SAMPLING: &str = include_str!("sampling.wgsl");
@@ -36,6 +36,10 @@ pub fn constants() -> String {
         ("STREAM_PATH", stream::PATH),
         ("STREAM_PHOTON", stream::PHOTON),
         ("STREAM_HIT_LIGHT", stream::HIT_LIGHT),
+        ("PUNCTUAL_LIGHT", PUNCTUAL_LIGHT),
+        ("LIGHT_POINT", LIGHT_POINT),
+        ("LIGHT_SPOT", LIGHT_SPOT),
+        ("LIGHT_DISTANT", LIGHT_DISTANT),
     ];
     let f32s = [("OFFSET_STEP", OFFSET_STEP)];
     let mut s = String::from("// Generated from the Rust constants (shader.rs).\n");

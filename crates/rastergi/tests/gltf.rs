@@ -619,3 +619,70 @@ fn regression_corpus_files_are_refused_without_panicking() {
         println!("{}: {message}", path.file_name().unwrap().to_string_lossy());
     }
 }
+
+/// The room with `lights` (KHR_lights_punctual JSON) on three new root nodes: one translated
+/// to (1, 2, 3), one under a parent translated by (0, 1, 0) and turned 90° about +X (its −Z
+/// then points down, −Y), one with the identity.
+fn with_lights(dir: &Path, name: &str, lights: Value) -> PathBuf {
+    edited(dir, name, |j, _| {
+        j["extensionsUsed"] = json!(["KHR_lights_punctual"]);
+        j["extensions"] = json!({ "KHR_lights_punctual": { "lights": lights } });
+        let nodes = j["nodes"].as_array_mut().unwrap();
+        let n = nodes.len();
+        let h = std::f32::consts::FRAC_1_SQRT_2;
+        nodes.push(json!({ "translation": [1.0, 2.0, 3.0], "extensions": { "KHR_lights_punctual": { "light": 0 } } }));
+        nodes.push(json!({ "translation": [0.0, 1.0, 0.0], "rotation": [-h, 0.0, 0.0, h], "children": [n + 2] }));
+        nodes.push(json!({ "extensions": { "KHR_lights_punctual": { "light": 1 } } }));
+        nodes.push(json!({ "extensions": { "KHR_lights_punctual": { "light": 2 } } }));
+        let roots = j["scenes"][0]["nodes"].as_array_mut().unwrap();
+        roots.extend([json!(n), json!(n + 1), json!(n + 3)]);
+    })
+}
+
+#[test]
+fn punctual_lights_are_placed_by_their_nodes_with_color_times_intensity() {
+    use rastergi::scene::Light;
+    let dir = tempfile::tempdir().unwrap();
+    let lights = json!([
+        { "type": "point", "color": [1.0, 0.5, 0.25], "intensity": 4.0 },
+        { "type": "spot", "intensity": 2.0, "spot": { "innerConeAngle": 0.2, "outerConeAngle": 0.5 } },
+        { "type": "directional", "color": [0.5, 0.5, 1.0], "intensity": 3.0, "range": 5.0 }
+    ]);
+    let scene = load_gltf(&with_lights(dir.path(), "lit", lights)).unwrap();
+    assert_eq!(scene.lights.len(), 3, "{:?}", scene.lights);
+    let find = |f: fn(&Light) -> bool| *scene.lights.iter().find(|l| f(l)).expect("the light");
+    let Light::Point { position, intensity } = find(|l| matches!(l, Light::Point { .. })) else { unreachable!() };
+    assert!(close(position, Vec3::new(1.0, 2.0, 3.0), 1e-6) && close(intensity, Vec3::new(4.0, 2.0, 1.0), 1e-6));
+    // Under the parent: at (0, 1, 0), its local −Z turned to −Y; glTF's default colour white.
+    let Light::Spot { position, direction, intensity, inner, outer } = find(|l| matches!(l, Light::Spot { .. })) else {
+        unreachable!()
+    };
+    assert!(close(position, Vec3::Y, 1e-6) && close(direction, -Vec3::Y, 1e-6), "{position} {direction}");
+    assert!(close(intensity, Vec3::splat(2.0), 1e-6) && inner == 0.2 && outer == 0.5);
+    // The identity node: −Z; `range` (a hint) is ignored with a warning.
+    let Light::Distant { direction, irradiance, angular_radius } = find(|l| matches!(l, Light::Distant { .. })) else {
+        unreachable!()
+    };
+    assert!(close(direction, -Vec3::Z, 1e-6) && close(irradiance, Vec3::new(1.5, 1.5, 3.0), 1e-6));
+    assert_eq!(angular_radius, 0.0);
+}
+
+#[test]
+fn hostile_punctual_lights_are_refused_with_one_line_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let ok_spot = json!({ "type": "spot", "spot": {} });
+    let ok_sun = json!({ "type": "directional" });
+    let cases = [
+        ("negative", json!({ "type": "point", "intensity": -1.0 }), "negative"),
+        ("negative_colour", json!({ "type": "point", "color": [1.0, -0.5, 1.0] }), "negative"),
+        ("cones", json!({ "type": "spot", "spot": { "innerConeAngle": 0.6, "outerConeAngle": 0.4 } }), "inner < outer"),
+        ("wide", json!({ "type": "spot", "spot": { "outerConeAngle": 2.0 } }), "π/2"),
+        ("unknown", json!({ "type": "area" }), "type"),
+        ("no_spot", json!({ "type": "spot" }), "spot"),
+    ];
+    for (name, light, fragment) in cases {
+        let path = with_lights(dir.path(), name, json!([light, ok_spot.clone(), ok_sun.clone()]));
+        let message = refused(&path);
+        assert!(message.contains(fragment), "{name}: {message}");
+    }
+}

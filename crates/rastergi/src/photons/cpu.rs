@@ -6,7 +6,7 @@ use rayon::prelude::*;
 use super::{MAX_BOUNCES, PhotonSettings, STREAM_PHOTON};
 use crate::gpu_scene::PreparedScene;
 use crate::photons::map::{GridSpec, MapLayout, PhotonMap};
-use crate::sampling::{Rng, cosine_hemisphere, uniform_triangle};
+use crate::sampling::{Rng, cosine_hemisphere};
 use crate::scene::triangle_normal;
 
 /// Flux deposited per slot, with the squares and counts used for noise estimates.
@@ -82,17 +82,10 @@ fn trace_photon(
     let scene = &prepared.scene;
     let eps = prepared.ray_epsilon();
     let mut rng = Rng::new(settings.seed ^ STREAM_PHOTON, index, pass);
-    let (u0, u1, u2) = (rng.next_f32(), rng.next_f32(), rng.next_f32());
-    let light = prepared.lights.pick(u0);
-    let tri = &scene.triangles[light.triangle as usize];
-    let ln = triangle_normal(tri);
-    let le = scene.material_of(light.triangle as usize).emission;
-    let mut flux = le * (std::f32::consts::PI * light.area / light.pmf / settings.count as f32);
-    let pos = uniform_triangle(tri, u1, u2);
-    let (u3, u4) = (rng.next_f32(), rng.next_f32());
-    let mut dir = cosine_hemisphere(ln, u3, u4);
-    let mut origin = pos + ln * eps;
-    let mut skip = light.triangle;
+    let u = [(); 5].map(|_| rng.next_f32());
+    let (mut origin, mut dir, flux, emitter) = prepared.lights.emit_photon(scene, u, eps);
+    let mut flux = flux / settings.count as f32;
+    let mut skip = emitter.unwrap_or(u32::MAX);
     let first_deposit = settings.indirect_only as u32;
     for bounce in 0..MAX_BOUNCES {
         let Some(hit) = prepared.bvh.intersect(&scene.triangles, origin, dir, eps, f32::INFINITY, skip) else {

@@ -55,17 +55,9 @@ impl Default for PhotonSettings {
 }
 
 impl PhotonSettings {
-    /// The largest flux, over lights and channels, that a photon starts with: π·Le·A/pmf/N.
+    /// The largest flux, over lights and channels, that a photon starts with
+    /// ([`crate::lights::LightTable::max_photon_flux`] / N).
     pub fn max_photon_flux(&self, prepared: &PreparedScene) -> f64 {
-        let s = &prepared.scene;
-        prepared
-            .lights
-            .entries
-            .iter()
-            .map(|e| {
-                let le = s.material_of(e.triangle as usize).emission.max_element() as f64;
-                std::f64::consts::PI * le * e.area as f64 / e.pmf as f64 / self.count.max(1) as f64
-            })
-            .fold(0.0, f64::max)
+        prepared.lights.max_photon_flux(&prepared.scene) / self.count.max(1) as f64
     }
 }

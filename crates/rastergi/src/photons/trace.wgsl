@@ -115,14 +115,14 @@ fn trace_photons(@builtin(global_invocation_id) gid: vec3u) {
     let u0 = rng_f32(&rng);
     let u1 = rng_f32(&rng);
     let u2 = rng_f32(&rng);
-    let light = sample_light(u0, u1, u2);
-    // Φ = π·Le·A/pmf/N.
-    var flux = light.radiance * (PI / light.pdf_area * params.inv_photon_count);
     let u3 = rng_f32(&rng);
     let u4 = rng_f32(&rng);
-    var dir = cosine_hemisphere(light.normal, u3, u4);
-    var origin = light.pos + light.normal * params.ray_epsilon;
-    var skip = light.tri;
+    let start = emit_photon(u0, u1, u2, u3, u4, params.ray_epsilon);
+    // Φ/N.
+    var flux = start.flux * params.inv_photon_count;
+    var dir = start.dir;
+    var origin = start.origin;
+    var skip = start.skip;
     for (var bounce = 0u; bounce < params.max_bounces; bounce++) {
         let hit = trace(origin, dir, params.ray_epsilon, 3.0e38, skip, NO_TRIANGLE, false);
         if hit.tri == NO_TRIANGLE {

@@ -13,6 +13,13 @@
 //!   emission is constant per material); `doubleSided` → two-sided reflection (glTF's default
 //!   is one-sided). Metal, roughness, alpha, normal maps and texture transforms are ignored.
 //!   Primitives without a material get a grey albedo of 0.5 like OBJ faces without one.
+//! - **Lights** (`KHR_lights_punctual`): point, spot and directional lights placed by their
+//!   node (position: the node's origin; direction: its local −Z), `color` × `intensity` read
+//!   1:1 as radiometric — W/sr for point and spot lights, W/m² on a surface facing a
+//!   directional light (Mitsuba's `point`, `spot` and `directional` take the same values).
+//!   Spot cones from the extension's inner and outer angles with its smooth falloff
+//!   ([`super::Light::Spot`]). `range` is a hint and ignored with a warning (1/d² at every
+//!   distance). Invalid values (negative intensity, outer cone not above the inner) are refused.
 //! - **Camera**: a perspective camera placed by the first node of the scene that uses it,
 //!   looking down its −z with +y up (yfov is the vertical field of view; the aspect ratio is the
 //!   image's). [`GltfOptions::camera`] picks one by its index in the file's `cameras`; by
@@ -34,13 +41,13 @@ use ::gltf::{Document, Semantic};
 use base64::Engine as _;
 use glam::{Mat4, Quat, Vec2, Vec3};
 
-use super::{Camera, Material, Scene, Texture};
+use super::{Camera, Light, Material, Scene, Texture};
 use crate::error::{Error, Result};
 
 /// Most triangles a glTF scene may expand to (instances included).
 pub const MAX_TRIANGLES: u64 = 1 << 25;
 /// glTF extensions that a file may require.
-const SUPPORTED_REQUIRED: &[&str] = &["KHR_materials_emissive_strength"];
+const SUPPORTED_REQUIRED: &[&str] = &["KHR_materials_emissive_strength", "KHR_lights_punctual"];
 const DEFAULT_ALBEDO: f32 = 0.5;
 
 /// Choices made when loading a glTF file.
@@ -377,6 +384,7 @@ impl<'a> Loader<'a> {
         let mut stack: Vec<(::gltf::Node, Mat4)> = roots.into_iter().rev().map(|n| (n, Mat4::IDENTITY)).collect();
         let mut instances: Vec<(::gltf::Mesh, Mat4)> = Vec::new();
         let mut cameras: Vec<(usize, Mat4)> = Vec::new();
+        let mut warned_range = false;
         while let Some((node, parent)) = stack.pop() {
             let what = || named("node", node.index(), node.name());
             if std::mem::replace(&mut visited[node.index()], true) {
@@ -391,6 +399,18 @@ impl<'a> Loader<'a> {
             }
             if let Some(camera) = node.camera() {
                 cameras.push((camera.index(), world));
+            }
+            if let Some(light) = node.light() {
+                let what = || format!("{}'s light {}", what(), named("light", light.index(), light.name()));
+                if light.range().is_some() && !std::mem::replace(&mut warned_range, true) {
+                    log::warn!(
+                        "{}: light ranges are ignored (a glTF hint): lights fall off as 1/d² at every distance",
+                        what()
+                    );
+                }
+                let l = punctual_light(&light, world).map_err(|e| format!("{}: {e}", what()))?;
+                l.validate().map_err(|e| format!("{}: {e}", what()))?;
+                self.scene.lights.push(l);
             }
             let children: Vec<::gltf::Node> = node.children().collect();
             stack.extend(children.into_iter().rev().map(|c| (c, world)));
@@ -696,6 +716,27 @@ impl<'a> Loader<'a> {
 }
 
 /// A node's local transform: its matrix, or translation × rotation × scale.
+/// A `KHR_lights_punctual` light placed by its node's world transform: at the node's origin,
+/// shining along its local −Z; `color` × `intensity` read 1:1 as W/sr (point, spot) or W/m²
+/// (directional).
+fn punctual_light(light: &::gltf::khr_lights_punctual::Light, world: Mat4) -> Res<Light> {
+    use ::gltf::khr_lights_punctual::Kind;
+    let value = Vec3::from(light.color()) * light.intensity();
+    let position = world.transform_point3(Vec3::ZERO);
+    let axis = world.transform_vector3(-Vec3::Z);
+    if axis.is_nan() || axis.length() <= 1e-12 {
+        return Err("its node's transform collapses the light's direction".into());
+    }
+    let direction = axis.normalize();
+    Ok(match light.kind() {
+        Kind::Point => Light::Point { position, intensity: value },
+        Kind::Spot { inner_cone_angle, outer_cone_angle } => {
+            Light::Spot { position, direction, intensity: value, inner: inner_cone_angle, outer: outer_cone_angle }
+        }
+        Kind::Directional => Light::Distant { direction, irradiance: value, angular_radius: 0.0 },
+    })
+}
+
 fn local_transform(node: &::gltf::Node) -> Res<Mat4> {
     match node.transform() {
         ::gltf::scene::Transform::Matrix { matrix } => Ok(Mat4::from_cols_array_2d(&matrix)),

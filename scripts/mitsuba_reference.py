@@ -499,12 +499,26 @@ def check_scene(mi):
     return ok and worst < 1e-6
 
 
+def add_lights(d, args):
+    """rastergi's point lights (--point, W/sr) and sun (--sun, W/m², a delta direction: use
+    rastergi's --sun-size 0) as Mitsuba's `point` and `directional` emitters."""
+    for k, v in enumerate(args.point or []):
+        d[f"point_{k}"] = {"type": "point", "position": list(v[:3]), "intensity": rgb(v[3:])}
+    if args.sun:
+        az, el, irr = (float(x) for x in args.sun)
+        a, e = math.radians(az), math.radians(el)
+        towards = [math.sin(a) * math.cos(e), math.sin(e), math.cos(a) * math.cos(e)]
+        d["sun"] = {"type": "directional", "direction": [-c for c in towards],
+                    "irradiance": rgb([irr, irr, irr])}
+    return d
+
+
 def load_scene(mi, args, spp):
-    """The Mitsuba scene of --scene with the camera options applied."""
+    """The Mitsuba scene of --scene with the camera options and extra lights applied."""
     if args.scene == "cornell":
         camera = scene_camera(args, CORNELL_CAMERA)
-        return mi.load_dict(cornell_scene_dict(mi, args.width, args.height,
-                                               args.max_depth, spp, camera))
+        return mi.load_dict(add_lights(cornell_scene_dict(mi, args.width, args.height,
+                                                          args.max_depth, spp, camera), args))
     if not args.scene.lower().endswith(".obj"):
         raise SceneError(f"unknown scene '{args.scene}': use the built-in 'cornell' "
                          "or a path to a .obj file")
@@ -521,8 +535,8 @@ def load_scene(mi, args, spp):
               f"{camera['up']}, fov {camera['fov']}", file=sys.stderr)
     with tempfile.TemporaryDirectory(prefix="rastergi-mitsuba-") as mesh_dir:
         # Mitsuba reads the meshes while loading; the files can go afterwards.
-        return mi.load_dict(obj_scene_dict(mi, groups, camera, args.width, args.height,
-                                           args.max_depth, spp, mesh_dir))
+        return mi.load_dict(add_lights(obj_scene_dict(mi, groups, camera, args.width, args.height,
+                                                      args.max_depth, spp, mesh_dir), args))
 
 
 def render(mi, args):
@@ -596,6 +610,20 @@ def stats(a, b=None):
     return out
 
 
+def parse_floats(n):
+    """An argparse type: n comma-separated finite numbers."""
+    def parse(s):
+        parts = s.split(",")
+        try:
+            v = [float(x) for x in parts]
+        except ValueError:
+            v = []
+        if len(v) != n or not all(math.isfinite(x) for x in v):
+            raise argparse.ArgumentTypeError(f"expected {n} comma-separated numbers, got '{s}'")
+        return v
+    return parse
+
+
 def parse_vec3(s):
     """`x,y,z` as three finite floats (the format of rastergi's camera options)."""
     parts = s.split(",")
@@ -635,6 +663,12 @@ def main():
     p.add_argument("--width", type=int, default=128)
     p.add_argument("--height", type=int, default=128)
     p.add_argument("--spp", type=int, default=1024)
+    p.add_argument("--point", type=parse_floats(6), action="append",
+                   help="add a point light x,y,z,r,g,b (intensity W/sr, as a glTF point light "
+                        "in rastergi); repeatable")
+    p.add_argument("--sun", type=parse_floats(3),
+                   help="add rastergi's --sun AZIMUTH,ELEVATION,IRRADIANCE as a directional "
+                        "light (a delta: render rastergi with --sun-size 0)")
     p.add_argument("--max-depth", type=int, default=-1,
                    help="Mitsuba path depth: -1 unlimited, 2 = direct lighting")
     p.add_argument("--seed", type=int, default=0)

@@ -226,3 +226,28 @@ fn photons_carry_each_lights_flux_to_the_floor() {
     assert!(((g - expected) / expected).abs().max_element() < tol, "GPU {g} against {expected}");
     assert!(((c - expected) / expected).abs().max_element() < tol, "CPU {c} against {expected}");
 }
+
+/// The sun of rastergi's `--sun AZIMUTH,ELEVATION,IRRADIANCE` with `--sun-size 0`
+/// (`rastergi-cli`'s `sun_light`, restated: travelling along −(sin a cos e, sin e, cos a cos e)).
+fn sun(azimuth: f32, elevation: f32, irradiance: f32) -> Light {
+    let (a, e) = (azimuth.to_radians(), elevation.to_radians());
+    let towards = Vec3::new(a.sin() * e.cos(), e.sin(), a.cos() * e.cos());
+    Light::Distant { direction: -towards, irradiance: Vec3::splat(irradiance), angular_radius: 0.0 }
+}
+
+#[test]
+fn the_cornell_box_with_a_point_light_and_the_sun_through_its_open_front_matches_mitsuba() {
+    // References: scripts/mitsuba_reference.py --spp 8192 --seed 5|6
+    //   --point=-0.5,0.5,0.3,0.3,0.3,0.3 --sun 20,25,1.5 (tests/data/README.md).
+    let mut scene = rastergi::scene::cornell_box();
+    scene.lights.push(Light::Point { position: Vec3::new(-0.5, 0.5, 0.3), intensity: Vec3::splat(0.3) });
+    scene.lights.push(sun(20.0, 25.0, 1.5));
+    common::matches_mitsuba(
+        "cornell + point + sun",
+        &scene,
+        rastergi::gather::HitLight::Map,
+        256,
+        "cornell_lights_path_128",
+        true,
+    );
+}

@@ -6,10 +6,8 @@ mod common;
 
 use rastergi::film::Show;
 use rastergi::gather::{GatherMethod, HitLight};
-use rastergi::metrics::{compare, masked_mean, rmse};
 use rastergi::photons::passes::pass_resolution;
 use rastergi::renderer::{RenderSettings, Renderer};
-use rastergi::scene::Scene;
 use rastergi::scene::generate::rooms;
 
 fn settings(passes: u32) -> RenderSettings {
@@ -90,7 +88,7 @@ fn doorway_rooms_match_mitsuba_within_noise() {
     // same within noise; the Cornell box and the small object test that mode.)
     // The bounds (5 %, 1.5 %) were set for 256² at 1024 iterations; at 128² with
     // 2 × 256 the noise is about the same per pixel.
-    matches_mitsuba("rooms", &rooms(true), HitLight::Map, 256, "rooms_path_128");
+    common::matches_mitsuba("rooms", &rooms(true), HitLight::Map, 256, "rooms_path_128", false);
 }
 
 #[test]
@@ -115,43 +113,5 @@ fn small_object(hit_light: HitLight) {
         up: glam::Vec3::Y,
         fov_y_deg: 40.0,
     };
-    matches_mitsuba("small object", &scene, hit_light, 128, "small_object_path_128");
-}
-
-/// Renders `scene` at 128² with the settings the command line fits to it (grid, photons,
-/// photon passes), the traced gather and `hit_light`, twice (seeds 1 and 2, `iterations`
-/// each), and compares their mean with the committed Mitsuba pair `stem`_{a,b}: relative
-/// RMSE under 5 %, block-mean error under 1.5 %, channel means within 1 %.
-fn matches_mitsuba(label: &str, scene: &Scene, hit_light: HitLight, iterations: u32, stem: &str) {
-    let gpu = common::gpu();
-    let grid = rastergi::fit::grid_resolution(&scene.bounds());
-    let settings = |seed| RenderSettings {
-        width: 128,
-        height: 128,
-        seed,
-        grid_resolution: grid,
-        photons: rastergi::fit::photon_count(scene, grid),
-        gather: GatherMethod::Trace,
-        hit_light,
-        ..Default::default()
-    };
-    let a = common::render(&gpu, scene, settings(1), iterations, Show::Full);
-    let b = common::render(&gpu, scene, settings(2), iterations, Show::Full);
-    let ours = common::average(&a, &b);
-    let (reference, ref_noise) = common::reference_pair(stem, None);
-    let mean = masked_mean(&reference, None);
-    // Two seeds differ in every random choice, the photons included: their difference is all
-    // of our noise; the pair's difference is the reference's.
-    let noise = (rmse(&a, &b, None).powi(2) / 4.0 + ref_noise.powi(2)).sqrt() / mean;
-    let c = compare(&ours, &reference, None);
-    let bias = (c.relative_rmse.powi(2) - noise.powi(2)).max(0.0).sqrt();
-    println!(
-        "{label} (grid {grid}), {hit_light:?}: relative RMSE {:.4} = noise {noise:.4} ⊕ bias {bias:.4}; block-mean error {:.4}; mean ratio {:?}",
-        c.relative_rmse, c.block_mean_error, c.mean_ratio
-    );
-    assert!(c.relative_rmse < 0.05, "{label}: relative RMSE {}", c.relative_rmse);
-    assert!(c.block_mean_error < 0.015, "{label}: block-mean error {}", c.block_mean_error);
-    for r in c.mean_ratio {
-        assert!((r - 1.0).abs() < 0.01, "{label}: mean ratio {:?}", c.mean_ratio);
-    }
+    common::matches_mitsuba("small object", &scene, hit_light, 128, "small_object_path_128", false);
 }

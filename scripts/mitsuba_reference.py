@@ -624,17 +624,8 @@ def parse_floats(n):
     return parse
 
 
-def parse_vec3(s):
-    """`x,y,z` as three finite floats (the format of rastergi's camera options)."""
-    parts = s.split(",")
-    try:
-        v = [float(x) for x in parts]
-    except ValueError:
-        v = []
-    if len(v) != 3 or not all(math.isfinite(x) for x in v):
-        raise argparse.ArgumentTypeError(
-            f"expected three comma-separated finite numbers like 0,1,3.5, got '{s}'")
-    return v
+# `x,y,z` as three finite floats (the format of rastergi's camera options).
+parse_vec3 = parse_floats(3)
 
 
 def _join_camera_values(argv):

@@ -108,15 +108,20 @@ impl PunctualLight {
         }
     }
 
-    /// The entry weight (module docs): Φ/π of the sampling density's support, summed over R, G, B.
+    /// Where photons start from, as a measure: the solid angle they leave into (4π for a
+    /// point light, 2π(1 − cos θ_o) for a spot) or the disc's area πR² (distant).
+    fn support(&self) -> f64 {
+        match self.kind {
+            LIGHT_POINT => 4.0 * std::f64::consts::PI,
+            LIGHT_SPOT => 2.0 * std::f64::consts::PI * (1.0 - self.cos_outer as f64),
+            _ => std::f64::consts::PI * (self.disc_radius as f64).powi(2),
+        }
+    }
+
+    /// The entry weight (module docs): the support × the intensity summed over R, G, B, / π.
     fn weight(&self) -> f64 {
         let i = Vec3::from(self.intensity);
-        let sum = (i.x + i.y + i.z) as f64;
-        match self.kind {
-            LIGHT_POINT => 4.0 * sum,
-            LIGHT_SPOT => 2.0 * (1.0 - self.cos_outer as f64) * sum,
-            _ => (self.disc_radius as f64).powi(2) * sum,
-        }
+        self.support() * (i.x + i.y + i.z) as f64 / std::f64::consts::PI
     }
 }
 
@@ -185,13 +190,7 @@ impl LightTable {
                     std::f64::consts::PI * le.max_element() as f64 * e.area as f64
                 } else {
                     let p = &self.punctual[(e.triangle & !PUNCTUAL_LIGHT) as usize];
-                    let i = Vec3::from(p.intensity).max_element() as f64;
-                    let support = match p.kind {
-                        LIGHT_POINT => 4.0 * std::f64::consts::PI,
-                        LIGHT_SPOT => 2.0 * std::f64::consts::PI * (1.0 - p.cos_outer as f64),
-                        _ => std::f64::consts::PI * (p.disc_radius as f64).powi(2),
-                    };
-                    i * support
+                    Vec3::from(p.intensity).max_element() as f64 * p.support()
                 };
                 per_pmf / e.pmf as f64
             })

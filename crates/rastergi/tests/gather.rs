@@ -277,12 +277,9 @@ fn converged_cornell_box(hit_light: HitLight) {
     let b = common::render(&gpu, &scene, settings(2), 256, Show::Full);
     let ours = common::average(&a, &b);
     let (reference, ref_noise, mask) = cornell_reference();
-    let mean = masked_mean(&reference, Some(&mask));
     // Two seeds differ in every random choice — gather directions, jitter, light samples and
     // the photon map itself — so their difference measures all of our noise.
-    let noise = (rmse(&a, &b, Some(&mask)).powi(2) / 4.0 + ref_noise.powi(2)).sqrt() / mean;
-    let c = compare(&ours, &reference, Some(&mask));
-    let bias = (c.relative_rmse.powi(2) - noise.powi(2)).max(0.0).sqrt();
+    let (c, noise, bias) = common::against_reference(&a, &b, &reference, ref_noise, Some(&mask));
     println!(
         "{hit_light:?}: relative RMSE {:.4} = noise {noise:.4} ⊕ bias {bias:.4}; block-mean error {:.4}; mean ratio {:?}",
         c.relative_rmse, c.block_mean_error, c.mean_ratio

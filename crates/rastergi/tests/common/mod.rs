@@ -40,6 +40,24 @@ pub fn reference_pair(stem: &str, mask: Option<&[bool]>) -> (LinearImage, f64) {
     (average(&a, &b), noise)
 }
 
+/// Our renders `a` and `b`, whose seeds differ in every random choice (the photons included),
+/// against the mean of a reference pair of RMS noise `ref_noise`: the comparison of our mean
+/// with it, the relative noise of that comparison (ours from a − b, the reference's), and
+/// the bias beyond that noise, √(RMSE² − noise²).
+pub fn against_reference(
+    a: &LinearImage,
+    b: &LinearImage,
+    reference: &LinearImage,
+    ref_noise: f64,
+    mask: Option<&[bool]>,
+) -> (rastergi::metrics::Comparison, f64, f64) {
+    let mean = rastergi::metrics::masked_mean(reference, mask);
+    let noise = (rastergi::metrics::rmse(a, b, mask).powi(2) / 4.0 + ref_noise.powi(2)).sqrt() / mean;
+    let c = rastergi::metrics::compare(&average(a, b), reference, mask);
+    let bias = (c.relative_rmse.powi(2) - noise.powi(2)).max(0.0).sqrt();
+    (c, noise, bias)
+}
+
 pub fn average(a: &LinearImage, b: &LinearImage) -> LinearImage {
     LinearImage {
         width: a.width,
@@ -100,18 +118,12 @@ pub fn matches_mitsuba(
     };
     let a = render(&gpu, scene, settings(1), iterations, Show::Full);
     let b = render(&gpu, scene, settings(2), iterations, Show::Full);
-    let ours = average(&a, &b);
     // Emitter pixels (over 3 in the reference, and their neighbours) left out where asked.
     let probe = read_exr(&data(&format!("{stem}_a.exr"))).expect("reference a");
     let mask = mask_emitters.then(|| rastergi::metrics::emitter_mask(&probe, 3.0));
     let mask = mask.as_deref();
     let (reference, ref_noise) = reference_pair(stem, mask);
-    let mean = rastergi::metrics::masked_mean(&reference, mask);
-    // Two seeds differ in every random choice, the photons included: their difference is all
-    // of our noise; the pair's difference is the reference's.
-    let noise = (rastergi::metrics::rmse(&a, &b, mask).powi(2) / 4.0 + ref_noise.powi(2)).sqrt() / mean;
-    let c = rastergi::metrics::compare(&ours, &reference, mask);
-    let bias = (c.relative_rmse.powi(2) - noise.powi(2)).max(0.0).sqrt();
+    let (c, noise, bias) = against_reference(&a, &b, &reference, ref_noise, mask);
     println!(
         "{label} (grid {grid}), {hit_light:?}: relative RMSE {:.4} = noise {noise:.4} ⊕ bias {bias:.4}; block-mean error {:.4}; mean ratio {:?}",
         c.relative_rmse, c.block_mean_error, c.mean_ratio

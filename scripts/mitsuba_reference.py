@@ -37,6 +37,19 @@ the corresponding parts, exactly as `rastergi render` does; give the same
 values to both. The near clip is 1e-4 of the bounds' diagonal (rastergi's;
 0.001 for the Cornell box, as the committed references were made).
 
+Extra lights, added to either scene: --point x,y,z,r,g,b (repeatable) is a `point` emitter
+of that intensity (W/sr, a glTF point light in rastergi); --sun AZ,EL,IRR is a
+`directional` emitter of irradiance IRR (W/m^2) from azimuth AZ and elevation EL in
+degrees, as rastergi's --sun with --sun-size 0 (a delta direction); --env FILE (an .exr or
+.hdr latitude-longitude image, linear radiance) is an `envmap` emitter
+{"filename": FILE, "scale": --env-scale (default 1)} with no to_world transform (the
+identity). That is the convention for rastergi's environment maps too: direction
+d = (x, y, z) <-> u = atan2(x, -z) / 2pi, v = acos(y) / pi, image row 0 at the zenith +Y;
+Mitsuba puts column i of a W x H image at u = (i + 0.5) / W and row j at v = j / (H - 1)
+(the first and last rows on the poles) and interpolates bilinearly between these
+positions, periodically in u, so one bright pixel is a small extended source with a tent
+profile two pixels wide (scripts/make_test_sky.py). Rays that leave the scene see the map.
+
 Make a reference for an OBJ scene and compare a rastergi render with it:
 
     python3 scripts/mitsuba_reference.py --scene room.obj --width 128 --height 128 --spp 4096 --out room_ref.exr
@@ -60,6 +73,13 @@ takes about 1.5 minutes and a full path-traced one about 2.7 minutes:
     python3 scripts/mitsuba_reference.py --width 128 --height 128 --spp 32768 --max-depth 2  --seed 2 --out $D/cornell_direct_128_b.exr
     python3 scripts/mitsuba_reference.py --width 128 --height 128 --spp 16384 --max-depth -1 --seed 3 --out $D/cornell_path_128_a.exr
     python3 scripts/mitsuba_reference.py --width 128 --height 128 --spp 16384 --max-depth -1 --seed 4 --out $D/cornell_path_128_b.exr
+    # the courtyard under the test sky (environment map only; README.md there)
+    python3 scripts/make_test_sky.py --out $D/env/sky_64x32.exr
+    COURT="--scene $D/obj/courtyard.obj --eye 0,3,5.5 --target 0,0.3,0 --up 0,1,0 --fov 45 --env $D/env/sky_64x32.exr --width 128 --height 128 --spp 4096"
+    python3 scripts/mitsuba_reference.py $COURT --max-depth -1 --seed 11 --out $D/courtyard_env_path_128_a.exr
+    python3 scripts/mitsuba_reference.py $COURT --max-depth -1 --seed 12 --out $D/courtyard_env_path_128_b.exr
+    python3 scripts/mitsuba_reference.py $COURT --max-depth 2  --seed 13 --out $D/courtyard_env_direct_128_a.exr
+    python3 scripts/mitsuba_reference.py $COURT --max-depth 2  --seed 14 --out $D/courtyard_env_direct_128_b.exr
 
 (--chunk-spp defaults to 256; the images depend on it through the chunk seeds,
 and on the Mitsuba version and variant. Results are not bit-reproducible
@@ -501,7 +521,8 @@ def check_scene(mi):
 
 def add_lights(d, args):
     """rastergi's point lights (--point, W/sr) and sun (--sun, W/m², a delta direction: use
-    rastergi's --sun-size 0) as Mitsuba's `point` and `directional` emitters."""
+    rastergi's --sun-size 0) as Mitsuba's `point` and `directional` emitters, and an
+    environment map (--env, --env-scale) as an `envmap` emitter with the identity to_world."""
     for k, v in enumerate(args.point or []):
         d[f"point_{k}"] = {"type": "point", "position": list(v[:3]), "intensity": rgb(v[3:])}
     if args.sun:
@@ -510,11 +531,32 @@ def add_lights(d, args):
         towards = [math.sin(a) * math.cos(e), math.sin(e), math.cos(a) * math.cos(e)]
         d["sun"] = {"type": "directional", "direction": [-c for c in towards],
                     "irradiance": rgb([irr, irr, irr])}
+    if args.env:
+        # No to_world: Mitsuba's own frame is the convention (module docstring).
+        d["env"] = {"type": "envmap", "filename": os.path.abspath(args.env),
+                    "scale": float(args.env_scale)}
     return d
+
+
+def check_env(args):
+    """--env names a readable .exr or .hdr file; --env-scale is finite and not negative."""
+    if not args.env:
+        return
+    if not args.env.lower().endswith((".exr", ".hdr")):
+        raise SceneError(f"{args.env}: an environment map must be an .exr or .hdr "
+                         "latitude-longitude image")
+    if not os.path.isfile(args.env):
+        raise SceneError(f"{args.env}: no such file")
+    if not (math.isfinite(args.env_scale) and args.env_scale >= 0):
+        raise SceneError(f"--env-scale must be a finite number >= 0, got {args.env_scale}")
 
 
 def load_scene(mi, args, spp):
     """The Mitsuba scene of --scene with the camera options and extra lights applied."""
+    check_env(args)
+    if args.env and not args.quiet:
+        print(f"  environment map: {os.path.abspath(args.env)}, scale {args.env_scale}, "
+              "identity to_world", file=sys.stderr)
     if args.scene == "cornell":
         camera = scene_camera(args, CORNELL_CAMERA)
         return mi.load_dict(add_lights(cornell_scene_dict(mi, args.width, args.height,
@@ -660,6 +702,11 @@ def main():
     p.add_argument("--sun", type=parse_floats(3),
                    help="add rastergi's --sun AZIMUTH,ELEVATION,IRRADIANCE as a directional "
                         "light (a delta: render rastergi with --sun-size 0)")
+    p.add_argument("--env", metavar="FILE",
+                   help="add an environment map (.exr or .hdr, latitude-longitude, linear) as "
+                        "Mitsuba's envmap emitter with the identity transform")
+    p.add_argument("--env-scale", type=float, default=1.0, metavar="S",
+                   help="radiance scale of --env (default 1)")
     p.add_argument("--max-depth", type=int, default=-1,
                    help="Mitsuba path depth: -1 unlimited, 2 = direct lighting")
     p.add_argument("--seed", type=int, default=0)

@@ -171,6 +171,14 @@ pub struct SceneArgs {
     /// The sun's angular diameter in degrees (its soft shadows; 0 for a sharp one).
     #[arg(long, default_value_t = 0.53, requires = "sun", value_parser = parse_sun_size)]
     pub sun_size: f32,
+    /// Lights the scene with an environment map: an equirectangular .exr or .hdr image of
+    /// the radiance from every direction (Mitsuba 3's `envmap` convention: row 0 is +Y, the
+    /// image's left edge looks along −Z, its first quarter turns towards +X).
+    #[arg(long, value_name = "FILE")]
+    pub env: Option<std::path::PathBuf>,
+    /// Scales the environment map's radiance.
+    #[arg(long, default_value_t = 1.0, requires = "env", value_parser = parse_env_scale)]
+    pub env_scale: f32,
     /// Light samples per pixel per iteration.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=64))]
     pub light_samples: u32,
@@ -237,10 +245,19 @@ impl SceneArgs {
         if let Some(sun) = self.sun {
             scene.lights.push(sun_light(sun, self.sun_size));
         }
-        if scene.lights.is_empty() && scene.emissive_triangles().is_empty() {
+        if let Some(path) = &self.env {
+            let env = rastergi::environment::Environment::load(path, self.env_scale)?;
+            if env.is_dark() {
+                log::warn!("{}: the environment map is black everywhere; it adds no light", path.display());
+            }
+            scene.environment = Some(env);
+        }
+        let lit_by_env = scene.environment.as_ref().is_some_and(|e| !e.is_dark());
+        if scene.lights.is_empty() && scene.emissive_triangles().is_empty() && !lit_by_env {
             log::warn!(
                 "{}: the scene has no light, so it renders black: give it emission (OBJ Ke, glTF \
-                 emissiveFactor), glTF KHR_lights_punctual lights, or --sun AZIMUTH,ELEVATION,IRRADIANCE",
+                 emissiveFactor), glTF KHR_lights_punctual lights, --sun AZIMUTH,ELEVATION,IRRADIANCE \
+                 or --env SKY.exr",
                 self.scene
             );
         }
@@ -295,6 +312,14 @@ fn parse_sun(s: &str) -> Result<Vec3, String> {
     }
     if v.z < 0.0 {
         return Err(format!("the sun's irradiance {} W/m² is negative", v.z));
+    }
+    Ok(v)
+}
+
+fn parse_env_scale(s: &str) -> Result<f32, String> {
+    let v: f32 = s.parse().map_err(|_| format!("'{s}' is not a number"))?;
+    if !v.is_finite() || v < 0.0 {
+        return Err(format!("the environment's scale {v} must be a finite number ≥ 0"));
     }
     Ok(v)
 }

@@ -13,6 +13,9 @@ pub const NO_TEXTURE: u32 = u32::MAX;
 /// Light-table entry bit of a point, spot or distant light ([`crate::lights`]); the other
 /// bits index the punctual lights.
 pub const PUNCTUAL_LIGHT: u32 = 1 << 31;
+/// Light-table entry of the environment ([`crate::environment`]): the punctual bit with
+/// every other bit set, which no punctual index reaches.
+pub const ENVIRONMENT_LIGHT: u32 = u32::MAX - 1;
 /// Punctual light kinds ([`crate::lights::PunctualLight::kind`]).
 pub const LIGHT_POINT: u32 = 0;
 pub const LIGHT_SPOT: u32 = 1;

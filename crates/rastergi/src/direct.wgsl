@@ -1,4 +1,5 @@
-// Direct pass (direct.rs): emission + next-event estimation with BVH shadow rays.
+// Direct pass (direct.rs): emission, the environment seen by the eye, and next-event
+// estimation with BVH shadow rays.
 
 // Bind group 2: gbuffer_film.wgsl.
 
@@ -9,6 +10,10 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     }
     let p = visible_point(textureLoad(gbuffer, gid.xy, 0));
     var radiance = vec3f(0.0);
+    if !p.seen {
+        // The camera ray escapes: the environment along it (black without one).
+        radiance = env_radiance(camera_direction(gid.xy));
+    }
     if p.front {
         radiance = p.x.emission;
     }
@@ -22,7 +27,18 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         var sum = vec3f(0.0);
         for (var k = 0u; k < frame.light_samples; k++) {
             let u = light_sample_uniforms(frame.iteration * frame.light_samples + k, seed);
-            sum += light_sample_irradiance(origin, n, s.tri, frame.ray_epsilon, u.x, u.y, u.z);
+            let l = sample_light_at(origin, u.x, u.y, u.z);
+            let cos_x = dot(n, l.dir);
+            if cos_x <= 0.0 || all(l.e == vec3f(0.0))
+                || occluded(origin, l.dir, frame.ray_epsilon, l.dist * (1.0 - 1e-4), s.tri, l.tri) {
+                continue;
+            }
+            // The environment is also found by the gather's escaping rays (env_gather_weight).
+            var mis = 1.0;
+            if l.pdf > 0.0 {
+                mis = 1.0 - env_gather_weight(n, l.dir);
+            }
+            sum += l.e * (cos_x * mis);
         }
         radiance += s.albedo / PI * sum / f32(frame.light_samples);
     }

@@ -15,6 +15,8 @@ use crate::scene::{Aabb, Camera};
 pub struct FrameUniforms {
     /// World → clip, including this iteration's sub-pixel jitter.
     pub view_proj: [[f32; 4]; 4],
+    /// Its inverse (camera rays: `camera_ray` in `frame.wgsl`).
+    pub inv_view_proj: [[f32; 4]; 4],
     pub eye: [f32; 3],
     pub iteration: u32,
     pub resolution: [u32; 2],
@@ -22,7 +24,13 @@ pub struct FrameUniforms {
     pub light_samples: u32,
     /// Minimum hit distance and origin offset of secondary rays.
     pub ray_epsilon: f32,
-    pub _pad: [u32; 3],
+    /// The final gather's directions per pixel this iteration (0: no gather), and 1 where
+    /// they are cosine-distributed (per-pixel) rather than uniform on the hemisphere (shared):
+    /// the gather's escaping rays and the direct pass's environment samples are combined by
+    /// multiple importance sampling (`env_mis_weight`).
+    pub gather_count: u32,
+    pub gather_cosine: u32,
+    pub _pad: u32,
 }
 
 impl FrameUniforms {
@@ -39,15 +47,23 @@ impl FrameUniforms {
         light_samples: u32,
     ) -> FrameUniforms {
         let (w, h) = size;
+        let view_proj = view_projection(camera, w, h, near_plane(&scene.bounds), jitter);
         FrameUniforms {
-            view_proj: view_projection(camera, w, h, near_plane(&scene.bounds), jitter).to_cols_array_2d(),
+            view_proj: view_proj.to_cols_array_2d(),
+            // Inverted in f64: the f32 matrix the rasterizer uses, inverted without further loss.
+            inv_view_proj: glam::DMat4::from_cols_array_2d(&view_proj.to_cols_array_2d().map(|c| c.map(f64::from)))
+                .inverse()
+                .to_cols_array_2d()
+                .map(|c| c.map(|v| v as f32)),
             eye: camera.eye.into(),
             iteration,
             resolution: [w, h],
             seed,
             light_samples: light_samples.max(1),
             ray_epsilon: scene.ray_epsilon,
-            _pad: [0; 3],
+            gather_count: 0,
+            gather_cosine: 0,
+            _pad: 0,
         }
     }
 }

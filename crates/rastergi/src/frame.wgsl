@@ -2,15 +2,57 @@
 
 struct Frame {
     view_proj: mat4x4f,
+    inv_view_proj: mat4x4f,
     eye: vec3f,
     iteration: u32,
     resolution: vec2u,
     seed: u32,
     light_samples: u32,
     ray_epsilon: f32,
+    // The gather's directions per pixel this iteration (0: none) and whether they are
+    // cosine-distributed (1) or uniform on the hemisphere (0).
+    gather_count: u32,
+    gather_cosine: u32,
     _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
 }
 
 @group(1) @binding(0) var<uniform> frame: Frame;
+
+// The unit direction of the camera ray through the point p (in pixels, from the top-left
+// corner) of the jittered view. Clip (x, y, 0, 1) is the point at infinity in reversed-Z, so
+// the inverse view-projection maps it to the homogeneous world point (direction, 0), the same
+// ray the rasterizer's pixel sees.
+fn camera_ray(p: vec2f) -> vec3f {
+    let res = vec2f(frame.resolution);
+    let ndc = vec2f(2.0 * p.x / res.x - 1.0, 1.0 - 2.0 * p.y / res.y);
+    return normalize((frame.inv_view_proj * vec4f(ndc, 0.0, 1.0)).xyz);
+}
+
+// The camera ray through the centre of pixel `xy`.
+fn camera_direction(xy: vec2u) -> vec3f {
+    return camera_ray(vec2f(xy) + 0.5);
+}
+
+// The power heuristic (β = 2) weight of the strategy with density pa against pb (each the
+// sample count × the density).
+fn power_heuristic(pa: f32, pb: f32) -> f32 {
+    let a = pa * pa;
+    return a / (a + pb * pb);
+}
+
+// The environment's light along w at a point of normal n is estimated twice: by the direct
+// pass's light samples (frame.light_samples of them, density pmf·pdf(w)) and by the final
+// gather's rays that escape (frame.gather_count, density 1/2π or cos θ/π). Each estimate is
+// weighted by the power heuristic over both (Veach's multi-sample model), so the weights sum
+// to one for every direction. This is the gather's weight; the direct pass's is 1 − it.
+fn env_gather_weight(n: vec3f, w: vec3f) -> f32 {
+    if frame.gather_count == 0u {
+        return 0.0;
+    }
+    var p_gather = 1.0 / (2.0 * PI);
+    if frame.gather_cosine != 0u {
+        p_gather = max(dot(n, w), 0.0) / PI;
+    }
+    let p_light = environment.pmf * env_pdf(w);
+    return power_heuristic(f32(frame.gather_count) * p_gather, f32(frame.light_samples) * p_light);
+}

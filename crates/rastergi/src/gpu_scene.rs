@@ -1,5 +1,5 @@
-//! The scene on the GPU: triangles in BVH order, materials, BVH nodes, the light table and the
-//! albedo textures with the triangles' texture coordinates, bound together as bind group 0 of
+//! The scene on the GPU: triangles in BVH order, materials, BVH nodes, the light table, the
+//! environment map and the albedo textures with the triangles' texture coordinates, bound together as bind group 0 of
 //! every pass that reads the scene (`gpu_scene.wgsl`).
 
 use bytemuck::{Pod, Zeroable};
@@ -7,7 +7,10 @@ use glam::{Vec2, Vec3};
 
 use crate::bvh::{Bvh, BvhNode};
 use crate::error::Result;
-use crate::gpu::{Gpu, storage_entry};
+use wgpu::util::DeviceExt;
+
+use crate::environment::{Environment, GpuEnvironment};
+use crate::gpu::{Gpu, storage_entry, uniform_entry};
 use crate::lights::{LightEntry, LightTable};
 use crate::scene::{Aabb, Scene};
 use crate::textures::TextureArray;
@@ -150,6 +153,17 @@ impl GpuScene {
             punctual.push(bytemuck::Zeroable::zeroed());
         }
         let nodes: &[BvhNode] = &prepared.bvh.nodes;
+        let env = s.environment.as_deref();
+        let env_data = env.map_or(vec![0.0f32; 4], Environment::gpu_data);
+        crate::limits::check_storage_buffer(
+            &limits,
+            "the environment map",
+            env_data.len() as u64,
+            4,
+            "use a smaller --env image",
+        )?;
+        let (disc_centre, disc_radius) = prepared.lights.disc;
+        let env_uniform = GpuEnvironment::new(env, disc_centre, disc_radius, prepared.lights.environment_pmf);
         let none = wgpu::BufferUsages::empty();
         let buffers = [
             gpu.storage_buffer("scene triangles", bytemuck::cast_slice(&triangles), none),
@@ -158,7 +172,13 @@ impl GpuScene {
             gpu.storage_buffer("scene lights", bytemuck::cast_slice(&lights), none),
             gpu.storage_buffer("scene texture coordinates", bytemuck::cast_slice(&uvs), none),
             gpu.storage_buffer("scene punctual lights", bytemuck::cast_slice(&punctual), none),
+            gpu.storage_buffer("scene environment map", bytemuck::cast_slice(&env_data), none),
         ];
+        let env_uniform_buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("scene environment"),
+            contents: bytemuck::bytes_of(&env_uniform),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
         let vis = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
         let layout = gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("scene"),
@@ -185,10 +205,12 @@ impl GpuScene {
                     count: None,
                 },
                 storage_entry::<crate::lights::PunctualLight>(7, vis, true),
+                storage_entry::<f32>(8, vis, true),
+                uniform_entry::<GpuEnvironment>(9, vis),
             ],
         });
         // The buffers' bindings, in the order of `buffers`.
-        const BUFFER_BINDINGS: [u32; 6] = [0, 1, 2, 3, 4, 7];
+        const BUFFER_BINDINGS: [u32; 7] = [0, 1, 2, 3, 4, 7, 8];
         let mut entries: Vec<wgpu::BindGroupEntry> = buffers
             .iter()
             .zip(BUFFER_BINDINGS)
@@ -196,6 +218,7 @@ impl GpuScene {
             .collect();
         entries.push(wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&texture_view) });
         entries.push(wgpu::BindGroupEntry { binding: 6, resource: wgpu::BindingResource::Sampler(&sampler) });
+        entries.push(wgpu::BindGroupEntry { binding: 9, resource: env_uniform_buffer.as_entire_binding() });
         let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("scene"),
             layout: &layout,

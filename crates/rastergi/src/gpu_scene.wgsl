@@ -215,21 +215,35 @@ fn cone_direction(axis: vec3f, cos_max: f32, u1: f32, u2: f32) -> vec3f {
 }
 
 // A light sample as seen from a point x: the unit direction from x towards the light, the
-// shadow ray's length (to the light's point; 3e38 for a distant light), e such that the
-// estimate of the irradiance at x on a surface of normal n is e · max(0, n·dir), and the
-// emitter triangle (excluded from the shadow ray; NO_TRIANGLE for a punctual light).
+// shadow ray's length (to the light's point; 3e38 for a distant light or the environment), e
+// such that the estimate of the irradiance at x on a surface of normal n is e · max(0, n·dir),
+// the emitter triangle (excluded from the shadow ray; NO_TRIANGLE for the others) and, for the
+// environment, the sample's solid-angle density pmf · pdf(dir) (0 for the others: a BSDF
+// sample never finds them, or finds them with its own weight, see the path tracer).
 //   triangle: e = Le cos θ_y / (d² p_A)    point: I / (d² pmf)    spot: I s(cos θ) / (d² pmf)
 //   distant:  e = E / pmf, dir uniform in its cone (E cos θ_x = L Ω cos θ_x for its radiance L)
+//   environment: e = L(dir) / (pmf · pdf(dir)), dir from its distribution
 struct LightRay {
     dir: vec3f,
     dist: f32,
     e: vec3f,
     tri: u32,
+    pdf: f32,
 }
 
 fn sample_light_at(x: vec3f, u0: f32, u1: f32, u2: f32) -> LightRay {
     var r: LightRay;
     let entry = lights[light_pick(u0)];
+    r.pdf = 0.0;
+    if entry.triangle == ENVIRONMENT_LIGHT {
+        let s = env_sample(u1, u2);
+        r.dir = s.xyz;
+        r.dist = 3.0e38;
+        r.tri = NO_TRIANGLE;
+        r.pdf = entry.pmf * s.w;
+        r.e = select(vec3f(0.0), env_radiance(r.dir) / r.pdf, r.pdf > 0.0);
+        return r;
+    }
     if (entry.triangle & PUNCTUAL_LIGHT) == 0u {
         let l = sample_light(u0, u1, u2);
         let to_light = l.pos - x;
@@ -258,7 +272,7 @@ fn sample_light_at(x: vec3f, u0: f32, u1: f32, u2: f32) -> LightRay {
 }
 
 // A photon leaving the lights (lights.rs: LightTable::emit_photon): origin, direction, flux ×
-// the photon count, and the emitter triangle to skip (NO_TRIANGLE for a punctual light).
+// the photon count, and the emitter triangle to skip (NO_TRIANGLE for the other lights).
 struct PhotonStart {
     origin: vec3f,
     skip: u32,
@@ -266,9 +280,29 @@ struct PhotonStart {
     flux: vec3f,
 }
 
+// A point uniform (u1, u2) on the disc of radius r, normal to `axis`, that a photon crossing
+// the sphere (centre, r) along `axis` starts from.
+fn disc_point(axis: vec3f, centre: vec3f, r: f32, u1: f32, u2: f32) -> vec3f {
+    let tb = orthonormal_basis(axis);
+    let rho = r * sqrt(u1);
+    let phi = 2.0 * PI * u2;
+    return centre - axis * r + (tb[0] * cos(phi) + tb[1] * sin(phi)) * rho;
+}
+
 fn emit_photon(u0: f32, u1: f32, u2: f32, u3: f32, u4: f32, eps: f32) -> PhotonStart {
     var s: PhotonStart;
     let entry = lights[light_pick(u0)];
+    if entry.triangle == ENVIRONMENT_LIGHT {
+        // Towards the sky along the sampled direction; the photon travels the other way, from
+        // the disc across the bounding sphere: L(ω)·πR²/(pdf(ω)·pmf).
+        let e = env_sample(u3, u4);
+        let r = environment.disc_radius;
+        s.dir = -e.xyz;
+        s.origin = disc_point(s.dir, environment.disc_centre, r, u1, u2);
+        s.flux = select(vec3f(0.0), env_radiance(e.xyz) * (PI * r * r / (e.w * entry.pmf)), e.w > 0.0);
+        s.skip = NO_TRIANGLE;
+        return s;
+    }
     if (entry.triangle & PUNCTUAL_LIGHT) == 0u {
         let l = sample_light(u0, u1, u2);
         // Φ = π·Le·A/pmf.
@@ -290,11 +324,7 @@ fn emit_photon(u0: f32, u1: f32, u2: f32, u3: f32, u4: f32, eps: f32) -> PhotonS
         let solid = 2.0 * PI * (1.0 - p.cos_outer);
         s.flux = p.intensity * (spot_falloff(p, dot(p.direction, s.dir)) * solid / entry.pmf);
     } else {
-        let tb = orthonormal_basis(p.direction);
-        let r = p.disc_radius * sqrt(u1);
-        let phi = 2.0 * PI * u2;
-        let centre = p.disc_centre - p.direction * p.disc_radius;
-        s.origin = centre + (tb[0] * cos(phi) + tb[1] * sin(phi)) * r;
+        s.origin = disc_point(p.direction, p.disc_centre, p.disc_radius, u1, u2);
         s.dir = cone_direction(p.direction, p.cos_outer, u3, u4);
         s.flux = p.intensity * (PI * p.disc_radius * p.disc_radius / entry.pmf);
     }

@@ -9,6 +9,7 @@ use std::mem::{offset_of, size_of};
 
 use crate::bvh::BvhNode;
 use crate::display::DisplayUniforms;
+use crate::environment::GpuEnvironment;
 use crate::film::ResolveUniforms;
 use crate::frame::FrameUniforms;
 use crate::gather::GatherUniforms;
@@ -40,7 +41,27 @@ macro_rules! twin {
 
 fn twins() -> Vec<Twin> {
     vec![
-        twin!(FrameUniforms, "Frame", [view_proj, eye, iteration, resolution, seed, light_samples, ray_epsilon]),
+        twin!(
+            FrameUniforms,
+            "Frame",
+            [
+                view_proj,
+                inv_view_proj,
+                eye,
+                iteration,
+                resolution,
+                seed,
+                light_samples,
+                ray_epsilon,
+                gather_count,
+                gather_cosine
+            ]
+        ),
+        twin!(
+            GpuEnvironment,
+            "Environment",
+            [disc_centre, disc_radius, width, height, pmf, row_cdf, column_cdf, cell_pmf]
+        ),
         twin!(GpuTriangle, "Triangle", [v0, material, v1, v2]),
         twin!(GpuMaterial, "Material", [albedo, flags, emission, texture]),
         twin!(BvhNode, "BvhNode", [min, offset, max, count]),
@@ -86,7 +107,7 @@ fn twins() -> Vec<Twin> {
         twin!(ResolveUniforms, "Resolve", [resolution, samples, show, scale]),
         twin!(DisplayUniforms, "Display", [image_size, target_size, decode_srgb, text_cols, text_rows, text_scale]),
         twin!(TrianglePlane, "TrianglePlane", [normal, offset, bins]),
-        twin!(PathParams, "PathParams", [inv_view_proj, light_weight, light_count, max_bounces, rr_start]),
+        twin!(PathParams, "PathParams", [light_weight, light_count, max_bounces, rr_start]),
     ]
 }
 

@@ -15,6 +15,7 @@ pub mod camera_control;
 pub mod consts;
 pub mod direct;
 pub mod display;
+pub mod environment;
 pub mod error;
 pub mod film;
 pub mod fit;

@@ -3,7 +3,8 @@
 //! are Φ/π summed over R, G and B: A·ΣLe for a triangle (Φ = π·A·Le), 4·ΣI for a point light
 //! (Φ = 4π·I), 2(1 − cos θ_o)·ΣI for a spot (its outer cone's solid angle times I, over π),
 //! R²·ΣE for a distant light (Φ = E·πR² through a disc covering the scene's bounding sphere
-//! of radius R). The same table drives the photon pass (emission), the direct pass and the
+//! of radius R), R²·Σ∫L dω for the environment (Φ = πR²·∫L dω: every direction's radiance
+//! through its own disc). The same table drives the photon pass (emission), the direct pass and the
 //! gather's exact hit light (light samples) and the path tracer.
 
 use bytemuck::{Pod, Zeroable};
@@ -14,7 +15,7 @@ use crate::scene::{Light, Scene, triangle_area, triangle_normal};
 
 /// [`LightEntry::triangle`] bit of an entry that is a [`PunctualLight`] (the other bits: its
 /// index in [`LightTable::punctual`]); [`PunctualLight::kind`] values.
-pub use crate::consts::{LIGHT_DISTANT, LIGHT_POINT, LIGHT_SPOT, PUNCTUAL_LIGHT};
+pub use crate::consts::{ENVIRONMENT_LIGHT, LIGHT_DISTANT, LIGHT_POINT, LIGHT_SPOT, PUNCTUAL_LIGHT};
 
 /// One light of the distribution, as stored on the GPU (`LightEntry` in `gpu_scene.wgsl`).
 #[repr(C)]
@@ -135,6 +136,11 @@ pub struct LightTable {
     /// Σ of the entries' weights (module docs): an emitter of radiance Le is picked with area
     /// density ΣLe / weight.
     pub weight: f64,
+    /// The probability of picking the environment (0 without one).
+    pub environment_pmf: f32,
+    /// The photon disc of distant light and the environment: the bounding sphere's centre
+    /// and its radius enlarged by 1 %.
+    pub disc: (Vec3, f32),
 }
 
 impl LightTable {
@@ -152,6 +158,13 @@ impl LightTable {
             })
             .collect();
         weights.extend(punctual.iter().enumerate().map(|(k, p)| (PUNCTUAL_LIGHT | k as u32, p.weight(), 1.0)));
+        let disc = (centre, 1.01 * radius);
+        let env_power =
+            scene.environment.as_ref().map_or(Vec3::ZERO, |e| std::f32::consts::PI * disc.1 * disc.1 * e.integral);
+        if let Some(env) = scene.environment.as_ref().filter(|e| !e.is_dark()) {
+            let l = env.integral;
+            weights.push((ENVIRONMENT_LIGHT, (disc.1 as f64).powi(2) * (l.x + l.y + l.z) as f64, 1.0));
+        }
         weights.retain(|w| w.1 > 0.0);
         let total: f64 = weights.iter().map(|w| w.1).sum();
         let mut acc = 0.0f64;
@@ -165,8 +178,9 @@ impl LightTable {
         if let Some(last) = entries.last_mut() {
             last.cdf = 1.0;
         }
-        let power = scene.emitted_power() + punctual.iter().map(PunctualLight::power).sum::<Vec3>();
-        Self { entries, punctual, power, weight: total }
+        let power = scene.emitted_power() + punctual.iter().map(PunctualLight::power).sum::<Vec3>() + env_power;
+        let environment_pmf = entries.iter().find(|e| e.triangle == ENVIRONMENT_LIGHT).map_or(0.0, |e| e.pmf);
+        Self { entries, punctual, power, weight: total, environment_pmf, disc }
     }
 
     pub fn is_empty(&self) -> bool {
@@ -185,7 +199,10 @@ impl LightTable {
     pub fn max_photon_flux(&self, scene: &Scene) -> f64 {
         (self.entries.iter())
             .map(|e| {
-                let per_pmf = if e.triangle & PUNCTUAL_LIGHT == 0 {
+                let per_pmf = if e.triangle == ENVIRONMENT_LIGHT {
+                    let env = scene.environment.as_ref().expect("an environment entry has a map");
+                    std::f64::consts::PI * (self.disc.1 as f64).powi(2) * env.max_radiance_over_pdf()
+                } else if e.triangle & PUNCTUAL_LIGHT == 0 {
                     let le = scene.material_of(e.triangle as usize).emission;
                     std::f64::consts::PI * le.max_element() as f64 * e.area as f64
                 } else {
@@ -203,9 +220,23 @@ impl LightTable {
     /// flux π·Le·A/pmf; a point light's direction uniform on the sphere, 4π·I/pmf; a spot's
     /// uniform in its outer cone, I·s(cos θ)·2π(1 − cos θ_o)/pmf; a distant light's origin
     /// uniform on a disc of radius R across the bounding sphere (u1, u2) and direction uniform
-    /// in its cone (u3, u4), E·πR²/pmf.
+    /// in its cone (u3, u4), E·πR²/pmf; the environment's direction from its distribution
+    /// (u3, u4) and origin on the disc, L(ω)·πR²/(pdf(ω)·pmf).
     pub fn emit_photon(&self, scene: &Scene, u: [f32; 5], eps: f32) -> (Vec3, Vec3, Vec3, Option<u32>) {
         let e = self.pick(u[0]);
+        let disc_origin = |axis: Vec3, centre: Vec3, radius: f32| {
+            let (t, b) = orthonormal_basis(axis);
+            let r = radius * u[1].sqrt();
+            let phi = 2.0 * std::f32::consts::PI * u[2];
+            centre - axis * radius + (t * phi.cos() + b * phi.sin()) * r
+        };
+        if e.triangle == ENVIRONMENT_LIGHT {
+            let env = scene.environment.as_ref().expect("an environment entry has a map");
+            let (to_sky, pdf) = env.sample(u[3], u[4]);
+            let (centre, radius) = self.disc;
+            let flux = env.eval(to_sky) * (std::f32::consts::PI * radius * radius / (pdf * e.pmf));
+            return (disc_origin(-to_sky, centre, radius), -to_sky, flux, None);
+        }
         if e.triangle & PUNCTUAL_LIGHT == 0 {
             let tri = &scene.triangles[e.triangle as usize];
             let n = triangle_normal(tri);
@@ -229,11 +260,7 @@ impl LightTable {
                 (Vec3::from(p.position), d, flux, None)
             }
             _ => {
-                let (t, b) = orthonormal_basis(axis);
-                let r = p.disc_radius * u[1].sqrt();
-                let phi = 2.0 * std::f32::consts::PI * u[2];
-                let centre = Vec3::from(p.disc_centre) - axis * p.disc_radius;
-                let origin = centre + (t * phi.cos() + b * phi.sin()) * r;
+                let origin = disc_origin(axis, Vec3::from(p.disc_centre), p.disc_radius);
                 let flux = i * (std::f32::consts::PI * p.disc_radius * p.disc_radius / e.pmf);
                 (origin, cone_direction(axis, p.cos_outer, u[3], u[4]), flux, None)
             }

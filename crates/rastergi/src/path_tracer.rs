@@ -38,7 +38,6 @@
 //! zero, so the film's resolve, EXR/PNG output and display work unchanged with [`Show::Full`].
 
 use bytemuck::{Pod, Zeroable};
-use glam::DMat4;
 
 use crate::error::Result;
 use crate::film::{Film, Show};
@@ -60,8 +59,6 @@ pub const RR_START: u32 = 1;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct PathParams {
-    /// Clip → world for this iteration's jittered camera.
-    pub inv_view_proj: [[f32; 4]; 4],
     /// Σ over the emissive triangles of area · (Le.r + Le.g + Le.b).
     pub light_weight: f32,
     pub light_count: u32,
@@ -176,16 +173,13 @@ impl PathTracer {
     }
 
     /// The uniforms of `iteration`: exactly the rasterizer's jittered view-projection
-    /// (`Renderer`'s near plane, which the rays do not depend on), and its inverse.
+    /// (`Renderer`'s near plane, which the rays do not depend on) and its inverse.
     fn uniforms(&self, iteration: u32) -> (FrameUniforms, PathParams) {
         let (w, h) = (self.settings.width, self.settings.height);
         let jitter = pixel_jitter(iteration, self.settings.seed);
         // The path tracer takes one light sample per vertex.
         let frame = FrameUniforms::new(&self.camera, (w, h), &self.scene, iteration, jitter, self.settings.seed, 1);
-        // Inverted in f64: the f32 matrix the rasterizer uses, inverted without further loss.
-        let inverse = DMat4::from_cols_array_2d(&frame.view_proj.map(|c| c.map(f64::from))).inverse();
         let params = PathParams {
-            inv_view_proj: inverse.to_cols_array_2d().map(|c| c.map(|v| v as f32)),
             light_weight: self.light_weight,
             light_count: self.scene.light_count,
             max_bounces: MAX_BOUNCES,

@@ -3,8 +3,6 @@
 
 // `PathParams` in path_tracer.rs.
 struct PathParams {
-    // Clip → world for this iteration's jittered camera: the inverse of frame.view_proj.
-    inv_view_proj: mat4x4f,
     // Σ over the emissive triangles of area · (Le.r + Le.g + Le.b), the light table's
     // normaliser: an emitter point with radiance Le has density (Le.r + Le.g + Le.b) / this.
     light_weight: f32,
@@ -22,21 +20,6 @@ struct PathParams {
 @group(2) @binding(2) var<storage, read_write> visibility: array<vec4u>;
 
 const FAR: f32 = 1e30;
-
-// The unit direction of the camera ray through the point p (in pixels, from the top-left
-// corner) of the jittered view. Clip (x, y, 0, 1) is the point at infinity in reversed-Z, so
-// the inverse view-projection maps it to the homogeneous world point (direction, 0), the same
-// ray the rasterizer's pixel sees.
-fn camera_ray(p: vec2f) -> vec3f {
-    let res = vec2f(frame.resolution);
-    let ndc = vec2f(2.0 * p.x / res.x - 1.0, 1.0 - 2.0 * p.y / res.y);
-    return normalize((params.inv_view_proj * vec4f(ndc, 0.0, 1.0)).xyz);
-}
-
-// The camera ray through the centre of pixel `xy`.
-fn camera_direction(xy: vec2u) -> vec3f {
-    return camera_ray(vec2f(xy) + 0.5);
-}
 
 // Texture coordinates where the ray (o, d) meets the plane of triangle `tri`.
 fn plane_uv(tri: u32, o: vec3f, d: vec3f) -> vec2f {
@@ -64,12 +47,6 @@ fn light_pdf_area(le: vec3f) -> f32 {
     return (le.r + le.g + le.b) / params.light_weight;
 }
 
-// The power heuristic (β = 2) weight of the strategy with density pa against pb.
-fn power_heuristic(pa: f32, pb: f32) -> f32 {
-    let a = pa * pa;
-    return a / (a + pb * pb);
-}
-
 // One sample of the radiance arriving at `origin` from direction −dir (see path_tracer.rs
 // for the estimator), for the camera ray through pixel `xy`. Textures are read filtered over
 // the pixel's footprint at the first hit and unfiltered (level 0) at every later one. Random
@@ -86,6 +63,14 @@ fn path_radiance(origin: vec3f, dir: vec3f, xy: vec2u, rng: ptr<function, u32>) 
     for (var bounce = 0u; ; bounce++) {
         let hit = trace(o, d, t_min, FAR, skip, NO_TRIANGLE, false);
         if hit.tri == NO_TRIANGLE {
+            // The environment, weighted against the light sample at the previous vertex.
+            if has_environment() {
+                var w = 1.0;
+                if bsdf_pdf > 0.0 {
+                    w = power_heuristic(bsdf_pdf, environment.pmf * env_pdf(d));
+                }
+                radiance += throughput * env_radiance(d) * w;
+            }
             break;
         }
         var lod = 0.0;
@@ -128,9 +113,12 @@ fn path_radiance(origin: vec3f, dir: vec3f, xy: vec2u, rng: ptr<function, u32>) 
                 // Against BSDF sampling where it could have found the same point: an emissive
                 // triangle, its area density → solid angle at x, from the same formula as the
                 // emitter hits above so that the two weights sum to one exactly. A punctual or
-                // distant light is found by light samples only (weight 1).
+                // distant light is found by light samples only (weight 1); the environment
+                // by BSDF samples that escape too.
                 var mis = 1.0;
-                if l.tri != NO_TRIANGLE {
+                if l.pdf > 0.0 {
+                    mis = power_heuristic(l.pdf, cos_x / PI);
+                } else if l.tri != NO_TRIANGLE {
                     let t = triangles[l.tri];
                     let cos_y = -dot(triangle_normal(t), l.dir);
                     let to_solid_angle = l.dist * l.dist / cos_y;

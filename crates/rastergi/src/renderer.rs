@@ -305,8 +305,15 @@ impl Renderer {
         let seed = self.settings.seed;
         let jitter = o.pixel_jitter.unwrap_or_else(|| pixel_jitter(iteration, seed));
         let size = (w, h);
-        let uniforms =
+        let mut uniforms =
             FrameUniforms::new(&self.camera, size, &self.scene, iteration, jitter, seed, self.settings.light_samples);
+        let fixed = FixedSample { direction: o.direction, texel_jitter: o.texel_jitter };
+        let map = self.photons.as_ref().map(PhotonPasses::map);
+        if let (Some(gather), Some(_)) = (&self.passes.gather, map) {
+            let (count, cosine) = gather.strategy(self.settings.directions, &fixed);
+            uniforms.gather_count = count;
+            uniforms.gather_cosine = cosine as u32;
+        }
         self.frame.write(&self.gpu, &uniforms);
         let mut enc =
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("iteration") });
@@ -315,14 +322,12 @@ impl Renderer {
         // 2. Emission + direct light with soft shadows → film (direct component).
         self.passes.direct.encode(&mut enc, &self.scene, &self.frame, w, h);
         // Debug view: the photon map's radiance at the visible points → film (photon view).
-        let map = self.photons.as_ref().map(PhotonPasses::map);
         if let (Some(view), Some(map)) = (&self.passes.photon_view, map) {
             view.encode(&mut enc, &self.scene, &self.frame, map, w, h);
         }
         // 3. Final gather along the iteration's directions for every visible point → film (indirect).
         if let (Some(gather), Some(map)) = (&mut self.passes.gather, map) {
             let f = GatherFrame { scene: &self.scene, frame: &self.frame, map, width: w, height: h };
-            let fixed = FixedSample { direction: o.direction, texel_jitter: o.texel_jitter };
             gather.encode(&self.gpu, &mut enc, &f, iteration, self.settings.directions, &fixed)?;
         }
         // 4. Accumulate: every pass above added its estimate to the film's sums.

@@ -7,12 +7,14 @@
 //! (`layout_test.rs`), which parses every composed shader with naga.
 
 use crate::consts::{
-    FILM_DIRECT, FILM_INDIRECT, FILM_PHOTON_VIEW, LIGHT_DISTANT, LIGHT_POINT, LIGHT_SPOT, MATERIAL_TWO_SIDED,
-    MAX_DIRECTIONS, MAX_SEPARATORS, NO_TEXTURE, OFFSET_SHIFT, OFFSET_STEP, PUNCTUAL_LIGHT, REGION_SHIFT, stream,
+    ENVIRONMENT_LIGHT, FILM_DIRECT, FILM_INDIRECT, FILM_PHOTON_VIEW, LIGHT_DISTANT, LIGHT_POINT, LIGHT_SPOT,
+    MATERIAL_TWO_SIDED, MAX_DIRECTIONS, MAX_SEPARATORS, NO_TEXTURE, OFFSET_SHIFT, OFFSET_STEP, PUNCTUAL_LIGHT,
+    REGION_SHIFT, stream,
 };
 
 pub const SAMPLING: &str = include_str!("sampling.wgsl");
-pub const SCENE: &str = include_str!("gpu_scene.wgsl");
+/// The scene's bind group: geometry, materials, lights and the environment.
+pub const SCENE: &str = concat!(include_str!("gpu_scene.wgsl"), "\n", include_str!("environment.wgsl"));
 pub const BVH: &str = include_str!("bvh.wgsl");
 pub const FRAME: &str = include_str!("frame.wgsl");
 /// The G-buffer texel → visible point decode (`visible_point`), for per-pixel passes.
@@ -37,6 +39,7 @@ pub fn constants() -> String {
         ("STREAM_PHOTON", stream::PHOTON),
         ("STREAM_HIT_LIGHT", stream::HIT_LIGHT),
         ("PUNCTUAL_LIGHT", PUNCTUAL_LIGHT),
+        ("ENVIRONMENT_LIGHT", ENVIRONMENT_LIGHT),
         ("LIGHT_POINT", LIGHT_POINT),
         ("LIGHT_SPOT", LIGHT_SPOT),
         ("LIGHT_DISTANT", LIGHT_DISTANT),

@@ -41,6 +41,20 @@ fn gather_estimate_cosine(p: VisiblePoint, w: vec3f, tri: u32, hit: vec3f, b: ve
     return p.x.albedo * gather_radiance(w, tri, hit, b, pixel, j);
 }
 
+// A gather ray from x along w that escapes the scene sees the environment: its estimate,
+// weighted against the direct pass's environment samples (env_gather_weight). Shared
+// directions (pdf 1/2π): (ρ_x/π)·L_env(w)·cos θ_x·2π; per-pixel (pdf cos θ_x/π): ρ_x·L_env(w).
+fn escape_estimate(p: VisiblePoint, cos_x: f32, w: vec3f) -> vec3f {
+    if !has_environment() {
+        return vec3f(0.0);
+    }
+    var f = p.x.albedo * env_radiance(w) * env_gather_weight(p.n, w);
+    if frame.gather_cosine == 0u {
+        f *= 2.0 * cos_x;
+    }
+    return f;
+}
+
 // Direct irradiance at h (side normal n) from one light sample (light_sample_irradiance):
 // sample j of the pixel's own Owen-scrambled Sobol' sequence (light_sample_uniforms, as the
 // direct pass draws them), whose seed depends on (seed, pixel) only. j is the gather

@@ -466,6 +466,17 @@ impl GatherPass {
         }
     }
 
+    /// The directions per pixel that [`encode`](Self::encode) will gather along with the same
+    /// arguments, and whether they are cosine-distributed (per-pixel; else uniform on the
+    /// hemisphere): the direct pass weighs its environment samples against them
+    /// ([`crate::frame::FrameUniforms::gather_count`]).
+    pub fn strategy(&self, directions: u32, fixed: &FixedSample) -> (u32, bool) {
+        let count = if fixed.direction.is_some() { 1 } else { directions.clamp(1, MAX_DIRECTIONS) };
+        let trial = (!self.chosen).then(|| self.next_candidate());
+        let per_pixel = trial.map_or(self.per_pixel, |k| self.candidates[k].per_pixel);
+        (count, per_pixel && fixed.direction.is_none())
+    }
+
     /// The candidate `Auto` tries next: the one with the fewest trials so far, in order.
     fn next_candidate(&self) -> usize {
         (0..self.candidates.len()).min_by_key(|&k| self.candidates[k].trials.len()).expect("a gather candidate")

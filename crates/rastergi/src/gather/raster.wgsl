@@ -36,6 +36,9 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         // Nothing at this texel in this layer, hence in no later (nearer) layer: along ω the ray
         // escapes; along −ω the nearest surface behind x, if any, is in `behind`.
         found[pixel] = 1u;
+        if dot(w, gather.direction) > 0.0 {
+            film_add(FILM_INDIRECT, gid.xy, escape_estimate(p, cos_x, w) / f32(gather.count));
+        }
         return;
     }
     let tri = l.x - 1u;
@@ -67,7 +70,9 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
 }
 
 // After the last layer: the estimate of each point gathering along −ω from the nearest surface
-// behind it.
+// behind it; and the environment for every ray that found no surface: along −ω none behind,
+// along ω no layer in front of x (an empty texel already counted its escape; where every layer
+// of x's texel lies behind x or is x's own, none was empty).
 @compute @workgroup_size(8, 8)
 fn resolve_behind(@builtin(global_invocation_id) gid: vec3u) {
     if any(gid.xy >= frame.resolution) {
@@ -75,10 +80,20 @@ fn resolve_behind(@builtin(global_invocation_id) gid: vec3u) {
     }
     let pixel = gid.y * frame.resolution.x + gid.x;
     let b = behind[pixel];
-    if b.x == 0u {
+    if b.x != 0u {
+        let p = visible_point(textureLoad(gbuffer, gid.xy, 0));
+        let w = -gather.direction;
+        film_add(FILM_INDIRECT, gid.xy, texel_estimate(p, dot(p.n, w), w, b.x - 1u, bitcast<f32>(b.y), pixel) / f32(gather.count));
+        return;
+    }
+    if !has_environment() {
         return;
     }
     let p = visible_point(textureLoad(gbuffer, gid.xy, 0));
-    let w = -gather.direction;
-    film_add(FILM_INDIRECT, gid.xy, texel_estimate(p, dot(p.n, w), w, b.x - 1u, bitcast<f32>(b.y), pixel) / f32(gather.count));
+    let w = gather_side(p.n, gather.direction);
+    let cos_x = dot(p.n, w);
+    let along = dot(w, gather.direction) > 0.0;
+    if p.ok && cos_x > 0.0 && (!along || found[pixel] == 0u) {
+        film_add(FILM_INDIRECT, gid.xy, escape_estimate(p, cos_x, w) / f32(gather.count));
+    }
 }

@@ -33,11 +33,11 @@ fn on_triangle(b: vec2f) -> bool {
 }
 
 // The exact nearest hit along ω from x (BVH), for the rays a texel cannot answer: the
-// estimate, or zero where the ray escapes.
+// estimate, or the environment's where the ray escapes.
 fn traced_estimate(p: VisiblePoint, cos_x: f32, w: vec3f, pixel: u32, j: u32) -> vec3f {
     let h = trace(p.x.pos, w, frame.ray_epsilon, 3.0e38, p.x.tri, NO_TRIANGLE, false);
     if h.tri == NO_TRIANGLE {
-        return vec3f(0.0);
+        return escape_estimate(p, cos_x, w);
     }
     return gather_estimate(p, cos_x, w, h.tri, p.x.pos + w * h.t, vec2f(h.b1, h.b2), pixel, j);
 }

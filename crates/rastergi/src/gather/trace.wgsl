@@ -40,6 +40,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             } else {
                 sum += gather_estimate(p, cos_x, w, h.tri, hit, b, pixel, j);
             }
+        } else {
+            sum += escape_estimate(p, cos_x, w);
         }
     }
     film_add(FILM_INDIRECT, gid.xy, sum / f32(gather.count));

@@ -192,6 +192,8 @@ pub struct Scene {
     /// Lights that are not surfaces (glTF punctual lights, the sun); emissive triangles are
     /// lights too.
     pub lights: Vec<Light>,
+    /// Radiance from every direction at infinity (`--env`), if any.
+    pub environment: Option<std::sync::Arc<crate::environment::Environment>>,
     /// Triangle corners, counter-clockwise about the front face.
     pub triangles: Vec<[Vec3; 3]>,
     /// Index into `materials` for each triangle.
@@ -209,6 +211,7 @@ impl Scene {
     pub fn new(camera: Camera) -> Self {
         Self {
             lights: Vec::new(),
+            environment: None,
             triangles: Vec::new(),
             material_ids: Vec::new(),
             materials: Vec::new(),

@@ -1,0 +1,242 @@
+//! The environment light (`--env`) against closed forms: a constant sky over an open floor
+//! gives E = πL, so every pass's image of the floor is ρL (the direct pass's light samples and
+//! the gather's escaping rays, weighted by MIS, must sum to it for every gather); the camera's
+//! escaping rays see the map; photons carry ∫ L cos θ dω · A to the floor.
+
+mod common;
+
+use std::sync::Arc;
+
+use glam::{Vec2, Vec3, Vec4};
+use rastergi::environment::Environment;
+use rastergi::film::Show;
+use rastergi::gather::{GatherDirections, GatherMethod};
+use rastergi::gpu_scene::PreparedScene;
+use rastergi::path_tracer::PathTracer;
+use rastergi::photons::map::GridSpec;
+use rastergi::photons::{PhotonSettings, cpu, gpu::GpuPhotonMap};
+use rastergi::renderer::{Overrides, RenderSettings, Renderer};
+use rastergi::scene::{Camera, Material, Scene};
+
+const ALBEDO: f32 = 0.5;
+/// Half the side of the floor, y = 0, x and z in [−A, A].
+const A: f32 = 4.0;
+const SIZE: u32 = 32;
+
+/// A one-sided square floor of albedo ½ facing up, seen from above (it fills the view), under
+/// `env`: nothing else, so its radiance is ρ/π · E with E the sky's irradiance.
+fn floor(env: Environment) -> Scene {
+    let camera = Camera { eye: Vec3::new(0.0, 3.0, 0.001), target: Vec3::ZERO, up: Vec3::Z, fov_y_deg: 60.0 };
+    let mut s = Scene::new(camera);
+    let m = s.add_material(Material::diffuse("floor", Vec3::splat(ALBEDO)));
+    let (p, q, r, t) = (Vec3::new(-A, 0.0, -A), Vec3::new(A, 0.0, -A), Vec3::new(A, 0.0, A), Vec3::new(-A, 0.0, A));
+    s.add_triangle([p, t, r], m);
+    s.add_triangle([p, r, q], m);
+    s.environment = Some(Arc::new(env));
+    s
+}
+
+/// A sky with structure: brighter towards the zenith, a bright patch, a dark ground.
+fn gradient_sky() -> Environment {
+    let (w, h) = (32u32, 17u32);
+    let mut t = Vec::new();
+    for j in 0..h {
+        for i in 0..w {
+            let theta = j as f32 * std::f32::consts::PI / (h - 1) as f32;
+            let sky = Vec3::new(0.3, 0.5, 1.0) * (0.4 + 0.6 * theta.cos().max(0.0)) + Vec3::splat(0.02 * i as f32);
+            t.push(if (i, j) == (5, 4) {
+                Vec3::new(40.0, 36.0, 30.0)
+            } else if j > 8 {
+                Vec3::splat(0.05)
+            } else {
+                sky
+            });
+        }
+    }
+    Environment::new(w, h, t).unwrap()
+}
+
+/// The mean of the floor's pixels per iteration over `iterations` (the film's sums read after
+/// each), for a render with `settings`: (mean, its standard error from the iterations' spread).
+fn floor_mean(scene: &Scene, settings: RenderSettings, iterations: u32, path: bool) -> (Vec3, Vec3) {
+    let gpu = common::gpu();
+    let mut means = Vec::new();
+    let mut previous = Vec3::ZERO;
+    let image_mean = |img: &rastergi::image_io::LinearImage| {
+        img.pixels.iter().map(|p| Vec3::from(*p)).sum::<Vec3>() / img.pixels.len() as f32
+    };
+    if path {
+        let mut pt = PathTracer::new(&gpu, scene, settings).unwrap();
+        for i in 1..=iterations {
+            pt.iterate();
+            let sum = image_mean(&pt.read_linear().unwrap()) * i as f32;
+            means.push(sum - previous);
+            previous = sum;
+        }
+    } else {
+        let mut r = Renderer::new(&gpu, scene, settings).unwrap();
+        for i in 1..=iterations {
+            r.iterate().unwrap();
+            let sum = image_mean(&r.read_linear(Show::Full).unwrap()) * i as f32;
+            means.push(sum - previous);
+            previous = sum;
+        }
+    }
+    let n = means.len() as f32;
+    let mean = means.iter().copied().sum::<Vec3>() / n;
+    let var = means.iter().map(|m| (*m - mean) * (*m - mean)).sum::<Vec3>() / (n - 1.0);
+    (mean, (var / n).powf(0.5))
+}
+
+fn settings(gather: GatherMethod, directions: GatherDirections) -> RenderSettings {
+    RenderSettings {
+        width: SIZE,
+        height: SIZE,
+        photons: 1 << 12,
+        grid_resolution: 8,
+        gather,
+        gather_directions: directions,
+        ..Default::default()
+    }
+}
+
+#[test]
+fn a_constant_sky_over_an_open_floor_gives_rho_l_in_every_gather_and_the_path_tracer() {
+    let l = Vec3::new(1.0, 0.6, 0.3);
+    let scene = floor(Environment::constant(l));
+    let expected = l * ALBEDO;
+    let cases = [
+        ("trace, per-pixel directions", settings(GatherMethod::Trace, GatherDirections::PerPixel), false),
+        ("trace, shared directions", settings(GatherMethod::Trace, GatherDirections::Shared), false),
+        ("lists", settings(GatherMethod::Lists, GatherDirections::Shared), false),
+        ("raster", settings(GatherMethod::Raster, GatherDirections::Shared), false),
+        ("path tracer", settings(GatherMethod::Trace, GatherDirections::PerPixel), true),
+    ];
+    for (label, s, path) in cases {
+        let (mean, sigma) = floor_mean(&scene, s, 24, path);
+        let err = (mean - expected).abs();
+        println!("{label}: floor mean {mean} (σ {sigma}), ρL {expected}");
+        // Within 5 standard errors (and float rounding): the MIS weights of the direct pass's
+        // sky samples and the gather's escaping rays sum to one.
+        assert!(err.cmple(5.0 * sigma + expected * 1e-3).all(), "{label}: {mean} against {expected} (σ {sigma})");
+    }
+}
+
+#[test]
+fn a_structured_sky_over_an_open_floor_gives_rho_e_over_pi() {
+    // A bright patch and a gradient: the sky's importance sampling, its pdf and the MIS
+    // weights against cosine-distributed gather rays (per-pixel) and uniform ones (lists), and
+    // the path tracer's own MIS, against ρ/π·E with E = ∫₊ L cos θ dω by quadrature.
+    let env = gradient_sky();
+    let m = 600;
+    let mut e = glam::DVec3::ZERO;
+    for a in 0..m {
+        for b in 0..m {
+            // Upper hemisphere, uniform in (φ, cos θ): dω = dφ d(cos θ).
+            let cos_t = (b as f32 + 0.5) / m as f32;
+            let phi = 2.0 * std::f32::consts::PI * (a as f32 + 0.5) / m as f32;
+            let s = (1.0 - cos_t * cos_t).sqrt();
+            e += (env.eval(Vec3::new(phi.sin() * s, cos_t, -phi.cos() * s)) * cos_t).as_dvec3();
+        }
+    }
+    let e = (e * (2.0 * std::f64::consts::PI / (m * m) as f64)).as_vec3();
+    let expected = e * (ALBEDO / std::f32::consts::PI);
+    let scene = floor(env);
+    for (label, s, path) in [
+        ("path tracer", settings(GatherMethod::Trace, GatherDirections::PerPixel), true),
+        ("trace, per-pixel directions", settings(GatherMethod::Trace, GatherDirections::PerPixel), false),
+        ("lists", settings(GatherMethod::Lists, GatherDirections::Shared), false),
+    ] {
+        let (mean, sigma) = floor_mean(&scene, s, 32, path);
+        println!("{label}, structured sky: floor mean {mean} (σ {sigma}), ρE/π {expected}");
+        assert!(
+            (mean - expected).abs().cmple(5.0 * sigma + expected * 2e-3).all(),
+            "{label}: {mean} against {expected}"
+        );
+    }
+}
+
+#[test]
+fn camera_rays_that_escape_see_the_environment() {
+    // Looking at the horizon from above the floor: the upper half of the image is sky. With no
+    // pixel jitter each background pixel is the map's value along its pixel-centre ray.
+    let env = gradient_sky();
+    let mut scene = floor(env.clone());
+    scene.camera =
+        Camera { eye: Vec3::new(0.0, 0.5, 3.0), target: Vec3::new(0.0, 0.8, 0.0), up: Vec3::Y, fov_y_deg: 70.0 };
+    let gpu = common::gpu();
+    let s = settings(GatherMethod::Trace, GatherDirections::PerPixel);
+    let mut r = Renderer::new(&gpu, &scene, s).unwrap();
+    r.iterate_with(&Overrides { pixel_jitter: Some(Vec2::ZERO), ..Default::default() }).unwrap();
+    let img = r.read_linear(Show::Full).unwrap();
+    let gbuffer = r.read_gbuffer().unwrap();
+    let prepared = PreparedScene::new(&scene);
+    let near = rastergi::frame::near_plane(&prepared.bounds);
+    let inv = rastergi::frame::view_projection(&scene.camera, SIZE, SIZE, near, Vec2::ZERO).inverse();
+    let mut sky_pixels = 0;
+    for (i, g) in gbuffer.iter().enumerate() {
+        if g[0] != 0 {
+            continue;
+        }
+        let (x, y) = ((i as u32 % SIZE) as f32 + 0.5, (i as u32 / SIZE) as f32 + 0.5);
+        let ndc = Vec2::new(2.0 * x / SIZE as f32 - 1.0, 1.0 - 2.0 * y / SIZE as f32);
+        let d = (inv * Vec4::new(ndc.x, ndc.y, 0.0, 1.0)).truncate().normalize();
+        let want = env.eval(d);
+        let got = Vec3::from(img.pixels[i]);
+        assert!((got - want).abs().max_element() < 1e-3 * want.max_element() + 1e-5, "pixel {i}: {got}, map {want}");
+        sky_pixels += 1;
+    }
+    assert!(sky_pixels > 300, "{sky_pixels} sky pixels");
+}
+
+#[test]
+fn photons_carry_the_skys_flux_to_the_floor() {
+    // Photons cross the scene's bounding sphere from discs of area πR²: the flux that meets
+    // the floor from direction ω is L(ω) cos θ · A, so the total is A·∫₊ L cos θ dω (the
+    // floor's back absorbs what comes from below). Binomial noise in the photons that hit.
+    for (label, env) in [("constant", Environment::constant(Vec3::new(1.0, 0.6, 0.3))), ("structured", gradient_sky())]
+    {
+        let m = 600;
+        let mut e = glam::DVec3::ZERO;
+        for a in 0..m {
+            for b in 0..m {
+                let cos_t = (b as f32 + 0.5) / m as f32;
+                let phi = 2.0 * std::f32::consts::PI * (a as f32 + 0.5) / m as f32;
+                let s = (1.0 - cos_t * cos_t).sqrt();
+                e += (env.eval(Vec3::new(phi.sin() * s, cos_t, -phi.cos() * s)) * cos_t).as_dvec3();
+            }
+        }
+        let area = (2.0 * A) * (2.0 * A);
+        let expected = (e * (2.0 * std::f64::consts::PI / (m * m) as f64)).as_vec3() * area;
+        let mut scene = floor(env);
+        scene.materials[0].albedo = Vec3::ZERO;
+        let n = 1 << 16;
+        let settings = PhotonSettings { count: n, seed: 5, grid_resolution: 8, indirect_only: false };
+        let prepared = PreparedScene::new(&scene);
+        let gpu = common::gpu();
+        let gs = rastergi::gpu_scene::GpuScene::new(&gpu, &prepared).unwrap();
+        let f = |v: [f64; 3]| Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32);
+        let g = f(GpuPhotonMap::build(&gpu, &gs, &prepared, &settings).unwrap().read(&gpu).unwrap().total_flux());
+        let c = f(cpu::trace(&prepared, &GridSpec::new(&scene.bounds(), 8), &settings).total_flux());
+        // The noise of the total: each photon adds its flux where it meets the floor's top,
+        // zero elsewhere; the variance of that per photon, from the emission alone (CPU
+        // samples of the same distribution meeting the plane).
+        let mut rng = rastergi::sampling::Rng::new(9, 9, 9);
+        let (mut s1, mut s2) = (0.0f64, 0.0f64);
+        let samples = 1 << 18;
+        for _ in 0..samples {
+            let u = [(); 5].map(|_| rng.next_f32());
+            let (o, d, flux, _) = prepared.lights.emit_photon(&prepared.scene, u, 0.0);
+            let t = -o.y / d.y;
+            let hit = o + d * t;
+            let x = if d.y < 0.0 && hit.x.abs() < A && hit.z.abs() < A { flux.x as f64 } else { 0.0 };
+            s1 += x;
+            s2 += x * x;
+        }
+        let (mean, var) = (s1 / samples as f64, s2 / samples as f64 - (s1 / samples as f64).powi(2));
+        let tol = 5.0 * ((var / n as f64).sqrt() / mean) as f32;
+        println!("{label} sky: GPU {g}, CPU {c}, A ∫ L cos θ dω {expected} (tolerance {tol:.4})");
+        assert!(((g - expected) / expected).abs().max_element() < tol, "{label}: GPU {g} against {expected}");
+        assert!(((c - expected) / expected).abs().max_element() < tol, "{label}: CPU {c} against {expected}");
+    }
+}

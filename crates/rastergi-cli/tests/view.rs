@@ -196,6 +196,34 @@ fn resizing_and_retracing_rebuild_the_image_at_the_window_size() {
 }
 
 #[test]
+fn turning_the_sun_re_traces_and_shows_what_a_render_with_that_sun_shows() {
+    // The sun through the Cornell box's open front, turned by the script (as the J/L I/K keys
+    // do): each screenshot's direct light equals a headless render's with `--sun` at those
+    // angles (the same seed and iteration count draw the same light samples).
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let script = "show direct\nafter 4 iterations: screenshot\nsun 340,15\nafter 4 iterations: screenshot\nquit\n";
+    std::fs::write(d.join("script.txt"), script).unwrap();
+    let mut args = vec!["cornell", "--script", "script.txt", "--sun", "20,25,1.5"];
+    args.extend_from_slice(SIZE);
+    args.extend_from_slice(PHOTONS);
+    let run = view(d, &args);
+    run.check_success("view");
+    let shots = screenshots(d, &run.stdout);
+    assert_eq!(shots.len(), 2, "{}", run.stdout);
+    assert_eq!(shots[1].iterations, 4, "the new sun restarted the image");
+    for (shot, sun) in shots.iter().zip(["20,25,1.5", "340,15,1.5"]) {
+        let options: Vec<String> = ["--sun", sun, "--show", "direct"].map(String::from).to_vec();
+        let out = format!("sun-{}.exr", sun.split(',').next().unwrap());
+        let rendered = render(d, &out, 0, 4, &options);
+        let c = compare(&read_exr(&shot.exr).unwrap(), &rendered, None);
+        assert!(c.relative_rmse < 1e-4, "sun {sun}: the viewer's direct light differs from the render's: {c:?}");
+    }
+    let (a, b) = (read_exr(&shots[0].exr).unwrap(), read_exr(&shots[1].exr).unwrap());
+    assert!(compare(&a, &b, None).relative_rmse > 0.05, "turning the sun changes the light");
+}
+
+#[test]
 fn view_without_a_display_fails_with_one_clear_line() {
     let dir = tempfile::tempdir().unwrap();
     let env = [("DISPLAY", None), ("WAYLAND_DISPLAY", None), ("WAYLAND_SOCKET", None)];

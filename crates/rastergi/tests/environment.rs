@@ -240,3 +240,23 @@ fn photons_carry_the_skys_flux_to_the_floor() {
         assert!(((c - expected) / expected).abs().max_element() < tol, "{label}: CPU {c} against {expected}");
     }
 }
+
+#[test]
+fn a_courtyard_under_a_sky_with_a_sun_matches_mitsuba() {
+    // References: scripts/mitsuba_reference.py --scene obj/courtyard.obj --env env/sky_64x32.exr
+    //   --eye 0,3,5.5 --target 0,0.3,0 --fov 45 --spp 4096 --seed 11|12 (tests/data/README.md):
+    // the sky's one bright pixel is a sun of ~2.7° radius casting soft shadows, the rest sky
+    // light, the camera's escaping rays the map's ground colour.
+    let mut scene = rastergi::scene::load_obj(&common::data("obj/courtyard.obj")).unwrap();
+    scene.camera =
+        Camera { eye: Vec3::new(0.0, 3.0, 5.5), target: Vec3::new(0.0, 0.3, 0.0), up: Vec3::Y, fov_y_deg: 45.0 };
+    scene.environment = Some(Environment::load(&common::data("env/sky_64x32.exr"), 1.0).unwrap());
+    common::matches_mitsuba(
+        "courtyard + sky",
+        &scene,
+        rastergi::gather::HitLight::Map,
+        256,
+        "courtyard_env_path_128",
+        false,
+    );
+}

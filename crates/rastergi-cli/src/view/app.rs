@@ -11,7 +11,7 @@ use rastergi::display::{Presented, WindowSurface};
 use rastergi::film::Show;
 use rastergi::gpu::{Gpu, GpuOptions};
 use rastergi::renderer::{RenderSettings, Renderer, default_bundle};
-use rastergi::scene::Scene;
+use rastergi::scene::{Light, Scene};
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
 use winit::event::{ElementState, KeyEvent, MouseButton, MouseScrollDelta, WindowEvent};
@@ -19,7 +19,7 @@ use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoopProxy};
 use winit::keyboard::{Key as LogicalKey, KeyCode, NamedKey, PhysicalKey};
 use winit::window::{Window, WindowId};
 
-use super::controls::{Controls, Key, Response, camera_options, show_name};
+use super::controls::{Controls, Key, Response, SunAngles, camera_options, show_name};
 use super::screenshots::Screenshots;
 use super::script::{Action, Step, When};
 use crate::args::SceneArgs;
@@ -58,6 +58,10 @@ fn key_of(event: &KeyEvent) -> Option<Key> {
             KeyCode::Comma => Some(Key::CoarserGrid),
             KeyCode::Period => Some(Key::FinerGrid),
             KeyCode::KeyP => Some(Key::Screenshot),
+            KeyCode::KeyJ => Some(Key::SunWest),
+            KeyCode::KeyL => Some(Key::SunEast),
+            KeyCode::KeyI => Some(Key::SunHigher),
+            KeyCode::KeyK => Some(Key::SunLower),
             KeyCode::KeyH | KeyCode::F1 => Some(Key::ToggleOverlay),
             KeyCode::Escape => Some(Key::Quit),
             _ => None,
@@ -143,6 +147,9 @@ pub struct App {
     renderer: Option<Renderer>,
     /// The generation of the build in flight, if any; results of older ones are dropped.
     building: Option<u64>,
+    /// The sun of the build in flight and of the current renderer.
+    building_sun: Option<SunAngles>,
+    renderer_sun: Option<SunAngles>,
     generation: u64,
     controls: Controls,
     /// The window's inner size (0 while minimised on some platforms).
@@ -177,16 +184,14 @@ impl App {
         proxy: EventLoopProxy<UserEvent>,
     ) -> App {
         let camera = CameraControl::new(&scene.camera, &scene.bounds());
+        let sun = last_sun(&scene).map(SunAngles::of_direction);
+        let mut controls =
+            Controls::new(camera, a.show.show(), a.exposure.unwrap_or(0.0), base.photons, base.grid_resolution);
+        controls.sun = sun;
         App {
             args_scene: a.scene.clone(),
             scene: Arc::new(scene),
-            controls: Controls::new(
-                camera,
-                a.show.show(),
-                a.exposure.unwrap_or(0.0),
-                base.photons,
-                base.grid_resolution,
-            ),
+            controls,
             base,
             gpu_options: a.gpu.options(),
             proxy,
@@ -195,6 +200,8 @@ impl App {
             surface: None,
             renderer: None,
             building: None,
+            building_sun: sun,
+            renderer_sun: sun,
             generation: 0,
             size: (a.width, a.height),
             resized_at: None,
@@ -240,12 +247,13 @@ impl App {
         }
     }
 
-    /// Whether the current renderer (if any) was built with `settings`.
+    /// Whether the current renderer (if any) was built with `settings` and the controls' sun.
     fn renderer_matches(&self, s: &RenderSettings) -> bool {
-        self.renderer.as_ref().is_some_and(|r| {
-            let t = r.settings();
-            (t.width, t.height, t.photons, t.grid_resolution) == (s.width, s.height, s.photons, s.grid_resolution)
-        })
+        self.renderer_sun == self.controls.sun
+            && self.renderer.as_ref().is_some_and(|r| {
+                let t = r.settings();
+                (t.width, t.height, t.photons, t.grid_resolution) == (s.width, s.height, s.photons, s.grid_resolution)
+            })
     }
 
     /// Starts building a renderer with the wanted settings on a worker thread.
@@ -261,6 +269,12 @@ impl App {
         let generation = self.generation;
         let mut scene = (*self.scene).clone();
         scene.camera = self.controls.camera.camera();
+        self.building_sun = self.controls.sun;
+        if let (Some(sun), Some(Light::Distant { direction, .. })) =
+            (self.controls.sun, scene.lights.iter_mut().rev().find(|l| matches!(l, Light::Distant { .. })))
+        {
+            *direction = sun.direction();
+        }
         let proxy = self.proxy.clone();
         self.status = format!("tracing {} photons...", settings.photons);
         std::thread::spawn(move || {
@@ -294,6 +308,9 @@ impl App {
         if r.retrace {
             // Applied by about_to_wait once no build is in flight.
             self.status = format!("photons {}, grid {}: re-tracing", self.controls.photons, self.controls.grid);
+            if let Some(s) = self.controls.sun.filter(|&s| Some(s) != self.renderer_sun) {
+                self.status = format!("sun {:.0}°, {:.0}°: re-tracing", s.azimuth, s.elevation);
+            }
         }
         if r.screenshot {
             self.screenshot();
@@ -483,12 +500,23 @@ impl App {
             format!("photons {}  grid {}  bundle {}", c.photons, c.grid, bundle),
             format!("show {} [1-4]  exposure {:+.1} EV [+/-]", show_name(c.show), c.exposure),
         ];
+        if let Some(sun) = c.sun {
+            lines.push(format!("sun azimuth {:.0}  elevation {:.0} [J/L I/K]", sun.azimuth, sun.elevation));
+        }
         if !self.status.is_empty() {
             lines.push(self.status.clone());
         }
         lines.push("WASDQE drag scroll  Tab mode  P save  H hide".into());
         lines
     }
+}
+
+/// The direction of the scene's last distant light (the viewer's sun), if any.
+fn last_sun(scene: &Scene) -> Option<glam::Vec3> {
+    scene.lights.iter().rev().find_map(|l| match l {
+        Light::Distant { direction, .. } => Some(*direction),
+        _ => None,
+    })
 }
 
 impl ApplicationHandler<UserEvent> for App {
@@ -530,6 +558,7 @@ impl ApplicationHandler<UserEvent> for App {
             Ok(renderer) => {
                 self.status.clear();
                 self.renderer = Some(renderer);
+                self.renderer_sun = self.building_sun;
                 if let Some(run) = &mut self.script {
                     run.last = Instant::now();
                 }
@@ -638,10 +667,11 @@ impl ApplicationHandler<UserEvent> for App {
                     // A new size alone keeps the scene and its photon map: only the
                     // size-dependent passes are rebuilt. New photon settings re-trace.
                     let wanted = self.wanted();
-                    let same_map = self.renderer.as_ref().is_some_and(|r| {
-                        let t = r.settings();
-                        (t.photons, t.grid_resolution) == (wanted.photons, wanted.grid_resolution)
-                    });
+                    let same_map = self.renderer_sun == self.controls.sun
+                        && self.renderer.as_ref().is_some_and(|r| {
+                            let t = r.settings();
+                            (t.photons, t.grid_resolution) == (wanted.photons, wanted.grid_resolution)
+                        });
                     match self.renderer.as_mut() {
                         Some(r) if same_map => {
                             self.resized_at = None;

@@ -28,10 +28,43 @@ pub enum Key {
     MorePhotons,
     CoarserGrid,
     FinerGrid,
+    /// Turn the sun (a distant light) by [`SUN_STEP`]: azimuth down / up, elevation up / down.
+    SunWest,
+    SunEast,
+    SunHigher,
+    SunLower,
     Screenshot,
     ToggleOverlay,
     Quit,
 }
+
+/// The sun's direction as the viewer turns it, in `--sun`'s terms: degrees from +Z towards
+/// +X about +Y, and degrees above the XZ plane.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SunAngles {
+    pub azimuth: f32,
+    pub elevation: f32,
+}
+
+impl SunAngles {
+    /// The angles of a distant light travelling along `direction`.
+    pub fn of_direction(direction: glam::Vec3) -> SunAngles {
+        let towards = -direction.normalize();
+        SunAngles {
+            azimuth: towards.x.atan2(towards.z).to_degrees().rem_euclid(360.0),
+            elevation: towards.y.clamp(-1.0, 1.0).asin().to_degrees(),
+        }
+    }
+
+    /// The direction a sun at these angles shines along (as `--sun`).
+    pub fn direction(self) -> glam::Vec3 {
+        let (a, e) = (self.azimuth.to_radians(), self.elevation.to_radians());
+        -glam::Vec3::new(a.sin() * e.cos(), e.sin(), a.cos() * e.cos())
+    }
+}
+
+/// Degrees per press of the sun keys.
+pub const SUN_STEP: f32 = 5.0;
 
 /// What the application must do after an input.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -59,6 +92,8 @@ pub struct Controls {
     pub exposure: f32,
     pub photons: u32,
     pub grid: u32,
+    /// The scene's sun (its last distant light), if it has one.
+    pub sun: Option<SunAngles>,
     pub overlay: bool,
 }
 
@@ -72,6 +107,7 @@ impl Controls {
             exposure,
             photons,
             grid,
+            sun: None,
             overlay: true,
         }
     }
@@ -96,10 +132,13 @@ impl Controls {
         if !pressed {
             return r;
         }
-        // Auto-repeat steps the exposure; other keys act once per press.
+        // Auto-repeat steps the exposure and the sun; other keys act once per press.
         match key {
             Key::ExposureUp => self.exposure += EXPOSURE_STEP,
             Key::ExposureDown => self.exposure -= EXPOSURE_STEP,
+            Key::SunWest | Key::SunEast | Key::SunHigher | Key::SunLower if repeat => {
+                return self.key(key, true, false);
+            }
             _ if repeat => {}
             Key::ToggleMode => self.camera.toggle_mode(),
             Key::Home => {
@@ -113,6 +152,10 @@ impl Controls {
             Key::MorePhotons => r.retrace = self.set_photons(self.photons.saturating_mul(2)),
             Key::CoarserGrid => r.retrace = self.set_grid(self.grid / 2),
             Key::FinerGrid => r.retrace = self.set_grid(self.grid * 2),
+            Key::SunWest => r.retrace = self.turn_sun(-SUN_STEP, 0.0),
+            Key::SunEast => r.retrace = self.turn_sun(SUN_STEP, 0.0),
+            Key::SunHigher => r.retrace = self.turn_sun(0.0, SUN_STEP),
+            Key::SunLower => r.retrace = self.turn_sun(0.0, -SUN_STEP),
             Key::Screenshot => r.screenshot = true,
             Key::ToggleOverlay => self.overlay = !self.overlay,
             Key::Quit => r.quit = true,
@@ -131,6 +174,21 @@ impl Controls {
     pub fn set_grid(&mut self, grid: u32) -> bool {
         let grid = grid.clamp(1, 1024);
         std::mem::replace(&mut self.grid, grid) != grid
+    }
+
+    /// Turns the sun by (azimuth, elevation) degrees (the elevation kept within ±90°);
+    /// whether that is a change (none without a sun).
+    pub fn turn_sun(&mut self, azimuth: f32, elevation: f32) -> bool {
+        let Some(s) = self.sun else { return false };
+        self.set_sun(SunAngles { azimuth: s.azimuth + azimuth, elevation: s.elevation + elevation })
+    }
+
+    /// Puts the sun at these angles (azimuth wrapped to [0, 360), elevation clamped to ±90°);
+    /// whether that is a change (none without a sun).
+    pub fn set_sun(&mut self, to: SunAngles) -> bool {
+        let Some(sun) = &mut self.sun else { return false };
+        let to = SunAngles { azimuth: to.azimuth.rem_euclid(360.0), elevation: to.elevation.clamp(-90.0, 90.0) };
+        std::mem::replace(sun, to) != to
     }
 
     /// Time passes with the held keys down: fly.
@@ -177,6 +235,7 @@ impl Controls {
             Action::Exposure(ev) => self.exposure = ev,
             Action::Photons(n) => r.retrace = self.set_photons(n),
             Action::Grid(n) => r.retrace = self.set_grid(n),
+            Action::Sun { azimuth, elevation } => r.retrace = self.set_sun(SunAngles { azimuth, elevation }),
             Action::Screenshot => r.screenshot = true,
             Action::Quit => r.quit = true,
             Action::Resize { .. } => {}
@@ -282,6 +341,28 @@ mod tests {
         assert!(c.action(&Action::Photons(7), 64.0).retrace && c.photons == 7);
         assert!(!c.action(&Action::Photons(7), 64.0).retrace);
         assert!(c.key(Key::Screenshot, true, false).screenshot && c.key(Key::Quit, true, false).quit);
+    }
+
+    #[test]
+    fn the_sun_keys_turn_a_sun_and_nothing_else() {
+        let mut c = controls();
+        assert!(!c.key(Key::SunEast, true, false).retrace, "no sun, nothing to turn");
+        c.sun = Some(SunAngles::of_direction(SunAngles { azimuth: 30.0, elevation: 45.0 }.direction()));
+        let s = c.sun.unwrap();
+        assert!((s.azimuth - 30.0).abs() < 1e-3 && (s.elevation - 45.0).abs() < 1e-3, "{s:?}");
+        assert!(c.key(Key::SunWest, true, false).retrace && (c.sun.unwrap().azimuth - 25.0).abs() < 1e-3);
+        assert!(c.key(Key::SunHigher, true, true).retrace, "auto-repeat turns it on");
+        assert!((c.sun.unwrap().elevation - 50.0).abs() < 1e-3);
+        for _ in 0..10 {
+            c.key(Key::SunHigher, true, false);
+        }
+        assert_eq!(c.sun.unwrap().elevation, 90.0, "the elevation stops at the zenith");
+        assert!(!c.key(Key::SunHigher, true, false).retrace);
+        assert!(c.action(&Action::Sun { azimuth: -10.0, elevation: 20.0 }, 64.0).retrace);
+        assert_eq!(c.sun, Some(SunAngles { azimuth: 350.0, elevation: 20.0 }));
+        // --sun's convention: azimuth 90° (towards +X), elevation 0 shines along −X.
+        let d = SunAngles { azimuth: 90.0, elevation: 0.0 }.direction();
+        assert!(d.abs_diff_eq(-glam::Vec3::X, 1e-6), "{d}");
     }
 
     #[test]

@@ -54,6 +54,7 @@ Keys and mouse:
   + -               exposure up / down by half a stop
   [ ]               halve / double the photons (re-traces the photon map)
   , .               halve / double the photon grid resolution (re-traces)
+  J L / I K         turn the sun (the scene's distant light): azimuth / elevation by 5 degrees (re-traces)
   P                 screenshot: rastergi-NNNN.png (as shown) and .exr (linear)
   H                 hide / show the overlay
   Esc               quit
@@ -86,7 +87,7 @@ Script (--script FILE): one action per line, optionally after a condition; # com
   ACTION                       right after the previous line
 Actions: move R,U,F | look YAW,PITCH | orbit YAW,PITCH | pan X,Y | zoom STEPS |
   mode fly|orbit | show full|direct|indirect|photon-map | exposure EV | photons N |
-  grid N | resize W,H | screenshot | quit
+  grid N | sun AZIMUTH,ELEVATION | resize W,H | screenshot | quit
 Each screenshot prints its files and the camera as render options to stdout."
 );
 

@@ -57,17 +57,42 @@ pub enum When {
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Action {
-    Move { right: f32, up: f32, forward: f32 },
-    Look { yaw_deg: f32, pitch_deg: f32 },
-    Orbit { yaw_deg: f32, pitch_deg: f32 },
-    Pan { dx: f32, dy: f32 },
-    Zoom { steps: f32 },
-    Mode { orbit: bool },
+    Move {
+        right: f32,
+        up: f32,
+        forward: f32,
+    },
+    Look {
+        yaw_deg: f32,
+        pitch_deg: f32,
+    },
+    Orbit {
+        yaw_deg: f32,
+        pitch_deg: f32,
+    },
+    Pan {
+        dx: f32,
+        dy: f32,
+    },
+    Zoom {
+        steps: f32,
+    },
+    Mode {
+        orbit: bool,
+    },
     Show(Show),
     Exposure(f32),
     Photons(u32),
     Grid(u32),
-    Resize { width: u32, height: u32 },
+    /// Puts the scene's sun at (azimuth, elevation) degrees.
+    Sun {
+        azimuth: f32,
+        elevation: f32,
+    },
+    Resize {
+        width: u32,
+        height: u32,
+    },
     Screenshot,
     Quit,
 }
@@ -134,7 +159,8 @@ fn parse_when(condition: &str) -> Result<When> {
     }
 }
 
-const ACTIONS: &str = "move, look, orbit, pan, zoom, mode, show, exposure, photons, grid, resize, screenshot, quit";
+const ACTIONS: &str =
+    "move, look, orbit, pan, zoom, mode, show, exposure, photons, grid, sun, resize, screenshot, quit";
 
 fn parse_action(action: &str) -> Result<Action> {
     let (name, args) = match action.split_once(char::is_whitespace) {
@@ -176,6 +202,10 @@ fn parse_action(action: &str) -> Result<Action> {
         }),
         "photons" => Action::Photons(count(args, "photons", 1, u32::MAX)?),
         "grid" => Action::Grid(count(args, "grid", 1, 1024)?),
+        "sun" => {
+            let [azimuth, elevation] = numbers::<2>(args, "AZIMUTH,ELEVATION")?;
+            Action::Sun { azimuth, elevation }
+        }
         "resize" => {
             let [width, height] = numbers::<2>(args, "W,H")?;
             let side = |v: f32| (1.0..=16384.0).contains(&v) && v.fract() == 0.0;

@@ -40,8 +40,15 @@ values to both. The near clip is 1e-4 of the bounds' diagonal (rastergi's;
 Extra lights, added to either scene: --point x,y,z,r,g,b (repeatable) is a `point` emitter
 of that intensity (W/sr, a glTF point light in rastergi); --sun AZ,EL,IRR is a
 `directional` emitter of irradiance IRR (W/m^2) from azimuth AZ and elevation EL in
-degrees, as rastergi's --sun with --sun-size 0 (a delta direction); --env FILE (an .exr or
-.hdr latitude-longitude image, linear radiance) is an `envmap` emitter
+degrees, as rastergi's --sun with --sun-size 0 (a delta direction); --spot
+x,y,z,tx,ty,tz,r,g,b,ANGLE (repeatable) is a `spot` emitter at x,y,z aimed at the point
+tx,ty,tz, of radiant intensity r,g,b on its axis (W/sr, a glTF spot light's color x
+intensity), with a HARD cone of half-angle ANGLE degrees: cutoff_angle = beam_width = ANGLE,
+which Mitsuba's spot accepts and turns into a step (full intensity for theta <= ANGLE, 0
+beyond). Mitsuba cannot reproduce glTF's smooth falloff between an inner and an outer cone;
+give rastergi's spot inner = outer = ANGLE (its falloff then ramps over 1e-3 in cos theta
+just inside the edge, about 0.14 degrees at 25); --env FILE (an .exr or .hdr latitude-longitude image, linear
+radiance) is an `envmap` emitter
 {"filename": FILE, "scale": --env-scale (default 1)} with no to_world transform (the
 identity). That is the convention for rastergi's environment maps too: direction
 d = (x, y, z) <-> u = atan2(x, -z) / 2pi, v = acos(y) / pi, image row 0 at the zenith +Y;
@@ -519,12 +526,42 @@ def check_scene(mi):
     return ok and worst < 1e-6
 
 
-def add_lights(d, args):
-    """rastergi's point lights (--point, W/sr) and sun (--sun, W/m², a delta direction: use
-    rastergi's --sun-size 0) as Mitsuba's `point` and `directional` emitters, and an
-    environment map (--env, --env-scale) as an `envmap` emitter with the identity to_world."""
+def spot_dict(mi, v):
+    """A hard-cone spot light x,y,z,tx,ty,tz,r,g,b,ANGLE as Mitsuba's `spot`: at x,y,z, its
+    axis (local +z) towards tx,ty,tz, `intensity` r,g,b W/sr on the axis, and
+    cutoff_angle = beam_width = ANGLE degrees. With beam_width == cutoff_angle spot.cpp's
+    falloff is 1 for cos(theta) > cos(cutoff) and 0 otherwise (the linear ramp between
+    the two angles is never selected), a step."""
+    pos, aim, color, angle = v[:3], v[3:6], v[6:9], v[9]
+    axis = [a - p for a, p in zip(aim, pos)]
+    length = math.sqrt(sum(c * c for c in axis))
+    if not length > 0:
+        raise SceneError(f"--spot {','.join(f'{x:g}' for x in v)}: the position and the "
+                         "aim point must differ")
+    if not 0 < angle < 90:
+        raise SceneError(f"--spot: the cone's half-angle must lie strictly between 0 and 90 "
+                         f"degrees, got {angle:g}")
+    if min(color) < 0:
+        raise SceneError(f"--spot: the intensity must not be negative, got {color}")
+    # Any up vector not parallel to the axis: the coordinate axis least aligned with it
+    # (the cone is round, its roll does not matter).
+    k = min(range(3), key=lambda i: abs(axis[i]))
+    up = [1.0 if i == k else 0.0 for i in range(3)]
+    return {"type": "spot", "intensity": rgb(color), "cutoff_angle": float(angle),
+            "beam_width": float(angle),
+            "to_world": mi.ScalarTransform4f().look_at(origin=list(pos), target=list(aim),
+                                                       up=up)}
+
+
+def add_lights(mi, d, args):
+    """rastergi's point lights (--point, W/sr), hard-cone spot lights (--spot, W/sr on the
+    axis) and sun (--sun, W/m², a delta direction: use rastergi's --sun-size 0) as Mitsuba's
+    `point`, `spot` and `directional` emitters, and an environment map (--env,
+    --env-scale) as an `envmap` emitter with the identity to_world."""
     for k, v in enumerate(args.point or []):
         d[f"point_{k}"] = {"type": "point", "position": list(v[:3]), "intensity": rgb(v[3:])}
+    for k, v in enumerate(args.spot or []):
+        d[f"spot_{k}"] = spot_dict(mi, v)
     if args.sun:
         az, el, irr = (float(x) for x in args.sun)
         a, e = math.radians(az), math.radians(el)
@@ -559,8 +596,8 @@ def load_scene(mi, args, spp):
               "identity to_world", file=sys.stderr)
     if args.scene == "cornell":
         camera = scene_camera(args, CORNELL_CAMERA)
-        return mi.load_dict(add_lights(cornell_scene_dict(mi, args.width, args.height,
-                                                          args.max_depth, spp, camera), args))
+        return mi.load_dict(add_lights(mi, cornell_scene_dict(mi, args.width, args.height,
+                                                              args.max_depth, spp, camera), args))
     if not args.scene.lower().endswith(".obj"):
         raise SceneError(f"unknown scene '{args.scene}': use the built-in 'cornell' "
                          "or a path to a .obj file")
@@ -577,8 +614,9 @@ def load_scene(mi, args, spp):
               f"{camera['up']}, fov {camera['fov']}", file=sys.stderr)
     with tempfile.TemporaryDirectory(prefix="rastergi-mitsuba-") as mesh_dir:
         # Mitsuba reads the meshes while loading; the files can go afterwards.
-        return mi.load_dict(add_lights(obj_scene_dict(mi, groups, camera, args.width, args.height,
-                                                      args.max_depth, spp, mesh_dir), args))
+        return mi.load_dict(add_lights(mi, obj_scene_dict(mi, groups, camera, args.width,
+                                                          args.height, args.max_depth, spp,
+                                                          mesh_dir), args))
 
 
 def render(mi, args):
@@ -699,6 +737,12 @@ def main():
     p.add_argument("--point", type=parse_floats(6), action="append",
                    help="add a point light x,y,z,r,g,b (intensity W/sr, as a glTF point light "
                         "in rastergi); repeatable")
+    p.add_argument("--spot", type=parse_floats(10), action="append",
+                   metavar="X,Y,Z,TX,TY,TZ,R,G,B,ANGLE",
+                   help="add a hard-cone spot light at x,y,z aimed at tx,ty,tz, intensity "
+                        "r,g,b W/sr on its axis (a glTF spot's color x intensity), half-angle "
+                        "ANGLE degrees (Mitsuba spot, cutoff_angle = beam_width = ANGLE: a "
+                        "step; give rastergi's spot inner = outer cone = ANGLE); repeatable")
     p.add_argument("--sun", type=parse_floats(3),
                    help="add rastergi's --sun AZIMUTH,ELEVATION,IRRADIANCE as a directional "
                         "light (a delta: render rastergi with --sun-size 0)")

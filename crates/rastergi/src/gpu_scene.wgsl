@@ -195,12 +195,17 @@ fn light_sample_uniforms(j: u32, seed: u32) -> vec3f {
     return vec3f(u0, remap_in_entry(p.x, light_pick(u0)), unit_f32(p.y));
 }
 
-// The spot's falloff s(cos θ) (lights.rs: PunctualLight::falloff); 1 for the other kinds.
+// The spot's falloff s(cos θ) (lights.rs: PunctualLight::falloff): a squared ramp between the
+// cones, a step where they coincide; 1 for the other kinds.
 fn spot_falloff(p: PunctualLight, cos_theta: f32) -> f32 {
     if p.kind != LIGHT_SPOT {
         return 1.0;
     }
-    let t = clamp((cos_theta - p.cos_outer) / max(p.cos_inner - p.cos_outer, 1e-3), 0.0, 1.0);
+    let width = p.cos_inner - p.cos_outer;
+    if width <= 0.0 {
+        return select(0.0, 1.0, cos_theta > p.cos_outer);
+    }
+    let t = clamp((cos_theta - p.cos_outer) / width, 0.0, 1.0);
     return t * t;
 }
 

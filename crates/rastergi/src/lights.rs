@@ -86,13 +86,17 @@ impl PunctualLight {
         }
     }
 
-    /// The spot's falloff s(cos θ) (glTF's: squared linear ramp between the cones; 1 for the
-    /// others). Mirrors `spot_falloff` in WGSL.
+    /// The spot's falloff s(cos θ) (glTF's: squared linear ramp between the cones, a step
+    /// where they coincide; 1 for the others). Mirrors `spot_falloff` in WGSL.
     pub fn falloff(&self, cos_theta: f32) -> f32 {
         if self.kind != LIGHT_SPOT {
             return 1.0;
         }
-        let t = ((cos_theta - self.cos_outer) / (self.cos_inner - self.cos_outer).max(1e-3)).clamp(0.0, 1.0);
+        let width = self.cos_inner - self.cos_outer;
+        if width <= 0.0 {
+            return if cos_theta > self.cos_outer { 1.0 } else { 0.0 };
+        }
+        let t = ((cos_theta - self.cos_outer) / width).clamp(0.0, 1.0);
         t * t
     }
 

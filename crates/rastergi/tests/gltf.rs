@@ -675,7 +675,7 @@ fn hostile_punctual_lights_are_refused_with_one_line_errors() {
     let cases = [
         ("negative", json!({ "type": "point", "intensity": -1.0 }), "negative"),
         ("negative_colour", json!({ "type": "point", "color": [1.0, -0.5, 1.0] }), "negative"),
-        ("cones", json!({ "type": "spot", "spot": { "innerConeAngle": 0.6, "outerConeAngle": 0.4 } }), "inner < outer"),
+        ("cones", json!({ "type": "spot", "spot": { "innerConeAngle": 0.6, "outerConeAngle": 0.4 } }), "inner ≤ outer"),
         ("wide", json!({ "type": "spot", "spot": { "outerConeAngle": 2.0 } }), "π/2"),
         ("unknown", json!({ "type": "area" }), "type"),
         ("no_spot", json!({ "type": "spot" }), "spot"),

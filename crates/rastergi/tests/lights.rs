@@ -251,3 +251,24 @@ fn the_cornell_box_with_a_point_light_and_the_sun_through_its_open_front_matches
         true,
     );
 }
+
+#[test]
+fn the_cornell_box_with_a_hard_edged_spot_matches_mitsuba() {
+    // References: scripts/mitsuba_reference.py --spp 8192 --seed 7|8
+    //   --spot=-0.4,0.9,0.4,0.2,-1,-0.2,1.5,1.5,1.5,25 (tests/data/README.md): Mitsuba's `spot`
+    // with beam_width = cutoff_angle is a step at 25°, which is rastergi's spot with equal
+    // cones (glTF's smooth ramp has no Mitsuba twin).
+    let mut scene = rastergi::scene::cornell_box();
+    let (position, aim) = (Vec3::new(-0.4, 0.9, 0.4), Vec3::new(0.2, -1.0, -0.2));
+    let angle = 25f32.to_radians();
+    let direction = (aim - position).normalize();
+    scene.lights.push(Light::Spot { position, direction, intensity: Vec3::splat(1.5), inner: angle, outer: angle });
+    common::matches_mitsuba(
+        "cornell + spot",
+        &scene,
+        rastergi::gather::HitLight::Map,
+        256,
+        "cornell_spot_path_128",
+        true,
+    );
+}

@@ -42,7 +42,9 @@ fn gather_estimate_cosine(p: VisiblePoint, w: vec3f, tri: u32, hit: vec3f, b: ve
 }
 
 // A gather ray from x along w that escapes the scene sees the environment: its estimate,
-// weighted against the direct pass's environment samples (env_gather_weight). Shared
+// weighted against the direct pass's environment samples (env_gather_weight). It is direct
+// light, so the gathers add it to the film's direct component (with the direct pass's share:
+// Show::Direct is all of the direct light, Show::Indirect the light from surfaces). Shared
 // directions (pdf 1/2π): (ρ_x/π)·L_env(w)·cos θ_x·2π; per-pixel (pdf cos θ_x/π): ρ_x·L_env(w).
 fn escape_estimate(p: VisiblePoint, cos_x: f32, w: vec3f) -> vec3f {
     if !has_environment() {

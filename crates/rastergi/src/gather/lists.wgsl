@@ -41,7 +41,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         }
     }
     if best_tri == NO_TRIANGLE {
-        film_add(FILM_INDIRECT, gid.xy, escape_estimate(p, cos_x, w) / f32(gather.count));
+        film_add(FILM_DIRECT, gid.xy, escape_estimate(p, cos_x, w) / f32(gather.count));
         return;
     }
     let pixel = gid.y * frame.resolution.x + gid.x;

@@ -294,7 +294,8 @@ impl PixelVariance {
 /// What `Auto` measures of each candidate while trying it, to compare how fast each lowers
 /// the error. After T seconds an estimator of per-iteration variance σ² (summed over pixels)
 /// whose iterations take t has error² ≈ σ²·t/T: the efficiency to maximise is 1/(σ²·t). With
-/// σ² = σ²_direct + σ²_gather and t = t_rest + t_gather — the direct pass's noise and the
+/// σ² = σ²_direct + σ²_gather (the gather's: all it adds, the environment's share of the
+/// direct light through its escaping rays included) and t = t_rest + t_gather — the direct pass's noise and the
 /// G-buffer and direct passes' time are the same for every candidate — each candidate's cost
 /// is (σ²_direct + σ²_gather)·(t_rest + t_gather). σ² is the per-pixel sample variance of the
 /// film's per-iteration increments, pooled over the candidates with the same directions
@@ -304,8 +305,9 @@ impl PixelVariance {
 /// neighbours, whose noise (the light's edges under the pixel jitter) no gather changes.
 #[derive(Default)]
 struct Efficiency {
-    /// The film's direct sums at the last trial's gather, while the film has not been cleared
-    /// since (the next trial's minus these are one iteration's direct estimates).
+    /// The film's direct sums after the last trial's gather, while the film has not been
+    /// cleared since (the next trial's before its gather minus these are one iteration's
+    /// direct-pass estimates).
     last_direct: Option<Vec<f32>>,
     direct: PixelVariance,
     /// The time of the work before the gather in each trial iteration.
@@ -506,19 +508,20 @@ impl GatherPass {
         self.candidates[k].trials.push(start.elapsed());
         let after = gpu.read_buffer(&self.film, sums)?;
 
+        // The direct pass's estimate: the direct sums since the previous trial's gather. The
+        // gather's: what it added to both components (escaping rays add the environment's
+        // share of the direct light).
         let e = &mut self.efficiency;
-        let direct = film_component(&before, self.pixels, FILM_DIRECT as usize);
+        let component = |sums: &[u8], c: u32| film_component(sums, self.pixels, c as usize);
         if let Some(last) = &e.last_direct {
-            let increment: Vec<f32> = direct.iter().zip(last).map(|(a, b)| a - b).collect();
+            let increment: Vec<f32> = component(&before, FILM_DIRECT).iter().zip(last).map(|(a, b)| a - b).collect();
             e.direct.add(&increment);
         }
-        e.last_direct = Some(direct);
-        let indirect = film_component(&before, self.pixels, FILM_INDIRECT as usize);
-        let increment: Vec<f32> = film_component(&after, self.pixels, FILM_INDIRECT as usize)
-            .iter()
-            .zip(&indirect)
-            .map(|(a, b)| a - b)
-            .collect();
+        e.last_direct = Some(component(&after, FILM_DIRECT));
+        let total = |sums: &[u8]| -> Vec<f32> {
+            component(sums, FILM_DIRECT).iter().zip(component(sums, FILM_INDIRECT)).map(|(d, i)| d + i).collect()
+        };
+        let increment: Vec<f32> = total(&after).iter().zip(total(&before)).map(|(a, b)| a - b).collect();
         self.candidates[k].noise.add(&increment);
 
         // Once every candidate has run, drop those whose fastest run is more than DROP_SLOWER

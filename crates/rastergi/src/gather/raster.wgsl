@@ -37,7 +37,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         // escapes; along −ω the nearest surface behind x, if any, is in `behind`.
         found[pixel] = 1u;
         if dot(w, gather.direction) > 0.0 {
-            film_add(FILM_INDIRECT, gid.xy, escape_estimate(p, cos_x, w) / f32(gather.count));
+            film_add(FILM_DIRECT, gid.xy, escape_estimate(p, cos_x, w) / f32(gather.count));
         }
         return;
     }
@@ -94,6 +94,6 @@ fn resolve_behind(@builtin(global_invocation_id) gid: vec3u) {
     let cos_x = dot(p.n, w);
     let along = dot(w, gather.direction) > 0.0;
     if p.ok && cos_x > 0.0 && (!along || found[pixel] == 0u) {
-        film_add(FILM_INDIRECT, gid.xy, escape_estimate(p, cos_x, w) / f32(gather.count));
+        film_add(FILM_DIRECT, gid.xy, escape_estimate(p, cos_x, w) / f32(gather.count));
     }
 }

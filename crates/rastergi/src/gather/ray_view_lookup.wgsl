@@ -33,11 +33,14 @@ fn on_triangle(b: vec2f) -> bool {
 }
 
 // The exact nearest hit along ω from x (BVH), for the rays a texel cannot answer: the
-// estimate, or the environment's where the ray escapes.
+// estimate; where the ray escapes, zero, and the environment's estimate goes to the pixel's
+// direct light (as every escaping gather ray's does).
 fn traced_estimate(p: VisiblePoint, cos_x: f32, w: vec3f, pixel: u32, j: u32) -> vec3f {
     let h = trace(p.x.pos, w, frame.ray_epsilon, 3.0e38, p.x.tri, NO_TRIANGLE, false);
     if h.tri == NO_TRIANGLE {
-        return escape_estimate(p, cos_x, w);
+        let texel = vec2u(pixel % frame.resolution.x, pixel / frame.resolution.x);
+        film_add(FILM_DIRECT, texel, escape_estimate(p, cos_x, w) / f32(gather.count));
+        return vec3f(0.0);
     }
     return gather_estimate(p, cos_x, w, h.tri, p.x.pos + w * h.t, vec2f(h.b1, h.b2), pixel, j);
 }

@@ -19,6 +19,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let per_pixel = gather.per_pixel != 0u;
     let seed = pixel_seed(gather.pixel_key, gid.x, gid.y);
     var sum = vec3f(0.0);
+    // Rays that escape see the environment: direct light, kept with the direct pass's.
+    var sky = vec3f(0.0);
     for (var k = 0u; k < gather.count && p.ok; k++) {
         var w = gather_side(p.n, gather.directions[k].xyz);
         if per_pixel {
@@ -41,8 +43,11 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
                 sum += gather_estimate(p, cos_x, w, h.tri, hit, b, pixel, j);
             }
         } else {
-            sum += escape_estimate(p, cos_x, w);
+            sky += escape_estimate(p, cos_x, w);
         }
     }
     film_add(FILM_INDIRECT, gid.xy, sum / f32(gather.count));
+    if has_environment() {
+        film_add(FILM_DIRECT, gid.xy, sky / f32(gather.count));
+    }
 }

@@ -19,7 +19,7 @@
 //!   directional light (Mitsuba's `point`, `spot` and `directional` take the same values).
 //!   Spot cones from the extension's inner and outer angles with its smooth falloff
 //!   ([`super::Light::Spot`]). `range` is a hint and ignored with a warning (1/d² at every
-//!   distance). Invalid values (negative intensity, outer cone not above the inner) are refused.
+//!   distance). Invalid values (negative intensity, outer cone below the inner) are refused; equal cones are a hard edge.
 //! - **Camera**: a perspective camera placed by the first node of the scene that uses it,
 //!   looking down its −z with +y up (yfov is the vertical field of view; the aspect ratio is the
 //!   image's). [`GltfOptions::camera`] picks one by its index in the file's `cameras`; by

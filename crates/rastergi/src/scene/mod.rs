@@ -134,7 +134,8 @@ pub enum Light {
     Point { position: Vec3, intensity: Vec3 },
     /// A point light within a cone about `direction` (unit, where it shines): intensity
     /// I · s(cos θ), s = clamp((cos θ − cos θ_o)/(cos θ_i − cos θ_o), 0, 1)² (glTF's smooth
-    /// falloff between the inner and outer cone half-angles, radians, 0 ≤ θ_i < θ_o ≤ π/2).
+    /// falloff between the inner and outer cone half-angles, radians, 0 ≤ θ_i ≤ θ_o ≤ π/2, θ_o > 0;
+    /// equal angles are a hard-edged cone, as Blender exports a spot without blend).
     Spot { position: Vec3, direction: Vec3, intensity: Vec3, inner: f32, outer: f32 },
     /// Light from far away along `direction` (unit, the way it travels): irradiance E (W/m²,
     /// RGB) on a surface facing it, E cos θ on others, from a disc of `angular_radius` radians
@@ -167,9 +168,9 @@ impl Light {
                 finite(position)?;
                 unit(direction)?;
                 colour(intensity, "intensity")?;
-                if !(inner >= 0.0 && inner < outer && outer <= std::f32::consts::FRAC_PI_2 + 1e-6) {
+                if !(inner >= 0.0 && inner <= outer && outer > 0.0 && outer <= std::f32::consts::FRAC_PI_2 + 1e-6) {
                     return Err(format!(
-                        "a spot light's cone angles (inner {inner}, outer {outer} radians) must satisfy 0 ≤ inner < outer ≤ π/2"
+                        "a spot light's cone angles (inner {inner}, outer {outer} radians) must satisfy 0 ≤ inner ≤ outer ≤ π/2 and outer > 0"
                     ));
                 }
                 Ok(())

@@ -241,6 +241,29 @@ fn photons_carry_the_skys_flux_to_the_floor() {
     }
 }
 
+fn courtyard() -> Scene {
+    let mut scene = rastergi::scene::load_obj(&common::data("obj/courtyard.obj")).unwrap();
+    scene.camera =
+        Camera { eye: Vec3::new(0.0, 3.0, 5.5), target: Vec3::new(0.0, 0.3, 0.0), up: Vec3::Y, fov_y_deg: 45.0 };
+    scene.environment = Some(Environment::load(&common::data("env/sky_64x32.exr"), 1.0).unwrap());
+    scene
+}
+
+#[test]
+fn the_courtyards_direct_light_matches_mitsubas_at_depth_two() {
+    // The direct component holds all of the sky's direct light: the direct pass's share and the
+    // gather's escaping rays' (MIS), so it is Mitsuba's max_depth 2 (references: seeds 13|14).
+    common::image_matches_mitsuba(
+        "courtyard + sky, direct",
+        &courtyard(),
+        rastergi::gather::HitLight::Map,
+        256,
+        "courtyard_env_direct_128",
+        false,
+        Show::Direct,
+    );
+}
+
 #[test]
 fn a_courtyard_under_a_sky_with_a_sun_matches_mitsuba() {
     // References: scripts/mitsuba_reference.py --scene obj/courtyard.obj --env env/sky_64x32.exr

@@ -104,6 +104,19 @@ pub fn matches_mitsuba(
     stem: &str,
     mask_emitters: bool,
 ) {
+    image_matches_mitsuba(label, scene, hit_light, iterations, stem, mask_emitters, Show::Full)
+}
+
+/// [`matches_mitsuba`] for the image `show` (a direct-light reference for Show::Direct).
+pub fn image_matches_mitsuba(
+    label: &str,
+    scene: &Scene,
+    hit_light: rastergi::gather::HitLight,
+    iterations: u32,
+    stem: &str,
+    mask_emitters: bool,
+    show: Show,
+) {
     let gpu = gpu();
     let grid = rastergi::fit::grid_resolution(&scene.bounds());
     let settings = |seed| RenderSettings {
@@ -116,8 +129,8 @@ pub fn matches_mitsuba(
         hit_light,
         ..Default::default()
     };
-    let a = render(&gpu, scene, settings(1), iterations, Show::Full);
-    let b = render(&gpu, scene, settings(2), iterations, Show::Full);
+    let a = render(&gpu, scene, settings(1), iterations, show);
+    let b = render(&gpu, scene, settings(2), iterations, show);
     // Emitter pixels (over 3 in the reference, and their neighbours) left out where asked.
     let probe = read_exr(&data(&format!("{stem}_a.exr"))).expect("reference a");
     let mask = mask_emitters.then(|| rastergi::metrics::emitter_mask(&probe, 3.0));

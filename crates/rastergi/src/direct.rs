@@ -56,12 +56,13 @@ pub fn remap_in_entry(a: u32, lights: &LightTable, e: usize) -> f32 {
     (offset as f32 / ((lights.entries[e].cdf - lo) * 4_294_967_296.0)).min(1.0 - f32::EPSILON / 2.0)
 }
 
-/// The light sample (u0, u1, u2) — the arguments of `sample_light`: u0 picks the emitter
-/// triangle, (u1, u2) the point on it — of index j = i·L + k (iteration i, sample k) of pixel
+/// The light sample (u0, u1, u2) — u0 picks the light, (u1, u2) the point or direction on
+/// it — of index j = i·L + k (iteration i, sample k) of pixel
 /// (x, y) for `seed`: the Owen-scrambled Sobol' point (a, b) = [`sobol_owen_2d`]`(j, s)`
 /// with s = [`pixel_seed`]`(`[`light_sample_key`]`(seed), x, y)`; u0 = a, u1 = a's position
 /// in the picked entry's cdf interval ([`remap_in_entry`]), u2 = b. Mirrors
-/// `light_sample_uniforms` in `gpu_scene.wgsl`.
+/// `light_sample_uniforms` in `gpu_scene.wgsl`, which returns the picked entry in place of u0
+/// (its `LightChoice`, the argument of `sample_light_at`).
 pub fn light_sample_uniforms(seed: u32, x: u32, y: u32, j: u32, lights: &LightTable) -> [f32; 3] {
     let [a, b] = sobol_owen_2d(j, pixel_seed(light_sample_key(seed), x, y));
     let u0 = unit_f32(a);

@@ -26,8 +26,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         let seed = pixel_seed(pcg_hash(frame.seed ^ STREAM_DIRECT), gid.x, gid.y);
         var sum = vec3f(0.0);
         for (var k = 0u; k < frame.light_samples; k++) {
-            let u = light_sample_uniforms(frame.iteration * frame.light_samples + k, seed);
-            let l = sample_light_at(origin, u.x, u.y, u.z);
+            let c = light_sample_uniforms(frame.iteration * frame.light_samples + k, seed);
+            let l = sample_light_at(origin, c);
             let cos_x = dot(n, l.dir);
             if cos_x <= 0.0 || all(l.e == vec3f(0.0))
                 || occluded(origin, l.dir, frame.ray_epsilon, l.dist * (1.0 - 1e-4), s.tri, l.tri) {

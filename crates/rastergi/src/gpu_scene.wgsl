@@ -185,14 +185,25 @@ fn remap_in_entry(a: u32, e: u32) -> f32 {
     return min(f32(offset) / ((lights[e].cdf - lo) * 4294967296.0), 0.99999994);
 }
 
-// The light sample (u0, u1, u2) of index j for the pixel's scramble seed: one Owen-scrambled
-// Sobol' point (x, y); u0 = x picks the emitter, u1 = x's position within the emitter's
-// interval, u2 = y (direct::light_sample_uniforms; the direct pass and the
-// gather's exact hit light).
-fn light_sample_uniforms(j: u32, seed: u32) -> vec3f {
+// A light of the table and two uniforms for the point or direction on it.
+struct LightChoice {
+    entry: u32,
+    u1: f32,
+    u2: f32,
+}
+
+// The light sample of index j for the pixel's scramble seed: one Owen-scrambled Sobol' point
+// (x, y); x picks the light, x's position within the light's interval is u1, y is u2
+// (direct::light_sample_uniforms; the direct pass and the gather's exact hit light).
+fn light_sample_uniforms(j: u32, seed: u32) -> LightChoice {
     let p = sobol_owen_2d(j, seed);
-    let u0 = unit_f32(p.x);
-    return vec3f(u0, remap_in_entry(p.x, light_pick(u0)), unit_f32(p.y));
+    let e = light_pick(unit_f32(p.x));
+    return LightChoice(e, remap_in_entry(p.x, e), unit_f32(p.y));
+}
+
+// Light sample uniforms (u0, u1, u2): u0 picks the light.
+fn light_choice(u0: f32, u1: f32, u2: f32) -> LightChoice {
+    return LightChoice(light_pick(u0), u1, u2);
 }
 
 // The spot's falloff s(cos θ) (lights.rs: PunctualLight::falloff): a squared ramp between the
@@ -236,9 +247,11 @@ struct LightRay {
     pdf: f32,
 }
 
-fn sample_light_at(x: vec3f, u0: f32, u1: f32, u2: f32) -> LightRay {
+fn sample_light_at(x: vec3f, c: LightChoice) -> LightRay {
     var r: LightRay;
-    let entry = lights[light_pick(u0)];
+    let entry = lights[c.entry];
+    let u1 = c.u1;
+    let u2 = c.u2;
     r.pdf = 0.0;
     if entry.triangle == ENVIRONMENT_LIGHT {
         let s = env_sample(u1, u2);
@@ -250,7 +263,7 @@ fn sample_light_at(x: vec3f, u0: f32, u1: f32, u2: f32) -> LightRay {
         return r;
     }
     if (entry.triangle & PUNCTUAL_LIGHT) == 0u {
-        let l = sample_light(u0, u1, u2);
+        let l = sample_light(c.entry, u1, u2);
         let to_light = l.pos - x;
         let dist2 = dot(to_light, to_light);
         r.dist = sqrt(dist2);
@@ -296,7 +309,8 @@ fn disc_point(axis: vec3f, centre: vec3f, r: f32, u1: f32, u2: f32) -> vec3f {
 
 fn emit_photon(u0: f32, u1: f32, u2: f32, u3: f32, u4: f32, eps: f32) -> PhotonStart {
     var s: PhotonStart;
-    let entry = lights[light_pick(u0)];
+    let e = light_pick(u0);
+    let entry = lights[e];
     if entry.triangle == ENVIRONMENT_LIGHT {
         // Towards the sky along the sampled direction; the photon travels the other way, from
         // the disc across the bounding sphere: L(ω)·πR²/(pdf(ω)·pmf).
@@ -309,7 +323,7 @@ fn emit_photon(u0: f32, u1: f32, u2: f32, u3: f32, u4: f32, eps: f32) -> PhotonS
         return s;
     }
     if (entry.triangle & PUNCTUAL_LIGHT) == 0u {
-        let l = sample_light(u0, u1, u2);
+        let l = sample_light(e, u1, u2);
         // Φ = π·Le·A/pmf.
         s.flux = l.radiance * (PI / l.pdf_area);
         s.dir = cosine_hemisphere(l.normal, u3, u4);
@@ -345,9 +359,9 @@ struct LightSample {
     tri: u32,
 }
 
-// A point on the emitters: a triangle chosen by power, then uniformly on it.
-fn sample_light(u0: f32, u1: f32, u2: f32) -> LightSample {
-    let e = lights[light_pick(u0)];
+// A point uniformly (u1, u2) on the emissive triangle of light entry `entry`.
+fn sample_light(entry: u32, u1: f32, u2: f32) -> LightSample {
+    let e = lights[entry];
     let t = triangles[e.triangle];
     let b = uniform_triangle_bary(u1, u2);
     var s: LightSample;

@@ -106,7 +106,7 @@ fn path_radiance(origin: vec3f, dir: vec3f, xy: vec2u, rng: ptr<function, u32>) 
         let u1 = rng_f32(rng);
         let u2 = rng_f32(rng);
         if params.light_count > 0u {
-            let l = sample_light_at(x, u0, u1, u2);
+            let l = sample_light_at(x, light_choice(u0, u1, u2));
             let cos_x = dot(n, l.dir);
             if cos_x > 0.0 && any(l.e > vec3f(0.0))
                 && !occluded(x, l.dir, frame.ray_epsilon, l.dist * (1.0 - 1e-4), s.tri, l.tri) {

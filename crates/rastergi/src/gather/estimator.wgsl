@@ -69,6 +69,6 @@ fn hit_direct(h: vec3f, n: vec3f, tri: u32, pixel: u32, j: u32) -> vec3f {
     }
     let xy = vec2u(pixel % frame.resolution.x, pixel / frame.resolution.x);
     let seed = pixel_seed(pcg_hash(frame.seed ^ STREAM_HIT_LIGHT), xy.x, xy.y);
-    let u = light_sample_uniforms(j, seed);
-    return light_sample_irradiance(h + n * frame.ray_epsilon, n, tri, frame.ray_epsilon, u.x, u.y, u.z);
+    let c = light_sample_uniforms(j, seed);
+    return light_sample_irradiance(h + n * frame.ray_epsilon, n, tri, frame.ray_epsilon, c);
 }

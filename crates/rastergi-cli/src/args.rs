@@ -171,6 +171,16 @@ pub struct SceneArgs {
     /// The sun's angular diameter in degrees (its soft shadows; 0 for a sharp one).
     #[arg(long, default_value_t = 0.53, requires = "sun", value_parser = parse_sun_size)]
     pub sun_size: f32,
+    /// Adds a point light: X,Y,Z,R,G,B — position and intensity in W/sr (repeatable; the
+    /// same values as `scripts/mitsuba_reference.py --point`).
+    #[arg(long, value_parser = parse_point, allow_hyphen_values = true, value_name = "X,Y,Z,R,G,B")]
+    pub point: Vec<rastergi::scene::Light>,
+    /// Adds a spot light: X,Y,Z,TX,TY,TZ,R,G,B,ANGLE[,INNER] — position, a point it aims at,
+    /// intensity in W/sr on its axis and its cone's half-angle in degrees; a hard edge, or
+    /// glTF's smooth falloff from INNER degrees out (repeatable; without INNER the same values
+    /// as `scripts/mitsuba_reference.py --spot`).
+    #[arg(long, value_parser = parse_spot, allow_hyphen_values = true, value_name = "X,Y,Z,TX,TY,TZ,R,G,B,ANGLE")]
+    pub spot: Vec<rastergi::scene::Light>,
     /// Lights the scene with an environment map: an equirectangular .exr or .hdr image of
     /// the radiance from every direction (Mitsuba 3's `envmap` convention: row 0 is +Y, the
     /// image's left edge looks along −Z, its first quarter turns towards +X).
@@ -242,6 +252,7 @@ impl SceneArgs {
         c.up = self.up.unwrap_or(c.up);
         c.fov_y_deg = self.fov.unwrap_or(c.fov_y_deg);
         scene.camera.validate()?;
+        scene.lights.extend(self.point.iter().chain(&self.spot).cloned());
         if let Some(sun) = self.sun {
             scene.lights.push(sun_light(sun, self.sun_size));
         }
@@ -333,18 +344,49 @@ fn parse_sun_size(s: &str) -> Result<f32, String> {
 }
 
 fn parse_vec3(s: &str) -> Result<Vec3, String> {
+    parse_floats(s, &[3], "three comma-separated numbers like 0,1,3.5").map(|v| Vec3::new(v[0], v[1], v[2]))
+}
+
+/// Comma-separated finite numbers, as many as one of `counts`; `shape` says what is expected.
+fn parse_floats(s: &str, counts: &[usize], shape: &str) -> Result<Vec<f32>, String> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();
-    if parts.len() != 3 {
-        return Err(format!("expected three comma-separated numbers like 0,1,3.5, got '{s}'"));
+    if !counts.contains(&parts.len()) {
+        return Err(format!("expected {shape}, got '{s}'"));
     }
-    let mut v = [0.0f32; 3];
-    for (i, p) in parts.iter().enumerate() {
-        v[i] = p.parse().map_err(|_| format!("'{p}' is not a number"))?;
-        if !v[i].is_finite() {
-            return Err(format!("'{p}' is not a finite number"));
-        }
+    parts
+        .iter()
+        .map(|p| match p.parse::<f32>() {
+            Ok(v) if v.is_finite() => Ok(v),
+            Ok(_) => Err(format!("'{p}' is not a finite number")),
+            Err(_) => Err(format!("'{p}' is not a number")),
+        })
+        .collect()
+}
+
+fn parse_point(s: &str) -> Result<rastergi::scene::Light, String> {
+    let v = parse_floats(s, &[6], "X,Y,Z,R,G,B (position, intensity W/sr)")?;
+    let light =
+        rastergi::scene::Light::Point { position: Vec3::new(v[0], v[1], v[2]), intensity: Vec3::new(v[3], v[4], v[5]) };
+    light.validate()?;
+    Ok(light)
+}
+
+fn parse_spot(s: &str) -> Result<rastergi::scene::Light, String> {
+    let v = parse_floats(s, &[10, 11], "X,Y,Z,TX,TY,TZ,R,G,B,ANGLE[,INNER] (degrees)")?;
+    let (position, aim) = (Vec3::new(v[0], v[1], v[2]), Vec3::new(v[3], v[4], v[5]));
+    if (aim - position).length() == 0.0 {
+        return Err("the spot's aim point is its position; give a point it shines towards".into());
     }
-    Ok(Vec3::from(v))
+    let outer = v[9].to_radians();
+    let light = rastergi::scene::Light::Spot {
+        position,
+        direction: (aim - position).normalize(),
+        intensity: Vec3::new(v[6], v[7], v[8]),
+        inner: v.get(10).map_or(outer, |i| i.to_radians()),
+        outer,
+    };
+    light.validate()?;
+    Ok(light)
 }
 
 pub fn gpu(args: &GpuArgs) -> Result<Gpu> {

@@ -375,3 +375,43 @@ fn environment_map_errors_are_one_line_and_write_nothing() {
         assert!(!d.join("x.png").exists());
     }
 }
+
+#[test]
+fn point_and_spot_options_light_the_floor_below_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let floor = floor_obj(dir.path());
+    // 15 × 15 pixels looking straight down from 3 m: the centre pixel sees the floor within
+    // 0.08 m of the point below the light (1 m up), where E = I·cos θ/d² ∈ [0.98, 1]·I.
+    let camera = ["--eye", "0,3,0.001", "--target", "0,0,0", "--fov", "40", "--width", "15", "--height", "15"];
+    let centre = |img: &rastergi::image_io::LinearImage| img.pixels[7 * 15 + 7];
+    let corner = |img: &rastergi::image_io::LinearImage| img.pixels[0];
+    let rho_over_pi = 0.5 / std::f32::consts::PI;
+    for (light, out) in [(["--point", "0,1,0,1,1,1"], "point.exr"), (["--spot", "0,1,0,0,0,0,1,1,1,10"], "spot.exr")] {
+        let args = [&["render", floor, "--iterations", "8", "--out", out][..], &light[..], &camera[..]].concat();
+        let run = rastergi(dir.path(), &args);
+        assert!(run.status.success(), "{}", run.stderr);
+        assert!(!run.stderr.contains("has no light"), "{}", run.stderr);
+        let img = rastergi::image_io::read_exr(&dir.path().join(out)).unwrap();
+        let c = centre(&img);
+        assert!(c.iter().all(|&v| (0.98 * rho_over_pi..=1.0001 * rho_over_pi).contains(&v)), "{out}: centre {c:?}");
+        // The corner is 1.5 m out: lit by the point light, outside the spot's 10° cone.
+        let k = corner(&img);
+        if out == "spot.exr" {
+            assert_eq!(k, [0.0; 3], "outside the cone");
+        } else {
+            assert!(k[0] > 0.01 * rho_over_pi, "{k:?}");
+        }
+    }
+    for (args, fragment) in [
+        (&["--point", "0,1,0,1,1"][..], "X,Y,Z,R,G,B"),
+        (&["--point", "0,1,0,1,-1,1"][..], "negative"),
+        (&["--spot", "0,1,0,0,0,0,1,1,1"][..], "ANGLE"),
+        (&["--spot", "0,1,0,0,1,0,1,1,1,10"][..], "aim point"),
+        (&["--spot", "0,1,0,0,0,0,1,1,1,100"][..], "cone angles"),
+    ] {
+        let run = rastergi(dir.path(), &[&["render", "cornell", "--out", "x.png"], args].concat());
+        assert_eq!(run.status.code(), Some(2), "{args:?}:\n{}", run.stderr);
+        assert!(run.stderr.contains(fragment), "{args:?}: {}", run.stderr);
+        assert!(!dir.path().join("x.png").exists());
+    }
+}

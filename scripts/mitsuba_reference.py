@@ -14,19 +14,34 @@ with a box pixel filter and a vertical field of view).
 
 OBJ scenes are read here, not by Mitsuba (whose `obj` loader ignores MTL), the
 way rastergi reads them (crates/rastergi/src/scene/obj.rs, through tobj):
-`v` and `f` lines (`l` lines of three or more vertices count as faces, as in
+`v`, `vn` and `f` lines (`l` lines of three or more vertices count as faces, as in
 tobj), relative (negative) indices, polygons triangulated as fans (v0, vi,
-vi+1), `mtllib` and `usemtl`; `vt`, `vn`, `o`, `g`, `s` and the rest are
-ignored. From the MTL, `Kd` is the diffuse reflectance (default 0.5, as for
+vi+1), `mtllib` and `usemtl`; `vt`, `o`, `g`, `s` and the rest are ignored.
+From the MTL, `Kd` is the diffuse reflectance (default 0.5, as for
 faces without a material) and `Ke` the emitted radiance (a single number means
-grey); albedo textures (`map_Kd`) are not reproduced (a warning says so). The triangles of each material are written to a binary PLY file in a
-temporary directory and loaded as one `ply` shape with face normals (no
-smoothing), its BSDF `twosided(diffuse(Kd))` (OBJ surfaces reflect on both
-sides in rastergi) and, where Ke > 0, an `area` emitter, which Mitsuba makes
-one-sided: it emits from the front face, the side the counter-clockwise
-winding faces (normal (v1-v0) x (v2-v0)), as rastergi does. The conventions
-were checked with crates/rastergi/tests/data/obj/emitter_sides.obj: a CCW
-quad facing the camera shows its Ke in both renderers, a CW one is black.
+grey); albedo textures (`map_Kd`) are not reproduced (a warning says so). The
+triangles of each material are written to a binary PLY file in a temporary
+directory and loaded as a `ply` shape, its BSDF `twosided(diffuse(Kd))` (OBJ
+surfaces reflect on both sides in rastergi) and, where Ke > 0, an `area` emitter,
+which Mitsuba makes one-sided: it emits from the front face, the side the
+counter-clockwise winding faces (normal (v1-v0) x (v2-v0)), as rastergi does. The
+conventions were checked with crates/rastergi/tests/data/obj/emitter_sides.obj: a
+CCW quad facing the camera shows its Ke in both renderers, a CW one is black.
+
+Normals: faces without normal indices (`f v` or `f v/vt`) are flat: their PLY has
+positions only and is loaded with `face_normals: True`. Faces whose every corner
+names a `vn` (`f v//vn` or `f v/vt/vn`) are smooth: each corner gets its own PLY
+vertex (three per triangle) carrying its `vn`, normalised as read, as nx, ny, nz,
+and the shape is loaded with `face_normals: False`, so that Mitsuba interpolates
+the three corner normals barycentrically (and renormalises) as the shading normal;
+the geometric normal stays the face's. A material with both kinds of faces becomes
+two shapes. A face naming a `vn` for only some corners, a `vn` index out of range,
+or a `vn` of zero length or with non-numbers, when a face uses it, is an error.
+Emitting materials (Ke > 0) keep face normals even where their faces give `vn`:
+Mitsuba's `area` emitter would take its side and the density of its samples from
+the shading normal, no longer the winding's front. How Mitsuba shades with these
+normals (it neither flips nor bends a shading normal that faces away from the
+viewer; the facets' own shadows cut the light at their terminator): docs/references.md.
 
 Camera: as in rastergi, the built-in Cornell box has its own camera and an
 OBJ file is framed by rastergi's default camera (Scene::framing_camera): it
@@ -87,6 +102,13 @@ takes about 1.5 minutes and a full path-traced one about 2.7 minutes:
     python3 scripts/mitsuba_reference.py $COURT --max-depth -1 --seed 12 --out $D/courtyard_env_path_128_b.exr
     python3 scripts/mitsuba_reference.py $COURT --max-depth 2  --seed 13 --out $D/courtyard_env_direct_128_a.exr
     python3 scripts/mitsuba_reference.py $COURT --max-depth 2  --seed 14 --out $D/courtyard_env_direct_128_b.exr
+    # smooth (vn) and flat shading normals under the test sky (README.md there)
+    python3 scripts/make_sphere_scenes.py
+    SPH="--eye 0,1.6,3.2 --target 0,0.6,0 --up 0,1,0 --fov 40 --env $D/env/sky_64x32.exr --width 128 --height 128 --spp 4096 --max-depth -1"
+    python3 scripts/mitsuba_reference.py --scene $D/obj/sphere_smooth.obj $SPH --seed 21 --out $D/sphere_smooth_path_128_a.exr
+    python3 scripts/mitsuba_reference.py --scene $D/obj/sphere_smooth.obj $SPH --seed 22 --out $D/sphere_smooth_path_128_b.exr
+    python3 scripts/mitsuba_reference.py --scene $D/obj/sphere_flat.obj   $SPH --seed 23 --out $D/sphere_flat_path_128_a.exr
+    python3 scripts/mitsuba_reference.py --scene $D/obj/sphere_flat.obj   $SPH --seed 24 --out $D/sphere_flat_path_128_b.exr
 
 (--chunk-spp defaults to 256; the images depend on it through the chunk seeds,
 and on the Mitsuba version and variant. Results are not bit-reproducible
@@ -301,8 +323,11 @@ def load_mtl(path):
 def load_obj(path):
     """The triangles of an OBJ file grouped by material, as rastergi loads them.
 
-    Returns a list of (material, triangles): material is {"name", "kd", "ke"},
-    triangles a float32 array (n, 3, 3) of counter-clockwise corners.
+    Returns a list of (material, triangles, normals): material is {"name", "kd", "ke"},
+    triangles a float32 array (n, 3, 3) of counter-clockwise corners, normals None (the
+    faces give no `vn`: face normals) or a float32 array (n, 3, 3) of the corners' unit
+    vertex normals. A material whose faces are partly with and partly without `vn` comes
+    as two entries (in the order of their first faces in the file).
     """
     try:
         text = open(path, encoding="utf-8").read()
@@ -310,9 +335,32 @@ def load_obj(path):
         raise SceneError(f"{path}: cannot be read: {e}")
     directory = os.path.dirname(path)
     positions = []
+    normals = []  # `vn` lines: (line number, words); parsed where a face uses them
+    parsed_normals = {}  # index into normals -> unit float32 normal
     library = {}  # material name -> material, from the mtllib lines so far
-    groups = {}  # material name (None: no material) -> list of index triples
+    # (material name (None: no material), with vertex normals) -> list of corner triples,
+    # each corner (position index, normal index or None)
+    groups = {}
     current = None
+
+    def unit_normal(j):
+        """The `vn` line j, normalised (float32, as read); an error if it is not a normal."""
+        if j not in parsed_normals:
+            ln, words = normals[j]
+            try:
+                vals = [float(np.float32(w)) for w in words[1:]]
+            except ValueError:
+                raise SceneError(f"{path}: line {ln}: a 'vn' line does not hold numbers")
+            if len(vals) != 3:
+                raise SceneError(f"{path}: line {ln}: a 'vn' line needs three numbers x y z")
+            v = np.array(vals, dtype=np.float64)
+            length = float(np.sqrt(v @ v))
+            if not (np.isfinite(v).all() and length > 0):
+                raise SceneError(f"{path}: line {ln}: a 'vn' normal used by a face is zero "
+                                 "or not finite")
+            parsed_normals[j] = (v / length).astype(np.float32)
+        return parsed_normals[j]
+
     for n, raw in enumerate(text.splitlines(), 1):
         line = raw.strip()
         words = line.split()
@@ -332,6 +380,8 @@ def load_obj(path):
                     raise SceneError(f"{path}: line {n}: a 'v' line has a weight w of 0")
                 p = p / vals[3]
             positions.append(p)
+        elif key == "vn":
+            normals.append((n, words))
         elif key in ("f", "l"):
             # tobj reads `l` lines as faces too; fewer than three vertices are
             # points and lines, which rastergi ignores.
@@ -339,8 +389,9 @@ def load_obj(path):
                 continue
             idx = []
             for w in words[1:]:
+                parts = w.split("/")
                 try:
-                    i = int(w.split("/")[0])
+                    i = int(parts[0])
                 except ValueError:
                     raise SceneError(f"{path}: line {n}: an '{key}' line holds something "
                                      "other than vertex indices")
@@ -348,8 +399,24 @@ def load_obj(path):
                 if not 0 <= i < len(positions):
                     raise SceneError(f"{path}: line {n}: a face refers to a vertex that "
                                      "does not exist")
-                idx.append(i)
-            tris = groups.setdefault(current, [])
+                j = None  # v/vt/vn or v//vn: the corner's normal
+                if key == "f" and len(parts) >= 3 and parts[2] != "":
+                    try:
+                        j = int(parts[2])
+                    except ValueError:
+                        raise SceneError(f"{path}: line {n}: a face's normal index "
+                                         f"'{parts[2]}' is not a number")
+                    j = j - 1 if j > 0 else len(normals) + j
+                    if not 0 <= j < len(normals):
+                        raise SceneError(f"{path}: line {n}: a face refers to a normal "
+                                         "('vn') that does not exist")
+                idx.append((i, j))
+            with_normals = [j is not None for _, j in idx]
+            if any(with_normals) and not all(with_normals):
+                raise SceneError(f"{path}: line {n}: a face gives normals ('vn') for some "
+                                 "of its corners only")
+            smooth = all(with_normals)
+            tris = groups.setdefault((current, smooth), [])
             for k in range(1, len(idx) - 1):  # fan, as tobj
                 tris.append((idx[0], idx[k], idx[k + 1]))
         elif key == "usemtl":
@@ -374,17 +441,21 @@ def load_obj(path):
             raise SceneError(f"{path}: material '{name}' has an albedo above 1 ({kd}), "
                              "which would create energy")
     result = []
-    for name, tris in groups.items():
+    for (name, smooth), tris in groups.items():
         if not tris:
             continue
         m = library.get(name) if name is not None else None
         kd = (m or {}).get("kd") or [OBJ_DEFAULT_ALBEDO] * 3
         ke = (m or {}).get("ke") or [0.0] * 3
         label = name if m is not None else "default"
-        triangles = pos[np.array(tris, dtype=np.int64)]
+        triangles = pos[np.array([[c[0] for c in t] for t in tris], dtype=np.int64)]
         if not np.isfinite(triangles).all():
             raise SceneError(f"{path}: a triangle has a non-finite coordinate")
-        result.append(({"name": label, "kd": kd, "ke": ke}, triangles))
+        vertex_normals = None
+        if smooth:
+            vertex_normals = np.array([[unit_normal(c[1]) for c in t] for t in tris],
+                                      dtype=np.float32).reshape(-1, 3, 3)
+        result.append(({"name": label, "kd": kd, "ke": ke}, triangles, vertex_normals))
     if not result:
         raise SceneError(f"{path}: contains no faces; an OBJ scene needs at least one "
                          "triangle ('f' lines)")
@@ -392,7 +463,7 @@ def load_obj(path):
 
 
 def bounds(groups):
-    pts = np.concatenate([t.reshape(-1, 3) for _, t in groups]).astype(np.float32)
+    pts = np.concatenate([g[1].reshape(-1, 3) for g in groups]).astype(np.float32)
     return pts.min(0), pts.max(0)
 
 
@@ -424,19 +495,33 @@ def check_camera(camera):
                          f"and 180 degrees, got {camera['fov']}")
 
 
-def write_ply(path, triangles):
-    """Triangles (n, 3, 3) as a binary PLY mesh, three vertices per triangle."""
+def write_ply(path, triangles, normals=None):
+    """Triangles (n, 3, 3) as a binary PLY mesh, three vertices per triangle; with normals
+    (n, 3, 3), each vertex also carries its corner's normal (properties nx, ny, nz)."""
     n = len(triangles)
+    props = ["x", "y", "z"] + (["nx", "ny", "nz"] if normals is not None else [])
     header = ("ply\nformat binary_little_endian 1.0\n"
-              f"element vertex {3 * n}\nproperty float x\nproperty float y\nproperty float z\n"
-              f"element face {n}\nproperty list uchar int vertex_indices\nend_header\n")
+              f"element vertex {3 * n}\n" + "".join(f"property float {p}\n" for p in props)
+              + f"element face {n}\nproperty list uchar int vertex_indices\nend_header\n")
+    vertices = np.asarray(triangles, dtype="<f4").reshape(3 * n, 3)
+    if normals is not None:
+        vertices = np.concatenate([vertices, np.asarray(normals, dtype="<f4").reshape(3 * n, 3)],
+                                  axis=1)
     faces = np.zeros(n, dtype=[("count", "u1"), ("idx", "<i4", 3)])
     faces["count"] = 3
     faces["idx"] = np.arange(3 * n, dtype=np.int32).reshape(n, 3)
     with open(path, "wb") as f:
         f.write(header.encode("ascii"))
-        f.write(np.ascontiguousarray(triangles, dtype="<f4").tobytes())
+        f.write(np.ascontiguousarray(vertices, dtype="<f4").tobytes())
         f.write(faces.tobytes())
+
+
+def smooth_shaded(material, normals):
+    """Whether a group of load_obj is rendered with its `vn` normals as shading normals: it
+    has them and does not emit. Emitting triangles keep face normals: Mitsuba's `area`
+    emitter takes its side, and the area-to-solid-angle density of its samples, from the
+    shading normal, which would no longer be the winding's front (module docstring)."""
+    return normals is not None and not max(material["ke"]) > 0
 
 
 def obj_scene_dict(mi, groups, camera, width, height, max_depth, spp, mesh_dir):
@@ -449,13 +534,17 @@ def obj_scene_dict(mi, groups, camera, width, height, max_depth, spp, mesh_dir):
         "sensor": sensor_dict(mi, camera, width, height, spp,
                               1e-4 * max(diagonal, 1e-3), far_clip_for(camera, lo, hi)),
     }
-    for i, (material, triangles) in enumerate(groups):
+    for i, (material, triangles, normals) in enumerate(groups):
+        smooth = smooth_shaded(material, normals)
         filename = os.path.join(mesh_dir, f"material_{i}.ply")
-        write_ply(filename, triangles)
+        write_ply(filename, triangles, normals if smooth else None)
         shape = {
             "type": "ply",
             "filename": filename,
-            "face_normals": True,
+            # False: Mitsuba interpolates the PLY's vertex normals (nx, ny, nz) over each
+            # triangle as its shading normal. (Without nx, ny, nz in the file it would
+            # compute smoothed ones itself, so face normals need True.)
+            "face_normals": not smooth,
             "bsdf": {"type": "twosided",
                      "bsdf": {"type": "diffuse", "reflectance": rgb(material["kd"])}},
         }
@@ -606,10 +695,13 @@ def load_scene(mi, args, spp):
     groups = load_obj(args.scene)
     camera = scene_camera(args, framing_camera(*bounds(groups)))
     if not args.quiet:
-        for material, triangles in groups:
+        for material, triangles, normals in groups:
             kd, ke = (", ".join(f"{v:.7g}" for v in material[k]) for k in ("kd", "ke"))
-            print(f"  {material['name']}: {len(triangles)} triangles, Kd ({kd}), Ke ({ke})",
-                  file=sys.stderr)
+            shading = ("vertex normals (vn)" if smooth_shaded(material, normals) else
+                       "face normals" + (" (vn ignored: an emitter)" if normals is not None
+                                         else ""))
+            print(f"  {material['name']}: {len(triangles)} triangles, Kd ({kd}), Ke ({ke}), "
+                  f"{shading}", file=sys.stderr)
         print(f"  camera: eye {camera['eye']}, target {camera['target']}, up "
               f"{camera['up']}, fov {camera['fov']}", file=sys.stderr)
     with tempfile.TemporaryDirectory(prefix="rastergi-mitsuba-") as mesh_dir:

@@ -104,13 +104,15 @@ fn occluded(o: vec3f, d: vec3f, t_min: f32, t_max: f32, skip_a: u32, skip_b: u32
 }
 
 // One sample of next-event estimation: the irradiance at `origin` (just off triangle tri,
-// normal n) from the light sample c (sample_light_at): e · cos θ_x — for an
-// emitter point y with area density p_A, Le · cos θ_x · cos θ_y / (|y − x|² p_A) — zero where
-// the segment (from t = eps) is occluded.
-fn light_sample_irradiance(origin: vec3f, n: vec3f, tri: u32, eps: f32, c: LightChoice) -> vec3f {
+// geometric normal n, shading normal ns on the same side) from the light sample c
+// (sample_light_at): e · cos θ_x with the shading cosine — for an emitter point y with area
+// density p_A, Le · cos θ_x · cos θ_y / (|y − x|² p_A) — zero from below the geometric surface
+// and where the segment (from t = eps) is occluded.
+fn light_sample_irradiance(origin: vec3f, n: vec3f, ns: vec3f, tri: u32, eps: f32, c: LightChoice) -> vec3f {
     let l = sample_light_at(origin, c);
-    let cos_x = dot(n, l.dir);
-    if cos_x <= 0.0 || all(l.e == vec3f(0.0)) || occluded(origin, l.dir, eps, l.dist * (1.0 - 1e-4), tri, l.tri) {
+    let cos_x = dot(ns, l.dir);
+    if dot(n, l.dir) <= 0.0 || cos_x <= 0.0 || all(l.e == vec3f(0.0))
+        || occluded(origin, l.dir, eps, l.dist * (1.0 - 1e-4), tri, l.tri) {
         return vec3f(0.0);
     }
     return l.e * cos_x;

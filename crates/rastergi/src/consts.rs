@@ -31,6 +31,9 @@ pub const FILM_PHOTON_VIEW: u32 = 2;
 /// Plane offsets of the photon map's slots are rounded to this many cell sides
 /// ([`crate::photons::map`]).
 pub const OFFSET_STEP: f32 = 0.125;
+/// Photon-map lookups leave out slots of less than this many cell faces h² of area
+/// ([`crate::photons::map::PhotonMap::irradiance_on_plane`]).
+pub const MIN_LOOKUP_AREA: f32 = 1e-4;
 /// Most separators of one photon-map slot (each doubles its regions).
 pub const MAX_SEPARATORS: usize = 4;
 /// Bit offset of the region in a slot's plane key (the orientation bin below it, < 64).

@@ -28,15 +28,16 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         for (var k = 0u; k < frame.light_samples; k++) {
             let c = light_sample_uniforms(frame.iteration * frame.light_samples + k, seed);
             let l = sample_light_at(origin, c);
-            let cos_x = dot(n, l.dir);
-            if cos_x <= 0.0 || all(l.e == vec3f(0.0))
+            // Light from above the geometric surface only, weighed by the shading cosine.
+            let cos_x = dot(p.ns, l.dir);
+            if dot(n, l.dir) <= 0.0 || cos_x <= 0.0 || all(l.e == vec3f(0.0))
                 || occluded(origin, l.dir, frame.ray_epsilon, l.dist * (1.0 - 1e-4), s.tri, l.tri) {
                 continue;
             }
             // The environment is also found by the gather's escaping rays (env_gather_weight).
             var mis = 1.0;
             if l.pdf > 0.0 {
-                mis = 1.0 - env_gather_weight(n, l.dir);
+                mis = 1.0 - env_gather_weight(p.ns, l.dir);
             }
             sum += l.e * (cos_x * mis);
         }

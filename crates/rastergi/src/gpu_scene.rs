@@ -61,6 +61,9 @@ impl PreparedScene {
         if !scene.uvs.is_empty() {
             scene.uvs = bvh.permute(&scene.uvs);
         }
+        if !scene.normals.is_empty() {
+            scene.normals = bvh.permute(&scene.normals);
+        }
         let bvh = Bvh { order: (0..scene.triangles.len() as u32).collect(), ..bvh };
         let lights = LightTable::new(&scene);
         let bounds = scene.bounds();
@@ -74,6 +77,20 @@ impl PreparedScene {
             Some(uv) => uv[0] * (1.0 - b1 - b2) + uv[1] * b1 + uv[2] * b2,
             None => Vec2::ZERO,
         }
+    }
+
+    /// The shading normal at barycentrics (b1, b2) of triangle `tri`: the corners' normals
+    /// interpolated and normalised, turned into the geometric normal's hemisphere; the
+    /// geometric normal where the triangle has none (`shading_normal` in WGSL).
+    pub fn shading_normal_at(&self, tri: usize, b1: f32, b2: f32) -> Vec3 {
+        let n = crate::scene::triangle_normal(&self.scene.triangles[tri]);
+        let Some(c) = self.scene.normals.get(tri) else { return n };
+        let v = c[0] * (1.0 - b1 - b2) + c[1] * b1 + c[2] * b2;
+        if v.length() < 1e-6 {
+            return n;
+        }
+        let v = v.normalize();
+        if v.dot(n) >= 0.0 { v } else { -v }
     }
 
     /// The albedo at barycentrics (b1, b2) of triangle `tri`, its texture read at level of
@@ -145,6 +162,12 @@ impl GpuScene {
         } else {
             s.uvs.iter().flat_map(|t| t.map(|uv| uv.to_array())).collect()
         };
+        // Nine zeros (one flat triangle) when the scene has no shading normals.
+        let normals: Vec<f32> = if s.normals.is_empty() {
+            vec![0.0; 9]
+        } else {
+            s.normals.iter().flat_map(|t| t.iter().flat_map(|n| n.to_array())).collect()
+        };
         let (texture_view, sampler) = prepared.textures.upload(gpu);
         let lights: Vec<LightEntry> = prepared.lights.entries.clone();
         // A binding cannot be empty: one zero light where the scene has none.
@@ -173,6 +196,7 @@ impl GpuScene {
             gpu.storage_buffer("scene texture coordinates", bytemuck::cast_slice(&uvs), none),
             gpu.storage_buffer("scene punctual lights", bytemuck::cast_slice(&punctual), none),
             gpu.storage_buffer("scene environment map", bytemuck::cast_slice(&env_data), none),
+            gpu.storage_buffer("scene shading normals", bytemuck::cast_slice(&normals), none),
         ];
         let env_uniform_buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("scene environment"),
@@ -205,12 +229,18 @@ impl GpuScene {
                     count: None,
                 },
                 storage_entry::<crate::lights::PunctualLight>(7, vis, true),
-                storage_entry::<f32>(8, vis, true),
-                uniform_entry::<GpuEnvironment>(9, vis),
+                // The environment and the shading normals are read by compute passes only, and
+                // hidden from the raster stages: lavapipe (Mesa 22.3) silently loses fragment
+                // writes once a fragment stage sees 11 storage buffers (it reports 32): with
+                // them visible, the fragment lists' gather lost 10 % of its estimates
+                // (tests/gather.rs).
+                storage_entry::<f32>(8, wgpu::ShaderStages::COMPUTE, true),
+                uniform_entry::<GpuEnvironment>(9, wgpu::ShaderStages::COMPUTE),
+                storage_entry::<[f32; 9]>(10, wgpu::ShaderStages::COMPUTE, true),
             ],
         });
         // The buffers' bindings, in the order of `buffers`.
-        const BUFFER_BINDINGS: [u32; 7] = [0, 1, 2, 3, 4, 7, 8];
+        const BUFFER_BINDINGS: [u32; 8] = [0, 1, 2, 3, 4, 7, 8, 10];
         let mut entries: Vec<wgpu::BindGroupEntry> = buffers
             .iter()
             .zip(BUFFER_BINDINGS)

@@ -59,16 +59,22 @@ struct PunctualLight {
 @group(0) @binding(5) var textures: texture_2d_array<f32>;
 // Trilinear filtering, repeat addressing.
 @group(0) @binding(6) var texture_sampler: sampler;
+// Shading normals at the triangles' corners, nine floats per triangle (zero: the triangle
+// shades flat; one zero triangle when the scene has none).
+@group(0) @binding(10) var<storage, read> normals: array<f32>;
 
 // MATERIAL_TWO_SIDED and NO_TEXTURE: shader::constants.
 
 // No triangle (a miss; an emitter that is not a triangle; no triangle to skip).
 const NO_TRIANGLE: u32 = 0xffffffffu;
 
-// A point on a surface: position, front-face geometric normal and material.
+// A point on a surface: position, front-face geometric normal, shading normal (interpolated,
+// in the geometric normal's hemisphere; the geometric normal where the triangle has none)
+// and material.
 struct Surface {
     pos: vec3f,
     normal: vec3f,
+    shading: vec3f,
     albedo: vec3f,
     emission: vec3f,
     flags: u32,
@@ -105,6 +111,35 @@ fn surface_uv(tri: u32, b1: f32, b2: f32) -> vec2f {
     return uvs[i] * (1.0 - b1 - b2) + uvs[i + 1u] * b1 + uvs[i + 2u] * b2;
 }
 
+// The shading normal at barycentrics (b1, b2) of triangle `tri` of geometric normal n: its
+// corners' normals interpolated and normalised, turned into n's hemisphere; n where the
+// triangle has none or they cancel (PreparedScene::shading_normal_at).
+fn shading_normal(tri: u32, b1: f32, b2: f32, n: vec3f) -> vec3f {
+    let i = 9u * min(tri, arrayLength(&normals) / 9u - 1u);
+    var v = vec3f(0.0);
+    let w = vec3f(1.0 - b1 - b2, b1, b2);
+    for (var k = 0u; k < 3u; k++) {
+        v += w[k] * vec3f(normals[i + 3u * k], normals[i + 3u * k + 1u], normals[i + 3u * k + 2u]);
+    }
+    let len = length(v);
+    if len < 1e-6 {
+        return n;
+    }
+    v /= len;
+    return select(-v, v, dot(v, n) >= 0.0);
+}
+
+// A shading normal ns seen from direction v (unit, towards the viewer): unchanged where it
+// faces v, else bent in the plane of ns and v until it is just past perpendicular to v (the
+// surface seen from behind its shading normal would be black or lit from below).
+fn bend_towards(ns: vec3f, v: vec3f) -> vec3f {
+    let c = dot(ns, v);
+    if c >= 0.0 {
+        return ns;
+    }
+    return normalize(ns + (1e-3 - c) * v);
+}
+
 // Level of detail of a footprint whose texture coordinates change by dx and dy across one
 // pixel: log2 of the longer change in texels of level 0, 0 under magnification
 // (TextureArray::lod).
@@ -139,6 +174,7 @@ fn surface_at(tri: u32, b1: f32, b2: f32, lod: f32) -> Surface {
     var s: Surface;
     s.pos = t.v0 * (1.0 - b1 - b2) + t.v1 * b1 + t.v2 * b2;
     s.normal = triangle_normal(t);
+    s.shading = shading_normal(tri, b1, b2, s.normal);
     s.albedo = m.albedo;
     if m.texture != NO_TEXTURE {
         let uv = surface_uv(tri, b1, b2);

@@ -98,6 +98,9 @@ fn path_radiance(origin: vec3f, dir: vec3f, xy: vec2u, rng: ptr<function, u32>) 
             break;
         }
         let n = select(-s.normal, s.normal, front);
+        // The shading normal on the side hit, bent towards where the path came from; light
+        // from below the geometric surface does not count, nor do paths into it.
+        let ns = bend_towards(select(-s.shading, s.shading, front), -d);
         let x = s.pos + n * frame.ray_epsilon;
         let f = s.albedo / PI;
 
@@ -107,8 +110,8 @@ fn path_radiance(origin: vec3f, dir: vec3f, xy: vec2u, rng: ptr<function, u32>) 
         let u2 = rng_f32(rng);
         if params.light_count > 0u {
             let l = sample_light_at(x, light_choice(u0, u1, u2));
-            let cos_x = dot(n, l.dir);
-            if cos_x > 0.0 && any(l.e > vec3f(0.0))
+            let cos_x = dot(ns, l.dir);
+            if cos_x > 0.0 && dot(n, l.dir) > 0.0 && any(l.e > vec3f(0.0))
                 && !occluded(x, l.dir, frame.ray_epsilon, l.dist * (1.0 - 1e-4), s.tri, l.tri) {
                 // Against BSDF sampling where it could have found the same point: an emissive
                 // triangle, its area density → solid angle at x, from the same formula as the
@@ -140,9 +143,9 @@ fn path_radiance(origin: vec3f, dir: vec3f, xy: vec2u, rng: ptr<function, u32>) 
         // Cosine sampling: f · cos θ / pdf = ρ.
         let v1 = rng_f32(rng);
         let v2 = rng_f32(rng);
-        d = cosine_hemisphere(n, v1, v2);
-        bsdf_pdf = max(dot(n, d), 0.0) / PI;
-        if bsdf_pdf <= 0.0 {
+        d = cosine_hemisphere(ns, v1, v2);
+        bsdf_pdf = max(dot(ns, d), 0.0) / PI;
+        if bsdf_pdf <= 0.0 || dot(n, d) <= 0.0 {
             break;
         }
         throughput *= s.albedo / q;

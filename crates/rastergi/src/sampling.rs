@@ -51,6 +51,14 @@ pub fn orthonormal_basis(n: Vec3) -> (Vec3, Vec3) {
     (Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x), Vec3::new(b, sign + n.y * n.y * a, -n.y))
 }
 
+/// A shading normal `ns` seen from unit direction `v` (towards the viewer): unchanged where it
+/// faces v, else bent in the plane of ns and v until it is just past perpendicular to v.
+/// Mirrors `bend_towards` in `gpu_scene.wgsl`.
+pub fn bend_towards(ns: Vec3, v: Vec3) -> Vec3 {
+    let c = ns.dot(v);
+    if c >= 0.0 { ns } else { (ns + (1e-3 - c) * v).normalize() }
+}
+
 /// A direction about the unit normal n with pdf cos θ / π (Malley's method).
 pub fn cosine_hemisphere(n: Vec3, u1: f32, u2: f32) -> Vec3 {
     let r = u1.sqrt();

@@ -8,8 +8,8 @@
 
 use crate::consts::{
     ENVIRONMENT_LIGHT, FILM_DIRECT, FILM_INDIRECT, FILM_PHOTON_VIEW, LIGHT_DISTANT, LIGHT_POINT, LIGHT_SPOT,
-    MATERIAL_TWO_SIDED, MAX_DIRECTIONS, MAX_SEPARATORS, NO_TEXTURE, OFFSET_SHIFT, OFFSET_STEP, PUNCTUAL_LIGHT,
-    REGION_SHIFT, stream,
+    MATERIAL_TWO_SIDED, MAX_DIRECTIONS, MAX_SEPARATORS, MIN_LOOKUP_AREA, NO_TEXTURE, OFFSET_SHIFT, OFFSET_STEP,
+    PUNCTUAL_LIGHT, REGION_SHIFT, stream,
 };
 
 pub const SAMPLING: &str = include_str!("sampling.wgsl");
@@ -44,7 +44,7 @@ pub fn constants() -> String {
         ("LIGHT_SPOT", LIGHT_SPOT),
         ("LIGHT_DISTANT", LIGHT_DISTANT),
     ];
-    let f32s = [("OFFSET_STEP", OFFSET_STEP)];
+    let f32s = [("OFFSET_STEP", OFFSET_STEP), ("MIN_LOOKUP_AREA", MIN_LOOKUP_AREA)];
     let mut s = String::from("// Generated from the Rust constants (shader.rs).\n");
     for (name, value) in u32s {
         s += &format!("const {name}: u32 = {value}u;\n");

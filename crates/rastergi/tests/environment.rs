@@ -261,6 +261,7 @@ fn the_courtyards_direct_light_matches_mitsubas_at_depth_two() {
         "courtyard_env_direct_128",
         false,
         Show::Direct,
+        None,
     );
 }
 

@@ -177,6 +177,7 @@ fn committed_atrium_obj_is_the_generated_scene() {
         committed.triangles == generated.triangles,
         "scenes/atrium.obj differs from the generator: run `rastergi export atrium --out scenes/atrium.obj`"
     );
+    assert!(committed.normals == generated.normals, "scenes/atrium.obj's shading normals differ from the generator's");
     for i in 0..generated.triangles.len() {
         let (a, b) = (committed.material_of(i), generated.material_of(i));
         assert_eq!((a.albedo, a.emission), (b.albedo, b.emission), "material of triangle {i}");

@@ -15,17 +15,27 @@ fn gather_radiance(w: vec3f, tri: u32, hit: vec3f, b: vec2f, pixel: u32, j: u32)
         return vec3f(0.0);
     }
     // ρ_h at the hit point itself, unfiltered (level 0), like every secondary point.
-    let albedo_h = surface_at(tri, b.x, b.y, 0.0).albedo;
+    let s_h = surface_at(tri, b.x, b.y, 0.0);
     var e = photon_irradiance(hit, tri, !front_h);
     if photon_grid.indirect_only != 0u {
-        e += hit_direct(hit, select(-n_h, n_h, front_h), tri, pixel, j);
+        let ns_h = bend_towards(select(-s_h.shading, s_h.shading, front_h), -w);
+        e += hit_direct(hit, select(-n_h, n_h, front_h), ns_h, tri, pixel, j);
     }
-    return albedo_h / PI * e;
+    return s_h.albedo / PI * e;
+}
+
+// The cosine that weighs direction w at x: the shading normal's, where w lies above the
+// geometric surface (else 0: no light from below it, and no ray into it).
+fn gather_cosine(p: VisiblePoint, w: vec3f) -> f32 {
+    if dot(p.n, w) <= 0.0 {
+        return 0.0;
+    }
+    return max(dot(p.ns, w), 0.0);
 }
 
 // Shared directions, bidirectional: ω uniform on the sphere, and x gathers along whichever of
-// ±ω lies above its surface (w = sign(n·ω)·ω, uniform on x's hemisphere, pdf 1/2π):
-// (ρ_x/π) · L(h → x) · cos θ_x · 2π, cos θ_x = n·w > 0.
+// ±ω lies above its geometric surface (w = sign(n·ω)·ω, uniform on x's hemisphere, pdf
+// 1/2π): (ρ_x/π) · L(h → x) · cos θ_x · 2π, cos θ_x = gather_cosine (the shading normal's).
 fn gather_estimate(p: VisiblePoint, cos_x: f32, w: vec3f, tri: u32, hit: vec3f, b: vec2f, pixel: u32, j: u32) -> vec3f {
     return p.x.albedo / PI * gather_radiance(w, tri, hit, b, pixel, j) * (cos_x * 2.0 * PI);
 }
@@ -35,8 +45,8 @@ fn gather_side(n: vec3f, w: vec3f) -> vec3f {
     return select(-w, w, dot(n, w) >= 0.0);
 }
 
-// Per-pixel directions, cosine-distributed about n_x (pdf cos θ_x/π): the cosine and the π
-// cancel, ρ_x · L(h → x).
+// Per-pixel directions, cosine-distributed about the shading normal (pdf cos θ_x/π): the
+// cosine and the π cancel, ρ_x · L(h → x); directions below the geometric surface count zero.
 fn gather_estimate_cosine(p: VisiblePoint, w: vec3f, tri: u32, hit: vec3f, b: vec2f, pixel: u32, j: u32) -> vec3f {
     return p.x.albedo * gather_radiance(w, tri, hit, b, pixel, j);
 }
@@ -50,25 +60,25 @@ fn escape_estimate(p: VisiblePoint, cos_x: f32, w: vec3f) -> vec3f {
     if !has_environment() {
         return vec3f(0.0);
     }
-    var f = p.x.albedo * env_radiance(w) * env_gather_weight(p.n, w);
+    var f = p.x.albedo * env_radiance(w) * env_gather_weight(p.ns, w);
     if frame.gather_cosine == 0u {
         f *= 2.0 * cos_x;
     }
     return f;
 }
 
-// Direct irradiance at h (side normal n) from one light sample (light_sample_irradiance):
+// Direct irradiance at h (side normal n, shading normal ns) from one light sample (light_sample_irradiance):
 // sample j of the pixel's own Owen-scrambled Sobol' sequence (light_sample_uniforms, as the
 // direct pass draws them), whose seed depends on (seed, pixel) only. j is the gather
 // direction's sample index i·K + k, so an iteration's K hits take an aligned block of the
 // sequence and the iterations keep stratifying it; the index shuffle of sobol_owen_2d keeps
 // it independent of the per-pixel directions, which use the same indices with other seeds.
-fn hit_direct(h: vec3f, n: vec3f, tri: u32, pixel: u32, j: u32) -> vec3f {
+fn hit_direct(h: vec3f, n: vec3f, ns: vec3f, tri: u32, pixel: u32, j: u32) -> vec3f {
     if !has_lights() {
         return vec3f(0.0);
     }
     let xy = vec2u(pixel % frame.resolution.x, pixel / frame.resolution.x);
     let seed = pixel_seed(pcg_hash(frame.seed ^ STREAM_HIT_LIGHT), xy.x, xy.y);
     let c = light_sample_uniforms(j, seed);
-    return light_sample_irradiance(h + n * frame.ray_epsilon, n, tri, frame.ray_epsilon, c);
+    return light_sample_irradiance(h + n * frame.ray_epsilon, n, ns, tri, frame.ray_epsilon, c);
 }

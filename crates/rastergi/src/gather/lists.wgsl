@@ -18,7 +18,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     // Both sides of the ray view serve: points below ω gather along −ω, whose nearest surface
     // is in the same texel's list (the projection along ±ω is the same).
     let w = gather_side(p.n, gather.direction);
-    let cos_x = dot(p.n, w);
+    let cos_x = gather_cosine(p, w);
     if !p.ok || cos_x <= 0.0 {
         return;
     }

@@ -26,7 +26,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     }
     let p = visible_point(textureLoad(gbuffer, gid.xy, 0));
     let w = gather_side(p.n, gather.direction);
-    let cos_x = dot(p.n, w);
+    let cos_x = gather_cosine(p, w);
     if !p.ok || cos_x <= 0.0 {
         found[pixel] = 1u;
         return;
@@ -83,7 +83,7 @@ fn resolve_behind(@builtin(global_invocation_id) gid: vec3u) {
     if b.x != 0u {
         let p = visible_point(textureLoad(gbuffer, gid.xy, 0));
         let w = -gather.direction;
-        film_add(FILM_INDIRECT, gid.xy, texel_estimate(p, dot(p.n, w), w, b.x - 1u, bitcast<f32>(b.y), pixel) / f32(gather.count));
+        film_add(FILM_INDIRECT, gid.xy, texel_estimate(p, gather_cosine(p, w), w, b.x - 1u, bitcast<f32>(b.y), pixel) / f32(gather.count));
         return;
     }
     if !has_environment() {
@@ -91,7 +91,7 @@ fn resolve_behind(@builtin(global_invocation_id) gid: vec3u) {
     }
     let p = visible_point(textureLoad(gbuffer, gid.xy, 0));
     let w = gather_side(p.n, gather.direction);
-    let cos_x = dot(p.n, w);
+    let cos_x = gather_cosine(p, w);
     let along = dot(w, gather.direction) > 0.0;
     if p.ok && cos_x > 0.0 && (!along || found[pixel] == 0u) {
         film_add(FILM_DIRECT, gid.xy, escape_estimate(p, cos_x, w) / f32(gather.count));

@@ -25,9 +25,9 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         var w = gather_side(p.n, gather.directions[k].xyz);
         if per_pixel {
             let u = sobol_owen_2d(gather.first_index + k, seed);
-            w = cosine_hemisphere(p.n, unit_f32(u.x), unit_f32(u.y));
+            w = cosine_hemisphere(p.ns, unit_f32(u.x), unit_f32(u.y));
         }
-        let cos_x = dot(p.n, w);
+        let cos_x = gather_cosine(p, w);
         if cos_x <= 0.0 {
             continue;
         }

@@ -6,7 +6,7 @@ use rayon::prelude::*;
 use super::{MAX_BOUNCES, PhotonSettings, STREAM_PHOTON};
 use crate::gpu_scene::PreparedScene;
 use crate::photons::map::{GridSpec, MapLayout, PhotonMap};
-use crate::sampling::{Rng, cosine_hemisphere};
+use crate::sampling::{Rng, bend_towards, cosine_hemisphere};
 use crate::scene::triangle_normal;
 
 /// Flux deposited per slot, with the squares and counts used for noise estimates.
@@ -100,13 +100,17 @@ fn trace_photon(
         }
         let n = if front { n } else { -n };
         let p = tri[0] * (1.0 - hit.b1 - hit.b2) + tri[1] * hit.b1 + tri[2] * hit.b2;
+        let shading = prepared.shading_normal_at(hit.triangle as usize, hit.b1, hit.b2);
+        let ns = bend_towards(if front { shading } else { -shading }, -dir);
+        let arrive = (-dir).dot(ns) / (-dir).dot(n);
         if bounce >= first_deposit {
+            let deposit = flux * arrive;
             match layout.deposit_slot(hit.triangle as usize, !front, p) {
                 Some(slot) => {
                     for c in 0..3 {
-                        t.flux[slot][c] += flux[c] as f64;
+                        t.flux[slot][c] += deposit[c] as f64;
                     }
-                    t.flux_sq[slot] += (flux.y as f64).powi(2);
+                    t.flux_sq[slot] += (deposit.y as f64).powi(2);
                     t.deposits[slot] += 1;
                 }
                 None => t.dropped += 1,
@@ -119,7 +123,12 @@ fn trace_photon(
         }
         flux *= albedo / survive;
         let (u1, u2) = (rng.next_f32(), rng.next_f32());
-        dir = cosine_hemisphere(n, u1, u2);
+        dir = cosine_hemisphere(ns, u1, u2);
+        let (cos_s, cos_g) = (dir.dot(ns), dir.dot(n));
+        if cos_g <= 0.0 || cos_s <= 0.0 {
+            break;
+        }
+        flux *= arrive * (cos_g / cos_s);
         origin = p + n * eps;
         skip = hit.triangle;
     }

@@ -46,6 +46,7 @@ use super::clip::{clip_to_box, clip_to_half_space, polygon_area};
 use super::separators::{Fragment, separators_of};
 pub use super::separators::{MAX_SEPARATORS, MIN_REGION, Separator, Separators, region_of};
 pub use super::table::{EMPTY, SlotTable};
+pub use crate::consts::MIN_LOOKUP_AREA;
 use crate::scene::{Aabb, Scene, triangle_normal};
 
 /// The slot table's search in WGSL (`find_slot`, the twin of [`SlotTable::find`]). The GPU
@@ -372,7 +373,10 @@ impl PhotonMap {
     /// Σ w_i Φ_i / Σ w_i A_i over the slots of side `back` of `plane` in the 8 cells around p
     /// (trilinear weights on cell centres, clamped at the grid's border), each cell's slot of
     /// p's region among that cell's separators; a cell whose centre lies on the other side of a
-    /// separator of p's own cell is left out.
+    /// separator of p's own cell is left out, and so is a slot of less than
+    /// [`MIN_LOOKUP_AREA`]·h²: what photons rounding put there (a sliver of a plane that only
+    /// touches the cell, a region that a separator only grazes) would read as Φ/A with A ≈ 0,
+    /// spikes of 10⁸ times the irradiance around them (measured on a 120-triangle sphere).
     pub fn irradiance_on_plane(&self, p: Vec3, plane: &TrianglePlane, back: bool) -> [f64; 3] {
         let (grid, layout) = (&self.layout.grid, &self.layout);
         // The separators of p's own slot: cells beyond them (across a wall) do not count.
@@ -396,7 +400,9 @@ impl PhotonMap {
                 continue;
             }
             let (cell, key) = (grid.cell_index(c), plane.key(grid, c, back));
-            if let Some(s) = layout.table.find(cell, key | layout.region(cell, key, p) << REGION_SHIFT) {
+            if let Some(s) = layout.table.find(cell, key | layout.region(cell, key, p) << REGION_SHIFT)
+                && self.layout.area[s] >= MIN_LOOKUP_AREA as f64 * (grid.cell as f64).powi(2)
+            {
                 for (acc, f) in flux.iter_mut().zip(self.flux[s]) {
                     *acc += w * f;
                 }

@@ -65,7 +65,8 @@ fn photon_irradiance(p: vec3f, tri: u32, back: bool) -> vec3f {
         let cell = grid_cell_index(c);
         let key = plane_key(plane, centre, h, back);
         let s = find_slot(cell, key | (photon_region(cell, key, p) << REGION_SHIFT), photon_grid.mask, photon_grid.max_probe);
-        if s != NO_SLOT {
+        // Slots of almost no area are left out (PhotonMap::irradiance_on_plane).
+        if s != NO_SLOT && photon_slots[s].a >= MIN_LOOKUP_AREA {
             sum += (w3.x * w3.y * w3.z) * photon_slots[s];
         }
     }

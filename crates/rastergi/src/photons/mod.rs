@@ -1,4 +1,4 @@
-//! Photon pass: photons leave the area lights and deposit their flux into the grid photon map
+//! Photon pass: photons leave the lights and deposit their flux into the grid photon map
 //! ([`map`]) at every diffuse hit.
 //!
 //! Emission: a light triangle is chosen with probability pmf ∝ its power, a point uniformly on
@@ -15,11 +15,22 @@
 //! unfiltered (level 0), so each photon takes the colour of the texel it hits. There is no depth limit, only a safety cap
 //! ([`MAX_BOUNCES`]). Hitting the back of a one-sided surface absorbs the photon.
 //!
+//! Shading normals (Veach 1997, §5.3): at a hit with geometric normal n_g and shading normal
+//! n_s (both on the side hit; n_s bent towards the arriving photon where it faces away), the
+//! photon arriving from ω_o deposits Φ·|ω_o·n_s|/|ω_o·n_g| — the map then estimates the
+//! irradiance that the shading normal sees, E_s = ∫ L |ω·n_s| dω, as the eye's passes use
+//! it — and scatters cosine-distributed about n_s into ω_i with the adjoint weight
+//! ρ·(|ω_o·n_s|/|ω_o·n_g|)·(|ω_i·n_g|/|ω_i·n_s|), so that the flux leaving through the geometric
+//! surface is what radiance ρ/π·E_s carries. A direction below the geometric surface ends the
+//! path. Without shading normals both factors are 1.
+//!
 //! Every random number comes from the stream (seed ⊕ [`STREAM_PHOTON`], photon index), so the
 //! GPU tracer ([`gpu`]) and its CPU twin ([`cpu`]) draw identical samples for a photon.
 //!
 //! Since ρ_c/max(ρ) ≤ 1, a photon's flux per channel never exceeds its initial flux, which is
-//! at most [`PhotonSettings::max_photon_flux`]: the GPU's fixed-point tally relies on this.
+//! at most [`PhotonSettings::max_photon_flux`], except by the shading-normal factors: the
+//! GPU's fixed-point tally maps that bound to 2²⁴ quanta of a 32-bit add and clamps a deposit
+//! at 2³¹ (128 times the bound).
 
 mod clip;
 pub mod cpu;

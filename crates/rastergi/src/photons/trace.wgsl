@@ -99,7 +99,9 @@ fn deposit(p: vec3f, tri: u32, back: bool, flux: vec3f) {
     if s == NO_SLOT {
         return;
     }
-    let q = vec3u(round(flux * params.quantum));
+    // Below u32's range whatever the shading-normal corrections did (2⁷ times the largest
+    // initial flux, 2²⁴ quanta: never reached in practice).
+    let q = vec3u(round(min(flux * params.quantum, vec3f(2147483648.0))));
     add64(0u, s, q.x);
     add64(1u, s, q.y);
     add64(2u, s, q.z);
@@ -135,8 +137,13 @@ fn trace_photons(@builtin(global_invocation_id) gid: vec3u) {
             break;
         }
         let n = select(-s.normal, s.normal, front);
+        // Shading normals (photons/mod.rs): the deposit estimates the shading irradiance,
+        // flux × |ω_o·n_s|/|ω_o·n_g| with ω_o = −dir, and scattering is cosine-distributed
+        // about n_s with the adjoint weight (|ω_o·n_s|/|ω_o·n_g|)·(|ω_i·n_g|/|ω_i·n_s|).
+        let ns = bend_towards(select(-s.shading, s.shading, front), -dir);
+        let arrive = dot(-dir, ns) / dot(-dir, n);
         if bounce >= params.first_deposit {
-            deposit(s.pos, hit.tri, !front, flux);
+            deposit(s.pos, hit.tri, !front, flux * arrive);
         }
         let survive = max(s.albedo.x, max(s.albedo.y, s.albedo.z));
         if rng_f32(&rng) >= survive {
@@ -145,7 +152,14 @@ fn trace_photons(@builtin(global_invocation_id) gid: vec3u) {
         flux *= s.albedo / survive;
         let v1 = rng_f32(&rng);
         let v2 = rng_f32(&rng);
-        dir = cosine_hemisphere(n, v1, v2);
+        dir = cosine_hemisphere(ns, v1, v2);
+        let cos_s = dot(dir, ns);
+        let cos_g = dot(dir, n);
+        // No way into the surface.
+        if cos_g <= 0.0 || cos_s <= 0.0 {
+            break;
+        }
+        flux *= arrive * (cos_g / cos_s);
         origin = s.pos + n * params.ray_epsilon;
         skip = hit.tri;
     }

@@ -4,7 +4,8 @@
 //! Vertices shared by triangles are written once; faces keep their corners' order (so their
 //! front faces), grouped by `usemtl` runs; each material gets `Kd` (albedo) and `Ke`
 //! (emission). Coordinates are written with the shortest decimal that reads back as the same
-//! `f32`, so a loaded file has exactly the scene's triangles. OBJ has no sidedness and no
+//! `f32`, so a loaded file has exactly the scene's triangles; shading normals are written as
+//! `vn` (faces `f v//vn`, in objects of their own), so they load back bit for bit. OBJ has no sidedness and no
 //! camera: materials load back two-sided, and the camera is written as a comment holding the
 //! command-line options that restore it.
 
@@ -12,6 +13,8 @@ use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::io::Write as _;
 use std::path::Path;
+
+use glam::Vec3;
 
 use super::Scene;
 use crate::error::{Error, Result};
@@ -94,13 +97,39 @@ pub fn write_obj(scene: &Scene, obj: &Path, comment: &str) -> Result<()> {
             })
         }));
     }
+    // Shading normals likewise, for the triangles that have them (`f v//vn`).
+    let mut normal_index: HashMap<[u32; 3], usize> = HashMap::new();
+    let normals: Vec<Option<[usize; 3]>> = (0..scene.triangles.len())
+        .map(|i| {
+            let n = scene.normals.get(i).filter(|n| n.iter().all(|v| *v != Vec3::ZERO))?;
+            Some(n.map(|v| {
+                let next = normal_index.len() + 1;
+                *normal_index.entry(v.to_array().map(f32::to_bits)).or_insert_with(|| {
+                    let _ = writeln!(o, "vn {} {} {}", v.x, v.y, v.z);
+                    next
+                })
+            }))
+        })
+        .collect();
+    // A new object wherever the material or smoothness changes: a reader takes an object's
+    // normals only when all its faces have them.
     let mut current = None;
-    for (f, &material) in corners.iter().zip(&scene.material_ids) {
-        if current != Some(material) {
+    for ((f, &material), n) in corners.iter().zip(&scene.material_ids).zip(&normals) {
+        if current != Some((material, n.is_some())) {
+            if !normal_index.is_empty() {
+                let _ = writeln!(o, "o {}{}", names[material as usize], if n.is_some() { "_smooth" } else { "" });
+            }
             let _ = writeln!(o, "usemtl {}", names[material as usize]);
-            current = Some(material);
+            current = Some((material, n.is_some()));
         }
-        let _ = writeln!(o, "f {} {} {}", f[0], f[1], f[2]);
+        match n {
+            Some(n) => {
+                let _ = writeln!(o, "f {}//{} {}//{} {}//{}", f[0], n[0], f[1], n[1], f[2], n[2]);
+            }
+            None => {
+                let _ = writeln!(o, "f {} {} {}", f[0], f[1], f[2]);
+            }
+        }
     }
     write_atomically(&mtl, m.as_bytes())?;
     write_atomically(obj, o.as_bytes())

@@ -116,7 +116,7 @@ pub fn rooms(doorway: bool) -> Scene {
 }
 
 /// A UV sphere: `segments` around the axis, `segments / 2` rings from pole to pole;
-/// `2·segments·(rings − 1)` triangles, front faces outwards.
+/// `2·segments·(rings − 1)` triangles, front faces outwards, smooth (radial shading normals).
 fn add_sphere(scene: &mut Scene, centre: Vec3, radius: f32, segments: u32, material: u32) {
     let segments = segments.max(3);
     let rings = (segments / 2).max(2);
@@ -131,11 +131,15 @@ fn add_sphere(scene: &mut Scene, centre: Vec3, radius: f32, segments: u32, mater
             let (c, d) = (point(ring + 1, seg + 1), point(ring + 1, seg));
             // Seen from outside, a → b runs along φ and b → c down towards the −y pole, so
             // (a, b, d) and (b, c, d) wind counter-clockwise; at the poles one is degenerate.
+            // Smooth: each corner's shading normal is the sphere's radial direction.
+            let normal = |p: Vec3| (p - centre) / radius;
             if ring > 0 {
                 scene.add_triangle([a, b, d], material);
+                scene.set_last_normals([a, b, d].map(normal));
             }
             if ring + 1 < rings {
                 scene.add_triangle([b, c, d], material);
+                scene.set_last_normals([b, c, d].map(normal));
             }
         }
     }
@@ -147,15 +151,26 @@ fn sphere_triangles(segments: u32) -> usize {
     2 * segments.max(3) as usize * (rings as usize - 1)
 }
 
-/// An open cylinder (no caps) along +y from `base`, `sides` faces, front faces outwards.
+/// An open cylinder (no caps) along +y from `base`, `sides` faces, front faces outwards,
+/// smooth (radial shading normals).
 fn add_cylinder(scene: &mut Scene, base: Vec3, radius: f32, height: f32, sides: u32, material: u32) {
     for k in 0..sides {
         let angle = |k: u32| std::f32::consts::TAU * k as f32 / sides as f32;
         let (a0, a1) = (angle(k), angle(k + 1));
         let p = |a: f32, y: f32| base + Vec3::new(radius * a.cos(), y, radius * a.sin());
-        let mid = 0.5 * (a0 + a1);
-        let outward = Vec3::new(mid.cos(), 0.0, mid.sin());
-        add_quad_facing(scene, [p(a0, 0.0), p(a1, 0.0), p(a1, height), p(a0, height)], outward, material);
+        let radial = |a: f32| Vec3::new(a.cos(), 0.0, a.sin());
+        // Seen from outside with +y up, angle a1 lies to the left of a0 (the angle turns from
+        // +x towards +z): (a0 top, a1 top, a1 bottom, a0 bottom) winds counter-clockwise.
+        let q = [p(a0, height), p(a1, height), p(a1, 0.0), p(a0, 0.0)];
+        let n = [radial(a0), radial(a1), radial(a1), radial(a0)];
+        let [i, j, l] =
+            if (q[1] - q[0]).cross(q[2] - q[0]).dot(radial(0.5 * (a0 + a1))) >= 0.0 { [0, 1, 2] } else { [0, 2, 1] };
+        scene.add_triangle([q[i], q[j], q[l]], material);
+        scene.set_last_normals([n[i], n[j], n[l]]);
+        let [i, j, l] =
+            if (q[2] - q[0]).cross(q[3] - q[0]).dot(radial(0.5 * (a0 + a1))) >= 0.0 { [0, 2, 3] } else { [0, 3, 2] };
+        scene.add_triangle([q[i], q[j], q[l]], material);
+        scene.set_last_normals([n[i], n[j], n[l]]);
     }
 }
 

@@ -7,6 +7,9 @@
 //!   Triangle lists, strips and fans; points and lines have no area and are skipped with a
 //!   warning. glTF's front faces are counter-clockwise like ours; a transform with a negative
 //!   determinant mirrors the mesh, so its triangles' corners are swapped to keep the front.
+//!   `NORMAL` gives the shading normals (through the inverse transpose of the transform);
+//!   primitives without it shade flat. Other attributes (COLOR_0, JOINTS, WEIGHTS, more UV
+//!   sets) are not read.
 //! - **Materials** (Lambertian only): albedo = baseColorFactor.rgb × baseColorTexture (sRGB,
 //!   read at the TEXCOORD set the texture names); emitted radiance = emissiveFactor ×
 //!   KHR_materials_emissive_strength (× the emissive texture's mean colour, with a warning:
@@ -337,6 +340,8 @@ impl Elements<'_> {
 struct Primitive {
     triangles: Vec<[Vec3; 3]>,
     uvs: Option<Vec<[Vec2; 3]>>,
+    /// The corners' NORMALs in the mesh's space, where the primitive has them.
+    normals: Option<Vec<[Vec3; 3]>>,
     material: u32,
 }
 
@@ -444,21 +449,31 @@ impl<'a> Loader<'a> {
     }
 
     /// Adds a mesh's primitives transformed by `world`.
+    /// Normals go through the inverse transpose of `world` (mirrored instances too: the
+    /// winding is swapped to keep the front face, the normals keep pointing where they did).
     fn add_instance(&mut self, primitives: &[Primitive], world: Mat4) {
         let mirrored = world.determinant() < 0.0;
+        let normal_matrix = glam::Mat3::from_mat4(world).inverse().transpose();
         for p in primitives {
             for (k, t) in p.triangles.iter().enumerate() {
                 let mut tri = t.map(|v| world.transform_point3(v));
                 let mut uv = p.uvs.as_ref().map(|uvs| uvs[k]);
+                let mut normals = p.normals.as_ref().map(|n| n[k].map(|v| normal_matrix * v));
                 if mirrored {
                     tri.swap(1, 2);
                     if let Some(uv) = &mut uv {
                         uv.swap(1, 2);
                     }
+                    if let Some(n) = &mut normals {
+                        n.swap(1, 2);
+                    }
                 }
                 match uv {
                     Some(uv) => self.scene.add_textured_triangle(tri, uv, p.material),
                     None => self.scene.add_triangle(tri, p.material),
+                }
+                if let Some(n) = normals {
+                    self.scene.set_last_normals(n);
                 }
             }
         }
@@ -642,7 +657,22 @@ impl<'a> Loader<'a> {
             }
             None => None,
         };
-        Ok(Some(Primitive { triangles, uvs, material }))
+        let normals = match p.get(&Semantic::Normals) {
+            Some(accessor) => {
+                let e = self.elements(&accessor, &format!("{what} NORMAL"), &[DataType::F32], Dimensions::Vec3)?;
+                if e.count != vertices.len() {
+                    return Err(format!("{what} NORMAL has {} elements for {} vertices", e.count, vertices.len()));
+                }
+                let n: Vec<Vec3> =
+                    (0..e.count).map(|i| Vec3::new(e.float(i, 0), e.float(i, 1), e.float(i, 2))).collect();
+                if let Some(i) = n.iter().position(|v| !v.is_finite()) {
+                    return Err(format!("{what}: vertex {i} has a non-finite NORMAL"));
+                }
+                Some(corners.iter().map(|c| c.map(|i| n[i as usize])).collect())
+            }
+            None => None,
+        };
+        Ok(Some(Primitive { triangles, uvs, normals, material }))
     }
 
     /// The scene material of a glTF material, created on first use.

@@ -203,6 +203,10 @@ pub struct Scene {
     /// Texture coordinates of each triangle's corners, in the order of `triangles`: empty when
     /// no triangle has any, else one entry per triangle (zero where a triangle has none).
     pub uvs: Vec<[Vec2; 3]>,
+    /// Shading normals at the triangles' corners (glTF NORMAL, OBJ vn), unit, in the order of
+    /// `triangles`: empty when no triangle has any, else one entry per triangle (zero where a
+    /// triangle has none: it shades with its geometric normal).
+    pub normals: Vec<[Vec3; 3]>,
     /// Albedo textures, referred to by [`Material::albedo_texture`].
     pub textures: Vec<Texture>,
     pub camera: Camera,
@@ -217,6 +221,7 @@ impl Scene {
             material_ids: Vec::new(),
             materials: Vec::new(),
             uvs: Vec::new(),
+            normals: Vec::new(),
             textures: Vec::new(),
             camera,
         }
@@ -234,14 +239,26 @@ impl Scene {
         if !self.uvs.is_empty() {
             self.uvs.push([Vec2::ZERO; 3]);
         }
+        if !self.normals.is_empty() {
+            self.normals.push([Vec3::ZERO; 3]);
+        }
     }
 
     /// Adds a triangle with texture coordinates `uv` at its corners.
     pub fn add_textured_triangle(&mut self, tri: [Vec3; 3], uv: [Vec2; 3], material: u32) {
         self.uvs.resize(self.triangles.len(), [Vec2::ZERO; 3]);
-        self.triangles.push(tri);
-        self.material_ids.push(material);
-        self.uvs.push(uv);
+        self.add_triangle(tri, material);
+        *self.uvs.last_mut().expect("the triangle's texture coordinates") = uv;
+    }
+
+    /// Gives the last triangle added the shading normals `n` at its corners (normalised;
+    /// a zero or non-finite one makes the triangle shade flat).
+    pub fn set_last_normals(&mut self, n: [Vec3; 3]) {
+        let count = self.triangles.len();
+        self.normals.resize(count, [Vec3::ZERO; 3]);
+        // Unit vectors are kept bit for bit (an exported file loads back the same normals).
+        let n = n.map(|v| if (v.length_squared() - 1.0).abs() < 1e-6 { v } else { v.normalize_or_zero() });
+        self.normals[count - 1] = if n.iter().all(|v| *v != Vec3::ZERO) { n } else { [Vec3::ZERO; 3] };
     }
 
     /// Adds a texture and returns its index.
@@ -308,6 +325,9 @@ impl Scene {
         }
         if let Some(i) = self.uvs.iter().position(|t| !t.iter().all(|uv| uv.is_finite())) {
             return Err(Error::InvalidScene(format!("triangle {i} has a non-finite texture coordinate")));
+        }
+        if !self.normals.is_empty() && self.normals.len() != self.triangles.len() {
+            return Err(Error::InvalidScene("shading normals must be given for every triangle or none".into()));
         }
         if self.textures.len() > MAX_TEXTURES {
             return Err(Error::InvalidScene(format!(

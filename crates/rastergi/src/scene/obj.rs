@@ -9,6 +9,10 @@
 //! `Kd` (1 when `Kd` is absent), read at the faces' `vt` coordinates; OBJ's v points up the
 //! image, so v is flipped into the scene's convention (v down). Texture options (`-o`, `-s`,
 //! …) are skipped with a warning.
+//!
+//! Faces whose corners name `vn` normals (`f v//vn`, `f v/vt/vn`) shade with them, interpolated
+//! (normalised as read); a model whose faces do not all have them shades flat. Smoothing
+//! groups (`s`) are not read: without `vn` every face is flat.
 
 use std::cell::RefCell;
 use std::collections::HashMap;
@@ -49,12 +53,25 @@ pub fn load_obj(path: &Path) -> Result<Scene> {
         ));
     }
     let textured = materials.iter().any(|m| m.diffuse_texture.is_some());
-    if textured {
-        // Textures need the texture coordinates: load again with them, once every face's
-        // references are known to be in range (tobj overflows on some that are not).
-        let mut text = std::fs::read(path).map_err(|e| file_error(path, format!("cannot be read: {e}")))?;
-        comment_out_normals(&mut text);
-        check_texcoord_references(&text).map_err(|message| file_error(path, message))?;
+    let mut text = text_of(path)?;
+    // Normals that faces refer to out of range are not used (the faces shade flat).
+    let smooth = has_keyword(&text, b"vn")
+        && check_references(&text, "vn", 2, "normal")
+            .map_err(|message| log::warn!("{}: {message}; its faces shade flat", path.display()))
+            .is_ok();
+    if textured || smooth {
+        // Textures need the texture coordinates and smooth shading the normals: load again
+        // with them, once every face's references are known to be in range (tobj overflows
+        // on some that are not).
+        if !textured {
+            comment_out(&mut text, b"vt");
+        }
+        if !smooth {
+            comment_out(&mut text, b"vn");
+        }
+        if textured {
+            check_references(&text, "vt", 1, "texture coordinate").map_err(|message| file_error(path, message))?;
+        }
         models = load_obj_text(path, &text, &tobj::LoadOptions { single_index: true, ..options })?.0;
     }
 
@@ -105,6 +122,8 @@ pub fn load_obj(path: &Path) -> Result<Scene> {
                 ),
             ));
         }
+        // Likewise normals: a model whose faces do not all have them shades flat.
+        let has_normals = !mesh.normals.is_empty() && mesh.normals.len() / 3 == vertex_count;
         for (f, face) in mesh.indices.chunks_exact(3).enumerate() {
             let mut tri = [Vec3::ZERO; 3];
             for (k, &i) in face.iter().enumerate() {
@@ -125,6 +144,12 @@ pub fn load_obj(path: &Path) -> Result<Scene> {
                 scene.add_textured_triangle(tri, uv, material);
             } else {
                 scene.add_triangle(tri, material);
+            }
+            if has_normals {
+                scene.set_last_normals(std::array::from_fn(|k| {
+                    let i = face[k] as usize;
+                    Vec3::new(mesh.normals[3 * i], mesh.normals[3 * i + 1], mesh.normals[3 * i + 2])
+                }));
             }
         }
     }
@@ -163,44 +188,62 @@ fn load_obj_text(
     Ok((models, materials.unwrap_or_default()))
 }
 
-/// Turns `vn` lines into comments in place (see [`comment_out_texcoords_and_normals`]).
-fn comment_out_normals(text: &mut [u8]) {
+/// The file's bytes.
+fn text_of(path: &Path) -> Result<Vec<u8>> {
+    std::fs::read(path).map_err(|e| file_error(path, format!("cannot be read: {e}")))
+}
+
+/// The first word of a line.
+fn keyword_of(line: &[u8]) -> &[u8] {
+    let indent = line.iter().take_while(|b| b.is_ascii_whitespace()).count();
+    let line = &line[indent..];
+    &line[..line.iter().position(u8::is_ascii_whitespace).unwrap_or(line.len())]
+}
+
+/// Whether any line starts with `keyword`.
+fn has_keyword(text: &[u8], keyword: &[u8]) -> bool {
+    text.split(|&b| b == b'\n').any(|l| keyword_of(l) == keyword)
+}
+
+/// Turns the lines starting with `keyword` into comments in place (see
+/// [`comment_out_texcoords_and_normals`]).
+fn comment_out(text: &mut [u8], keyword: &[u8]) {
     for line in text.split_mut(|&b| b == b'\n') {
-        let indent = line.iter().take_while(|b| b.is_ascii_whitespace()).count();
-        let line = &mut line[indent..];
-        let keyword = line.iter().position(u8::is_ascii_whitespace).unwrap_or(line.len());
-        if &line[..keyword] == b"vn" {
-            line[0] = b'#';
+        if keyword_of(line) == keyword {
+            let indent = line.iter().take_while(|b| b.is_ascii_whitespace()).count();
+            line[indent] = b'#';
         }
     }
 }
 
-/// Checks that every texture-coordinate reference of an `f` line names a `vt` line of the file:
-/// 1 to the number of `vt` lines, or −1 back to the first `vt` line before it.
-fn check_texcoord_references(text: &[u8]) -> Result<(), String> {
-    let is_vt = |line: &[u8]| line.split(u8::is_ascii_whitespace).find(|w| !w.is_empty()) == Some(b"vt");
-    let total = text.split(|&b| b == b'\n').filter(|&l| is_vt(l)).count() as i64;
+/// Checks that every reference of an `f` line in slot `slot` (1: texture coordinate, 2:
+/// normal) names a `keyword` line of the file: 1 to the number of such lines, or −1 back to
+/// the first one before it.
+fn check_references(text: &[u8], keyword: &str, slot: usize, what: &str) -> Result<(), String> {
+    let is_keyword = |line: &[u8]| keyword_of(line) == keyword.as_bytes();
+    let total = text.split(|&b| b == b'\n').filter(|&l| is_keyword(l)).count() as i64;
     let mut seen = 0i64;
     for (n, line) in text.split(|&b| b == b'\n').enumerate() {
+        if is_keyword(line) {
+            seen += 1;
+            continue;
+        }
         let line = String::from_utf8_lossy(line);
         let mut words = line.split_whitespace();
-        match words.next() {
-            Some("vt") => seen += 1,
-            Some("f") => {
-                for vertex in words {
-                    let Some(Ok(i)) = vertex.split('/').nth(1).filter(|s| !s.is_empty()).map(str::parse::<i64>) else {
-                        continue;
-                    };
-                    if (i > 0 && i > total) || (i < 0 && seen + i < 0) {
-                        return Err(format!(
-                            "line {}: a face refers to texture coordinate {i}, but there are {} (vt lines); fix the face or export the file again",
-                            n + 1,
-                            if i > 0 { total } else { seen }
-                        ));
-                    }
-                }
+        if words.next() != Some("f") {
+            continue;
+        }
+        for vertex in words {
+            let Some(Ok(i)) = vertex.split('/').nth(slot).filter(|s| !s.is_empty()).map(str::parse::<i64>) else {
+                continue;
+            };
+            if (i > 0 && i > total) || (i < 0 && seen + i < 0) {
+                return Err(format!(
+                    "line {}: a face refers to {what} {i}, but there are {} ({keyword} lines); fix the face or export the file again",
+                    n + 1,
+                    if i > 0 { total } else { seen }
+                ));
             }
-            _ => {}
         }
     }
     Ok(())
@@ -212,11 +255,13 @@ fn texture_file_name(value: &str) -> std::result::Result<&str, String> {
     let mut rest = value.trim();
     while rest.starts_with('-') {
         let (option, after) = rest.split_once(char::is_whitespace).unwrap_or((rest, ""));
+        // Unknown options (exporters invent some) are skipped with the numbers after them.
         let (min, max) = match option {
             "-blendu" | "-blendv" | "-cc" | "-clamp" | "-texres" | "-bm" | "-boost" | "-imfchan" => (1, 1),
+            "-type" | "-colorspace" => (1, 1),
             "-mm" => (2, 2),
             "-o" | "-s" | "-t" => (1, 3),
-            _ => return Err(format!("map_Kd has an unknown option '{option}'")),
+            _ => (0, usize::MAX),
         };
         rest = after.trim_start();
         // The required values are taken as they come, the optional ones only if numbers.
@@ -347,14 +392,8 @@ fn first_bad_face(text: &[u8]) -> Option<(usize, String)> {
 /// Turns `vt` and `vn` lines into comments in place: a scene needs positions only, and tobj
 /// rejects (in debug builds: panics on) texture and normal indices out of range.
 fn comment_out_texcoords_and_normals(text: &mut [u8]) {
-    for line in text.split_mut(|&b| b == b'\n') {
-        let indent = line.iter().take_while(|b| b.is_ascii_whitespace()).count();
-        let line = &mut line[indent..];
-        let keyword = line.iter().position(u8::is_ascii_whitespace).unwrap_or(line.len());
-        if matches!(&line[..keyword], b"vt" | b"vn") {
-            line[0] = b'#';
-        }
-    }
+    comment_out(text, b"vt");
+    comment_out(text, b"vn");
 }
 
 /// Loads the MTL library `name`, found relative to the OBJ file `obj` as tobj does. MTL lets
@@ -414,4 +453,20 @@ fn load_mtl(obj: &Path, name: &Path, error: &RefCell<Option<String>>) -> tobj::M
         }
     }
     Ok((materials, names))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::texture_file_name;
+
+    #[test]
+    fn texture_options_are_skipped_and_unknown_ones_do_not_refuse_the_file() {
+        assert_eq!(texture_file_name("tex.png"), Ok("tex.png"));
+        assert_eq!(texture_file_name("-o 0.5 0.5 -s 2 2 1 -bm 0.3 tex.png"), Ok("tex.png"));
+        // Options exporters write that MTL does not define: skipped with their values.
+        assert_eq!(texture_file_name("-colorspace sRGB -type sphere tex.png"), Ok("tex.png"));
+        assert_eq!(texture_file_name("-invented 1 2 3 tex.png"), Ok("tex.png"));
+        assert!(texture_file_name("-bm").unwrap_err().contains("lacks its value"));
+        assert!(texture_file_name("-s 1 1").unwrap_err().contains("names no file"));
+    }
 }

@@ -104,10 +104,12 @@ pub fn matches_mitsuba(
     stem: &str,
     mask_emitters: bool,
 ) {
-    image_matches_mitsuba(label, scene, hit_light, iterations, stem, mask_emitters, Show::Full)
+    image_matches_mitsuba(label, scene, hit_light, iterations, stem, mask_emitters, Show::Full, None)
 }
 
-/// [`matches_mitsuba`] for the image `show` (a direct-light reference for Show::Direct).
+/// [`matches_mitsuba`] for the image `show` (a direct-light reference for Show::Direct), over
+/// the pixels `keep` keeps (all where `None`; emitters left out as well where asked).
+#[allow(clippy::too_many_arguments)]
 pub fn image_matches_mitsuba(
     label: &str,
     scene: &Scene,
@@ -116,6 +118,7 @@ pub fn image_matches_mitsuba(
     stem: &str,
     mask_emitters: bool,
     show: Show,
+    keep: Option<&[bool]>,
 ) {
     let gpu = gpu();
     let grid = rastergi::fit::grid_resolution(&scene.bounds());
@@ -133,7 +136,11 @@ pub fn image_matches_mitsuba(
     let b = render(&gpu, scene, settings(2), iterations, show);
     // Emitter pixels (over 3 in the reference, and their neighbours) left out where asked.
     let probe = read_exr(&data(&format!("{stem}_a.exr"))).expect("reference a");
-    let mask = mask_emitters.then(|| rastergi::metrics::emitter_mask(&probe, 3.0));
+    let mut mask = mask_emitters.then(|| rastergi::metrics::emitter_mask(&probe, 3.0));
+    if let Some(keep) = keep {
+        let m = mask.get_or_insert_with(|| vec![true; keep.len()]);
+        m.iter_mut().zip(keep).for_each(|(m, &k)| *m &= k);
+    }
     let mask = mask.as_deref();
     let (reference, ref_noise) = reference_pair(stem, mask);
     let (c, noise, bias) = against_reference(&a, &b, &reference, ref_noise, mask);

@@ -8,7 +8,8 @@
 //!   warning. glTF's front faces are counter-clockwise like ours; a transform with a negative
 //!   determinant mirrors the mesh, so its triangles' corners are swapped to keep the front.
 //!   `NORMAL` gives the shading normals (through the inverse transpose of the transform);
-//!   primitives without it shade flat. Other attributes (COLOR_0, JOINTS, WEIGHTS, more UV
+//!   primitives without it, or with one that cannot be read (quantized, non-finite), shade
+//!   flat (the latter with a warning). Other attributes (COLOR_0, JOINTS, WEIGHTS, more UV
 //!   sets) are not read.
 //! - **Materials** (Lambertian only): albedo = baseColorFactor.rgb × baseColorTexture (sRGB,
 //!   read at the TEXCOORD set the texture names); emitted radiance = emissiveFactor ×
@@ -657,21 +658,29 @@ impl<'a> Loader<'a> {
             }
             None => None,
         };
-        let normals = match p.get(&Semantic::Normals) {
-            Some(accessor) => {
+        // Normals rastergi cannot read (quantized, sparse, the wrong count, non-finite) make
+        // the primitive shade flat, with a warning: the geometry is still right.
+        let normals = p.get(&Semantic::Normals).and_then(|accessor| {
+            let read = || -> Res<Vec<Vec3>> {
                 let e = self.elements(&accessor, &format!("{what} NORMAL"), &[DataType::F32], Dimensions::Vec3)?;
                 if e.count != vertices.len() {
                     return Err(format!("{what} NORMAL has {} elements for {} vertices", e.count, vertices.len()));
                 }
                 let n: Vec<Vec3> =
                     (0..e.count).map(|i| Vec3::new(e.float(i, 0), e.float(i, 1), e.float(i, 2))).collect();
-                if let Some(i) = n.iter().position(|v| !v.is_finite()) {
-                    return Err(format!("{what}: vertex {i} has a non-finite NORMAL"));
+                match n.iter().position(|v| !v.is_finite()) {
+                    Some(i) => Err(format!("{what}: vertex {i} has a non-finite NORMAL")),
+                    None => Ok(n),
                 }
-                Some(corners.iter().map(|c| c.map(|i| n[i as usize])).collect())
+            };
+            match read() {
+                Ok(n) => Some(corners.iter().map(|c| c.map(|i| n[i as usize])).collect()),
+                Err(e) => {
+                    log::warn!("{e}; it shades flat");
+                    None
+                }
             }
-            None => None,
-        };
+        });
         Ok(Some(Primitive { triangles, uvs, normals, material }))
     }
 

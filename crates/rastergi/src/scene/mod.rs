@@ -246,8 +246,9 @@ impl Scene {
 
     /// Adds a triangle with texture coordinates `uv` at its corners.
     pub fn add_textured_triangle(&mut self, tri: [Vec3; 3], uv: [Vec2; 3], material: u32) {
-        self.uvs.resize(self.triangles.len(), [Vec2::ZERO; 3]);
         self.add_triangle(tri, material);
+        // The earlier triangles (and this one, if it is the first with any) get zeros first.
+        self.uvs.resize(self.triangles.len(), [Vec2::ZERO; 3]);
         *self.uvs.last_mut().expect("the triangle's texture coordinates") = uv;
     }
 

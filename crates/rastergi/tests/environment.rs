@@ -88,6 +88,22 @@ fn floor_mean(scene: &Scene, settings: RenderSettings, iterations: u32, path: bo
     (mean, (var / n).powf(0.5))
 }
 
+/// E = ∫₊ L cos θ dω on an upward-facing plane, by a 600² midpoint quadrature uniform in
+/// (φ, cos θ) over the upper hemisphere (dω = dφ d(cos θ)).
+fn upward_irradiance(env: &Environment) -> Vec3 {
+    let m = 600;
+    let mut e = glam::DVec3::ZERO;
+    for a in 0..m {
+        for b in 0..m {
+            let cos_t = (b as f32 + 0.5) / m as f32;
+            let phi = 2.0 * std::f32::consts::PI * (a as f32 + 0.5) / m as f32;
+            let s = (1.0 - cos_t * cos_t).sqrt();
+            e += (env.eval(Vec3::new(phi.sin() * s, cos_t, -phi.cos() * s)) * cos_t).as_dvec3();
+        }
+    }
+    (e * (2.0 * std::f64::consts::PI / (m * m) as f64)).as_vec3()
+}
+
 fn settings(gather: GatherMethod, directions: GatherDirections) -> RenderSettings {
     RenderSettings {
         width: SIZE,
@@ -128,18 +144,7 @@ fn a_structured_sky_over_an_open_floor_gives_rho_e_over_pi() {
     // weights against cosine-distributed gather rays (per-pixel) and uniform ones (lists), and
     // the path tracer's own MIS, against ρ/π·E with E = ∫₊ L cos θ dω by quadrature.
     let env = gradient_sky();
-    let m = 600;
-    let mut e = glam::DVec3::ZERO;
-    for a in 0..m {
-        for b in 0..m {
-            // Upper hemisphere, uniform in (φ, cos θ): dω = dφ d(cos θ).
-            let cos_t = (b as f32 + 0.5) / m as f32;
-            let phi = 2.0 * std::f32::consts::PI * (a as f32 + 0.5) / m as f32;
-            let s = (1.0 - cos_t * cos_t).sqrt();
-            e += (env.eval(Vec3::new(phi.sin() * s, cos_t, -phi.cos() * s)) * cos_t).as_dvec3();
-        }
-    }
-    let e = (e * (2.0 * std::f64::consts::PI / (m * m) as f64)).as_vec3();
+    let e = upward_irradiance(&env);
     let expected = e * (ALBEDO / std::f32::consts::PI);
     let scene = floor(env);
     for (label, s, path) in [
@@ -196,18 +201,8 @@ fn photons_carry_the_skys_flux_to_the_floor() {
     // floor's back absorbs what comes from below). Binomial noise in the photons that hit.
     for (label, env) in [("constant", Environment::constant(Vec3::new(1.0, 0.6, 0.3))), ("structured", gradient_sky())]
     {
-        let m = 600;
-        let mut e = glam::DVec3::ZERO;
-        for a in 0..m {
-            for b in 0..m {
-                let cos_t = (b as f32 + 0.5) / m as f32;
-                let phi = 2.0 * std::f32::consts::PI * (a as f32 + 0.5) / m as f32;
-                let s = (1.0 - cos_t * cos_t).sqrt();
-                e += (env.eval(Vec3::new(phi.sin() * s, cos_t, -phi.cos() * s)) * cos_t).as_dvec3();
-            }
-        }
         let area = (2.0 * A) * (2.0 * A);
-        let expected = (e * (2.0 * std::f64::consts::PI / (m * m) as f64)).as_vec3() * area;
+        let expected = upward_irradiance(&env) * area;
         let mut scene = floor(env);
         scene.materials[0].albedo = Vec3::ZERO;
         let n = 1 << 16;

@@ -16,10 +16,12 @@ OBJ scenes are read here, not by Mitsuba (whose `obj` loader ignores MTL), the
 way rastergi reads them (crates/rastergi/src/scene/obj.rs, through tobj):
 `v`, `vn` and `f` lines (`l` lines of three or more vertices count as faces, as in
 tobj), relative (negative) indices, polygons triangulated as fans (v0, vi,
-vi+1), `mtllib` and `usemtl`; `vt`, `o`, `g`, `s` and the rest are ignored.
+vi+1), `mtllib` and `usemtl`; `vt` (read only for faces of a material with `map_d`), `o`,
+`g`, `s` and the rest are ignored.
 From the MTL, `Kd` is the diffuse reflectance (default 0.5, as for
-faces without a material) and `Ke` the emitted radiance (a single number means
-grey); albedo textures (`map_Kd`) are not reproduced (a warning says so). The
+faces without a material), `Ke` the emitted radiance (a single number means
+grey) and `d` / `map_d` the opacity (below); albedo textures (`map_Kd`) are not
+reproduced (a warning says so). The
 triangles of each material are written to a binary PLY file in a temporary
 directory and loaded as a `ply` shape, its BSDF `twosided(diffuse(Kd))` (OBJ
 surfaces reflect on both sides in rastergi) and, where Ke > 0, an `area` emitter,
@@ -27,6 +29,28 @@ which Mitsuba makes one-sided: it emits from the front face, the side the
 counter-clockwise winding faces (normal (v1-v0) x (v2-v0)), as rastergi does. The
 conventions were checked with crates/rastergi/tests/data/obj/emitter_sides.obj: a
 CCW quad facing the camera shows its Ke in both renderers, a CW one is black.
+
+Opacity (alpha-masked, "cut-out" surfaces): a material with `map_d FILE` (FILE relative to
+the .mtl; no texture options) or with `d X`, X < 1 (or, without `d`, `Tr Y`: X = 1 - Y),
+gets Mitsuba's `mask` BSDF around its twosided(diffuse(Kd)), with `opacity` a `bitmap`
+texture of FILE (`raw: True`: the stored values, no sRGB decoding; the default bilinear
+filter and repeat wrap) or the constant X; with both, the image's values times X (one
+in-memory bitmap; bilinear interpolation commutes with the factor). The image must have one
+grey channel (which channel of a colour image is the opacity is not settled here); a masked
+material may not emit (Ke), and its faces must give `vt` at every corner. The `vt` (u, v)
+of OBJ, v pointing up the image (v = 0 its bottom row), go to the PLY as (u, 1 - v):
+Mitsuba's PLY loader keeps u, v as they are and its bitmap puts v = 0 on the image's top
+row (Mitsuba's own OBJ loader flips v the same way, its `flip_tex_coords` defaulting to
+true); checked by experiment, see crates/rastergi/tests/data/README.md ("An alpha-masked
+card"). The mask is stochastic: a ray that meets the surface passes straight on, unchanged
+and uncounted as a bounce, with probability 1 - opacity, and otherwise meets the nested
+BSDF. Scenes with a masked material are rendered with `volpath` instead of `path` (printed
+as the integrator): Mitsuba's `path` traces shadow rays with scene.ray_test, for which a
+mask surface is opaque whatever its opacity (a point light would never shine through a
+hole), while `volpath`'s shadow rays cross null surfaces and take 1 - opacity as their
+transmittance there (deterministically). Without media the two integrators are otherwise
+the same estimator; scenes without masks still use `path` and give the same files as
+before.
 
 Normals: faces without normal indices (`f v` or `f v/vt`) are flat: their PLY has
 positions only and is loaded with `face_normals: True`. Faces whose every corner
@@ -109,6 +133,11 @@ takes about 1.5 minutes and a full path-traced one about 2.7 minutes:
     python3 scripts/mitsuba_reference.py --scene $D/obj/sphere_smooth.obj $SPH --seed 22 --out $D/sphere_smooth_path_128_b.exr
     python3 scripts/mitsuba_reference.py --scene $D/obj/sphere_flat.obj   $SPH --seed 23 --out $D/sphere_flat_path_128_a.exr
     python3 scripts/mitsuba_reference.py --scene $D/obj/sphere_flat.obj   $SPH --seed 24 --out $D/sphere_flat_path_128_b.exr
+    # an alpha-masked card and a 50 % veil under a point light (README.md there)
+    python3 scripts/make_alpha_card_scene.py
+    CARD="--scene $D/obj/alpha_card.obj --eye 0,2.6,2.4 --target 0,0.35,0 --up 0,1,0 --fov 45 --point 0.15,2.2,0.1,6,6,6 --width 128 --height 128 --spp 4096 --max-depth -1"
+    python3 scripts/mitsuba_reference.py $CARD --seed 31 --out $D/alpha_card_path_128_a.exr
+    python3 scripts/mitsuba_reference.py $CARD --seed 32 --out $D/alpha_card_path_128_b.exr
 
 (--chunk-spp defaults to 256; the images depend on it through the chunk seeds,
 and on the Mitsuba version and variant. Results are not bit-reproducible
@@ -294,7 +323,8 @@ def _colour(words, path, n):
 
 
 def load_mtl(path):
-    """Materials of an MTL file: name -> {"kd": [r,g,b] or None, "ke": [r,g,b] or None}."""
+    """Materials of an MTL file: name -> {"kd": [r,g,b] or None, "ke": [r,g,b] or None,
+    "d": opacity in [0, 1] or None, "map_d": absolute path of the opacity image or None}."""
     try:
         text = open(path, encoding="utf-8").read()
     except (OSError, UnicodeDecodeError) as e:
@@ -310,24 +340,51 @@ def load_mtl(path):
             name = _rest_of_line(line, 6)
             if not name:
                 raise SceneError(f"{path}: line {n}: 'newmtl' names no material")
-            current = materials[name] = {"kd": None, "ke": None}
+            current = materials[name] = {"kd": None, "ke": None, "d": None, "tr": None,
+                                         "map_d": None}
         elif words[0] in ("Kd", "Ke") and current is not None:
             current[words[0].lower()] = _colour(words, path, n)
+        elif words[0] in ("d", "Tr") and current is not None:
+            # Dissolve: the opacity, 1 solid, 0 invisible (a mask BSDF; module docstring);
+            # `Tr` is its complement, used where `d` is absent (as rastergi reads them).
+            try:
+                d = float(np.float32(words[1])) if len(words) == 2 else None
+            except ValueError:
+                d = None
+            if d is None or not (math.isfinite(d) and 0 <= d <= 1):
+                raise SceneError(f"{path}: line {n}: '{words[0]}' needs one number between 0 "
+                                 "and 1")
+            current["d" if words[0] == "d" else "tr"] = d
+        elif words[0] == "map_d" and current is not None:
+            # An opacity image, relative to the .mtl file (a mask BSDF; module docstring).
+            name = _rest_of_line(line, 5)
+            if not name:
+                raise SceneError(f"{path}: line {n}: 'map_d' names no file")
+            if name.startswith("-"):
+                raise SceneError(f"{path}: line {n}: map_d options ({name.split()[0]} ...) "
+                                 "are not supported here; give the file name alone")
+            current["map_d"] = os.path.abspath(os.path.join(os.path.dirname(path), name))
         elif words[0] == "map_Kd" and current is not None:
             # Albedo textures are not reproduced here (see the module docstring).
             print(f"warning: {path}: line {n}: map_Kd is ignored; the reference uses Kd "
                   "alone and differs from rastergi where the texture shows", file=sys.stderr)
+    for m in materials.values():
+        tr = m.pop("tr")
+        if m["d"] is None and tr is not None:
+            m["d"] = float(np.float32(1.0 - tr))
     return materials
 
 
 def load_obj(path):
     """The triangles of an OBJ file grouped by material, as rastergi loads them.
 
-    Returns a list of (material, triangles, normals): material is {"name", "kd", "ke"},
-    triangles a float32 array (n, 3, 3) of counter-clockwise corners, normals None (the
-    faces give no `vn`: face normals) or a float32 array (n, 3, 3) of the corners' unit
-    vertex normals. A material whose faces are partly with and partly without `vn` comes
-    as two entries (in the order of their first faces in the file).
+    Returns a list of (material, triangles, normals, uvs): material is {"name", "kd", "ke",
+    "d", "map_d"}, triangles a float32 array (n, 3, 3) of counter-clockwise corners, normals
+    None (the faces give no `vn`: face normals) or a float32 array (n, 3, 3) of the corners'
+    unit vertex normals, uvs None (the material has no `map_d`; `vt` is not read) or a
+    float32 array (n, 3, 2) of the corners' `vt` (u, v) as written in the file (OBJ
+    convention, v up the image). A material whose faces are partly with and partly without
+    `vn` comes as two entries (in the order of their first faces in the file).
     """
     try:
         text = open(path, encoding="utf-8").read()
@@ -337,9 +394,12 @@ def load_obj(path):
     positions = []
     normals = []  # `vn` lines: (line number, words); parsed where a face uses them
     parsed_normals = {}  # index into normals -> unit float32 normal
+    texcoords = []  # `vt` lines: (line number, words); parsed where a masked face uses them
+    parsed_texcoords = {}  # index into texcoords -> float32 (u, v)
     library = {}  # material name -> material, from the mtllib lines so far
     # (material name (None: no material), with vertex normals) -> list of corner triples,
-    # each corner (position index, normal index or None)
+    # each corner (position index, normal index or None, texture coordinate index or None;
+    # read only for materials with map_d)
     groups = {}
     current = None
 
@@ -360,6 +420,20 @@ def load_obj(path):
                                  "or not finite")
             parsed_normals[j] = (v / length).astype(np.float32)
         return parsed_normals[j]
+
+    def texcoord(j):
+        """The `vt` line j as float32 (u, v) (v 0 when absent, as tobj); an error if it is not
+        a pair of finite numbers."""
+        if j not in parsed_texcoords:
+            ln, words = texcoords[j]
+            try:
+                vals = [float(np.float32(w)) for w in words[1:]]
+            except ValueError:
+                raise SceneError(f"{path}: line {ln}: a 'vt' line does not hold numbers")
+            if not 1 <= len(vals) <= 3 or not all(math.isfinite(v) for v in vals):
+                raise SceneError(f"{path}: line {ln}: a 'vt' line needs finite numbers u [v [w]]")
+            parsed_texcoords[j] = np.array((vals + [0.0])[:2], dtype=np.float32)
+        return parsed_texcoords[j]
 
     for n, raw in enumerate(text.splitlines(), 1):
         line = raw.strip()
@@ -382,11 +456,14 @@ def load_obj(path):
             positions.append(p)
         elif key == "vn":
             normals.append((n, words))
+        elif key == "vt":
+            texcoords.append((n, words))
         elif key in ("f", "l"):
             # tobj reads `l` lines as faces too; fewer than three vertices are
             # points and lines, which rastergi ignores.
             if len(words) < 4:
                 continue
+            masked = current is not None and library[current]["map_d"] is not None
             idx = []
             for w in words[1:]:
                 parts = w.split("/")
@@ -410,8 +487,23 @@ def load_obj(path):
                     if not 0 <= j < len(normals):
                         raise SceneError(f"{path}: line {n}: a face refers to a normal "
                                          "('vn') that does not exist")
-                idx.append((i, j))
-            with_normals = [j is not None for _, j in idx]
+                t = None  # v/vt or v/vt/vn: the corner's texture coordinate (map_d only)
+                if masked:
+                    if key != "f" or len(parts) < 2 or parts[1] == "":
+                        raise SceneError(f"{path}: line {n}: faces of the material "
+                                         f"'{current}' (map_d) need texture coordinates "
+                                         "(f v/vt) at every corner")
+                    try:
+                        t = int(parts[1])
+                    except ValueError:
+                        raise SceneError(f"{path}: line {n}: a face's texture coordinate index "
+                                         f"'{parts[1]}' is not a number")
+                    t = t - 1 if t > 0 else len(texcoords) + t
+                    if not 0 <= t < len(texcoords):
+                        raise SceneError(f"{path}: line {n}: a face refers to a texture "
+                                         "coordinate ('vt') that does not exist")
+                idx.append((i, j, t))
+            with_normals = [j is not None for _, j, _ in idx]
             if any(with_normals) and not all(with_normals):
                 raise SceneError(f"{path}: line {n}: a face gives normals ('vn') for some "
                                  "of its corners only")
@@ -434,6 +526,9 @@ def load_obj(path):
     for name, m in library.items():
         kd = m["kd"] or [OBJ_DEFAULT_ALBEDO] * 3
         ke = m["ke"] or [0.0] * 3
+        if max(ke) > 0 and opacity_of(m) is not None:
+            raise SceneError(f"{path}: material '{name}' emits (Ke) and is not opaque (d or "
+                             "map_d); Mitsuba's area emitter would ignore the mask")
         if not all(math.isfinite(v) and v >= 0 for v in kd + ke):
             raise SceneError(f"{path}: material '{name}' has a negative or non-finite "
                              "albedo or emission")
@@ -447,6 +542,7 @@ def load_obj(path):
         m = library.get(name) if name is not None else None
         kd = (m or {}).get("kd") or [OBJ_DEFAULT_ALBEDO] * 3
         ke = (m or {}).get("ke") or [0.0] * 3
+        d, map_d = (m or {}).get("d"), (m or {}).get("map_d")
         label = name if m is not None else "default"
         triangles = pos[np.array([[c[0] for c in t] for t in tris], dtype=np.int64)]
         if not np.isfinite(triangles).all():
@@ -455,11 +551,27 @@ def load_obj(path):
         if smooth:
             vertex_normals = np.array([[unit_normal(c[1]) for c in t] for t in tris],
                                       dtype=np.float32).reshape(-1, 3, 3)
-        result.append(({"name": label, "kd": kd, "ke": ke}, triangles, vertex_normals))
+        uvs = None
+        if map_d is not None:
+            uvs = np.array([[texcoord(c[2]) for c in t] for t in tris],
+                           dtype=np.float32).reshape(-1, 3, 2)
+        result.append(({"name": label, "kd": kd, "ke": ke, "d": d, "map_d": map_d}, triangles,
+                       vertex_normals, uvs))
     if not result:
         raise SceneError(f"{path}: contains no faces; an OBJ scene needs at least one "
                          "triangle ('f' lines)")
     return result
+
+
+def opacity_of(material):
+    """How a material of load_mtl/load_obj is masked: None (opaque: no map_d, d absent or 1),
+    ("constant", d) or ("texture", map_d path, d factor (1 when absent))."""
+    d, map_d = material.get("d"), material.get("map_d")
+    if map_d is not None:
+        return ("texture", map_d, 1.0 if d is None else d)
+    if d is not None and d < 1:
+        return ("constant", d)
+    return None
 
 
 def bounds(groups):
@@ -495,11 +607,17 @@ def check_camera(camera):
                          f"and 180 degrees, got {camera['fov']}")
 
 
-def write_ply(path, triangles, normals=None):
+def write_ply(path, triangles, normals=None, uvs=None):
     """Triangles (n, 3, 3) as a binary PLY mesh, three vertices per triangle; with normals
-    (n, 3, 3), each vertex also carries its corner's normal (properties nx, ny, nz)."""
+    (n, 3, 3), each vertex also carries its corner's normal (properties nx, ny, nz); with uvs
+    (n, 3, 2), OBJ `vt` (v up the image), each vertex also carries its corner's texture
+    coordinates in Mitsuba's convention (properties u, v): (u, 1 - v). Mitsuba's PLY loader
+    takes u, v as they are and its bitmap texture puts v = 0 on the image's top row (row 0),
+    so OBJ's v must be flipped here, as Mitsuba's own OBJ loader does (flip_tex_coords,
+    default true); checked by experiment (crates/rastergi/tests/data/README.md)."""
     n = len(triangles)
-    props = ["x", "y", "z"] + (["nx", "ny", "nz"] if normals is not None else [])
+    props = (["x", "y", "z"] + (["nx", "ny", "nz"] if normals is not None else [])
+             + (["u", "v"] if uvs is not None else []))
     header = ("ply\nformat binary_little_endian 1.0\n"
               f"element vertex {3 * n}\n" + "".join(f"property float {p}\n" for p in props)
               + f"element face {n}\nproperty list uchar int vertex_indices\nend_header\n")
@@ -507,6 +625,10 @@ def write_ply(path, triangles, normals=None):
     if normals is not None:
         vertices = np.concatenate([vertices, np.asarray(normals, dtype="<f4").reshape(3 * n, 3)],
                                   axis=1)
+    if uvs is not None:
+        uv = np.asarray(uvs, dtype=np.float64).reshape(3 * n, 2)
+        uv = np.stack([uv[:, 0], 1.0 - uv[:, 1]], axis=1).astype("<f4")
+        vertices = np.concatenate([vertices, uv], axis=1)
     faces = np.zeros(n, dtype=[("count", "u1"), ("idx", "<i4", 3)])
     faces["count"] = 3
     faces["idx"] = np.arange(3 * n, dtype=np.int32).reshape(n, 3)
@@ -524,20 +646,65 @@ def smooth_shaded(material, normals):
     return normals is not None and not max(material["ke"]) > 0
 
 
+def opacity_texture(mi, opacity):
+    """The `opacity` of a mask BSDF for opacity_of(material) (not None): a constant, or a
+    `bitmap` texture of the map_d image read raw (its stored values, no sRGB decoding),
+    bilinear, repeating, and, where the MTL also gives `d`, multiplied by it (the image's
+    values times d, as one bitmap; bilinear interpolation commutes with the factor)."""
+    if opacity[0] == "constant":
+        return float(opacity[1])
+    _, filename, factor = opacity
+    try:
+        bitmap = mi.Bitmap(filename)
+    except Exception as e:
+        raise SceneError(f"{filename}: the opacity image (map_d) cannot be read: {e}")
+    if bitmap.pixel_format() != mi.Bitmap.PixelFormat.Y or bitmap.channel_count() != 1:
+        raise SceneError(f"{filename}: an opacity image (map_d) must have one grey channel "
+                         f"(PNG colour type 0), not {bitmap.pixel_format()}; which channel of "
+                         "a colour image is the opacity is not settled")
+    if factor == 1.0:
+        return {"type": "bitmap", "filename": filename, "raw": True}
+    values = np.array(bitmap)
+    if values.dtype.kind == "u":
+        values = values.astype(np.float64) / np.iinfo(values.dtype).max
+    values = (np.asarray(values, dtype=np.float64) * factor).astype(np.float32)
+    scaled = mi.Bitmap(values.reshape(values.shape[0], values.shape[1], 1),
+                       mi.Bitmap.PixelFormat.Y)
+    scaled.set_srgb_gamma(False)
+    return {"type": "bitmap", "bitmap": scaled, "raw": True}
+
+
+def obj_integrator(groups):
+    """`path`, or `volpath` where some material is masked (d < 1 or map_d): Mitsuba's `path`
+    traces its shadow rays with scene.ray_test, for which a mask surface is opaque whatever
+    its opacity (a point light never shines through a hole), while `volpath` multiplies a
+    shadow ray's weight by 1 - opacity at every null (mask) surface it crosses. Without media
+    the two are otherwise the same estimator (volpath does not count null crossings as
+    bounces for max_depth)."""
+    return "volpath" if any(opacity_of(g[0]) is not None for g in groups) else "path"
+
+
 def obj_scene_dict(mi, groups, camera, width, height, max_depth, spp, mesh_dir):
     """An OBJ scene (from load_obj) as a Mitsuba scene dict; meshes go to mesh_dir."""
     lo, hi = bounds(groups)
     diagonal = float(np.linalg.norm(np.maximum(hi.astype(np.float64) - lo, 0.0)))
     scene = {
         "type": "scene",
-        "integrator": {"type": "path", "max_depth": int(max_depth)},
+        "integrator": {"type": obj_integrator(groups), "max_depth": int(max_depth)},
         "sensor": sensor_dict(mi, camera, width, height, spp,
                               1e-4 * max(diagonal, 1e-3), far_clip_for(camera, lo, hi)),
     }
-    for i, (material, triangles, normals) in enumerate(groups):
+    for i, (material, triangles, normals, uvs) in enumerate(groups):
         smooth = smooth_shaded(material, normals)
         filename = os.path.join(mesh_dir, f"material_{i}.ply")
-        write_ply(filename, triangles, normals if smooth else None)
+        write_ply(filename, triangles, normals if smooth else None, uvs)
+        bsdf = {"type": "twosided",
+                "bsdf": {"type": "diffuse", "reflectance": rgb(material["kd"])}}
+        opacity = opacity_of(material)
+        if opacity is not None:
+            # Stochastic: a ray meeting the surface passes straight on with probability
+            # 1 - opacity (a null event), else it meets the nested BSDF.
+            bsdf = {"type": "mask", "opacity": opacity_texture(mi, opacity), "bsdf": bsdf}
         shape = {
             "type": "ply",
             "filename": filename,
@@ -545,8 +712,7 @@ def obj_scene_dict(mi, groups, camera, width, height, max_depth, spp, mesh_dir):
             # triangle as its shading normal. (Without nx, ny, nz in the file it would
             # compute smoothed ones itself, so face normals need True.)
             "face_normals": not smooth,
-            "bsdf": {"type": "twosided",
-                     "bsdf": {"type": "diffuse", "reflectance": rgb(material["kd"])}},
+            "bsdf": bsdf,
         }
         if max(material["ke"]) > 0:
             # One-sided: emits from the front (counter-clockwise) face only.
@@ -695,13 +861,19 @@ def load_scene(mi, args, spp):
     groups = load_obj(args.scene)
     camera = scene_camera(args, framing_camera(*bounds(groups)))
     if not args.quiet:
-        for material, triangles, normals in groups:
+        for material, triangles, normals, uvs in groups:
             kd, ke = (", ".join(f"{v:.7g}" for v in material[k]) for k in ("kd", "ke"))
             shading = ("vertex normals (vn)" if smooth_shaded(material, normals) else
                        "face normals" + (" (vn ignored: an emitter)" if normals is not None
                                          else ""))
+            opacity = opacity_of(material)
+            mask = ("" if opacity is None else
+                    f", mask opacity {opacity[1]:g}" if opacity[0] == "constant" else
+                    f", mask opacity {os.path.basename(opacity[1])}"
+                    + (f" x {opacity[2]:g}" if opacity[2] != 1 else "") + " (vt as u, 1 - v)")
             print(f"  {material['name']}: {len(triangles)} triangles, Kd ({kd}), Ke ({ke}), "
-                  f"{shading}", file=sys.stderr)
+                  f"{shading}{mask}", file=sys.stderr)
+        print(f"  integrator: {obj_integrator(groups)}", file=sys.stderr)
         print(f"  camera: eye {camera['eye']}, target {camera['target']}, up "
               f"{camera['up']}, fov {camera['fov']}", file=sys.stderr)
     with tempfile.TemporaryDirectory(prefix="rastergi-mitsuba-") as mesh_dir:

@@ -90,6 +90,22 @@ impl Bvh {
         t_max: f32,
         skip: u32,
     ) -> Option<Hit> {
+        self.intersect_where(triangles, o, d, t_min, t_max, skip, |_| true)
+    }
+
+    /// [`Bvh::intersect`] counting only the hits that `solid` accepts (the others, holes of a
+    /// cut-out or of a stochastic surface, are passed through), as `trace` in `bvh.wgsl`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn intersect_where(
+        &self,
+        triangles: &[[Vec3; 3]],
+        o: Vec3,
+        d: Vec3,
+        t_min: f32,
+        t_max: f32,
+        skip: u32,
+        solid: impl Fn(&Hit) -> bool,
+    ) -> Option<Hit> {
         let mut best: Option<Hit> = None;
         let mut t_far = t_max;
         self.traverse(o, d, t_min, &mut t_far, |i, t_far| {
@@ -100,8 +116,11 @@ impl Bvh {
                 && t > t_min
                 && t < *t_far
             {
-                *t_far = t;
-                best = Some(Hit { t, triangle: i, b1, b2 });
+                let hit = Hit { t, triangle: i, b1, b2 };
+                if solid(&hit) {
+                    *t_far = t;
+                    best = Some(hit);
+                }
             }
             false
         });

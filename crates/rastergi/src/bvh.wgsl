@@ -41,8 +41,9 @@ fn slab(n: BvhNode, o: vec3f, inv: vec3f, t_min: f32, t_max: f32) -> f32 {
     return select(-1.0, near, near <= far);
 }
 
-// Closest hit in (t_min, t_max), skipping triangles skip_a and skip_b (any_hit: stop at the
-// first). Returns tri = NO_TRIANGLE on a miss.
+// Closest hit in (t_min, t_max), skipping triangles skip_a and skip_b and the points where a
+// material lets the ray through (passes_through: cut-outs and stochastic opacity); any_hit:
+// stop at the first. Returns tri = NO_TRIANGLE on a miss.
 fn trace(o: vec3f, d: vec3f, t_min: f32, t_max: f32, skip_a: u32, skip_b: u32, any_hit: bool) -> RayHit {
     var hit = RayHit(t_max, NO_TRIANGLE, 0.0, 0.0);
     let inv = 1.0 / d;
@@ -57,8 +58,10 @@ fn trace(o: vec3f, d: vec3f, t_min: f32, t_max: f32, skip_a: u32, skip_b: u32, a
                 if i == skip_a || i == skip_b {
                     continue;
                 }
-                let r = intersect_triangle(triangles[i], o, d);
-                if r.x > t_min && r.x < hit.t {
+                let tri = triangles[i];
+                let r = intersect_triangle(tri, o, d);
+                if r.x > t_min && r.x < hit.t
+                    && ((tri.flags & TRIANGLE_HAS_HOLES) == 0u || !passes_through(i, r.y, r.z, 0.0)) {
                     hit = RayHit(r.x, i, r.y, r.z);
                     if any_hit {
                         return hit;

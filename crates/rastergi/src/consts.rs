@@ -7,8 +7,15 @@ pub const MAX_DIRECTIONS: u32 = 16;
 
 /// Material flag: the back face reflects too ([`crate::gpu_scene`]).
 pub const MATERIAL_TWO_SIDED: u32 = 1;
-/// A material without an albedo texture.
+/// Material flag: a cut-out, holes where α < the cutoff ([`crate::scene::AlphaMode::Mask`]).
+pub const MATERIAL_ALPHA_MASK: u32 = 2;
+/// Material flag: stochastic opacity α ([`crate::scene::AlphaMode::Blend`]).
+pub const MATERIAL_ALPHA_BLEND: u32 = 4;
+/// A texture slot without a texture.
 pub const NO_TEXTURE: u32 = u32::MAX;
+/// Triangle flag ([`crate::gpu_scene::GpuTriangle::flags`]): its material may have holes, so
+/// a ray that meets it asks the material whether it passes.
+pub const TRIANGLE_HAS_HOLES: u32 = 1;
 
 /// Light-table entry bit of a point, spot or distant light ([`crate::lights`]); the other
 /// bits index the punctual lights.

@@ -8,6 +8,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if any(gid.xy >= frame.resolution) {
         return;
     }
+    start_alpha_stream();
     let p = visible_point(textureLoad(gbuffer, gid.xy, 0));
     var radiance = vec3f(0.0);
     if !p.seen {

@@ -18,6 +18,11 @@ struct Frame {
 
 @group(1) @binding(0) var<uniform> frame: Frame;
 
+// Starts this iteration's stream of stochastic opacity (alpha_seed, passes_through).
+fn start_alpha_stream() {
+    alpha_seed = pcg_hash(frame.seed ^ pcg_hash(frame.iteration));
+}
+
 // The unit direction of the camera ray through the point p (in pixels, from the top-left
 // corner) of the jittered view. Clip (x, y, 0, 1) is the point at infinity in reversed-Z, so
 // the inverse view-projection maps it to the homogeneous world point (direction, 0), the same

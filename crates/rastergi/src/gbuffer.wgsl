@@ -23,9 +23,15 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> VertexOut {
 // The level of detail comes from the texture coordinates' change to the neighbouring pixels
 // (screen-space derivatives), as a fragment shader's implicit texture sampling would do. They
 // are taken of an interpolated input, not of values loaded in the fragment shader: helper
-// invocations outside the triangle may not load memory (lavapipe's read zeros).
+// invocations outside the triangle may not load memory (lavapipe's read zeros). Where the
+// material lets the eye through (a cut-out's hole, stochastic opacity), the fragment is
+// discarded and the surface behind it is seen.
 @fragment
 fn fs_main(in: VertexOut) -> @location(0) vec4u {
     let lod = texture_lod(dpdx(in.uv), dpdy(in.uv));
+    start_alpha_stream();
+    if (triangles[in.tri].flags & TRIANGLE_HAS_HOLES) != 0u && passes_through(in.tri, in.bary.x, in.bary.y, lod) {
+        discard;
+    }
     return vec4u(in.tri + 1u, bitcast<u32>(in.bary.x), bitcast<u32>(in.bary.y), bitcast<u32>(lod));
 }

@@ -3,7 +3,7 @@
 //! every pass that reads the scene (`gpu_scene.wgsl`).
 
 use bytemuck::{Pod, Zeroable};
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 
 use crate::bvh::{Bvh, BvhNode};
 use crate::error::Result;
@@ -12,7 +12,7 @@ use wgpu::util::DeviceExt;
 use crate::environment::{Environment, GpuEnvironment};
 use crate::gpu::{Gpu, storage_entry, uniform_entry};
 use crate::lights::{LightEntry, LightTable};
-use crate::scene::{Aabb, Scene};
+use crate::scene::{Aabb, AlphaMode, Material, Scene, TextureRef, UvTransform};
 use crate::textures::TextureArray;
 
 /// `Triangle` in `gpu_scene.wgsl`.
@@ -22,23 +22,74 @@ pub struct GpuTriangle {
     pub v0: [f32; 3],
     pub material: u32,
     pub v1: [f32; 3],
-    pub _pad0: u32,
+    /// [`TRIANGLE_HAS_HOLES`] where the material may let rays through.
+    pub flags: u32,
     pub v2: [f32; 3],
     pub _pad1: u32,
 }
 
-/// `Material` in `gpu_scene.wgsl`. Bit 0 of `flags`: the back face reflects too. `texture`:
-/// the layer of the albedo texture in the texture array, [`NO_TEXTURE`] for none.
+/// `TextureSlot` in `gpu_scene.wgsl`: a texture a material reads, the layer of the texture
+/// array ([`NO_TEXTURE`] for none) and the rows (`u`, `v`) of its [`UvTransform`].
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuTextureSlot {
+    pub u: [f32; 3],
+    pub layer: u32,
+    pub v: [f32; 3],
+    pub _pad: u32,
+}
+
+impl GpuTextureSlot {
+    pub fn new(slot: Option<TextureRef>) -> GpuTextureSlot {
+        let (layer, t) = slot.map_or((NO_TEXTURE, UvTransform::IDENTITY), |t| (t.texture as u32, t.transform));
+        GpuTextureSlot { u: t.0[0], layer, v: t.0[1], _pad: 0 }
+    }
+}
+
+/// `Material` in `gpu_scene.wgsl`: [`crate::scene::Material`] with its flags
+/// ([`MATERIAL_TWO_SIDED`], [`MATERIAL_ALPHA_MASK`], [`MATERIAL_ALPHA_BLEND`]).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuMaterial {
     pub albedo: [f32; 3],
     pub flags: u32,
     pub emission: [f32; 3],
-    pub texture: u32,
+    pub opacity: f32,
+    pub alpha_cutoff: f32,
+    pub normal_scale: f32,
+    pub _pad: [u32; 2],
+    pub albedo_map: GpuTextureSlot,
+    pub emission_map: GpuTextureSlot,
+    pub opacity_map: GpuTextureSlot,
+    pub normal_map: GpuTextureSlot,
 }
 
-pub use crate::consts::{MATERIAL_TWO_SIDED, NO_TEXTURE};
+impl GpuMaterial {
+    pub fn new(m: &Material) -> GpuMaterial {
+        let (alpha, alpha_cutoff) = match m.alpha_mode {
+            AlphaMode::Opaque => (0, 0.0),
+            AlphaMode::Mask { cutoff } => (MATERIAL_ALPHA_MASK, cutoff),
+            AlphaMode::Blend => (MATERIAL_ALPHA_BLEND, 0.0),
+        };
+        GpuMaterial {
+            albedo: m.albedo.into(),
+            flags: if m.two_sided { MATERIAL_TWO_SIDED } else { 0 } | alpha,
+            emission: m.emission.into(),
+            opacity: m.opacity,
+            alpha_cutoff,
+            normal_scale: m.normal_scale,
+            _pad: [0; 2],
+            albedo_map: GpuTextureSlot::new(
+                m.albedo_texture.map(|texture| TextureRef { texture, transform: m.albedo_transform }),
+            ),
+            emission_map: GpuTextureSlot::new(m.emission_texture),
+            opacity_map: GpuTextureSlot::new(m.opacity_texture),
+            normal_map: GpuTextureSlot::new(m.normal_texture),
+        }
+    }
+}
+
+pub use crate::consts::{MATERIAL_ALPHA_BLEND, MATERIAL_ALPHA_MASK, MATERIAL_TWO_SIDED, NO_TEXTURE, TRIANGLE_HAS_HOLES};
 
 /// A scene prepared for rendering: triangles permuted into BVH order, with the BVH and the
 /// light table over them and the textures as the GPU samples them. CPU twins use this
@@ -64,6 +115,9 @@ impl PreparedScene {
         if !scene.normals.is_empty() {
             scene.normals = bvh.permute(&scene.normals);
         }
+        if !scene.tangents.is_empty() {
+            scene.tangents = bvh.permute(&scene.tangents);
+        }
         let bvh = Bvh { order: (0..scene.triangles.len() as u32).collect(), ..bvh };
         let lights = LightTable::new(&scene);
         let bounds = scene.bounds();
@@ -79,18 +133,31 @@ impl PreparedScene {
         }
     }
 
-    /// The shading normal at barycentrics (b1, b2) of triangle `tri`: the corners' normals
-    /// interpolated and normalised, turned into the geometric normal's hemisphere; the
-    /// geometric normal where the triangle has none (`shading_normal` in WGSL).
+    /// The shading normal at barycentrics (b1, b2) of triangle `tri` (`shading_normal` in
+    /// WGSL): the corners' normals interpolated and normalised, turned into the geometric
+    /// normal's hemisphere (the geometric normal where the triangle has none), then perturbed
+    /// by the material's normal map, if any ([`perturb_normal`]).
     pub fn shading_normal_at(&self, tri: usize, b1: f32, b2: f32) -> Vec3 {
         let n = crate::scene::triangle_normal(&self.scene.triangles[tri]);
-        let Some(c) = self.scene.normals.get(tri) else { return n };
-        let v = c[0] * (1.0 - b1 - b2) + c[1] * b1 + c[2] * b2;
-        if v.length() < 1e-6 {
-            return n;
-        }
-        let v = v.normalize();
-        if v.dot(n) >= 0.0 { v } else { -v }
+        let interpolated = self.scene.normals.get(tri).map(|c| c[0] * (1.0 - b1 - b2) + c[1] * b1 + c[2] * b2);
+        let ns = match interpolated {
+            Some(v) if v.length() >= 1e-6 => {
+                let v = v.normalize();
+                if v.dot(n) >= 0.0 { v } else { -v }
+            }
+            _ => n,
+        };
+        let m = self.scene.material_of(tri);
+        let (Some(map), Some(t)) = (m.normal_texture, self.scene.tangents.get(tri)) else { return ns };
+        let t = t[0] * (1.0 - b1 - b2) + t[1] * b1 + t[2] * b2;
+        let texel = self.textures.sample(map.texture as u32, map.transform.apply(self.uv_at(tri, b1, b2)), 0.0);
+        perturb_normal(n, ns, t, texel, m.normal_scale)
+    }
+
+    /// A texture of the material of `tri` read at barycentrics (b1, b2) and level of detail
+    /// `lod` (linear RGBA).
+    fn texel(&self, slot: TextureRef, tri: usize, b1: f32, b2: f32, lod: f32) -> Vec4 {
+        self.textures.sample_rgba(slot.texture as u32, slot.transform.apply(self.uv_at(tri, b1, b2)), lod)
     }
 
     /// The albedo at barycentrics (b1, b2) of triangle `tri`, its texture read at level of
@@ -98,8 +165,50 @@ impl PreparedScene {
     pub fn albedo_at(&self, tri: usize, b1: f32, b2: f32, lod: f32) -> Vec3 {
         let m = self.scene.material_of(tri);
         match m.albedo_texture {
-            Some(layer) => m.albedo * self.textures.sample(layer as u32, self.uv_at(tri, b1, b2), lod),
+            Some(texture) => {
+                m.albedo * self.texel(TextureRef { texture, transform: m.albedo_transform }, tri, b1, b2, lod).truncate()
+            }
             None => m.albedo,
+        }
+    }
+
+    /// The emitted radiance at barycentrics (b1, b2) of triangle `tri` (`surface_at(…).emission`).
+    pub fn emission_at(&self, tri: usize, b1: f32, b2: f32) -> Vec3 {
+        let m = self.scene.material_of(tri);
+        match m.emission_texture {
+            Some(t) => m.emission * self.texel(t, tri, b1, b2, 0.0).truncate(),
+            None => m.emission,
+        }
+    }
+
+    /// The radiance an emitter sends from barycentrics (b1, b2) of triangle `tri` as a light
+    /// sample or a photon sees it: its emission there, nothing from a cut-out's hole, α × it
+    /// on a stochastic surface (the expectation of meeting it). `emitter_radiance` in WGSL.
+    pub fn emitter_radiance(&self, tri: usize, b1: f32, b2: f32) -> Vec3 {
+        let le = self.emission_at(tri, b1, b2);
+        match self.scene.material_of(tri).alpha_mode {
+            AlphaMode::Opaque => le,
+            AlphaMode::Mask { .. } if self.passes_through(tri, b1, b2, 0.0) => Vec3::ZERO,
+            AlphaMode::Mask { .. } => le,
+            AlphaMode::Blend => le * self.opacity_at(tri, b1, b2, 0.0),
+        }
+    }
+
+    /// The opacity α at barycentrics (b1, b2) of triangle `tri`, its texture read at `lod`
+    /// (`surface_opacity` in WGSL).
+    pub fn opacity_at(&self, tri: usize, b1: f32, b2: f32, lod: f32) -> f32 {
+        let m = self.scene.material_of(tri);
+        m.opacity * m.opacity_texture.map_or(1.0, |t| self.texel(t, tri, b1, b2, lod).w)
+    }
+
+    /// Whether a ray meeting triangle `tri` at (b1, b2) passes through it (`passes_through`
+    /// in WGSL): through a cut-out's holes (α < cutoff), through a stochastic surface when
+    /// the uniform `u` ≥ α; never through an opaque one.
+    pub fn passes_through(&self, tri: usize, b1: f32, b2: f32, u: f32) -> bool {
+        match self.scene.material_of(tri).alpha_mode {
+            AlphaMode::Opaque => false,
+            AlphaMode::Mask { cutoff } => self.opacity_at(tri, b1, b2, 0.0) < cutoff,
+            AlphaMode::Blend => u >= self.opacity_at(tri, b1, b2, 0.0),
         }
     }
 
@@ -110,6 +219,36 @@ impl PreparedScene {
         let scale = b.min.abs().max(b.max.abs()).max_element().max(b.extent().max_element());
         1e-5 * scale.max(1e-3)
     }
+}
+
+/// A shading normal `ns` (unit, on the side of the geometric normal `n`) perturbed by a
+/// normal-map texel (linear RGB c): with the tangent t (xyz interpolated, w the handedness)
+/// made orthogonal to ns, t' = normalize(t − (ns·t) ns), and the bitangent b = w · ns × t',
+/// the tangent-space normal m = (2c − 1) · (scale, scale, 1) gives
+/// normalize(m.x t' + m.y b + m.z ns), bent into n's hemisphere where it falls below the
+/// surface ([`crate::sampling::bend_towards`] towards n). Without a usable tangent ns is kept.
+/// `perturb_normal` in WGSL.
+pub fn perturb_normal(n: Vec3, ns: Vec3, t: Vec4, texel: Vec3, scale: f32) -> Vec3 {
+    let tangent = t.truncate() - ns * ns.dot(t.truncate());
+    if tangent.length_squared() < 1e-12 {
+        return ns;
+    }
+    let tangent = tangent.normalize();
+    let bitangent = ns.cross(tangent) * if t.w < 0.0 { -1.0 } else { 1.0 };
+    let m = (2.0 * texel - Vec3::ONE) * Vec3::new(scale, scale, 1.0);
+    let v = tangent * m.x + bitangent * m.y + ns * m.z;
+    if v.length_squared() < 1e-12 {
+        return ns;
+    }
+    crate::sampling::bend_towards(v.normalize(), n)
+}
+
+/// The uniform that decides whether a ray meeting triangle `tri` at (b1, b2) passes through a
+/// stochastic surface, hashed from the point and the stream's `seed` (as in `passes_through`
+/// in WGSL).
+pub fn alpha_uniform(tri: u32, b1: f32, b2: f32, seed: u32) -> f32 {
+    use crate::sampling::{pcg_hash, unit_f32};
+    unit_f32(pcg_hash(pcg_hash(pcg_hash(tri ^ seed) ^ b1.to_bits()) ^ b2.to_bits()))
 }
 
 pub struct GpuScene {
@@ -140,21 +279,12 @@ impl GpuScene {
                 v0: t[0].into(),
                 material: m,
                 v1: t[1].into(),
-                _pad0: 0,
+                flags: if s.materials[m as usize].has_holes() { TRIANGLE_HAS_HOLES } else { 0 },
                 v2: t[2].into(),
                 _pad1: 0,
             })
             .collect();
-        let materials: Vec<GpuMaterial> = s
-            .materials
-            .iter()
-            .map(|m| GpuMaterial {
-                albedo: m.albedo.into(),
-                flags: if m.two_sided { MATERIAL_TWO_SIDED } else { 0 },
-                emission: m.emission.into(),
-                texture: m.albedo_texture.map_or(NO_TEXTURE, |t| t as u32),
-            })
-            .collect();
+        let materials: Vec<GpuMaterial> = s.materials.iter().map(GpuMaterial::new).collect();
         // One triangle's worth of zeros when the scene has no texture coordinates: a binding
         // cannot be empty, and `surface_uv` clamps its index into the buffer.
         let uvs: Vec<[f32; 2]> = if s.uvs.is_empty() {
@@ -167,6 +297,12 @@ impl GpuScene {
             vec![0.0; 9]
         } else {
             s.normals.iter().flat_map(|t| t.iter().flat_map(|n| n.to_array())).collect()
+        };
+        // Twelve zeros (one triangle without tangents) when the scene has none.
+        let tangents: Vec<f32> = if s.tangents.is_empty() {
+            vec![0.0; 12]
+        } else {
+            s.tangents.iter().flat_map(|t| t.iter().flat_map(|v| v.to_array())).collect()
         };
         let (texture_view, sampler) = prepared.textures.upload(gpu);
         let lights: Vec<LightEntry> = prepared.lights.entries.clone();
@@ -197,6 +333,7 @@ impl GpuScene {
             gpu.storage_buffer("scene punctual lights", bytemuck::cast_slice(&punctual), none),
             gpu.storage_buffer("scene environment map", bytemuck::cast_slice(&env_data), none),
             gpu.storage_buffer("scene shading normals", bytemuck::cast_slice(&normals), none),
+            gpu.storage_buffer("scene tangents", bytemuck::cast_slice(&tangents), none),
         ];
         let env_uniform_buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("scene environment"),
@@ -229,7 +366,8 @@ impl GpuScene {
                     count: None,
                 },
                 storage_entry::<crate::lights::PunctualLight>(7, vis, true),
-                // The environment and the shading normals are read by compute passes only, and
+                // The environment, the shading normals and the tangents are read by compute
+                // passes only, and
                 // hidden from the raster stages: lavapipe (Mesa 22.3) silently loses fragment
                 // writes once a fragment stage sees 11 storage buffers (it reports 32): with
                 // them visible, the fragment lists' gather lost 10 % of its estimates
@@ -237,10 +375,11 @@ impl GpuScene {
                 storage_entry::<f32>(8, wgpu::ShaderStages::COMPUTE, true),
                 uniform_entry::<GpuEnvironment>(9, wgpu::ShaderStages::COMPUTE),
                 storage_entry::<[f32; 9]>(10, wgpu::ShaderStages::COMPUTE, true),
+                storage_entry::<[f32; 12]>(11, wgpu::ShaderStages::COMPUTE, true),
             ],
         });
         // The buffers' bindings, in the order of `buffers`.
-        const BUFFER_BINDINGS: [u32; 8] = [0, 1, 2, 3, 4, 7, 8, 10];
+        const BUFFER_BINDINGS: [u32; 9] = [0, 1, 2, 3, 4, 7, 8, 10, 11];
         let mut entries: Vec<wgpu::BindGroupEntry> = buffers
             .iter()
             .zip(BUFFER_BINDINGS)

@@ -1,21 +1,37 @@
 // The scene, bind group 0 of every pass that reads it (gpu_scene.rs).
 
+// flags: TRIANGLE_HAS_HOLES where the material may let rays through.
 struct Triangle {
     v0: vec3f,
     material: u32,
     v1: vec3f,
-    _pad0: u32,
+    flags: u32,
     v2: vec3f,
     _pad1: u32,
 }
 
-// Bit 0 of flags: the back face reflects too. texture: layer of the albedo texture in
-// `textures`, NO_TEXTURE for none.
+// A texture a material reads: its layer in `textures` (NO_TEXTURE for none) and the affine
+// map of the triangle's texture coordinates onto it, (dot(u, (uv, 1)), dot(v, (uv, 1))).
+struct TextureSlot {
+    u: vec3f,
+    layer: u32,
+    v: vec3f,
+    _pad: u32,
+}
+
+// flags: MATERIAL_TWO_SIDED, MATERIAL_ALPHA_MASK, MATERIAL_ALPHA_BLEND (gpu_scene.rs).
 struct Material {
     albedo: vec3f,
     flags: u32,
     emission: vec3f,
-    texture: u32,
+    opacity: f32,
+    alpha_cutoff: f32,
+    normal_scale: f32,
+    _pad: vec2u,
+    albedo_map: TextureSlot,
+    emission_map: TextureSlot,
+    opacity_map: TextureSlot,
+    normal_map: TextureSlot,
 }
 
 struct BvhNode {
@@ -62,6 +78,14 @@ struct PunctualLight {
 // Shading normals at the triangles' corners, nine floats per triangle (zero: the triangle
 // shades flat; one zero triangle when the scene has none).
 @group(0) @binding(10) var<storage, read> normals: array<f32>;
+// Tangents (xyz, handedness w) at the triangles' corners for normal maps, twelve floats per
+// triangle (zero: none; one zero triangle when the scene has none).
+@group(0) @binding(11) var<storage, read> tangents: array<f32>;
+
+// The random stream of stochastic opacity (passes_through): each entry point that finds
+// surfaces sets it from its iteration's seed, so that the holes of a semi-transparent
+// surface move from one iteration to the next.
+var<private> alpha_seed: u32 = 0u;
 
 // MATERIAL_TWO_SIDED and NO_TEXTURE: shader::constants.
 
@@ -111,10 +135,17 @@ fn surface_uv(tri: u32, b1: f32, b2: f32) -> vec2f {
     return uvs[i] * (1.0 - b1 - b2) + uvs[i + 1u] * b1 + uvs[i + 2u] * b2;
 }
 
-// The shading normal at barycentrics (b1, b2) of triangle `tri` of geometric normal n: its
-// corners' normals interpolated and normalised, turned into n's hemisphere; n where the
-// triangle has none or they cancel (PreparedScene::shading_normal_at).
-fn shading_normal(tri: u32, b1: f32, b2: f32, n: vec3f) -> vec3f {
+// The texture of slot s at the triangle's texture coordinates uv and level of detail lod.
+fn slot_sample(s: TextureSlot, uv: vec2f, lod: f32) -> vec4f {
+    let st = vec2f(dot(s.u, vec3f(uv, 1.0)), dot(s.v, vec3f(uv, 1.0)));
+    return textureSampleLevel(textures, texture_sampler, st, s.layer, lod);
+}
+
+// The shading normal at barycentrics (b1, b2) of triangle `tri` of geometric normal n and
+// material m: its corners' normals interpolated and normalised, turned into n's hemisphere (n
+// where the triangle has none or they cancel), perturbed by m's normal map
+// (PreparedScene::shading_normal_at).
+fn shading_normal(tri: u32, b1: f32, b2: f32, n: vec3f, m: Material, uv: vec2f) -> vec3f {
     let i = 9u * min(tri, arrayLength(&normals) / 9u - 1u);
     var v = vec3f(0.0);
     let w = vec3f(1.0 - b1 - b2, b1, b2);
@@ -122,11 +153,86 @@ fn shading_normal(tri: u32, b1: f32, b2: f32, n: vec3f) -> vec3f {
         v += w[k] * vec3f(normals[i + 3u * k], normals[i + 3u * k + 1u], normals[i + 3u * k + 2u]);
     }
     let len = length(v);
-    if len < 1e-6 {
-        return n;
+    var ns = n;
+    if len >= 1e-6 {
+        v /= len;
+        ns = select(-v, v, dot(v, n) >= 0.0);
     }
-    v /= len;
-    return select(-v, v, dot(v, n) >= 0.0);
+    if m.normal_map.layer == NO_TEXTURE {
+        return ns;
+    }
+    let j = 12u * min(tri, arrayLength(&tangents) / 12u - 1u);
+    var t = vec4f(0.0);
+    for (var k = 0u; k < 3u; k++) {
+        t += w[k] * vec4f(tangents[j + 4u * k], tangents[j + 4u * k + 1u], tangents[j + 4u * k + 2u],
+            tangents[j + 4u * k + 3u]);
+    }
+    return perturb_normal(n, ns, t, slot_sample(m.normal_map, uv, 0.0).rgb, m.normal_scale);
+}
+
+// gpu_scene::perturb_normal: ns perturbed by the normal-map texel c in the frame (t', b, ns).
+fn perturb_normal(n: vec3f, ns: vec3f, t: vec4f, c: vec3f, scale: f32) -> vec3f {
+    var tangent = t.xyz - ns * dot(ns, t.xyz);
+    if dot(tangent, tangent) < 1e-12 {
+        return ns;
+    }
+    tangent = normalize(tangent);
+    let bitangent = cross(ns, tangent) * select(1.0, -1.0, t.w < 0.0);
+    let m = (2.0 * c - 1.0) * vec3f(scale, scale, 1.0);
+    let v = tangent * m.x + bitangent * m.y + ns * m.z;
+    if dot(v, v) < 1e-12 {
+        return ns;
+    }
+    return bend_towards(normalize(v), n);
+}
+
+// The opacity α of material m at texture coordinates uv (PreparedScene::opacity_at).
+fn surface_opacity(m: Material, uv: vec2f, lod: f32) -> f32 {
+    var a = m.opacity;
+    if m.opacity_map.layer != NO_TEXTURE {
+        a *= slot_sample(m.opacity_map, uv, lod).a;
+    }
+    return a;
+}
+
+// Whether a ray (or a fragment) meeting triangle `tri` at barycentrics (b1, b2) passes through
+// it (PreparedScene::passes_through): through a cut-out where α < its cutoff; through a
+// stochastic surface where a uniform hashed from the point and alpha_seed is ≥ α.
+fn passes_through(tri: u32, b1: f32, b2: f32, lod: f32) -> bool {
+    let m = materials[triangles[tri].material];
+    if (m.flags & (MATERIAL_ALPHA_MASK | MATERIAL_ALPHA_BLEND)) == 0u {
+        return false;
+    }
+    let a = surface_opacity(m, surface_uv(tri, b1, b2), lod);
+    if (m.flags & MATERIAL_ALPHA_MASK) != 0u {
+        return a < m.alpha_cutoff;
+    }
+    let u = unit_f32(pcg_hash(pcg_hash(pcg_hash(tri ^ alpha_seed) ^ bitcast<u32>(b1)) ^ bitcast<u32>(b2)));
+    return u >= a;
+}
+
+// The radiance emitter triangle `tri` sends from barycentrics (b1, b2) as a light sample or a
+// photon sees it (PreparedScene::emitter_radiance): none from a cut-out's hole, α × its
+// emission on a stochastic surface.
+fn emitter_radiance(tri: u32, b1: f32, b2: f32) -> vec3f {
+    let m = materials[triangles[tri].material];
+    let uv = surface_uv(tri, b1, b2);
+    let le = surface_emission(m, uv);
+    if (m.flags & MATERIAL_ALPHA_MASK) != 0u {
+        return select(le, vec3f(0.0), surface_opacity(m, uv, 0.0) < m.alpha_cutoff);
+    }
+    if (m.flags & MATERIAL_ALPHA_BLEND) != 0u {
+        return le * surface_opacity(m, uv, 0.0);
+    }
+    return le;
+}
+
+// The emitted radiance of material m at texture coordinates uv (PreparedScene::emission_at).
+fn surface_emission(m: Material, uv: vec2f) -> vec3f {
+    if m.emission_map.layer == NO_TEXTURE {
+        return m.emission;
+    }
+    return m.emission * slot_sample(m.emission_map, uv, 0.0).rgb;
 }
 
 // A shading normal ns seen from direction v (unit, towards the viewer): unchanged where it
@@ -167,20 +273,21 @@ fn plane_barycentrics(t: Triangle, p: vec3f) -> vec2f {
 }
 
 // The surface at barycentrics (b1, b2) of triangle `tri`, its albedo texture (if any) read at
-// level of detail `lod` (PreparedScene::albedo_at).
+// level of detail `lod`, the others at level 0 (PreparedScene::albedo_at, emission_at,
+// shading_normal_at).
 fn surface_at(tri: u32, b1: f32, b2: f32, lod: f32) -> Surface {
     let t = triangles[tri];
     let m = materials[t.material];
+    let uv = surface_uv(tri, b1, b2);
     var s: Surface;
     s.pos = t.v0 * (1.0 - b1 - b2) + t.v1 * b1 + t.v2 * b2;
     s.normal = triangle_normal(t);
-    s.shading = shading_normal(tri, b1, b2, s.normal);
+    s.shading = shading_normal(tri, b1, b2, s.normal, m, uv);
     s.albedo = m.albedo;
-    if m.texture != NO_TEXTURE {
-        let uv = surface_uv(tri, b1, b2);
-        s.albedo *= textureSampleLevel(textures, texture_sampler, uv, m.texture, lod).rgb;
+    if m.albedo_map.layer != NO_TEXTURE {
+        s.albedo *= slot_sample(m.albedo_map, uv, lod).rgb;
     }
-    s.emission = m.emission;
+    s.emission = surface_emission(m, uv);
     s.flags = m.flags;
     s.tri = tri;
     return s;
@@ -403,7 +510,7 @@ fn sample_light(entry: u32, u1: f32, u2: f32) -> LightSample {
     var s: LightSample;
     s.pos = t.v0 * b.x + t.v1 * b.y + t.v2 * b.z;
     s.normal = triangle_normal(t);
-    s.radiance = materials[t.material].emission;
+    s.radiance = emitter_radiance(e.triangle, b.y, b.z);
     s.pdf_area = e.pmf / e.area;
     s.tri = e.triangle;
     return s;

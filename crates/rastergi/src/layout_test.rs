@@ -13,7 +13,7 @@ use crate::environment::GpuEnvironment;
 use crate::film::ResolveUniforms;
 use crate::frame::FrameUniforms;
 use crate::gather::GatherUniforms;
-use crate::gpu_scene::{GpuMaterial, GpuTriangle};
+use crate::gpu_scene::{GpuMaterial, GpuTextureSlot, GpuTriangle};
 use crate::lights::{LightEntry, PunctualLight};
 use crate::path_tracer::PathParams;
 use crate::photons::gpu::{PhotonGridUniforms, PhotonParams};
@@ -62,8 +62,13 @@ fn twins() -> Vec<Twin> {
             "Environment",
             [disc_centre, disc_radius, width, height, pmf, row_cdf, column_cdf, cell_pmf]
         ),
-        twin!(GpuTriangle, "Triangle", [v0, material, v1, v2]),
-        twin!(GpuMaterial, "Material", [albedo, flags, emission, texture]),
+        twin!(GpuTriangle, "Triangle", [v0, material, v1, flags, v2]),
+        twin!(GpuTextureSlot, "TextureSlot", [u, layer, v]),
+        twin!(
+            GpuMaterial,
+            "Material",
+            [albedo, flags, emission, opacity, alpha_cutoff, normal_scale, albedo_map, emission_map, opacity_map, normal_map]
+        ),
         twin!(BvhNode, "BvhNode", [min, offset, max, count]),
         twin!(LightEntry, "LightEntry", [triangle, cdf, pmf, area]),
         twin!(

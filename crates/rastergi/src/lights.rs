@@ -225,8 +225,16 @@ impl LightTable {
     /// uniform in its outer cone, I·s(cos θ)·2π(1 − cos θ_o)/pmf; a distant light's origin
     /// uniform on a disc of radius R across the bounding sphere (u1, u2) and direction uniform
     /// in its cone (u3, u4), E·πR²/pmf; the environment's direction from its distribution
-    /// (u3, u4) and origin on the disc, L(ω)·πR²/(pdf(ω)·pmf).
-    pub fn emit_photon(&self, scene: &Scene, u: [f32; 5], eps: f32) -> (Vec3, Vec3, Vec3, Option<u32>) {
+    /// (u3, u4) and origin on the disc, L(ω)·πR²/(pdf(ω)·pmf). `emitted(triangle, b1, b2)`
+    /// is the radiance a triangle emits at barycentrics (b1, b2)
+    /// ([`crate::gpu_scene::PreparedScene::emitter_radiance`]).
+    pub fn emit_photon(
+        &self,
+        scene: &Scene,
+        emitted: impl Fn(usize, f32, f32) -> Vec3,
+        u: [f32; 5],
+        eps: f32,
+    ) -> (Vec3, Vec3, Vec3, Option<u32>) {
         let e = self.pick(u[0]);
         let disc_origin = |axis: Vec3, centre: Vec3, radius: f32| {
             let (t, b) = orthonormal_basis(axis);
@@ -244,7 +252,9 @@ impl LightTable {
         if e.triangle & PUNCTUAL_LIGHT == 0 {
             let tri = &scene.triangles[e.triangle as usize];
             let n = triangle_normal(tri);
-            let le = scene.material_of(e.triangle as usize).emission;
+            let su = u[1].sqrt();
+            let (b1, b2) = (u[2] * su, su * (1.0 - u[2]));
+            let le = emitted(e.triangle as usize, b1, b2);
             let flux = le * (std::f32::consts::PI * e.area / e.pmf);
             let pos = uniform_triangle(tri, u[1], u[2]);
             return (pos + n * eps, cosine_hemisphere(n, u[3], u[4]), flux, Some(e.triangle));

@@ -74,7 +74,7 @@ fn path_radiance(origin: vec3f, dir: vec3f, xy: vec2u, rng: ptr<function, u32>) 
             break;
         }
         var lod = 0.0;
-        if bounce == 0u && materials[triangles[hit.tri].material].texture != NO_TEXTURE {
+        if bounce == 0u && materials[triangles[hit.tri].material].albedo_map.layer != NO_TEXTURE {
             lod = primary_lod(hit.tri, xy);
         }
         let s = surface_at(hit.tri, hit.b1, hit.b2, lod);
@@ -85,7 +85,7 @@ fn path_radiance(origin: vec3f, dir: vec3f, xy: vec2u, rng: ptr<function, u32>) 
         if front && any(s.emission > vec3f(0.0)) {
             var w = 1.0;
             if bsdf_pdf > 0.0 {
-                let p_light = light_pdf_area(s.emission) * hit.t * hit.t / cos_in;
+                let p_light = light_pdf_area(materials[triangles[hit.tri].material].emission) * hit.t * hit.t / cos_in;
                 w = power_heuristic(bsdf_pdf, p_light);
             }
             radiance += throughput * s.emission * w;
@@ -162,6 +162,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if any(gid.xy >= frame.resolution) {
         return;
     }
+    start_alpha_stream();
     let pixel = gid.y * frame.resolution.x + gid.x;
     var rng = rng_new(frame.seed ^ STREAM_PATH, pixel, frame.iteration);
     let radiance = path_radiance(frame.eye, camera_direction(gid.xy), gid.xy, &rng);
@@ -175,6 +176,7 @@ fn primary_hits(@builtin(global_invocation_id) gid: vec3u) {
     if any(gid.xy >= frame.resolution) {
         return;
     }
+    start_alpha_stream();
     let pixel = gid.y * frame.resolution.x + gid.x;
     let hit = trace(frame.eye, camera_direction(gid.xy), 0.0, FAR, NO_TRIANGLE, NO_TRIANGLE, false);
     var v = vec4u(0u);

@@ -28,7 +28,7 @@
 //! over many samples, and a footprint filter there would only add a bias. [`TextureArray`]
 //! holds the very texels the GPU samples, and [`TextureArray::sample`] is its twin.
 
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 
 use crate::error::{Error, Result};
 use crate::gpu::{Gpu, compute_pipeline, groups, storage_entry};
@@ -125,26 +125,28 @@ fn resample_axis(n: usize, m: usize) -> Vec<Vec<(usize, f32)>> {
         .collect()
 }
 
-/// A texture's texels in linear RGB, resampled to `dw × dh` with repeat addressing. The
-/// texels are decoded as they are read: no linear copy of a large source is made.
-fn resample(t: &Texture, dw: u32, dh: u32) -> Vec<Vec3> {
+/// A texture's texels as linear RGBA (sRGB colour decoded, linear data and alpha as c/255),
+/// resampled to `dw × dh` with repeat addressing. The texels are decoded as they are read: no
+/// linear copy of a large source is made.
+fn resample(t: &Texture, dw: u32, dh: u32) -> Vec<Vec4> {
     let (sw, sh, dw, dh) = (t.width as usize, t.height as usize, dw as usize, dh as usize);
+    let rgb = |c: u8| if t.linear { c as f32 / 255.0 } else { srgb_to_linear(c) };
     let src = |i: usize| {
         let p = t.texels[i];
-        Vec3::new(srgb_to_linear(p[0]), srgb_to_linear(p[1]), srgb_to_linear(p[2]))
+        Vec4::new(rgb(p[0]), rgb(p[1]), rgb(p[2]), p[3] as f32 / 255.0)
     };
     if (sw, sh) == (dw, dh) {
         return (0..sw * sh).map(src).collect();
     }
     let xs = resample_axis(sw, dw);
     let ys = resample_axis(sh, dh);
-    let mut rows = vec![Vec3::ZERO; dw * sh];
+    let mut rows = vec![Vec4::ZERO; dw * sh];
     for y in 0..sh {
         for (x, taps) in xs.iter().enumerate() {
             rows[y * dw + x] = taps.iter().map(|&(i, w)| src(y * sw + i) * w).sum();
         }
     }
-    let mut out = vec![Vec3::ZERO; dw * dh];
+    let mut out = vec![Vec4::ZERO; dw * dh];
     for (y, taps) in ys.iter().enumerate() {
         for x in 0..dw {
             out[y * dw + x] = taps.iter().map(|&(i, w)| rows[i * dw + x] * w).sum();
@@ -154,13 +156,13 @@ fn resample(t: &Texture, dw: u32, dh: u32) -> Vec<Vec3> {
 }
 
 /// The 2 × 2 box average of a `w × h` level (a side of 1 stays 1).
-fn downsample(src: &[Vec3], w: u32, h: u32) -> (Vec<Vec3>, u32, u32) {
+fn downsample(src: &[Vec4], w: u32, h: u32) -> (Vec<Vec4>, u32, u32) {
     let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
     let (fx, fy) = ((w / nw) as usize, (h / nh) as usize);
     let mut out = Vec::with_capacity((nw * nh) as usize);
     for y in 0..nh as usize {
         for x in 0..nw as usize {
-            let mut sum = Vec3::ZERO;
+            let mut sum = Vec4::ZERO;
             for dy in 0..fy {
                 for dx in 0..fx {
                     sum += src[(y * fy + dy) * w as usize + x * fx + dx];
@@ -172,9 +174,9 @@ fn downsample(src: &[Vec3], w: u32, h: u32) -> (Vec<Vec3>, u32, u32) {
     (out, nw, nh)
 }
 
-fn encode(level: &[Vec3]) -> impl Iterator<Item = [u16; 4]> + '_ {
+fn encode(level: &[Vec4]) -> impl Iterator<Item = [u16; 4]> + '_ {
     let h = |v: f32| half::f16::from_f32(v).to_bits();
-    level.iter().map(move |c| [h(c.x), h(c.y), h(c.z), h(1.0)])
+    level.iter().map(move |c| c.to_array().map(h))
 }
 
 impl TextureArray {
@@ -212,14 +214,19 @@ impl TextureArray {
 
     /// The linear RGB of texel (x, y) of `layer` at level `k`.
     pub fn texel(&self, k: usize, layer: u32, x: u32, y: u32) -> Vec3 {
+        self.texel_rgba(k, layer, x, y).truncate()
+    }
+
+    /// The linear RGB and alpha of texel (x, y) of `layer` at level `k`.
+    pub fn texel_rgba(&self, k: usize, layer: u32, x: u32, y: u32) -> Vec4 {
         let (w, h) = self.level_size(k);
         let p = self.levels[k][((layer * h + y) * w + x) as usize].map(|b| half::f16::from_bits(b).to_f32());
-        Vec3::new(p[0], p[1], p[2])
+        Vec4::from_array(p)
     }
 
     /// Bilinear filtering of level `k` at `uv`, repeat addressing (`textureSampleLevel` within
     /// one level).
-    fn bilinear(&self, k: usize, layer: u32, uv: Vec2) -> Vec3 {
+    fn bilinear(&self, k: usize, layer: u32, uv: Vec2) -> Vec4 {
         let (w, h) = self.level_size(k);
         let x = uv.x * w as f32 - 0.5;
         let y = uv.y * h as f32 - 0.5;
@@ -228,13 +235,18 @@ impl TextureArray {
         let wrap = |i: f32, n: u32| (i as i64).rem_euclid(n as i64) as u32;
         let (x0, x1) = (wrap(x0, w), wrap(x0 + 1.0, w));
         let (y0, y1) = (wrap(y0, h), wrap(y0 + 1.0, h));
-        let t = |x, y| self.texel(k, layer, x, y);
+        let t = |x, y| self.texel_rgba(k, layer, x, y);
         (t(x0, y0) * (1.0 - a) + t(x1, y0) * a) * (1.0 - b) + (t(x0, y1) * (1.0 - a) + t(x1, y1) * a) * b
     }
 
     /// Trilinear sample of `layer` at `uv` and level of detail `lod`: the CPU twin of
     /// `textureSampleLevel` with the array's sampler (linear filters, repeat addressing).
     pub fn sample(&self, layer: u32, uv: Vec2, lod: f32) -> Vec3 {
+        self.sample_rgba(layer, uv, lod).truncate()
+    }
+
+    /// [`TextureArray::sample`] with the alpha channel.
+    pub fn sample_rgba(&self, layer: u32, uv: Vec2, lod: f32) -> Vec4 {
         let last = self.levels.len() - 1;
         let lod = if lod.is_nan() { 0.0 } else { lod.clamp(0.0, last as f32) };
         let k = (lod.floor() as usize).min(last);
@@ -398,7 +410,7 @@ mod tests {
 
     fn texture(w: u32, h: u32, f: impl Fn(u32, u32) -> [u8; 4]) -> Texture {
         let texels = (0..h).flat_map(|y| (0..w).map(move |x| (x, y))).map(|(x, y)| f(x, y)).collect();
-        Texture { name: "t".into(), width: w, height: h, texels }
+        Texture { name: "t".into(), width: w, height: h, texels, linear: false }
     }
 
     #[test]

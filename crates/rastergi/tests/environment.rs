@@ -221,7 +221,7 @@ fn photons_carry_the_skys_flux_to_the_floor() {
         let samples = 1 << 18;
         for _ in 0..samples {
             let u = [(); 5].map(|_| rng.next_f32());
-            let (o, d, flux, _) = prepared.lights.emit_photon(&prepared.scene, u, 0.0);
+            let (o, d, flux, _) = prepared.lights.emit_photon(&prepared.scene, |_, _, _| unreachable!(), u, 0.0);
             let t = -o.y / d.y;
             let hit = o + d * t;
             let x = if d.y < 0.0 && hit.x.abs() < A && hit.z.abs() < A { flux.x as f64 } else { 0.0 };

@@ -28,7 +28,7 @@ fn texture(name: &str, w: u32, h: u32, mut f: impl FnMut(u32, u32) -> [u8; 3]) -
         let [r, g, b] = f(x, y);
         [r, g, b, 255]
     });
-    Texture { name: name.into(), width: w, height: h, texels: texels.collect() }
+    Texture { name: name.into(), width: w, height: h, texels: texels.collect(), linear: false }
 }
 
 /// The textured room, loaded from its glTF file.

@@ -14,6 +14,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if any(gid.xy >= frame.resolution) {
         return;
     }
+    start_alpha_stream();
     let p = visible_point(textureLoad(gbuffer, gid.xy, 0));
     // Both sides of the ray view serve: points below ω gather along −ω, whose nearest surface
     // is in the same texel's list (the projection along ±ω is the same).

@@ -20,6 +20,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if any(gid.xy >= frame.resolution) {
         return;
     }
+    start_alpha_stream();
     let pixel = gid.y * frame.resolution.x + gid.x;
     if found[pixel] != 0u {
         return;
@@ -78,6 +79,7 @@ fn resolve_behind(@builtin(global_invocation_id) gid: vec3u) {
     if any(gid.xy >= frame.resolution) {
         return;
     }
+    start_alpha_stream();
     let pixel = gid.y * frame.resolution.x + gid.x;
     let b = behind[pixel];
     if b.x != 0u {

@@ -20,12 +20,22 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> VertexOut {
     return out;
 }
 
+// Whether the fragment is a hole of its surface (passes_through), decided the same way in the
+// count, the peel and the lists: the stream of stochastic opacity is the direction's.
+fn is_hole(in: VertexOut) -> bool {
+    alpha_seed = pcg_hash(gather.pixel_key ^ pcg_hash(gather.first_index + gather.current));
+    return (triangles[in.tri].flags & TRIANGLE_HAS_HOLES) != 0u && passes_through(in.tri, in.bary.x, in.bary.y, 0.0);
+}
+
 // Depth complexity: fragments per texel, and their maximum over the ray view.
 @group(1) @binding(1) var<storage, read_write> counts: array<atomic<u32>>;
 @group(1) @binding(2) var<storage, read_write> max_count: atomic<u32>;
 
 @fragment
 fn fs_count(in: VertexOut) -> @location(0) vec4u {
+    if is_hole(in) {
+        discard;
+    }
     let texel = vec2u(in.clip.xy);
     let n = atomicAdd(&counts[texel.y * gather.bundle + texel.x], 1u) + 1u;
     atomicMax(&max_count, n);
@@ -37,6 +47,9 @@ fn fs_count(in: VertexOut) -> @location(0) vec4u {
 
 @fragment
 fn fs_peel(in: VertexOut) -> @location(0) vec4u {
+    if is_hole(in) {
+        discard;
+    }
     let previous = bitcast<f32>(textureLoad(previous_layer, vec2u(in.clip.xy), 0).w);
     if in.clip.z >= previous {
         discard;
@@ -53,6 +66,9 @@ fn fs_peel(in: VertexOut) -> @location(0) vec4u {
 
 @fragment
 fn fs_list(in: VertexOut) -> @location(0) vec4u {
+    if is_hole(in) {
+        discard;
+    }
     let node = atomicAdd(&node_count, 1u);
     if node < arrayLength(&nodes) {
         let texel = vec2u(in.clip.xy);

@@ -14,6 +14,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if any(gid.xy >= frame.resolution) {
         return;
     }
+    start_alpha_stream();
     let p = visible_point(textureLoad(gbuffer, gid.xy, 0));
     let pixel = gid.y * frame.resolution.x + gid.x;
     let per_pixel = gather.per_pixel != 0u;

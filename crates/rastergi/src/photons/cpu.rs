@@ -4,9 +4,9 @@
 use rayon::prelude::*;
 
 use super::{MAX_BOUNCES, PhotonSettings, STREAM_PHOTON};
-use crate::gpu_scene::PreparedScene;
+use crate::gpu_scene::{PreparedScene, alpha_uniform};
 use crate::photons::map::{GridSpec, MapLayout, PhotonMap};
-use crate::sampling::{Rng, bend_towards, cosine_hemisphere};
+use crate::sampling::{Rng, bend_towards, cosine_hemisphere, pcg_hash};
 use crate::scene::triangle_normal;
 
 /// Flux deposited per slot, with the squares and counts used for noise estimates.
@@ -81,14 +81,20 @@ fn trace_photon(
 ) {
     let scene = &prepared.scene;
     let eps = prepared.ray_epsilon();
+    let alpha_seed = pcg_hash(settings.seed ^ STREAM_PHOTON ^ pcg_hash(pass));
     let mut rng = Rng::new(settings.seed ^ STREAM_PHOTON, index, pass);
     let u = [(); 5].map(|_| rng.next_f32());
-    let (mut origin, mut dir, flux, emitter) = prepared.lights.emit_photon(scene, u, eps);
+    let (mut origin, mut dir, flux, emitter) = prepared.lights.emit_photon(scene, |t, b1, b2| prepared.emitter_radiance(t, b1, b2), u, eps);
     let mut flux = flux / settings.count as f32;
     let mut skip = emitter.unwrap_or(u32::MAX);
     let first_deposit = settings.indirect_only as u32;
     for bounce in 0..MAX_BOUNCES {
-        let Some(hit) = prepared.bvh.intersect(&scene.triangles, origin, dir, eps, f32::INFINITY, skip) else {
+        let solid = |h: &crate::bvh::Hit| {
+            let u = alpha_uniform(h.triangle, h.b1, h.b2, alpha_seed);
+            !prepared.passes_through(h.triangle as usize, h.b1, h.b2, u)
+        };
+        let Some(hit) = prepared.bvh.intersect_where(&scene.triangles, origin, dir, eps, f32::INFINITY, skip, solid)
+        else {
             break;
         };
         let tri = &scene.triangles[hit.triangle as usize];

@@ -113,6 +113,8 @@ fn trace_photons(@builtin(global_invocation_id) gid: vec3u) {
     if local >= params.batch_size {
         return;
     }
+    // Stochastic opacity, per pass (passes_through hashes the hit point with it).
+    alpha_seed = pcg_hash(params.seed ^ STREAM_PHOTON ^ pcg_hash(params.pass_index));
     var rng = rng_new(params.seed ^ STREAM_PHOTON, params.first_photon + local, params.pass_index);
     let u0 = rng_f32(&rng);
     let u1 = rng_f32(&rng);

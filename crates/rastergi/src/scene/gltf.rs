@@ -9,14 +9,22 @@
 //!   determinant mirrors the mesh, so its triangles' corners are swapped to keep the front.
 //!   `NORMAL` gives the shading normals (through the inverse transpose of the transform);
 //!   primitives without it, or with one that cannot be read (quantized, non-finite), shade
-//!   flat (the latter with a warning). Other attributes (COLOR_0, JOINTS, WEIGHTS, more UV
-//!   sets) are not read.
-//! - **Materials** (Lambertian only): albedo = baseColorFactor.rgb × baseColorTexture (sRGB,
-//!   read at the TEXCOORD set the texture names); emitted radiance = emissiveFactor ×
-//!   KHR_materials_emissive_strength (× the emissive texture's mean colour, with a warning:
-//!   emission is constant per material); `doubleSided` → two-sided reflection (glTF's default
-//!   is one-sided). Metal, roughness, alpha, normal maps and texture transforms are ignored.
-//!   Primitives without a material get a grey albedo of 0.5 like OBJ faces without one.
+//!   flat (the latter with a warning). `TANGENT` where a normal map needs it. Other attributes
+//!   (COLOR_0, JOINTS, WEIGHTS, more UV sets) are not read.
+//! - **Materials** (Lambertian only): albedo = baseColorFactor.rgb × baseColorTexture (sRGB);
+//!   emitted radiance = emissiveFactor × KHR_materials_emissive_strength × emissiveTexture
+//!   (sRGB, per texel); `doubleSided` → two-sided reflection (glTF's default is one-sided).
+//!   `alphaMode` MASK (a cut-out at `alphaCutoff`, default 0.5) and BLEND (stochastic
+//!   opacity, [`super::AlphaMode::Blend`]) with α = baseColorFactor.a × the base texture's
+//!   alpha; OPAQUE ignores α. `normalTexture` (linear, with its `scale`) in the frame of the
+//!   primitive's `TANGENT`s, or of MikkTSpace tangents (the `mikktspace` crate, fed v flipped
+//!   to v up so that the bitangent points up the image, glTF's +Y) where it has none.
+//!   `KHR_texture_transform` on every texture (offset, rotation, scale; uv' = T·R·S·uv with
+//!   R = [[cos r, sin r], [−sin r, cos r]], as the extension's worked example needs). One
+//!   TEXCOORD set per primitive: the base colour texture's (else the emissive's, else the
+//!   normal map's); textures naming another set read it with a warning. Metal and roughness
+//!   are ignored. Primitives without a material get a grey albedo of 0.5 like OBJ faces
+//!   without one.
 //! - **Lights** (`KHR_lights_punctual`): point, spot and directional lights placed by their
 //!   node (position: the node's origin; direction: its local −Z), `color` × `intensity` read
 //!   1:1 as radiometric — W/sr for point and spot lights, W/m² on a surface facing a
@@ -43,15 +51,16 @@ use ::gltf::accessor::{DataType, Dimensions};
 use ::gltf::mesh::Mode;
 use ::gltf::{Document, Semantic};
 use base64::Engine as _;
-use glam::{Mat4, Quat, Vec2, Vec3};
+use glam::{Mat4, Quat, Vec2, Vec3, Vec4};
 
-use super::{Camera, Light, Material, Scene, Texture};
+use super::{AlphaMode, Camera, Light, Material, Scene, Texture, TextureRef, UvTransform};
 use crate::error::{Error, Result};
 
 /// Most triangles a glTF scene may expand to (instances included).
 pub const MAX_TRIANGLES: u64 = 1 << 25;
 /// glTF extensions that a file may require.
-const SUPPORTED_REQUIRED: &[&str] = &["KHR_materials_emissive_strength", "KHR_lights_punctual"];
+const SUPPORTED_REQUIRED: &[&str] =
+    &["KHR_materials_emissive_strength", "KHR_lights_punctual", "KHR_texture_transform"];
 const DEFAULT_ALBEDO: f32 = 0.5;
 
 /// Choices made when loading a glTF file.
@@ -106,6 +115,7 @@ fn load(path: &Path, bytes: &[u8], options: &GltfOptions) -> Res<Scene> {
         scene: Scene::new(placeholder_camera()),
         materials: HashMap::new(),
         textures: HashMap::new(),
+        warned_sets: false,
         camera: None,
         warned_sampler: false,
     };
@@ -343,6 +353,8 @@ struct Primitive {
     uvs: Option<Vec<[Vec2; 3]>>,
     /// The corners' NORMALs in the mesh's space, where the primitive has them.
     normals: Option<Vec<[Vec3; 3]>>,
+    /// The corners' tangents in the mesh's space, where its material has a normal map.
+    tangents: Option<Vec<[Vec4; 3]>>,
     material: u32,
 }
 
@@ -354,10 +366,12 @@ struct Loader<'a> {
     /// glTF material index (None: the default material) → scene material.
     materials: HashMap<Option<usize>, u32>,
     /// glTF image index → scene texture.
-    textures: HashMap<usize, usize>,
+    /// Scene textures by (image, read as linear data).
+    textures: HashMap<(usize, bool), usize>,
     /// The camera chosen, once found.
     camera: Option<Camera>,
     warned_sampler: bool,
+    warned_sets: bool,
 }
 
 /// A name for an element in messages: `mesh 3 ('Chair')`.
@@ -460,8 +474,17 @@ impl<'a> Loader<'a> {
                 let mut tri = t.map(|v| world.transform_point3(v));
                 let mut uv = p.uvs.as_ref().map(|uvs| uvs[k]);
                 let mut normals = p.normals.as_ref().map(|n| n[k].map(|v| normal_matrix * v));
+                // Tangents follow the surface (the transform itself); a mirror flips the
+                // handedness: (M n) × (M t) = det M · M(n × t) for orthogonal M.
+                let handedness = if mirrored { -1.0 } else { 1.0 };
+                let mut tangents = p.tangents.as_ref().map(|t| {
+                    t[k].map(|v| (glam::Mat3::from_mat4(world) * v.truncate()).extend(v.w * handedness))
+                });
                 if mirrored {
                     tri.swap(1, 2);
+                    if let Some(t) = &mut tangents {
+                        t.swap(1, 2);
+                    }
                     if let Some(uv) = &mut uv {
                         uv.swap(1, 2);
                     }
@@ -475,6 +498,9 @@ impl<'a> Loader<'a> {
                 }
                 if let Some(n) = normals {
                     self.scene.set_last_normals(n);
+                }
+                if let Some(t) = tangents {
+                    self.scene.set_last_tangents(t);
                 }
             }
         }
@@ -608,7 +634,11 @@ impl<'a> Loader<'a> {
             return Ok(None);
         }
         let material = self.material(&p.material())?;
-        let tex_coord_set = p.material().pbr_metallic_roughness().base_color_texture().map(|t| t.tex_coord());
+        let sets = texture_sets(&p.material());
+        let tex_coord_set = sets.first().copied();
+        if sets.iter().any(|&s| Some(s) != tex_coord_set) && !std::mem::replace(&mut self.warned_sets, true) {
+            log::warn!("{what}: its material's textures name different TEXCOORD sets; all read TEXCOORD_{}", sets[0]);
+        }
         let positions = self.positions(p, &what)?;
         let vertices: Vec<Vec3> = (0..positions.count)
             .map(|i| Vec3::new(positions.float(i, 0), positions.float(i, 1), positions.float(i, 2)))
@@ -632,12 +662,12 @@ impl<'a> Loader<'a> {
                 .collect(),
             _ => (1..indices.len().saturating_sub(1)).map(|i| [indices[i], indices[i + 1], indices[0]]).collect(),
         };
-        let triangles = corners.iter().map(|c| c.map(|i| vertices[i as usize])).collect();
-        let uvs = match tex_coord_set {
+        let triangles: Vec<[Vec3; 3]> = corners.iter().map(|c| c.map(|i| vertices[i as usize])).collect();
+        let uvs: Option<Vec<[Vec2; 3]>> = match tex_coord_set {
             Some(set) => {
                 let accessor = p
                     .get(&Semantic::TexCoords(set))
-                    .ok_or_else(|| format!("{what} has a base colour texture but no TEXCOORD_{set} attribute"))?;
+                    .ok_or_else(|| format!("{what} has a texture but no TEXCOORD_{set} attribute"))?;
                 let types = [DataType::F32, DataType::U8, DataType::U16];
                 let e = self.elements(&accessor, &format!("{what} TEXCOORD_{set}"), &types, Dimensions::Vec2)?;
                 if e.data_type != DataType::F32 && !e.normalized {
@@ -660,7 +690,7 @@ impl<'a> Loader<'a> {
         };
         // Normals rastergi cannot read (quantized, sparse, the wrong count, non-finite) make
         // the primitive shade flat, with a warning: the geometry is still right.
-        let normals = p.get(&Semantic::Normals).and_then(|accessor| {
+        let normals: Option<Vec<[Vec3; 3]>> = p.get(&Semantic::Normals).and_then(|accessor| {
             let read = || -> Res<Vec<Vec3>> {
                 let e = self.elements(&accessor, &format!("{what} NORMAL"), &[DataType::F32], Dimensions::Vec3)?;
                 if e.count != vertices.len() {
@@ -681,7 +711,46 @@ impl<'a> Loader<'a> {
                 }
             }
         });
-        Ok(Some(Primitive { triangles, uvs, normals, material }))
+        let tangents = match (p.material().normal_texture(), &uvs) {
+            (Some(_), Some(uvs)) => Some(self.tangents(p, &what, &corners, &triangles, uvs, normals.as_deref())),
+            _ => None,
+        };
+        Ok(Some(Primitive { triangles, uvs, normals, tangents, material }))
+    }
+
+    /// The corners' tangents of a primitive with a normal map: its TANGENT attribute, or
+    /// MikkTSpace's from its positions, normals (the faces' where it has none) and texture
+    /// coordinates when it has none or one that cannot be read (with a warning).
+    fn tangents(
+        &self,
+        p: &::gltf::Primitive,
+        what: &str,
+        corners: &[[u32; 3]],
+        triangles: &[[Vec3; 3]],
+        uvs: &[[Vec2; 3]],
+        normals: Option<&[[Vec3; 3]]>,
+    ) -> Vec<[Vec4; 3]> {
+        if let Some(accessor) = p.get(&Semantic::Tangents) {
+            let read = || -> Res<Vec<[Vec4; 3]>> {
+                let e = self.elements(&accessor, &format!("{what} TANGENT"), &[DataType::F32], Dimensions::Vec4)?;
+                let count = corners.iter().flatten().max().map_or(0, |&i| i as usize + 1);
+                if e.count < count {
+                    return Err(format!("{what} TANGENT has {} elements for {count} vertices", e.count));
+                }
+                let t: Vec<Vec4> = (0..e.count)
+                    .map(|i| Vec4::new(e.float(i, 0), e.float(i, 1), e.float(i, 2), e.float(i, 3)))
+                    .collect();
+                match t.iter().position(|v| !v.is_finite()) {
+                    Some(i) => Err(format!("{what}: vertex {i} has a non-finite TANGENT")),
+                    None => Ok(corners.iter().map(|c| c.map(|i| t[i as usize])).collect()),
+                }
+            };
+            match read() {
+                Ok(t) => return t,
+                Err(e) => log::warn!("{e}; MikkTSpace tangents are used instead"),
+            }
+        }
+        super::tangents::mikktspace(triangles, uvs, normals)
     }
 
     /// The scene material of a glTF material, created on first use.
@@ -694,27 +763,49 @@ impl<'a> Loader<'a> {
             Some(index) => {
                 let what = named("material", index, m.name());
                 let pbr = m.pbr_metallic_roughness();
-                let albedo_texture = match pbr.base_color_texture() {
-                    Some(info) => Some(self.texture(&info.texture()).map_err(|e| format!("{what}: {e}"))?),
-                    None => None,
+                let mut texture = |info: Option<(::gltf::Texture, UvTransform)>, linear: bool| match info {
+                    Some((t, transform)) => self
+                        .texture(&t, linear)
+                        .map(|texture| Some(TextureRef { texture, transform }))
+                        .map_err(|e| format!("{what}: {e}")),
+                    None => Ok(None),
                 };
-                let mut emission = Vec3::from(m.emissive_factor()) * m.emissive_strength().unwrap_or(1.0);
-                if let Some(info) = m.emissive_texture()
-                    && emission.max_element() > 0.0
+                let base = texture(pbr.base_color_texture().map(|i| (i.texture(), info_transform(&i))), false)?;
+                let emission = Vec3::from(m.emissive_factor()) * m.emissive_strength().unwrap_or(1.0);
+                let emissive = m.emissive_texture().filter(|_| emission.max_element() > 0.0);
+                let emission_texture = texture(emissive.map(|i| (i.texture(), info_transform(&i))), false)?;
+                let normal = m.normal_texture();
+                let normal_scale = normal.as_ref().map_or(1.0, |n| n.scale());
+                let normal_texture = texture(normal.map(|n| (n.texture(), normal_transform(&n))), true)?;
+                let alpha_mode = match m.alpha_mode() {
+                    ::gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
+                    ::gltf::material::AlphaMode::Mask => AlphaMode::Mask { cutoff: m.alpha_cutoff().unwrap_or(0.5) },
+                    ::gltf::material::AlphaMode::Blend => AlphaMode::Blend,
+                };
+                if let AlphaMode::Mask { cutoff } = alpha_mode
+                    && !(cutoff.is_finite() && cutoff >= 0.0)
                 {
-                    let t = self.texture(&info.texture()).map_err(|e| format!("{what}: {e}"))?;
-                    let mean = mean_colour(&self.scene.textures[t]);
-                    log::warn!(
-                        "{what}: its emissive texture is replaced by its mean colour {mean} (emission is constant per material)"
-                    );
-                    emission *= mean;
+                    return Err(format!("{what}: alphaCutoff {cutoff} is not a non-negative number"));
+                }
+                let opacity = pbr.base_color_factor()[3];
+                if !(0.0..=1.0).contains(&opacity) {
+                    return Err(format!("{what}: baseColorFactor's alpha {opacity} is outside [0, 1]"));
                 }
                 Material {
-                    name: m.name().map_or_else(|| format!("material {index}"), str::to_owned),
-                    albedo: Vec3::from_slice(&pbr.base_color_factor()[..3]),
-                    albedo_texture,
+                    albedo_texture: base.map(|t| t.texture),
+                    albedo_transform: base.map_or(UvTransform::IDENTITY, |t| t.transform),
                     emission,
+                    emission_texture,
+                    opacity,
+                    opacity_texture: base.filter(|_| alpha_mode != AlphaMode::Opaque),
+                    alpha_mode,
+                    normal_texture,
+                    normal_scale,
                     two_sided: m.double_sided(),
+                    ..Material::diffuse(
+                        &m.name().map_or_else(|| format!("material {index}"), str::to_owned),
+                        Vec3::from_slice(&pbr.base_color_factor()[..3]),
+                    )
                 }
             }
         };
@@ -723,8 +814,9 @@ impl<'a> Loader<'a> {
         Ok(id)
     }
 
-    /// The scene texture of a glTF texture's image, decoded on first use.
-    fn texture(&mut self, texture: &::gltf::Texture) -> Res<usize> {
+    /// The scene texture of a glTF texture's image (sRGB colour, or `linear` data), decoded on
+    /// first use.
+    fn texture(&mut self, texture: &::gltf::Texture, linear: bool) -> Res<usize> {
         let sampler = texture.sampler();
         use ::gltf::texture::WrappingMode::Repeat;
         if (sampler.wrap_s() != Repeat || sampler.wrap_t() != Repeat)
@@ -733,7 +825,7 @@ impl<'a> Loader<'a> {
             log::warn!("textures are always sampled with repeat addressing; clamped and mirrored samplers are ignored");
         }
         let image = texture.source();
-        if let Some(&t) = self.textures.get(&image.index()) {
+        if let Some(&t) = self.textures.get(&(image.index(), linear)) {
             return Ok(t);
         }
         let what = named("image", image.index(), image.name());
@@ -748,8 +840,8 @@ impl<'a> Loader<'a> {
         };
         let name = image.name().map_or_else(|| format!("image {}", image.index()), str::to_owned);
         let decoded = Texture::decode(&name, &bytes).map_err(|e| format!("{what} {e}"))?;
-        let t = self.scene.add_texture(decoded);
-        self.textures.insert(image.index(), t);
+        let t = self.scene.add_texture(if linear { decoded.into_linear() } else { decoded });
+        self.textures.insert((image.index(), linear), t);
         Ok(t)
     }
 }
@@ -800,10 +892,39 @@ fn camera_from(world: Mat4, yfov: f32) -> Res<Camera> {
 }
 
 /// The mean linear colour of a texture.
-fn mean_colour(t: &Texture) -> Vec3 {
-    let sum: Vec3 =
-        t.texels.iter().map(|p| Vec3::from_array([0, 1, 2].map(|c| crate::textures::srgb_to_linear(p[c])))).sum();
-    sum / t.texels.len().max(1) as f32
+/// KHR_texture_transform's affine map, T(offset) · R(rotation) · S(scale): (u, v) ↦
+/// (c·sx·u + s·sy·v + ox, −s·sx·u + c·sy·v + oy) with c, s the rotation's cosine and sine.
+pub fn texture_transform(offset: [f32; 2], rotation: f32, scale: [f32; 2]) -> UvTransform {
+    let (s, c) = rotation.sin_cos();
+    UvTransform([[c * scale[0], s * scale[1], offset[0]], [-s * scale[0], c * scale[1], offset[1]]])
+}
+
+fn info_transform(info: &::gltf::texture::Info) -> UvTransform {
+    info.texture_transform().map_or(UvTransform::IDENTITY, |t| texture_transform(t.offset(), t.rotation(), t.scale()))
+}
+
+/// The normal texture's KHR_texture_transform (the `gltf` crate leaves it unparsed there).
+fn normal_transform(n: &::gltf::material::NormalTexture) -> UvTransform {
+    parsed_normal_transform(n).map_or(UvTransform::IDENTITY, |t| texture_transform(t.offset.0, t.rotation.0, t.scale.0))
+}
+
+fn parsed_normal_transform(
+    n: &::gltf::material::NormalTexture,
+) -> Option<::gltf::json::extensions::texture::TextureTransform> {
+    let value = n.extension_value("KHR_texture_transform")?;
+    ::gltf::json::deserialize::from_value(value.clone())
+        .map_err(|e| log::warn!("a normal texture's KHR_texture_transform is not valid ({e}); it is ignored"))
+        .ok()
+}
+
+/// The TEXCOORD sets a material's textures read (base colour, emissive, normal map), each
+/// overridden by its KHR_texture_transform's texCoord.
+fn texture_sets(m: &::gltf::Material) -> Vec<u32> {
+    let info = |i: ::gltf::texture::Info| i.texture_transform().and_then(|t| t.tex_coord()).unwrap_or(i.tex_coord());
+    let base = m.pbr_metallic_roughness().base_color_texture().map(info);
+    let emissive = m.emissive_texture().map(info);
+    let normal = m.normal_texture().map(|n| parsed_normal_transform(&n).and_then(|t| t.tex_coord).unwrap_or(n.tex_coord()));
+    base.into_iter().chain(emissive).chain(normal).collect()
 }
 
 #[cfg(test)]

@@ -13,14 +13,16 @@ pub mod export;
 pub mod generate;
 mod gltf;
 mod obj;
+mod tangents;
 mod texture;
 
 pub use cornell::cornell_box;
 pub use gltf::{GltfOptions, load_gltf, load_gltf_with};
 pub use obj::load_obj;
 pub use texture::{MAX_DECODED_SIDE, Texture};
+pub use tangents::mikktspace;
 
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 
 use crate::error::{Error, Result};
 
@@ -28,28 +30,129 @@ use crate::error::{Error, Result};
 /// WebGPU device supports.
 pub const MAX_TEXTURES: usize = 256;
 
-/// A Lambertian material with optional one-sided emission.
+/// An affine map of texture coordinates, (u', v') = (a·u + b·v + c, d·u + e·v + f), stored as
+/// its two rows `[[a, b, c], [d, e, f]]`: a texture's placement (glTF `KHR_texture_transform`,
+/// MTL `-o`/`-s`), in the scene's convention (v down the image).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UvTransform(pub [[f32; 3]; 2]);
+
+impl UvTransform {
+    pub const IDENTITY: UvTransform = UvTransform([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
+
+    pub fn apply(&self, uv: Vec2) -> Vec2 {
+        let [r, s] = self.0;
+        Vec2::new(r[0] * uv.x + r[1] * uv.y + r[2], s[0] * uv.x + s[1] * uv.y + s[2])
+    }
+
+    /// `self` after `first`: uv ↦ self(first(uv)).
+    pub fn after(&self, first: &UvTransform) -> UvTransform {
+        let ([a, b, c], [d, e, f]) = (self.0[0], self.0[1]);
+        let ([p, q, r], [s, t, w]) = (first.0[0], first.0[1]);
+        UvTransform([
+            [a * p + b * s, a * q + b * t, a * r + b * w + c],
+            [d * p + e * s, d * q + e * t, d * r + e * w + f],
+        ])
+    }
+
+    pub fn is_finite(&self) -> bool {
+        self.0.iter().flatten().all(|x| x.is_finite())
+    }
+}
+
+impl Default for UvTransform {
+    fn default() -> Self {
+        Self::IDENTITY
+    }
+}
+
+/// A texture as a material reads it: an index into [`Scene::textures`] and the placement of
+/// the triangle's texture coordinates on it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TextureRef {
+    pub texture: usize,
+    pub transform: UvTransform,
+}
+
+impl TextureRef {
+    pub fn new(texture: usize) -> TextureRef {
+        TextureRef { texture, transform: UvTransform::IDENTITY }
+    }
+}
+
+/// How a material's opacity α (its factor × its texture's alpha) cuts the surface.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum AlphaMode {
+    /// α is ignored: the surface is everywhere.
+    Opaque,
+    /// A cut-out: the surface is where α ≥ the cutoff, a hole elsewhere (glTF MASK).
+    Mask { cutoff: f32 },
+    /// Stochastic opacity (glTF BLEND, OBJ `d`/`map_d`): each ray, camera sample and photon
+    /// meets the surface with probability α and passes through it otherwise, so every image is
+    /// α × the surface + (1 − α) × what lies behind, in expectation (without sorting).
+    Blend,
+}
+
+/// A Lambertian material with optional one-sided emission, opacity and a normal map.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
     pub name: String,
     /// Diffuse albedo ρ in linear RGB; the BRDF is ρ/π. With a texture, ρ = albedo × texel.
     pub albedo: Vec3,
     /// Index into [`Scene::textures`] of an albedo texture (sRGB, decoded to linear), read at
-    /// the triangle's texture coordinates ([`Scene::uvs`]).
+    /// the triangle's texture coordinates ([`Scene::uvs`]) placed by `albedo_transform`.
     pub albedo_texture: Option<usize>,
-    /// Radiance emitted from the front face, linear RGB.
+    pub albedo_transform: UvTransform,
+    /// Radiance emitted from the front face, linear RGB; with a texture, Le = emission × texel.
     pub emission: Vec3,
+    pub emission_texture: Option<TextureRef>,
+    /// Opacity α = `opacity` × the alpha channel of `opacity_texture` (if any), used as
+    /// `alpha_mode` says.
+    pub opacity: f32,
+    pub opacity_texture: Option<TextureRef>,
+    pub alpha_mode: AlphaMode,
+    /// A tangent-space normal map (linear RGB, glTF's convention: n = (2c − 1) scaled by
+    /// (scale, scale, 1) in the frame (tangent, bitangent, shading normal)).
+    pub normal_texture: Option<TextureRef>,
+    pub normal_scale: f32,
     /// Whether the back face reflects too (it never emits).
     pub two_sided: bool,
 }
 
 impl Material {
     pub fn diffuse(name: &str, albedo: Vec3) -> Self {
-        Self { name: name.to_owned(), albedo, albedo_texture: None, emission: Vec3::ZERO, two_sided: false }
+        Self {
+            name: name.to_owned(),
+            albedo,
+            albedo_texture: None,
+            albedo_transform: UvTransform::IDENTITY,
+            emission: Vec3::ZERO,
+            emission_texture: None,
+            opacity: 1.0,
+            opacity_texture: None,
+            alpha_mode: AlphaMode::Opaque,
+            normal_texture: None,
+            normal_scale: 1.0,
+            two_sided: false,
+        }
     }
 
     pub fn is_emitter(&self) -> bool {
         self.emission.max_element() > 0.0
+    }
+
+    /// Whether some of the surface may let rays through.
+    pub fn has_holes(&self) -> bool {
+        match self.alpha_mode {
+            AlphaMode::Opaque => false,
+            AlphaMode::Mask { cutoff } => cutoff > 0.0 && (self.opacity < cutoff || self.opacity_texture.is_some()),
+            AlphaMode::Blend => self.opacity < 1.0 || self.opacity_texture.is_some(),
+        }
+    }
+
+    /// The textures the material reads.
+    pub fn texture_refs(&self) -> impl Iterator<Item = TextureRef> + '_ {
+        let albedo = self.albedo_texture.map(|texture| TextureRef { texture, transform: self.albedo_transform });
+        albedo.into_iter().chain(self.emission_texture).chain(self.opacity_texture).chain(self.normal_texture)
     }
 }
 
@@ -207,7 +310,11 @@ pub struct Scene {
     /// `triangles`: empty when no triangle has any, else one entry per triangle (zero where a
     /// triangle has none: it shades with its geometric normal).
     pub normals: Vec<[Vec3; 3]>,
-    /// Albedo textures, referred to by [`Material::albedo_texture`].
+    /// Tangents at the triangles' corners for normal maps (glTF TANGENT, or MikkTSpace's): xyz
+    /// a unit tangent along increasing u, w = ±1 the handedness (bitangent = w · n × t, glTF's
+    /// convention); empty or one entry per triangle like `normals` (zero: none).
+    pub tangents: Vec<[Vec4; 3]>,
+    /// Textures, referred to by the materials.
     pub textures: Vec<Texture>,
     pub camera: Camera,
 }
@@ -222,6 +329,7 @@ impl Scene {
             materials: Vec::new(),
             uvs: Vec::new(),
             normals: Vec::new(),
+            tangents: Vec::new(),
             textures: Vec::new(),
             camera,
         }
@@ -242,6 +350,16 @@ impl Scene {
         if !self.normals.is_empty() {
             self.normals.push([Vec3::ZERO; 3]);
         }
+        if !self.tangents.is_empty() {
+            self.tangents.push([Vec4::ZERO; 3]);
+        }
+    }
+
+    /// Gives the last triangle added the tangents `t` at its corners (see [`Scene::tangents`]).
+    pub fn set_last_tangents(&mut self, t: [Vec4; 3]) {
+        let count = self.triangles.len();
+        self.tangents.resize(count, [Vec4::ZERO; 3]);
+        self.tangents[count - 1] = t;
     }
 
     /// Adds a triangle with texture coordinates `uv` at its corners.
@@ -330,6 +448,12 @@ impl Scene {
         if !self.normals.is_empty() && self.normals.len() != self.triangles.len() {
             return Err(Error::InvalidScene("shading normals must be given for every triangle or none".into()));
         }
+        if !self.tangents.is_empty() && self.tangents.len() != self.triangles.len() {
+            return Err(Error::InvalidScene("tangents must be given for every triangle or none".into()));
+        }
+        if let Some(i) = self.tangents.iter().position(|t| !t.iter().all(|v| v.is_finite())) {
+            return Err(Error::InvalidScene(format!("triangle {i} has a non-finite tangent")));
+        }
         if self.textures.len() > MAX_TEXTURES {
             return Err(Error::InvalidScene(format!(
                 "the scene has {} textures, more than the {MAX_TEXTURES} supported",
@@ -350,11 +474,25 @@ impl Scene {
                     m.name
                 )));
             }
-            if let Some(t) = m.albedo_texture.filter(|&t| t >= self.textures.len()) {
+            if let Some(t) = m.texture_refs().find(|t| t.texture >= self.textures.len()) {
                 return Err(Error::InvalidScene(format!(
-                    "material '{}' refers to texture {t}, but the scene has {}",
+                    "material '{}' refers to texture {}, but the scene has {}",
                     m.name,
+                    t.texture,
                     self.textures.len()
+                )));
+            }
+            if !m.texture_refs().all(|t| t.transform.is_finite()) || !m.albedo_transform.is_finite() {
+                return Err(Error::InvalidScene(format!("material '{}' has a non-finite texture transform", m.name)));
+            }
+            let cutoff_ok = match m.alpha_mode {
+                AlphaMode::Mask { cutoff } => cutoff.is_finite() && cutoff >= 0.0,
+                _ => true,
+            };
+            if !(0.0..=1.0).contains(&m.opacity) || !cutoff_ok || !m.normal_scale.is_finite() {
+                return Err(Error::InvalidScene(format!(
+                    "material '{}' has an opacity outside [0, 1], a negative alpha cutoff or a non-finite normal scale",
+                    m.name
                 )));
             }
             if m.albedo.max_element() > 1.0 {

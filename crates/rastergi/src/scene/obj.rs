@@ -7,8 +7,12 @@
 //!
 //! A material's `map_Kd` image (PNG or JPEG, found relative to its .mtl file) multiplies its
 //! `Kd` (1 when `Kd` is absent), read at the faces' `vt` coordinates; OBJ's v points up the
-//! image, so v is flipped into the scene's convention (v down). Texture options (`-o`, `-s`,
-//! …) are skipped with a warning.
+//! image, so v is flipped into the scene's convention (v down). `map_Ke` likewise multiplies
+//! `Ke` (1 when absent), per texel. Opacity: `d` (or 1 − `Tr`) times `map_d`'s alpha channel
+//! (its first channel when the image has no transparent texel: a grey mask), as stochastic
+//! opacity ([`super::AlphaMode::Blend`], Mitsuba's `mask`). The texture options `-o u v` and
+//! `-s u v` place the image (uv' = s·uv + o in OBJ's coordinates); the others (`-bm`,
+//! `-blendu`, `-clamp`, `-colorspace`, `-type` …) are skipped with a warning.
 //!
 //! Faces whose corners name `vn` normals (`f v//vn`, `f v/vt/vn`) shade with them, interpolated
 //! (normalised as read); a model whose faces do not all have them shades flat. Smoothing
@@ -20,7 +24,7 @@ use std::path::{Path, PathBuf};
 
 use glam::{Vec2, Vec3};
 
-use super::{Material, Scene, Texture};
+use super::{Material, Scene, Texture, TextureRef, UvTransform};
 use crate::error::{Error, Result};
 
 const DEFAULT_ALBEDO: f32 = 0.5;
@@ -52,7 +56,7 @@ pub fn load_obj(path: &Path) -> Result<Scene> {
             ),
         ));
     }
-    let textured = materials.iter().any(|m| m.diffuse_texture.is_some());
+    let textured = materials.iter().any(|m| TEXTURE_KEYS.iter().any(|&key| map_file(m, key).is_some()));
     let mut text = text_of(path)?;
     // Normals that faces refer to out of range are not used (the faces shade flat).
     let smooth = has_keyword(&text, b"vn")
@@ -76,26 +80,54 @@ pub fn load_obj(path: &Path) -> Result<Scene> {
     }
 
     let mut scene = Scene::new(super::Camera { eye: Vec3::Z, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 45.0 });
-    let mut texture_of_file: HashMap<PathBuf, usize> = HashMap::new();
+    // Each image once as colour and once as an opacity mask, however many materials use it.
+    let mut texture_of_file: HashMap<(PathBuf, bool), usize> = HashMap::new();
     for m in &materials {
-        let albedo_texture = match &m.diffuse_texture {
-            Some(file) => Some(match texture_of_file.get(Path::new(file)) {
-                Some(&t) => t,
-                None => {
-                    let texture = read_texture(Path::new(file)).map_err(|e| {
-                        file_error(path, format!("the texture {file} (map_Kd of material '{}') {e}", m.name))
-                    })?;
-                    let t = scene.add_texture(texture);
-                    texture_of_file.insert(PathBuf::from(file), t);
-                    t
-                }
-            }),
-            None => None,
+        let mut texture = |key: &str, opacity: bool| -> Result<Option<TextureRef>> {
+            let Some(file) = map_file(m, key) else { return Ok(None) };
+            let transform = map_transform(m, key);
+            let file = PathBuf::from(file);
+            if let Some(&t) = texture_of_file.get(&(file.clone(), opacity)) {
+                return Ok(Some(TextureRef { texture: t, transform }));
+            }
+            let mut texture = read_texture(&file).map_err(|e| {
+                file_error(path, format!("the texture {} ({key} of material '{}') {e}", file.display(), m.name))
+            })?;
+            if opacity && !texture.has_alpha() {
+                // A grey mask: its first channel is the opacity.
+                texture.texels.iter_mut().for_each(|t| t[3] = t[0]);
+                texture.name += " (opacity)";
+            }
+            let t = scene.add_texture(texture);
+            texture_of_file.insert((file, opacity), t);
+            Ok(Some(TextureRef { texture: t, transform }))
         };
-        let default_albedo = if albedo_texture.is_some() { 1.0 } else { DEFAULT_ALBEDO };
+        let albedo_map = texture("map_Kd", false)?;
+        let emission_texture = texture("map_Ke", false)?;
+        let opacity_texture = texture("map_d", true)?;
+        let default_albedo = if albedo_map.is_some() { 1.0 } else { DEFAULT_ALBEDO };
         let albedo = m.diffuse.map(Vec3::from).unwrap_or(Vec3::splat(default_albedo));
-        let emission = m.emissive.map(Vec3::from).unwrap_or(Vec3::ZERO);
-        scene.add_material(Material { name: m.name.clone(), albedo, albedo_texture, emission, two_sided: true });
+        let default_emission = if emission_texture.is_some() { 1.0 } else { 0.0 };
+        let emission = m.emissive.map(Vec3::from).unwrap_or(Vec3::splat(default_emission));
+        let transparency = m.unknown_param.get("Tr").and_then(|t| t.trim().parse::<f32>().ok());
+        let mut opacity = m.dissolve.or(transparency.map(|t| 1.0 - t)).unwrap_or(1.0);
+        if !(0.0..=1.0).contains(&opacity) {
+            log::warn!("{}: material '{}' has an opacity d = {opacity} outside [0, 1]; clamped", path.display(), m.name);
+            opacity = if opacity.is_nan() { 1.0 } else { opacity.clamp(0.0, 1.0) };
+        }
+        let alpha_mode =
+            if opacity < 1.0 || opacity_texture.is_some() { super::AlphaMode::Blend } else { super::AlphaMode::Opaque };
+        scene.add_material(Material {
+            albedo_texture: albedo_map.map(|t| t.texture),
+            albedo_transform: albedo_map.map_or(UvTransform::IDENTITY, |t| t.transform),
+            emission,
+            emission_texture,
+            opacity,
+            opacity_texture,
+            alpha_mode,
+            two_sided: true,
+            ..Material::diffuse(&m.name, albedo)
+        });
     }
     let mut default_material = None;
     for model in &models {
@@ -112,7 +144,7 @@ pub fn load_obj(path: &Path) -> Result<Scene> {
         let vertex_count = mesh.positions.len() / 3;
         // tobj gives texture coordinates per vertex only when every vertex of the model has one.
         let has_uvs = !mesh.texcoords.is_empty() && mesh.texcoords.len() / 2 == vertex_count;
-        let needs_uvs = scene.materials[material as usize].albedo_texture.is_some();
+        let needs_uvs = scene.materials[material as usize].texture_refs().next().is_some();
         if needs_uvs && !has_uvs {
             return Err(file_error(
                 path,
@@ -249,10 +281,44 @@ fn check_references(text: &[u8], keyword: &str, slot: usize, what: &str) -> Resu
     Ok(())
 }
 
-/// The file name of a `map_Kd` statement's value, after its options (`-o u v w`, `-s …`,
-/// `-clamp on`, …), which are skipped.
-fn texture_file_name(value: &str) -> std::result::Result<&str, String> {
+/// The MTL statements that name a texture rastergi reads.
+const TEXTURE_KEYS: [&str; 3] = ["map_Kd", "map_Ke", "map_d"];
+
+/// The value of a tobj material's texture statement `key`.
+fn map_value<'a>(m: &'a tobj::Material, key: &str) -> Option<&'a String> {
+    match key {
+        "map_Kd" => m.diffuse_texture.as_ref(),
+        "map_d" => m.dissolve_texture.as_ref(),
+        _ => m.unknown_param.get(key),
+    }
+}
+
+/// The file a texture statement names, once [`load_mtl`] resolved it.
+fn map_file<'a>(m: &'a tobj::Material, key: &str) -> Option<&'a String> {
+    m.unknown_param.get(&format!("{key} file"))
+}
+
+/// The texture transform of statement `key` as [`load_mtl`] recorded it.
+fn map_transform(m: &tobj::Material, key: &str) -> UvTransform {
+    let values: Vec<f32> = m
+        .unknown_param
+        .get(&format!("{key} transform"))
+        .map(|t| t.split_whitespace().filter_map(|w| w.parse().ok()).collect())
+        .unwrap_or_default();
+    match values.as_slice() {
+        &[a, b, c, d, e, f] => UvTransform([[a, b, c], [d, e, f]]),
+        _ => UvTransform::IDENTITY,
+    }
+}
+
+/// A texture statement's value (`map_Kd`, `map_d`, `map_Ke`): its file name after the options,
+/// and the placement its `-o` (offset) and `-s` (scale) options give: uv' = s·uv + o in OBJ's
+/// texture coordinates (v up), written in the scene's (v down) as
+/// (u, v) ↦ (s_u u + o_u, s_v v + 1 − s_v − o_v). The other options (`-clamp on`, `-bm`, and
+/// those exporters invent) are skipped with their values and a warning.
+fn texture_statement(key: &str, value: &str) -> std::result::Result<(String, UvTransform), String> {
     let mut rest = value.trim();
+    let (mut offset, mut scale) = ([0.0f32; 2], [1.0f32; 2]);
     while rest.starts_with('-') {
         let (option, after) = rest.split_once(char::is_whitespace).unwrap_or((rest, ""));
         // Unknown options (exporters invent some) are skipped with the numbers after them.
@@ -265,22 +331,38 @@ fn texture_file_name(value: &str) -> std::result::Result<&str, String> {
         };
         rest = after.trim_start();
         // The required values are taken as they come, the optional ones only if numbers.
+        let mut values = Vec::new();
         for k in 0..max {
             let (word, after) = rest.split_once(char::is_whitespace).unwrap_or((rest, ""));
             if word.is_empty() || (k >= min && word.parse::<f32>().is_err()) {
                 if k < min {
-                    return Err(format!("map_Kd option '{option}' lacks its value"));
+                    return Err(format!("{key} option '{option}' lacks its value"));
                 }
                 break;
             }
+            values.push(word);
             rest = after.trim_start();
         }
-        log::warn!("map_Kd option '{option}' is not supported and is ignored");
+        if option == "-o" || option == "-s" {
+            let numbers: Vec<f32> = values.iter().map(|w| w.parse::<f32>()).collect::<std::result::Result<_, _>>()
+                .ok()
+                .filter(|v: &Vec<f32>| v.iter().all(|x| x.is_finite()))
+                .ok_or_else(|| format!("{key} option '{option}' needs numbers, got '{}'", values.join(" ")))?;
+            // -o u [v [w]], -s u [v [w]]: v defaults to 0 (offset) or 1 (scale); w is unused.
+            let target = if option == "-o" { &mut offset } else { &mut scale };
+            target[0] = numbers[0];
+            if let Some(&v) = numbers.get(1) {
+                target[1] = v;
+            }
+        } else {
+            log::warn!("{key} option '{option}' is not supported and is ignored");
+        }
     }
     if rest.is_empty() {
-        return Err("map_Kd names no file".into());
+        return Err(format!("{key} names no file"));
     }
-    Ok(rest)
+    let transform = UvTransform([[scale[0], 0.0, offset[0]], [0.0, scale[1], 1.0 - scale[1] - offset[1]]]);
+    Ok((rest.to_owned(), transform))
 }
 
 /// What is wrong with an OBJ file tobj refused, where, and what to do about it.
@@ -438,13 +520,18 @@ fn load_mtl(obj: &Path, name: &Path, error: &RefCell<Option<String>>) -> tobj::M
     }
     let (mut materials, names) =
         tobj::load_mtl_buf(&mut completed.as_bytes()).or_else(|e| fail(format!("not a valid MTL file ({e})"), e))?;
-    // Texture files are named relative to the MTL file.
+    // Texture files are named relative to the MTL file: each statement's resolved file and
+    // placement are recorded beside it (map_file, map_transform).
     for m in &mut materials {
-        if let Some(value) = &m.diffuse_texture {
-            match texture_file_name(value) {
-                Ok(file) => {
+        for key in TEXTURE_KEYS {
+            let Some(value) = map_value(m, key) else { continue };
+            match texture_statement(key, value) {
+                Ok((file, t)) => {
                     let resolved = mtl_path.parent().unwrap_or(Path::new("")).join(file);
-                    m.diffuse_texture = Some(resolved.to_string_lossy().into_owned());
+                    m.unknown_param.insert(format!("{key} file"), resolved.to_string_lossy().into_owned());
+                    let [r, s] = t.0;
+                    let numbers = format!("{} {} {} {} {} {}", r[0], r[1], r[2], s[0], s[1], s[2]);
+                    m.unknown_param.insert(format!("{key} transform"), numbers);
                 }
                 Err(message) => {
                     return fail(format!("material '{}': {message}", m.name), tobj::LoadError::MaterialParseError);
@@ -457,16 +544,38 @@ fn load_mtl(obj: &Path, name: &Path, error: &RefCell<Option<String>>) -> tobj::M
 
 #[cfg(test)]
 mod tests {
-    use super::texture_file_name;
+    use super::UvTransform;
+    use glam::Vec2;
+
+    fn texture_file_name(value: &str) -> Result<String, String> {
+        super::texture_statement("map_Kd", value).map(|(file, _)| file)
+    }
 
     #[test]
     fn texture_options_are_skipped_and_unknown_ones_do_not_refuse_the_file() {
-        assert_eq!(texture_file_name("tex.png"), Ok("tex.png"));
-        assert_eq!(texture_file_name("-o 0.5 0.5 -s 2 2 1 -bm 0.3 tex.png"), Ok("tex.png"));
+        assert_eq!(texture_file_name("tex.png"), Ok("tex.png".into()));
+        assert_eq!(texture_file_name("-o 0.5 0.5 -s 2 2 1 -bm 0.3 tex.png"), Ok("tex.png".into()));
         // Options exporters write that MTL does not define: skipped with their values.
-        assert_eq!(texture_file_name("-colorspace sRGB -type sphere tex.png"), Ok("tex.png"));
-        assert_eq!(texture_file_name("-invented 1 2 3 tex.png"), Ok("tex.png"));
+        assert_eq!(texture_file_name("-colorspace sRGB -type sphere tex.png"), Ok("tex.png".into()));
+        assert_eq!(texture_file_name("-invented 1 2 3 tex.png"), Ok("tex.png".into()));
         assert!(texture_file_name("-bm").unwrap_err().contains("lacks its value"));
         assert!(texture_file_name("-s 1 1").unwrap_err().contains("names no file"));
+        assert_eq!(super::texture_statement("map_Kd", "tex.png").unwrap().1, UvTransform::IDENTITY);
+    }
+
+    #[test]
+    fn offset_and_scale_place_the_texture_in_obj_coordinates() {
+        // -s 2 4 -o 0.25 0.5: OBJ (u, v) ↦ (2u + 0.25, 4v + 0.5); the scene's v is 1 − OBJ's
+        // on both sides of the map.
+        let (_, t) = super::texture_statement("map_Kd", "-s 2 4 1 -o 0.25 0.5 0 tex.png").unwrap();
+        for (u, v) in [(0.0, 0.0), (0.3, 0.7), (1.0, 0.2)] {
+            let obj = Vec2::new(2.0 * u + 0.25, 4.0 * v + 0.5);
+            let expected = Vec2::new(obj.x, 1.0 - obj.y);
+            assert!((t.apply(Vec2::new(u, 1.0 - v)) - expected).length() < 1e-6, "{u} {v}");
+        }
+        // One value: the u scale alone (v keeps 1), the u offset alone (v keeps 0).
+        let (_, t) = super::texture_statement("map_Kd", "-s 3 -o 0.5 tex.png").unwrap();
+        assert_eq!(t, UvTransform([[3.0, 0.0, 0.5], [0.0, 1.0, 0.0]]));
+        assert!(super::texture_statement("map_Kd", "-s 1 nan tex.png").is_err());
     }
 }

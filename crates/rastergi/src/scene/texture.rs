@@ -1,5 +1,6 @@
-//! Albedo textures as a scene holds them: decoded images, 8 bits per channel, sRGB-encoded
-//! colour (what PNG and JPEG base-colour images store). Resampling, mip maps and sampling are
+//! Textures as a scene holds them: decoded images, 8 bits per channel, sRGB-encoded colour
+//! (what PNG and JPEG base-colour and emissive images store) or linear data (normal maps), and
+//! a linear alpha channel (opacity). Resampling, mip maps and sampling are
 //! the renderer's business ([`crate::textures`]).
 
 use std::io::Cursor;
@@ -12,7 +13,7 @@ pub const MAX_DECODED_SIDE: u32 = 8192;
 /// Largest allocation the image decoder may make for one image (8192² texels of 16-bit RGBA).
 const MAX_DECODE_BYTES: u64 = 512 << 20;
 
-/// An image used as an albedo texture. Texture coordinates (u, v) address it with u to the
+/// An image used as a texture. Texture coordinates (u, v) address it with u to the
 /// right and v down the image, (0, 0) the top-left corner of the first row (glTF's and
 /// WebGPU's convention), repeating outside [0, 1].
 #[derive(Clone, Debug, PartialEq)]
@@ -20,8 +21,11 @@ pub struct Texture {
     pub name: String,
     pub width: u32,
     pub height: u32,
-    /// Row by row from the top: sRGB-encoded red, green, blue and a linear alpha (unused).
+    /// Row by row from the top: red, green, blue (sRGB-encoded unless `linear`) and a linear
+    /// alpha (255 where the image has none).
     pub texels: Vec<[u8; 4]>,
+    /// The red, green and blue codes are linear values c/255 (normal maps), not sRGB colour.
+    pub linear: bool,
 }
 
 impl Texture {
@@ -45,7 +49,7 @@ impl Texture {
             return Err("is an empty image".into());
         }
         let texels = rgba.pixels().map(|p| p.0).collect();
-        Ok(Texture { name: name.to_owned(), width, height, texels })
+        Ok(Texture { name: name.to_owned(), width, height, texels, linear: false })
     }
 
     /// Reads and decodes an image file; errors say what is wrong without naming the file.
@@ -53,6 +57,16 @@ impl Texture {
         let bytes = std::fs::read(path).map_err(|e| format!("cannot be read ({e})"))?;
         let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
         Texture::decode(&name, &bytes)
+    }
+
+    /// The same image read as linear data (a normal map).
+    pub fn into_linear(self) -> Texture {
+        Texture { linear: true, ..self }
+    }
+
+    /// Whether some texel is not fully opaque.
+    pub fn has_alpha(&self) -> bool {
+        self.texels.iter().any(|t| t[3] < 255)
     }
 
     /// Checks the texel count against the size.

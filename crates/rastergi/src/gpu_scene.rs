@@ -89,7 +89,9 @@ impl GpuMaterial {
     }
 }
 
-pub use crate::consts::{MATERIAL_ALPHA_BLEND, MATERIAL_ALPHA_MASK, MATERIAL_TWO_SIDED, NO_TEXTURE, TRIANGLE_HAS_HOLES};
+pub use crate::consts::{
+    MATERIAL_ALPHA_BLEND, MATERIAL_ALPHA_MASK, MATERIAL_TWO_SIDED, NO_TEXTURE, TRIANGLE_HAS_HOLES,
+};
 
 /// A scene prepared for rendering: triangles permuted into BVH order, with the BVH and the
 /// light table over them and the textures as the GPU samples them. CPU twins use this
@@ -166,7 +168,8 @@ impl PreparedScene {
         let m = self.scene.material_of(tri);
         match m.albedo_texture {
             Some(texture) => {
-                m.albedo * self.texel(TextureRef { texture, transform: m.albedo_transform }, tri, b1, b2, lod).truncate()
+                m.albedo
+                    * self.texel(TextureRef { texture, transform: m.albedo_transform }, tri, b1, b2, lod).truncate()
             }
             None => m.albedo,
         }

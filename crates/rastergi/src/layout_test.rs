@@ -67,7 +67,18 @@ fn twins() -> Vec<Twin> {
         twin!(
             GpuMaterial,
             "Material",
-            [albedo, flags, emission, opacity, alpha_cutoff, normal_scale, albedo_map, emission_map, opacity_map, normal_map]
+            [
+                albedo,
+                flags,
+                emission,
+                opacity,
+                alpha_cutoff,
+                normal_scale,
+                albedo_map,
+                emission_map,
+                opacity_map,
+                normal_map
+            ]
         ),
         twin!(BvhNode, "BvhNode", [min, offset, max, count]),
         twin!(LightEntry, "LightEntry", [triangle, cdf, pmf, area]),

@@ -7,7 +7,9 @@
 //! half floats (`rgba16float`, filterable everywhere): the sRGB decoding happens here, exactly,
 //! so the GPU filters the very values the CPU twin reads (hardware sRGB decoding is only
 //! approximately specified: lavapipe's is off by up to 0.7 %), and 11 significant bits keep
-//! more precision than 8-bit sRGB at every level.
+//! more precision than 8-bit sRGB at every level. The alpha channel (opacity) is linear, c/255,
+//! and so are the RGB of textures holding data rather than colour (normal maps,
+//! [`Texture::linear`]).
 //! W and H are the largest texture's sides rounded up to powers of two, at most
 //! [`MAX_SIDE`], halved (the longer one first) until the whole chain fits [`BUDGET_BYTES`].
 //! Resampling happens in linear RGB with a tent filter as wide as the larger of one source

@@ -4,7 +4,10 @@
 //!   side's orientation bin and its plane's offset. Photons deposit their flux Φ in the slot of
 //!   the cell they land in and the plane of the side they land on; the slot's area A is the
 //!   part of the scene's surfaces with that plane key inside the cell (triangles clipped to
-//!   the cell). Irradiance of a slot: E = Φ / A.
+//!   the cell). Irradiance of a slot: E = Φ / A. Where the surface has holes (cut-outs,
+//!   stochastic opacity), photons stop only with the probability c(x) that it is there
+//!   ([`Scene::coverage_at`]), so A = ∫ c dA over the piece ([`mean_coverage`]): the holes
+//!   would otherwise dilute the irradiance of what is solid.
 //! * **Orientation bins** ([`orientation_bin`]): the cube face of the dominant axis and sign
 //!   of the side's normal, each face divided 3 × 3 by the other two coordinates over the
 //!   dominant one, 54 bins in all; axis-aligned normals lie at the centre of a bin, and normals
@@ -165,6 +168,44 @@ pub struct MapLayout {
     pub separators: Separators,
 }
 
+/// The mean coverage ([`Scene::coverage_at`]) of triangle `tri` over the convex polygon
+/// `piece` of its plane: 16 stratified points in each triangle of the polygon's fan, weighted
+/// by area.
+pub fn mean_coverage(scene: &Scene, tri: usize, piece: &[DVec3]) -> f64 {
+    let t = scene.triangles[tri].map(|p| p.as_dvec3());
+    let (e1, e2) = (t[1] - t[0], t[2] - t[0]);
+    let (d11, d12, d22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+    let det = d11 * d22 - d12 * d12;
+    if det <= 0.0 || piece.len() < 3 {
+        return 1.0;
+    }
+    let (mut sum, mut total) = (0.0, 0.0);
+    for k in 1..piece.len() - 1 {
+        let (a, b, c) = (piece[0], piece[k], piece[k + 1]);
+        let w = (b - a).cross(c - a).length();
+        if w <= 0.0 {
+            continue;
+        }
+        let mut mean = 0.0;
+        for i in 0..4 {
+            for j in 0..4 {
+                // Uniform on the sub-triangle: (√u1, u2) warped, stratified 4 × 4.
+                let su = ((i as f64 + 0.5) / 4.0).sqrt();
+                let v = (j as f64 + 0.5) / 4.0;
+                let p = a * (1.0 - su) + b * (su * (1.0 - v)) + c * (su * v);
+                let d = p - t[0];
+                let (p1, p2) = (d.dot(e1), d.dot(e2));
+                let b1 = (d22 * p1 - d12 * p2) / det;
+                let b2 = (d11 * p2 - d12 * p1) / det;
+                mean += scene.coverage_at(tri, b1 as f32, b2 as f32) as f64 / 16.0;
+            }
+        }
+        sum += w * mean;
+        total += w;
+    }
+    if total > 0.0 { sum / total } else { 1.0 }
+}
+
 impl MapLayout {
     /// The layout of `scene` over `grid`: every triangle clipped to every cell its bounding
     /// box overlaps, its area added to the slot of each side that reflects light (the front
@@ -179,6 +220,7 @@ impl MapLayout {
                 continue;
             }
             let sides: &[bool] = if scene.material_of(i).two_sided { &[false, true] } else { &[false] };
+            let holed = scene.material_of(i).has_holes();
             let poly: Vec<DVec3> = t.iter().map(|p| p.as_dvec3()).collect();
             let lo = grid.cell_of(t[0].min(t[1]).min(t[2]));
             let hi = grid.cell_of(t[0].max(t[1]).max(t[2]));
@@ -189,7 +231,8 @@ impl MapLayout {
                         let c = UVec3::new(x, y, z);
                         let min = grid.origin.as_dvec3() + c.as_dvec3() * grid.cell as f64;
                         let piece = clip_to_box(&poly, min, min + DVec3::splat(grid.cell as f64));
-                        let area = polygon_area(&piece);
+                        let coverage = if holed { mean_coverage(scene, i, &piece) } else { 1.0 };
+                        let area = polygon_area(&piece) * coverage;
                         if area > 0.0 {
                             for &back in sides {
                                 let side = if back { -n } else { n };
@@ -198,6 +241,7 @@ impl MapLayout {
                                     plane: (side, side.dot(poly[0])),
                                     poly: piece.clone(),
                                     area,
+                                    coverage,
                                 });
                             }
                         }
@@ -231,7 +275,7 @@ impl MapLayout {
                         for (k, &(n, d)) in separators.iter().enumerate() {
                             piece = clip_to_half_space(&piece, n, d, region >> k & 1 == 1);
                         }
-                        area += polygon_area(&piece);
+                        area += polygon_area(&piece) * f.coverage;
                     }
                     // Regions that only rounding creates (where two cuts nearly meet) get no slot.
                     if area > 1e-9 * own.iter().map(|f| f.area).sum::<f64>() {

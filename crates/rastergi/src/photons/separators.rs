@@ -14,7 +14,10 @@ pub(crate) struct Fragment {
     /// Its plane, (n, d) with n·x = d on it, n the side's normal.
     pub(crate) plane: (DVec3, f64),
     pub(crate) poly: Vec<DVec3>,
+    /// Its area, weighted by its surface's mean coverage (see `MapLayout::new`).
     pub(crate) area: f64,
+    /// The mean coverage of its surface over it (1 where the material has no holes).
+    pub(crate) coverage: f64,
 }
 
 /// A separator plane (n, d), n unit: a point x lies on its negative side where n·x − d < 0.

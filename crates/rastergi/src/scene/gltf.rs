@@ -477,9 +477,10 @@ impl<'a> Loader<'a> {
                 // Tangents follow the surface (the transform itself); a mirror flips the
                 // handedness: (M n) × (M t) = det M · M(n × t) for orthogonal M.
                 let handedness = if mirrored { -1.0 } else { 1.0 };
-                let mut tangents = p.tangents.as_ref().map(|t| {
-                    t[k].map(|v| (glam::Mat3::from_mat4(world) * v.truncate()).extend(v.w * handedness))
-                });
+                let mut tangents = p
+                    .tangents
+                    .as_ref()
+                    .map(|t| t[k].map(|v| (glam::Mat3::from_mat4(world) * v.truncate()).extend(v.w * handedness)));
                 if mirrored {
                     tri.swap(1, 2);
                     if let Some(t) = &mut tangents {
@@ -923,7 +924,8 @@ fn texture_sets(m: &::gltf::Material) -> Vec<u32> {
     let info = |i: ::gltf::texture::Info| i.texture_transform().and_then(|t| t.tex_coord()).unwrap_or(i.tex_coord());
     let base = m.pbr_metallic_roughness().base_color_texture().map(info);
     let emissive = m.emissive_texture().map(info);
-    let normal = m.normal_texture().map(|n| parsed_normal_transform(&n).and_then(|t| t.tex_coord).unwrap_or(n.tex_coord()));
+    let normal =
+        m.normal_texture().map(|n| parsed_normal_transform(&n).and_then(|t| t.tex_coord).unwrap_or(n.tex_coord()));
     base.into_iter().chain(emissive).chain(normal).collect()
 }
 

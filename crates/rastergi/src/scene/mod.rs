@@ -19,8 +19,8 @@ mod texture;
 pub use cornell::cornell_box;
 pub use gltf::{GltfOptions, load_gltf, load_gltf_with};
 pub use obj::load_obj;
-pub use texture::{MAX_DECODED_SIDE, Texture};
 pub use tangents::mikktspace;
+pub use texture::{MAX_DECODED_SIDE, Texture};
 
 use glam::{Vec2, Vec3, Vec4};
 
@@ -402,6 +402,27 @@ impl Scene {
 
     pub fn material_of(&self, tri: usize) -> &Material {
         &self.materials[self.material_ids[tri] as usize]
+    }
+
+    /// The fraction of triangle `tri`'s surface that is there at barycentrics (b1, b2): 1 where
+    /// it is opaque, 0 or 1 on a cut-out (α ≥ cutoff), α on a stochastic surface — the
+    /// probability that a ray meeting it there stops. α is read from the image as decoded
+    /// ([`Texture::alpha_at`]; the renderer reads its resampled twin).
+    pub fn coverage_at(&self, tri: usize, b1: f32, b2: f32) -> f32 {
+        let m = self.material_of(tri);
+        if !m.has_holes() {
+            return 1.0;
+        }
+        let alpha = m.opacity
+            * m.opacity_texture.map_or(1.0, |t| {
+                let uv = self.uvs.get(tri).map_or(Vec2::ZERO, |c| c[0] * (1.0 - b1 - b2) + c[1] * b1 + c[2] * b2);
+                self.textures[t.texture].alpha_at(t.transform.apply(uv))
+            });
+        match m.alpha_mode {
+            AlphaMode::Opaque => 1.0,
+            AlphaMode::Mask { cutoff } => (alpha >= cutoff) as u32 as f32,
+            AlphaMode::Blend => alpha,
+        }
     }
 
     /// Indices of the triangles that emit light and have a non-zero area.

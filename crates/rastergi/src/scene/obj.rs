@@ -90,6 +90,13 @@ pub fn load_obj(path: &Path) -> Result<Scene> {
             if let Some(&t) = texture_of_file.get(&(file.clone(), opacity)) {
                 return Ok(Some(TextureRef { texture: t, transform }));
             }
+            // An image with an alpha channel serves as colour and opacity from one texture.
+            if let Some(&t) = texture_of_file.get(&(file.clone(), false))
+                && opacity
+                && scene.textures[t].has_alpha()
+            {
+                return Ok(Some(TextureRef { texture: t, transform }));
+            }
             let mut texture = read_texture(&file).map_err(|e| {
                 file_error(path, format!("the texture {} ({key} of material '{}') {e}", file.display(), m.name))
             })?;
@@ -98,7 +105,11 @@ pub fn load_obj(path: &Path) -> Result<Scene> {
                 texture.texels.iter_mut().for_each(|t| t[3] = t[0]);
                 texture.name += " (opacity)";
             }
+            let has_alpha = texture.has_alpha();
             let t = scene.add_texture(texture);
+            if opacity && has_alpha {
+                texture_of_file.insert((file.clone(), false), t);
+            }
             texture_of_file.insert((file, opacity), t);
             Ok(Some(TextureRef { texture: t, transform }))
         };
@@ -112,7 +123,11 @@ pub fn load_obj(path: &Path) -> Result<Scene> {
         let transparency = m.unknown_param.get("Tr").and_then(|t| t.trim().parse::<f32>().ok());
         let mut opacity = m.dissolve.or(transparency.map(|t| 1.0 - t)).unwrap_or(1.0);
         if !(0.0..=1.0).contains(&opacity) {
-            log::warn!("{}: material '{}' has an opacity d = {opacity} outside [0, 1]; clamped", path.display(), m.name);
+            log::warn!(
+                "{}: material '{}' has an opacity d = {opacity} outside [0, 1]; clamped",
+                path.display(),
+                m.name
+            );
             opacity = if opacity.is_nan() { 1.0 } else { opacity.clamp(0.0, 1.0) };
         }
         let alpha_mode =
@@ -344,7 +359,10 @@ fn texture_statement(key: &str, value: &str) -> std::result::Result<(String, UvT
             rest = after.trim_start();
         }
         if option == "-o" || option == "-s" {
-            let numbers: Vec<f32> = values.iter().map(|w| w.parse::<f32>()).collect::<std::result::Result<_, _>>()
+            let numbers: Vec<f32> = values
+                .iter()
+                .map(|w| w.parse::<f32>())
+                .collect::<std::result::Result<_, _>>()
                 .ok()
                 .filter(|v: &Vec<f32>| v.iter().all(|x| x.is_finite()))
                 .ok_or_else(|| format!("{key} option '{option}' needs numbers, got '{}'", values.join(" ")))?;

@@ -63,7 +63,8 @@ mod tests {
     #[test]
     fn a_quad_mapped_u_right_v_down_gets_tangent_along_u_and_bitangent_up_the_image() {
         // The quad z = 0 facing +z, u along +x, v (down the image) along −y.
-        let p = [Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(1.0, 1.0, 0.0), Vec3::new(0.0, 1.0, 0.0)];
+        let p =
+            [Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(1.0, 1.0, 0.0), Vec3::new(0.0, 1.0, 0.0)];
         let uv = |v: Vec3| Vec2::new(v.x, 1.0 - v.y);
         let triangles = [[p[0], p[1], p[2]], [p[0], p[2], p[3]]];
         let uvs = triangles.map(|t| t.map(uv));

@@ -69,6 +69,18 @@ impl Texture {
         self.texels.iter().any(|t| t[3] < 255)
     }
 
+    /// The alpha channel at `uv` (repeat addressing, bilinear between texel centres) of the
+    /// image as decoded, level 0.
+    pub fn alpha_at(&self, uv: glam::Vec2) -> f32 {
+        let (w, h) = (self.width as i64, self.height as i64);
+        let (x, y) = (uv.x * w as f32 - 0.5, uv.y * h as f32 - 0.5);
+        let (x0, y0) = (x.floor(), y.floor());
+        let (a, b) = (x - x0, y - y0);
+        let at = |i: i64, j: i64| self.texels[(j.rem_euclid(h) * w + i.rem_euclid(w)) as usize][3] as f32 / 255.0;
+        let (i, j) = (x0 as i64, y0 as i64);
+        (at(i, j) * (1.0 - a) + at(i + 1, j) * a) * (1.0 - b) + (at(i, j + 1) * (1.0 - a) + at(i + 1, j + 1) * a) * b
+    }
+
     /// Checks the texel count against the size.
     pub fn validate(&self) -> Result<(), String> {
         if self.width == 0 || self.height == 0 {

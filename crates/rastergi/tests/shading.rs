@@ -255,3 +255,47 @@ fn a_white_furnace_of_smooth_walls_gains_no_energy_and_has_no_dark_seams() {
         assert!(lo >= 0.75 * expected, "{label}: a dark pixel {lo} (seam?) against {expected}");
     }
 }
+
+#[test]
+fn obj_smoothing_groups_give_area_weighted_vertex_normals() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("s.obj");
+    // A 1 × 1 floor (y = 0, up) and a 1 × 2 wall (x = 0, facing +x) sharing the edge x = 0,
+    // y = 0, z ∈ [0, 1]; vertices 1 and 2 are on the edge.
+    let geometry = "v 0 0 0\nv 0 0 1\nv 1 0 1\nv 1 0 0\nv 0 2 0\nv 0 2 1\n";
+    let floor = "f 1 2 3 4\n";
+    let wall = "f 1 5 6 2\n";
+    let normals_at = |text: String| {
+        std::fs::write(&path, text).unwrap();
+        let s = load_obj(&path).unwrap();
+        let mut at: Vec<(Vec3, Vec3, Vec3)> = Vec::new();
+        for (t, n) in s.triangles.iter().zip(&s.normals) {
+            let face = rastergi::scene::triangle_normal(t);
+            for k in 0..3 {
+                at.push((t[k], face, n[k]));
+            }
+        }
+        at
+    };
+    let edge = |p: Vec3| p.x == 0.0 && p.y == 0.0;
+    // One group: on the edge (2·x̂ + 1·ŷ)/√5 — the wall has twice the floor's area.
+    let shared = Vec3::new(2.0, 1.0, 0.0).normalize();
+    for (p, face, n) in normals_at(format!("{geometry}s 1\n{floor}{wall}")) {
+        let want = if edge(p) { shared } else { face };
+        assert!(close(n, want, 1e-6), "{p}: {n} against {want}");
+    }
+    // The wall flat (`s off`) or in another group: every corner keeps its own face's normal.
+    for text in [format!("{geometry}s 1\n{floor}s off\n{wall}"), format!("{geometry}s 1\n{floor}s 2\n{wall}")] {
+        for (p, face, n) in normals_at(text) {
+            assert!(close(n, face, 1e-6), "{p}: {n} against {face}");
+        }
+    }
+    // Faces that name their own normals keep them, and the smoothed ones still smooth.
+    let own = format!("{geometry}vn 0 0 -1\ns 1\n{floor}{wall}s off\nf 3//1 4//1 1//1\n");
+    let at = normals_at(own);
+    assert!(at.iter().filter(|(_, _, n)| close(*n, Vec3::NEG_Z, 1e-6)).count() == 3, "{at:?}");
+    assert!(at.iter().any(|(p, _, n)| edge(*p) && close(*n, shared, 1e-6)), "{at:?}");
+    // No smoothing group: flat, no normals at all.
+    std::fs::write(&path, format!("{geometry}s off\n{floor}{wall}")).unwrap();
+    assert!(load_obj(&path).unwrap().normals.is_empty());
+}

@@ -15,8 +15,10 @@
 //! `-blendu`, `-clamp`, `-colorspace`, `-type` …) are skipped with a warning.
 //!
 //! Faces whose corners name `vn` normals (`f v//vn`, `f v/vt/vn`) shade with them, interpolated
-//! (normalised as read); a model whose faces do not all have them shades flat. Smoothing
-//! groups (`s`) are not read: without `vn` every face is flat.
+//! (normalised as read); a model whose faces do not all have them shades flat. Faces without
+//! `vn` in a smoothing group (`s 1`, `s 2` …; not `s off` or `s 0`) get vertex normals: at each
+//! vertex the area-weighted mean of the normals of the group's faces around it (faces of
+//! other groups and flat faces keep their own), as Blender and 3ds Max read them.
 
 use std::cell::RefCell;
 use std::collections::HashMap;
@@ -59,10 +61,17 @@ pub fn load_obj(path: &Path) -> Result<Scene> {
     let textured = materials.iter().any(|m| TEXTURE_KEYS.iter().any(|&key| map_file(m, key).is_some()));
     let mut text = text_of(path)?;
     // Normals that faces refer to out of range are not used (the faces shade flat).
-    let smooth = has_keyword(&text, b"vn")
+    let mut smooth = has_keyword(&text, b"vn")
         && check_references(&text, "vn", 2, "normal")
             .map_err(|message| log::warn!("{}: {message}; its faces shade flat", path.display()))
             .is_ok();
+    // Smoothing groups become vertex normals (written into the text tobj reads).
+    if (smooth || !has_keyword(&text, b"vn"))
+        && let Some(with_normals) = apply_smoothing_groups(&text)
+    {
+        text = with_normals;
+        smooth = true;
+    }
     if textured || smooth {
         // Textures need the texture coordinates and smooth shading the normals: load again
         // with them, once every face's references are known to be in range (tobj overflows
@@ -381,6 +390,132 @@ fn texture_statement(key: &str, value: &str) -> std::result::Result<(String, UvT
     }
     let transform = UvTransform([[scale[0], 0.0, offset[0]], [0.0, scale[1], 1.0 - scale[1] - offset[1]]]);
     Ok((rest.to_owned(), transform))
+}
+
+/// The OBJ text with smoothing groups turned into vertex normals, or `None` where no face
+/// without `vn` is in a smoothing group (or a line cannot be read: tobj then says why). Every
+/// face without `vn` gets normals: its group's vertex normals (the area-weighted mean of the
+/// group's face normals at each vertex position), or its own face normal at every corner if
+/// it is flat (`s off`). The new `vn` lines go first, so tobj knows them wherever it looks
+/// them up; the file's own positive `vn` references shift past them.
+fn apply_smoothing_groups(text: &[u8]) -> Option<Vec<u8>> {
+    let text = std::str::from_utf8(text).ok()?;
+    let mut positions: Vec<glam::DVec3> = Vec::new();
+    let mut group = 0u32;
+    // Faces without normals: (line, absolute 1-based position indices, group).
+    let mut faces: Vec<(usize, Vec<usize>, u32)> = Vec::new();
+    let mut any_group = false;
+    for (n, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("v") => {
+                let c: Vec<f64> = words.take(3).map(|w| w.parse().unwrap_or(0.0)).collect();
+                positions.push(glam::DVec3::new(
+                    c.first().copied().unwrap_or(0.0),
+                    c.get(1).copied().unwrap_or(0.0),
+                    c.get(2).copied().unwrap_or(0.0),
+                ));
+            }
+            Some("s") => {
+                group = match words.next() {
+                    Some("off") | None => 0,
+                    Some(w) => w.parse().ok()?,
+                };
+            }
+            Some("f") => {
+                let corners: Vec<&str> = words.collect();
+                if corners.iter().any(|c| c.split('/').nth(2).is_some_and(|v| !v.is_empty())) {
+                    continue;
+                }
+                let mut indices = Vec::with_capacity(corners.len());
+                for c in &corners {
+                    let i: i64 = c.split('/').next()?.parse().ok()?;
+                    let i = if i < 0 { positions.len() as i64 + 1 + i } else { i };
+                    if i < 1 || i as usize > positions.len() {
+                        return None;
+                    }
+                    indices.push(i as usize);
+                }
+                any_group |= group != 0;
+                faces.push((n, indices, group));
+            }
+            _ => {}
+        }
+    }
+    if !any_group {
+        return None;
+    }
+    // Newell's normal: twice the area times the unit normal of a planar polygon.
+    let newell = |ix: &[usize]| {
+        (0..ix.len()).fold(glam::DVec3::ZERO, |acc, k| {
+            let (a, b) = (positions[ix[k] - 1], positions[ix[(k + 1) % ix.len()] - 1]);
+            acc + glam::DVec3::new((a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x), (a.x - b.x) * (a.y + b.y))
+        })
+    };
+    let mut sums: HashMap<(u32, usize), glam::DVec3> = HashMap::new();
+    for (_, ix, g) in faces.iter().filter(|f| f.2 != 0) {
+        let n = newell(ix);
+        for &i in ix {
+            *sums.entry((*g, i)).or_default() += n;
+        }
+    }
+    // One new vn per (group, vertex) and per flat face; corners map to them.
+    let mut normals: Vec<glam::DVec3> = Vec::new();
+    let mut index_of: HashMap<(u32, usize), usize> = HashMap::new();
+    let mut rewritten: HashMap<usize, Vec<usize>> = HashMap::new();
+    for (line, ix, g) in &faces {
+        let refs = if *g == 0 {
+            normals.push(newell(ix));
+            vec![normals.len(); ix.len()]
+        } else {
+            ix.iter()
+                .map(|&i| {
+                    *index_of.entry((*g, i)).or_insert_with(|| {
+                        normals.push(sums[&(*g, i)]);
+                        normals.len()
+                    })
+                })
+                .collect()
+        };
+        rewritten.insert(*line, refs);
+    }
+    let shift = normals.len() as i64;
+    let mut out = String::with_capacity(text.len() + 40 * normals.len());
+    for n in &normals {
+        let n = n.normalize_or_zero();
+        out += &format!("vn {} {} {}\n", n.x, n.y, n.z);
+    }
+    for (k, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        match (words.next(), rewritten.get(&k)) {
+            (Some("f"), Some(refs)) => {
+                out += "f";
+                for (c, r) in words.zip(refs) {
+                    let mut parts = c.split('/');
+                    let v = parts.next().unwrap_or("");
+                    let vt = parts.next().unwrap_or("");
+                    out += &format!(" {v}/{vt}/{r}");
+                }
+            }
+            (Some("f"), None) => {
+                // A face with its own normals: positive vn indices move past the new ones.
+                out += "f";
+                for c in words {
+                    let parts: Vec<&str> = c.split('/').collect();
+                    match parts.as_slice() {
+                        [v, vt, vn] => match vn.parse::<i64>() {
+                            Ok(i) if i > 0 => out += &format!(" {v}/{vt}/{}", i + shift),
+                            _ => out += &format!(" {c}"),
+                        },
+                        _ => out += &format!(" {c}"),
+                    }
+                }
+            }
+            _ => out += line,
+        }
+        out.push('\n');
+    }
+    Some(out.into_bytes())
 }
 
 /// What is wrong with an OBJ file tobj refused, where, and what to do about it.

@@ -393,3 +393,58 @@ fn obj_opacity_emissive_maps_and_texture_options_are_read() {
     assert_eq!((glow.emission, glow.emission_texture.map(|t| t.texture)), (Vec3::splat(3.0), Some(albedo)));
     assert_eq!(glow.alpha_mode, AlphaMode::Opaque);
 }
+
+#[test]
+fn gltf_tangents_follow_the_transform_and_flip_handedness_when_mirrored() {
+    // A triangle in z = 0 (front +z) with TANGENT (1, 0, 0, +1): bitangent w · n × t = +y.
+    let dir = tempfile::tempdir().unwrap();
+    image::RgbaImage::from_pixel(1, 1, image::Rgba([128, 128, 255, 255])).save(dir.path().join("n.png")).unwrap();
+    let positions: [[f32; 3]; 3] = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    let uvs: [[f32; 2]; 3] = [[0.0, 1.0], [1.0, 1.0], [0.0, 0.0]];
+    let tangents: [[f32; 4]; 3] = [[1.0, 0.0, 0.0, 1.0]; 3];
+    let mut bytes: Vec<u8> = positions.iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
+    bytes.extend(uvs.iter().flatten().flat_map(|v| v.to_le_bytes()));
+    bytes.extend(tangents.iter().flatten().flat_map(|v| v.to_le_bytes()));
+    let uri = format!(
+        "data:application/octet-stream;base64,{}",
+        base64::Engine::encode(&base64::engine::general_purpose::STANDARD, &bytes)
+    );
+    let file = |scale: [f32; 3]| {
+        let doc = json!({
+            "asset": { "version": "2.0" },
+            "buffers": [{ "byteLength": bytes.len(), "uri": uri }],
+            "bufferViews": [
+                { "buffer": 0, "byteOffset": 0, "byteLength": 36 },
+                { "buffer": 0, "byteOffset": 36, "byteLength": 24 },
+                { "buffer": 0, "byteOffset": 60, "byteLength": 48 }
+            ],
+            "accessors": [
+                { "bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0] },
+                { "bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2" },
+                { "bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC4" }
+            ],
+            "images": [{ "uri": "n.png" }],
+            "textures": [{ "source": 0 }],
+            "materials": [{ "normalTexture": { "index": 0 } }],
+            "meshes": [{ "primitives": [{ "attributes": { "POSITION": 0, "TEXCOORD_0": 1, "TANGENT": 2 }, "material": 0 }] }],
+            "nodes": [{ "mesh": 0, "scale": scale }],
+            "scenes": [{ "nodes": [0] }],
+            "scene": 0
+        });
+        let path = dir.path().join("t.gltf");
+        std::fs::write(&path, serde_json::to_vec(&doc).unwrap()).unwrap();
+        load_gltf(&path).unwrap()
+    };
+    let s = file([1.0; 3]);
+    assert_eq!(s.tangents[0], [Vec4::new(1.0, 0.0, 0.0, 1.0); 3]);
+    // Mirrored in x: the tangent mirrors with the surface, and w flips so that the bitangent
+    // w · n × t is still the mirrored bitangent M(+y) = +y (n stays +z: the corners swap).
+    let s = file([-1.0, 1.0, 1.0]);
+    let t = &s.triangles[0];
+    let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize();
+    assert!((n - Vec3::Z).length() < 1e-6, "{n}");
+    for tangent in s.tangents[0] {
+        assert_eq!(tangent, Vec4::new(-1.0, 0.0, 0.0, -1.0));
+        assert!((n.cross(tangent.truncate()) * tangent.w - Vec3::Y).length() < 1e-6);
+    }
+}

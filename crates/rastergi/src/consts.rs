@@ -11,6 +11,10 @@ pub const MATERIAL_TWO_SIDED: u32 = 1;
 pub const MATERIAL_ALPHA_MASK: u32 = 2;
 /// Material flag: stochastic opacity α ([`crate::scene::AlphaMode::Blend`]).
 pub const MATERIAL_ALPHA_BLEND: u32 = 4;
+/// Material flag: it reads some texture (so its points need texture coordinates).
+pub const MATERIAL_TEXTURED: u32 = 8;
+/// Most holes a ray passes through before it counts as stopped (`trace` in `bvh.wgsl`).
+pub const MAX_HOLE_CROSSINGS: u32 = 256;
 /// A texture slot without a texture.
 pub const NO_TEXTURE: u32 = u32::MAX;
 /// Triangle flag ([`crate::gpu_scene::GpuTriangle::flags`]): its material may have holes, so

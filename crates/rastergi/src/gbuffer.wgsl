@@ -28,9 +28,15 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> VertexOut {
 // discarded and the surface behind it is seen.
 @fragment
 fn fs_main(in: VertexOut) -> @location(0) vec4u {
-    let lod = texture_lod(dpdx(in.uv), dpdy(in.uv));
+    let dx = dpdx(in.uv);
+    let dy = dpdy(in.uv);
+    let t = triangles[in.tri];
+    var lod = 0.0;
+    if (materials[t.material].flags & MATERIAL_TEXTURED) != 0u {
+        lod = albedo_lod(t.material, dx, dy);
+    }
     start_alpha_stream();
-    if (triangles[in.tri].flags & TRIANGLE_HAS_HOLES) != 0u && passes_through(in.tri, in.bary.x, in.bary.y, lod) {
+    if (t.flags & TRIANGLE_HAS_HOLES) != 0u && passes_through(in.tri, in.bary.x, in.bary.y, lod) {
         discard;
     }
     return vec4u(in.tri + 1u, bitcast<u32>(in.bary.x), bitcast<u32>(in.bary.y), bitcast<u32>(lod));

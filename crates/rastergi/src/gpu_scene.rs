@@ -46,8 +46,11 @@ impl GpuTextureSlot {
     }
 }
 
-/// `Material` in `gpu_scene.wgsl`: [`crate::scene::Material`] with its flags
-/// ([`MATERIAL_TWO_SIDED`], [`MATERIAL_ALPHA_MASK`], [`MATERIAL_ALPHA_BLEND`]).
+/// `Material` in `gpu_scene.wgsl`: what every surface point reads of
+/// [`crate::scene::Material`], its flags ([`MATERIAL_TWO_SIDED`], [`MATERIAL_ALPHA_MASK`],
+/// [`MATERIAL_ALPHA_BLEND`], [`MATERIAL_TEXTURED`]) and its opacity factor. Its textures are
+/// in [`GpuMaterialMaps`], read only where the flags say: loading them with every material
+/// cost 30 % of the gather on lavapipe (it gathers every word of every lane).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuMaterial {
@@ -55,6 +58,13 @@ pub struct GpuMaterial {
     pub flags: u32,
     pub emission: [f32; 3],
     pub opacity: f32,
+}
+
+/// `MaterialMaps` in `gpu_scene.wgsl`: a material's textures and their parameters, at the
+/// material's index.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuMaterialMaps {
     pub alpha_cutoff: f32,
     pub normal_scale: f32,
     pub _pad: [u32; 2],
@@ -65,17 +75,21 @@ pub struct GpuMaterial {
 }
 
 impl GpuMaterial {
-    pub fn new(m: &Material) -> GpuMaterial {
+    pub fn new(m: &Material) -> (GpuMaterial, GpuMaterialMaps) {
         let (alpha, alpha_cutoff) = match m.alpha_mode {
             AlphaMode::Opaque => (0, 0.0),
             AlphaMode::Mask { cutoff } => (MATERIAL_ALPHA_MASK, cutoff),
             AlphaMode::Blend => (MATERIAL_ALPHA_BLEND, 0.0),
         };
-        GpuMaterial {
+        let material = GpuMaterial {
             albedo: m.albedo.into(),
-            flags: if m.two_sided { MATERIAL_TWO_SIDED } else { 0 } | alpha,
+            flags: if m.two_sided { MATERIAL_TWO_SIDED } else { 0 }
+                | alpha
+                | if m.texture_refs().next().is_some() { MATERIAL_TEXTURED } else { 0 },
             emission: m.emission.into(),
             opacity: m.opacity,
+        };
+        let maps = GpuMaterialMaps {
             alpha_cutoff,
             normal_scale: m.normal_scale,
             _pad: [0; 2],
@@ -85,12 +99,13 @@ impl GpuMaterial {
             emission_map: GpuTextureSlot::new(m.emission_texture),
             opacity_map: GpuTextureSlot::new(m.opacity_texture),
             normal_map: GpuTextureSlot::new(m.normal_texture),
-        }
+        };
+        (material, maps)
     }
 }
 
 pub use crate::consts::{
-    MATERIAL_ALPHA_BLEND, MATERIAL_ALPHA_MASK, MATERIAL_TWO_SIDED, NO_TEXTURE, TRIANGLE_HAS_HOLES,
+    MATERIAL_ALPHA_BLEND, MATERIAL_ALPHA_MASK, MATERIAL_TEXTURED, MATERIAL_TWO_SIDED, NO_TEXTURE, TRIANGLE_HAS_HOLES,
 };
 
 /// A scene prepared for rendering: triangles permuted into BVH order, with the BVH and the
@@ -287,7 +302,8 @@ impl GpuScene {
                 _pad1: 0,
             })
             .collect();
-        let materials: Vec<GpuMaterial> = s.materials.iter().map(GpuMaterial::new).collect();
+        let (materials, maps): (Vec<GpuMaterial>, Vec<GpuMaterialMaps>) =
+            s.materials.iter().map(GpuMaterial::new).unzip();
         // One triangle's worth of zeros when the scene has no texture coordinates: a binding
         // cannot be empty, and `surface_uv` clamps its index into the buffer.
         let uvs: Vec<[f32; 2]> = if s.uvs.is_empty() {
@@ -337,6 +353,7 @@ impl GpuScene {
             gpu.storage_buffer("scene environment map", bytemuck::cast_slice(&env_data), none),
             gpu.storage_buffer("scene shading normals", bytemuck::cast_slice(&normals), none),
             gpu.storage_buffer("scene tangents", bytemuck::cast_slice(&tangents), none),
+            gpu.storage_buffer("scene material maps", bytemuck::cast_slice(&maps), none),
         ];
         let env_uniform_buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("scene environment"),
@@ -344,13 +361,17 @@ impl GpuScene {
             usage: wgpu::BufferUsages::UNIFORM,
         });
         let vis = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
+        // The BVH and the lights serve compute passes only: the raster stages (which pull
+        // vertices and discard holes) see five storage buffers of the scene, well under the
+        // count at which lavapipe loses fragment writes (below).
+        let compute = wgpu::ShaderStages::COMPUTE;
         let layout = gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("scene"),
             entries: &[
                 storage_entry::<GpuTriangle>(0, vis, true),
                 storage_entry::<GpuMaterial>(1, vis, true),
-                storage_entry::<crate::bvh::BvhNode>(2, vis, true),
-                storage_entry::<crate::lights::LightEntry>(3, vis, true),
+                storage_entry::<crate::bvh::BvhNode>(2, compute, true),
+                storage_entry::<crate::lights::LightEntry>(3, compute, true),
                 storage_entry::<[f32; 2]>(4, vis, true),
                 wgpu::BindGroupLayoutEntry {
                     binding: 5,
@@ -368,7 +389,7 @@ impl GpuScene {
                     ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
                     count: None,
                 },
-                storage_entry::<crate::lights::PunctualLight>(7, vis, true),
+                storage_entry::<crate::lights::PunctualLight>(7, compute, true),
                 // The environment, the shading normals and the tangents are read by compute
                 // passes only, and
                 // hidden from the raster stages: lavapipe (Mesa 22.3) silently loses fragment
@@ -379,10 +400,11 @@ impl GpuScene {
                 uniform_entry::<GpuEnvironment>(9, wgpu::ShaderStages::COMPUTE),
                 storage_entry::<[f32; 9]>(10, wgpu::ShaderStages::COMPUTE, true),
                 storage_entry::<[f32; 12]>(11, wgpu::ShaderStages::COMPUTE, true),
+                storage_entry::<GpuMaterialMaps>(12, vis, true),
             ],
         });
         // The buffers' bindings, in the order of `buffers`.
-        const BUFFER_BINDINGS: [u32; 9] = [0, 1, 2, 3, 4, 7, 8, 10, 11];
+        const BUFFER_BINDINGS: [u32; 10] = [0, 1, 2, 3, 4, 7, 8, 10, 11, 12];
         let mut entries: Vec<wgpu::BindGroupEntry> = buffers
             .iter()
             .zip(BUFFER_BINDINGS)

@@ -19,12 +19,17 @@ struct TextureSlot {
     _pad: u32,
 }
 
-// flags: MATERIAL_TWO_SIDED, MATERIAL_ALPHA_MASK, MATERIAL_ALPHA_BLEND (gpu_scene.rs).
+// flags: MATERIAL_TWO_SIDED, MATERIAL_ALPHA_MASK, MATERIAL_ALPHA_BLEND, MATERIAL_TEXTURED
+// (gpu_scene.rs). Its textures are in material_maps, read only where the flags say.
 struct Material {
     albedo: vec3f,
     flags: u32,
     emission: vec3f,
     opacity: f32,
+}
+
+// A material's textures and their parameters (gpu_scene.rs, GpuMaterialMaps).
+struct MaterialMaps {
     alpha_cutoff: f32,
     normal_scale: f32,
     _pad: vec2u,
@@ -81,6 +86,8 @@ struct PunctualLight {
 // Tangents (xyz, handedness w) at the triangles' corners for normal maps, twelve floats per
 // triangle (zero: none; one zero triangle when the scene has none).
 @group(0) @binding(11) var<storage, read> tangents: array<f32>;
+// The materials' textures, at the materials' indices.
+@group(0) @binding(12) var<storage, read> material_maps: array<MaterialMaps>;
 
 // The random stream of stochastic opacity (passes_through): each entry point that finds
 // surfaces sets it from its iteration's seed, so that the holes of a semi-transparent
@@ -142,10 +149,10 @@ fn slot_sample(s: TextureSlot, uv: vec2f, lod: f32) -> vec4f {
 }
 
 // The shading normal at barycentrics (b1, b2) of triangle `tri` of geometric normal n and
-// material m: its corners' normals interpolated and normalised, turned into n's hemisphere (n
-// where the triangle has none or they cancel), perturbed by m's normal map
-// (PreparedScene::shading_normal_at).
-fn shading_normal(tri: u32, b1: f32, b2: f32, n: vec3f, m: Material, uv: vec2f) -> vec3f {
+// material mi: its corners' normals interpolated and normalised, turned into n's hemisphere (n
+// where the triangle has none or they cancel), perturbed by the material's normal map
+// (PreparedScene::shading_normal_at); `textured`: the material reads some texture.
+fn shading_normal(tri: u32, b1: f32, b2: f32, n: vec3f, mi: u32, textured: bool, uv: vec2f) -> vec3f {
     let i = 9u * min(tri, arrayLength(&normals) / 9u - 1u);
     var v = vec3f(0.0);
     let w = vec3f(1.0 - b1 - b2, b1, b2);
@@ -158,7 +165,11 @@ fn shading_normal(tri: u32, b1: f32, b2: f32, n: vec3f, m: Material, uv: vec2f) 
         v /= len;
         ns = select(-v, v, dot(v, n) >= 0.0);
     }
-    if m.normal_map.layer == NO_TEXTURE {
+    if !textured {
+        return ns;
+    }
+    let map = material_maps[mi].normal_map;
+    if map.layer == NO_TEXTURE {
         return ns;
     }
     let j = 12u * min(tri, arrayLength(&tangents) / 12u - 1u);
@@ -167,7 +178,7 @@ fn shading_normal(tri: u32, b1: f32, b2: f32, n: vec3f, m: Material, uv: vec2f) 
         t += w[k] * vec4f(tangents[j + 4u * k], tangents[j + 4u * k + 1u], tangents[j + 4u * k + 2u],
             tangents[j + 4u * k + 3u]);
     }
-    return perturb_normal(n, ns, t, slot_sample(m.normal_map, uv, 0.0).rgb, m.normal_scale);
+    return perturb_normal(n, ns, t, slot_sample(map, uv, 0.0).rgb, material_maps[mi].normal_scale);
 }
 
 // gpu_scene::perturb_normal: ns perturbed by the normal-map texel c in the frame (t', b, ns).
@@ -186,26 +197,28 @@ fn perturb_normal(n: vec3f, ns: vec3f, t: vec4f, c: vec3f, scale: f32) -> vec3f 
     return bend_towards(normalize(v), n);
 }
 
-// The opacity α of material m at texture coordinates uv (PreparedScene::opacity_at).
-fn surface_opacity(m: Material, uv: vec2f, lod: f32) -> f32 {
-    var a = m.opacity;
-    if m.opacity_map.layer != NO_TEXTURE {
-        a *= slot_sample(m.opacity_map, uv, lod).a;
+// The opacity α of material mi (its factor `opacity`) at texture coordinates uv
+// (PreparedScene::opacity_at).
+fn surface_opacity(mi: u32, opacity: f32, uv: vec2f, lod: f32) -> f32 {
+    let map = material_maps[mi].opacity_map;
+    if map.layer == NO_TEXTURE {
+        return opacity;
     }
-    return a;
+    return opacity * slot_sample(map, uv, lod).a;
 }
 
 // Whether a ray (or a fragment) meeting triangle `tri` at barycentrics (b1, b2) passes through
 // it (PreparedScene::passes_through): through a cut-out where α < its cutoff; through a
 // stochastic surface where a uniform hashed from the point and alpha_seed is ≥ α.
 fn passes_through(tri: u32, b1: f32, b2: f32, lod: f32) -> bool {
-    let m = materials[triangles[tri].material];
+    let mi = triangles[tri].material;
+    let m = materials[mi];
     if (m.flags & (MATERIAL_ALPHA_MASK | MATERIAL_ALPHA_BLEND)) == 0u {
         return false;
     }
-    let a = surface_opacity(m, surface_uv(tri, b1, b2), lod);
+    let a = surface_opacity(mi, m.opacity, surface_uv(tri, b1, b2), lod);
     if (m.flags & MATERIAL_ALPHA_MASK) != 0u {
-        return a < m.alpha_cutoff;
+        return a < material_maps[mi].alpha_cutoff;
     }
     let u = unit_f32(pcg_hash(pcg_hash(pcg_hash(tri ^ alpha_seed) ^ bitcast<u32>(b1)) ^ bitcast<u32>(b2)));
     return u >= a;
@@ -215,24 +228,30 @@ fn passes_through(tri: u32, b1: f32, b2: f32, lod: f32) -> bool {
 // photon sees it (PreparedScene::emitter_radiance): none from a cut-out's hole, α × its
 // emission on a stochastic surface.
 fn emitter_radiance(tri: u32, b1: f32, b2: f32) -> vec3f {
-    let m = materials[triangles[tri].material];
+    let mi = triangles[tri].material;
+    let m = materials[mi];
+    if (m.flags & MATERIAL_TEXTURED) == 0u {
+        return m.emission * select(1.0, m.opacity, (m.flags & MATERIAL_ALPHA_BLEND) != 0u);
+    }
     let uv = surface_uv(tri, b1, b2);
-    let le = surface_emission(m, uv);
+    let le = surface_emission(mi, m.emission, uv);
     if (m.flags & MATERIAL_ALPHA_MASK) != 0u {
-        return select(le, vec3f(0.0), surface_opacity(m, uv, 0.0) < m.alpha_cutoff);
+        return select(le, vec3f(0.0), surface_opacity(mi, m.opacity, uv, 0.0) < material_maps[mi].alpha_cutoff);
     }
     if (m.flags & MATERIAL_ALPHA_BLEND) != 0u {
-        return le * surface_opacity(m, uv, 0.0);
+        return le * surface_opacity(mi, m.opacity, uv, 0.0);
     }
     return le;
 }
 
-// The emitted radiance of material m at texture coordinates uv (PreparedScene::emission_at).
-fn surface_emission(m: Material, uv: vec2f) -> vec3f {
-    if m.emission_map.layer == NO_TEXTURE {
-        return m.emission;
+// The emitted radiance of material mi (its factor `emission`) at texture coordinates uv
+// (PreparedScene::emission_at).
+fn surface_emission(mi: u32, emission: vec3f, uv: vec2f) -> vec3f {
+    let map = material_maps[mi].emission_map;
+    if map.layer == NO_TEXTURE {
+        return emission;
     }
-    return m.emission * slot_sample(m.emission_map, uv, 0.0).rgb;
+    return emission * slot_sample(map, uv, 0.0).rgb;
 }
 
 // A shading normal ns seen from direction v (unit, towards the viewer): unchanged where it
@@ -253,6 +272,14 @@ fn texture_lod(dx: vec2f, dy: vec2f) -> f32 {
     let size = vec2f(textureDimensions(textures));
     let rho = max(length(dx * size), length(dy * size));
     return min(log2(max(rho, 1.0)), 32.0);
+}
+
+// The level of detail of material mi's albedo texture where the triangle's texture coordinates
+// change by dx and dy across a pixel: those changes placed by the texture's transform.
+fn albedo_lod(mi: u32, dx: vec2f, dy: vec2f) -> f32 {
+    let s = material_maps[mi].albedo_map;
+    let a = mat2x2f(vec2f(s.u.x, s.v.x), vec2f(s.u.y, s.v.y));
+    return texture_lod(a * dx, a * dy);
 }
 
 // Barycentrics (b1, b2) of the point p of triangle t's plane.
@@ -277,17 +304,28 @@ fn plane_barycentrics(t: Triangle, p: vec3f) -> vec2f {
 // shading_normal_at).
 fn surface_at(tri: u32, b1: f32, b2: f32, lod: f32) -> Surface {
     let t = triangles[tri];
-    let m = materials[t.material];
-    let uv = surface_uv(tri, b1, b2);
+    let mi = t.material;
+    let m = materials[mi];
+    let textured = (m.flags & MATERIAL_TEXTURED) != 0u;
+    var uv = vec2f(0.0);
+    if textured {
+        uv = surface_uv(tri, b1, b2);
+    }
     var s: Surface;
     s.pos = t.v0 * (1.0 - b1 - b2) + t.v1 * b1 + t.v2 * b2;
     s.normal = triangle_normal(t);
-    s.shading = shading_normal(tri, b1, b2, s.normal, m, uv);
+    s.shading = shading_normal(tri, b1, b2, s.normal, mi, textured, uv);
     s.albedo = m.albedo;
-    if m.albedo_map.layer != NO_TEXTURE {
-        s.albedo *= slot_sample(m.albedo_map, uv, lod).rgb;
+    s.emission = m.emission;
+    if textured {
+        let maps = material_maps[mi];
+        if maps.albedo_map.layer != NO_TEXTURE {
+            s.albedo *= slot_sample(maps.albedo_map, uv, lod).rgb;
+        }
+        if maps.emission_map.layer != NO_TEXTURE {
+            s.emission *= slot_sample(maps.emission_map, uv, 0.0).rgb;
+        }
     }
-    s.emission = surface_emission(m, uv);
     s.flags = m.flags;
     s.tri = tri;
     return s;

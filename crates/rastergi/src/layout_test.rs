@@ -13,7 +13,7 @@ use crate::environment::GpuEnvironment;
 use crate::film::ResolveUniforms;
 use crate::frame::FrameUniforms;
 use crate::gather::GatherUniforms;
-use crate::gpu_scene::{GpuMaterial, GpuTextureSlot, GpuTriangle};
+use crate::gpu_scene::{GpuMaterial, GpuMaterialMaps, GpuTextureSlot, GpuTriangle};
 use crate::lights::{LightEntry, PunctualLight};
 use crate::path_tracer::PathParams;
 use crate::photons::gpu::{PhotonGridUniforms, PhotonParams};
@@ -64,21 +64,11 @@ fn twins() -> Vec<Twin> {
         ),
         twin!(GpuTriangle, "Triangle", [v0, material, v1, flags, v2]),
         twin!(GpuTextureSlot, "TextureSlot", [u, layer, v]),
+        twin!(GpuMaterial, "Material", [albedo, flags, emission, opacity]),
         twin!(
-            GpuMaterial,
-            "Material",
-            [
-                albedo,
-                flags,
-                emission,
-                opacity,
-                alpha_cutoff,
-                normal_scale,
-                albedo_map,
-                emission_map,
-                opacity_map,
-                normal_map
-            ]
+            GpuMaterialMaps,
+            "MaterialMaps",
+            [alpha_cutoff, normal_scale, albedo_map, emission_map, opacity_map, normal_map]
         ),
         twin!(BvhNode, "BvhNode", [min, offset, max, count]),
         twin!(LightEntry, "LightEntry", [triangle, cdf, pmf, area]),

@@ -38,7 +38,7 @@ fn primary_lod(tri: u32, xy: vec2u) -> f32 {
     let uv = plane_uv(tri, frame.eye, camera_ray(p));
     let dx = plane_uv(tri, frame.eye, camera_ray(p + vec2f(1.0, 0.0))) - uv;
     let dy = plane_uv(tri, frame.eye, camera_ray(p + vec2f(0.0, 1.0))) - uv;
-    let lod = texture_lod(dx, dy);
+    let lod = albedo_lod(triangles[tri].material, dx, dy);
     return select(lod, 32.0, lod != lod);
 }
 
@@ -74,7 +74,7 @@ fn path_radiance(origin: vec3f, dir: vec3f, xy: vec2u, rng: ptr<function, u32>) 
             break;
         }
         var lod = 0.0;
-        if bounce == 0u && materials[triangles[hit.tri].material].albedo_map.layer != NO_TEXTURE {
+        if bounce == 0u && (materials[triangles[hit.tri].material].flags & MATERIAL_TEXTURED) != 0u {
             lod = primary_lod(hit.tri, xy);
         }
         let s = surface_at(hit.tri, hit.b1, hit.b2, lod);

@@ -230,8 +230,8 @@ fn passes_through(tri: u32, b1: f32, b2: f32, lod: f32) -> bool {
 fn emitter_radiance(tri: u32, b1: f32, b2: f32) -> vec3f {
     let mi = triangles[tri].material;
     let m = materials[mi];
-    if (m.flags & MATERIAL_TEXTURED) == 0u {
-        return m.emission * select(1.0, m.opacity, (m.flags & MATERIAL_ALPHA_BLEND) != 0u);
+    if (m.flags & (MATERIAL_TEXTURED | MATERIAL_ALPHA_MASK | MATERIAL_ALPHA_BLEND)) == 0u {
+        return m.emission;
     }
     let uv = surface_uv(tri, b1, b2);
     let le = surface_emission(mi, m.emission, uv);

@@ -1,0 +1,342 @@
+//! The BSDF against independent computations: sampled directions against the density by a
+//! chi-square test (as pbrt and Mitsuba test theirs), the mean sample weight against a
+//! quadrature of f·|cos θ| (sampling agrees with evaluation), reciprocity, the white furnace
+//! and the closed forms of the Fresnel terms.
+
+use std::f64::consts::PI;
+
+use glam::Vec3;
+
+use super::*;
+use crate::sampling::Rng;
+
+fn dir(theta_deg: f32, phi_deg: f32) -> Vec3 {
+    let (t, p) = (theta_deg.to_radians(), phi_deg.to_radians());
+    Vec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos())
+}
+
+fn metal(base: Vec3, roughness: f32) -> Bsdf {
+    Bsdf { metallic: 1.0, alpha: roughness * roughness, specular: 1.0, ..Bsdf::diffuse(base) }
+}
+
+fn plastic(base: Vec3, roughness: f32) -> Bsdf {
+    Bsdf { alpha: roughness * roughness, specular: 1.0, ..Bsdf::diffuse(base) }
+}
+
+fn glass(roughness: f32, thin: bool) -> Bsdf {
+    Bsdf { transmission: 1.0, alpha: roughness * roughness, specular: 1.0, thin, ..Bsdf::diffuse(Vec3::ONE) }
+}
+
+/// Bins of the sphere: cos θ uniform in [−1, 1] (equal solid angles) × φ.
+const COS_BINS: usize = 24;
+const PHI_BINS: usize = 48;
+const SUB: usize = 16;
+
+fn bin_of(w: Vec3) -> usize {
+    let c = ((w.z.clamp(-1.0, 1.0) + 1.0) * 0.5 * COS_BINS as f32).min(COS_BINS as f32 - 1.0) as usize;
+    let phi = (w.y as f64).atan2(w.x as f64).rem_euclid(2.0 * PI);
+    let p = ((phi / (2.0 * PI) * PHI_BINS as f64) as usize).min(PHI_BINS - 1);
+    c * PHI_BINS + p
+}
+
+/// ∫ over each bin of the density, by a midpoint rule in (θ, φ) with weight sin θ, steps of
+/// at most ¼° in θ and SUB per bin in φ (a rule in cos θ puts too few points near the poles,
+/// where a refracted lobe, a third as wide as its microfacets' spread, peaks).
+fn expected_fractions(b: &Bsdf, wo: Vec3) -> Vec<f64> {
+    let dp = 2.0 * PI / (PHI_BINS * SUB) as f64;
+    let mut e = vec![0.0f64; COS_BINS * PHI_BINS];
+    for c in 0..COS_BINS {
+        let cos_lo = -1.0 + 2.0 * c as f64 / COS_BINS as f64;
+        let cos_hi = -1.0 + 2.0 * (c + 1) as f64 / COS_BINS as f64;
+        let (t0, t1) = (cos_hi.clamp(-1.0, 1.0).acos(), cos_lo.clamp(-1.0, 1.0).acos());
+        let steps = (((t1 - t0) / 0.25f64.to_radians()).ceil() as usize).max(SUB);
+        let dt = (t1 - t0) / steps as f64;
+        for i in 0..steps {
+            let theta = t0 + (i as f64 + 0.5) * dt;
+            let (st, ct) = theta.sin_cos();
+            for j in 0..PHI_BINS * SUB {
+                let phi = (j as f64 + 0.5) * dp;
+                let w = Vec3::new((st * phi.cos()) as f32, (st * phi.sin()) as f32, ct as f32);
+                e[c * PHI_BINS + j / SUB] += b.pdf(wo, w) as f64 * st * dt * dp;
+            }
+        }
+    }
+    e
+}
+
+/// 1 − the chi-square distribution's cdf at x for k degrees of freedom (Wilson–Hilferty's
+/// normal approximation, good to 10⁻³ in p for k ≥ 30).
+fn chi2_p_value(x: f64, k: usize) -> f64 {
+    let k = k as f64;
+    let z = ((x / k).powf(1.0 / 3.0) - (1.0 - 2.0 / (9.0 * k))) / (2.0 / (9.0 * k)).sqrt();
+    0.5 * erfc(z / std::f64::consts::SQRT_2)
+}
+
+/// The complementary error function (Numerical Recipes' erfcc, relative error < 1.2·10⁻⁷).
+fn erfc(x: f64) -> f64 {
+    let z = x.abs();
+    let t = 1.0 / (1.0 + 0.5 * z);
+    let r = t
+        * (-z * z - 1.26551223
+            + t * (1.00002368
+                + t * (0.37409196
+                    + t * (0.09678418
+                        + t * (-0.18628806
+                            + t * (0.27886807
+                                + t * (-1.13520398 + t * (1.48851587 + t * (-0.82215223 + t * 0.17087277)))))))))
+            .exp();
+    if x >= 0.0 { r } else { 2.0 - r }
+}
+
+/// Pearson's test of N sampled directions (non-specular samples; specular ones and failures
+/// pooled into one more cell, whose expectation is 1 − ∫pdf) against the density; bins
+/// expecting fewer than 5 samples are pooled too. Returns the p-value.
+fn chi_square(b: &Bsdf, wo: Vec3, n: usize, seed: u32) -> f64 {
+    let expected: Vec<f64> = expected_fractions(b, wo).iter().map(|f| f * n as f64).collect();
+    let mut observed = vec![0.0f64; expected.len()];
+    let mut rng = Rng::new(seed, 7, 11);
+    let mut outside = 0.0;
+    for _ in 0..n {
+        let u = [rng.next_f32(), rng.next_f32(), rng.next_f32()];
+        match b.sample(wo, u, Transport::Radiance) {
+            Some(s) if !s.delta => observed[bin_of(s.wi)] += 1.0,
+            _ => outside += 1.0,
+        }
+    }
+    let mut cells = vec![(n as f64 - expected.iter().sum::<f64>(), outside)];
+    let (mut pooled_e, mut pooled_o) = (0.0, 0.0);
+    for (e, o) in expected.iter().zip(&observed) {
+        if *e < 5.0 {
+            pooled_e += e;
+            pooled_o += o;
+        } else {
+            cells.push((*e, *o));
+        }
+    }
+    cells.push((pooled_e, pooled_o));
+    let cells: Vec<(f64, f64)> = cells.into_iter().filter(|&(e, o)| e >= 5.0 || o > 0.0).collect();
+    let chi2: f64 = cells.iter().map(|&(e, o)| (o - e) * (o - e) / e.max(1e-9)).sum();
+    chi2_p_value(chi2, cells.len() - 1)
+}
+
+/// The materials and outgoing directions every statistical test runs on.
+fn cases() -> Vec<(&'static str, Bsdf, Vec3)> {
+    let c = Vec3::new(0.9, 0.6, 0.3);
+    let mut v = vec![];
+    for (name, b) in [
+        ("diffuse", Bsdf::diffuse(c)),
+        ("metal 0.5", metal(c, 0.5)),
+        ("metal 0.8", metal(c, 0.8)),
+        ("plastic 0.6", plastic(c, 0.6)),
+        ("mix", Bsdf { metallic: 0.5, ..plastic(c, 0.7) }),
+        ("glass 0.6", glass(0.6, false)),
+        ("glass 0.8", glass(0.8, false)),
+        ("thin glass 0.6", glass(0.6, true)),
+        ("half glass", Bsdf { transmission: 0.5, ..plastic(c, 0.7) }),
+        ("smooth plastic", plastic(c, 0.0)),
+    ] {
+        for wo in [dir(10.0, 30.0), dir(60.0, 200.0), dir(150.0, 80.0)] {
+            v.push((name, b, wo));
+        }
+    }
+    v
+}
+
+#[test]
+fn sampled_directions_follow_the_density() {
+    // 18 + 12 cases at a 10⁻⁴ threshold: a false alarm with probability 0.3 %.
+    for (k, (name, b, wo)) in cases().into_iter().enumerate() {
+        let p = chi_square(&b, wo, 400_000, k as u32);
+        assert!(p > 1e-4, "{name}, ω_o = {wo}: chi-square p-value {p:.2e}");
+    }
+}
+
+/// ∫ f(ω_o, ω) |cos θ| dω by a midpoint rule over (cos θ, φ), 1024 × 1024 cells, plus the
+/// specular lobes' reflectance given separately (Dirac deltas have no density to integrate).
+fn albedo_by_quadrature(b: &Bsdf, wo: Vec3, transport: Transport) -> Vec3 {
+    let n = 1024;
+    let (dc, dp) = (2.0 / n as f64, 2.0 * PI / n as f64);
+    let mut sum = [0.0f64; 3];
+    for i in 0..n {
+        let c = -1.0 + (i as f64 + 0.5) * dc;
+        let s = (1.0 - c * c).sqrt();
+        for j in 0..n {
+            let phi = (j as f64 + 0.5) * dp;
+            let w = Vec3::new((s * phi.cos()) as f32, (s * phi.sin()) as f32, c as f32);
+            let f = b.eval(wo, w, transport) * c.abs() as f32;
+            for k in 0..3 {
+                sum[k] += f[k] as f64 * dc * dp;
+            }
+        }
+    }
+    Vec3::new(sum[0] as f32, sum[1] as f32, sum[2] as f32)
+}
+
+/// E[weight] over `n` samples and its standard error (per channel, the largest).
+fn albedo_by_sampling(b: &Bsdf, wo: Vec3, n: usize, transport: Transport) -> (Vec3, f32) {
+    let mut rng = Rng::new(3, 5, 7);
+    let (mut sum, mut sum2) = ([0.0f64; 3], [0.0f64; 3]);
+    for _ in 0..n {
+        let u = [rng.next_f32(), rng.next_f32(), rng.next_f32()];
+        if let Some(s) = b.sample(wo, u, transport) {
+            for k in 0..3 {
+                sum[k] += s.weight[k] as f64;
+                sum2[k] += (s.weight[k] as f64).powi(2);
+            }
+        }
+    }
+    let mean = sum.map(|s| s / n as f64);
+    let se = (0..3).map(|k| ((sum2[k] / n as f64 - mean[k] * mean[k]).max(0.0) / n as f64).sqrt()).fold(0.0, f64::max);
+    (Vec3::new(mean[0] as f32, mean[1] as f32, mean[2] as f32), se as f32)
+}
+
+#[test]
+fn sampling_agrees_with_evaluation() {
+    // The rough cases (no specular lobe): the mean sample weight estimates ∫ f |cos| dω,
+    // which the quadrature of `eval` computes independently of `sample` and `pdf`.
+    for (name, b, wo) in cases().into_iter().filter(|(n, ..)| !n.starts_with("smooth")) {
+        for transport in [Transport::Radiance, Transport::Importance] {
+            let q = albedo_by_quadrature(&b, wo, transport);
+            let (s, se) = albedo_by_sampling(&b, wo, 400_000, transport);
+            let tol = 5.0 * se + 2e-3 * q.max_element();
+            assert!(
+                (q - s).abs().max_element() < tol,
+                "{name}, ω_o = {wo}, {transport:?}: quadrature {q}, sampling {s} ± {se}"
+            );
+        }
+    }
+}
+
+#[test]
+fn reflection_is_reciprocal_and_refraction_obeys_the_eta_squared_rule() {
+    let mut rng = Rng::new(9, 9, 9);
+    for (name, b, _) in cases() {
+        for _ in 0..2000 {
+            let a = crate::sampling::uniform_sphere(rng.next_f32(), rng.next_f32());
+            let c = crate::sampling::uniform_sphere(rng.next_f32(), rng.next_f32());
+            // Within 2° of the critical angle on the microfacet, the Fresnel term's slope is
+            // unbounded and f32 cannot resolve it: skip those pairs of a solid.
+            if b.transmission > 0.0 && !b.thin && a.z * c.z < 0.0 {
+                let h = (if a.z > 0.0 { c * b.ior + a } else { a * b.ior + c }).normalize();
+                if h.dot(a).abs().min(h.dot(c).abs()) < 2f32.to_radians().sin() {
+                    continue;
+                }
+            }
+            // f(a → c) η(c)² = f(c → a) η(a)², η(w) the index on w's side: 1 above, η below for
+            // a solid (reflection and thin slabs: both 1).
+            let eta = |w: Vec3| if b.transmission > 0.0 && !b.thin && w.z < 0.0 { b.ior } else { 1.0 };
+            let lhs = b.eval(a, c, Transport::Radiance) * eta(c).powi(2);
+            let rhs = b.eval(c, a, Transport::Radiance) * eta(a).powi(2);
+            let scale = lhs.max_element().max(rhs.max_element()).max(1e-3);
+            assert!((lhs - rhs).abs().max_element() < 2e-3 * scale, "{name}: f({a} → {c}) = {lhs}, reversed {rhs}");
+            // Importance transport's BTDF is the adjoint: f*(a → c) = f(c → a).
+            let adj = b.eval(a, c, Transport::Importance);
+            let rev = b.eval(c, a, Transport::Radiance);
+            assert!(
+                (adj - rev).abs().max_element() < 2e-3 * scale.max(rev.max_element()),
+                "{name}: adjoint {adj} vs {rev}"
+            );
+        }
+    }
+}
+
+#[test]
+fn white_furnace() {
+    let white = Vec3::ONE;
+    let mut rows = vec![];
+    for theta in [0.0f32, 45.0, 80.0] {
+        let wo = dir(theta, 20.0);
+        let albedo = |b: Bsdf| albedo_by_sampling(&b, wo, 200_000, Transport::Importance);
+        // Lossless lobes: a white diffuse surface, a white mirror, smooth glass (R + T from
+        // either side) and a thin slab reflect or pass all the energy.
+        for (name, b) in [
+            ("diffuse", Bsdf::diffuse(white)),
+            ("mirror", metal(white, 0.0)),
+            ("smooth specular layer over diffuse", plastic(white, 0.0)),
+            ("glass", glass(0.0, false)),
+            ("thin glass", glass(0.0, true)),
+        ] {
+            for w in [wo, -wo] {
+                let (a, se) = albedo_by_sampling(&b, w, 200_000, Transport::Importance);
+                assert!((a - Vec3::ONE).abs().max_element() < 5.0 * se + 1e-4, "{name} at {theta}°: albedo {a} ± {se}");
+            }
+        }
+        // Rough lobes lose energy to the bounces between microfacets that single scattering
+        // leaves out, and gain none.
+        for r in [0.3f32, 0.6, 1.0] {
+            let (m, se) = albedo(metal(white, r));
+            let (g, se_g) = albedo(glass(r, false));
+            rows.push(format!("θ {theta:>2}°, roughness {r}: metal {:.4}, glass {:.4}", m.x, g.x));
+            assert!(m.max_element() < 1.0 + 5.0 * se && g.max_element() < 1.0 + 5.0 * se_g);
+            // A mix is the mix of its lobes' albedos (each lobe weighted as the model says).
+            let (mix, se_mix) = albedo(Bsdf { metallic: 0.3, ..metal(white, r) });
+            let (d, _) = albedo(Bsdf::diffuse(white));
+            let (layer, _) = albedo(plastic(white, r));
+            let want = 0.3 * m + 0.7 * layer;
+            assert!((mix - want).abs().max_element() < 5.0 * (se_mix + se) + 2e-3, "mix {mix} vs {want}");
+            // A rough specular layer over a white diffuse base loses what its microfacets do.
+            rows.push(format!("θ {theta:>2}°, roughness {r}: specular layer over white diffuse {:.4}", layer.x));
+            assert!(layer.max_element() < d.max_element() + 5.0 * se_mix, "layer {layer} vs diffuse {d}");
+        }
+    }
+    println!("white furnace (single-scattering GGX, no compensation):\n{}", rows.join("\n"));
+}
+
+#[test]
+fn fresnel_terms_match_their_closed_forms() {
+    // Normal incidence: ((η − 1)/(η + 1))² = 0.04 for η = 1.5, from either side.
+    assert!((fresnel_dielectric(1.0, 1.5) - 0.04).abs() < 1e-6);
+    assert!((fresnel_dielectric(-1.0, 1.5) - 0.04).abs() < 1e-6);
+    // Brewster's angle tan θ_B = η: the parallel part vanishes, F = r_⊥²/2 with
+    // r_⊥ = (cos θ_i − η cos θ_t)/(cos θ_i + η cos θ_t) and θ_t = 90° − θ_B.
+    let tb = 1.5f64.atan();
+    let (ci, ct) = (tb.cos(), tb.sin());
+    let r_perp = (ci - 1.5 * ct) / (ci + 1.5 * ct);
+    assert!((fresnel_dielectric(ci as f32, 1.5) as f64 - r_perp * r_perp / 2.0).abs() < 1e-6);
+    // Total internal reflection past the critical angle asin(1/η) from inside.
+    let critical = (1.0f32 / 1.5).asin();
+    assert_eq!(fresnel_dielectric(-(critical + 0.01).cos(), 1.5), 1.0);
+    assert!(fresnel_dielectric(-(critical - 0.01).cos(), 1.5) < 1.0);
+    // Schlick: f₀ at normal incidence, 1 at grazing.
+    let c = Vec3::new(0.9, 0.6, 0.3);
+    assert_eq!(schlick(c, 1.0), c);
+    assert!((schlick(c, 0.0) - Vec3::ONE).abs().max_element() < 1e-6);
+    // A smooth white glass's reflected share at normal incidence is 4 %: of 10⁵ samples,
+    // 4000 ± 62 reflect.
+    let g = glass(0.0, false);
+    let mut rng = Rng::new(1, 2, 3);
+    let reflected = (0..100_000)
+        .filter(|_| {
+            g.sample(Vec3::Z, [rng.next_f32(), rng.next_f32(), rng.next_f32()], Transport::Radiance).unwrap().wi.z > 0.0
+        })
+        .count();
+    assert!((reflected as f64 - 4000.0).abs() < 5.0 * 62.0, "{reflected}");
+}
+
+#[test]
+fn glass_refracts_by_snells_law_and_scales_radiance_by_eta_squared() {
+    let g = glass(0.0, false);
+    let wo = dir(40.0, 0.0);
+    // Take the transmitted branch: u0 past F.
+    let s = g.sample(wo, [0.99, 0.5, 0.5], Transport::Radiance).unwrap();
+    assert!(s.delta && s.wi.z < 0.0);
+    let sin_t = (1.0 - s.wi.z * s.wi.z).sqrt();
+    assert!((40f32.to_radians().sin() - 1.5 * sin_t).abs() < 1e-5, "Snell: {}", sin_t);
+    // Seen from outside, light refracted out of glass: radiance × (1 − F)/η².
+    let f = fresnel_dielectric(wo.z, 1.5);
+    assert!((s.weight.x * (1.0 - f) - (1.0 - f) / 2.25).abs() < 1e-5, "{}", s.weight.x);
+    let i = g.sample(wo, [0.99, 0.5, 0.5], Transport::Importance).unwrap();
+    assert!((i.weight.x - 1.0).abs() < 1e-6);
+}
+
+#[test]
+fn a_lambertian_model_evaluates_to_albedo_over_pi() {
+    let c = Vec3::new(0.8, 0.5, 0.2);
+    let b = Bsdf::diffuse(c);
+    assert!(b.is_lambertian());
+    let f = b.eval(dir(30.0, 10.0), dir(70.0, 250.0), Transport::Radiance);
+    assert!((f - c / std::f32::consts::PI).abs().max_element() < 1e-7);
+    // Both on the back side: a two-sided surface reflects alike; opposite sides: nothing.
+    assert_eq!(b.eval(-dir(30.0, 10.0), -dir(70.0, 250.0), Transport::Radiance), f);
+    assert_eq!(b.eval(dir(30.0, 10.0), -dir(70.0, 250.0), Transport::Radiance), Vec3::ZERO);
+}

@@ -13,6 +13,10 @@ pub const MATERIAL_ALPHA_MASK: u32 = 2;
 pub const MATERIAL_ALPHA_BLEND: u32 = 4;
 /// Material flag: it reads some texture (so its points need texture coordinates).
 pub const MATERIAL_TEXTURED: u32 = 8;
+/// Material flag: thin-walled glass ([`crate::bsdf::Bsdf::thin`]).
+pub const MATERIAL_THIN: u32 = 16;
+/// Material flag: it scatters as a plain Lambertian surface (f = ρ/π), the fast path.
+pub const MATERIAL_LAMBERTIAN: u32 = 32;
 /// Most holes a ray passes through before it counts as stopped (`trace` in `bvh.wgsl`).
 pub const MAX_HOLE_CROSSINGS: u32 = 256;
 /// A texture slot without a texture.

@@ -58,6 +58,13 @@ pub struct GpuMaterial {
     pub flags: u32,
     pub emission: [f32; 3],
     pub opacity: f32,
+    /// The scattering model ([`crate::bsdf::Bsdf`]; `Material`'s fields of the same names).
+    pub metallic: f32,
+    pub roughness: f32,
+    pub specular: f32,
+    pub ior: f32,
+    pub transmission: f32,
+    pub _pad: [u32; 3],
 }
 
 /// `MaterialMaps` in `gpu_scene.wgsl`: a material's textures and their parameters, at the
@@ -72,6 +79,7 @@ pub struct GpuMaterialMaps {
     pub emission_map: GpuTextureSlot,
     pub opacity_map: GpuTextureSlot,
     pub normal_map: GpuTextureSlot,
+    pub metal_rough_map: GpuTextureSlot,
 }
 
 impl GpuMaterial {
@@ -85,9 +93,17 @@ impl GpuMaterial {
             albedo: m.albedo.into(),
             flags: if m.two_sided { MATERIAL_TWO_SIDED } else { 0 }
                 | alpha
-                | if m.texture_refs().next().is_some() { MATERIAL_TEXTURED } else { 0 },
+                | if m.texture_refs().next().is_some() { MATERIAL_TEXTURED } else { 0 }
+                | if m.thin { MATERIAL_THIN } else { 0 }
+                | if m.is_lambertian() { MATERIAL_LAMBERTIAN } else { 0 },
             emission: m.emission.into(),
             opacity: m.opacity,
+            metallic: m.metallic,
+            roughness: m.roughness,
+            specular: m.specular,
+            ior: m.ior,
+            transmission: m.transmission,
+            _pad: [0; 3],
         };
         let maps = GpuMaterialMaps {
             alpha_cutoff,
@@ -99,13 +115,15 @@ impl GpuMaterial {
             emission_map: GpuTextureSlot::new(m.emission_texture),
             opacity_map: GpuTextureSlot::new(m.opacity_texture),
             normal_map: GpuTextureSlot::new(m.normal_texture),
+            metal_rough_map: GpuTextureSlot::new(m.metal_rough_texture),
         };
         (material, maps)
     }
 }
 
 pub use crate::consts::{
-    MATERIAL_ALPHA_BLEND, MATERIAL_ALPHA_MASK, MATERIAL_TEXTURED, MATERIAL_TWO_SIDED, NO_TEXTURE, TRIANGLE_HAS_HOLES,
+    MATERIAL_ALPHA_BLEND, MATERIAL_ALPHA_MASK, MATERIAL_LAMBERTIAN, MATERIAL_TEXTURED, MATERIAL_THIN, MATERIAL_TWO_SIDED,
+    NO_TEXTURE, TRIANGLE_HAS_HOLES,
 };
 
 /// A scene prepared for rendering: triangles permuted into BVH order, with the BVH and the
@@ -188,6 +206,14 @@ impl PreparedScene {
             }
             None => m.albedo,
         }
+    }
+
+    /// The scattering model at barycentrics (b1, b2) of triangle `tri`, its albedo texture read
+    /// at `lod` (`surface_bsdf(surface_at(…))` in WGSL).
+    pub fn bsdf_at(&self, tri: usize, b1: f32, b2: f32, lod: f32) -> crate::bsdf::Bsdf {
+        let m = self.scene.material_of(tri);
+        let mr = m.metal_rough_texture.map_or(Vec3::ONE, |t| self.texel(t, tri, b1, b2, 0.0).truncate());
+        m.bsdf(self.albedo_at(tri, b1, b2, lod), mr)
     }
 
     /// The emitted radiance at barycentrics (b1, b2) of triangle `tri` (`surface_at(…).emission`).

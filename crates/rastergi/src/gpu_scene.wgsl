@@ -26,6 +26,13 @@ struct Material {
     flags: u32,
     emission: vec3f,
     opacity: f32,
+    // The scattering model (bsdf.wgsl): perceptual roughness, α = roughness².
+    metallic: f32,
+    roughness: f32,
+    specular: f32,
+    ior: f32,
+    transmission: f32,
+    _pad: vec3u,
 }
 
 // A material's textures and their parameters (gpu_scene.rs, GpuMaterialMaps).
@@ -37,6 +44,8 @@ struct MaterialMaps {
     emission_map: TextureSlot,
     opacity_map: TextureSlot,
     normal_map: TextureSlot,
+    // Linear: roughness × G, metallic × B.
+    metal_rough_map: TextureSlot,
 }
 
 struct BvhNode {
@@ -101,7 +110,8 @@ const NO_TRIANGLE: u32 = 0xffffffffu;
 
 // A point on a surface: position, front-face geometric normal, shading normal (interpolated,
 // in the geometric normal's hemisphere; the geometric normal where the triangle has none)
-// and material.
+// and material: its base colour `albedo`, emission, flags and scattering model (bsdf.wgsl;
+// metallic and roughness with their texture applied).
 struct Surface {
     pos: vec3f,
     normal: vec3f,
@@ -110,6 +120,11 @@ struct Surface {
     emission: vec3f,
     flags: u32,
     tri: u32,
+    metallic: f32,
+    roughness: f32,
+    specular: f32,
+    ior: f32,
+    transmission: f32,
 }
 
 // Vertex `vi` of the scene drawn as one non-indexed triangle list (vertex pulling in the
@@ -328,7 +343,27 @@ fn surface_at(tri: u32, b1: f32, b2: f32, lod: f32) -> Surface {
     }
     s.flags = m.flags;
     s.tri = tri;
+    s.metallic = m.metallic;
+    s.roughness = m.roughness;
+    s.specular = m.specular;
+    s.ior = m.ior;
+    s.transmission = m.transmission;
+    if textured {
+        let map = material_maps[mi].metal_rough_map;
+        if map.layer != NO_TEXTURE {
+            let mr = slot_sample(map, uv, 0.0);
+            s.roughness *= mr.g;
+            s.metallic *= mr.b;
+        }
+    }
     return s;
+}
+
+// The model at a surface point (PreparedScene::bsdf_at).
+fn surface_bsdf(s: Surface) -> Bsdf {
+    let r = clamp(s.roughness, 0.0, 1.0);
+    return Bsdf(s.albedo, clamp(s.metallic, 0.0, 1.0), r * r, s.specular, s.ior, s.transmission,
+        (s.flags & MATERIAL_THIN) != 0u);
 }
 
 // Whether the scene has emitters: an empty light table is stored as one zero entry (a

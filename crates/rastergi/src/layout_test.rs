@@ -64,11 +64,15 @@ fn twins() -> Vec<Twin> {
         ),
         twin!(GpuTriangle, "Triangle", [v0, material, v1, flags, v2]),
         twin!(GpuTextureSlot, "TextureSlot", [u, layer, v]),
-        twin!(GpuMaterial, "Material", [albedo, flags, emission, opacity]),
+        twin!(
+            GpuMaterial,
+            "Material",
+            [albedo, flags, emission, opacity, metallic, roughness, specular, ior, transmission]
+        ),
         twin!(
             GpuMaterialMaps,
             "MaterialMaps",
-            [alpha_cutoff, normal_scale, albedo_map, emission_map, opacity_map, normal_map]
+            [alpha_cutoff, normal_scale, albedo_map, emission_map, opacity_map, normal_map, metal_rough_map]
         ),
         twin!(BvhNode, "BvhNode", [min, offset, max, count]),
         twin!(LightEntry, "LightEntry", [triangle, cdf, pmf, area]),

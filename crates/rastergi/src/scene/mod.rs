@@ -116,6 +116,22 @@ pub struct Material {
     pub normal_scale: f32,
     /// Whether the back face reflects too (it never emits).
     pub two_sided: bool,
+    /// The scattering model's parameters ([`crate::bsdf::Bsdf`]): `albedo` is its base colour.
+    /// glTF's metallic factor (× the blue channel of `metal_rough_texture`).
+    pub metallic: f32,
+    /// Perceptual roughness r (× the green channel of `metal_rough_texture`): GGX α = r².
+    pub roughness: f32,
+    /// glTF's `metallicRoughnessTexture` (linear): roughness in G, metallic in B.
+    pub metal_rough_texture: Option<TextureRef>,
+    /// Weight of the dielectric specular layer (`KHR_materials_specular`'s specularFactor):
+    /// 1 for glTF materials, 0 for a plain Lambertian surface.
+    pub specular: f32,
+    /// Index of refraction (`KHR_materials_ior`, MTL `Ni`).
+    pub ior: f32,
+    /// `KHR_materials_transmission`'s factor: the share of the dielectric that is glass.
+    pub transmission: f32,
+    /// Thin-walled glass (glTF transmission without `KHR_materials_volume`): no refraction.
+    pub thin: bool,
 }
 
 impl Material {
@@ -133,7 +149,34 @@ impl Material {
             normal_texture: None,
             normal_scale: 1.0,
             two_sided: false,
+            metallic: 0.0,
+            roughness: 1.0,
+            metal_rough_texture: None,
+            specular: 0.0,
+            ior: 1.5,
+            transmission: 0.0,
+            thin: false,
         }
+    }
+
+    /// The scattering model with base colour `base` (the albedo × its texel) and the
+    /// metallic-roughness texel `mr` (G roughness, B metallic; ones without a texture).
+    pub fn bsdf(&self, base: Vec3, mr: Vec3) -> crate::bsdf::Bsdf {
+        let r = (self.roughness * mr.y).clamp(0.0, 1.0);
+        crate::bsdf::Bsdf {
+            base,
+            metallic: (self.metallic * mr.z).clamp(0.0, 1.0),
+            alpha: r * r,
+            specular: self.specular,
+            ior: self.ior,
+            transmission: self.transmission,
+            thin: self.thin,
+        }
+    }
+
+    /// Whether it scatters as a plain Lambertian surface (f = ρ/π).
+    pub fn is_lambertian(&self) -> bool {
+        self.metallic == 0.0 && self.transmission == 0.0 && self.specular == 0.0
     }
 
     pub fn is_emitter(&self) -> bool {
@@ -152,7 +195,12 @@ impl Material {
     /// The textures the material reads.
     pub fn texture_refs(&self) -> impl Iterator<Item = TextureRef> + '_ {
         let albedo = self.albedo_texture.map(|texture| TextureRef { texture, transform: self.albedo_transform });
-        albedo.into_iter().chain(self.emission_texture).chain(self.opacity_texture).chain(self.normal_texture)
+        albedo
+            .into_iter()
+            .chain(self.emission_texture)
+            .chain(self.opacity_texture)
+            .chain(self.normal_texture)
+            .chain(self.metal_rough_texture)
     }
 }
 

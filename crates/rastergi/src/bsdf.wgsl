@@ -1,0 +1,414 @@
+// The scattering model (bsdf.rs states the math; this is its twin, checked against it on the
+// GPU by bsdf::eval_on_gpu). Directions are unit vectors away from the surface in the shading
+// frame (z = the front face's shading normal).
+
+const SMOOTH_ALPHA: f32 = 1e-3;
+const TRANSPORT_RADIANCE: u32 = 0u;
+const TRANSPORT_IMPORTANCE: u32 = 1u;
+
+struct Bsdf {
+    base: vec3f,
+    metallic: f32,
+    alpha: f32,
+    specular: f32,
+    ior: f32,
+    transmission: f32,
+    thin: bool,
+}
+
+struct BsdfSample {
+    wi: vec3f,
+    weight: vec3f,
+    pdf: f32,
+    delta: bool,
+    // False where nothing was sampled.
+    ok: bool,
+}
+
+fn bsdf_is_smooth(b: Bsdf) -> bool {
+    return b.alpha < SMOOTH_ALPHA;
+}
+
+fn mean3(c: vec3f) -> f32 {
+    return (c.x + c.y + c.z) / 3.0;
+}
+
+fn schlick_weight(c: f32) -> f32 {
+    let m = clamp(1.0 - c, 0.0, 1.0);
+    let m2 = m * m;
+    return m2 * m2 * m;
+}
+
+fn schlick(f0: vec3f, c: f32) -> vec3f {
+    return f0 + (vec3f(1.0) - f0) * schlick_weight(c);
+}
+
+fn fresnel_dielectric(cos_in: f32, eta_in: f32) -> f32 {
+    var c = cos_in;
+    var eta = eta_in;
+    if c < 0.0 {
+        c = -c;
+        eta = 1.0 / eta;
+    }
+    let sin2_t = max(1.0 - c * c, 0.0) / (eta * eta);
+    if sin2_t >= 1.0 {
+        return 1.0;
+    }
+    let cos_t = sqrt(max(1.0 - sin2_t, 0.0));
+    let r_parl = (eta * c - cos_t) / (eta * c + cos_t);
+    let r_perp = (c - eta * cos_t) / (c + eta * cos_t);
+    return 0.5 * (r_parl * r_parl + r_perp * r_perp);
+}
+
+fn slab_reflectance(r: f32) -> f32 {
+    if r >= 1.0 {
+        return 1.0;
+    }
+    return 2.0 * r / (1.0 + r);
+}
+
+fn ggx_d(h: vec3f, alpha: f32) -> f32 {
+    if h.z <= 0.0 {
+        return 0.0;
+    }
+    let a2 = alpha * alpha;
+    let t = h.z * h.z * (a2 - 1.0) + 1.0;
+    return a2 / (PI * t * t);
+}
+
+fn ggx_g1(w: vec3f, h: vec3f, alpha: f32) -> f32 {
+    if dot(w, h) * w.z <= 0.0 {
+        return 0.0;
+    }
+    let a2 = alpha * alpha;
+    return 2.0 * abs(w.z) / (abs(w.z) + sqrt(a2 + (1.0 - a2) * w.z * w.z));
+}
+
+fn vndf_pdf(w: vec3f, h: vec3f, alpha: f32) -> f32 {
+    if w.z == 0.0 {
+        return 0.0;
+    }
+    return ggx_g1(w, h, alpha) * abs(dot(w, h)) * ggx_d(h, alpha) / abs(w.z);
+}
+
+fn vndf_sample(w_in: vec3f, alpha: f32, u1: f32, u2: f32) -> vec3f {
+    let w = select(w_in, -w_in, w_in.z < 0.0);
+    let vh = normalize(vec3f(alpha * w.x, alpha * w.y, w.z));
+    let len2 = vh.x * vh.x + vh.y * vh.y;
+    var t1 = vec3f(1.0, 0.0, 0.0);
+    if len2 > 0.0 {
+        t1 = vec3f(-vh.y, vh.x, 0.0) / sqrt(len2);
+    }
+    let t2 = cross(vh, t1);
+    let r = sqrt(u1);
+    let phi = 2.0 * PI * u2;
+    let p1 = r * cos(phi);
+    let s = 0.5 * (1.0 + vh.z);
+    let p2 = (1.0 - s) * sqrt(max(1.0 - p1 * p1, 0.0)) + s * r * sin(phi);
+    let nh = t1 * p1 + t2 * p2 + vh * sqrt(max(1.0 - p1 * p1 - p2 * p2, 0.0));
+    return normalize(vec3f(alpha * nh.x, alpha * nh.y, max(nh.z, 1e-6)));
+}
+
+fn reflect_about(w: vec3f, h: vec3f) -> vec3f {
+    return 2.0 * dot(w, h) * h - w;
+}
+
+// w refracted through h for the relative index of the side h faces; w = 0 under total internal
+// reflection. Returns (direction, η' used).
+fn refract_through(w: vec3f, h_in: vec3f, eta_in: f32) -> vec4f {
+    var c = dot(h_in, w);
+    var eta = eta_in;
+    var h = h_in;
+    if c < 0.0 {
+        eta = 1.0 / eta;
+        c = -c;
+        h = -h;
+    }
+    let sin2_t = max(1.0 - c * c, 0.0) / (eta * eta);
+    if sin2_t >= 1.0 {
+        return vec4f(0.0);
+    }
+    let cos_t = sqrt(1.0 - sin2_t);
+    return vec4f(-w / eta + (c / eta - cos_t) * h, eta);
+}
+
+fn mirror_z(w: vec3f) -> vec3f {
+    return vec3f(w.x, w.y, -w.z);
+}
+
+fn layer_f0(b: Bsdf) -> f32 {
+    let r = (b.ior - 1.0) / (b.ior + 1.0);
+    return r * r;
+}
+
+fn layer_fresnel(b: Bsdf, c: f32) -> f32 {
+    let f0 = layer_f0(b);
+    return b.specular * (f0 + (1.0 - f0) * schlick_weight(c));
+}
+
+fn diffuse_share(b: Bsdf, cos_o: f32, cos_i: f32) -> f32 {
+    if b.specular == 0.0 {
+        return 1.0;
+    }
+    let f0 = layer_f0(b);
+    let m = b.specular * (f0 + (1.0 - f0) / 21.0);
+    return (1.0 - layer_fresnel(b, cos_o)) * (1.0 - layer_fresnel(b, cos_i)) / (1.0 - m);
+}
+
+// The lobes' probabilities (metal, layer, diffuse, glass) for |cos θ_o|.
+fn lobe_probabilities(b: Bsdf, cos_o: f32) -> vec4f {
+    let m = b.metallic;
+    let opaque = (1.0 - m) * (1.0 - b.transmission);
+    let fs = layer_fresnel(b, cos_o);
+    let w = vec4f(m * mean3(schlick(b.base, cos_o)), opaque * fs, opaque * (1.0 - fs) * mean3(b.base),
+        (1.0 - m) * b.transmission);
+    let total = w.x + w.y + w.z + w.w;
+    if total > 0.0 {
+        return w / total;
+    }
+    return vec4f(0.0);
+}
+
+// The generalized half vector of a solid glass's pair (wo, wi) and η' (bsdf.rs glass_eval):
+// (h, η'), or η' = 0 where the pair has none.
+fn glass_half(b: Bsdf, wo: vec3f, wi: vec3f) -> vec4f {
+    let reflected = wo.z * wi.z > 0.0;
+    var etap = 1.0;
+    if !reflected {
+        etap = select(1.0 / b.ior, b.ior, wo.z > 0.0);
+    }
+    var h = wi * etap + wo;
+    if dot(h, h) == 0.0 {
+        return vec4f(0.0);
+    }
+    h = normalize(h);
+    h = select(h, -h, h.z < 0.0);
+    if dot(h, wi) * wi.z < 0.0 || dot(h, wo) * wo.z < 0.0 {
+        return vec4f(0.0);
+    }
+    return vec4f(h, etap);
+}
+
+fn glass_eval(b: Bsdf, wo: vec3f, wi: vec3f, transport: u32) -> vec3f {
+    if bsdf_is_smooth(b) || wo.z == 0.0 || wi.z == 0.0 {
+        return vec3f(0.0);
+    }
+    let a = b.alpha;
+    if b.thin {
+        let o = select(wo, -wo, wo.z < 0.0);
+        let i = select(wi, -wi, wo.z < 0.0);
+        let reflected = i.z > 0.0;
+        let ir = select(mirror_z(i), i, reflected);
+        let h = normalize(o + ir);
+        let r = slab_reflectance(fresnel_dielectric(dot(o, h), b.ior));
+        let w = select((1.0 - r) * b.base, vec3f(r), reflected);
+        return w * ggx_d(h, a) * ggx_g1(o, h, a) * ggx_g1(ir, h, a) / (4.0 * o.z * ir.z);
+    }
+    let he = glass_half(b, wo, wi);
+    if he.w == 0.0 {
+        return vec3f(0.0);
+    }
+    let h = he.xyz;
+    let etap = he.w;
+    let f = fresnel_dielectric(dot(wo, h), b.ior);
+    let dg = ggx_d(h, a) * ggx_g1(wo, h, a) * ggx_g1(wi, h, a);
+    if wo.z * wi.z > 0.0 {
+        return vec3f(dg * f / abs(4.0 * wo.z * wi.z));
+    }
+    let s = dot(wi, h) + dot(wo, h) / etap;
+    let denom = s * s * wi.z * wo.z;
+    var ft = dg * (1.0 - f) * abs(dot(wi, h) * dot(wo, h) / denom);
+    if transport == TRANSPORT_RADIANCE {
+        ft /= etap * etap;
+    }
+    return ft * b.base;
+}
+
+fn glass_pdf(b: Bsdf, wo: vec3f, wi: vec3f) -> f32 {
+    if bsdf_is_smooth(b) || wo.z == 0.0 || wi.z == 0.0 {
+        return 0.0;
+    }
+    let a = b.alpha;
+    if b.thin {
+        let o = select(wo, -wo, wo.z < 0.0);
+        let i = select(wi, -wi, wo.z < 0.0);
+        let reflected = i.z > 0.0;
+        let ir = select(mirror_z(i), i, reflected);
+        let h = normalize(o + ir);
+        let r = slab_reflectance(fresnel_dielectric(dot(o, h), b.ior));
+        return vndf_pdf(o, h, a) / (4.0 * abs(dot(o, h))) * select(1.0 - r, r, reflected);
+    }
+    let he = glass_half(b, wo, wi);
+    if he.w == 0.0 {
+        return 0.0;
+    }
+    let h = he.xyz;
+    let r = fresnel_dielectric(dot(wo, h), b.ior);
+    if wo.z * wi.z > 0.0 {
+        return vndf_pdf(wo, h, a) / (4.0 * abs(dot(wo, h))) * r;
+    }
+    let s = dot(wi, h) + dot(wo, h) / he.w;
+    return vndf_pdf(wo, h, a) * abs(dot(wi, h)) / (s * s) * (1.0 - r);
+}
+
+// f(wo, wi) of the non-specular lobes (Bsdf::eval).
+fn bsdf_eval(b: Bsdf, wo: vec3f, wi: vec3f, transport: u32) -> vec3f {
+    var f = vec3f(0.0);
+    let opaque = (1.0 - b.metallic) * (1.0 - b.transmission);
+    if b.transmission > 0.0 && b.metallic < 1.0 {
+        f += (1.0 - b.metallic) * b.transmission * glass_eval(b, wo, wi, transport);
+    }
+    let o = select(wo, -wo, wo.z < 0.0);
+    let i = select(wi, -wi, wo.z < 0.0);
+    if o.z <= 0.0 || i.z <= 0.0 {
+        return f;
+    }
+    let h = normalize(o + i);
+    let vh = dot(o, h);
+    f += opaque * b.base * (diffuse_share(b, o.z, i.z) / PI);
+    if !bsdf_is_smooth(b) {
+        let a = b.alpha;
+        let spec = ggx_d(h, a) * ggx_g1(o, h, a) * ggx_g1(i, h, a) / (4.0 * o.z * i.z);
+        f += spec * (b.metallic * schlick(b.base, vh) + vec3f(opaque * layer_fresnel(b, vh)));
+    }
+    return f;
+}
+
+// The density with which bsdf_sample draws wi (its non-specular lobes; Bsdf::pdf).
+fn bsdf_pdf(b: Bsdf, wo: vec3f, wi: vec3f) -> f32 {
+    let p = lobe_probabilities(b, abs(wo.z));
+    var pdf = p.w * glass_pdf(b, wo, wi);
+    let o = select(wo, -wo, wo.z < 0.0);
+    let i = select(wi, -wi, wo.z < 0.0);
+    if o.z <= 0.0 || i.z <= 0.0 {
+        return pdf;
+    }
+    pdf += p.z * i.z / PI;
+    if !bsdf_is_smooth(b) {
+        let h = normalize(o + i);
+        pdf += (p.x + p.y) * vndf_pdf(o, h, b.alpha) / (4.0 * dot(o, h));
+    }
+    return pdf;
+}
+
+fn no_sample() -> BsdfSample {
+    return BsdfSample(vec3f(0.0), vec3f(0.0), 0.0, false, false);
+}
+
+// The sample of a non-specular direction wi: its weight f·|cos θ_i|/pdf.
+fn finish_sample(b: Bsdf, wo: vec3f, wi: vec3f, transport: u32) -> BsdfSample {
+    let pdf = bsdf_pdf(b, wo, wi);
+    if pdf <= 0.0 {
+        return no_sample();
+    }
+    return BsdfSample(wi, bsdf_eval(b, wo, wi, transport) * (abs(wi.z) / pdf), pdf, false, true);
+}
+
+// A direction for wo from three uniforms (Bsdf::sample).
+fn bsdf_sample(b: Bsdf, wo: vec3f, u: vec3f, transport: u32) -> BsdfSample {
+    if wo.z == 0.0 {
+        return no_sample();
+    }
+    let p = lobe_probabilities(b, abs(wo.z));
+    var u0 = u.x;
+    var lobe = 4u;
+    for (var k = 0u; k < 4u; k++) {
+        if p[k] > 0.0 {
+            lobe = k;
+            if u0 < p[k] {
+                break;
+            }
+            u0 -= p[k];
+        }
+    }
+    if lobe == 4u {
+        return no_sample();
+    }
+    let pl = p[lobe];
+    u0 = clamp(u0 / pl, 0.0, 0.99999994);
+    let side = select(1.0, -1.0, wo.z < 0.0);
+    let o = wo * side;
+    if lobe == 3u {
+        return sample_glass(b, wo, u0, u.y, u.z, pl, transport);
+    }
+    var wi: vec3f;
+    if lobe == 2u {
+        wi = cosine_hemisphere(vec3f(0.0, 0.0, 1.0), u.y, u.z);
+    } else if bsdf_is_smooth(b) {
+        var w = vec3f((1.0 - b.metallic) * (1.0 - b.transmission) * layer_fresnel(b, o.z));
+        if lobe == 0u {
+            w = b.metallic * schlick(b.base, o.z);
+        }
+        return BsdfSample(vec3f(-o.x, -o.y, o.z) * side, w / pl, pl, true, true);
+    } else {
+        wi = reflect_about(o, vndf_sample(o, b.alpha, u.y, u.z));
+    }
+    if wi.z <= 0.0 {
+        return no_sample();
+    }
+    return finish_sample(b, wo, wi * side, transport);
+}
+
+fn sample_glass(b: Bsdf, wo: vec3f, u0: f32, u1: f32, u2: f32, p: f32, transport: u32) -> BsdfSample {
+    let scale = 1.0 - b.metallic;
+    if bsdf_is_smooth(b) {
+        if b.thin {
+            let r = slab_reflectance(fresnel_dielectric(abs(wo.z), b.ior));
+            if u0 < r {
+                return BsdfSample(mirror_z(-wo), vec3f(scale / p), p * r, true, true);
+            }
+            return BsdfSample(-wo, scale * b.base / p, p * (1.0 - r), true, true);
+        }
+        let r = fresnel_dielectric(wo.z, b.ior);
+        if u0 < r {
+            return BsdfSample(mirror_z(-wo), vec3f(scale / p), p * r, true, true);
+        }
+        let t = refract_through(wo, vec3f(0.0, 0.0, 1.0), b.ior);
+        if t.w == 0.0 {
+            return no_sample();
+        }
+        var w = scale * b.base / p;
+        if transport == TRANSPORT_RADIANCE {
+            w /= t.w * t.w;
+        }
+        return BsdfSample(t.xyz, w, p * (1.0 - r), true, true);
+    }
+    var wi: vec3f;
+    if b.thin {
+        let side = select(1.0, -1.0, wo.z < 0.0);
+        let o = wo * side;
+        let h = vndf_sample(o, b.alpha, u1, u2);
+        let ir = reflect_about(o, h);
+        if ir.z <= 0.0 {
+            return no_sample();
+        }
+        let r = slab_reflectance(fresnel_dielectric(dot(o, h), b.ior));
+        wi = select(mirror_z(ir), ir, u0 < r) * side;
+    } else {
+        let h = vndf_sample(wo, b.alpha, u1, u2);
+        let r = fresnel_dielectric(dot(wo, h), b.ior);
+        if u0 < r {
+            wi = reflect_about(wo, h);
+            if wi.z * wo.z <= 0.0 {
+                return no_sample();
+            }
+        } else {
+            let t = refract_through(wo, h, b.ior);
+            if t.w == 0.0 || t.z * wo.z >= 0.0 {
+                return no_sample();
+            }
+            wi = t.xyz;
+        }
+    }
+    return finish_sample(b, wo, wi, transport);
+}
+
+// The shading frame about unit n: columns t, b, n (local = transpose · world).
+fn shading_frame(n: vec3f) -> mat3x3f {
+    let tb = orthonormal_basis(n);
+    return mat3x3f(tb[0], tb[1], n);
+}
+
+fn to_local(f: mat3x3f, v: vec3f) -> vec3f {
+    return vec3f(dot(v, f[0]), dot(v, f[1]), dot(v, f[2]));
+}

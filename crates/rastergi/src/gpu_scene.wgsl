@@ -32,7 +32,9 @@ struct Material {
     specular: f32,
     ior: f32,
     transmission: f32,
-    _pad: vec3u,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 // A material's textures and their parameters (gpu_scene.rs, GpuMaterialMaps).

@@ -20,15 +20,53 @@ vi+1), `mtllib` and `usemtl`; `vt` (read only for faces of a material with `map_
 `g`, `s` and the rest are ignored.
 From the MTL, `Kd` is the diffuse reflectance (default 0.5, as for
 faces without a material), `Ke` the emitted radiance (a single number means
-grey) and `d` / `map_d` the opacity (below); albedo textures (`map_Kd`) are not
+grey), `d` / `map_d` the opacity (below) and `Pm`, `Pr`, `illum`, `Ks`, `Ni`, `Tf` make
+metals and glass (Materials, below); albedo textures (`map_Kd`) are not
 reproduced (a warning says so). The
 triangles of each material are written to a binary PLY file in a temporary
 directory and loaded as a `ply` shape, its BSDF `twosided(diffuse(Kd))` (OBJ
-surfaces reflect on both sides in rastergi) and, where Ke > 0, an `area` emitter,
+surfaces reflect on both sides in rastergi; metals and glass: Materials, below)
+and, where Ke > 0, an `area` emitter,
 which Mitsuba makes one-sided: it emits from the front face, the side the
 counter-clockwise winding faces (normal (v1-v0) x (v2-v0)), as rastergi does. The
 conventions were checked with crates/rastergi/tests/data/obj/emitter_sides.obj: a
 CCW quad facing the camera shows its Ke in both renderers, a CW one is black.
+
+Materials: rastergi maps MTL materials to its model as follows, and the script to
+Mitsuba BSDFs where Mitsuba can reproduce the model exactly:
+- none of `Pm`, `Pr` nor a glass `illum` (4, 6, 7, 9): Lambertian Kd, twosided(diffuse(Kd))
+  as ever (such scenes give the same scene, meshes and files as before);
+- `Pm m` and/or `Pr r` (each one number in [0, 1]): glTF metallic-roughness, base colour
+  Kd, metallic m (default 0), roughness r (default 1), GGX alpha r², and glTF's dielectric
+  specular layer (F0 0.04) unless `Ks 0 0 0` (all three zero) removes it; `illum 3`
+  without `Pm`: metallic 1, roughness `Pr` (default 0). Mitsuba reproduces these only
+  where the base colour is exactly white (Kd 1 1 1, so that the metal's Schlick Fresnel,
+  F0 = Kd, is 1 at every angle) and there is no specular layer over a diffuse part:
+  metallic 1 -> twosided(`conductor`, material "none": eta 0, k 1, reflectance 1) for
+  r = 0, twosided(`roughconductor`, material "none", distribution "ggx", alpha r²,
+  sample_visible) for r > 0; 0 < m < 1 with `Ks 0 0 0` -> twosided(`blendbsdf`, weight m,
+  bsdf_0 `diffuse` of reflectance 1, bsdf_1 that conductor), i.e. (1 - m)/pi + m GGX(F = 1),
+  as rastergi's model is then; metallic 0 with `Ks 0 0 0` is Lambertian Kd. Mitsuba's GGX
+  masking-shadowing is the separable Smith G1(wi) G1(wo) (glTF's specification form, not
+  the height-correlated one), its microfacet BRDF D G F / (4 cos_i cos_o). A coloured metal
+  (metallic > 0, Kd not 1 1 1: Schlick's Fresnel, which no Mitsuba conductor follows) and
+  glTF's specular layer over a diffuse part (metallic < 1 without `Ks 0 0 0`: Mitsuba's
+  plastic, roughplastic and principled layer differently) are refused with an error
+  naming the material, as is a metal that emits (Ke);
+- `illum 4`, `6`, `7` or `9`: glass, a refracting solid, of index `Ni` (default 1.5),
+  tint `Tf` (default 1 1 1; each in [0, 1]) and roughness `Pr` (default 0; Pm, Kd, Ks are
+  ignored): `dielectric` (int_ior Ni, ext_ior 1, specular_transmittance Tf) for r = 0,
+  `roughdielectric` (the same, distribution "ggx", alpha r², sample_visible) for r > 0.
+  Not two-sided-wrapped (Mitsuba's twosided refuses transmitting BSDFs): the outside,
+  ext_ior, is the side of the counter-clockwise front face, so a glass solid must be
+  wound outward. Mitsuba's dielectrics use the exact (unpolarised) Fresnel equations, scale
+  radiance by 1/eta² when it enters (eta² when it leaves), and multiply by Tf at every
+  crossing of the surface (so Tf² through a solid, not an absorption along the path).
+  Emitting (Ke) or masked (d < 1, map_d) glass is refused.
+Exporters write `Ni`, `Tf` and `Ks` into every material; they are read only where they
+matter (Ni and Tf for glass, Ks for the specular layer). `illum` must be a whole number
+0..10. Values rastergi would refuse are refused for every material of the libraries; what
+Mitsuba cannot reproduce only for materials that faces use.
 
 Opacity (alpha-masked, "cut-out" surfaces): a material with `map_d FILE` (FILE relative to
 the .mtl; no texture options) or with `d X`, X < 1 (or, without `d`, `Tr Y`: X = 1 - Y),
@@ -138,6 +176,23 @@ takes about 1.5 minutes and a full path-traced one about 2.7 minutes:
     CARD="--scene $D/obj/alpha_card.obj --eye 0,2.6,2.4 --target 0,0.35,0 --up 0,1,0 --fov 45 --point 0.15,2.2,0.1,6,6,6 --width 128 --height 128 --spp 4096 --max-depth -1"
     python3 scripts/mitsuba_reference.py $CARD --seed 31 --out $D/alpha_card_path_128_a.exr
     python3 scripts/mitsuba_reference.py $CARD --seed 32 --out $D/alpha_card_path_128_b.exr
+    # metal and glass: a sphere on a stage in five materials, and the Cornell box with a
+    # glass and a mirror sphere (README.md there; about 15-60 s per render)
+    python3 scripts/make_material_scenes.py
+    MAT="--eye 0,1.2,2.6 --target 0,0.45,0 --up 0,1,0 --fov 40 --width 64 --height 64 --spp 16384 --max-depth -1"
+    python3 scripts/mitsuba_reference.py --scene $D/obj/mat_metal_rough.obj $MAT --seed 41 --out $D/mat_metal_rough_path_64_a.exr
+    python3 scripts/mitsuba_reference.py --scene $D/obj/mat_metal_rough.obj $MAT --seed 42 --out $D/mat_metal_rough_path_64_b.exr
+    python3 scripts/mitsuba_reference.py --scene $D/obj/mat_mirror.obj      $MAT --seed 43 --out $D/mat_mirror_path_64_a.exr
+    python3 scripts/mitsuba_reference.py --scene $D/obj/mat_mirror.obj      $MAT --seed 44 --out $D/mat_mirror_path_64_b.exr
+    python3 scripts/mitsuba_reference.py --scene $D/obj/mat_mix.obj         $MAT --seed 45 --out $D/mat_mix_path_64_a.exr
+    python3 scripts/mitsuba_reference.py --scene $D/obj/mat_mix.obj         $MAT --seed 46 --out $D/mat_mix_path_64_b.exr
+    python3 scripts/mitsuba_reference.py --scene $D/obj/mat_glass.obj       $MAT --seed 47 --out $D/mat_glass_path_64_a.exr
+    python3 scripts/mitsuba_reference.py --scene $D/obj/mat_glass.obj       $MAT --seed 48 --out $D/mat_glass_path_64_b.exr
+    python3 scripts/mitsuba_reference.py --scene $D/obj/mat_rough_glass.obj $MAT --seed 49 --out $D/mat_rough_glass_path_64_a.exr
+    python3 scripts/mitsuba_reference.py --scene $D/obj/mat_rough_glass.obj $MAT --seed 50 --out $D/mat_rough_glass_path_64_b.exr
+    CS="--scene $D/obj/cornell_spheres.obj --eye 0,0,3.9 --target 0,0,0 --up 0,1,0 --fov 39.3077 --width 128 --height 128 --spp 8192 --max-depth -1"
+    python3 scripts/mitsuba_reference.py $CS --seed 51 --out $D/cornell_spheres_path_128_a.exr
+    python3 scripts/mitsuba_reference.py $CS --seed 52 --out $D/cornell_spheres_path_128_b.exr
 
 (--chunk-spp defaults to 256; the images depend on it through the chunk seeds,
 and on the Mitsuba version and variant. Results are not bit-reproducible
@@ -322,9 +377,26 @@ def _colour(words, path, n):
         raise SceneError(f"{path}: line {n}: '{words[0]}' holds something other than numbers")
 
 
+def _unit_number(words, path, n):
+    """`Pm X` or `Pr X`: one number in [0, 1]."""
+    try:
+        v = float(np.float32(words[1])) if len(words) == 2 else None
+    except ValueError:
+        v = None
+    if v is None or not (math.isfinite(v) and 0 <= v <= 1):
+        raise SceneError(f"{path}: line {n}: '{words[0]}' needs one number between 0 and 1")
+    return v
+
+
 def load_mtl(path):
     """Materials of an MTL file: name -> {"kd": [r,g,b] or None, "ke": [r,g,b] or None,
-    "d": opacity in [0, 1] or None, "map_d": absolute path of the opacity image or None}."""
+    "d": opacity in [0, 1] or None, "map_d": absolute path of the opacity image or None,
+    "pm": metallic in [0, 1] or None, "pr": roughness in [0, 1] or None, "illum": the
+    illumination model (an integer 0..10) or None, and "ks", "ni", "tf": None or the
+    (path, line number, words) of the line, parsed by material_model only where they
+    matter (Ks for the dielectric specular layer, Ni and Tf for glass), so that the values
+    exporters write into every material (`Ni 1.45`, `Tf 1 1 1`, `Ks 0.5 0.5 0.5`) stay
+    harmless where they do not}."""
     try:
         text = open(path, encoding="utf-8").read()
     except (OSError, UnicodeDecodeError) as e:
@@ -341,9 +413,24 @@ def load_mtl(path):
             if not name:
                 raise SceneError(f"{path}: line {n}: 'newmtl' names no material")
             current = materials[name] = {"kd": None, "ke": None, "d": None, "tr": None,
-                                         "map_d": None}
+                                         "map_d": None, "pm": None, "pr": None,
+                                         "illum": None, "ks": None, "ni": None, "tf": None}
         elif words[0] in ("Kd", "Ke") and current is not None:
             current[words[0].lower()] = _colour(words, path, n)
+        elif words[0] in ("Pm", "Pr") and current is not None:
+            # glTF metallic-roughness (module docstring, "Materials").
+            current[words[0].lower()] = _unit_number(words, path, n)
+        elif words[0] == "illum" and current is not None:
+            try:
+                illum = int(words[1]) if len(words) == 2 else None
+            except ValueError:
+                illum = None
+            if illum is None or not 0 <= illum <= 10:
+                raise SceneError(f"{path}: line {n}: 'illum' needs one whole number from 0 "
+                                 "to 10")
+            current["illum"] = illum
+        elif words[0] in ("Ks", "Ni", "Tf") and current is not None:
+            current[words[0].lower()] = (path, n, words)
         elif words[0] in ("d", "Tr") and current is not None:
             # Dissolve: the opacity, 1 solid, 0 invisible (a mask BSDF; module docstring);
             # `Tr` is its complement, used where `d` is absent (as rastergi reads them).
@@ -379,9 +466,9 @@ def load_obj(path):
     """The triangles of an OBJ file grouped by material, as rastergi loads them.
 
     Returns a list of (material, triangles, normals, uvs): material is {"name", "kd", "ke",
-    "d", "map_d"}, triangles a float32 array (n, 3, 3) of counter-clockwise corners, normals
-    None (the faces give no `vn`: face normals) or a float32 array (n, 3, 3) of the corners'
-    unit vertex normals, uvs None (the material has no `map_d`; `vt` is not read) or a
+    "d", "map_d", "model"} (model: material_model's), triangles a float32 array (n, 3, 3)
+    of counter-clockwise corners, normals None (the faces give no `vn`: face normals) or a
+    float32 array (n, 3, 3) of the corners' unit vertex normals, uvs None (the material has no `map_d`; `vt` is not read) or a
     float32 array (n, 3, 2) of the corners' `vt` (u, v) as written in the file (OBJ
     convention, v up the image). A material whose faces are partly with and partly without
     `vn` comes as two entries (in the order of their first faces in the file).
@@ -523,9 +610,11 @@ def load_obj(path):
             library.update(load_mtl(os.path.join(directory, name)))
     pos = np.array(positions, dtype=np.float32).reshape(-1, 3)
     # Every material of the libraries, used or not, is checked, as rastergi does.
+    models = {}
     for name, m in library.items():
         kd = m["kd"] or [OBJ_DEFAULT_ALBEDO] * 3
         ke = m["ke"] or [0.0] * 3
+        models[name] = material_model(m, f"{path}: material '{name}'")
         if max(ke) > 0 and opacity_of(m) is not None:
             raise SceneError(f"{path}: material '{name}' emits (Ke) and is not opaque (d or "
                              "map_d); Mitsuba's area emitter would ignore the mask")
@@ -555,8 +644,13 @@ def load_obj(path):
         if map_d is not None:
             uvs = np.array([[texcoord(c[2]) for c in t] for t in tris],
                            dtype=np.float32).reshape(-1, 3, 2)
-        result.append(({"name": label, "kd": kd, "ke": ke, "d": d, "map_d": map_d}, triangles,
-                       vertex_normals, uvs))
+        material = {"name": label, "kd": kd, "ke": ke, "d": d, "map_d": map_d,
+                    "model": models[name] if m is not None else {"kind": "diffuse"}}
+        try:  # refuses, before rendering, what Mitsuba cannot reproduce
+            bsdf_of(material)
+        except SceneError as e:
+            raise SceneError(f"{path}: {e}")
+        result.append((material, triangles, vertex_normals, uvs))
     if not result:
         raise SceneError(f"{path}: contains no faces; an OBJ scene needs at least one "
                          "triangle ('f' lines)")
@@ -572,6 +666,150 @@ def opacity_of(material):
     if d is not None and d < 1:
         return ("constant", d)
     return None
+
+
+GLASS_ILLUM = (4, 6, 7, 9)  # MTL illumination models with refraction: a glass solid
+GLASS_DEFAULT_IOR = 1.5
+
+
+def _mtl_value(entry, count, what):
+    """A lazily parsed `Ks`/`Tf` (count 3: a colour, one number meaning grey) or `Ni` (count
+    1) line of load_mtl, as floats; an error naming the line if it is not that."""
+    path, n, words = entry
+    if count == 3:
+        return _colour(words, path, n)
+    try:
+        v = float(np.float32(words[1])) if len(words) == 2 else None
+    except ValueError:
+        v = None
+    if v is None or not math.isfinite(v):
+        raise SceneError(f"{path}: line {n}: '{words[0]}' needs one number ({what})")
+    return v
+
+
+def material_model(m, label):
+    """rastergi's material model of an MTL material of load_mtl (module docstring,
+    "Materials"), one of
+      {"kind": "diffuse"}: Lambertian Kd (no Pm, no Pr, no glass illum);
+      {"kind": "metallic_roughness", "metallic": m, "roughness": r, "specular": bool}:
+        glTF metallic-roughness with base colour Kd, GGX alpha r², and glTF's dielectric
+        specular layer (F0 0.04) unless `Ks 0 0 0`. From `Pm` (default 0) and `Pr`
+        (default 1), or from `illum 3` without `Pm`: metallic 1, roughness Pr (default 0);
+      {"kind": "glass", "ior": Ni (default 1.5), "tint": Tf (default 1 1 1),
+        "roughness": Pr (default 0)}: a refracting solid (illum 4, 6, 7 or 9; Pm, Kd and Ks
+        are then ignored).
+    Refuses values that make no glass (an Ni that is not a positive number, a Tf outside
+    [0, 1]), naming `label` (the file and material); whether Mitsuba can reproduce the model
+    is bsdf_of's question."""
+    illum, pm, pr = m["illum"], m["pm"], m["pr"]
+    if illum in GLASS_ILLUM:
+        ior = GLASS_DEFAULT_IOR if m["ni"] is None else _mtl_value(m["ni"], 1, "the index "
+                                                                   "of refraction")
+        if not ior > 0:
+            raise SceneError(f"{label}: a glass's index of refraction (Ni) must be positive, "
+                             f"got {ior:g}")
+        tint = [1.0] * 3 if m["tf"] is None else _mtl_value(m["tf"], 3, "")
+        if not all(math.isfinite(v) and 0 <= v <= 1 for v in tint):
+            raise SceneError(f"{label}: a glass's tint (Tf) must lie in [0, 1], "
+                             f"got {' '.join(f'{v:g}' for v in tint)}")
+        return {"kind": "glass", "ior": ior, "tint": tint,
+                "roughness": 0.0 if pr is None else pr}
+    if pm is None and pr is None and illum != 3:
+        return {"kind": "diffuse"}
+    if illum == 3 and pm is None:
+        metallic, roughness = 1.0, 0.0 if pr is None else pr
+    else:
+        metallic, roughness = 0.0 if pm is None else pm, 1.0 if pr is None else pr
+    specular = m["ks"] is None or any(v != 0 for v in _mtl_value(m["ks"], 3, ""))
+    return {"kind": "metallic_roughness", "metallic": metallic, "roughness": roughness,
+            "specular": specular}
+
+
+def _metal_bsdf(roughness):
+    """glTF's metal lobe with base colour 1 (Schlick F = 1 at every angle): a perfect mirror,
+    Mitsuba's `conductor` with material "none" (eta 0, k 1: reflectance 1), or for r > 0 the
+    GGX `roughconductor` of alpha r² (Mitsuba's masking is separable Smith G1(wi) G1(wo),
+    glTF's specification form)."""
+    if roughness == 0:
+        return {"type": "conductor", "material": "none"}
+    return {"type": "roughconductor", "material": "none", "distribution": "ggx",
+            "alpha": float(roughness) ** 2, "sample_visible": True}
+
+
+def bsdf_of(material):
+    """The Mitsuba BSDF of a material of load_obj, or a SceneError where Mitsuba cannot
+    reproduce rastergi's model (module docstring, "Materials"):
+      diffuse -> twosided(diffuse(Kd)), as always;
+      metallic 1, Kd 1 1 1 -> twosided(conductor | roughconductor, material "none");
+      0 < metallic < 1, Kd 1 1 1, Ks 0 0 0 -> twosided(blendbsdf(weight m, diffuse(1),
+        that conductor)): (1 - m)/pi + m GGX(F = 1);
+      metallic 0, Ks 0 0 0 -> twosided(diffuse(Kd)) (no specular layer, no metal lobe);
+      glass -> dielectric | roughdielectric (int_ior Ni, ext_ior 1, specular_transmittance
+        Tf, GGX alpha Pr²), not twosided (its outside is the side of the counter-clockwise
+        front face).
+    Masked materials (d, map_d) get the `mask` around this (obj_scene_dict); masked glass and
+    emitting glass or metal are refused."""
+    model, name = material["model"], material["name"]
+    kd, emits = material["kd"], max(material["ke"]) > 0
+    if model["kind"] == "diffuse":
+        return {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": rgb(kd)}}
+    if model["kind"] == "glass":
+        if emits:
+            raise SceneError(f"material '{name}' is glass (illum) and emits (Ke); an emitting "
+                             "glass is not reproduced here")
+        if opacity_of(material) is not None:
+            raise SceneError(f"material '{name}' is glass (illum) and has an opacity (d < 1 or "
+                             "map_d); a cut-out glass is not reproduced here (give glass no "
+                             "d, or d 1)")
+        bsdf = {"type": "dielectric", "int_ior": float(model["ior"]), "ext_ior": 1.0,
+                "specular_transmittance": rgb(model["tint"])}
+        if model["roughness"] > 0:
+            bsdf.update({"type": "roughdielectric", "distribution": "ggx",
+                         "alpha": float(model["roughness"]) ** 2, "sample_visible": True})
+        return bsdf
+    m, r, specular = model["metallic"], model["roughness"], model["specular"]
+    if m == 0 and not specular:
+        # glTF with metallic 0 and no specular layer is Lambertian Kd.
+        return {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": rgb(kd)}}
+    what = f"material '{name}' (Kd {' '.join(f'{v:g}' for v in kd)}, metallic {m:g}, " \
+           f"roughness {r:g}{'' if specular else ', Ks 0 0 0'})"
+    if emits:
+        raise SceneError(f"{what} is metallic-roughness and emits (Ke); an emitting metal is "
+                         "not reproduced here")
+    white = all(v == 1.0 for v in kd)
+    if m > 0 and not white:
+        raise SceneError(f"{what}: a coloured metal: rastergi's metal reflects with Schlick's "
+                         "Fresnel of F0 = Kd, which no Mitsuba conductor reproduces; only base "
+                         "colour Kd 1 1 1 (F = 1) is rendered here")
+    if m < 1 and specular:
+        raise SceneError(f"{what}: glTF's dielectric specular layer (F0 0.04) over the "
+                         "diffuse part has no Mitsuba equivalent (plastic, roughplastic and "
+                         "principled layer differently); give Ks 0 0 0 to remove the layer, "
+                         "or metallic 1")
+    if m == 1:
+        return {"type": "twosided", "bsdf": _metal_bsdf(r)}
+    return {"type": "twosided", "bsdf": {
+        "type": "blendbsdf", "weight": float(m),
+        "bsdf_0": {"type": "diffuse", "reflectance": rgb([1.0, 1.0, 1.0])},
+        "bsdf_1": _metal_bsdf(r)}}
+
+
+def describe_bsdf(bsdf):
+    """A short description of bsdf_of's answer for the summary lines."""
+    if bsdf["type"] == "mask":
+        return describe_bsdf(bsdf["bsdf"])
+    if bsdf["type"] == "twosided":
+        return f"twosided({describe_bsdf(bsdf['bsdf'])})"
+    if bsdf["type"] == "blendbsdf":
+        return (f"blendbsdf({bsdf['weight']:g}: {describe_bsdf(bsdf['bsdf_0'])}, "
+                f"{describe_bsdf(bsdf['bsdf_1'])})")
+    if bsdf["type"] == "diffuse":
+        return f"diffuse({', '.join(f'{v:.7g}' for v in bsdf['reflectance']['value'])})"
+    extra = (f" ior {bsdf['int_ior']:g}, Tf "
+             f"({', '.join(f'{v:g}' for v in bsdf['specular_transmittance']['value'])})"
+             if "int_ior" in bsdf else " F = 1")
+    alpha = f", GGX alpha {bsdf['alpha']:g}" if "alpha" in bsdf else ""
+    return f"{bsdf['type']}{extra}{alpha}"
 
 
 def bounds(groups):
@@ -698,8 +936,7 @@ def obj_scene_dict(mi, groups, camera, width, height, max_depth, spp, mesh_dir):
         smooth = smooth_shaded(material, normals)
         filename = os.path.join(mesh_dir, f"material_{i}.ply")
         write_ply(filename, triangles, normals if smooth else None, uvs)
-        bsdf = {"type": "twosided",
-                "bsdf": {"type": "diffuse", "reflectance": rgb(material["kd"])}}
+        bsdf = bsdf_of(material)
         opacity = opacity_of(material)
         if opacity is not None:
             # Stochastic: a ray meeting the surface passes straight on with probability
@@ -871,8 +1108,10 @@ def load_scene(mi, args, spp):
                     f", mask opacity {opacity[1]:g}" if opacity[0] == "constant" else
                     f", mask opacity {os.path.basename(opacity[1])}"
                     + (f" x {opacity[2]:g}" if opacity[2] != 1 else "") + " (vt as u, 1 - v)")
+            bsdf = ("" if material["model"]["kind"] == "diffuse" else
+                    f", {describe_bsdf(bsdf_of(material))}")
             print(f"  {material['name']}: {len(triangles)} triangles, Kd ({kd}), Ke ({ke}), "
-                  f"{shading}{mask}", file=sys.stderr)
+                  f"{shading}{mask}{bsdf}", file=sys.stderr)
         print(f"  integrator: {obj_integrator(groups)}", file=sys.stderr)
         print(f"  camera: eye {camera['eye']}, target {camera['target']}, up "
               f"{camera['up']}, fov {camera['fov']}", file=sys.stderr)

@@ -50,7 +50,7 @@ fn light_pdf_area(le: vec3f) -> f32 {
 // One sample of the radiance arriving at `origin` from direction −dir (see path_tracer.rs
 // for the estimator), for the camera ray through pixel `xy`. Textures are read filtered over
 // the pixel's footprint at the first hit and unfiltered (level 0) at every later one. Random
-// numbers per scattering event: 3 (light), 1 (roulette), 2 (BSDF).
+// numbers per scattering event: 3 (light), 3 (BSDF), 1 (roulette).
 fn path_radiance(origin: vec3f, dir: vec3f, xy: vec2u, rng: ptr<function, u32>) -> vec3f {
     var radiance = vec3f(0.0);
     var throughput = vec3f(1.0);
@@ -59,15 +59,15 @@ fn path_radiance(origin: vec3f, dir: vec3f, xy: vec2u, rng: ptr<function, u32>) 
     var t_min = 0.0;
     var skip = NO_TRIANGLE;
     // Solid-angle density of d under BSDF sampling; 0 for the camera ray (no light strategy).
-    var bsdf_pdf = 0.0;
+    var last_pdf = 0.0;
     for (var bounce = 0u; ; bounce++) {
         let hit = trace(o, d, t_min, FAR, skip, NO_TRIANGLE, false);
         if hit.tri == NO_TRIANGLE {
             // The environment, weighted against the light sample at the previous vertex.
             if has_environment() {
                 var w = 1.0;
-                if bsdf_pdf > 0.0 {
-                    w = power_heuristic(bsdf_pdf, environment.pmf * env_pdf(d));
+                if last_pdf > 0.0 {
+                    w = power_heuristic(last_pdf, environment.pmf * env_pdf(d));
                 }
                 radiance += throughput * env_radiance(d) * w;
             }
@@ -84,72 +84,88 @@ fn path_radiance(origin: vec3f, dir: vec3f, xy: vec2u, rng: ptr<function, u32>) 
         // vertex, which could have produced the same point with density p_light.
         if front && any(s.emission > vec3f(0.0)) {
             var w = 1.0;
-            if bsdf_pdf > 0.0 {
+            if last_pdf > 0.0 {
                 let p_light = light_pdf_area(materials[triangles[hit.tri].material].emission) * hit.t * hit.t / cos_in;
-                w = power_heuristic(bsdf_pdf, p_light);
+                w = power_heuristic(last_pdf, p_light);
             }
             radiance += throughput * s.emission * w;
         }
-        // The back of a one-sided surface absorbs.
-        if !front && (s.flags & MATERIAL_TWO_SIDED) == 0u {
+        // The back of a one-sided surface absorbs; glass is entered and left by either face.
+        let glass = s.transmission > 0.0;
+        if !front && (s.flags & MATERIAL_TWO_SIDED) == 0u && !glass {
             break;
         }
         if bounce >= params.max_bounces {
             break;
         }
+        // The geometric normal on the side hit, and the shading frame on that side, bent
+        // towards where the path came from: directions whose geometric and shading sides
+        // disagree (light from below the surface, paths into it) do not count. Hit from
+        // behind, a solid glass is left: its relative index inverts.
         let n = select(-s.normal, s.normal, front);
-        // The shading normal on the side hit, bent towards where the path came from; light
-        // from below the geometric surface does not count, nor do paths into it.
         let ns = bend_towards(select(-s.shading, s.shading, front), -d);
-        let x = s.pos + n * frame.ray_epsilon;
-        let f = s.albedo / PI;
+        let sf = shading_frame(ns);
+        var b = surface_bsdf(s);
+        if !front && !b.thin {
+            b.ior = 1.0 / b.ior;
+        }
+        let wo = to_local(sf, -d);
 
         // Next-event estimation: a point y on the emitters, weighted against BSDF sampling.
         let u0 = rng_f32(rng);
         let u1 = rng_f32(rng);
         let u2 = rng_f32(rng);
         if params.light_count > 0u {
-            let l = sample_light_at(x, light_choice(u0, u1, u2));
-            let cos_x = dot(ns, l.dir);
-            if cos_x > 0.0 && dot(n, l.dir) > 0.0 && any(l.e > vec3f(0.0))
+            let l = sample_light_at(s.pos, light_choice(u0, u1, u2));
+            let wi = to_local(sf, l.dir);
+            let below = dot(n, l.dir) < 0.0;
+            let x = s.pos + select(n, -n, below) * frame.ray_epsilon;
+            let f = bsdf_eval(b, wo, wi, TRANSPORT_RADIANCE);
+            if (wi.z < 0.0) == below && wi.z != 0.0 && any(f > vec3f(0.0)) && any(l.e > vec3f(0.0))
                 && !occluded(x, l.dir, frame.ray_epsilon, l.dist * (1.0 - 1e-4), s.tri, l.tri) {
                 // Against BSDF sampling where it could have found the same point: an emissive
                 // triangle, its area density → solid angle at x, from the same formula as the
                 // emitter hits above so that the two weights sum to one exactly. A punctual or
                 // distant light is found by light samples only (weight 1); the environment
                 // by BSDF samples that escape too.
+                let p_bsdf = bsdf_pdf(b, wo, wi);
                 var mis = 1.0;
                 if l.pdf > 0.0 {
-                    mis = power_heuristic(l.pdf, cos_x / PI);
+                    mis = power_heuristic(l.pdf, p_bsdf);
                 } else if l.tri != NO_TRIANGLE {
                     let t = triangles[l.tri];
                     let cos_y = -dot(triangle_normal(t), l.dir);
                     let to_solid_angle = l.dist * l.dist / cos_y;
-                    mis = power_heuristic(light_pdf_area(materials[t.material].emission) * to_solid_angle, cos_x / PI);
+                    mis = power_heuristic(light_pdf_area(materials[t.material].emission) * to_solid_angle, p_bsdf);
                 }
-                radiance += throughput * f * l.e * (cos_x * mis);
+                radiance += throughput * f * l.e * (abs(wi.z) * mis);
             }
         }
 
-        // Russian roulette: continue with probability q = max(ρ), dividing by q.
+        // Scattering: a direction from the BSDF, then Russian roulette by its weight.
+        let v = vec3f(rng_f32(rng), rng_f32(rng), rng_f32(rng));
+        let u_rr = rng_f32(rng);
+        let bs = bsdf_sample(b, wo, v, TRANSPORT_RADIANCE);
+        if !bs.ok {
+            break;
+        }
+        let dir_world = sf * bs.wi;
+        let below = dot(n, dir_world) < 0.0;
+        if (bs.wi.z < 0.0) != below || dot(n, dir_world) == 0.0 {
+            break;
+        }
         var q = 1.0;
         if bounce >= params.rr_start {
-            q = min(max(max(s.albedo.r, s.albedo.g), s.albedo.b), 1.0);
+            q = min(max(max(bs.weight.r, bs.weight.g), bs.weight.b), 1.0);
         }
-        let u_rr = rng_f32(rng);
         if u_rr >= q {
             break;
         }
-        // Cosine sampling: f · cos θ / pdf = ρ.
-        let v1 = rng_f32(rng);
-        let v2 = rng_f32(rng);
-        d = cosine_hemisphere(ns, v1, v2);
-        bsdf_pdf = max(dot(ns, d), 0.0) / PI;
-        if bsdf_pdf <= 0.0 || dot(n, d) <= 0.0 {
-            break;
-        }
-        throughput *= s.albedo / q;
-        o = x;
+        throughput *= bs.weight / q;
+        // A specular bounce gives emitters it finds weight 1 (no light sample finds them).
+        last_pdf = select(bs.pdf, 0.0, bs.delta);
+        d = normalize(dir_world);
+        o = s.pos + select(n, -n, below) * frame.ray_epsilon;
         t_min = frame.ray_epsilon;
         skip = s.tri;
     }

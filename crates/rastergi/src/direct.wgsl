@@ -18,21 +18,50 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if p.front {
         radiance = p.x.emission;
     }
-    if has_lights() && p.ok {
+    let glass = p.seen && p.x.transmission > 0.0;
+    if has_lights() && (p.ok || glass) {
         let s = p.x;
         let n = p.n;
-        let origin = s.pos + n * frame.ray_epsilon;
+        let lambertian = (s.flags & MATERIAL_LAMBERTIAN) != 0u;
+        // The scattering model in the shading frame on the eye's side (a solid glass seen
+        // from inside: its relative index inverted).
+        let sf = shading_frame(p.ns);
+        var b = surface_bsdf(s);
+        if !p.front && !b.thin {
+            b.ior = 1.0 / b.ior;
+        }
+        let wo = to_local(sf, normalize(frame.eye - s.pos));
         // Sample k of iteration i has index i·L + k in the pixel's own sequence, whose seed
         // depends on (seed, pixel) only: a restart replays the same light samples.
         let seed = pixel_seed(pcg_hash(frame.seed ^ STREAM_DIRECT), gid.x, gid.y);
         var sum = vec3f(0.0);
         for (var k = 0u; k < frame.light_samples; k++) {
             let c = light_sample_uniforms(frame.iteration * frame.light_samples + k, seed);
-            let l = sample_light_at(origin, c);
-            // Light from above the geometric surface only, weighed by the shading cosine.
-            let cos_x = dot(p.ns, l.dir);
-            if dot(n, l.dir) <= 0.0 || cos_x <= 0.0 || all(l.e == vec3f(0.0))
-                || occluded(origin, l.dir, frame.ray_epsilon, l.dist * (1.0 - 1e-4), s.tri, l.tri) {
+            let l = sample_light_at(s.pos + n * frame.ray_epsilon, c);
+            if all(l.e == vec3f(0.0)) {
+                continue;
+            }
+            // The light's side by the geometric normal; the shading cosine must agree (light
+            // from below the geometric surface counts only through glass).
+            let below = dot(n, l.dir) <= 0.0;
+            let wi = to_local(sf, l.dir);
+            var f: vec3f;
+            if lambertian {
+                f = s.albedo / PI;
+                if below || wi.z <= 0.0 {
+                    continue;
+                }
+            } else {
+                if (wi.z <= 0.0) != below || wi.z == 0.0 {
+                    continue;
+                }
+                f = bsdf_eval(b, wo, wi, TRANSPORT_RADIANCE);
+                if all(f == vec3f(0.0)) {
+                    continue;
+                }
+            }
+            let origin = s.pos + select(n, -n, below) * frame.ray_epsilon;
+            if occluded(origin, l.dir, frame.ray_epsilon, l.dist * (1.0 - 1e-4), s.tri, l.tri) {
                 continue;
             }
             // The environment is also found by the gather's escaping rays (env_gather_weight).
@@ -40,9 +69,9 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             if l.pdf > 0.0 {
                 mis = 1.0 - env_gather_weight(p.ns, l.dir);
             }
-            sum += l.e * (cos_x * mis);
+            sum += f * l.e * (abs(wi.z) * mis);
         }
-        radiance += s.albedo / PI * sum / f32(frame.light_samples);
+        radiance += sum / f32(frame.light_samples);
     }
     film_add(FILM_DIRECT, gid.xy, radiance);
 }

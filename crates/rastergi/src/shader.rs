@@ -8,20 +8,15 @@
 
 use crate::consts::{
     ENVIRONMENT_LIGHT, FILM_DIRECT, FILM_INDIRECT, FILM_PHOTON_VIEW, LIGHT_DISTANT, LIGHT_POINT, LIGHT_SPOT,
-    MATERIAL_ALPHA_BLEND, MATERIAL_ALPHA_MASK, MATERIAL_LAMBERTIAN, MATERIAL_TEXTURED, MATERIAL_THIN, MATERIAL_TWO_SIDED, MAX_DIRECTIONS,
-    MAX_HOLE_CROSSINGS, MAX_SEPARATORS, MIN_LOOKUP_AREA, NO_TEXTURE, OFFSET_SHIFT, OFFSET_STEP, PUNCTUAL_LIGHT,
-    REGION_SHIFT, TRIANGLE_HAS_HOLES, stream,
+    MATERIAL_ALPHA_BLEND, MATERIAL_ALPHA_MASK, MATERIAL_LAMBERTIAN, MATERIAL_TEXTURED, MATERIAL_THIN,
+    MATERIAL_TWO_SIDED, MAX_DIRECTIONS, MAX_HOLE_CROSSINGS, MAX_SEPARATORS, MIN_LOOKUP_AREA, NO_TEXTURE, OFFSET_SHIFT,
+    OFFSET_STEP, PUNCTUAL_LIGHT, REGION_SHIFT, TRIANGLE_HAS_HOLES, stream,
 };
 
 pub const SAMPLING: &str = include_str!("sampling.wgsl");
 /// The scene's bind group: geometry, materials, lights and the environment.
-pub const SCENE: &str = concat!(
-    include_str!("gpu_scene.wgsl"),
-    "\n",
-    include_str!("environment.wgsl"),
-    "\n",
-    include_str!("bsdf.wgsl")
-);
+pub const SCENE: &str =
+    concat!(include_str!("gpu_scene.wgsl"), "\n", include_str!("environment.wgsl"), "\n", include_str!("bsdf.wgsl"));
 /// The scattering model alone (it needs [`SAMPLING`]).
 pub const BSDF: &str = include_str!("bsdf.wgsl");
 pub const BVH: &str = include_str!("bvh.wgsl");

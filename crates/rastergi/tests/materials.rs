@@ -79,3 +79,176 @@ fn the_gpu_bsdf_agrees_with_its_cpu_twin() {
     println!("compared {compared}, skipped {skipped} near the critical angle");
     assert!(skipped * 50 < compared);
 }
+
+/// The scene of `tests/data/obj/NAME.obj` seen from the camera of its Mitsuba references.
+fn material_scene(name: &str, camera: rastergi::scene::Camera) -> rastergi::scene::Scene {
+    let mut scene = rastergi::scene::load_obj(&common::data(&format!("obj/{name}.obj"))).expect("scene");
+    scene.camera = camera;
+    scene
+}
+
+/// The stage's camera (scripts/make_material_scenes.py, tests/data/README.md).
+fn stage_camera() -> rastergi::scene::Camera {
+    rastergi::scene::Camera {
+        eye: Vec3::new(0.0, 1.2, 2.6),
+        target: Vec3::new(0.0, 0.45, 0.0),
+        up: Vec3::Y,
+        fov_y_deg: 40.0,
+    }
+}
+
+/// The reference path tracer's mean of two renders (seeds 1, 2; `iterations` each) against
+/// the Mitsuba pair `stem`, emitters left out. Both are unbiased estimates of one integral:
+/// per pixel and channel, E[(ours − ref)²] = Var(ours) + Var(ref), each variance estimated
+/// without bias by (a − b)²/4 of its pair. The test is a z-test of zero bias on the mean of
+/// d² − (a − b)²/4 − (a' − b')²/4 over pixels, against its own standard error (heavy-tailed
+/// caustic noise makes a fixed margin on the RMSE meaningless at 64²); block means (16 × 16
+/// pixels) and channel means are checked against their expected noise as well.
+fn path_tracer_matches_mitsuba(scene: &rastergi::scene::Scene, size: u32, iterations: u32, stem: &str) {
+    use rastergi::image_io::read_exr;
+    use rastergi::metrics::{compare, emitter_mask, masked_mean, rmse};
+    let gpu = common::gpu();
+    let render = |seed| {
+        let settings = rastergi::renderer::RenderSettings { width: size, height: size, seed, ..Default::default() };
+        let mut pt = rastergi::path_tracer::PathTracer::new(&gpu, scene, settings).expect("path tracer");
+        for i in 0..iterations {
+            pt.iterate();
+            if i % 16 == 15 {
+                pt.wait().unwrap();
+            }
+        }
+        pt.read_linear().expect("readback")
+    };
+    let (a, b) = (render(1), render(2));
+    let ref_a = read_exr(&common::data(&format!("{stem}_a.exr"))).unwrap();
+    let ref_b = read_exr(&common::data(&format!("{stem}_b.exr"))).unwrap();
+    let mask = emitter_mask(&ref_a, 3.0);
+    let reference = common::average(&ref_a, &ref_b);
+    let ours = common::average(&a, &b);
+    let c = compare(&ours, &reference, Some(&mask));
+    let mean_ref = masked_mean(&reference, Some(&mask));
+    let (noise_ours, noise_ref) = (rmse(&a, &b, Some(&mask)) / 2.0, rmse(&ref_a, &ref_b, Some(&mask)) / 2.0);
+    let expected = (noise_ours.powi(2) + noise_ref.powi(2)).sqrt() / mean_ref;
+    // The bias z-test.
+    let mut excess = vec![];
+    for (i, keep) in mask.iter().enumerate() {
+        if *keep {
+            for ch in 0..3 {
+                let d = (ours.pixels[i][ch] - reference.pixels[i][ch]) as f64;
+                let va = ((a.pixels[i][ch] - b.pixels[i][ch]) as f64).powi(2) / 4.0;
+                let vr = ((ref_a.pixels[i][ch] - ref_b.pixels[i][ch]) as f64).powi(2) / 4.0;
+                excess.push(d * d - va - vr);
+            }
+        }
+    }
+    let n = excess.len() as f64;
+    let mean = excess.iter().sum::<f64>() / n;
+    let se = (excess.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
+    let bias = mean.max(0.0).sqrt() / mean_ref;
+    let expected_block = expected / 16.0 * (2.0 / std::f64::consts::PI).sqrt();
+    println!(
+        "{stem}: relative RMSE {:.4} (noise predicts {expected:.4}: ours {:.4}, Mitsuba {:.4}); squared bias {:.3e} ± {:.3e} (bias {bias:.4}); block-mean error {:.4} (noise {expected_block:.4}); mean ratio {:.4?}",
+        c.relative_rmse,
+        noise_ours / mean_ref,
+        noise_ref / mean_ref,
+        mean / mean_ref.powi(2),
+        se / mean_ref.powi(2),
+        c.block_mean_error,
+        c.mean_ratio
+    );
+    assert!(mean < 3.0 * se, "{stem}: squared bias {mean:.3e} is {:.1} standard errors above 0", mean / se);
+    assert!(c.block_mean_error < 2.0 * expected_block, "{stem}: block-mean error {}", c.block_mean_error);
+    let pixels = mask.iter().filter(|&&k| k).count() as f64;
+    for r in c.mean_ratio {
+        // A channel mean's relative standard error is about the image's relative noise over
+        // √pixels; 5 of them.
+        assert!((r - 1.0).abs() < 5.0 * expected / pixels.sqrt(), "{stem}: mean ratio {:?}", c.mean_ratio);
+    }
+}
+
+#[test]
+fn path_traced_metal_spheres_match_mitsuba() {
+    for kind in ["metal_rough", "mirror", "mix"] {
+        let scene = material_scene(&format!("mat_{kind}"), stage_camera());
+        path_tracer_matches_mitsuba(&scene, 64, 2048, &format!("mat_{kind}_path_64"));
+    }
+}
+
+#[test]
+fn path_traced_glass_spheres_match_mitsuba() {
+    for kind in ["glass", "rough_glass"] {
+        let scene = material_scene(&format!("mat_{kind}"), stage_camera());
+        path_tracer_matches_mitsuba(&scene, 64, 1024, &format!("mat_{kind}_path_64"));
+    }
+}
+
+/// The MTL statements of each sphere material map to the model its Mitsuba reference assumes
+/// (scripts/mitsuba_reference.py, `material_model`).
+#[test]
+fn mtl_materials_map_to_the_model() {
+    let sphere = |name: &str| {
+        let scene = material_scene(name, stage_camera());
+        scene.materials.iter().find(|m| m.name == "sphere").expect("sphere material").clone()
+    };
+    let m = sphere("mat_metal_rough");
+    assert_eq!((m.metallic, m.roughness, m.specular, m.transmission), (1.0, 0.5, 1.0, 0.0));
+    let m = sphere("mat_mirror");
+    assert_eq!((m.metallic, m.roughness), (1.0, 0.0));
+    let m = sphere("mat_mix");
+    assert_eq!((m.metallic, m.roughness, m.specular), (0.5, 0.4, 0.0));
+    let m = sphere("mat_glass");
+    assert_eq!((m.transmission, m.ior, m.roughness, m.thin, m.albedo), (1.0, 1.5, 0.0, false, Vec3::ONE));
+    let m = sphere("mat_rough_glass");
+    assert_eq!((m.transmission, m.roughness), (1.0, 0.3));
+    // The stage's walls stay Lambertian.
+    let scene = material_scene("mat_glass", stage_camera());
+    assert!(scene.materials.iter().filter(|m| m.name != "sphere").all(|m| m.is_lambertian()));
+}
+
+/// glTF: metallic and roughness factors (default 1, 1), the metallic-roughness texture, the
+/// specular layer, transmission, ior and volume (thin without one).
+#[test]
+fn gltf_materials_map_to_the_model() {
+    use serde_json::json;
+    let dir = tempfile::tempdir().unwrap();
+    let positions: Vec<f32> = vec![0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+    let bytes: Vec<u8> = bytemuck::cast_slice(&positions).to_vec();
+    std::fs::write(dir.path().join("t.bin"), &bytes).unwrap();
+    let materials = json!([
+        { "name": "default" },
+        { "name": "rough plastic", "pbrMetallicRoughness": { "metallicFactor": 0.0, "roughnessFactor": 0.25 } },
+        { "name": "glass", "pbrMetallicRoughness": { "metallicFactor": 0.0, "roughnessFactor": 0.0 },
+          "extensions": { "KHR_materials_transmission": { "transmissionFactor": 1.0 },
+                          "KHR_materials_ior": { "ior": 1.33 },
+                          "KHR_materials_volume": { "thicknessFactor": 0.1 } } },
+        { "name": "window", "pbrMetallicRoughness": { "metallicFactor": 0.0 },
+          "extensions": { "KHR_materials_transmission": { "transmissionFactor": 0.9 } } },
+        { "name": "matte", "extensions": { "KHR_materials_specular": { "specularFactor": 0.0 } } }
+    ]);
+    let primitives: Vec<_> = (0..5).map(|i| json!({ "attributes": { "POSITION": 0 }, "material": i })).collect();
+    let doc = json!({
+        "asset": { "version": "2.0" },
+        "extensionsUsed": ["KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume", "KHR_materials_specular"],
+        "buffers": [{ "uri": "t.bin", "byteLength": bytes.len() }],
+        "bufferViews": [{ "buffer": 0, "byteOffset": 0, "byteLength": bytes.len() }],
+        "accessors": [{ "bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0] }],
+        "materials": materials,
+        "meshes": [{ "primitives": primitives }],
+        "nodes": [{ "mesh": 0 }],
+        "scenes": [{ "nodes": [0] }],
+        "scene": 0
+    });
+    let path = dir.path().join("m.gltf");
+    std::fs::write(&path, serde_json::to_vec(&doc).unwrap()).unwrap();
+    let scene = rastergi::scene::load_gltf(&path).unwrap();
+    let m = |name: &str| scene.materials.iter().find(|m| m.name == name).unwrap().clone();
+    let d = m("default");
+    assert_eq!((d.metallic, d.roughness, d.specular, d.transmission), (1.0, 1.0, 1.0, 0.0));
+    let p = m("rough plastic");
+    assert_eq!((p.metallic, p.roughness, p.specular), (0.0, 0.25, 1.0));
+    let g = m("glass");
+    assert_eq!((g.transmission, g.ior, g.thin, g.roughness), (1.0, 1.33, false, 0.0));
+    let w = m("window");
+    assert_eq!((w.transmission, w.ior, w.thin), (0.9, 1.5, true));
+    assert_eq!(m("matte").specular, 0.0);
+}

@@ -11,7 +11,13 @@
 //!   primitives without it, or with one that cannot be read (quantized, non-finite), shade
 //!   flat (the latter with a warning). `TANGENT` where a normal map needs it. Other attributes
 //!   (COLOR_0, JOINTS, WEIGHTS, more UV sets) are not read.
-//! - **Materials** (Lambertian only): albedo = baseColorFactor.rgb × baseColorTexture (sRGB);
+//! - **Materials** (glTF's metallic-roughness model, [`crate::bsdf`]): base colour =
+//!   baseColorFactor.rgb × baseColorTexture (sRGB); metallicFactor and roughnessFactor ×
+//!   metallicRoughnessTexture's B and G (linear); `KHR_materials_specular`'s specularFactor
+//!   (its colour and textures are not read, with a warning), `KHR_materials_ior`,
+//!   `KHR_materials_transmission`'s factor (its texture is not read, with a warning) and
+//!   `KHR_materials_volume` (a thickness > 0 makes the glass a refracting solid; without a
+//!   volume it is thin-walled, as the extension says; attenuation is not read);
 //!   emitted radiance = emissiveFactor × KHR_materials_emissive_strength × emissiveTexture
 //!   (sRGB, per texel); `doubleSided` → two-sided reflection (glTF's default is one-sided).
 //!   `alphaMode` MASK (a cut-out at `alphaCutoff`, default 0.5) and BLEND (stochastic
@@ -22,9 +28,8 @@
 //!   `KHR_texture_transform` on every texture (offset, rotation, scale; uv' = T·R·S·uv with
 //!   R = [[cos r, sin r], [−sin r, cos r]], as the extension's worked example needs). One
 //!   TEXCOORD set per primitive: the base colour texture's (else the emissive's, else the
-//!   normal map's); textures naming another set read it with a warning. Metal and roughness
-//!   are ignored. Primitives without a material get a grey albedo of 0.5 like OBJ faces
-//!   without one.
+//!   normal map's); textures naming another set read it with a warning. Primitives without a
+//!   material get a grey Lambertian albedo of 0.5 like OBJ faces without one.
 //! - **Lights** (`KHR_lights_punctual`): point, spot and directional lights placed by their
 //!   node (position: the node's origin; direction: its local −Z), `color` × `intensity` read
 //!   1:1 as radiometric — W/sr for point and spot lights, W/m² on a surface facing a
@@ -59,8 +64,15 @@ use crate::error::{Error, Result};
 /// Most triangles a glTF scene may expand to (instances included).
 pub const MAX_TRIANGLES: u64 = 1 << 25;
 /// glTF extensions that a file may require.
-const SUPPORTED_REQUIRED: &[&str] =
-    &["KHR_materials_emissive_strength", "KHR_lights_punctual", "KHR_texture_transform"];
+const SUPPORTED_REQUIRED: &[&str] = &[
+    "KHR_materials_emissive_strength",
+    "KHR_lights_punctual",
+    "KHR_texture_transform",
+    "KHR_materials_transmission",
+    "KHR_materials_ior",
+    "KHR_materials_volume",
+    "KHR_materials_specular",
+];
 const DEFAULT_ALBEDO: f32 = 0.5;
 
 /// Choices made when loading a glTF file.
@@ -792,6 +804,38 @@ impl<'a> Loader<'a> {
                 if !(0.0..=1.0).contains(&opacity) {
                     return Err(format!("{what}: baseColorFactor's alpha {opacity} is outside [0, 1]"));
                 }
+                let metal_rough = pbr.metallic_roughness_texture().map(|i| (i.texture(), info_transform(&i)));
+                let metal_rough_texture = texture(metal_rough, true)?;
+                let unit = |name: &str, v: f32| -> Res<f32> {
+                    if (0.0..=1.0).contains(&v) { Ok(v) } else { Err(format!("{what}: {name} {v} is outside [0, 1]")) }
+                };
+                let metallic = unit("metallicFactor", pbr.metallic_factor())?;
+                let roughness = unit("roughnessFactor", pbr.roughness_factor())?;
+                let transmission = m.transmission();
+                if transmission.as_ref().is_some_and(|t| t.transmission_texture().is_some()) {
+                    log::warn!("{what}: transmissionTexture is not read; its transmissionFactor applies everywhere");
+                }
+                let transmission = unit("transmissionFactor", transmission.map_or(0.0, |t| t.transmission_factor()))?;
+                let ior = m.ior().unwrap_or(1.5);
+                if !(ior.is_finite() && (ior == 0.0 || ior >= 1.0)) {
+                    return Err(format!("{what}: ior {ior} is not 0 or at least 1"));
+                }
+                // ior 0 is the extension's "infinite": a perfect reflector; clamped to 10⁴.
+                let ior = if ior == 0.0 { 1e4 } else { ior };
+                let specular = m.specular();
+                if specular.as_ref().is_some_and(|s| {
+                    s.specular_color_factor() != [1.0; 3]
+                        || s.specular_texture().is_some()
+                        || s.specular_color_texture().is_some()
+                }) {
+                    log::warn!(
+                        "{what}: KHR_materials_specular's colour and textures are not read; its specularFactor is"
+                    );
+                }
+                let specular = unit("specularFactor", specular.map_or(1.0, |s| s.specular_factor()))?;
+                // A volume makes the glass a refracting solid; thickness 0 (its default) or no
+                // volume: thin-walled, as the extension says.
+                let thin = m.volume().is_none_or(|v| v.thickness_factor() <= 0.0);
                 Material {
                     albedo_texture: base.map(|t| t.texture),
                     albedo_transform: base.map_or(UvTransform::IDENTITY, |t| t.transform),
@@ -802,6 +846,13 @@ impl<'a> Loader<'a> {
                     alpha_mode,
                     normal_texture,
                     normal_scale,
+                    metallic,
+                    roughness,
+                    metal_rough_texture,
+                    specular,
+                    ior,
+                    transmission,
+                    thin,
                     two_sided: m.double_sided(),
                     ..Material::diffuse(
                         &m.name().map_or_else(|| format!("material {index}"), str::to_owned),
@@ -918,7 +969,8 @@ fn parsed_normal_transform(
         .ok()
 }
 
-/// The TEXCOORD sets a material's textures read (base colour, emissive, normal map), each
+/// The TEXCOORD sets a material's textures read (base colour, emissive, normal map,
+/// metallic-roughness), each
 /// overridden by its KHR_texture_transform's texCoord.
 fn texture_sets(m: &::gltf::Material) -> Vec<u32> {
     let info = |i: ::gltf::texture::Info| i.texture_transform().and_then(|t| t.tex_coord()).unwrap_or(i.tex_coord());
@@ -926,7 +978,8 @@ fn texture_sets(m: &::gltf::Material) -> Vec<u32> {
     let emissive = m.emissive_texture().map(info);
     let normal =
         m.normal_texture().map(|n| parsed_normal_transform(&n).and_then(|t| t.tex_coord).unwrap_or(n.tex_coord()));
-    base.into_iter().chain(emissive).chain(normal).collect()
+    let metal_rough = m.pbr_metallic_roughness().metallic_roughness_texture().map(info);
+    base.into_iter().chain(emissive).chain(normal).chain(metal_rough).collect()
 }
 
 #[cfg(test)]

@@ -14,6 +14,17 @@
 //! `-s u v` place the image (uv' = s·uv + o in OBJ's coordinates); the others (`-bm`,
 //! `-blendu`, `-clamp`, `-colorspace`, `-type` …) are skipped with a warning.
 //!
+//! Scattering (`crate::bsdf`; the Mitsuba reference script maps these the same way):
+//! - no `Pm`, `Pr` nor a glass `illum`: Lambertian `Kd` (`Ks`, `Ns` and the Phong models of
+//!   `illum` 2 are not read);
+//! - `Pm m` and/or `Pr r` (the PBR extension of MTL that Blender and others write): glTF's
+//!   metallic-roughness with base colour `Kd`, metallic m (default 0), roughness r (default
+//!   1), and its dielectric specular layer (f₀ from `Ni`, default 1.5: 0.04) unless `Ks 0 0 0`;
+//! - `illum 3` (reflection, ray traced) without `Pm`: a metal, roughness `Pr` (default 0);
+//! - `illum` 4, 6, 7 or 9 (refraction): glass, a refracting solid of index `Ni` (default 1.5)
+//!   tinted by `Tf` (default white), roughness `Pr` (default 0); `Kd` and `Pm` are not used.
+//! Values outside their range are clamped with a warning.
+//!
 //! Faces whose corners name `vn` normals (`f v//vn`, `f v/vt/vn`) shade with them, interpolated
 //! (normalised as read); a model whose faces do not all have them shades flat. Faces without
 //! `vn` in a smoothing group (`s 1`, `s 2` …; not `s off` or `s 0`) get vertex normals: at each
@@ -141,7 +152,14 @@ pub fn load_obj(path: &Path) -> Result<Scene> {
         }
         let alpha_mode =
             if opacity < 1.0 || opacity_texture.is_some() { super::AlphaMode::Blend } else { super::AlphaMode::Opaque };
+        let scattering = Scattering::of(m, path);
+        let albedo = scattering.base.unwrap_or(albedo);
         scene.add_material(Material {
+            metallic: scattering.metallic,
+            roughness: scattering.roughness,
+            specular: scattering.specular,
+            ior: scattering.ior,
+            transmission: scattering.transmission,
             albedo_texture: albedo_map.map(|t| t.texture),
             albedo_transform: albedo_map.map_or(UvTransform::IDENTITY, |t| t.transform),
             emission,
@@ -320,6 +338,84 @@ fn map_value<'a>(m: &'a tobj::Material, key: &str) -> Option<&'a String> {
 /// The file a texture statement names, once [`load_mtl`] resolved it.
 fn map_file<'a>(m: &'a tobj::Material, key: &str) -> Option<&'a String> {
     m.unknown_param.get(&format!("{key} file"))
+}
+
+/// Which OBJ `illum` models are glass (refraction on).
+const GLASS_ILLUM: [u8; 4] = [4, 6, 7, 9];
+
+/// A material's scattering model from its MTL statements (the module's documentation).
+struct Scattering {
+    metallic: f32,
+    roughness: f32,
+    specular: f32,
+    ior: f32,
+    transmission: f32,
+    /// The base colour where it is not `Kd` (glass: its tint `Tf`).
+    base: Option<Vec3>,
+}
+
+impl Scattering {
+    fn of(m: &tobj::Material, path: &Path) -> Scattering {
+        let warn = |what: &str| log::warn!("{}: material '{}': {what}", path.display(), m.name);
+        let unit = |key: &str| -> Option<f32> {
+            let text = m.unknown_param.get(key)?;
+            match text.split_whitespace().next().and_then(|w| w.parse::<f32>().ok()) {
+                Some(v) if (0.0..=1.0).contains(&v) => Some(v),
+                Some(v) if v.is_finite() => {
+                    warn(&format!("{key} {v} is outside [0, 1]; clamped"));
+                    Some(v.clamp(0.0, 1.0))
+                }
+                _ => {
+                    warn(&format!("{key} '{text}' is not a number; ignored"));
+                    None
+                }
+            }
+        };
+        let (pm, pr) = (unit("Pm"), unit("Pr"));
+        let illum = m.illumination_model;
+        let ior = match m.optical_density {
+            Some(n) if n.is_finite() && n > 0.0 => n,
+            Some(n) => {
+                warn(&format!("Ni {n} is not a positive index of refraction; 1.5 is used"));
+                1.5
+            }
+            None => 1.5,
+        };
+        let lambertian =
+            Scattering { metallic: 0.0, roughness: 1.0, specular: 0.0, ior, transmission: 0.0, base: None };
+        if illum.is_some_and(|i| GLASS_ILLUM.contains(&i)) {
+            let tint = m.unknown_param.get("Tf").map(|t| {
+                let v: Vec<f32> = t.split_whitespace().filter_map(|w| w.parse().ok()).collect();
+                match v.as_slice() {
+                    [g] => Vec3::splat(*g),
+                    [r, g, b, ..] => Vec3::new(*r, *g, *b),
+                    _ => Vec3::ONE,
+                }
+            });
+            let tint = tint.unwrap_or(Vec3::ONE);
+            if !(tint.is_finite() && tint.min_element() >= 0.0 && tint.max_element() <= 1.0) {
+                warn("Tf is outside [0, 1]; clamped");
+            }
+            let tint = if tint.is_finite() { tint.clamp(Vec3::ZERO, Vec3::ONE) } else { Vec3::ONE };
+            return Scattering {
+                transmission: 1.0,
+                roughness: pr.unwrap_or(0.0),
+                specular: 1.0,
+                base: Some(tint),
+                ..lambertian
+            };
+        }
+        if pm.is_none() && pr.is_none() && illum != Some(3) {
+            return lambertian;
+        }
+        let (metallic, roughness) = if illum == Some(3) && pm.is_none() {
+            (1.0, pr.unwrap_or(0.0))
+        } else {
+            (pm.unwrap_or(0.0), pr.unwrap_or(1.0))
+        };
+        let specular = if m.specular == Some([0.0; 3]) { 0.0 } else { 1.0 };
+        Scattering { metallic, roughness, specular, ..lambertian }
+    }
 }
 
 /// The texture transform of statement `key` as [`load_mtl`] recorded it.

@@ -365,7 +365,7 @@ pub fn room_gltf(variant: Variant) -> Gltf {
     let mut g = Gltf {
         json: json!({
             "asset": { "version": "2.0", "generator": "rastergi tests" },
-            "extensionsUsed": ["KHR_materials_emissive_strength"],
+            "extensionsUsed": ["KHR_materials_emissive_strength", "KHR_materials_specular"],
             "scene": 0,
         }),
         bin: Vec::new(),
@@ -400,10 +400,16 @@ pub fn room_gltf(variant: Variant) -> Gltf {
         if let Some(t) = texture {
             pbr["baseColorTexture"] = json!({ "index": t });
         }
-        let mut m = json!({ "name": name, "pbrMetallicRoughness": pbr, "doubleSided": double_sided });
+        // Without glTF's specular layer (specularFactor 0): Lambertian, like the OBJ room.
+        let mut m = json!({
+            "name": name,
+            "pbrMetallicRoughness": pbr,
+            "doubleSided": double_sided,
+            "extensions": { "KHR_materials_specular": { "specularFactor": 0.0 } },
+        });
         if emissive {
             m["emissiveFactor"] = json!(EMISSIVE_FACTOR);
-            m["extensions"] = json!({ "KHR_materials_emissive_strength": { "emissiveStrength": EMISSIVE_STRENGTH } });
+            m["extensions"]["KHR_materials_emissive_strength"] = json!({ "emissiveStrength": EMISSIVE_STRENGTH });
         }
         push(&mut g.json["materials"], m);
     }

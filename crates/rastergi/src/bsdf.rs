@@ -206,6 +206,18 @@ impl Bsdf {
         Self { base: albedo, metallic: 0.0, alpha: 1.0, specular: 0.0, ior: 1.5, transmission: 0.0, thin: false }
     }
 
+    /// The albedo of a Lambertian surface standing in for this model where the final gather's
+    /// rays and the photon map's lookups meet it (an approximation, stated in docs/design.md):
+    /// c for the metal and the opaque dielectric (the specular layer's energy counted as
+    /// diffuse), the hemispherical reflectance F̄ = f₀ + (1 − f₀)/21 for glass (the light it
+    /// transmits is not seen there).
+    pub fn diffuse_equivalent(&self) -> Vec3 {
+        let f0 = self.layer_f0();
+        let mean_f = f0 + (1.0 - f0) / 21.0;
+        let opaque = (1.0 - self.metallic) * (1.0 - self.transmission);
+        self.metallic * self.base + opaque * self.base + Vec3::splat((1.0 - self.metallic) * self.transmission * mean_f)
+    }
+
     /// Whether the model is plain Lambertian (f = c/π).
     pub fn is_lambertian(&self) -> bool {
         self.metallic == 0.0 && self.transmission == 0.0 && self.specular == 0.0

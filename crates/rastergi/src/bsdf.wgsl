@@ -412,3 +412,13 @@ fn shading_frame(n: vec3f) -> mat3x3f {
 fn to_local(f: mat3x3f, v: vec3f) -> vec3f {
     return vec3f(dot(v, f[0]), dot(v, f[1]), dot(v, f[2]));
 }
+
+// The albedo of a Lambertian surface standing in for b where the final gather's rays and the
+// photon map's lookups meet it (Bsdf::diffuse_equivalent): c for the metal and the diffuse base
+// (the specular layer's share included), the hemispherical reflectance F̄ for glass.
+fn bsdf_diffuse_equivalent(b: Bsdf) -> vec3f {
+    let f0 = layer_f0(b);
+    let mean_f = f0 + (1.0 - f0) / 21.0;
+    let opaque = (1.0 - b.metallic) * (1.0 - b.transmission);
+    return b.metallic * b.base + opaque * b.base + vec3f((1.0 - b.metallic) * b.transmission * mean_f);
+}

@@ -252,3 +252,87 @@ fn gltf_materials_map_to_the_model() {
     assert_eq!((w.transmission, w.ior, w.thin), (0.9, 1.5, true));
     assert_eq!(m("matte").specular, 0.0);
 }
+
+/// A black floor under a thin smooth glass pane (η 1.5, a slab) and a sun straight down: the
+/// floor under the pane receives E·(1 − R') with R' = 2R/(1 + R), R = 0.04 (nothing comes back:
+/// the floor absorbs), and E beside it. The photon map's irradiance there, GPU and CPU twin,
+/// within 4 standard errors of the photons' own noise (the map's slots are uniform there).
+#[test]
+fn photons_pass_a_thin_glass_pane_as_the_slab_formula_says() {
+    use rastergi::gpu_scene::{GpuScene, PreparedScene};
+    use rastergi::photons::map::GridSpec;
+    use rastergi::photons::{PhotonSettings, cpu, gpu::GpuPhotonMap};
+    use rastergi::scene::{Camera, Light, Material, Scene};
+    let camera = Camera { eye: Vec3::new(0.0, 3.0, 0.001), target: Vec3::ZERO, up: Vec3::Z, fov_y_deg: 60.0 };
+    let mut s = Scene::new(camera);
+    let floor = s.add_material(Material::diffuse("floor", Vec3::ZERO));
+    let pane = s.add_material(Material {
+        transmission: 1.0,
+        roughness: 0.0,
+        specular: 1.0,
+        thin: true,
+        two_sided: true,
+        ..Material::diffuse("pane", Vec3::ONE)
+    });
+    let quad = |h: f32, y: f32| [Vec3::new(-h, y, h), Vec3::new(h, y, h), Vec3::new(h, y, -h), Vec3::new(-h, y, -h)];
+    s.add_quad(quad(2.0, 0.0), floor);
+    s.add_quad(quad(1.0, 1.0), pane);
+    s.lights.push(Light::Distant { direction: -Vec3::Y, irradiance: Vec3::ONE, angular_radius: 0.0 });
+    let r = rastergi::bsdf::fresnel_dielectric(1.0, 1.5);
+    let transmitted = 1.0 - 2.0 * r / (1.0 + r);
+    let settings = PhotonSettings { count: 1 << 20, seed: 5, grid_resolution: 8, ..Default::default() };
+    let prepared = PreparedScene::new(&s);
+    let gpu = common::gpu();
+    let gs = GpuScene::new(&gpu, &prepared).unwrap();
+    let g = GpuPhotonMap::build(&gpu, &gs, &prepared, &settings).unwrap().read(&gpu).unwrap();
+    let c = cpu::trace(&prepared, &GridSpec::new(&s.bounds(), 8), &settings);
+    for (name, map) in [("gpu", &g), ("cpu", &c)] {
+        for (x, z, want) in [(0.0, 0.0, transmitted), (0.4, -0.3, transmitted), (1.6, 0.0, 1.0), (-1.7, 1.6, 1.0)] {
+            let e = map.irradiance(Vec3::new(x, 0.0, z), Vec3::Y)[1];
+            // The sun's photons start uniformly on a disc of radius 1.01 R across the bounding
+            // sphere: about N·A_cells/(π R²) of them land in the lookup's cells; each carries
+            // E·πR²/N and passes with probability T: the count that arrives is Poisson with
+            // mean T·n, so E's relative variance is 1/(T·n), E's variance T/n (E in units of
+            // the sun's).
+            let radius = s.bounds().extent().length() / 2.0 * 1.01;
+            let cell = s.bounds().extent().max_element() / 8.0;
+            let expected_count =
+                settings.count as f64 * (cell * cell) as f64 / (std::f64::consts::PI * (radius * radius) as f64);
+            let se = (want as f64 / expected_count).sqrt();
+            println!("{name}: E({x}, {z}) = {e:.4}, expected {want:.4} ± {se:.4}");
+            assert!((e - want as f64).abs() < 4.0 * se + 1e-3, "{name}: E({x}, {z}) = {e}, expected {want}");
+        }
+    }
+}
+
+/// The GPU photon tracer and its CPU twin scatter alike off metal and through glass: the
+/// Cornell box with a glass and a mirror sphere, maps of independent seeds, slot by slot
+/// within their noise (as tests/photons.rs checks the Lambertian box).
+#[test]
+fn gpu_and_cpu_photons_agree_through_glass_and_off_mirrors() {
+    use rastergi::gpu_scene::{GpuScene, PreparedScene};
+    use rastergi::photons::{PhotonSettings, cpu, gpu::GpuPhotonMap};
+    let scene = rastergi::scene::load_obj(&common::data("obj/cornell_spheres.obj")).unwrap();
+    let gpu = common::gpu();
+    let prepared = PreparedScene::new(&scene);
+    let gs = GpuScene::new(&gpu, &prepared).unwrap();
+    let n = 1u32 << 19;
+    let settings = |seed| PhotonSettings { count: n, seed, grid_resolution: 16, ..Default::default() };
+    let g = GpuPhotonMap::build(&gpu, &gs, &prepared, &settings(11)).unwrap().read(&gpu).unwrap();
+    let c = cpu::trace(&prepared, g.grid(), &settings(12));
+    let (mut sum_z2, mut max_z, mut cells) = (0.0f64, 0.0f64, 0usize);
+    for s in 0..g.flux.len() {
+        if c.deposits[s] < 400 {
+            continue;
+        }
+        let z = (g.flux[s][1] - c.flux[s][1]) / (2.0 * c.flux_sq[s]).sqrt();
+        sum_z2 += z * z;
+        max_z = max_z.max(z.abs());
+        cells += 1;
+    }
+    let mean_z2 = sum_z2 / cells as f64;
+    println!("{cells} slots: mean z² {mean_z2:.3}, max |z| {max_z:.2}");
+    assert!(cells > 300, "too few populated slots ({cells})");
+    assert!((mean_z2 - 1.0).abs() < 0.25, "GPU and CPU maps differ beyond noise: mean z² = {mean_z2}");
+    assert!(max_z < 6.0, "a slot differs beyond noise: |z| = {max_z}");
+}

@@ -3,7 +3,8 @@
 // point gathers where it is `ok` (visible_point.wgsl).
 
 // L(h → x) for the hit point h on triangle tri at barycentrics b, seen along w from x:
-// ρ_h/π · E(h) on the side of h facing x, zero from the back of a one-sided h. E(h) is the
+// ρ_h/π · E(h) on the side of h facing x (ρ_h the diffuse equivalent of a glossy or
+// specular h: bsdf_diffuse_equivalent, an approximation), zero from the back of a one-sided h. E(h) is the
 // photon map's, or — for a map of indirect light only — the map's plus the direct irradiance
 // from one light sample with a shadow ray (hit_direct): sample j (the gather direction's
 // sample index) of the pixel's sequence.
@@ -21,7 +22,25 @@ fn gather_radiance(w: vec3f, tri: u32, hit: vec3f, b: vec2f, pixel: u32, j: u32)
         let ns_h = bend_towards(select(-s_h.shading, s_h.shading, front_h), -w);
         e += hit_direct(hit, select(-n_h, n_h, front_h), ns_h, tri, pixel, j);
     }
-    return s_h.albedo / PI * e;
+    var rho = s_h.albedo;
+    if (s_h.flags & MATERIAL_LAMBERTIAN) == 0u {
+        rho = bsdf_diffuse_equivalent(surface_bsdf(s_h));
+    }
+    return rho / PI * e;
+}
+
+// f(ω_eye, w) at the visible point x: ρ_x/π for a Lambertian surface, else the BSDF's
+// non-specular lobes (bsdf.wgsl) in the shading frame of p.ns.
+fn visible_f(p: VisiblePoint, w: vec3f) -> vec3f {
+    if (p.x.flags & MATERIAL_LAMBERTIAN) != 0u {
+        return p.x.albedo / PI;
+    }
+    let sf = shading_frame(p.ns);
+    var b = surface_bsdf(p.x);
+    if !p.front && !b.thin {
+        b.ior = 1.0 / b.ior;
+    }
+    return bsdf_eval(b, to_local(sf, normalize(frame.eye - p.x.pos)), to_local(sf, w), TRANSPORT_RADIANCE);
 }
 
 // The cosine that weighs direction w at x: the shading normal's, where w lies above the
@@ -35,9 +54,10 @@ fn gather_cosine(p: VisiblePoint, w: vec3f) -> f32 {
 
 // Shared directions, bidirectional: ω uniform on the sphere, and x gathers along whichever of
 // ±ω lies above its geometric surface (w = sign(n·ω)·ω, uniform on x's hemisphere, pdf
-// 1/2π): (ρ_x/π) · L(h → x) · cos θ_x · 2π, cos θ_x = gather_cosine (the shading normal's).
+// 1/2π): f(ω_eye, w) · L(h → x) · cos θ_x · 2π, cos θ_x = gather_cosine (the shading
+// normal's); f = ρ_x/π on a Lambertian surface.
 fn gather_estimate(p: VisiblePoint, cos_x: f32, w: vec3f, tri: u32, hit: vec3f, b: vec2f, pixel: u32, j: u32) -> vec3f {
-    return p.x.albedo / PI * gather_radiance(w, tri, hit, b, pixel, j) * (cos_x * 2.0 * PI);
+    return visible_f(p, w) * gather_radiance(w, tri, hit, b, pixel, j) * (cos_x * 2.0 * PI);
 }
 
 // The side of shared direction ω that x gathers along: ω, or −ω where ω lies below x's surface.
@@ -46,21 +66,22 @@ fn gather_side(n: vec3f, w: vec3f) -> vec3f {
 }
 
 // Per-pixel directions, cosine-distributed about the shading normal (pdf cos θ_x/π): the
-// cosine and the π cancel, ρ_x · L(h → x); directions below the geometric surface count zero.
+// cosine cancels, π f(ω_eye, w) · L(h → x) (ρ_x · L on a Lambertian surface); directions below
+// the geometric surface count zero.
 fn gather_estimate_cosine(p: VisiblePoint, w: vec3f, tri: u32, hit: vec3f, b: vec2f, pixel: u32, j: u32) -> vec3f {
-    return p.x.albedo * gather_radiance(w, tri, hit, b, pixel, j);
+    return PI * visible_f(p, w) * gather_radiance(w, tri, hit, b, pixel, j);
 }
 
 // A gather ray from x along w that escapes the scene sees the environment: its estimate,
 // weighted against the direct pass's environment samples (env_gather_weight). It is direct
 // light, so the gathers add it to the film's direct component (with the direct pass's share:
 // Show::Direct is all of the direct light, Show::Indirect the light from surfaces). Shared
-// directions (pdf 1/2π): (ρ_x/π)·L_env(w)·cos θ_x·2π; per-pixel (pdf cos θ_x/π): ρ_x·L_env(w).
+// directions (pdf 1/2π): f·L_env(w)·cos θ_x·2π; per-pixel (pdf cos θ_x/π): π f·L_env(w).
 fn escape_estimate(p: VisiblePoint, cos_x: f32, w: vec3f) -> vec3f {
     if !has_environment() {
         return vec3f(0.0);
     }
-    var f = p.x.albedo * env_radiance(w) * env_gather_weight(p.ns, w);
+    var f = PI * visible_f(p, w) * env_radiance(w) * env_gather_weight(p.ns, w);
     if frame.gather_cosine == 0u {
         f *= 2.0 * cos_x;
     }

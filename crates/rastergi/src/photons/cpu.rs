@@ -4,6 +4,7 @@
 use rayon::prelude::*;
 
 use super::{MAX_BOUNCES, PhotonSettings, STREAM_PHOTON};
+use crate::bsdf::{Frame, Transport};
 use crate::gpu_scene::{PreparedScene, alpha_uniform};
 use crate::photons::map::{GridSpec, MapLayout, PhotonMap};
 use crate::sampling::{Rng, bend_towards, cosine_hemisphere, pcg_hash};
@@ -102,7 +103,8 @@ fn trace_photon(
         let material = scene.material_of(hit.triangle as usize);
         let n = triangle_normal(tri);
         let front = n.dot(dir) < 0.0;
-        if !front && !material.two_sided {
+        // Glass is entered and left by either face.
+        if !front && !material.two_sided && material.transmission <= 0.0 {
             break;
         }
         let n = if front { n } else { -n };
@@ -123,20 +125,47 @@ fn trace_photon(
                 None => t.dropped += 1,
             }
         }
-        let albedo = prepared.albedo_at(hit.triangle as usize, hit.b1, hit.b2, 0.0);
-        let survive = albedo.max_element();
-        if rng.next_f32() >= survive {
-            break;
+        let mut below = false;
+        if material.is_lambertian() {
+            let albedo = prepared.albedo_at(hit.triangle as usize, hit.b1, hit.b2, 0.0);
+            let survive = albedo.max_element();
+            if rng.next_f32() >= survive {
+                break;
+            }
+            flux *= albedo / survive;
+            let (u1, u2) = (rng.next_f32(), rng.next_f32());
+            dir = cosine_hemisphere(ns, u1, u2);
+            let (cos_s, cos_g) = (dir.dot(ns), dir.dot(n));
+            if cos_g <= 0.0 || cos_s <= 0.0 {
+                break;
+            }
+            flux *= arrive * (cos_g / cos_s);
+        } else {
+            // trace.wgsl: a direction from the BSDF, then roulette by its weight.
+            let frame = Frame::new(ns);
+            let mut b = prepared.bsdf_at(hit.triangle as usize, hit.b1, hit.b2, 0.0);
+            if !front && !b.thin {
+                b.ior = 1.0 / b.ior;
+            }
+            let v = [rng.next_f32(), rng.next_f32(), rng.next_f32()];
+            let sample = b.sample(frame.to_local(-dir), v, Transport::Importance);
+            let u_rr = rng.next_f32();
+            let Some(bs) = sample else { break };
+            let wi = frame.to_world(bs.wi).normalize();
+            let cos_g = wi.dot(n);
+            below = cos_g < 0.0;
+            if (bs.wi.z < 0.0) != below || cos_g == 0.0 || bs.wi.z == 0.0 {
+                break;
+            }
+            let w = bs.weight * (arrive * (cos_g / bs.wi.z).abs());
+            let survive = w.max_element().min(1.0);
+            if u_rr >= survive {
+                break;
+            }
+            flux *= w / survive;
+            dir = wi;
         }
-        flux *= albedo / survive;
-        let (u1, u2) = (rng.next_f32(), rng.next_f32());
-        dir = cosine_hemisphere(ns, u1, u2);
-        let (cos_s, cos_g) = (dir.dot(ns), dir.dot(n));
-        if cos_g <= 0.0 || cos_s <= 0.0 {
-            break;
-        }
-        flux *= arrive * (cos_g / cos_s);
-        origin = p + n * eps;
+        origin = p + if below { -n } else { n } * eps;
         skip = hit.triangle;
     }
 }

@@ -135,34 +135,68 @@ fn trace_photons(@builtin(global_invocation_id) gid: vec3u) {
         // The texel's albedo, unfiltered (level 0): photons sample the texture point-wise.
         let s = surface_at(hit.tri, hit.b1, hit.b2, 0.0);
         let front = dot(s.normal, dir) < 0.0;
-        if !front && (s.flags & MATERIAL_TWO_SIDED) == 0u {
+        let lambertian = (s.flags & MATERIAL_LAMBERTIAN) != 0u;
+        // Glass is entered and left by either face.
+        if !front && (s.flags & MATERIAL_TWO_SIDED) == 0u && s.transmission <= 0.0 {
             break;
         }
         let n = select(-s.normal, s.normal, front);
         // Shading normals (photons/mod.rs): the deposit estimates the shading irradiance,
-        // flux × |ω_o·n_s|/|ω_o·n_g| with ω_o = −dir, and scattering is cosine-distributed
-        // about n_s with the adjoint weight (|ω_o·n_s|/|ω_o·n_g|)·(|ω_i·n_g|/|ω_i·n_s|).
+        // flux × |ω_o·n_s|/|ω_o·n_g| with ω_o = −dir, and scattering has the adjoint weight
+        // f·|ω_i·n_s|/pdf · (|ω_o·n_s|/|ω_o·n_g|)·(|ω_i·n_g|/|ω_i·n_s|).
         let ns = bend_towards(select(-s.shading, s.shading, front), -dir);
         let arrive = dot(-dir, ns) / dot(-dir, n);
         if bounce >= params.first_deposit {
             deposit(s.pos, hit.tri, !front, flux * arrive);
         }
-        let survive = max(s.albedo.x, max(s.albedo.y, s.albedo.z));
-        if rng_f32(&rng) >= survive {
-            break;
+        var below = false;
+        if lambertian {
+            // Russian roulette by the albedo, then a cosine-distributed direction: f·cos/pdf = ρ.
+            let survive = max(s.albedo.x, max(s.albedo.y, s.albedo.z));
+            if rng_f32(&rng) >= survive {
+                break;
+            }
+            flux *= s.albedo / survive;
+            let v1 = rng_f32(&rng);
+            let v2 = rng_f32(&rng);
+            dir = cosine_hemisphere(ns, v1, v2);
+            let cos_s = dot(dir, ns);
+            let cos_g = dot(dir, n);
+            // No way into the surface.
+            if cos_g <= 0.0 || cos_s <= 0.0 {
+                break;
+            }
+            flux *= arrive * (cos_g / cos_s);
+        } else {
+            // A direction from the BSDF (importance: no 1/η² on refraction), then Russian
+            // roulette by its weight. A solid glass hit from behind is left: η inverts.
+            let sf = shading_frame(ns);
+            var b = surface_bsdf(s);
+            if !front && !b.thin {
+                b.ior = 1.0 / b.ior;
+            }
+            let v = vec3f(rng_f32(&rng), rng_f32(&rng), rng_f32(&rng));
+            let bs = bsdf_sample(b, to_local(sf, -dir), v, TRANSPORT_IMPORTANCE);
+            let u_rr = rng_f32(&rng);
+            if !bs.ok {
+                break;
+            }
+            let wi = normalize(sf * bs.wi);
+            let cos_g = dot(wi, n);
+            below = cos_g < 0.0;
+            // The geometric and the shading side agree, or the path ends.
+            if (bs.wi.z < 0.0) != below || cos_g == 0.0 || bs.wi.z == 0.0 {
+                break;
+            }
+            let w = bs.weight * (arrive * abs(cos_g / bs.wi.z));
+            let survive = min(max(w.x, max(w.y, w.z)), 1.0);
+            if u_rr >= survive {
+                break;
+            }
+            flux *= w / survive;
+            dir = wi;
         }
-        flux *= s.albedo / survive;
-        let v1 = rng_f32(&rng);
-        let v2 = rng_f32(&rng);
-        dir = cosine_hemisphere(ns, v1, v2);
-        let cos_s = dot(dir, ns);
-        let cos_g = dot(dir, n);
-        // No way into the surface.
-        if cos_g <= 0.0 || cos_s <= 0.0 {
-            break;
-        }
-        flux *= arrive * (cos_g / cos_s);
-        origin = s.pos + n * params.ray_epsilon;
+        origin = s.pos + select(n, -n, below) * params.ray_epsilon;
         skip = hit.tri;
     }
 }

@@ -23,6 +23,7 @@
 //! - `illum 3` (reflection, ray traced) without `Pm`: a metal, roughness `Pr` (default 0);
 //! - `illum` 4, 6, 7 or 9 (refraction): glass, a refracting solid of index `Ni` (default 1.5)
 //!   tinted by `Tf` (default white), roughness `Pr` (default 0); `Kd` and `Pm` are not used.
+//!
 //! Values outside their range are clamped with a warning.
 //!
 //! Faces whose corners name `vn` normals (`f v//vn`, `f v/vt/vn`) shade with them, interpolated

@@ -336,3 +336,44 @@ fn gpu_and_cpu_photons_agree_through_glass_and_off_mirrors() {
     assert!((mean_z2 - 1.0).abs() < 0.25, "GPU and CPU maps differ beyond noise: mean z² = {mean_z2}");
     assert!(max_z < 6.0, "a slot differs beyond noise: |z| = {max_z}");
 }
+
+/// The photon map and the traced gather on the rough metal and the diffuse + GGX blend
+/// spheres against Mitsuba, with the criteria of the Lambertian scenes (tests/common:
+/// relative RMSE under 5 %, block-mean error under 1.5 %, channel means within 1 %): the
+/// visible points evaluate the BSDF exactly; the gather's hits on the sphere see its diffuse
+/// equivalent (the stated approximation), which the block means bound.
+#[test]
+fn photon_map_and_gather_on_glossy_spheres_match_mitsuba() {
+    use rastergi::film::Show;
+    use rastergi::metrics::emitter_mask;
+    let gpu = common::gpu();
+    for kind in ["metal_rough", "mix"] {
+        let scene = material_scene(&format!("mat_{kind}"), stage_camera());
+        let grid = rastergi::fit::grid_resolution(&scene.bounds());
+        let settings = |seed| rastergi::renderer::RenderSettings {
+            width: 64,
+            height: 64,
+            seed,
+            grid_resolution: grid,
+            photons: rastergi::fit::photon_count(&scene, grid),
+            gather: rastergi::gather::GatherMethod::Trace,
+            ..Default::default()
+        };
+        let a = common::render(&gpu, &scene, settings(1), 256, Show::Full);
+        let b = common::render(&gpu, &scene, settings(2), 256, Show::Full);
+        let stem = format!("mat_{kind}_path_64");
+        let probe = rastergi::image_io::read_exr(&common::data(&format!("{stem}_a.exr"))).unwrap();
+        let mask = emitter_mask(&probe, 3.0);
+        let (reference, ref_noise) = common::reference_pair(&stem, Some(&mask));
+        let (c, noise, bias) = common::against_reference(&a, &b, &reference, ref_noise, Some(&mask));
+        println!(
+            "{kind} (grid {grid}): relative RMSE {:.4} = noise {noise:.4} ⊕ bias {bias:.4}; block-mean error {:.4}; mean ratio {:.4?}",
+            c.relative_rmse, c.block_mean_error, c.mean_ratio
+        );
+        assert!(c.relative_rmse < 0.05, "{kind}: relative RMSE {}", c.relative_rmse);
+        assert!(c.block_mean_error < 0.015, "{kind}: block-mean error {}", c.block_mean_error);
+        for r in c.mean_ratio {
+            assert!((r - 1.0).abs() < 0.01, "{kind}: mean ratio {:?}", c.mean_ratio);
+        }
+    }
+}

@@ -74,6 +74,8 @@ pub mod stream {
     /// The light samples at gather hits (`HitLight::Exact`): the key of the pixels' Sobol'
     /// scramble seeds (not the restart's).
     pub const HIT_LIGHT: u32 = 0xa54ff53a;
+    /// The specular chains from the eye, keyed (pixel, iteration).
+    pub const EYE_CHAIN: u32 = 0x1f83d9ab;
     /// The ray view's sub-texel offset, keyed (direction index, restart).
     pub const TEXEL_JITTER: u32 = 0x7e1a5;
     /// The scramble seed of the pixel jitter's Owen-scrambled Sobol' sequence (hashed, not a

@@ -9,7 +9,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         return;
     }
     start_alpha_stream();
-    let p = visible_point(textureLoad(gbuffer, gid.xy, 0));
+    let p = visible_point_at(gid.xy);
     var radiance = vec3f(0.0);
     if !p.seen {
         // The camera ray escapes: the environment along it (black without one).
@@ -30,7 +30,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         if !p.front && !b.thin {
             b.ior = 1.0 / b.ior;
         }
-        let wo = to_local(sf, normalize(frame.eye - s.pos));
+        let wo = to_local(sf, normalize(p.eye - s.pos));
         // Sample k of iteration i has index i·L + k in the pixel's own sequence, whose seed
         // depends on (seed, pixel) only: a restart replays the same light samples.
         let seed = pixel_seed(pcg_hash(frame.seed ^ STREAM_DIRECT), gid.x, gid.y);
@@ -73,5 +73,5 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         }
         radiance += sum / f32(frame.light_samples);
     }
-    film_add(FILM_DIRECT, gid.xy, radiance);
+    film_add(FILM_DIRECT, gid.xy, p.weight * (radiance));
 }

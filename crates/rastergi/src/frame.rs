@@ -4,7 +4,7 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec2, Vec3};
 
-use crate::gpu::{Gpu, buffer_bind_group, uniform_entry};
+use crate::gpu::{Gpu, buffer_bind_group, storage_entry, uniform_entry};
 use crate::gpu_scene::GpuScene;
 use crate::sampling::{pcg_hash, sobol_owen_2d, stream, unit_f32};
 use crate::scene::{Aabb, Camera};
@@ -30,7 +30,9 @@ pub struct FrameUniforms {
     /// multiple importance sampling (`env_mis_weight`).
     pub gather_count: u32,
     pub gather_cosine: u32,
-    pub _pad: u32,
+    /// 1 where the eye's specular chains ran this iteration ([`crate::specular`]): the visible
+    /// points are read through `eye_paths`.
+    pub eye_chains: u32,
 }
 
 impl FrameUniforms {
@@ -63,7 +65,7 @@ impl FrameUniforms {
             ray_epsilon: scene.ray_epsilon,
             gather_count: 0,
             gather_cosine: 0,
-            _pad: 0,
+            eye_chains: 0,
         }
     }
 }
@@ -99,12 +101,18 @@ pub fn view_projection(camera: &Camera, width: u32, height: u32, near: f32, jitt
     shift * proj * view
 }
 
-/// The uniform buffer and its bind group.
+/// The uniform buffer, the eye paths of the specular chains ([`crate::specular`]: per pixel
+/// the origin of the ray that found the visible point, its throughput and the point itself)
+/// and their bind group.
 pub struct FrameBinding {
     pub buffer: wgpu::Buffer,
+    pub eye_paths: wgpu::Buffer,
     pub layout: wgpu::BindGroupLayout,
     pub bind_group: wgpu::BindGroup,
 }
+
+/// Bytes of a pixel's eye path: three vec4f (`eye_paths` in `frame.wgsl`).
+pub const EYE_PATH_BYTES: u64 = 48;
 
 impl FrameBinding {
     pub fn new(gpu: &Gpu) -> Self {
@@ -116,10 +124,24 @@ impl FrameBinding {
         let vis = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
         let layout = gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("frame"),
-            entries: &[uniform_entry::<FrameUniforms>(0, vis)],
+            entries: &[
+                uniform_entry::<FrameUniforms>(0, vis),
+                storage_entry::<[f32; 4]>(1, wgpu::ShaderStages::COMPUTE, false),
+            ],
         });
-        let bind_group = buffer_bind_group(&gpu.device, "frame", &layout, &[&buffer]);
-        Self { buffer, layout, bind_group }
+        let eye_paths = gpu.zeroed_buffer("eye paths", EYE_PATH_BYTES, wgpu::BufferUsages::STORAGE);
+        let bind_group = buffer_bind_group(&gpu.device, "frame", &layout, &[&buffer, &eye_paths]);
+        Self { buffer, eye_paths, layout, bind_group }
+    }
+
+    /// Makes room for the eye paths of `pixels` pixels.
+    pub fn reserve_eye_paths(&mut self, gpu: &Gpu, pixels: u64) {
+        let size = (pixels * EYE_PATH_BYTES).max(EYE_PATH_BYTES);
+        if self.eye_paths.size() >= size {
+            return;
+        }
+        self.eye_paths = gpu.zeroed_buffer("eye paths", size, wgpu::BufferUsages::STORAGE);
+        self.bind_group = buffer_bind_group(&gpu.device, "frame", &self.layout, &[&self.buffer, &self.eye_paths]);
     }
 
     pub fn write(&self, gpu: &Gpu, u: &FrameUniforms) {

@@ -13,10 +13,16 @@ struct Frame {
     // cosine-distributed (1) or uniform on the hemisphere (0).
     gather_count: u32,
     gather_cosine: u32,
-    _pad0: u32,
+    // 1: the eye's specular chains ran (specular.wgsl); read visible points via eye_paths.
+    eye_chains: u32,
 }
 
 @group(1) @binding(0) var<uniform> frame: Frame;
+// Per pixel, written by the specular chains (specular.wgsl) where frame.eye_chains is set:
+// [3p] the origin of the ray that found the visible point (w = 1 where a chain replaced the
+// G-buffer's point), [3p + 1] the chain's throughput, [3p + 2] the visible point in the
+// G-buffer's format, bitcast (tri + 1, b1, b2, λ).
+@group(1) @binding(1) var<storage, read_write> eye_paths: array<vec4f>;
 
 // Starts this iteration's stream of stochastic opacity (alpha_seed, passes_through).
 fn start_alpha_stream() {

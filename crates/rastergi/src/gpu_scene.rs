@@ -306,6 +306,9 @@ pub struct GpuScene {
     /// Σ area and Σ perimeter of the triangles (bounds on what a projection of them covers).
     pub total_area: f64,
     pub total_perimeter: f64,
+    /// Whether the eye's rays continue through specular surfaces here
+    /// ([`crate::specular::scene_needs_chains`]).
+    pub eye_chains: bool,
 }
 
 impl GpuScene {
@@ -458,6 +461,7 @@ impl GpuScene {
                 .iter()
                 .map(|t| (t[0].distance(t[1]) + t[1].distance(t[2]) + t[2].distance(t[0])) as f64)
                 .sum(),
+            eye_chains: crate::specular::scene_needs_chains(s),
         })
     }
 }

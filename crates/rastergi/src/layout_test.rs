@@ -54,7 +54,8 @@ fn twins() -> Vec<Twin> {
                 light_samples,
                 ray_epsilon,
                 gather_count,
-                gather_cosine
+                gather_cosine,
+                eye_chains
             ]
         ),
         twin!(

@@ -3,7 +3,7 @@
 //! The modules follow the data flow of a render:
 //!
 //! scene → [`bvh`] → [`gpu_scene`] → [`photons`] (trace into the grid [`photons::map`]) → per
-//! iteration ([`gbuffer`] → [`direct`] → [`gather`] ([`gather::raster`], [`gather::lists`] or
+//! iteration ([`gbuffer`] → [`specular`] chains → [`direct`] → [`gather`] ([`gather::raster`], [`gather::lists`] or
 //! [`gather::trace`])) → [`film`] (accumulate, resolve) → [`image_io`]. [`path_tracer`] is the
 //! reference; both it and the [`renderer`] are [`progressive`] renderers. [`profile`] times the
 //! passes.
@@ -40,6 +40,7 @@ pub mod renderer;
 pub mod sampling;
 pub mod scene;
 mod shader;
+pub mod specular;
 pub mod textures;
 
 pub use error::{Error, Result};

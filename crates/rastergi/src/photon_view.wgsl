@@ -9,10 +9,10 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         return;
     }
     start_alpha_stream();
-    let p = visible_point(textureLoad(gbuffer, gid.xy, 0));
+    let p = visible_point_at(gid.xy);
     var radiance = vec3f(0.0);
     if p.ok {
         radiance = p.x.albedo / PI * photon_irradiance(p.x.pos, p.x.tri, !p.front);
     }
-    film_add(FILM_PHOTON_VIEW, gid.xy, radiance);
+    film_add(FILM_PHOTON_VIEW, gid.xy, p.weight * (radiance));
 }

@@ -20,6 +20,7 @@ use crate::photons::gpu::GpuPhotonMap;
 use crate::photons::map::GridSpec;
 use crate::photons::passes::{DEFAULT_PASS_ITERATIONS, PhotonPasses, fitted_pass_iterations};
 use crate::scene::{Camera, Scene};
+use crate::specular::SpecularPass;
 
 /// Settings of a render.
 #[derive(Clone, Debug)]
@@ -110,6 +111,7 @@ impl Default for RenderSettings {
 /// The passes whose resources depend on the image size.
 struct ImagePasses {
     gbuffer: GBufferPass,
+    specular: Option<SpecularPass>,
     direct: DirectPass,
     photon_view: Option<PhotonViewPass>,
     gather: Option<GatherPass>,
@@ -129,6 +131,7 @@ impl ImagePasses {
         let (width, height) = (settings.width, settings.height);
         let film = Film::new(gpu, width, height)?;
         let gbuffer = GBufferPass::new(gpu, scene, frame, width, height);
+        let specular = scene.eye_chains.then(|| SpecularPass::new(gpu, scene, frame, &gbuffer, &film));
         let direct = DirectPass::new(gpu, scene, frame, &gbuffer, &film);
         let photon_view = match map {
             Some(map) if settings.show_photon_map => Some(PhotonViewPass::new(gpu, scene, frame, &gbuffer, &film, map)),
@@ -142,7 +145,7 @@ impl ImagePasses {
             }
             None => None,
         };
-        Ok(ImagePasses { gbuffer, direct, photon_view, gather, film })
+        Ok(ImagePasses { gbuffer, specular, direct, photon_view, gather, film })
     }
 }
 
@@ -185,7 +188,8 @@ impl Renderer {
         );
         prepared.textures.check_limits(gpu)?;
         let gpu_scene = GpuScene::new(gpu, &prepared)?;
-        let frame = FrameBinding::new(gpu);
+        let mut frame = FrameBinding::new(gpu);
+        frame.reserve_eye_paths(gpu, settings.width as u64 * settings.height as u64);
         let photon_settings = PhotonSettings {
             count: settings.photons,
             seed: settings.seed,
@@ -225,6 +229,7 @@ impl Renderer {
         // The gather's random choices go on where they were.
         let sampler =
             self.passes.gather.as_ref().map_or_else(|| DirectionSampler::new(settings.seed), GatherPass::sampler);
+        self.frame.reserve_eye_paths(&self.gpu, width as u64 * height as u64);
         self.passes = ImagePasses::new(
             &self.gpu,
             &self.scene,
@@ -307,6 +312,7 @@ impl Renderer {
         let size = (w, h);
         let mut uniforms =
             FrameUniforms::new(&self.camera, size, &self.scene, iteration, jitter, seed, self.settings.light_samples);
+        uniforms.eye_chains = self.scene.eye_chains as u32;
         let fixed = FixedSample { direction: o.direction, texel_jitter: o.texel_jitter };
         let map = self.photons.as_ref().map(PhotonPasses::map);
         if let (Some(gather), Some(_)) = (&self.passes.gather, map) {
@@ -317,8 +323,12 @@ impl Renderer {
         self.frame.write(&self.gpu, &uniforms);
         let mut enc =
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("iteration") });
-        // 1. Eye pass: the visible point of each pixel, at this iteration's jitter.
+        // 1. Eye pass: the visible point of each pixel, at this iteration's jitter; through
+        //    mirrors and glass to the first surface that is not purely specular.
         self.passes.gbuffer.encode(&mut enc, &self.scene, &self.frame);
+        if let Some(specular) = &self.passes.specular {
+            specular.encode(&mut enc, &self.scene, &self.frame, w, h);
+        }
         // 2. Emission + direct light with soft shadows → film (direct component).
         self.passes.direct.encode(&mut enc, &self.scene, &self.frame, w, h);
         // Debug view: the photon map's radiance at the visible points → film (photon view).

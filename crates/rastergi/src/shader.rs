@@ -49,6 +49,7 @@ pub fn constants() -> String {
         ("STREAM_PATH", stream::PATH),
         ("STREAM_PHOTON", stream::PHOTON),
         ("STREAM_HIT_LIGHT", stream::HIT_LIGHT),
+        ("STREAM_EYE_CHAIN", stream::EYE_CHAIN),
         ("PUNCTUAL_LIGHT", PUNCTUAL_LIGHT),
         ("ENVIRONMENT_LIGHT", ENVIRONMENT_LIGHT),
         ("LIGHT_POINT", LIGHT_POINT),

@@ -15,10 +15,35 @@ struct VisiblePoint {
     front: bool,
     // The side facing the eye reflects: a front face, or either face of a two-sided surface.
     ok: bool,
+    // Where the point is seen from: the camera, or the last specular surface of the pixel's
+    // eye chain (specular.wgsl).
+    eye: vec3f,
+    // What the point's estimates are weighed by: 1, or the eye chain's throughput.
+    weight: vec3f,
 }
 
-fn visible_point(g: vec4u) -> VisiblePoint {
+// The visible point of pixel xy: the G-buffer's, or where a specular chain from the eye
+// replaced it (eye_paths, frame.wgsl), the one the chain found.
+fn visible_point_at(xy: vec2u) -> VisiblePoint {
+    var g = textureLoad(gbuffer, xy, 0);
+    var eye = frame.eye;
+    var weight = vec3f(1.0);
+    if frame.eye_chains != 0u {
+        let base = 3u * (xy.y * frame.resolution.x + xy.x);
+        let e = eye_paths[base];
+        if e.w > 0.0 {
+            eye = e.xyz;
+            weight = eye_paths[base + 1u].xyz;
+            g = bitcast<vec4u>(eye_paths[base + 2u]);
+        }
+    }
+    return visible_point(g, eye, weight);
+}
+
+fn visible_point(g: vec4u, eye: vec3f, weight: vec3f) -> VisiblePoint {
     var p: VisiblePoint;
+    p.eye = eye;
+    p.weight = weight;
     p.seen = g.x != 0u;
     p.front = false;
     p.ok = false;
@@ -26,9 +51,9 @@ fn visible_point(g: vec4u) -> VisiblePoint {
         return p;
     }
     p.x = surface_at(g.x - 1u, bitcast<f32>(g.y), bitcast<f32>(g.z), bitcast<f32>(g.w));
-    p.front = dot(p.x.normal, frame.eye - p.x.pos) > 0.0;
+    p.front = dot(p.x.normal, eye - p.x.pos) > 0.0;
     p.n = select(-p.x.normal, p.x.normal, p.front);
-    p.ns = bend_towards(select(-p.x.shading, p.x.shading, p.front), normalize(frame.eye - p.x.pos));
+    p.ns = bend_towards(select(-p.x.shading, p.x.shading, p.front), normalize(eye - p.x.pos));
     p.ok = p.front || (p.x.flags & MATERIAL_TWO_SIDED) != 0u;
     return p;
 }

@@ -40,7 +40,7 @@ fn visible_f(p: VisiblePoint, w: vec3f) -> vec3f {
     if !p.front && !b.thin {
         b.ior = 1.0 / b.ior;
     }
-    return bsdf_eval(b, to_local(sf, normalize(frame.eye - p.x.pos)), to_local(sf, w), TRANSPORT_RADIANCE);
+    return bsdf_eval(b, to_local(sf, normalize(p.eye - p.x.pos)), to_local(sf, w), TRANSPORT_RADIANCE);
 }
 
 // The cosine that weighs direction w at x: the shading normal's, where w lies above the

@@ -15,7 +15,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         return;
     }
     start_alpha_stream();
-    let p = visible_point(textureLoad(gbuffer, gid.xy, 0));
+    let p = visible_point_at(gid.xy);
     // Both sides of the ray view serve: points below ω gather along −ω, whose nearest surface
     // is in the same texel's list (the projection along ±ω is the same).
     let w = gather_side(p.n, gather.direction);
@@ -42,9 +42,9 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         }
     }
     if best_tri == NO_TRIANGLE {
-        film_add(FILM_DIRECT, gid.xy, escape_estimate(p, cos_x, w) / f32(gather.count));
+        film_add(FILM_DIRECT, gid.xy, p.weight * (escape_estimate(p, cos_x, w) / f32(gather.count)));
         return;
     }
     let pixel = gid.y * frame.resolution.x + gid.x;
-    film_add(FILM_INDIRECT, gid.xy, texel_estimate(p, cos_x, w, best_tri, best, pixel) / f32(gather.count));
+    film_add(FILM_INDIRECT, gid.xy, p.weight * (texel_estimate(p, cos_x, w, best_tri, best, pixel) / f32(gather.count)));
 }

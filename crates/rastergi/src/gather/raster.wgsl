@@ -25,7 +25,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if found[pixel] != 0u {
         return;
     }
-    let p = visible_point(textureLoad(gbuffer, gid.xy, 0));
+    let p = visible_point_at(gid.xy);
     let w = gather_side(p.n, gather.direction);
     let cos_x = gather_cosine(p, w);
     if !p.ok || cos_x <= 0.0 {
@@ -38,7 +38,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         // escapes; along −ω the nearest surface behind x, if any, is in `behind`.
         found[pixel] = 1u;
         if dot(w, gather.direction) > 0.0 {
-            film_add(FILM_DIRECT, gid.xy, escape_estimate(p, cos_x, w) / f32(gather.count));
+            film_add(FILM_DIRECT, gid.xy, p.weight * (escape_estimate(p, cos_x, w) / f32(gather.count)));
         }
         return;
     }
@@ -55,7 +55,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             return;
         }
         found[pixel] = 1u;
-        film_add(FILM_INDIRECT, gid.xy, texel_estimate(p, cos_x, w, tri, dist, pixel) / f32(gather.count));
+        film_add(FILM_INDIRECT, gid.xy, p.weight * (texel_estimate(p, cos_x, w, tri, dist, pixel) / f32(gather.count)));
         return;
     }
     // Along −ω the layers come farthest first: keep the nearest behind x. Once a layer lies in
@@ -83,19 +83,19 @@ fn resolve_behind(@builtin(global_invocation_id) gid: vec3u) {
     let pixel = gid.y * frame.resolution.x + gid.x;
     let b = behind[pixel];
     if b.x != 0u {
-        let p = visible_point(textureLoad(gbuffer, gid.xy, 0));
+        let p = visible_point_at(gid.xy);
         let w = -gather.direction;
-        film_add(FILM_INDIRECT, gid.xy, texel_estimate(p, gather_cosine(p, w), w, b.x - 1u, bitcast<f32>(b.y), pixel) / f32(gather.count));
+        film_add(FILM_INDIRECT, gid.xy, p.weight * (texel_estimate(p, gather_cosine(p, w), w, b.x - 1u, bitcast<f32>(b.y), pixel) / f32(gather.count)));
         return;
     }
     if !has_environment() {
         return;
     }
-    let p = visible_point(textureLoad(gbuffer, gid.xy, 0));
+    let p = visible_point_at(gid.xy);
     let w = gather_side(p.n, gather.direction);
     let cos_x = gather_cosine(p, w);
     let along = dot(w, gather.direction) > 0.0;
     if p.ok && cos_x > 0.0 && (!along || found[pixel] == 0u) {
-        film_add(FILM_DIRECT, gid.xy, escape_estimate(p, cos_x, w) / f32(gather.count));
+        film_add(FILM_DIRECT, gid.xy, p.weight * (escape_estimate(p, cos_x, w) / f32(gather.count)));
     }
 }

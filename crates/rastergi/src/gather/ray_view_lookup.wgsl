@@ -39,7 +39,7 @@ fn traced_estimate(p: VisiblePoint, cos_x: f32, w: vec3f, pixel: u32, j: u32) ->
     let h = trace(p.x.pos, w, frame.ray_epsilon, 3.0e38, p.x.tri, NO_TRIANGLE, false);
     if h.tri == NO_TRIANGLE {
         let texel = vec2u(pixel % frame.resolution.x, pixel / frame.resolution.x);
-        film_add(FILM_DIRECT, texel, escape_estimate(p, cos_x, w) / f32(gather.count));
+        film_add(FILM_DIRECT, texel, p.weight * (escape_estimate(p, cos_x, w) / f32(gather.count)));
         return vec3f(0.0);
     }
     return gather_estimate(p, cos_x, w, h.tri, p.x.pos + w * h.t, vec2f(h.b1, h.b2), pixel, j);

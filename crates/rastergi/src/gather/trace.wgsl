@@ -15,7 +15,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         return;
     }
     start_alpha_stream();
-    let p = visible_point(textureLoad(gbuffer, gid.xy, 0));
+    let p = visible_point_at(gid.xy);
     let pixel = gid.y * frame.resolution.x + gid.x;
     let per_pixel = gather.per_pixel != 0u;
     let seed = pixel_seed(gather.pixel_key, gid.x, gid.y);
@@ -47,8 +47,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             sky += escape_estimate(p, cos_x, w);
         }
     }
-    film_add(FILM_INDIRECT, gid.xy, sum / f32(gather.count));
+    film_add(FILM_INDIRECT, gid.xy, p.weight * (sum / f32(gather.count)));
     if has_environment() {
-        film_add(FILM_DIRECT, gid.xy, sky / f32(gather.count));
+        film_add(FILM_DIRECT, gid.xy, p.weight * (sky / f32(gather.count)));
     }
 }

@@ -1,0 +1,72 @@
+//! Specular chains from the eye (`specular.wgsl`): where the camera sees a perfect mirror or
+//! smooth glass, its ray continues through the specular surfaces (one delta lobe drawn at each:
+//! Fresnel picks reflection or refraction, so the mean over iterations is the sum of both) to
+//! the first surface that is not purely specular. That point is the pixel's visible point for
+//! the direct light, the gather and the photon view, seen from the last ray's origin, and their
+//! estimates are weighed by the chain's throughput (`visible_point_at` in
+//! `visible_point.wgsl`). The pass runs after the G-buffer, only for scenes with such materials.
+//!
+//! A surface that mixes a delta lobe with a diffuse or glossy one (a smooth specular layer over
+//! a diffuse base) stays the visible point; its delta reflection is not followed (stated in
+//! docs/design.md).
+
+use crate::film::Film;
+use crate::frame::FrameBinding;
+use crate::gbuffer::{GBUFFER_FILM_WGSL, GBufferPass, gbuffer_film_bind_group, gbuffer_film_layout};
+use crate::gpu::{Gpu, compute_pipeline, dispatch_pixels};
+use crate::gpu_scene::GpuScene;
+use crate::profile::{Profiler, compute_pass};
+use crate::scene::Scene;
+use crate::shader;
+
+/// The pass's composed shader.
+pub fn source() -> String {
+    shader::per_pixel(&[GBUFFER_FILM_WGSL, include_str!("specular.wgsl")])
+}
+
+/// Whether `scene` has a material the chains go through (perfectly specular: a smooth metal or
+/// smooth glass without a diffuse base; or one whose roughness a texture sets).
+pub fn scene_needs_chains(scene: &Scene) -> bool {
+    scene.materials.iter().any(|m| {
+        let opaque = (1.0 - m.metallic.clamp(0.0, 1.0)) * (1.0 - m.transmission);
+        opaque <= 0.0 && (m.roughness * m.roughness < crate::bsdf::SMOOTH_ALPHA || m.metal_rough_texture.is_some())
+    })
+}
+
+pub struct SpecularPass {
+    pipeline: wgpu::ComputePipeline,
+    bind_group: wgpu::BindGroup,
+    profiler: Option<Profiler>,
+}
+
+impl SpecularPass {
+    pub fn new(gpu: &Gpu, scene: &GpuScene, frame: &FrameBinding, gbuffer: &GBufferPass, film: &Film) -> Self {
+        let device = &gpu.device;
+        let module = shader::module(device, "specular chains", &source());
+        let layout = gbuffer_film_layout(device, "specular chains");
+        let bind_group = gbuffer_film_bind_group(device, "specular chains", &layout, gbuffer, film);
+        let pipeline =
+            compute_pipeline(device, "specular chains", &module, "main", &[&scene.layout, &frame.layout, &layout]);
+        Self { pipeline, bind_group, profiler: gpu.profiler.clone() }
+    }
+
+    /// Reads: scene, frame, G-buffer. Writes: the eye paths. Adds to: the film's direct
+    /// component (the environment seen through the chains).
+    pub fn encode(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        frame: &FrameBinding,
+        width: u32,
+        height: u32,
+    ) {
+        let mut pass = compute_pass(enc, self.profiler.as_ref(), "specular chains");
+        dispatch_pixels(
+            &mut pass,
+            &self.pipeline,
+            &[&scene.bind_group, &frame.bind_group, &self.bind_group],
+            width,
+            height,
+        );
+    }
+}

@@ -49,6 +49,9 @@ pub const OFFSET_STEP: f32 = 0.125;
 /// Photon-map lookups leave out slots of less than this many cell faces h² of area
 /// ([`crate::photons::map::PhotonMap::irradiance_on_plane`]).
 pub const MIN_LOOKUP_AREA: f32 = 1e-4;
+/// Bit of a slot's cell index that marks the caustic twin of the slot ([`crate::photons::map`]):
+/// the flux of photons that reached it through specular surfaces alone.
+pub const CAUSTIC_CELL: u32 = 1 << 31;
 /// Most separators of one photon-map slot (each doubles its regions).
 pub const MAX_SEPARATORS: usize = 4;
 /// Bit offset of the region in a slot's plane key (the orientation bin below it, < 64).
@@ -76,6 +79,8 @@ pub mod stream {
     pub const HIT_LIGHT: u32 = 0xa54ff53a;
     /// The specular chains from the eye, keyed (pixel, iteration).
     pub const EYE_CHAIN: u32 = 0x1f83d9ab;
+    /// The final gather's rays through specular surfaces, keyed (pixel, sample index).
+    pub const GATHER_CHAIN: u32 = 0x5be0cd19;
     /// The ray view's sub-texel offset, keyed (direction index, restart).
     pub const TEXEL_JITTER: u32 = 0x7e1a5;
     /// The scramble seed of the pixel jitter's Owen-scrambled Sobol' sequence (hashed, not a

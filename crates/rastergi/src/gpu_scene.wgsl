@@ -368,6 +368,24 @@ fn surface_bsdf(s: Surface) -> Bsdf {
         (s.flags & MATERIAL_THIN) != 0u);
 }
 
+// Whether the surface scatters by Dirac deltas alone (a perfect mirror or smooth glass, no
+// diffuse or glossy lobe): eye and gather rays continue through it (specular.wgsl,
+// gather_radiance).
+fn surface_purely_specular(s: Surface) -> bool {
+    let r = clamp(s.roughness, 0.0, 1.0);
+    let opaque = (1.0 - clamp(s.metallic, 0.0, 1.0)) * (1.0 - s.transmission);
+    return r * r < SMOOTH_ALPHA && opaque <= 0.0;
+}
+
+// The albedo with which a point reflects the photon map's irradiance: ρ, or the diffuse
+// equivalent of a glossy or specular surface (bsdf_diffuse_equivalent, an approximation).
+fn surface_rho(s: Surface) -> vec3f {
+    if (s.flags & MATERIAL_LAMBERTIAN) != 0u {
+        return s.albedo;
+    }
+    return bsdf_diffuse_equivalent(surface_bsdf(s));
+}
+
 // Whether the scene has emitters: an empty light table is stored as one zero entry (a
 // binding cannot be empty), whose pmf is 0.
 fn has_lights() -> bool {

@@ -67,12 +67,13 @@ pub fn check_bvh_nodes(limits: &wgpu::Limits, nodes: usize) -> Result<()> {
     check_storage_buffer(limits, &format!("the scene's {nodes} BVH nodes"), nodes as u64, stride, FEWER_TRIANGLES)
 }
 
-/// The photon grid: its cells must have 32-bit indices (the first word of a slot's key).
+/// The photon grid: its cells must have 31-bit indices (the first word of a slot's key; its
+/// top bit marks caustic twins, `CAUSTIC_CELL`).
 pub fn check_photon_grid(_limits: &wgpu::Limits, grid: &GridSpec) -> Result<()> {
     let d = grid.dims;
-    if grid.cell_count() >= u32::MAX as u64 {
+    if grid.cell_count() >= crate::consts::CAUSTIC_CELL as u64 {
         return Err(Error::Limits(format!(
-            "a photon grid of {}x{}x{} cells has more than 2^32 cells; choose a smaller --grid",
+            "a photon grid of {}x{}x{} cells has more than 2^31 cells; choose a smaller --grid",
             d.x, d.y, d.z
         )));
     }

@@ -21,6 +21,17 @@ pub struct PhotonViewPass {
     pipeline: wgpu::ComputePipeline,
     bind_group: wgpu::BindGroup,
     profiler: Option<Profiler>,
+    label: &'static str,
+}
+
+/// What a [`PhotonViewPass`] adds to the film.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PhotonView {
+    /// ρ/π · E(x) of the whole map → the photon-view component (`--show photon-map`).
+    Map,
+    /// ρ/π · E_caustic(x) of the caustic twins → the indirect component: the caustic term of
+    /// every render of a scene with perfect mirrors or smooth glass.
+    Caustics,
 }
 
 impl PhotonViewPass {
@@ -31,22 +42,23 @@ impl PhotonViewPass {
         gbuffer: &GBufferPass,
         film: &Film,
         map: &GpuPhotonMap,
+        view: PhotonView,
     ) -> Self {
         let device = &gpu.device;
-        let module = shader::module(device, "photon view", &source());
-        let layout = gbuffer_film_layout(device, "photon view");
-        let bind_group = gbuffer_film_bind_group(device, "photon view", &layout, gbuffer, film);
-        let pipeline = compute_pipeline(
-            device,
-            "photon view",
-            &module,
-            "main",
-            &[&scene.layout, &frame.layout, &layout, &map.bind_layout],
-        );
-        Self { pipeline, bind_group, profiler: gpu.profiler.clone() }
+        let (label, entry) = match view {
+            PhotonView::Map => ("photon view", "main"),
+            PhotonView::Caustics => ("caustics", "caustics"),
+        };
+        let module = shader::module(device, label, &source());
+        let layout = gbuffer_film_layout(device, label);
+        let bind_group = gbuffer_film_bind_group(device, label, &layout, gbuffer, film);
+        let pipeline =
+            compute_pipeline(device, label, &module, entry, &[&scene.layout, &frame.layout, &layout, &map.bind_layout]);
+        Self { pipeline, bind_group, profiler: gpu.profiler.clone(), label }
     }
 
-    /// Reads: scene, frame, G-buffer, photon map. Adds to: the film's photon-map component.
+    /// Reads: scene, frame, G-buffer, photon map. Adds to: the film's photon-map component, or
+    /// its indirect component (caustics).
     pub fn encode(
         &self,
         enc: &mut wgpu::CommandEncoder,
@@ -56,7 +68,7 @@ impl PhotonViewPass {
         width: u32,
         height: u32,
     ) {
-        let mut pass = compute_pass(enc, self.profiler.as_ref(), "photon view");
+        let mut pass = compute_pass(enc, self.profiler.as_ref(), self.label);
         let bind_groups = [&scene.bind_group, &frame.bind_group, &self.bind_group, &map.bind_group];
         dispatch_pixels(&mut pass, &self.pipeline, &bind_groups, width, height);
     }

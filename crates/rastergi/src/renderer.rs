@@ -14,7 +14,7 @@ use crate::gbuffer::GBufferPass;
 use crate::gpu::Gpu;
 use crate::gpu_scene::{GpuScene, PreparedScene};
 use crate::image_io::{DisplayImage, LinearImage};
-use crate::photon_view::PhotonViewPass;
+use crate::photon_view::{PhotonView, PhotonViewPass};
 use crate::photons::PhotonSettings;
 use crate::photons::gpu::GpuPhotonMap;
 use crate::photons::map::GridSpec;
@@ -114,6 +114,7 @@ struct ImagePasses {
     specular: Option<SpecularPass>,
     direct: DirectPass,
     photon_view: Option<PhotonViewPass>,
+    caustics: Option<PhotonViewPass>,
     gather: Option<GatherPass>,
     film: Film,
 }
@@ -134,7 +135,15 @@ impl ImagePasses {
         let specular = scene.eye_chains.then(|| SpecularPass::new(gpu, scene, frame, &gbuffer, &film));
         let direct = DirectPass::new(gpu, scene, frame, &gbuffer, &film);
         let photon_view = match map {
-            Some(map) if settings.show_photon_map => Some(PhotonViewPass::new(gpu, scene, frame, &gbuffer, &film, map)),
+            Some(map) if settings.show_photon_map => {
+                Some(PhotonViewPass::new(gpu, scene, frame, &gbuffer, &film, map, PhotonView::Map))
+            }
+            _ => None,
+        };
+        let caustics = match map {
+            Some(map) if scene.eye_chains => {
+                Some(PhotonViewPass::new(gpu, scene, frame, &gbuffer, &film, map, PhotonView::Caustics))
+            }
             _ => None,
         };
         let bundle = settings.bundle_for(detail_bundle);
@@ -145,7 +154,7 @@ impl ImagePasses {
             }
             None => None,
         };
-        Ok(ImagePasses { gbuffer, specular, direct, photon_view, gather, film })
+        Ok(ImagePasses { gbuffer, specular, direct, photon_view, caustics, gather, film })
     }
 }
 
@@ -335,12 +344,16 @@ impl Renderer {
         if let (Some(view), Some(map)) = (&self.passes.photon_view, map) {
             view.encode(&mut enc, &self.scene, &self.frame, map, w, h);
         }
-        // 3. Final gather along the iteration's directions for every visible point → film (indirect).
+        // 3. Caustics: the light that came through mirrors and glass, from the caustic map.
+        if let (Some(caustics), Some(map)) = (&self.passes.caustics, map) {
+            caustics.encode(&mut enc, &self.scene, &self.frame, map, w, h);
+        }
+        // 4. Final gather along the iteration's directions for every visible point → film (indirect).
         if let (Some(gather), Some(map)) = (&mut self.passes.gather, map) {
             let f = GatherFrame { scene: &self.scene, frame: &self.frame, map, width: w, height: h };
             gather.encode(&self.gpu, &mut enc, &f, iteration, self.settings.directions, &fixed)?;
         }
-        // 4. Accumulate: every pass above added its estimate to the film's sums.
+        // 5. Accumulate: every pass above added its estimate to the film's sums.
         self.gpu.queue.submit([enc.finish()]);
         self.passes.film.samples += 1;
         if let Some(p) = self.gpu.profiler.as_ref().filter(|p| p.half_full()) {

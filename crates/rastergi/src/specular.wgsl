@@ -10,13 +10,6 @@
 
 const MAX_CHAIN: u32 = 16u;
 
-// Whether the surface scatters by Dirac deltas alone (no diffuse or glossy lobe).
-fn purely_specular(s: Surface) -> bool {
-    let r = clamp(s.roughness, 0.0, 1.0);
-    let opaque = (1.0 - clamp(s.metallic, 0.0, 1.0)) * (1.0 - s.transmission);
-    return r * r < SMOOTH_ALPHA && opaque <= 0.0;
-}
-
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3u) {
     if any(gid.xy >= frame.resolution) {
@@ -33,7 +26,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         return;
     }
     var s = surface_at(g.x - 1u, bitcast<f32>(g.y), bitcast<f32>(g.z), bitcast<f32>(g.w));
-    if !purely_specular(s) {
+    if !surface_purely_specular(s) {
         return;
     }
     var rng = rng_new(frame.seed ^ STREAM_EYE_CHAIN, pixel, frame.iteration);
@@ -68,7 +61,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             break;
         }
         s = surface_at(hit.tri, hit.b1, hit.b2, 0.0);
-        if !purely_specular(s) {
+        if !surface_purely_specular(s) {
             eye_paths[base] = vec4f(o, 1.0);
             eye_paths[base + 1u] = vec4f(throughput, 0.0);
             eye_paths[base + 2u] = bitcast<vec4f>(vec4u(hit.tri + 1u, bitcast<u32>(hit.b1), bitcast<u32>(hit.b2), 0u));

@@ -8,7 +8,55 @@
 // photon map's, or — for a map of indirect light only — the map's plus the direct irradiance
 // from one light sample with a shadow ray (hit_direct): sample j (the gather direction's
 // sample index) of the pixel's sequence.
-fn gather_radiance(w: vec3f, tri: u32, hit: vec3f, b: vec2f, pixel: u32, j: u32) -> vec3f {
+fn gather_radiance(w0: vec3f, tri0: u32, hit0: vec3f, b0: vec2f, pixel: u32, j: u32) -> vec3f {
+    var w = w0;
+    var tri = tri0;
+    var hit = hit0;
+    var b = b0;
+    // Through perfect mirrors and smooth glass the ray goes on (one delta lobe drawn at each,
+    // as the eye's chains do) to the first surface that is not purely specular. Light that
+    // reaches x from the lights or the sky through specular surfaces alone is the caustic map's
+    // (caustic_term), so a chain that escapes or meets only emitters adds nothing here.
+    var weight = vec3f(1.0);
+    if frame.eye_chains != 0u {
+        var rng = rng_new(frame.seed ^ STREAM_GATHER_CHAIN, pixel, j);
+        for (var k = 0u; ; k++) {
+            let s = surface_at(tri, b.x, b.y, 0.0);
+            if !surface_purely_specular(s) {
+                break;
+            }
+            if k == 16u {
+                return vec3f(0.0);
+            }
+            let front = dot(s.normal, w) < 0.0;
+            let n = select(-s.normal, s.normal, front);
+            let sf = shading_frame(bend_towards(select(-s.shading, s.shading, front), -w));
+            var bsdf = surface_bsdf(s);
+            if !front && !bsdf.thin {
+                bsdf.ior = 1.0 / bsdf.ior;
+            }
+            let u = vec3f(rng_f32(&rng), rng_f32(&rng), rng_f32(&rng));
+            let bs = bsdf_sample(bsdf, to_local(sf, -w), u, TRANSPORT_RADIANCE);
+            if !bs.ok {
+                return vec3f(0.0);
+            }
+            let wi = normalize(sf * bs.wi);
+            let below = dot(n, wi) < 0.0;
+            if (bs.wi.z < 0.0) != below {
+                return vec3f(0.0);
+            }
+            weight *= bs.weight;
+            let o = s.pos + select(n, -n, below) * frame.ray_epsilon;
+            let h = trace(o, wi, frame.ray_epsilon, 3.0e38, tri, NO_TRIANGLE, false);
+            if h.tri == NO_TRIANGLE {
+                return vec3f(0.0);
+            }
+            w = wi;
+            tri = h.tri;
+            hit = o + wi * h.t;
+            b = vec2f(h.b1, h.b2);
+        }
+    }
     let t = triangles[tri];
     let n_h = triangle_normal(t);
     let front_h = dot(w, n_h) < 0.0;
@@ -22,11 +70,7 @@ fn gather_radiance(w: vec3f, tri: u32, hit: vec3f, b: vec2f, pixel: u32, j: u32)
         let ns_h = bend_towards(select(-s_h.shading, s_h.shading, front_h), -w);
         e += hit_direct(hit, select(-n_h, n_h, front_h), ns_h, tri, pixel, j);
     }
-    var rho = s_h.albedo;
-    if (s_h.flags & MATERIAL_LAMBERTIAN) == 0u {
-        rho = bsdf_diffuse_equivalent(surface_bsdf(s_h));
-    }
-    return rho / PI * e;
+    return weight * surface_rho(s_h) / PI * e;
 }
 
 // f(ω_eye, w) at the visible point x: ρ_x/π for a Lambertian surface, else the BSDF's

@@ -90,6 +90,8 @@ fn trace_photon(
     let mut flux = flux / settings.count as f32;
     let mut skip = emitter.unwrap_or(u32::MAX);
     let first_deposit = settings.indirect_only as u32;
+    // Every scattering so far was a specular (delta) one, and there was one.
+    let mut caustic = false;
     for bounce in 0..MAX_BOUNCES {
         let solid = |h: &crate::bvh::Hit| {
             let u = alpha_uniform(h.triangle, h.b1, h.b2, alpha_seed);
@@ -125,6 +127,18 @@ fn trace_photon(
                 None => t.dropped += 1,
             }
         }
+        // A photon that came through specular surfaces alone adds to the caustic map too.
+        if caustic
+            && let Some(slot) =
+                layout.deposit_slot(hit.triangle as usize, !front, p).and_then(|s| layout.caustic_twin(s))
+        {
+            let deposit = flux * arrive;
+            for c in 0..3 {
+                t.flux[slot][c] += deposit[c] as f64;
+            }
+            t.flux_sq[slot] += (deposit.y as f64).powi(2);
+            t.deposits[slot] += 1;
+        }
         let mut below = false;
         if material.is_lambertian() {
             let albedo = prepared.albedo_at(hit.triangle as usize, hit.b1, hit.b2, 0.0);
@@ -140,6 +154,7 @@ fn trace_photon(
                 break;
             }
             flux *= arrive * (cos_g / cos_s);
+            caustic = false;
         } else {
             // trace.wgsl: a direction from the BSDF, then roulette by its weight.
             let frame = Frame::new(ns);
@@ -164,6 +179,7 @@ fn trace_photon(
             }
             flux *= w / survive;
             dir = wi;
+            caustic = bs.delta && (caustic || bounce == 0);
         }
         origin = p + if below { -n } else { n } * eps;
         skip = hit.triangle;

@@ -49,6 +49,7 @@ use super::clip::{clip_to_box, clip_to_half_space, polygon_area};
 use super::separators::{Fragment, separators_of};
 pub use super::separators::{MAX_SEPARATORS, MIN_REGION, Separator, Separators, region_of};
 pub use super::table::{EMPTY, SlotTable};
+use crate::consts::CAUSTIC_CELL;
 pub use crate::consts::MIN_LOOKUP_AREA;
 use crate::scene::{Aabb, Scene, triangle_normal};
 
@@ -284,6 +285,13 @@ impl MapLayout {
                 }
             }
         }
+        // A scene with perfect mirrors or smooth glass gets a caustic twin of every slot (its
+        // cell index with CAUSTIC_CELL set, the same area): the flux of photons that reached
+        // it through specular surfaces alone, which visible points read directly.
+        if crate::specular::scene_needs_chains(scene) {
+            let twins: Vec<([u32; 2], f64)> = areas.iter().map(|(k, &a)| ([k[0] | CAUSTIC_CELL, k[1]], a)).collect();
+            areas.extend(twins);
+        }
         let mut keys: Vec<[u32; 2]> = areas.keys().copied().collect();
         keys.sort_unstable();
         let table = SlotTable::new(&keys);
@@ -324,8 +332,9 @@ impl MapLayout {
             let grid = GridSpec::new(bounds, resolution);
             crate::limits::check_photon_grid(limits, &grid)?;
             let h = grid.cell as f64;
-            // Both sides of every triangle, at most.
-            let estimate = 2.0 * (3f64.sqrt() * area / (h * h) + 3.0 * perimeter / h + count);
+            // Both sides of every triangle, at most; twice that with caustic twins.
+            let twins = if crate::specular::scene_needs_chains(scene) { 2.0 } else { 1.0 };
+            let estimate = twins * 2.0 * (3f64.sqrt() * area / (h * h) + 3.0 * perimeter / h + count);
             let fits = |slots: f64| {
                 let entries = (2.0 * slots).max(16.0).log2().ceil().exp2() as u64;
                 entries.saturating_mul(16) <= crate::limits::max_storage_buffer(limits)
@@ -360,6 +369,15 @@ impl MapLayout {
                 Err(e) => return Err(e),
             }
         }
+    }
+
+    /// The caustic twin of table entry `slot` ([`CAUSTIC_CELL`]), where the scene has them.
+    pub fn caustic_twin(&self, slot: usize) -> Option<usize> {
+        let [cell, key] = *self.table.keys.get(slot)?;
+        if cell == u32::MAX || cell & CAUSTIC_CELL != 0 {
+            return None;
+        }
+        self.table.find(cell | CAUSTIC_CELL, key)
     }
 
     /// The table entry where a photon landing at p on side `back` of triangle `tri` deposits
@@ -414,6 +432,12 @@ impl PhotonMap {
         self.irradiance_on_plane(p, &self.layout.planes[tri], back)
     }
 
+    /// The caustic map's E(p) on side `back` of triangle `tri`: the lookup over the caustic
+    /// twins of the slots ([`CAUSTIC_CELL`]; zero where the scene has none).
+    pub fn caustic_irradiance_on(&self, tri: usize, back: bool, p: Vec3) -> [f64; 3] {
+        self.lookup(p, &self.layout.planes[tri], back, CAUSTIC_CELL)
+    }
+
     /// Σ w_i Φ_i / Σ w_i A_i over the slots of side `back` of `plane` in the 8 cells around p
     /// (trilinear weights on cell centres, clamped at the grid's border), each cell's slot of
     /// p's region among that cell's separators; a cell whose centre lies on the other side of a
@@ -422,6 +446,11 @@ impl PhotonMap {
     /// touches the cell, a region that a separator only grazes) would read as Φ/A with A ≈ 0,
     /// spikes of 10⁸ times the irradiance around them (measured on a 120-triangle sphere).
     pub fn irradiance_on_plane(&self, p: Vec3, plane: &TrianglePlane, back: bool) -> [f64; 3] {
+        self.lookup(p, plane, back, 0)
+    }
+
+    /// [`Self::irradiance_on_plane`] over the slots whose cell index has the bits `twin` set.
+    fn lookup(&self, p: Vec3, plane: &TrianglePlane, back: bool, twin: u32) -> [f64; 3] {
         let (grid, layout) = (&self.layout.grid, &self.layout);
         // The separators of p's own slot: cells beyond them (across a wall) do not count.
         let home = grid.cell_of(p);
@@ -444,7 +473,7 @@ impl PhotonMap {
                 continue;
             }
             let (cell, key) = (grid.cell_index(c), plane.key(grid, c, back));
-            if let Some(s) = layout.table.find(cell, key | layout.region(cell, key, p) << REGION_SHIFT)
+            if let Some(s) = layout.table.find(cell | twin, key | layout.region(cell, key, p) << REGION_SHIFT)
                 && self.layout.area[s] >= MIN_LOOKUP_AREA as f64 * (grid.cell as f64).powi(2)
             {
                 for (acc, f) in flux.iter_mut().zip(self.flux[s]) {

@@ -38,6 +38,17 @@ fn grid_cell_index(c: vec3u) -> u32 {
 // E(p) on side `back` of triangle tri: Σ w_i Φ_i / Σ w_i A_i over the slots of its plane in
 // the 8 cells around p, w_i trilinear on cell centres (PhotonMap::irradiance_on).
 fn photon_irradiance(p: vec3f, tri: u32, back: bool) -> vec3f {
+    return photon_lookup(p, tri, back, 0u);
+}
+
+// The caustic map's E(p) (PhotonMap::caustic_irradiance_on): the same lookup over the slots'
+// caustic twins (zero where the map has none).
+fn caustic_irradiance(p: vec3f, tri: u32, back: bool) -> vec3f {
+    return photon_lookup(p, tri, back, CAUSTIC_CELL);
+}
+
+// The lookup over the slots whose cell index has the bits `twin` set.
+fn photon_lookup(p: vec3f, tri: u32, back: bool, twin: u32) -> vec3f {
     let plane = planes[tri];
     let origin = photon_grid.origin;
     let h = photon_grid.cell;
@@ -64,7 +75,7 @@ fn photon_irradiance(p: vec3f, tri: u32, back: bool) -> vec3f {
         }
         let cell = grid_cell_index(c);
         let key = plane_key(plane, centre, h, back);
-        let s = find_slot(cell, key | (photon_region(cell, key, p) << REGION_SHIFT), photon_grid.mask, photon_grid.max_probe);
+        let s = find_slot(cell | twin, key | (photon_region(cell, key, p) << REGION_SHIFT), photon_grid.mask, photon_grid.max_probe);
         // Slots of almost no area are left out (PhotonMap::irradiance_on_plane).
         if s != NO_SLOT && photon_slots[s].a >= MIN_LOOKUP_AREA {
             sum += (w3.x * w3.y * w3.z) * photon_slots[s];

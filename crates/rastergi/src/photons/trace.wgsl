@@ -45,7 +45,8 @@ struct PhotonParams {
 @group(1) @binding(9) var<storage, read> separator_planes: array<SeparatorRecord>;
 
 // The table entry of a deposit at p on side `back` of triangle tri (MapLayout::deposit_slot).
-fn slot_of(p: vec3f, tri: u32, back: bool) -> u32 {
+// With `twin` = CAUSTIC_CELL, the slot's caustic twin (NO_SLOT where the map has none).
+fn slot_of(p: vec3f, tri: u32, back: bool, twin: u32) -> u32 {
     let c = vec3u(clamp(vec3i(floor((p - params.origin) / params.cell)), vec3i(0), vec3i(params.dims) - 1));
     let cell = (c.z * params.dims.y + c.y) * params.dims.x + c.x;
     let key = plane_key(planes[tri], cell_centre(params.origin, params.cell, c), params.cell, back);
@@ -54,7 +55,7 @@ fn slot_of(p: vec3f, tri: u32, back: bool) -> u32 {
     if sep != NO_SLOT {
         region = region_of(separator_planes[sep], p);
     }
-    return find_slot(cell, key | (region << REGION_SHIFT), params.mask, params.max_probe);
+    return find_slot(cell | twin, key | (region << REGION_SHIFT), params.mask, params.max_probe);
 }
 
 // 64-bit add on the (low, high) words of slot s in channel c: whoever wraps the low word
@@ -94,8 +95,8 @@ fn tally64(c: u32, s: u32) -> f32 {
 
 // Adds flux to the slot of p on side `back` of tri; a hit that rounding moved into a cell
 // without area of its plane deposits nothing (counted by the CPU twin).
-fn deposit(p: vec3f, tri: u32, back: bool, flux: vec3f) {
-    let s = slot_of(p, tri, back);
+fn deposit(p: vec3f, tri: u32, back: bool, flux: vec3f, twin: u32) {
+    let s = slot_of(p, tri, back, twin);
     if s == NO_SLOT {
         return;
     }
@@ -127,6 +128,8 @@ fn trace_photons(@builtin(global_invocation_id) gid: vec3u) {
     var dir = start.dir;
     var origin = start.origin;
     var skip = start.skip;
+    // Every scattering so far was a specular (delta) one, and there was one.
+    var caustic = false;
     for (var bounce = 0u; bounce < params.max_bounces; bounce++) {
         let hit = trace(origin, dir, params.ray_epsilon, 3.0e38, skip, NO_TRIANGLE, false);
         if hit.tri == NO_TRIANGLE {
@@ -147,7 +150,11 @@ fn trace_photons(@builtin(global_invocation_id) gid: vec3u) {
         let ns = bend_towards(select(-s.shading, s.shading, front), -dir);
         let arrive = dot(-dir, ns) / dot(-dir, n);
         if bounce >= params.first_deposit {
-            deposit(s.pos, hit.tri, !front, flux * arrive);
+            deposit(s.pos, hit.tri, !front, flux * arrive, 0u);
+        }
+        // A photon that came through specular surfaces alone adds to the caustic map too.
+        if caustic {
+            deposit(s.pos, hit.tri, !front, flux * arrive, CAUSTIC_CELL);
         }
         var below = false;
         if lambertian {
@@ -167,6 +174,7 @@ fn trace_photons(@builtin(global_invocation_id) gid: vec3u) {
                 break;
             }
             flux *= arrive * (cos_g / cos_s);
+            caustic = false;
         } else {
             // A direction from the BSDF (importance: no 1/η² on refraction), then Russian
             // roulette by its weight. A solid glass hit from behind is left: η inverts.
@@ -195,6 +203,7 @@ fn trace_photons(@builtin(global_invocation_id) gid: vec3u) {
             }
             flux *= w / survive;
             dir = wi;
+            caustic = bs.delta && (caustic || bounce == 0u);
         }
         origin = s.pos + select(n, -n, below) * params.ray_epsilon;
         skip = hit.tri;

@@ -157,13 +157,14 @@ mod tests {
     }
 
     #[test]
-    fn photon_cells_need_32_bit_indices_and_the_slots_must_fit_the_bindings() {
+    fn photon_cells_need_31_bit_indices_and_the_slots_must_fit_the_bindings() {
         let bounds = crate::scene::Aabb { min: glam::Vec3::ZERO, max: glam::Vec3::ONE };
         let l = limits(128);
-        // 1600³ = 4.1·10⁹ cells fit 32 bits, 1700³ = 4.9·10⁹ do not.
-        assert!(check_photon_grid(&l, &GridSpec::new(&bounds, 1600)).is_ok());
-        let e = check_photon_grid(&l, &GridSpec::new(&bounds, 1700)).unwrap_err().to_string();
-        assert!(e.contains("1700x1700x1700") && e.contains("--grid"), "{e}");
+        // 1280³ = 2.10·10⁹ cells fit 31 bits (the top bit marks caustic twins), 1300³ = 2.20·10⁹
+        // do not.
+        assert!(check_photon_grid(&l, &GridSpec::new(&bounds, 1280)).is_ok());
+        let e = check_photon_grid(&l, &GridSpec::new(&bounds, 1300)).unwrap_err().to_string();
+        assert!(e.contains("1300x1300x1300") && e.contains("--grid"), "{e}");
         // The largest per-entry binding is the lookup values' 16 bytes; all counters share a
         // buffer of 24 bytes per entry.
         let scene = crate::scene::cornell_box();

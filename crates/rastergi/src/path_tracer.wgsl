@@ -116,7 +116,7 @@ fn path_radiance(origin: vec3f, dir: vec3f, xy: vec2u, rng: ptr<function, u32>) 
         let u1 = rng_f32(rng);
         let u2 = rng_f32(rng);
         if params.light_count > 0u {
-            let l = sample_light_at(s.pos, light_choice(u0, u1, u2));
+            let l = sample_light_at(s.pos + n * frame.ray_epsilon, light_choice(u0, u1, u2));
             let wi = to_local(sf, l.dir);
             let below = dot(n, l.dir) < 0.0;
             let x = s.pos + select(n, -n, below) * frame.ray_epsilon;

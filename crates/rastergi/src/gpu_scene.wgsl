@@ -386,6 +386,46 @@ fn surface_rho(s: Surface) -> vec3f {
     return bsdf_diffuse_equivalent(surface_bsdf(s));
 }
 
+// A ray arriving along d at surface s, scattered by its BSDF from three uniforms u (radiance
+// transport): the new direction, its weight f·|cos|/pdf, the origin just off the surface on
+// the new direction's side (eps away), and whether it was a delta lobe. `ok` is false where nothing
+// scatters or the geometric and the shading side of the direction disagree. Solid glass hit
+// from behind is left: its relative index inverts. (The eye's and the gather's specular
+// chains; the path tracer and the photon tracer do the same with their own bookkeeping.)
+struct Scatter {
+    dir: vec3f,
+    weight: vec3f,
+    origin: vec3f,
+    delta: bool,
+    ok: bool,
+}
+
+fn scatter_at(s: Surface, d: vec3f, u: vec3f, eps: f32) -> Scatter {
+    var r: Scatter;
+    r.ok = false;
+    let front = dot(s.normal, d) < 0.0;
+    let n = select(-s.normal, s.normal, front);
+    let sf = shading_frame(bend_towards(select(-s.shading, s.shading, front), -d));
+    var b = surface_bsdf(s);
+    if !front && !b.thin {
+        b.ior = 1.0 / b.ior;
+    }
+    let bs = bsdf_sample(b, to_local(sf, -d), u, TRANSPORT_RADIANCE);
+    if !bs.ok {
+        return r;
+    }
+    r.dir = normalize(sf * bs.wi);
+    let below = dot(n, r.dir) < 0.0;
+    if (bs.wi.z < 0.0) != below || dot(n, r.dir) == 0.0 {
+        return r;
+    }
+    r.weight = bs.weight;
+    r.origin = s.pos + select(n, -n, below) * eps;
+    r.delta = bs.delta;
+    r.ok = true;
+    return r;
+}
+
 // Whether the scene has emitters: an empty light table is stored as one zero entry (a
 // binding cannot be empty), whose pmf is 0.
 fn has_lights() -> bool {

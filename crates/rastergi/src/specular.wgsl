@@ -34,27 +34,13 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     var o = frame.eye;
     var throughput = vec3f(1.0);
     for (var k = 0u; k < MAX_CHAIN; k++) {
-        let front = dot(s.normal, d) < 0.0;
-        let n = select(-s.normal, s.normal, front);
-        let ns = bend_towards(select(-s.shading, s.shading, front), -d);
-        let sf = shading_frame(ns);
-        var b = surface_bsdf(s);
-        if !front && !b.thin {
-            b.ior = 1.0 / b.ior;
-        }
-        let u = vec3f(rng_f32(&rng), rng_f32(&rng), rng_f32(&rng));
-        let bs = bsdf_sample(b, to_local(sf, -d), u, TRANSPORT_RADIANCE);
-        if !bs.ok {
+        let sc = scatter_at(s, d, vec3f(rng_f32(&rng), rng_f32(&rng), rng_f32(&rng)), frame.ray_epsilon);
+        if !sc.ok {
             break;
         }
-        let wi = normalize(sf * bs.wi);
-        let below = dot(n, wi) < 0.0;
-        if (bs.wi.z < 0.0) != below || dot(n, wi) == 0.0 {
-            break;
-        }
-        throughput *= bs.weight;
-        o = s.pos + select(n, -n, below) * frame.ray_epsilon;
-        d = wi;
+        throughput *= sc.weight;
+        o = sc.origin;
+        d = sc.dir;
         let hit = trace(o, d, frame.ray_epsilon, 3.0e38, s.tri, NO_TRIANGLE, false);
         if hit.tri == NO_TRIANGLE {
             film_add(FILM_DIRECT, gid.xy, throughput * env_radiance(d));

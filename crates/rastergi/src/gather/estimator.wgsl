@@ -28,25 +28,13 @@ fn gather_radiance(w0: vec3f, tri0: u32, hit0: vec3f, b0: vec2f, pixel: u32, j: 
             if k == 16u {
                 return vec3f(0.0);
             }
-            let front = dot(s.normal, w) < 0.0;
-            let n = select(-s.normal, s.normal, front);
-            let sf = shading_frame(bend_towards(select(-s.shading, s.shading, front), -w));
-            var bsdf = surface_bsdf(s);
-            if !front && !bsdf.thin {
-                bsdf.ior = 1.0 / bsdf.ior;
-            }
-            let u = vec3f(rng_f32(&rng), rng_f32(&rng), rng_f32(&rng));
-            let bs = bsdf_sample(bsdf, to_local(sf, -w), u, TRANSPORT_RADIANCE);
-            if !bs.ok {
+            let sc = scatter_at(s, w, vec3f(rng_f32(&rng), rng_f32(&rng), rng_f32(&rng)), frame.ray_epsilon);
+            if !sc.ok {
                 return vec3f(0.0);
             }
-            let wi = normalize(sf * bs.wi);
-            let below = dot(n, wi) < 0.0;
-            if (bs.wi.z < 0.0) != below {
-                return vec3f(0.0);
-            }
-            weight *= bs.weight;
-            let o = s.pos + select(n, -n, below) * frame.ray_epsilon;
+            weight *= sc.weight;
+            let o = sc.origin;
+            let wi = sc.dir;
             let h = trace(o, wi, frame.ray_epsilon, 3.0e38, tri, NO_TRIANGLE, false);
             if h.tri == NO_TRIANGLE {
                 return vec3f(0.0);

@@ -320,21 +320,7 @@ fn gpu_and_cpu_photons_agree_through_glass_and_off_mirrors() {
     let settings = |seed| PhotonSettings { count: n, seed, grid_resolution: 16, ..Default::default() };
     let g = GpuPhotonMap::build(&gpu, &gs, &prepared, &settings(11)).unwrap().read(&gpu).unwrap();
     let c = cpu::trace(&prepared, g.grid(), &settings(12));
-    let (mut sum_z2, mut max_z, mut cells) = (0.0f64, 0.0f64, 0usize);
-    for s in 0..g.flux.len() {
-        if c.deposits[s] < 400 {
-            continue;
-        }
-        let z = (g.flux[s][1] - c.flux[s][1]) / (2.0 * c.flux_sq[s]).sqrt();
-        sum_z2 += z * z;
-        max_z = max_z.max(z.abs());
-        cells += 1;
-    }
-    let mean_z2 = sum_z2 / cells as f64;
-    println!("{cells} slots: mean z² {mean_z2:.3}, max |z| {max_z:.2}");
-    assert!(cells > 300, "too few populated slots ({cells})");
-    assert!((mean_z2 - 1.0).abs() < 0.25, "GPU and CPU maps differ beyond noise: mean z² = {mean_z2}");
-    assert!(max_z < 6.0, "a slot differs beyond noise: |z| = {max_z}");
+    common::maps_agree_within_noise(&g, &c);
 }
 
 /// The photon map and the traced gather on the rough metal and the diffuse + GGX blend

@@ -154,3 +154,28 @@ pub fn image_matches_mitsuba(
         assert!((r - 1.0).abs() < 0.01, "{label}: mean ratio {:?}", c.mean_ratio);
     }
 }
+
+/// Two photon maps of independent seeds (GPU `g`, CPU twin `c`) agree slot by slot within
+/// their noise: per slot with at least 400 deposits, z = ΔΦ/√(2·ΣΦ²) (compound Poisson, the
+/// CPU map's squared deposits); mean z² within 0.25 of 1, no |z| of 6. Returns (slots, mean z²).
+pub fn maps_agree_within_noise(
+    g: &rastergi::photons::map::PhotonMap,
+    c: &rastergi::photons::map::PhotonMap,
+) -> (usize, f64) {
+    let (mut sum_z2, mut max_z, mut cells) = (0.0f64, 0.0f64, 0usize);
+    for s in 0..g.flux.len() {
+        if c.deposits[s] < 400 {
+            continue;
+        }
+        let z = (g.flux[s][1] - c.flux[s][1]) / (2.0 * c.flux_sq[s]).sqrt();
+        sum_z2 += z * z;
+        max_z = max_z.max(z.abs());
+        cells += 1;
+    }
+    let mean_z2 = sum_z2 / cells as f64;
+    println!("{cells} slots: mean z² {mean_z2:.3}, max |z| {max_z:.2}");
+    assert!(cells > 300, "too few populated slots ({cells})");
+    assert!((mean_z2 - 1.0).abs() < 0.25, "GPU and CPU maps differ beyond noise: mean z² = {mean_z2}");
+    assert!(max_z < 6.0, "a slot differs beyond noise: |z| = {max_z}");
+    (cells, mean_z2)
+}

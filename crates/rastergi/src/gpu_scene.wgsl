@@ -377,6 +377,14 @@ fn surface_purely_specular(s: Surface) -> bool {
     return r * r < SMOOTH_ALPHA && opaque <= 0.0;
 }
 
+// Whether eye and gather rays go on through the surface rather than stop at it: a purely
+// specular one, or glass without a diffuse base, rough or smooth (its light comes from
+// behind it, which a stop on its surface cannot gather; specular::scene_needs_chains).
+fn surface_passes_rays(s: Surface) -> bool {
+    let opaque = (1.0 - clamp(s.metallic, 0.0, 1.0)) * (1.0 - s.transmission);
+    return opaque <= 0.0 && (surface_purely_specular(s) || s.transmission > 0.0);
+}
+
 // The albedo with which a point reflects the photon map's irradiance: ρ, or the diffuse
 // equivalent of a glossy or specular surface (bsdf_diffuse_equivalent, an approximation).
 fn surface_rho(s: Surface) -> vec3f {

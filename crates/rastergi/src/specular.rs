@@ -1,7 +1,8 @@
 //! Specular chains from the eye (`specular.wgsl`): where the camera sees a perfect mirror or
-//! smooth glass, its ray continues through the specular surfaces (one delta lobe drawn at each:
-//! Fresnel picks reflection or refraction, so the mean over iterations is the sum of both) to
-//! the first surface that is not purely specular. That point is the pixel's visible point for
+//! glass (rough or smooth, without a diffuse base), its ray continues through such surfaces
+//! (one direction drawn from the BSDF at each; at a smooth one a delta lobe: Fresnel picks
+//! reflection or refraction, so the mean over iterations is the sum of both) to the first
+//! other surface. That point is the pixel's visible point for
 //! the direct light, the gather and the photon view, seen from the last ray's origin, and their
 //! estimates are weighed by the chain's throughput (`visible_point_at` in
 //! `visible_point.wgsl`). The pass runs after the G-buffer, only for scenes with such materials.
@@ -24,12 +25,16 @@ pub fn source() -> String {
     shader::per_pixel(&[GBUFFER_FILM_WGSL, include_str!("specular.wgsl")])
 }
 
-/// Whether `scene` has a material the chains go through (perfectly specular: a smooth metal or
-/// smooth glass without a diffuse base; or one whose roughness a texture sets).
+/// Whether `scene` has a material the chains go through (`surface_passes_rays`: without a
+/// diffuse base, perfectly specular — a smooth metal — or glass, rough or smooth; or one whose
+/// roughness a texture sets).
 pub fn scene_needs_chains(scene: &Scene) -> bool {
     scene.materials.iter().any(|m| {
         let opaque = (1.0 - m.metallic.clamp(0.0, 1.0)) * (1.0 - m.transmission);
-        opaque <= 0.0 && (m.roughness * m.roughness < crate::bsdf::SMOOTH_ALPHA || m.metal_rough_texture.is_some())
+        opaque <= 0.0
+            && (m.roughness * m.roughness < crate::bsdf::SMOOTH_ALPHA
+                || m.transmission > 0.0
+                || m.metal_rough_texture.is_some())
     })
 }
 

@@ -1,7 +1,7 @@
 // Specular chains from the eye (specular.rs): a pixel whose G-buffer point is a perfect mirror
-// or smooth glass continues its camera ray through the specular surfaces, one delta lobe drawn
-// at each (Fresnel's choice between reflection and refraction), to the first surface that is
-// not purely specular: the pixel's visible point for every later pass, with the chain's
+// or glass continues its camera ray through such surfaces, one direction drawn from the BSDF
+// at each (for smooth ones a delta lobe: Fresnel's choice between reflection and refraction),
+// to the first other surface: the pixel's visible point for every later pass, with the chain's
 // throughput and the last ray's origin (eye_paths, frame.wgsl). A chain that leaves the scene
 // adds the environment it sees (times its throughput) to the film's direct component; one that
 // is absorbed or runs past MAX_CHAIN bounces ends with throughput 0.
@@ -26,7 +26,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         return;
     }
     var s = surface_at(g.x - 1u, bitcast<f32>(g.y), bitcast<f32>(g.z), bitcast<f32>(g.w));
-    if !surface_purely_specular(s) {
+    if !surface_passes_rays(s) {
         return;
     }
     var rng = rng_new(frame.seed ^ STREAM_EYE_CHAIN, pixel, frame.iteration);
@@ -47,7 +47,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             break;
         }
         s = surface_at(hit.tri, hit.b1, hit.b2, 0.0);
-        if !surface_purely_specular(s) {
+        if !surface_passes_rays(s) {
             eye_paths[base] = vec4f(o, 1.0);
             eye_paths[base + 1u] = vec4f(throughput, 0.0);
             eye_paths[base + 2u] = bitcast<vec4f>(vec4u(hit.tri + 1u, bitcast<u32>(hit.b1), bitcast<u32>(hit.b2), 0u));

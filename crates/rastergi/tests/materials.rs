@@ -323,17 +323,19 @@ fn gpu_and_cpu_photons_agree_through_glass_and_off_mirrors() {
     common::maps_agree_within_noise(&g, &c);
 }
 
-/// The photon map and the traced gather on the rough metal and the diffuse + GGX blend
-/// spheres against Mitsuba, with the criteria of the Lambertian scenes (tests/common:
-/// relative RMSE under 5 %, block-mean error under 1.5 %, channel means within 1 %): the
-/// visible points evaluate the BSDF exactly; the gather's hits on the sphere see its diffuse
-/// equivalent (the stated approximation), which the block means bound.
+/// The photon map and the traced gather on the spheres of each material against Mitsuba,
+/// with the criteria of the Lambertian scenes (tests/common: block-mean error under 1.5 %,
+/// channel means within 1 %; relative RMSE under 5 % where no caustic's fireflies dominate
+/// the references' noise): the visible points evaluate the BSDF exactly, the eye's and the
+/// gather's rays pass mirrors and glass, caustics come from the caustic map; the gather's hits
+/// on a rough metal see its diffuse equivalent (the stated approximation), which the block
+/// means bound.
 #[test]
-fn photon_map_and_gather_on_glossy_spheres_match_mitsuba() {
+fn photon_map_and_gather_on_spheres_of_each_material_match_mitsuba() {
     use rastergi::film::Show;
     use rastergi::metrics::emitter_mask;
     let gpu = common::gpu();
-    for kind in ["metal_rough", "mix"] {
+    for kind in ["metal_rough", "mix", "mirror", "glass", "rough_glass"] {
         let scene = material_scene(&format!("mat_{kind}"), stage_camera());
         let grid = rastergi::fit::grid_resolution(&scene.bounds());
         let settings = |seed| rastergi::renderer::RenderSettings {
@@ -356,7 +358,9 @@ fn photon_map_and_gather_on_glossy_spheres_match_mitsuba() {
             "{kind} (grid {grid}): relative RMSE {:.4} = noise {noise:.4} ⊕ bias {bias:.4}; block-mean error {:.4}; mean ratio {:.4?}",
             c.relative_rmse, c.block_mean_error, c.mean_ratio
         );
-        assert!(c.relative_rmse < 0.05, "{kind}: relative RMSE {}", c.relative_rmse);
+        if !kind.contains("glass") {
+            assert!(c.relative_rmse < 0.05, "{kind}: relative RMSE {}", c.relative_rmse);
+        }
         assert!(c.block_mean_error < 0.015, "{kind}: block-mean error {}", c.block_mean_error);
         for r in c.mean_ratio {
             assert!((r - 1.0).abs() < 0.01, "{kind}: mean ratio {:?}", c.mean_ratio);

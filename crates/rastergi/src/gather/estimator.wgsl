@@ -13,16 +13,24 @@ fn gather_radiance(w0: vec3f, tri0: u32, hit0: vec3f, b0: vec2f, pixel: u32, j: 
     var tri = tri0;
     var hit = hit0;
     var b = b0;
-    // Through perfect mirrors and smooth glass the ray goes on (one delta lobe drawn at each,
-    // as the eye's chains do) to the first surface that is not purely specular. Light that
-    // reaches x from the lights or the sky through specular surfaces alone is the caustic map's
-    // (caustic_term), so a chain that escapes or meets only emitters adds nothing here.
+    // Through perfect mirrors and glass the ray goes on (one direction drawn from the BSDF at
+    // each, as the eye's chains do) to the first other surface. Light that reaches x from the
+    // lights or the sky through smooth surfaces alone is the caustic map's (the caustics pass),
+    // so such a chain that escapes or meets an emitter adds nothing here.
     var weight = vec3f(1.0);
+    // Whether every surface passed so far scattered by a delta lobe: then the light the chain
+    // meets from the lights and the sky is the caustic map's; through rough glass it is not,
+    // and the chain adds it here (no light sample finds it).
+    var delta_only = true;
+    var seen = vec3f(0.0);
     if frame.eye_chains != 0u {
         var rng = rng_new(frame.seed ^ STREAM_GATHER_CHAIN, pixel, j);
         for (var k = 0u; ; k++) {
             let s = surface_at(tri, b.x, b.y, 0.0);
-            if !surface_purely_specular(s) {
+            if !surface_passes_rays(s) {
+                if !delta_only && dot(s.normal, w) < 0.0 {
+                    seen = weight * s.emission;
+                }
                 break;
             }
             if k == 16u {
@@ -33,11 +41,12 @@ fn gather_radiance(w0: vec3f, tri0: u32, hit0: vec3f, b0: vec2f, pixel: u32, j: 
                 return vec3f(0.0);
             }
             weight *= sc.weight;
+            delta_only = delta_only && sc.delta;
             let o = sc.origin;
             let wi = sc.dir;
             let h = trace(o, wi, frame.ray_epsilon, 3.0e38, tri, NO_TRIANGLE, false);
             if h.tri == NO_TRIANGLE {
-                return vec3f(0.0);
+                return select(weight * env_radiance(wi), vec3f(0.0), delta_only);
             }
             w = wi;
             tri = h.tri;
@@ -58,7 +67,7 @@ fn gather_radiance(w0: vec3f, tri0: u32, hit0: vec3f, b0: vec2f, pixel: u32, j: 
         let ns_h = bend_towards(select(-s_h.shading, s_h.shading, front_h), -w);
         e += hit_direct(hit, select(-n_h, n_h, front_h), ns_h, tri, pixel, j);
     }
-    return weight * surface_rho(s_h) / PI * e;
+    return seen + weight * surface_rho(s_h) / PI * e;
 }
 
 // f(ω_eye, w) at the visible point x: ρ_x/π for a Lambertian surface, else the BSDF's

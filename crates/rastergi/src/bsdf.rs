@@ -270,24 +270,21 @@ impl Bsdf {
         if total > 0.0 { w.map(|x| x / total) } else { [0.0; 4] }
     }
 
-    /// The glass's local frame: ω_o on the side it lies on for a thin slab (both sides alike);
-    /// as given for a solid.
-    fn glass_eval(&self, wo: Vec3, wi: Vec3, transport: Transport) -> Vec3 {
-        if self.smooth() || wo.z == 0.0 || wi.z == 0.0 {
-            return Vec3::ZERO;
-        }
-        let a = self.alpha;
-        if self.thin {
-            let (o, i) = if wo.z < 0.0 { (-wo, -wi) } else { (wo, wi) };
-            let reflected = i.z > 0.0;
-            let ir = if reflected { i } else { mirror_z(i) };
-            let h = (o + ir).normalize();
-            let r = slab_reflectance(fresnel_dielectric(o.dot(h), self.ior));
-            let weight = if reflected { Vec3::splat(r) } else { (1.0 - r) * self.base };
-            return weight * ggx_d(h, a) * ggx_g1(o, h, a) * ggx_g1(ir, h, a) / (4.0 * o.z * ir.z);
-        }
-        let reflected = wo.z * wi.z > 0.0;
-        let etap = if reflected {
+    /// A thin slab's pair (ω_o, ω_i) on ω_o's side: ω_o, ω_i reflected through the surface where
+    /// it is transmitted, their half vector, whether ω_i is reflected, and the slab's
+    /// reflectance R' at the half vector.
+    fn thin_pair(&self, wo: Vec3, wi: Vec3) -> (Vec3, Vec3, Vec3, bool, f32) {
+        let (o, i) = if wo.z < 0.0 { (-wo, -wi) } else { (wo, wi) };
+        let reflected = i.z > 0.0;
+        let ir = if reflected { i } else { mirror_z(i) };
+        let h = (o + ir).normalize();
+        (o, ir, h, reflected, slab_reflectance(fresnel_dielectric(o.dot(h), self.ior)))
+    }
+
+    /// A solid's generalized half vector h (upper hemisphere) of (ω_o, ω_i) and the relative
+    /// index η' of the refraction (1 for a reflection); None where no microfacet pairs them.
+    fn solid_half(&self, wo: Vec3, wi: Vec3) -> Option<(Vec3, f32)> {
+        let etap = if wo.z * wi.z > 0.0 {
             1.0
         } else if wo.z > 0.0 {
             self.ior
@@ -296,13 +293,29 @@ impl Bsdf {
         };
         let h = wi * etap + wo;
         if h.length_squared() == 0.0 {
-            return Vec3::ZERO;
+            return None;
         }
         let h = h.normalize();
         let h = if h.z < 0.0 { -h } else { h };
         if h.dot(wi) * wi.z < 0.0 || h.dot(wo) * wo.z < 0.0 {
+            return None;
+        }
+        Some((h, etap))
+    }
+
+    /// The glass's f: a thin slab alike from both sides, a solid entered from the front.
+    fn glass_eval(&self, wo: Vec3, wi: Vec3, transport: Transport) -> Vec3 {
+        if self.smooth() || wo.z == 0.0 || wi.z == 0.0 {
             return Vec3::ZERO;
         }
+        let a = self.alpha;
+        if self.thin {
+            let (o, ir, h, reflected, r) = self.thin_pair(wo, wi);
+            let weight = if reflected { Vec3::splat(r) } else { (1.0 - r) * self.base };
+            return weight * ggx_d(h, a) * ggx_g1(o, h, a) * ggx_g1(ir, h, a) / (4.0 * o.z * ir.z);
+        }
+        let Some((h, etap)) = self.solid_half(wo, wi) else { return Vec3::ZERO };
+        let reflected = wo.z * wi.z > 0.0;
         let f = fresnel_dielectric(wo.dot(h), self.ior);
         let dg = ggx_d(h, a) * ggx_g1(wo, h, a) * ggx_g1(wi, h, a);
         if reflected {
@@ -323,31 +336,12 @@ impl Bsdf {
         }
         let a = self.alpha;
         if self.thin {
-            let (o, i) = if wo.z < 0.0 { (-wo, -wi) } else { (wo, wi) };
-            let reflected = i.z > 0.0;
-            let ir = if reflected { i } else { mirror_z(i) };
-            let h = (o + ir).normalize();
-            let r = slab_reflectance(fresnel_dielectric(o.dot(h), self.ior));
+            let (o, _, h, reflected, r) = self.thin_pair(wo, wi);
             let choice = if reflected { r } else { 1.0 - r };
             return vndf_pdf(o, h, a) / (4.0 * o.dot(h).abs()) * choice;
         }
+        let Some((h, etap)) = self.solid_half(wo, wi) else { return 0.0 };
         let reflected = wo.z * wi.z > 0.0;
-        let etap = if reflected {
-            1.0
-        } else if wo.z > 0.0 {
-            self.ior
-        } else {
-            1.0 / self.ior
-        };
-        let h = wi * etap + wo;
-        if h.length_squared() == 0.0 {
-            return 0.0;
-        }
-        let h = h.normalize();
-        let h = if h.z < 0.0 { -h } else { h };
-        if h.dot(wi) * wi.z < 0.0 || h.dot(wo) * wo.z < 0.0 {
-            return 0.0;
-        }
         let r = fresnel_dielectric(wo.dot(h), self.ior);
         if reflected {
             vndf_pdf(wo, h, a) / (4.0 * wo.dot(h).abs()) * r

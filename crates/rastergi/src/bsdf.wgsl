@@ -169,7 +169,26 @@ fn lobe_probabilities(b: Bsdf, cos_o: f32) -> vec4f {
     return vec4f(0.0);
 }
 
-// The generalized half vector of a solid glass's pair (wo, wi) and η' (bsdf.rs glass_eval):
+// A thin slab's pair (Bsdf::thin_pair): ω_o and ω_i on ω_o's side, ω_i reflected through
+// the surface where transmitted (ir), their half vector, whether ω_i is reflected, and R'.
+struct ThinPair {
+    o: vec3f,
+    ir: vec3f,
+    h: vec3f,
+    reflected: bool,
+    r: f32,
+}
+
+fn thin_pair(b: Bsdf, wo: vec3f, wi: vec3f) -> ThinPair {
+    let o = select(wo, -wo, wo.z < 0.0);
+    let i = select(wi, -wi, wo.z < 0.0);
+    let reflected = i.z > 0.0;
+    let ir = select(mirror_z(i), i, reflected);
+    let h = normalize(o + ir);
+    return ThinPair(o, ir, h, reflected, slab_reflectance(fresnel_dielectric(dot(o, h), b.ior)));
+}
+
+// The generalized half vector of a solid glass's pair (wo, wi) and η' (Bsdf::solid_half):
 // (h, η'), or η' = 0 where the pair has none.
 fn glass_half(b: Bsdf, wo: vec3f, wi: vec3f) -> vec4f {
     let reflected = wo.z * wi.z > 0.0;
@@ -195,14 +214,9 @@ fn glass_eval(b: Bsdf, wo: vec3f, wi: vec3f, transport: u32) -> vec3f {
     }
     let a = b.alpha;
     if b.thin {
-        let o = select(wo, -wo, wo.z < 0.0);
-        let i = select(wi, -wi, wo.z < 0.0);
-        let reflected = i.z > 0.0;
-        let ir = select(mirror_z(i), i, reflected);
-        let h = normalize(o + ir);
-        let r = slab_reflectance(fresnel_dielectric(dot(o, h), b.ior));
-        let w = select((1.0 - r) * b.base, vec3f(r), reflected);
-        return w * ggx_d(h, a) * ggx_g1(o, h, a) * ggx_g1(ir, h, a) / (4.0 * o.z * ir.z);
+        let t = thin_pair(b, wo, wi);
+        let w = select((1.0 - t.r) * b.base, vec3f(t.r), t.reflected);
+        return w * ggx_d(t.h, a) * ggx_g1(t.o, t.h, a) * ggx_g1(t.ir, t.h, a) / (4.0 * t.o.z * t.ir.z);
     }
     let he = glass_half(b, wo, wi);
     if he.w == 0.0 {
@@ -230,13 +244,8 @@ fn glass_pdf(b: Bsdf, wo: vec3f, wi: vec3f) -> f32 {
     }
     let a = b.alpha;
     if b.thin {
-        let o = select(wo, -wo, wo.z < 0.0);
-        let i = select(wi, -wi, wo.z < 0.0);
-        let reflected = i.z > 0.0;
-        let ir = select(mirror_z(i), i, reflected);
-        let h = normalize(o + ir);
-        let r = slab_reflectance(fresnel_dielectric(dot(o, h), b.ior));
-        return vndf_pdf(o, h, a) / (4.0 * abs(dot(o, h))) * select(1.0 - r, r, reflected);
+        let t = thin_pair(b, wo, wi);
+        return vndf_pdf(t.o, t.h, a) / (4.0 * abs(dot(t.o, t.h))) * select(1.0 - t.r, t.r, t.reflected);
     }
     let he = glass_half(b, wo, wi);
     if he.w == 0.0 {

@@ -307,7 +307,7 @@ pub struct GpuScene {
     pub total_area: f64,
     pub total_perimeter: f64,
     /// Whether the eye's rays continue through specular surfaces here
-    /// ([`crate::specular::scene_needs_chains`]).
+    /// ([`Material::passes_rays`]).
     pub eye_chains: bool,
 }
 
@@ -461,7 +461,7 @@ impl GpuScene {
                 .iter()
                 .map(|t| (t[0].distance(t[1]) + t[1].distance(t[2]) + t[2].distance(t[0])) as f64)
                 .sum(),
-            eye_chains: crate::specular::scene_needs_chains(s),
+            eye_chains: s.materials.iter().any(Material::passes_rays),
         })
     }
 }

@@ -379,7 +379,7 @@ fn surface_purely_specular(s: Surface) -> bool {
 
 // Whether eye and gather rays go on through the surface rather than stop at it: a purely
 // specular one, or glass without a diffuse base, rough or smooth (its light comes from
-// behind it, which a stop on its surface cannot gather; specular::scene_needs_chains).
+// behind it, which a stop on its surface cannot gather; Material::passes_rays).
 fn surface_passes_rays(s: Surface) -> bool {
     let opaque = (1.0 - clamp(s.metallic, 0.0, 1.0)) * (1.0 - s.transmission);
     return opaque <= 0.0 && (surface_purely_specular(s) || s.transmission > 0.0);

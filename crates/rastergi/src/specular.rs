@@ -5,7 +5,8 @@
 //! other surface. That point is the pixel's visible point for
 //! the direct light, the gather and the photon view, seen from the last ray's origin, and their
 //! estimates are weighed by the chain's throughput (`visible_point_at` in
-//! `visible_point.wgsl`). The pass runs after the G-buffer, only for scenes with such materials.
+//! `visible_point.wgsl`). The pass runs after the G-buffer, only for scenes with such materials
+//! ([`crate::scene::Material::passes_rays`]).
 //!
 //! A surface that mixes a delta lobe with a diffuse or glossy one (a smooth specular layer over
 //! a diffuse base) stays the visible point; its delta reflection is not followed (stated in
@@ -17,25 +18,11 @@ use crate::gbuffer::{GBUFFER_FILM_WGSL, GBufferPass, gbuffer_film_bind_group, gb
 use crate::gpu::{Gpu, compute_pipeline, dispatch_pixels};
 use crate::gpu_scene::GpuScene;
 use crate::profile::{Profiler, compute_pass};
-use crate::scene::Scene;
 use crate::shader;
 
 /// The pass's composed shader.
 pub fn source() -> String {
     shader::per_pixel(&[GBUFFER_FILM_WGSL, include_str!("specular.wgsl")])
-}
-
-/// Whether `scene` has a material the chains go through (`surface_passes_rays`: without a
-/// diffuse base, perfectly specular — a smooth metal — or glass, rough or smooth; or one whose
-/// roughness a texture sets).
-pub fn scene_needs_chains(scene: &Scene) -> bool {
-    scene.materials.iter().any(|m| {
-        let opaque = (1.0 - m.metallic.clamp(0.0, 1.0)) * (1.0 - m.transmission);
-        opaque <= 0.0
-            && (m.roughness * m.roughness < crate::bsdf::SMOOTH_ALPHA
-                || m.transmission > 0.0
-                || m.metal_rough_texture.is_some())
-    })
 }
 
 pub struct SpecularPass {

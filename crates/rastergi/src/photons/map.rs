@@ -288,7 +288,7 @@ impl MapLayout {
         // A scene with perfect mirrors or smooth glass gets a caustic twin of every slot (its
         // cell index with CAUSTIC_CELL set, the same area): the flux of photons that reached
         // it through specular surfaces alone, which visible points read directly.
-        if crate::specular::scene_needs_chains(scene) {
+        if scene.materials.iter().any(crate::scene::Material::passes_rays) {
             let twins: Vec<([u32; 2], f64)> = areas.iter().map(|(k, &a)| ([k[0] | CAUSTIC_CELL, k[1]], a)).collect();
             areas.extend(twins);
         }
@@ -333,7 +333,7 @@ impl MapLayout {
             crate::limits::check_photon_grid(limits, &grid)?;
             let h = grid.cell as f64;
             // Both sides of every triangle, at most; twice that with caustic twins.
-            let twins = if crate::specular::scene_needs_chains(scene) { 2.0 } else { 1.0 };
+            let twins = if scene.materials.iter().any(crate::scene::Material::passes_rays) { 2.0 } else { 1.0 };
             let estimate = twins * 2.0 * (3f64.sqrt() * area / (h * h) + 3.0 * perimeter / h + count);
             let fits = |slots: f64| {
                 let entries = (2.0 * slots).max(16.0).log2().ceil().exp2() as u64;

@@ -174,6 +174,18 @@ impl Material {
         }
     }
 
+    /// Whether eye and gather rays go on through it rather than stop (`surface_passes_rays` in
+    /// WGSL, [`crate::specular`]): no diffuse base, and perfectly specular — a smooth metal — or
+    /// glass, rough or smooth; or one whose roughness a texture sets. Scenes with such
+    /// materials get the eye's specular chains and the photon map's caustic twins.
+    pub fn passes_rays(&self) -> bool {
+        let opaque = (1.0 - self.metallic.clamp(0.0, 1.0)) * (1.0 - self.transmission);
+        opaque <= 0.0
+            && (self.roughness * self.roughness < crate::bsdf::SMOOTH_ALPHA
+                || self.transmission > 0.0
+                || self.metal_rough_texture.is_some())
+    }
+
     /// Whether it scatters as a plain Lambertian surface (f = ρ/π).
     pub fn is_lambertian(&self) -> bool {
         self.metallic == 0.0 && self.transmission == 0.0 && self.specular == 0.0

@@ -81,6 +81,9 @@ pub mod stream {
     pub const EYE_CHAIN: u32 = 0x1f83d9ab;
     /// The final gather's rays through specular surfaces, keyed (pixel, sample index).
     pub const GATHER_CHAIN: u32 = 0x5be0cd19;
+    /// The lobe chosen by a per-pixel gather direction at a non-Lambertian visible point,
+    /// keyed (pixel, sample index).
+    pub const GATHER_LOBE: u32 = 0x510e527f;
     /// The ray view's sub-texel offset, keyed (direction index, restart).
     pub const TEXEL_JITTER: u32 = 0x7e1a5;
     /// The scramble seed of the pixel jitter's Owen-scrambled Sobol' sequence (hashed, not a

@@ -23,14 +23,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         let s = p.x;
         let n = p.n;
         let lambertian = (s.flags & MATERIAL_LAMBERTIAN) != 0u;
-        // The scattering model in the shading frame on the eye's side (a solid glass seen
-        // from inside: its relative index inverted).
-        let sf = shading_frame(p.ns);
-        var b = surface_bsdf(s);
-        if !p.front && !b.thin {
-            b.ior = 1.0 / b.ior;
-        }
-        let wo = to_local(sf, normalize(p.eye - s.pos));
+        // The scattering model in the shading frame on the eye's side.
+        let v = visible_bsdf(p);
         // Sample k of iteration i has index i·L + k in the pixel's own sequence, whose seed
         // depends on (seed, pixel) only: a restart replays the same light samples.
         let seed = pixel_seed(pcg_hash(frame.seed ^ STREAM_DIRECT), gid.x, gid.y);
@@ -44,7 +38,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             // The light's side by the geometric normal; the shading cosine must agree (light
             // from below the geometric surface counts only through glass).
             let below = dot(n, l.dir) <= 0.0;
-            let wi = to_local(sf, l.dir);
+            let wi = to_local(v.frame, l.dir);
             var f: vec3f;
             if lambertian {
                 f = s.albedo / PI;
@@ -55,7 +49,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
                 if (wi.z <= 0.0) != below || wi.z == 0.0 {
                     continue;
                 }
-                f = bsdf_eval(b, wo, wi, TRANSPORT_RADIANCE);
+                f = bsdf_eval(v.b, v.wo, wi, TRANSPORT_RADIANCE);
                 if all(f == vec3f(0.0)) {
                     continue;
                 }
@@ -67,7 +61,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             // The environment is also found by the gather's escaping rays (env_gather_weight).
             var mis = 1.0;
             if l.pdf > 0.0 {
-                mis = 1.0 - env_gather_weight(p.ns, l.dir);
+                mis = 1.0 - env_gather_weight(gather_density(p, l.dir), l.dir);
             }
             sum += f * l.e * (abs(wi.z) * mis);
         }

@@ -24,12 +24,13 @@ pub struct FrameUniforms {
     pub light_samples: u32,
     /// Minimum hit distance and origin offset of secondary rays.
     pub ray_epsilon: f32,
-    /// The final gather's directions per pixel this iteration (0: no gather), and 1 where
-    /// they are cosine-distributed (per-pixel) rather than uniform on the hemisphere (shared):
-    /// the gather's escaping rays and the direct pass's environment samples are combined by
-    /// multiple importance sampling (`env_mis_weight`).
+    /// The final gather's directions per pixel this iteration (0: no gather), and 1 where each
+    /// visible point draws them from its own scattering (per-pixel: cosine-distributed on a
+    /// Lambertian surface, by the BSDF elsewhere) rather than uniform on the hemisphere
+    /// (shared): the gather's escaping rays and the direct pass's environment samples are
+    /// combined by multiple importance sampling (`env_gather_weight`, `gather_density`).
     pub gather_count: u32,
-    pub gather_cosine: u32,
+    pub gather_importance: u32,
     /// 1 where the eye's specular chains ran this iteration ([`crate::specular`]): the visible
     /// points are read through `eye_paths`.
     pub eye_chains: u32,
@@ -64,7 +65,7 @@ impl FrameUniforms {
             light_samples: light_samples.max(1),
             ray_epsilon: scene.ray_epsilon,
             gather_count: 0,
-            gather_cosine: 0,
+            gather_importance: 0,
             eye_chains: 0,
         }
     }

@@ -9,10 +9,11 @@ struct Frame {
     seed: u32,
     light_samples: u32,
     ray_epsilon: f32,
-    // The gather's directions per pixel this iteration (0: none) and whether they are
-    // cosine-distributed (1) or uniform on the hemisphere (0).
+    // The gather's directions per pixel this iteration (0: none) and whether each point draws
+    // them from its own scattering (1: per-pixel directions, gather_direction) or they are
+    // uniform on the hemisphere (0: shared directions).
     gather_count: u32,
-    gather_cosine: u32,
+    gather_importance: u32,
     // 1: the eye's specular chains ran (specular.wgsl); read visible points via eye_paths.
     eye_chains: u32,
 }
@@ -51,18 +52,15 @@ fn power_heuristic(pa: f32, pb: f32) -> f32 {
     return a / (a + pb * pb);
 }
 
-// The environment's light along w at a point of normal n is estimated twice: by the direct
+// The environment's light along w at a visible point is estimated twice: by the direct
 // pass's light samples (frame.light_samples of them, density pmf·pdf(w)) and by the final
-// gather's rays that escape (frame.gather_count, density 1/2π or cos θ/π). Each estimate is
-// weighted by the power heuristic over both (Veach's multi-sample model), so the weights sum
-// to one for every direction. This is the gather's weight; the direct pass's is 1 − it.
-fn env_gather_weight(n: vec3f, w: vec3f) -> f32 {
-    if frame.gather_count == 0u {
+// gather's rays that escape (frame.gather_count of them, density p_gather = gather_density).
+// Each estimate is weighted by the power heuristic over both (Veach's multi-sample model), so
+// the weights sum to one for every direction. This is the gather's weight; the direct pass's
+// is 1 − it.
+fn env_gather_weight(p_gather: f32, w: vec3f) -> f32 {
+    if p_gather <= 0.0 {
         return 0.0;
-    }
-    var p_gather = 1.0 / (2.0 * PI);
-    if frame.gather_cosine != 0u {
-        p_gather = max(dot(n, w), 0.0) / PI;
     }
     let p_light = environment.pmf * env_pdf(w);
     return power_heuristic(f32(frame.gather_count) * p_gather, f32(frame.light_samples) * p_light);

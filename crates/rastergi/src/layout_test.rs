@@ -54,7 +54,7 @@ fn twins() -> Vec<Twin> {
                 light_samples,
                 ray_epsilon,
                 gather_count,
-                gather_cosine,
+                gather_importance,
                 eye_chains
             ]
         ),

@@ -325,9 +325,9 @@ impl Renderer {
         let fixed = FixedSample { direction: o.direction, texel_jitter: o.texel_jitter };
         let map = self.photons.as_ref().map(PhotonPasses::map);
         if let (Some(gather), Some(_)) = (&self.passes.gather, map) {
-            let (count, cosine) = gather.strategy(self.settings.directions, &fixed);
+            let (count, per_pixel) = gather.strategy(self.settings.directions, &fixed);
             uniforms.gather_count = count;
-            uniforms.gather_cosine = cosine as u32;
+            uniforms.gather_importance = per_pixel as u32;
         }
         self.frame.write(&self.gpu, &uniforms);
         let mut enc =

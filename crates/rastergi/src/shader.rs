@@ -51,6 +51,7 @@ pub fn constants() -> String {
         ("STREAM_HIT_LIGHT", stream::HIT_LIGHT),
         ("STREAM_EYE_CHAIN", stream::EYE_CHAIN),
         ("STREAM_GATHER_CHAIN", stream::GATHER_CHAIN),
+        ("STREAM_GATHER_LOBE", stream::GATHER_LOBE),
         ("PUNCTUAL_LIGHT", PUNCTUAL_LIGHT),
         ("ENVIRONMENT_LIGHT", ENVIRONMENT_LIGHT),
         ("CAUSTIC_CELL", CAUSTIC_CELL),

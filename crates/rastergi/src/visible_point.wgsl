@@ -57,3 +57,41 @@ fn visible_point(g: vec4u, eye: vec3f, weight: vec3f) -> VisiblePoint {
     p.ok = p.front || (p.x.flags & MATERIAL_TWO_SIDED) != 0u;
     return p;
 }
+
+// The scattering model at p, in the shading frame of p.ns, with the direction to the eye
+// there: a solid glass seen from inside has its relative index inverted.
+struct VisibleBsdf {
+    b: Bsdf,
+    frame: mat3x3f,
+    wo: vec3f,
+}
+
+fn visible_bsdf(p: VisiblePoint) -> VisibleBsdf {
+    let sf = shading_frame(p.ns);
+    var b = surface_bsdf(p.x);
+    if !p.front && !b.thin {
+        b.ior = 1.0 / b.ior;
+    }
+    return VisibleBsdf(b, sf, to_local(sf, normalize(p.eye - p.x.pos)));
+}
+
+// The density of this iteration's final gather directions at p along w (solid angle), for
+// the weights of multiple importance sampling against the direct pass's light samples: 0
+// where the gather counts nothing (no gather, w below the geometric surface or the shading
+// normal); shared directions (frame.gather_importance = 0) are uniform on the hemisphere,
+// 1/2π; per-pixel ones follow the point's own scattering, cos θ/π on a Lambertian surface,
+// else bsdf_pdf (its non-specular lobes, as gather_direction draws them).
+fn gather_density(p: VisiblePoint, w: vec3f) -> f32 {
+    let cos_s = dot(p.ns, w);
+    if frame.gather_count == 0u || dot(p.n, w) <= 0.0 || cos_s <= 0.0 {
+        return 0.0;
+    }
+    if frame.gather_importance == 0u {
+        return 1.0 / (2.0 * PI);
+    }
+    if (p.x.flags & MATERIAL_LAMBERTIAN) != 0u {
+        return cos_s / PI;
+    }
+    let v = visible_bsdf(p);
+    return bsdf_pdf(v.b, v.wo, to_local(v.frame, w));
+}

@@ -1,7 +1,9 @@
 //! The environment light (`--env`) against closed forms: a constant sky over an open floor
 //! gives E = πL, so every pass's image of the floor is ρL (the direct pass's light samples and
 //! the gather's escaping rays, weighted by MIS, must sum to it for every gather); the camera's
-//! escaping rays see the map; photons carry ∫ L cos θ dω · A to the floor.
+//! escaping rays see the map; photons carry ∫ L cos θ dω · A to the floor. A glossy floor
+//! under a constant sky reflects L times its directional albedo: the MIS weights still sum to
+//! one where the gather draws its directions from the BSDF.
 
 mod common;
 
@@ -26,9 +28,18 @@ const SIZE: u32 = 32;
 /// A one-sided square floor of albedo ½ facing up, seen from above (it fills the view), under
 /// `env`: nothing else, so its radiance is ρ/π · E with E the sky's irradiance.
 fn floor(env: Environment) -> Scene {
-    let camera = Camera { eye: Vec3::new(0.0, 3.0, 0.001), target: Vec3::ZERO, up: Vec3::Z, fov_y_deg: 60.0 };
-    let mut s = Scene::new(camera);
-    let m = s.add_material(Material::diffuse("floor", Vec3::splat(ALBEDO)));
+    floor_of(Material::diffuse("floor", Vec3::splat(ALBEDO)), env)
+}
+
+/// The floor's view: from above, filling it.
+fn floor_camera() -> Camera {
+    Camera { eye: Vec3::new(0.0, 3.0, 0.001), target: Vec3::ZERO, up: Vec3::Z, fov_y_deg: 60.0 }
+}
+
+/// The floor of `floor` made of `material`.
+fn floor_of(material: Material, env: Environment) -> Scene {
+    let mut s = Scene::new(floor_camera());
+    let m = s.add_material(material);
     let (p, q, r, t) = (Vec3::new(-A, 0.0, -A), Vec3::new(A, 0.0, -A), Vec3::new(A, 0.0, A), Vec3::new(-A, 0.0, A));
     s.add_triangle([p, t, r], m);
     s.add_triangle([p, r, q], m);
@@ -278,4 +289,77 @@ fn a_courtyard_under_a_sky_with_a_sun_matches_mitsuba() {
         "courtyard_env_path_128",
         false,
     );
+}
+
+/// The directional albedo a(ω_o) = ∫ f(ω_o, ω_i) cos θ_i dω_i of `b` at cos θ_o = `cos_o`
+/// (the models here are isotropic), by a 1024² midpoint quadrature in (θ_i, φ_i), dω = sin θ
+/// dθ dφ: fine enough at the pole for the narrow lobes of a glossy surface.
+fn directional_albedo(b: &rastergi::bsdf::Bsdf, cos_o: f32) -> Vec3 {
+    use std::f64::consts::PI;
+    let wo = Vec3::new((1.0 - cos_o * cos_o).max(0.0).sqrt(), 0.0, cos_o);
+    let m = 1024;
+    let mut sum = glam::DVec3::ZERO;
+    for i in 0..m {
+        let theta = (i as f64 + 0.5) / m as f64 * PI / 2.0;
+        let (st, ct) = theta.sin_cos();
+        for k in 0..m {
+            let phi = (k as f64 + 0.5) / m as f64 * 2.0 * PI;
+            let wi = glam::DVec3::new(st * phi.cos(), st * phi.sin(), ct).as_vec3();
+            sum += b.eval(wo, wi, rastergi::bsdf::Transport::Radiance).as_dvec3() * (ct * st);
+        }
+    }
+    (sum * (PI / 2.0 / m as f64) * (2.0 * PI / m as f64)).as_vec3()
+}
+
+/// The cosine between the floor's normal and the direction to the eye at each pixel's centre.
+fn floor_pixel_cosines() -> Vec<f32> {
+    let vp = rastergi::frame::view_projection(&floor_camera(), SIZE, SIZE, 1e-3, Vec2::ZERO);
+    let inv = vp.inverse();
+    let mut c = Vec::new();
+    for y in 0..SIZE {
+        for x in 0..SIZE {
+            let ndc = Vec2::new(2.0 * (x as f32 + 0.5) / SIZE as f32 - 1.0, 1.0 - 2.0 * (y as f32 + 0.5) / SIZE as f32);
+            let d = (inv * Vec4::new(ndc.x, ndc.y, 0.0, 1.0)).truncate().normalize();
+            c.push(-d.y);
+        }
+    }
+    c
+}
+
+#[test]
+fn a_glossy_floor_under_a_constant_sky_reflects_l_times_its_directional_albedo() {
+    // The direct pass's sky samples and the gather's escaping rays share the sky by MIS; on a
+    // glossy surface the traced gather's per-pixel directions come from the BSDF's sampling,
+    // and its density must be the one the weights use, or the two do not sum to L·a(ω_o).
+    let l = Vec3::new(1.0, 0.6, 0.3);
+    let metal = Material { metallic: 1.0, roughness: 0.5, ..Material::diffuse("metal", Vec3::new(0.9, 0.7, 0.5)) };
+    let layered = Material { specular: 1.0, roughness: 0.4, ..Material::diffuse("layered", Vec3::new(0.2, 0.5, 0.8)) };
+    let cosines = floor_pixel_cosines();
+    let (lo, hi) = cosines.iter().fold((1.0f32, 0.0f32), |(a, b), &c| (a.min(c), b.max(c)));
+    for material in [metal, layered] {
+        let b = material.bsdf(material.albedo, Vec3::ONE);
+        // a(cos θ_o) on 17 points spanning the pixels' cosines, linearly interpolated.
+        let table: Vec<Vec3> = (0..17).map(|k| directional_albedo(&b, lo + (hi - lo) * k as f32 / 16.0)).collect();
+        let a = |c: f32| {
+            let t = ((c - lo) / (hi - lo) * 16.0).clamp(0.0, 16.0);
+            let k = (t.floor() as usize).min(15);
+            table[k].lerp(table[k + 1], t - k as f32)
+        };
+        let expected = l * cosines.iter().map(|&c| a(c)).sum::<Vec3>() / cosines.len() as f32;
+        let scene = floor_of(material.clone(), Environment::constant(l));
+        for (label, s, path) in [
+            ("trace, per-pixel directions", settings(GatherMethod::Trace, GatherDirections::PerPixel), false),
+            ("trace, shared directions", settings(GatherMethod::Trace, GatherDirections::Shared), false),
+            ("lists", settings(GatherMethod::Lists, GatherDirections::Shared), false),
+            ("path tracer", settings(GatherMethod::Trace, GatherDirections::PerPixel), true),
+        ] {
+            let (mean, sigma) = floor_mean(&scene, s, 24, path);
+            println!("{} floor, {label}: mean {mean} (σ {sigma}), L·a(ω_o) {expected}", material.name);
+            assert!(
+                (mean - expected).abs().cmple(5.0 * sigma + expected * 2e-3).all(),
+                "{} floor, {label}: {mean} against {expected} (σ {sigma})",
+                material.name
+            );
+        }
+    }
 }

@@ -1,21 +1,25 @@
 //! The final gather's estimator and what every implementation shares: the uniforms, the
 //! resources a pass binds, and the per-pixel estimator pipeline.
 //!
-//! For a visible point x (normal n_x facing the eye, albedo ρ_x) and a direction ω, with h the
-//! nearest surface along ω (t > ε, x's own triangle excluded) and
-//! L(h → x) = (ρ_h/π) · E(h), E(h) the photon map's irradiance on the side of h facing x (zero
-//! from the back of a one-sided h; emission is never added: the direct pass owns it):
+//! For a visible point x (normal n_x facing the eye, BSDF f, f = ρ_x/π on a Lambertian
+//! surface) and a direction ω, with h the nearest surface along ω (t > ε, x's own triangle
+//! excluded) and L(h → x) = (ρ_h/π) · E(h), E(h) the photon map's irradiance on the side of h
+//! facing x (zero from the back of a one-sided h; emission is never added: the direct pass
+//! owns it):
 //!
 //! ```text
 //!   shared ω, uniform on the sphere; x gathers along w = sign(n_x·ω)·ω, uniform on its
-//!   hemisphere (pdf 1/2π):                           L_ind(x) ≈ (ρ_x/π) · L(h → x) · (n_x·w) · 2π
-//!   per-pixel ω, cosine about n_x (pdf cos θ_x/π):  L_ind(x) ≈ ρ_x · L(h → x)
+//!   hemisphere (pdf 1/2π):             L_ind(x) ≈ f(ω_eye, w) · L(h → x) · (n_x·w) · 2π
+//!   per-pixel w, drawn from x's own scattering (pdf p(w): cos θ_x/π on a Lambertian
+//!   surface, the BSDF's sampling density of its non-specular lobes elsewhere):
+//!                                      L_ind(x) ≈ f(ω_eye, w) cos θ_x / p(w) · L(h → x)
+//!                                               = ρ_x · L(h → x) on a Lambertian surface
 //! ```
 //!
-//! Both are unbiased for ∫ (ρ_x/π) L(h → x) cos θ_x dω over the hemisphere. `estimator.wgsl`
-//! holds `gather_estimate` (shared: every implementation) and `gather_estimate_cosine`
-//! (per-pixel: the traced gather only); each of an iteration's K directions adds its estimate
-//! weighted 1/K.
+//! Both are unbiased for ∫ f(ω_eye, w) L(h → x) cos θ_x dω over the hemisphere (the specular
+//! lobes are the eye chains'). `estimator.wgsl` holds `gather_estimate` (shared: every
+//! implementation) and `gather_direction` (per-pixel: the traced gather only); each of an
+//! iteration's K directions adds its estimate weighted 1/K.
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3};

@@ -76,12 +76,8 @@ fn visible_f(p: VisiblePoint, w: vec3f) -> vec3f {
     if (p.x.flags & MATERIAL_LAMBERTIAN) != 0u {
         return p.x.albedo / PI;
     }
-    let sf = shading_frame(p.ns);
-    var b = surface_bsdf(p.x);
-    if !p.front && !b.thin {
-        b.ior = 1.0 / b.ior;
-    }
-    return bsdf_eval(b, to_local(sf, normalize(p.eye - p.x.pos)), to_local(sf, w), TRANSPORT_RADIANCE);
+    let v = visible_bsdf(p);
+    return bsdf_eval(v.b, v.wo, to_local(v.frame, w), TRANSPORT_RADIANCE);
 }
 
 // The cosine that weighs direction w at x: the shading normal's, where w lies above the
@@ -106,27 +102,58 @@ fn gather_side(n: vec3f, w: vec3f) -> vec3f {
     return select(-w, w, dot(n, w) >= 0.0);
 }
 
-// Per-pixel directions, cosine-distributed about the shading normal (pdf cos θ_x/π): the
-// cosine cancels, π f(ω_eye, w) · L(h → x) (ρ_x · L on a Lambertian surface); directions below
-// the geometric surface count zero.
-fn gather_estimate_cosine(p: VisiblePoint, w: vec3f, tri: u32, hit: vec3f, b: vec2f, pixel: u32, j: u32) -> vec3f {
-    return PI * visible_f(p, w) * gather_radiance(w, tri, hit, b, pixel, j);
+// A per-pixel gather direction at x, drawn from x's own scattering: w, the estimator's factor
+// f(ω_eye, w) cos θ_x / pdf(w) (zero where w counts nothing: below the geometric surface or the
+// shading normal, or a specular lobe drawn — the eye's chains follow those), and pdf(w).
+struct GatherDirection {
+    w: vec3f,
+    weight: vec3f,
+    pdf: f32,
 }
 
-// A gather ray from x along w that escapes the scene sees the environment: its estimate,
-// weighted against the direct pass's environment samples (env_gather_weight). It is direct
-// light, so the gathers add it to the film's direct component (with the direct pass's share:
-// Show::Direct is all of the direct light, Show::Indirect the light from surfaces). Shared
-// directions (pdf 1/2π): f·L_env(w)·cos θ_x·2π; per-pixel (pdf cos θ_x/π): π f·L_env(w).
-fn escape_estimate(p: VisiblePoint, cos_x: f32, w: vec3f) -> vec3f {
+// The direction of Sobol' point u (two uniforms) and uniform `lobe` at x: on a Lambertian
+// surface cosine-distributed about the shading normal (pdf cos θ_x/π, the cosine cancels:
+// weight ρ_x; `lobe` unused); elsewhere drawn by bsdf_sample (the lobe chosen by `lobe`, the
+// direction within it by u), whose weight and density cover its non-specular lobes —
+// importance sampling of f cos θ_x, so a glossy lobe gathers where it reflects.
+fn gather_direction(p: VisiblePoint, u: vec2f, lobe: f32) -> GatherDirection {
+    var d = GatherDirection(p.ns, vec3f(0.0), 0.0);
+    if (p.x.flags & MATERIAL_LAMBERTIAN) != 0u {
+        d.w = cosine_hemisphere(p.ns, u.x, u.y);
+        d.pdf = max(dot(p.ns, d.w), 0.0) / PI;
+        if gather_cosine(p, d.w) > 0.0 {
+            d.weight = p.x.albedo;
+        }
+        return d;
+    }
+    let v = visible_bsdf(p);
+    let s = bsdf_sample(v.b, v.wo, vec3f(lobe, u.x, u.y), TRANSPORT_RADIANCE);
+    if !s.ok || s.delta {
+        return d;
+    }
+    d.w = v.frame * s.wi;
+    d.pdf = s.pdf;
+    if gather_cosine(p, d.w) > 0.0 {
+        d.weight = s.weight;
+    }
+    return d;
+}
+
+// A gather ray from x along w that escapes the scene sees the environment: its estimate
+// weight · L_env(w) (weight = f cos θ_x / pdf of the direction's strategy), weighted against
+// the direct pass's environment samples (env_gather_weight). It is direct light, so the
+// gathers add it to the film's direct component (with the direct pass's share: Show::Direct
+// is all of the direct light, Show::Indirect the light from surfaces).
+fn escape_estimate_weighted(p: VisiblePoint, weight: vec3f, w: vec3f) -> vec3f {
     if !has_environment() {
         return vec3f(0.0);
     }
-    var f = PI * visible_f(p, w) * env_radiance(w) * env_gather_weight(p.ns, w);
-    if frame.gather_cosine == 0u {
-        f *= 2.0 * cos_x;
-    }
-    return f;
+    return weight * env_radiance(w) * env_gather_weight(gather_density(p, w), w);
+}
+
+// escape_estimate_weighted for shared directions (pdf 1/2π): f·cos θ_x·2π.
+fn escape_estimate(p: VisiblePoint, cos_x: f32, w: vec3f) -> vec3f {
+    return escape_estimate_weighted(p, visible_f(p, w) * (cos_x * 2.0 * PI), w);
 }
 
 // Direct irradiance at h (side normal n, shading normal ns) from one light sample (light_sample_irradiance):

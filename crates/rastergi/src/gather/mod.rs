@@ -469,8 +469,8 @@ impl GatherPass {
     }
 
     /// The directions per pixel that [`encode`](Self::encode) will gather along with the same
-    /// arguments, and whether they are cosine-distributed (per-pixel; else uniform on the
-    /// hemisphere): the direct pass weighs its environment samples against them
+    /// arguments, and whether each point draws its own from its scattering (per-pixel; else
+    /// uniform on the hemisphere): the direct pass weighs its environment samples against them
     /// ([`crate::frame::FrameUniforms::gather_count`]).
     pub fn strategy(&self, directions: u32, fixed: &FixedSample) -> (u32, bool) {
         let count = if fixed.direction.is_some() { 1 } else { directions.clamp(1, MAX_DIRECTIONS) };

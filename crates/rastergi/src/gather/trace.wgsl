@@ -1,9 +1,11 @@
 // Final gather by ray casting (gather/trace.rs): the nearest surface along each of the
 // iteration's directions from each visible point, by BVH traversal, averaged over the
-// directions. Shared directions (gather.per_pixel == 0): the uniforms' ω_k, each cast along
-// whichever of ±ω_k lies above x's surface (gather_side), estimate gather_estimate. Per-pixel directions: ω_k cosine-distributed about n_x from the
-// Owen-scrambled Sobol' point of index first_index + k with this pixel's scramble seed,
-// estimate gather_estimate_cosine (estimator.wgsl).
+// directions, each estimate f(ω_eye, w) cos θ_x / pdf(w) · L(h → x) (estimator.wgsl). Shared
+// directions (gather.per_pixel == 0): the uniforms' ω_k, each cast along whichever of ±ω_k
+// lies above x's surface (gather_side), pdf 1/2π. Per-pixel directions: drawn from x's own
+// scattering (gather_direction: cosine-distributed on a Lambertian surface, by the BSDF
+// elsewhere) with the Owen-scrambled Sobol' point of index first_index + k and this pixel's
+// scramble seed, the lobe by a hash of (pixel, index).
 
 @group(2) @binding(0) var<uniform> gather: Gather;
 @group(2) @binding(1) var gbuffer: texture_2d<u32>;
@@ -23,28 +25,33 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     // Rays that escape see the environment: direct light, kept with the direct pass's.
     var sky = vec3f(0.0);
     for (var k = 0u; k < gather.count && p.ok; k++) {
-        var w = gather_side(p.n, gather.directions[k].xyz);
+        let j = gather.first_index + k;
+        // The direction and the estimator's factor f cos θ_x / pdf.
+        var w: vec3f;
+        var weight = vec3f(0.0);
         if per_pixel {
-            let u = sobol_owen_2d(gather.first_index + k, seed);
-            w = cosine_hemisphere(p.ns, unit_f32(u.x), unit_f32(u.y));
+            let u = sobol_owen_2d(j, seed);
+            var lobe = rng_new(frame.seed ^ STREAM_GATHER_LOBE, pixel, j);
+            let d = gather_direction(p, vec2f(unit_f32(u.x), unit_f32(u.y)), rng_f32(&lobe));
+            w = d.w;
+            weight = d.weight;
+        } else {
+            // Uniform on the hemisphere: pdf 1/2π.
+            w = gather_side(p.n, gather.directions[k].xyz);
+            let cos_x = gather_cosine(p, w);
+            if cos_x > 0.0 {
+                weight = visible_f(p, w) * (cos_x * 2.0 * PI);
+            }
         }
-        let cos_x = gather_cosine(p, w);
-        if cos_x <= 0.0 {
+        if all(weight == vec3f(0.0)) {
             continue;
         }
         // Nearest hit at t > ε, x's own triangle excluded (the raster gather's plane test).
         let h = trace(p.x.pos, w, frame.ray_epsilon, 3.0e38, p.x.tri, NO_TRIANGLE, false);
         if h.tri != NO_TRIANGLE {
-            let hit = p.x.pos + w * h.t;
-            let b = vec2f(h.b1, h.b2);
-            let j = gather.first_index + k;
-            if per_pixel {
-                sum += gather_estimate_cosine(p, w, h.tri, hit, b, pixel, j);
-            } else {
-                sum += gather_estimate(p, cos_x, w, h.tri, hit, b, pixel, j);
-            }
+            sum += weight * gather_radiance(w, h.tri, p.x.pos + w * h.t, vec2f(h.b1, h.b2), pixel, j);
         } else {
-            sky += escape_estimate(p, cos_x, w);
+            sky += escape_estimate_weighted(p, weight, w);
         }
     }
     film_add(FILM_INDIRECT, gid.xy, p.weight * (sum / f32(gather.count)));

@@ -101,8 +101,9 @@ impl GatherArg {
 /// Whose directions the traced gather casts.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
 pub enum GatherDirectionsArg {
-    /// Each pixel its own cosine-distributed directions (Owen-scrambled Sobol'): noise
-    /// instead of streaks.
+    /// Each pixel its own directions (Owen-scrambled Sobol'), drawn as the visible point
+    /// scatters (cosine-distributed on a Lambertian surface, by the BSDF on a glossy one):
+    /// noise instead of streaks.
     PerPixel,
     /// Each direction shared by every pixel (uniform on the sphere, scrambled Sobol'; each
     /// point gathers along whichever of ±ω lies above it).

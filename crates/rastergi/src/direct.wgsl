@@ -22,7 +22,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if has_lights() && (p.ok || glass) {
         let s = p.x;
         let n = p.n;
-        let lambertian = (s.flags & MATERIAL_LAMBERTIAN) != 0u;
+        let lambertian = surface_is_lambertian(s);
         // The scattering model in the shading frame on the eye's side.
         let v = visible_bsdf(p);
         // Sample k of iteration i has index i·L + k in the pixel's own sequence, whose seed

@@ -369,13 +369,26 @@ pub fn compute_pipeline(
     entry: &str,
     layouts: &[&wgpu::BindGroupLayout],
 ) -> wgpu::ComputePipeline {
+    compute_pipeline_with(device, label, module, entry, layouts, &[])
+}
+
+/// [`compute_pipeline`] with values for the shader's pipeline-overridable constants
+/// (`override` declarations), e.g. [`crate::gpu_scene::GpuScene::pipeline_constants`].
+pub fn compute_pipeline_with(
+    device: &wgpu::Device,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    entry: &str,
+    layouts: &[&wgpu::BindGroupLayout],
+    constants: &[(&str, f64)],
+) -> wgpu::ComputePipeline {
     let layout = pipeline_layout(device, label, layouts);
     device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
         label: Some(label),
         layout: Some(&layout),
         module,
         entry_point: Some(entry),
-        compilation_options: Default::default(),
+        compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
         cache: None,
     })
 }

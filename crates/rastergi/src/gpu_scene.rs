@@ -309,9 +309,20 @@ pub struct GpuScene {
     /// Whether the eye's rays continue through specular surfaces here
     /// ([`Material::passes_rays`]).
     pub eye_chains: bool,
+    /// Whether some material is not Lambertian ([`Material::is_lambertian`]).
+    pub has_bsdfs: bool,
 }
 
 impl GpuScene {
+    /// The values of the scene's pipeline-overridable constants (`gpu_scene.wgsl`), for every
+    /// pipeline whose shader reads the scene: a scene without glossy or specular materials,
+    /// or without surfaces that pass rays, gets kernels without the branches that serve them
+    /// (the same results: those branches are never taken there; smaller kernels run faster).
+    pub fn pipeline_constants(&self) -> [(&'static str, f64); 2] {
+        let flag = |b: bool| if b { 1.0 } else { 0.0 };
+        [("SCENE_BSDF", flag(self.has_bsdfs)), ("SCENE_PASSES_RAYS", flag(self.eye_chains))]
+    }
+
     /// Uploads `prepared`, after checking that its buffers fit the device (see [`crate::limits`]).
     pub fn new(gpu: &Gpu, prepared: &PreparedScene) -> Result<GpuScene> {
         let limits = gpu.device.limits();
@@ -462,6 +473,7 @@ impl GpuScene {
                 .map(|t| (t[0].distance(t[1]) + t[1].distance(t[2]) + t[2].distance(t[0])) as f64)
                 .sum(),
             eye_chains: s.materials.iter().any(Material::passes_rays),
+            has_bsdfs: !s.materials.iter().all(Material::is_lambertian),
         })
     }
 }

@@ -1,5 +1,13 @@
 // The scene, bind group 0 of every pass that reads it (gpu_scene.rs).
 
+// What the scene holds, fixed per pipeline (GpuScene::pipeline_constants): a scene without
+// it compiles without the branches that serve it (a Lambertian scene's kernels are as small
+// as before materials). Some material is not Lambertian (bsdf.wgsl evaluates it):
+override SCENE_BSDF: bool = true;
+// Some material passes eye and gather rays (Material::passes_rays: the eye's and the
+// gather's specular chains, the photon map's caustic twins):
+override SCENE_PASSES_RAYS: bool = true;
+
 // flags: TRIANGLE_HAS_HOLES where the material may let rays through.
 struct Triangle {
     v0: vec3f,
@@ -382,13 +390,18 @@ fn surface_purely_specular(s: Surface) -> bool {
 // behind it, which a stop on its surface cannot gather; Material::passes_rays).
 fn surface_passes_rays(s: Surface) -> bool {
     let opaque = (1.0 - clamp(s.metallic, 0.0, 1.0)) * (1.0 - s.transmission);
-    return opaque <= 0.0 && (surface_purely_specular(s) || s.transmission > 0.0);
+    return SCENE_PASSES_RAYS && opaque <= 0.0 && (surface_purely_specular(s) || s.transmission > 0.0);
+}
+
+// Whether the surface scatters as a plain Lambertian one, f = ρ/π.
+fn surface_is_lambertian(s: Surface) -> bool {
+    return !SCENE_BSDF || (s.flags & MATERIAL_LAMBERTIAN) != 0u;
 }
 
 // The albedo with which a point reflects the photon map's irradiance: ρ, or the diffuse
 // equivalent of a glossy or specular surface (bsdf_diffuse_equivalent, an approximation).
 fn surface_rho(s: Surface) -> vec3f {
-    if (s.flags & MATERIAL_LAMBERTIAN) != 0u {
+    if surface_is_lambertian(s) {
         return s.albedo;
     }
     return bsdf_diffuse_equivalent(surface_bsdf(s));

@@ -28,7 +28,7 @@ fn visible_point_at(xy: vec2u) -> VisiblePoint {
     var g = textureLoad(gbuffer, xy, 0);
     var eye = frame.eye;
     var weight = vec3f(1.0);
-    if frame.eye_chains != 0u {
+    if SCENE_PASSES_RAYS && frame.eye_chains != 0u {
         let base = 3u * (xy.y * frame.resolution.x + xy.x);
         let e = eye_paths[base];
         if e.w > 0.0 {
@@ -89,7 +89,7 @@ fn gather_density(p: VisiblePoint, w: vec3f) -> f32 {
     if frame.gather_importance == 0u {
         return 1.0 / (2.0 * PI);
     }
-    if (p.x.flags & MATERIAL_LAMBERTIAN) != 0u {
+    if surface_is_lambertian(p.x) {
         return cos_s / PI;
     }
     let v = visible_bsdf(p);

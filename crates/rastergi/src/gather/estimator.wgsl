@@ -23,7 +23,7 @@ fn gather_radiance(w0: vec3f, tri0: u32, hit0: vec3f, b0: vec2f, pixel: u32, j: 
     // and the chain adds it here (no light sample finds it).
     var delta_only = true;
     var seen = vec3f(0.0);
-    if frame.eye_chains != 0u {
+    if SCENE_PASSES_RAYS && frame.eye_chains != 0u {
         var rng = rng_new(frame.seed ^ STREAM_GATHER_CHAIN, pixel, j);
         for (var k = 0u; ; k++) {
             let s = surface_at(tri, b.x, b.y, 0.0);
@@ -73,7 +73,7 @@ fn gather_radiance(w0: vec3f, tri0: u32, hit0: vec3f, b0: vec2f, pixel: u32, j: 
 // f(ω_eye, w) at the visible point x: ρ_x/π for a Lambertian surface, else the BSDF's
 // non-specular lobes (bsdf.wgsl) in the shading frame of p.ns.
 fn visible_f(p: VisiblePoint, w: vec3f) -> vec3f {
-    if (p.x.flags & MATERIAL_LAMBERTIAN) != 0u {
+    if surface_is_lambertian(p.x) {
         return p.x.albedo / PI;
     }
     let v = visible_bsdf(p);
@@ -118,7 +118,7 @@ struct GatherDirection {
 // importance sampling of f cos θ_x, so a glossy lobe gathers where it reflects.
 fn gather_direction(p: VisiblePoint, u: vec2f, lobe: f32) -> GatherDirection {
     var d = GatherDirection(p.ns, vec3f(0.0), 0.0);
-    if (p.x.flags & MATERIAL_LAMBERTIAN) != 0u {
+    if surface_is_lambertian(p.x) {
         d.w = cosine_hemisphere(p.ns, u.x, u.y);
         d.pdf = max(dot(p.ns, d.w), 0.0) / PI;
         if gather_cosine(p, d.w) > 0.0 {

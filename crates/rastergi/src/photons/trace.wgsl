@@ -138,7 +138,7 @@ fn trace_photons(@builtin(global_invocation_id) gid: vec3u) {
         // The texel's albedo, unfiltered (level 0): photons sample the texture point-wise.
         let s = surface_at(hit.tri, hit.b1, hit.b2, 0.0);
         let front = dot(s.normal, dir) < 0.0;
-        let lambertian = (s.flags & MATERIAL_LAMBERTIAN) != 0u;
+        let lambertian = surface_is_lambertian(s);
         // Glass is entered and left by either face.
         if !front && (s.flags & MATERIAL_TWO_SIDED) == 0u && s.transmission <= 0.0 {
             break;
@@ -153,7 +153,7 @@ fn trace_photons(@builtin(global_invocation_id) gid: vec3u) {
             deposit(s.pos, hit.tri, !front, flux * arrive, 0u);
         }
         // A photon that came through specular surfaces alone adds to the caustic map too.
-        if caustic {
+        if SCENE_PASSES_RAYS && caustic {
             deposit(s.pos, hit.tri, !front, flux * arrive, CAUSTIC_CELL);
         }
         var below = false;

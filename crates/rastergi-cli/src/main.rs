@@ -4,6 +4,7 @@ mod args;
 mod bench;
 mod compare;
 mod export;
+mod merge;
 mod render;
 mod view;
 
@@ -31,6 +32,9 @@ enum Command {
     },
     /// Render a scene progressively and write the image (.exr linear, .png display).
     Render(render::RenderArgs),
+    /// Merge checkpoints of one image rendered with different seeds into one image (and
+    /// checkpoint), each weighted by its iterations.
+    Merge(merge::MergeArgs),
     /// Measure throughput, convergence and memory: `bench photons`, `gather`, `converge`, `frames`, `bvh`, `memory`.
     #[command(subcommand)]
     Bench(bench::BenchCommand),
@@ -74,16 +78,18 @@ fn main() -> ExitCode {
     if !cli.command.opens_window() {
         quiet_wayland_probe();
     }
+    let ok = |r: anyhow::Result<()>| r.map(|()| ExitCode::SUCCESS);
     let result = match cli.command {
-        Command::Info { gpu } => args::gpu(&gpu).map(|g| println!("{}", g.describe())),
+        Command::Info { gpu } => ok(args::gpu(&gpu).map(|g| println!("{}", g.describe()))),
         Command::Render(args) => render::run(&args),
-        Command::Bench(command) => bench::run(&command),
-        Command::Compare(args) => compare::run(&args),
-        Command::Export(args) => export::run(&args),
-        Command::View(args) => view::run(&args),
+        Command::Merge(args) => ok(merge::run(&args)),
+        Command::Bench(command) => ok(bench::run(&command)),
+        Command::Compare(args) => ok(compare::run(&args)),
+        Command::Export(args) => ok(export::run(&args)),
+        Command::View(args) => ok(view::run(&args)),
     };
     match result {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(code) => code,
         Err(e) => {
             // One line, whatever the error's sources hold (driver messages can span several).
             let message = format!("{e:#}");

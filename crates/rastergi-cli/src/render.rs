@@ -1,13 +1,23 @@
 //! `rastergi render`: renders a scene progressively with the photon-map renderer or the
 //! reference path tracer and writes the image (.exr linear, .png display).
+//!
+//! A render stops at `--iterations` (the total, counting a resumed checkpoint's), at
+//! `--time-limit`, when the error estimated without a reference falls under `--target-error`,
+//! or at SIGINT/SIGTERM (a second one exits at once); every way it stops writes the image of
+//! the iterations done, and the checkpoint where one is asked for (`--checkpoint`, also
+//! written every `--checkpoint-every` seconds). `--resume` continues a checkpoint.
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 use anyhow::Result;
 use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
+use rastergi::checkpoint::Checkpoint;
 use rastergi::fit;
 use rastergi::gather::GatherDirections;
 use rastergi::image_io::{ImageFormat, write_exr, write_png};
@@ -21,13 +31,30 @@ use crate::args::{SceneArgs, ShowArg, gpu_profiled, print_profile};
 pub struct RenderArgs {
     #[command(flatten)]
     scene: SceneArgs,
-    /// Progressive iterations (one sample per pixel each).
+    /// Progressive iterations (one sample per pixel each) in all, a resumed checkpoint's
+    /// included.
     #[arg(long, default_value_t = 256)]
     iterations: u32,
     /// Stop after this many seconds of rendering (set-up not counted) if the iterations are
     /// not done by then; the image holds the iterations done, and a note says how many.
-    #[arg(long, value_name = "SECONDS")]
-    max_seconds: Option<f64>,
+    #[arg(long, value_name = "SECONDS", alias = "max-seconds")]
+    time_limit: Option<f64>,
+    /// Stop once the image's estimated relative RMSE (its noise, estimated without a
+    /// reference from two independent halves of the iterations; the photon passes are the
+    /// halves' blocks, so a fixed map's own noise is not in it) falls under this, e.g. 0.02.
+    #[arg(long, value_name = "E")]
+    target_error: Option<f64>,
+    /// Write the render's state here when it stops and every --checkpoint-every seconds
+    /// (atomically), to --resume it later or `rastergi merge` it with other seeds' renders.
+    #[arg(long, value_name = "FILE")]
+    checkpoint: Option<PathBuf>,
+    /// Seconds between checkpoints while rendering (0: at every progress update).
+    #[arg(long, value_name = "SECONDS", default_value_t = 60.0)]
+    checkpoint_every: f64,
+    /// Continue the render of this checkpoint (same scene, options and seed), up to
+    /// --iterations in all.
+    #[arg(long, value_name = "FILE")]
+    resume: Option<PathBuf>,
     /// Output image: .exr (linear radiance, f32 RGB) or .png (exposure, sRGB).
     #[arg(long)]
     out: PathBuf,
@@ -47,7 +74,7 @@ enum Method {
 }
 
 /// Refuses, before any rendering, an output path the image could never be written to.
-fn check_output_path(out: &Path) -> Result<()> {
+pub fn check_output_path(out: &Path) -> Result<()> {
     if out.is_dir() {
         anyhow::bail!("{}: is a directory; give --out a file name ending in .exr or .png", out.display());
     }
@@ -65,9 +92,37 @@ fn check_output_path(out: &Path) -> Result<()> {
     Ok(())
 }
 
-pub fn run(args: &RenderArgs) -> Result<()> {
+/// Why a render stopped.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Stop {
+    Done,
+    TimeLimit,
+    TargetError(f64),
+    /// The signal's number.
+    Signal(i32),
+}
+
+/// SIGINT and SIGTERM set the returned number (the signal's) that the render loop reads
+/// between iterations; a second one of either ends the process at once (exit 130).
+fn catch_signals() -> Result<Arc<AtomicUsize>> {
+    use signal_hook::consts::{SIGINT, SIGTERM};
+    let caught = Arc::new(AtomicUsize::new(0));
+    let any = Arc::new(AtomicBool::new(false));
+    for sig in [SIGINT, SIGTERM] {
+        // In this order: the shutdown sees the flag of an earlier signal only.
+        signal_hook::flag::register_conditional_shutdown(sig, 130, any.clone())?;
+        signal_hook::flag::register(sig, any.clone())?;
+        signal_hook::flag::register_usize(sig, caught.clone(), sig as usize)?;
+    }
+    Ok(caught)
+}
+
+pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     let format = ImageFormat::from_path(&args.out)?;
     check_output_path(&args.out)?;
+    if let Some(path) = &args.checkpoint {
+        check_output_path(path).map_err(|e| anyhow::anyhow!("{e}").context("--checkpoint"))?;
+    }
     let a = &args.scene;
     let start = Instant::now();
     let scene = a.load_scene()?;
@@ -75,14 +130,38 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if args.iterations == 0 {
         anyhow::bail!("--iterations must be at least 1");
     }
-    if let Some(s) = args.max_seconds.filter(|s| !(s.is_finite() && *s > 0.0)) {
-        anyhow::bail!("--max-seconds must be a positive number of seconds, got {s}");
+    if let Some(s) = args.time_limit.filter(|s| !(s.is_finite() && *s > 0.0)) {
+        anyhow::bail!("--time-limit must be a positive number of seconds, got {s}");
     }
+    if let Some(e) = args.target_error.filter(|e| !(e.is_finite() && *e > 0.0)) {
+        anyhow::bail!("--target-error must be a positive relative error such as 0.02, got {e}");
+    }
+    if !(args.checkpoint_every.is_finite() && args.checkpoint_every >= 0.0) {
+        anyhow::bail!("--checkpoint-every must be a number of seconds ≥ 0, got {}", args.checkpoint_every);
+    }
+    let settings = a.settings(&scene, a.width, a.height, matches!(a.show, ShowArg::PhotonMap));
+    let method = match args.method {
+        Method::Gather => "gather",
+        Method::Path => "path",
+    };
+    let mut fingerprint = settings.fingerprint();
+    fingerprint.insert(0, ("method".to_owned(), method.to_owned()));
+    let scene_hash = scene.content_hash();
+    let resume = match &args.resume {
+        Some(path) => {
+            let c = Checkpoint::read(path)?;
+            c.check_matches(path, scene_hash, &fingerprint, Some(settings.seed))?;
+            Some(c)
+        }
+        None => None,
+    };
+    let caught = catch_signals()?;
     let gpu = gpu_profiled(&a.gpu, args.profile)?;
     if args.method == Method::Path && !matches!(a.show, ShowArg::Full) {
         anyhow::bail!("--method path renders the full image only; drop --show or use --method gather");
     }
-    let settings = a.settings(&scene, a.width, a.height, matches!(a.show, ShowArg::PhotonMap));
+    let seed = settings.seed;
+    let photon_blocks = args.method == Method::Gather && settings.photons > 0 && settings.photon_passes != 1;
     let start = Instant::now();
     // `bundle`: the photon-map renderer's gather ray view and directions, for the log.
     let (mut renderer, gather_info): (Box<dyn Progressive>, Option<(u32, GatherDirections)>) = match args.method {
@@ -93,6 +172,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         }
         Method::Path => (Box::new(PathTracer::new(&gpu, &scene, settings)?), None),
     };
+    if let Some(c) = &resume {
+        renderer.resume(&c.progress, &c.film)?;
+        log::info!("resumed {} iterations", c.film.samples);
+    }
     renderer.wait()?;
     log::info!("set-up (BVH, upload, photon map) in {:.2} s", start.elapsed().as_secs_f64());
     print_profile(&gpu, args.profile, "set-up", 1, "set-up")?;
@@ -103,66 +186,153 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             log::info!("gather ray view: {bundle}x{bundle} texels; directions {directions:?}");
         }
     }
+    let checkpoint_of = |r: &dyn Progressive, film: rastergi::film::FilmState| Checkpoint {
+        scene_hash,
+        seed,
+        settings: fingerprint.clone(),
+        progress: r.progress(),
+        film,
+    };
     let start = Instant::now();
-
+    let first = renderer.samples();
     let progress = if std::io::stderr().is_terminal() {
         let bar = ProgressBar::new(args.iterations as u64);
         bar.set_style(
-            ProgressStyle::with_template("{bar:40} {pos}/{len} iterations  {per_sec}  eta {eta}")
+            ProgressStyle::with_template("{bar:40} {pos}/{len} iterations  {per_sec}  eta {eta}  {msg}")
                 .expect("valid progress template"),
         );
+        bar.set_position(first as u64);
         bar.enable_steady_tick(Duration::from_millis(200));
         bar
     } else {
         ProgressBar::hidden()
     };
-    let mut done = 0;
-    while done < args.iterations {
+    // Test hook: destroy the device after this many iterations, as a lost GPU would be.
+    let lose_device_after: Option<u32> =
+        std::env::var("RASTERGI_TEST_LOSE_DEVICE_AFTER").ok().and_then(|v| v.parse().ok());
+    let mut done = first;
+    let mut last_checkpoint = Instant::now();
+    let mut last_estimate: Option<Instant> = None;
+    let mut error = None;
+    let stop = loop {
+        let sig = caught.load(Ordering::Relaxed);
+        if sig != 0 {
+            break Stop::Signal(sig as i32);
+        }
+        if done >= args.iterations {
+            break Stop::Done;
+        }
         renderer.iterate()?;
         done += 1;
-        // Keep the GPU queue short so the progress bar (and --max-seconds) tell the truth.
-        if done % 8 == 0 {
-            renderer.wait()?;
-            progress.set_position(done as u64);
-            if args.max_seconds.is_some_and(|s| start.elapsed().as_secs_f64() >= s) {
-                break;
-            }
+        if lose_device_after == Some(done - first) {
+            gpu.device.destroy();
         }
-    }
+        // Keep the GPU queue short so the progress bar, the limits and a signal act soon.
+        if done % 8 != 0 {
+            continue;
+        }
+        renderer.wait()?;
+        progress.set_position(done as u64);
+        if args.time_limit.is_some_and(|s| start.elapsed().as_secs_f64() >= s) {
+            break Stop::TimeLimit;
+        }
+        // The error estimate reads the film back: at most once a second.
+        let estimate_due = last_estimate.is_none_or(|t| t.elapsed() >= Duration::from_secs(1));
+        let checkpoint_due =
+            args.checkpoint.is_some() && last_checkpoint.elapsed().as_secs_f64() >= args.checkpoint_every;
+        if !(checkpoint_due || estimate_due && (args.target_error.is_some() || !progress.is_hidden())) {
+            continue;
+        }
+        let film = renderer.film_state()?;
+        last_estimate = Some(Instant::now());
+        error = film.error_estimate();
+        if let Some(e) = error {
+            progress.set_message(format!("error ≈ {:.2} %", 100.0 * e));
+        }
+        // The halves need a few blocks each before their difference means much.
+        let blocks =
+            if photon_blocks { renderer.progress().photon_pass + 1 } else { done / rastergi::film::BLOCK_ITERATIONS };
+        if let (Some(target), Some(e)) = (args.target_error, error)
+            && blocks >= 4
+            && e <= target
+        {
+            break Stop::TargetError(e);
+        }
+        if let Some(path) = args.checkpoint.as_ref().filter(|_| checkpoint_due) {
+            checkpoint_of(renderer.as_ref(), film).write(path)?;
+            last_checkpoint = Instant::now();
+        }
+    };
     renderer.wait()?;
     progress.finish_and_clear();
     let seconds = start.elapsed().as_secs_f64();
-    log::info!("{done} iterations in {seconds:.2} s");
-    if done < args.iterations {
-        eprintln!(
-            "note: --max-seconds {} reached: {done} of {} iterations in {seconds:.2} s",
-            args.max_seconds.unwrap_or_default(),
-            args.iterations
-        );
+    let rendered = done - first;
+    log::info!("{rendered} iterations in {seconds:.2} s");
+    let film = renderer.film_state()?;
+    if error.is_none() || stop != Stop::Done {
+        error = film.error_estimate();
     }
-    if args.profile {
+    if let Some(path) = &args.checkpoint {
+        checkpoint_of(renderer.as_ref(), film).write(path)?;
+    }
+    if args.profile && rendered > 0 {
         println!(
-            "{done} iterations in {seconds:.3} s wall clock ({:.3} ms per iteration)",
-            1e3 * seconds / done as f64
+            "{rendered} iterations in {seconds:.3} s wall clock ({:.3} ms per iteration)",
+            1e3 * seconds / rendered as f64
         );
     }
-    print_profile(&gpu, args.profile, "iterations", done as u64, "iteration")?;
+    print_profile(&gpu, args.profile, "iterations", rendered.max(1) as u64, "iteration")?;
 
     let show = a.show.show();
     let linear = renderer.read_linear(show)?;
     if format == ImageFormat::Exr {
-        return Ok(write_exr(&args.out, &linear)?);
+        write_exr(&args.out, &linear)?;
+    } else {
+        let exposure = a.exposure.unwrap_or_else(|| {
+            let fitted = fit::exposure(&linear);
+            if fitted != 0.0 {
+                eprintln!(
+                    "note: exposure {fitted:+} EV fitted to the image (its median luminance is far from middle grey); give --exposure to choose"
+                );
+            }
+            fitted
+        });
+        let display = renderer.read_display(show, exposure)?;
+        write_png(&args.out, &display)?;
     }
-    let exposure = a.exposure.unwrap_or_else(|| {
-        let fitted = fit::exposure(&linear);
-        if fitted != 0.0 {
-            eprintln!(
-                "note: exposure {fitted:+} EV fitted to the image (its median luminance is far from middle grey); give --exposure to choose"
-            );
+    let error_text = error.map_or(String::new(), |e| format!(", estimated error {:.2} %", 100.0 * e));
+    let saved = args.checkpoint.as_ref().map_or(String::new(), |p| format!("; checkpoint {}", p.display()));
+    match stop {
+        Stop::Done => {
+            if first >= args.iterations && resume.is_some() {
+                eprintln!("note: the checkpoint already holds {first} iterations (--iterations {})", args.iterations);
+            }
+            Ok(ExitCode::SUCCESS)
         }
-        fitted
-    });
-    let display = renderer.read_display(show, exposure)?;
-    write_png(&args.out, &display)?;
-    Ok(())
+        Stop::TimeLimit => {
+            eprintln!(
+                "note: --time-limit {} reached: {done} of {} iterations in {seconds:.2} s{error_text}{saved}",
+                args.time_limit.unwrap_or_default(),
+                args.iterations
+            );
+            Ok(ExitCode::SUCCESS)
+        }
+        Stop::TargetError(e) => {
+            eprintln!(
+                "note: --target-error {} reached: estimated error {:.2} % after {done} iterations in {seconds:.2} s{saved}",
+                args.target_error.unwrap_or_default(),
+                100.0 * e
+            );
+            Ok(ExitCode::SUCCESS)
+        }
+        Stop::Signal(sig) => {
+            let name = if sig == signal_hook::consts::SIGTERM { "SIGTERM" } else { "SIGINT" };
+            eprintln!(
+                "interrupted ({name}): {} holds {done} of {} iterations{error_text}{saved}",
+                args.out.display(),
+                args.iterations
+            );
+            Ok(ExitCode::from(128 + sig as u8))
+        }
+    }
 }

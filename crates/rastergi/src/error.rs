@@ -25,4 +25,8 @@ pub enum Error {
     ImageFile { path: PathBuf, message: String },
     #[error("GPU error: {0}")]
     Gpu(String),
+    #[error("{0}")]
+    Checkpoint(String),
+    #[error("checkpoint {}: {message}", path.display())]
+    CheckpointFile { path: PathBuf, message: String },
 }

@@ -7,6 +7,29 @@
 //! Accumulation is a plain f32 sum per pixel and component; after N iterations of values of
 //! magnitude v, the rounding error of the sum is about N·v·2⁻²⁴ (6·10⁻⁵ relative at 1000
 //! iterations), far under the Monte Carlo noise.
+//!
+//! **The error without a reference.** The renderer numbers its iterations in blocks (a photon
+//! pass, with its own photons; else [`BLOCK_ITERATIONS`] consecutive iterations) and the film
+//! keeps a second sum, B, of the iterations of odd blocks (`film_half.wgsl`). With
+//! A = S − B the even blocks' sum, n_a and n_b their iteration counts, a = A/n_a and b = B/n_b
+//! are independent estimates of the image with variances v/n_a and v/n_b (v per iteration),
+//! so for the mean S/n, n = n_a + n_b,
+//!
+//! ```text
+//!   E[(a − b)²] = v (1/n_a + 1/n_b)   ⇒   Var(S/n) = v/n ≈ (a − b)² · n_a n_b / n²
+//! ```
+//!
+//! per pixel and channel ((a − b)²/4 for equal halves). Blocks of single iterations would not
+//! do: the pixel jitter and the per-pixel light samples and gather directions are Owen-scrambled
+//! Sobol' sequences indexed by the iteration, and the even and the odd points of such a
+//! sequence lie in complementary strata (the first digit of the radical inverse), so two
+//! halves split by parity differ far more than independent estimates (the Cornell box's path
+//! tracer at 128², 256 iterations: estimated 19 %, true 4.7 %). Blocks of 16 consecutive
+//! iterations keep each half stratified like the whole (estimated 5.2 %; 8: 6.0 %, 4: 7.3 %):
+//! the estimate errs on the safe side by about a tenth. [`FilmState::error_estimate`] is the
+//! square root of its mean over the pixels and channels divided by the image's mean: the
+//! relative RMSE that `rastergi compare` would report against the expectation (the noise; a
+//! bias shared by both halves, such as a photon map's blur within a pass, is not in it).
 
 use bytemuck::{Pod, Zeroable};
 
@@ -15,11 +38,15 @@ use crate::gpu::{Gpu, buffer_bind_group, compute_pipeline, groups, storage_entry
 use crate::image_io::{DisplayImage, LinearImage};
 use crate::shader;
 
+/// Iterations per block of the error estimate where no photon pass sets the blocks (see the
+/// module's notes).
+pub const BLOCK_ITERATIONS: u32 = 16;
+
 /// Components accumulated per pixel: component c of pixel p at `c·W·H + p` (`film.wgsl`).
 pub const COMPONENTS: u64 = 3;
 pub use crate::consts::{FILM_DIRECT, FILM_INDIRECT, FILM_PHOTON_VIEW};
-/// Bytes per pixel of the film's GPU storage (accumulation + resolved copies).
-pub const BYTES_PER_PIXEL: u64 = COMPONENTS * 16 + 16 + 4;
+/// Bytes per pixel of the film's GPU storage (accumulation, its odd half, resolved copies).
+pub const BYTES_PER_PIXEL: u64 = 2 * COMPONENTS * 16 + 16 + 4;
 
 /// What the image shows.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -70,6 +97,14 @@ pub struct Film {
     pub samples: u32,
     /// `COMPONENTS × width × height` vec4 sums: component c of pixel p at `c·W·H + p`.
     pub accumulation: wgpu::Buffer,
+    /// The sums of the iterations of odd blocks, laid out as `accumulation`; while an odd
+    /// block is open it holds those of the blocks before it less the sums at its start.
+    half: wgpu::Buffer,
+    half_open: bool,
+    /// Iterations of odd blocks so far.
+    half_samples: u32,
+    half_pipelines: [wgpu::ComputePipeline; 2],
+    half_bind_group: wgpu::BindGroup,
     linear: wgpu::Buffer,
     display: wgpu::Buffer,
     uniforms: wgpu::Buffer,
@@ -104,7 +139,93 @@ impl Film {
         let bind_group = buffer_bind_group(device, "resolve", &layout, &[&uniforms, &accumulation, &linear, &display]);
         let module = shader::module(device, "resolve", &resolve_source());
         let pipeline = compute_pipeline(device, "resolve", &module, "main", &[&layout]);
-        Ok(Film { width, height, samples: 0, accumulation, linear, display, uniforms, pipeline, bind_group })
+        let half = gpu.zeroed_buffer("film odd half", COMPONENTS * pixels * 16, rw);
+        let half_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("film half"),
+            entries: &[storage_entry::<[f32; 4]>(0, c, true), storage_entry::<[f32; 4]>(1, c, false)],
+        });
+        let half_bind_group = buffer_bind_group(device, "film half", &half_layout, &[&accumulation, &half]);
+        let half_module = shader::module(device, "film half", include_str!("film_half.wgsl"));
+        let half_pipelines = ["open_block", "close_block"]
+            .map(|entry| compute_pipeline(device, "film half", &half_module, entry, &[&half_layout]));
+        Ok(Film {
+            width,
+            height,
+            samples: 0,
+            accumulation,
+            half,
+            half_open: false,
+            half_samples: 0,
+            half_pipelines,
+            half_bind_group,
+            linear,
+            display,
+            uniforms,
+            pipeline,
+            bind_group,
+        })
+    }
+
+    /// Called before the passes of each iteration add to the film, with the iteration's block
+    /// (see the module's notes): opens the odd half when an odd block starts, closes it when an
+    /// even one does, and counts the odd blocks' iterations.
+    pub fn begin_iteration(&mut self, gpu: &Gpu, block: u32) {
+        let odd = block % 2 == 1;
+        if odd != self.half_open {
+            let mut enc =
+                gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("film half") });
+            {
+                let mut pass = enc.begin_compute_pass(&Default::default());
+                pass.set_pipeline(&self.half_pipelines[if odd { 0 } else { 1 }]);
+                pass.set_bind_group(0, &self.half_bind_group, &[]);
+                let n = (COMPONENTS * self.width as u64 * self.height as u64).div_ceil(64);
+                let x = n.min(65535);
+                pass.dispatch_workgroups(x as u32, n.div_ceil(x) as u32, 1);
+            }
+            gpu.queue.submit([enc.finish()]);
+            self.half_open = odd;
+        }
+        if odd {
+            self.half_samples += 1;
+        }
+    }
+
+    /// The sums and their odd half, read back (for checkpoints, merging and the error
+    /// estimate).
+    pub fn read_state(&self, gpu: &Gpu) -> Result<FilmState> {
+        let floats = |bytes: Vec<u8>| bytemuck::cast_slice::<u8, f32>(&bytes).to_vec();
+        let n = (COMPONENTS * self.width as u64 * self.height as u64 * 16) as usize;
+        let sums = floats(gpu.read_buffer(&self.accumulation, self.accumulation.size())?[..n].to_vec());
+        let mut half = floats(gpu.read_buffer(&self.half, self.half.size())?[..n].to_vec());
+        if self.half_open {
+            for (h, s) in half.iter_mut().zip(&sums) {
+                *h += s;
+            }
+        }
+        Ok(FilmState {
+            width: self.width,
+            height: self.height,
+            samples: self.samples,
+            half_samples: self.half_samples,
+            sums,
+            half,
+        })
+    }
+
+    /// Puts `state`'s sums back (a resumed render). The next odd block opens afresh.
+    pub fn restore(&mut self, gpu: &Gpu, state: &FilmState) -> Result<()> {
+        if (state.width, state.height) != (self.width, self.height) {
+            return Err(crate::error::Error::Checkpoint(format!(
+                "the checkpoint's image is {}x{}, this render's {}x{}",
+                state.width, state.height, self.width, self.height
+            )));
+        }
+        gpu.queue.write_buffer(&self.accumulation, 0, bytemuck::cast_slice(&state.sums));
+        gpu.queue.write_buffer(&self.half, 0, bytemuck::cast_slice(&state.half));
+        self.samples = state.samples;
+        self.half_samples = state.half_samples;
+        self.half_open = false;
+        Ok(())
     }
 
     /// The display encoding written by [`encode_resolve`](Self::encode_resolve): one packed
@@ -117,8 +238,11 @@ impl Film {
     pub fn clear(&mut self, gpu: &Gpu) {
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         enc.clear_buffer(&self.accumulation, 0, None);
+        enc.clear_buffer(&self.half, 0, None);
         gpu.queue.submit([enc.finish()]);
         self.samples = 0;
+        self.half_open = false;
+        self.half_samples = 0;
     }
 
     /// Encodes the resolve of the current mean into the linear and display buffers.
@@ -160,5 +284,86 @@ impl Film {
         let bytes = gpu.read_buffer(&self.display, self.display.size())?;
         let n = (self.width * self.height) as usize * 4;
         Ok(DisplayImage { width: self.width, height: self.height, rgba: bytes[..n].to_vec() })
+    }
+}
+
+/// A film's sums read back: what a checkpoint holds of the image, and what merging adds up.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FilmState {
+    pub width: u32,
+    pub height: u32,
+    /// Iterations in `sums`, and of them in `half` (odd blocks).
+    pub samples: u32,
+    pub half_samples: u32,
+    /// `COMPONENTS × width × height × 4` floats, as [`Film::accumulation`].
+    pub sums: Vec<f32>,
+    /// The odd blocks' sums, the same layout.
+    pub half: Vec<f32>,
+}
+
+impl FilmState {
+    fn pixels(&self) -> usize {
+        (self.width * self.height) as usize
+    }
+
+    /// The sum of `show` at pixel `p` in `data` (the resolve pass's composition).
+    fn show_sum(&self, data: &[f32], show: Show, p: usize) -> [f32; 3] {
+        let n = self.pixels();
+        let at = |c: u32| {
+            let i = 4 * (c as usize * n + p);
+            [data[i], data[i + 1], data[i + 2]]
+        };
+        match show {
+            Show::Full => {
+                let (d, i) = (at(FILM_DIRECT), at(FILM_INDIRECT));
+                [d[0] + i[0], d[1] + i[1], d[2] + i[2]]
+            }
+            Show::Direct => at(FILM_DIRECT),
+            Show::Indirect => at(FILM_INDIRECT),
+            Show::PhotonMap => at(FILM_PHOTON_VIEW),
+        }
+    }
+
+    /// The mean of `show` (what [`Film::read_linear`] gives), computed here.
+    pub fn image(&self, show: Show) -> LinearImage {
+        let n = self.samples.max(1) as f32;
+        let pixels = (0..self.pixels()).map(|p| self.show_sum(&self.sums, show, p).map(|v| v / n)).collect();
+        LinearImage { width: self.width, height: self.height, pixels }
+    }
+
+    /// The estimated relative RMSE of the full image's noise (see the module's notes), from
+    /// the two halves; `None` until both hold iterations or where the image is black.
+    pub fn error_estimate(&self) -> Option<f64> {
+        let n = self.samples as f64;
+        let nb = self.half_samples as f64;
+        let na = n - nb;
+        if na < 1.0 || nb < 1.0 {
+            return None;
+        }
+        let (mut var, mut mean) = (0.0f64, 0.0f64);
+        for p in 0..self.pixels() {
+            let s = self.show_sum(&self.sums, Show::Full, p);
+            let b = self.show_sum(&self.half, Show::Full, p);
+            for c in 0..3 {
+                let d = (s[c] as f64 - b[c] as f64) / na - b[c] as f64 / nb;
+                var += d * d * na * nb / (n * n);
+                mean += s[c] as f64 / n;
+            }
+        }
+        let count = 3.0 * self.pixels() as f64;
+        (mean > 0.0).then(|| (var / count).sqrt() / (mean / count))
+    }
+
+    /// Adds `other`'s iterations (another seed's render of the same image): the sums and the
+    /// halves add, so the merged mean weighs each by its iteration count.
+    pub fn add(&mut self, other: &FilmState) {
+        for (a, b) in self.sums.iter_mut().zip(&other.sums) {
+            *a += b;
+        }
+        for (a, b) in self.half.iter_mut().zip(&other.half) {
+            *a += b;
+        }
+        self.samples += other.samples;
+        self.half_samples += other.half_samples;
     }
 }

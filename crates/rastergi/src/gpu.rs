@@ -39,6 +39,18 @@ pub struct Gpu {
     pub info: wgpu::AdapterInfo,
     /// Pass timings, when profiling was asked for and the adapter supports timestamps.
     pub profiler: Option<Profiler>,
+    /// The first error the device reported outside a call that returns one (a lost device, a
+    /// GPU timeout, an allocation that failed): [`Gpu::wait`] and every readback return it.
+    fault: std::sync::Arc<std::sync::Mutex<Fault>>,
+}
+
+/// What the device reported outside the calls that return errors.
+#[derive(Debug, Default)]
+struct Fault {
+    /// The device was lost: why.
+    lost: Option<String>,
+    /// The first uncaptured error.
+    error: Option<String>,
 }
 
 fn device_rank(t: wgpu::DeviceType) -> u32 {
@@ -97,7 +109,22 @@ impl Gpu {
         .map_err(|e| Error::Device(e.to_string()))?;
         log::info!("using {} ({:?}, {:?})", info.name, info.backend, info.device_type);
         let profiler = if options.profile { Profiler::new(&device, &queue) } else { None };
-        Ok(Gpu { adapter, device, queue, info, profiler })
+        let fault = std::sync::Arc::new(std::sync::Mutex::new(Fault::default()));
+        {
+            let fault = fault.clone();
+            device.on_uncaptured_error(std::sync::Arc::new(move |e: wgpu::Error| {
+                let message: String = e.to_string().lines().map(str::trim).collect::<Vec<_>>().join(" ");
+                fault.lock().unwrap_or_else(|e| e.into_inner()).error.get_or_insert(message);
+            }));
+        }
+        {
+            let fault = fault.clone();
+            device.set_device_lost_callback(move |reason, message| {
+                let why = if message.is_empty() { format!("{reason:?}") } else { format!("{reason:?}: {message}") };
+                fault.lock().unwrap_or_else(|e| e.into_inner()).lost.get_or_insert(why);
+            });
+        }
+        Ok(Gpu { adapter, device, queue, info, profiler, fault })
     }
 
     /// A multi-line description of the adapter and the limits that matter to rastergi.
@@ -155,8 +182,9 @@ impl Gpu {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | extra,
             mapped_at_creation: true,
         });
-        {
-            let mut view = buffer.get_mapped_range_mut(..).expect("a buffer mapped at creation is mappable");
+        // Not mappable only on a lost device: the buffer is invalid then, and the next wait
+        // reports the loss (Gpu::check).
+        if let Ok(mut view) = buffer.get_mapped_range_mut(..) {
             view.slice(..data.len()).copy_from_slice(data);
         }
         buffer.unmap();
@@ -184,6 +212,7 @@ impl Gpu {
             let _ = tx.send(r);
         });
         self.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| Error::Gpu(e.to_string()))?;
+        self.check()?;
         rx.recv()
             .map_err(|e| Error::Gpu(e.to_string()))?
             .map_err(|e| Error::Gpu(format!("mapping a readback buffer failed: {e}")))?;
@@ -224,7 +253,23 @@ impl Gpu {
 
     /// Blocks until all submitted work has finished.
     pub fn wait(&self) -> Result<()> {
-        self.device.poll(wgpu::PollType::wait_indefinitely()).map(|_| ()).map_err(|e| Error::Gpu(e.to_string()))
+        self.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| Error::Gpu(e.to_string()))?;
+        self.check()
+    }
+
+    /// The error the device reported since it was opened, if any (see `fault`): its loss
+    /// first (whatever failed after it failed for that reason).
+    pub fn check(&self) -> Result<()> {
+        let f = self.fault.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(why) = &f.lost {
+            return Err(Error::Gpu(format!(
+                "the GPU device was lost ({why}); a driver reset or a GPU timeout ends a render: resume it from its last checkpoint"
+            )));
+        }
+        match &f.error {
+            Some(message) => Err(Error::Gpu(message.clone())),
+            None => Ok(()),
+        }
     }
 }
 

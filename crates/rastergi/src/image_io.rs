@@ -133,6 +133,20 @@ pub fn read_exr(path: &Path) -> Result<LinearImage> {
     })
 }
 
+/// The display encoding of `image` on the CPU, as the film's resolve pass makes it on the GPU
+/// (`resolve.wgsl`): 2^exposure · value, clamped to [0, 1], the sRGB transfer function,
+/// rounded to 8 bits; alpha 255.
+pub fn display_encode(image: &LinearImage, exposure: f32) -> DisplayImage {
+    let scale = exposure.exp2();
+    let encode = |v: f32| {
+        let c = (v * scale).clamp(0.0, 1.0);
+        let e = if c <= 0.0031308 { c * 12.92 } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 };
+        (e * 255.0).round() as u8
+    };
+    let rgba = image.pixels.iter().flat_map(|p| [encode(p[0]), encode(p[1]), encode(p[2]), 255]).collect();
+    DisplayImage { width: image.width, height: image.height, rgba }
+}
+
 /// The sRGB transfer function's inverse (IEC 61966-2-1): display value in [0, 1] → linear.
 pub fn srgb_to_linear(v: f32) -> f32 {
     if v <= 0.04045 { v / 12.92 } else { ((v + 0.055) / 1.055).powf(2.4) }

@@ -13,6 +13,7 @@
 pub mod bsdf;
 pub mod bvh;
 pub mod camera_control;
+pub mod checkpoint;
 pub mod consts;
 pub mod direct;
 pub mod display;

@@ -205,6 +205,8 @@ impl PathTracer {
     /// One progressive iteration: one path per pixel, added to the film.
     pub fn iterate(&mut self) {
         let (w, h) = (self.settings.width, self.settings.height);
+        // The film's error estimate: blocks of BLOCK_ITERATIONS iterations.
+        self.film.begin_iteration(&self.gpu, self.film.samples / crate::film::BLOCK_ITERATIONS);
         self.write_uniforms(self.film.samples);
         let mut enc =
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("path tracer") });
@@ -228,6 +230,16 @@ impl PathTracer {
     /// The film: the radiance sums in its full component (for drawing it in a window).
     pub fn film(&self) -> &Film {
         &self.film
+    }
+
+    /// The film's sums and their odd half, read back (checkpoints, the error estimate).
+    pub fn film_state(&self) -> Result<crate::film::FilmState> {
+        self.film.read_state(&self.gpu)
+    }
+
+    /// Continues from a checkpoint's film: the next iteration is the one after its last.
+    pub fn resume(&mut self, film: &crate::film::FilmState) -> Result<()> {
+        self.film.restore(&self.gpu, film)
     }
 
     /// Encodes the resolve of the image at `exposure` into the film's linear and display buffers.

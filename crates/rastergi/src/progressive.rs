@@ -3,8 +3,9 @@
 //! it. Each iteration adds one estimate per pixel to a [`Film`]; the image is the mean of the
 //! estimates since the last restart (a camera move or [`Progressive::reset`]).
 
+use crate::checkpoint::Progress;
 use crate::error::Result;
-use crate::film::{Film, Show};
+use crate::film::{Film, FilmState, Show};
 use crate::image_io::{DisplayImage, LinearImage};
 use crate::path_tracer::PathTracer;
 use crate::renderer::{RenderSettings, Renderer};
@@ -36,6 +37,13 @@ pub trait Progressive {
     fn read_linear(&self, show: Show) -> Result<LinearImage>;
     /// The display encoding of `show`: 2^exposure · mean, clamped, sRGB, 8 bits.
     fn read_display(&self, show: Show, exposure: f32) -> Result<DisplayImage>;
+    /// Where the render stands besides its film (for a checkpoint).
+    fn progress(&self) -> Progress;
+    /// The film's sums and their odd half, read back (checkpoints, the error estimate).
+    fn film_state(&self) -> Result<FilmState>;
+    /// Continues from a checkpoint's state: the next iteration is the one the checkpointed
+    /// render would have run next.
+    fn resume(&mut self, progress: &Progress, film: &FilmState) -> Result<()>;
 }
 
 impl Progressive for Renderer {
@@ -77,6 +85,15 @@ impl Progressive for Renderer {
     }
     fn read_display(&self, show: Show, exposure: f32) -> Result<DisplayImage> {
         Renderer::read_display(self, show, exposure)
+    }
+    fn progress(&self) -> Progress {
+        Renderer::progress(self)
+    }
+    fn film_state(&self) -> Result<FilmState> {
+        Renderer::film_state(self)
+    }
+    fn resume(&mut self, progress: &Progress, film: &FilmState) -> Result<()> {
+        Renderer::resume(self, progress, film)
     }
 }
 
@@ -120,5 +137,14 @@ impl Progressive for PathTracer {
     }
     fn read_display(&self, _show: Show, exposure: f32) -> Result<DisplayImage> {
         PathTracer::read_display(self, exposure)
+    }
+    fn progress(&self) -> Progress {
+        Progress::default()
+    }
+    fn film_state(&self) -> Result<FilmState> {
+        PathTracer::film_state(self)
+    }
+    fn resume(&mut self, _progress: &Progress, film: &FilmState) -> Result<()> {
+        PathTracer::resume(self, film)
     }
 }

@@ -3,9 +3,10 @@
 
 use glam::{Vec2, Vec3};
 
+use crate::checkpoint::Progress;
 use crate::direct::DirectPass;
 use crate::error::Result;
-use crate::film::{Film, Show};
+use crate::film::{Film, FilmState, Show};
 use crate::frame::{FrameBinding, FrameUniforms, pixel_jitter};
 use crate::gather::{
     DirectionSampler, FixedSample, GatherDirections, GatherFrame, GatherMethod, GatherPass, GatherSetup, HitLight,
@@ -80,6 +81,30 @@ pub struct Overrides {
 }
 
 impl RenderSettings {
+    /// The settings other than the seed, as `(key, value)` text in a fixed order: what a
+    /// checkpoint records of them, so a render resumed or merged with other settings is
+    /// refused with what differs.
+    pub fn fingerprint(&self) -> Vec<(String, String)> {
+        let s = self;
+        [
+            ("size", format!("{}x{}", s.width, s.height)),
+            ("light-samples", s.light_samples.to_string()),
+            ("photons", s.photons.to_string()),
+            ("grid", s.grid_resolution.to_string()),
+            ("photon-view", s.show_photon_map.to_string()),
+            ("bundle", s.bundle.to_string()),
+            ("gather", format!("{:?}", s.gather)),
+            ("gather-directions", format!("{:?}", s.gather_directions)),
+            ("photon-passes", s.photon_passes.to_string()),
+            ("pass-iterations", s.pass_iterations.to_string()),
+            ("directions", s.directions.to_string()),
+            ("hit-light", format!("{:?}", s.hit_light)),
+        ]
+        .into_iter()
+        .map(|(k, v)| (k.to_owned(), v))
+        .collect()
+    }
+
     /// The gather's bundle: as set, or (0) fitted to a scene of this [`crate::fit::detail_bundle`].
     pub fn bundle_for(&self, detail_bundle: u32) -> u32 {
         if self.bundle == 0 { crate::fit::bundle(detail_bundle, self.width, self.height) } else { self.bundle }
@@ -316,6 +341,13 @@ impl Renderer {
             photons.advance(&self.gpu, &self.scene)?;
         }
         let iteration = self.passes.film.samples;
+        // The film's blocks for its error estimate: the photon passes (each its own photons),
+        // or runs of BLOCK_ITERATIONS iterations where the map is fixed.
+        let block = match &self.photons {
+            Some(p) if p.progressive() => p.pass(),
+            _ => iteration / crate::film::BLOCK_ITERATIONS,
+        };
+        self.passes.film.begin_iteration(&self.gpu, block);
         let seed = self.settings.seed;
         let jitter = o.pixel_jitter.unwrap_or_else(|| pixel_jitter(iteration, seed));
         let size = (w, h);
@@ -367,6 +399,29 @@ impl Renderer {
         self.gpu.wait()
     }
 
+    /// Where the render stands besides its film (for a checkpoint).
+    pub fn progress(&self) -> Progress {
+        Progress {
+            photon_pass: self.photons.as_ref().map_or(0, PhotonPasses::pass),
+            iterations_in_pass: self.photons.as_ref().map_or(0, PhotonPasses::iterations_in_pass),
+            gather: self.passes.gather.as_ref().and_then(GatherPass::choice),
+        }
+    }
+
+    /// Continues from a checkpoint's state (of this scene and these settings: the caller
+    /// checks, [`crate::checkpoint::Checkpoint::check_matches`]): the film's sums, the photon
+    /// pass, the gather chosen. The next iteration is the one the checkpointed render would
+    /// have run next.
+    pub fn resume(&mut self, progress: &Progress, film: &FilmState) -> Result<()> {
+        if let Some(photons) = &mut self.photons {
+            photons.resume_at(&self.gpu, &self.scene, progress.photon_pass, progress.iterations_in_pass)?;
+        }
+        if let (Some(gather), Some((method, directions))) = (&mut self.passes.gather, progress.gather) {
+            gather.choose_as(method, directions)?;
+        }
+        self.passes.film.restore(&self.gpu, film)
+    }
+
     /// The photon map of the current pass, if the render has one.
     pub fn photon_map(&self) -> Option<&GpuPhotonMap> {
         self.photons.as_ref().map(PhotonPasses::map)
@@ -380,6 +435,11 @@ impl Renderer {
     /// The film: accumulated sums and the resolved images (for drawing it in a window).
     pub fn film(&self) -> &Film {
         &self.passes.film
+    }
+
+    /// The film's sums and their odd half, read back (checkpoints, the error estimate).
+    pub fn film_state(&self) -> Result<FilmState> {
+        self.passes.film.read_state(&self.gpu)
     }
 
     /// Encodes the resolve of `show` at `exposure` into the film's linear and display

@@ -341,6 +341,8 @@ pub struct GatherPass {
     /// One implementation once chosen; `Auto`'s remaining candidates while it tries them.
     candidates: Vec<Candidate>,
     chosen: bool,
+    /// The settings asked for `Auto`.
+    auto: bool,
     /// `Auto`: the film (its sums are read back after each trial) and the measurements.
     film: wgpu::Buffer,
     pixels: usize,
@@ -399,6 +401,7 @@ impl GatherPass {
             per_pixel,
             candidates,
             chosen,
+            auto: method == GatherMethod::Auto,
             film: setup.film.accumulation.clone(),
             pixels: setup.film.width as usize * setup.film.height as usize,
             efficiency: Efficiency { direct: PixelVariance::new(setup.film.width), ..Default::default() },
@@ -578,11 +581,43 @@ impl GatherPass {
             self.candidates[k].method,
             if self.candidates[k].per_pixel { " with per-pixel directions" } else { "" }
         );
+        self.keep(k);
+    }
+
+    /// Keeps candidate `k` alone: the choice is made.
+    fn keep(&mut self, k: usize) {
         let chosen = self.candidates.swap_remove(k);
         self.per_pixel = chosen.per_pixel;
         self.candidates = vec![chosen];
         self.chosen = true;
         self.efficiency = Efficiency::default();
+    }
+
+    /// What `Auto` chose (`None` before its trials have ended, and where the settings fixed
+    /// the gather): for checkpoints, so a resumed render gathers as the render before it.
+    pub fn choice(&self) -> Option<(GatherMethod, GatherDirections)> {
+        (self.chosen && self.auto).then(|| (self.candidates[0].method, self.directions()))
+    }
+
+    /// Makes `Auto`'s choice without trials (a resumed render's): `method` with `directions`.
+    /// An error where this pass has no such candidate (it was not `Auto`, or the GPU cannot
+    /// run it).
+    pub fn choose_as(&mut self, method: GatherMethod, directions: GatherDirections) -> Result<()> {
+        let per_pixel = directions == GatherDirections::PerPixel;
+        let k = self
+            .candidates
+            .iter()
+            .position(|c| c.method == method && c.per_pixel == per_pixel)
+            .filter(|_| self.auto && !self.chosen);
+        match k {
+            Some(k) => {
+                self.keep(k);
+                Ok(())
+            }
+            None => Err(crate::error::Error::Checkpoint(format!(
+                "the checkpoint's gather ({method:?}, {directions:?}) is not available here"
+            ))),
+        }
     }
 }
 

@@ -102,6 +102,45 @@ impl PhotonPasses {
         self.pass
     }
 
+    /// The iterations the current pass has had.
+    pub fn iterations_in_pass(&self) -> u32 {
+        self.iterations_in_pass
+    }
+
+    /// Whether the map changes during the render (more than one pass).
+    pub fn progressive(&self) -> bool {
+        self.passes != 1
+    }
+
+    /// Continues a render that stopped `iterations_in_pass` iterations into pass `pass` (a
+    /// checkpoint's): the map of that pass is traced as the render had it — its cells by the
+    /// schedule, its photons from the stream (seed, photon, pass) — and the next iterations
+    /// follow the schedule from there.
+    pub fn resume_at(&mut self, gpu: &Gpu, scene: &GpuScene, pass: u32, iterations_in_pass: u32) -> Result<()> {
+        if pass > 0 && !(self.passes == 0 || pass < self.passes) {
+            return Err(crate::error::Error::Checkpoint(format!(
+                "the checkpoint is in photon pass {pass} of a render with {} passes",
+                self.passes
+            )));
+        }
+        if pass > 0 {
+            let wanted = pass_resolution(self.settings.grid_resolution, pass);
+            let limits = gpu.device.limits();
+            let layout = MapLayout::within(&self.prepared.scene, &self.prepared.bounds, wanted, &limits)?;
+            let got = layout.grid.dims.max_element();
+            self.finest = (got < wanted).then_some(got);
+            let current = self.map.grid().dims.max_element();
+            if got != current {
+                let settings = PhotonSettings { grid_resolution: got, ..self.settings };
+                self.map = GpuPhotonMap::with_layout(gpu, scene, &self.prepared, &settings, layout)?;
+            }
+            self.map.trace_pass(gpu, scene, pass);
+        }
+        self.pass = pass;
+        self.iterations_in_pass = iterations_in_pass;
+        Ok(())
+    }
+
     /// Called before each iteration: once the current pass has had its iterations, traces the
     /// next one (a new layout where the schedule asks for finer cells). Returns whether the map
     /// changed.

@@ -395,6 +395,37 @@ impl Scene {
         }
     }
 
+    /// A 64-bit hash (XXH3) of everything that is rendered: geometry, shading normals,
+    /// tangents, texture coordinates, materials, textures, lights, the sky and the camera. Two
+    /// scenes with the same hash render the same image (checkpoints compare it); it is the
+    /// same on every machine and build that reads the scene the same way.
+    pub fn content_hash(&self) -> u64 {
+        let mut h = xxhash_rust::xxh3::Xxh3::new();
+        let mut section = |name: &str, bytes: &[u8]| {
+            h.update(name.as_bytes());
+            h.update(&(bytes.len() as u64).to_le_bytes());
+            h.update(bytes);
+        };
+        section("triangles", bytemuck::cast_slice(&self.triangles));
+        section("material ids", bytemuck::cast_slice(&self.material_ids));
+        section("uvs", bytemuck::cast_slice(&self.uvs));
+        section("normals", bytemuck::cast_slice(&self.normals));
+        section("tangents", bytemuck::cast_slice(&self.tangents));
+        // Materials, lights and the camera by their field values (f32s print exactly).
+        section("materials", format!("{:?}", self.materials).as_bytes());
+        section("lights", format!("{:?}", self.lights).as_bytes());
+        section("camera", format!("{:?}", self.camera).as_bytes());
+        for t in &self.textures {
+            section("texture", format!("{} {}x{} {}", t.name, t.width, t.height, t.linear).as_bytes());
+            section("texels", bytemuck::cast_slice(&t.texels));
+        }
+        if let Some(env) = &self.environment {
+            section("environment", format!("{}x{}", env.width, env.height).as_bytes());
+            section("sky", bytemuck::cast_slice(&env.texels));
+        }
+        h.digest()
+    }
+
     /// Adds a material and returns its index.
     pub fn add_material(&mut self, material: Material) -> u32 {
         self.materials.push(material);

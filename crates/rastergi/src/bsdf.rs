@@ -219,6 +219,13 @@ impl Bsdf {
     }
 
     /// Whether the model is plain Lambertian (f = c/π).
+    /// Whether eye and gather rays pass it rather than stop (`surface_passes_rays` in WGSL): no
+    /// diffuse base, and smooth or glass.
+    pub fn passes_rays(&self) -> bool {
+        let opaque = (1.0 - self.metallic.clamp(0.0, 1.0)) * (1.0 - self.transmission);
+        opaque <= 0.0 && (self.alpha < SMOOTH_ALPHA || self.transmission > 0.0)
+    }
+
     pub fn is_lambertian(&self) -> bool {
         self.metallic == 0.0 && self.transmission == 0.0 && self.specular == 0.0
     }

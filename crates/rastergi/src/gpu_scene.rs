@@ -307,8 +307,11 @@ pub struct GpuScene {
     pub total_area: f64,
     pub total_perimeter: f64,
     /// Whether the eye's rays continue through specular surfaces here
-    /// ([`Material::passes_rays`]).
+    /// ([`Material::passes_rays`], [`Material::has_delta_lobe`]).
     pub eye_chains: bool,
+    /// Whether light reaches surfaces through mirrors and glass here ([`Material::passes_rays`]):
+    /// the photon map's caustic twins and the caustics pass.
+    pub caustics: bool,
     /// Whether some material is not Lambertian ([`Material::is_lambertian`]).
     pub has_bsdfs: bool,
 }
@@ -472,7 +475,8 @@ impl GpuScene {
                 .iter()
                 .map(|t| (t[0].distance(t[1]) + t[1].distance(t[2]) + t[2].distance(t[0])) as f64)
                 .sum(),
-            eye_chains: s.materials.iter().any(Material::passes_rays),
+            eye_chains: s.materials.iter().any(|m| m.passes_rays() || m.has_delta_lobe()),
+            caustics: s.materials.iter().any(Material::passes_rays),
             has_bsdfs: !s.materials.iter().all(Material::is_lambertian),
         })
     }

@@ -393,6 +393,48 @@ fn surface_passes_rays(s: Surface) -> bool {
     return SCENE_PASSES_RAYS && opaque <= 0.0 && (surface_purely_specular(s) || s.transmission > 0.0);
 }
 
+// For a ray arriving along d at a surface that scatters by a delta lobe and by others too (a
+// smooth specular layer over a diffuse base, a smooth partly metallic surface): the probability
+// pd with which bsdf_sample picks a delta lobe there, and for a uniform u0 the first uniform of
+// a scatter_at that picks the delta lobe u0 falls in where u0 < pd (−1 where u0 ≥ pd: a
+// non-delta lobe). pd = 0 elsewhere (no delta lobe, or one that passes rays anyway).
+struct DeltaChoice {
+    pd: f32,
+    u: f32,
+}
+
+fn surface_delta_choice(s: Surface, d: vec3f, u0: f32) -> DeltaChoice {
+    var c = DeltaChoice(0.0, -1.0);
+    if !SCENE_PASSES_RAYS || surface_is_lambertian(s) || surface_passes_rays(s) {
+        return c;
+    }
+    var b = surface_bsdf(s);
+    if !bsdf_is_smooth(b) {
+        return c;
+    }
+    let front = dot(s.normal, d) < 0.0;
+    if !front && !b.thin {
+        b.ior = 1.0 / b.ior;
+    }
+    let sf = shading_frame(bend_towards(select(-s.shading, s.shading, front), -d));
+    let p = lobe_probabilities(b, abs(to_local(sf, -d).z));
+    // The lobes in bsdf_sample's order: metal, layer (delta when smooth), diffuse, glass.
+    c.pd = p.x + p.y + p.w;
+    var rest = u0;
+    var start = 0.0;
+    for (var k = 0u; k < 4u; k++) {
+        if k != 2u {
+            if rest < p[k] {
+                c.u = start + rest;
+                return c;
+            }
+            rest -= p[k];
+        }
+        start += p[k];
+    }
+    return c;
+}
+
 // Whether the surface scatters as a plain Lambertian one, f = ρ/π.
 fn surface_is_lambertian(s: Surface) -> bool {
     return !SCENE_BSDF || (s.flags & MATERIAL_LAMBERTIAN) != 0u;

@@ -166,7 +166,7 @@ impl ImagePasses {
             _ => None,
         };
         let caustics = match map {
-            Some(map) if scene.eye_chains => {
+            Some(map) if scene.caustics => {
                 Some(PhotonViewPass::new(gpu, scene, frame, &gbuffer, &film, map, PhotonView::Caustics))
             }
             _ => None,

@@ -179,7 +179,8 @@ fn trace_photon(
             }
             flux *= w / survive;
             dir = wi;
-            caustic = bs.delta && (caustic || bounce == 0);
+            // trace.wgsl: caustic light only through surfaces the gather's rays pass.
+            caustic = bs.delta && b.passes_rays() && (caustic || bounce == 0);
         }
         origin = p + if below { -n } else { n } * eps;
         skip = hit.triangle;

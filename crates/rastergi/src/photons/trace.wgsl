@@ -203,7 +203,9 @@ fn trace_photons(@builtin(global_invocation_id) gid: vec3u) {
             }
             flux *= w / survive;
             dir = wi;
-            caustic = bs.delta && (caustic || bounce == 0u);
+            // Caustic light: through the surfaces the gather's rays pass (mirrors, glass) alone;
+            // a smooth layer over a diffuse base reflects into the gather's stand-in of it.
+            caustic = bs.delta && surface_passes_rays(s) && (caustic || bounce == 0u);
         }
         origin = s.pos + select(n, -n, below) * params.ray_epsilon;
         skip = hit.tri;

@@ -186,6 +186,15 @@ impl Material {
                 || self.metal_rough_texture.is_some())
     }
 
+    /// Whether it has a perfectly specular lobe besides others (polished plastic: a smooth
+    /// specular layer over a diffuse base; a smooth, partly metallic surface): the eye's
+    /// chains follow that lobe stochastically ([`crate::specular`]). Or may have, where a
+    /// texture sets the roughness.
+    pub fn has_delta_lobe(&self) -> bool {
+        let smooth = self.roughness * self.roughness < crate::bsdf::SMOOTH_ALPHA || self.metal_rough_texture.is_some();
+        smooth && (self.metallic > 0.0 || self.transmission > 0.0 || self.specular > 0.0)
+    }
+
     /// Whether it scatters as a plain Lambertian surface (f = ρ/π).
     pub fn is_lambertian(&self) -> bool {
         self.metallic == 0.0 && self.transmission == 0.0 && self.specular == 0.0

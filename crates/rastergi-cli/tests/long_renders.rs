@@ -103,10 +103,9 @@ fn a_signal_at_a_random_moment_leaves_a_valid_image_and_a_checkpoint_that_resume
         }
         let delay = (nanos >> (8 * k)) % 700;
         std::thread::sleep(Duration::from_millis(delay as u64));
-        let pid = child.id().to_string();
-        assert!(
-            std::process::Command::new("kill").args([&format!("-{name}"), pid.as_str()]).status().unwrap().success()
-        );
+        let sig = if name == "INT" { libc::SIGINT } else { libc::SIGTERM };
+        // SAFETY: kill(2) on the child's pid, which is alive until waited for below.
+        assert_eq!(unsafe { libc::kill(child.id() as libc::pid_t, sig) }, 0, "kill failed");
         let output = child.wait_with_output().unwrap();
         let stderr = String::from_utf8_lossy(&output.stderr);
         assert_eq!(output.status.code(), Some(code), "SIG{name} after {delay} ms: {stderr}");

@@ -89,8 +89,9 @@ fn shards_survive_a_killed_worker_and_merge_to_the_uninterrupted_image() {
         std::thread::sleep(Duration::from_millis(20));
     }
     let worker = std::fs::read_to_string(&pid).unwrap();
-    let killed = Command::new("kill").args(["-KILL", worker.trim()]).status().unwrap();
-    assert!(killed.success(), "could not kill worker {worker}");
+    let worker: libc::pid_t = worker.trim().parse().unwrap();
+    // SAFETY: kill(2) on the Ray worker's pid (it runs until its task ends, long after this).
+    assert_eq!(unsafe { libc::kill(worker, libc::SIGKILL) }, 0, "could not kill worker {worker}");
     let out = child.wait_with_output().unwrap();
     let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
     assert!(out.status.success(), "the runner failed:\n{stdout}\n{stderr}");

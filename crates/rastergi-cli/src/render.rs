@@ -214,6 +214,7 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     let mut last_checkpoint = Instant::now();
     let mut last_estimate: Option<Instant> = None;
     let mut error = None;
+    let (mut queued, mut sync_every, mut last_sync) = (0u32, 8u32, Instant::now());
     let stop = loop {
         let sig = caught.load(Ordering::Relaxed);
         if sig != 0 {
@@ -227,11 +228,16 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
         if lose_device_after == Some(done - first) {
             gpu.device.destroy();
         }
-        // Keep the GPU queue short so the progress bar, the limits and a signal act soon.
-        if done % 8 != 0 {
+        // Keep the GPU queue short so the progress bar, the limits and a signal act soon: at
+        // most 8 iterations in flight, or one where iterations take over 50 ms.
+        queued += 1;
+        if queued < sync_every {
             continue;
         }
         renderer.wait()?;
+        let per_iteration = last_sync.elapsed().as_secs_f64() / queued as f64;
+        sync_every = if per_iteration > 0.05 { 1 } else { 8 };
+        (queued, last_sync) = (0, Instant::now());
         progress.set_position(done as u64);
         if args.time_limit.is_some_and(|s| start.elapsed().as_secs_f64() >= s) {
             break Stop::TimeLimit;

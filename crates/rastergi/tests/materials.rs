@@ -125,14 +125,7 @@ fn path_tracer_matches_mitsuba(scene: &rastergi::scene::Scene, size: u32, iterat
     let gpu = common::gpu();
     let render = |seed| {
         let settings = rastergi::renderer::RenderSettings { width: size, height: size, seed, ..Default::default() };
-        let mut pt = rastergi::path_tracer::PathTracer::new(&gpu, scene, settings).expect("path tracer");
-        for i in 0..iterations {
-            pt.iterate();
-            if i % 16 == 15 {
-                pt.wait().unwrap();
-            }
-        }
-        pt.read_linear().expect("readback")
+        common::path_trace(&gpu, scene, settings, iterations)
     };
     let (a, b) = (render(1), render(2));
     let ref_a = read_exr(&common::data(&format!("{stem}_a.exr"))).unwrap();
@@ -437,25 +430,6 @@ fn cornell_box_with_glass_and_mirror_spheres_matches_mitsuba_caustic_included() 
     assert!((ours - theirs).abs() < 0.05 * theirs + 5.0 * se, "caustic region: ours {ours}, Mitsuba {theirs} ± {se}");
 }
 
-/// The reference path tracer's image of `scene` (seed `seed`, `iterations` at `size`²).
-fn path_traced(
-    gpu: &rastergi::gpu::Gpu,
-    scene: &rastergi::scene::Scene,
-    size: u32,
-    iterations: u32,
-    seed: u32,
-) -> rastergi::image_io::LinearImage {
-    let settings = rastergi::renderer::RenderSettings { width: size, height: size, seed, ..Default::default() };
-    let mut pt = rastergi::path_tracer::PathTracer::new(gpu, scene, settings).expect("path tracer");
-    for i in 0..iterations {
-        pt.iterate();
-        if i % 16 == 15 {
-            pt.wait().unwrap();
-        }
-    }
-    pt.read_linear().expect("readback")
-}
-
 /// A polished sphere — a smooth specular layer (η 1.5) over a white diffuse base, on the
 /// stage of mat_mix — against the reference path tracer (the same model; Mitsuba's `plastic`
 /// is another one): the eye's chains follow its mirror lobe stochastically (specular.wgsl), so
@@ -471,7 +445,9 @@ fn a_polished_sphere_reflects_the_stage_as_the_path_tracer_shows_it() {
     (m.metallic, m.roughness, m.specular) = (0.0, 0.0, 1.0);
     assert!(m.has_delta_lobe() && !m.passes_rays());
     let gpu = common::gpu();
-    let (ra, rb) = (path_traced(&gpu, &scene, 64, 1024, 1), path_traced(&gpu, &scene, 64, 1024, 2));
+    let settings = |seed| rastergi::renderer::RenderSettings { width: 64, height: 64, seed, ..Default::default() };
+    let (ra, rb) =
+        (common::path_trace(&gpu, &scene, settings(1), 1024), common::path_trace(&gpu, &scene, settings(2), 1024));
     let mask = emitter_mask(&ra, 3.0);
     let reference = common::average(&ra, &rb);
     let ref_noise = rmse(&ra, &rb, Some(&mask)) / 2.0;

@@ -13,9 +13,7 @@ use glam::{Vec2, Vec3};
 use rastergi::film::Show;
 use rastergi::gpu::Gpu;
 use rastergi::gpu_scene::{GpuScene, PreparedScene};
-use rastergi::image_io::LinearImage;
 use rastergi::metrics::{compare, emitter_mask, masked_mean, rmse};
-use rastergi::path_tracer::PathTracer;
 use rastergi::photons::map::PhotonMap;
 use rastergi::photons::{PhotonSettings, cpu, gpu::GpuPhotonMap};
 use rastergi::renderer::{RenderSettings, Renderer};
@@ -265,18 +263,6 @@ fn a_white_texture_changes_nothing() {
     assert!(worst <= 1e-6, "a white texture changed the image by {worst}");
 }
 
-/// The mean of `iterations` path-traced iterations.
-fn path_trace(gpu: &Gpu, scene: &Scene, settings: RenderSettings, iterations: u32) -> LinearImage {
-    let mut pt = PathTracer::new(gpu, scene, settings).expect("path tracer");
-    for i in 0..iterations {
-        pt.iterate();
-        if i % 16 == 15 {
-            pt.wait().unwrap();
-        }
-    }
-    pt.read_linear().expect("readback")
-}
-
 #[test]
 fn textured_room_render_matches_the_path_tracer_within_noise_and_grid_bias() {
     let gpu = common::gpu();
@@ -294,8 +280,8 @@ fn textured_room_render_matches_the_path_tracer_within_noise_and_grid_bias() {
     let a = common::render(&gpu, &scene, settings(1), n, Show::Full);
     let b = common::render(&gpu, &scene, settings(2), n, Show::Full);
     let rendered = start.elapsed();
-    let pa = path_trace(&gpu, &scene, settings(3), 2 * n);
-    let pb = path_trace(&gpu, &scene, settings(4), 2 * n);
+    let pa = common::path_trace(&gpu, &scene, settings(3), 2 * n);
+    let pb = common::path_trace(&gpu, &scene, settings(4), 2 * n);
     println!("renders {rendered:?}, path tracer {:?}", start.elapsed() - rendered);
     let (ours, reference) = (common::average(&a, &b), common::average(&pa, &pb));
     let mask = emitter_mask(&reference, 3.0);

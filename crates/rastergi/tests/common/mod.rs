@@ -27,6 +27,18 @@ pub fn render(gpu: &Gpu, scene: &Scene, settings: RenderSettings, iterations: u3
     r.read_linear(show).expect("readback")
 }
 
+/// The reference path tracer's mean of `iterations` iterations of `scene` with `settings`.
+pub fn path_trace(gpu: &Gpu, scene: &Scene, settings: RenderSettings, iterations: u32) -> LinearImage {
+    let mut pt = rastergi::path_tracer::PathTracer::new(gpu, scene, settings).expect("path tracer");
+    for i in 0..iterations {
+        pt.iterate();
+        if i % 16 == 15 {
+            pt.wait().unwrap();
+        }
+    }
+    pt.read_linear().expect("readback")
+}
+
 pub fn data(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(name)
 }

@@ -40,6 +40,16 @@ fn script() -> PathBuf {
 /// The render options of every shard here: the Cornell box at 32², traced gather, few photons.
 const RENDER: [&str; 8] = ["--width", "32", "--height", "32", "--gather", "trace", "--photons", "20000"];
 
+/// The runner's arguments: the Cornell box with `options`, this build's rastergi, and the
+/// render options of every shard here.
+fn runner_args(options: &[&str]) -> Vec<String> {
+    let mut args = vec![script().to_string_lossy().into_owned(), "cornell".into()];
+    args.extend(options.iter().map(|s| s.to_string()));
+    args.extend(["--rastergi", env!("CARGO_BIN_EXE_rastergi"), "--"].map(String::from));
+    args.extend(RENDER.iter().map(|s| s.to_string()));
+    args
+}
+
 fn rastergi(dir: &Path, args: &[&str]) {
     let run = common::rastergi(dir, args, TIMEOUT);
     assert!(run.status.success(), "rastergi {args:?}: {}", run.stderr);
@@ -50,9 +60,7 @@ fn shards_survive_a_killed_worker_and_merge_to_the_uninterrupted_image() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let work = d.join("work");
-    let exe = env!("CARGO_BIN_EXE_rastergi");
-    let mut args: Vec<String> = vec![script().to_string_lossy().into_owned(), "cornell".into()];
-    for a in [
+    let args = runner_args(&[
         "--shards",
         "2",
         "--iterations",
@@ -67,13 +75,7 @@ fn shards_survive_a_killed_worker_and_merge_to_the_uninterrupted_image() {
         "0",
         "--retries",
         "2",
-        "--rastergi",
-        exe,
-        "--",
-    ] {
-        args.push(a.into());
-    }
-    args.extend(RENDER.iter().map(|s| s.to_string()));
+    ]);
     let child = Command::new(python())
         .args(&args)
         .current_dir(d)
@@ -120,9 +122,7 @@ fn a_camera_path_renders_one_frame_per_interpolated_camera() {
         {"t": 0, "eye": [0, 0, 3.9], "target": [0, 0, 0], "up": [0, 1, 0], "fov": 40},
         {"t": 1, "eye": [0.4, 0.2, 3.5], "target": [0, -0.2, 0], "up": [0, 1, 0], "fov": 50}]}"#;
     std::fs::write(d.join("path.json"), path).unwrap();
-    let exe = env!("CARGO_BIN_EXE_rastergi");
-    let mut args: Vec<String> = vec![script().to_string_lossy().into_owned(), "cornell".into()];
-    for a in [
+    let args = runner_args(&[
         "--camera-path",
         "path.json",
         "--iterations",
@@ -133,13 +133,7 @@ fn a_camera_path_renders_one_frame_per_interpolated_camera() {
         "work",
         "--gpus-per-task",
         "0",
-        "--rastergi",
-        exe,
-        "--",
-    ] {
-        args.push(a.into());
-    }
-    args.extend(RENDER.iter().map(|s| s.to_string()));
+    ]);
     let out = Command::new(python()).args(&args).current_dir(d).output().unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     // Frame 1 is halfway between the keys; rendered directly, it is the same image.

@@ -32,7 +32,7 @@
 use crate::film::Film;
 use crate::frame::FrameBinding;
 use crate::gbuffer::{GBUFFER_FILM_WGSL, GBufferPass, gbuffer_film_bind_group, gbuffer_film_layout};
-use crate::gpu::{Gpu, compute_pipeline_with, dispatch_pixels};
+use crate::gpu::{Gpu, dispatch_pixels};
 use crate::gpu_scene::GpuScene;
 use crate::lights::LightTable;
 use crate::profile::{Profiler, compute_pass};
@@ -87,14 +87,8 @@ impl DirectPass {
         let module = shader::module(device, "direct", &source());
         let layout = gbuffer_film_layout(device, "direct");
         let bind_group = gbuffer_film_bind_group(device, "direct", &layout, gbuffer, film);
-        let pipeline = compute_pipeline_with(
-            device,
-            "direct",
-            &module,
-            "main",
-            &[&scene.layout, &frame.layout, &layout],
-            &scene.pipeline_constants(),
-        );
+        let pipeline =
+            scene.compute_pipeline(device, "direct", &module, "main", &[&scene.layout, &frame.layout, &layout]);
         Self { pipeline, bind_group, profiler: gpu.profiler.clone() }
     }
 

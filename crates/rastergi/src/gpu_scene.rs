@@ -326,6 +326,19 @@ impl GpuScene {
         [("SCENE_BSDF", flag(self.has_bsdfs)), ("SCENE_PASSES_RAYS", flag(self.eye_chains))]
     }
 
+    /// A compute pipeline for `module`'s entry point `entry` (a shader that reads this scene),
+    /// with bind groups `layouts`, specialized to this scene ([`Self::pipeline_constants`]).
+    pub fn compute_pipeline(
+        &self,
+        device: &wgpu::Device,
+        label: &str,
+        module: &wgpu::ShaderModule,
+        entry: &str,
+        layouts: &[&wgpu::BindGroupLayout],
+    ) -> wgpu::ComputePipeline {
+        crate::gpu::compute_pipeline_with(device, label, module, entry, layouts, &self.pipeline_constants())
+    }
+
     /// Uploads `prepared`, after checking that its buffers fit the device (see [`crate::limits`]).
     pub fn new(gpu: &Gpu, prepared: &PreparedScene) -> Result<GpuScene> {
         let limits = gpu.device.limits();

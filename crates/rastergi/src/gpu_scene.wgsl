@@ -408,16 +408,11 @@ fn surface_delta_choice(s: Surface, d: vec3f, u0: f32) -> DeltaChoice {
     if !SCENE_PASSES_RAYS || surface_is_lambertian(s) || surface_passes_rays(s) {
         return c;
     }
-    var b = surface_bsdf(s);
-    if !bsdf_is_smooth(b) {
+    let a = arrival(s, d);
+    if !bsdf_is_smooth(a.b) {
         return c;
     }
-    let front = dot(s.normal, d) < 0.0;
-    if !front && !b.thin {
-        b.ior = 1.0 / b.ior;
-    }
-    let sf = shading_frame(bend_towards(select(-s.shading, s.shading, front), -d));
-    let p = lobe_probabilities(b, abs(to_local(sf, -d).z));
+    let p = lobe_probabilities(a.b, abs(a.wo.z));
     // The lobes in bsdf_sample's order: metal, layer (delta when smooth), diffuse, glass.
     c.pd = p.x + p.y + p.w;
     var rest = u0;
@@ -463,21 +458,37 @@ struct Scatter {
     ok: bool,
 }
 
-fn scatter_at(s: Surface, d: vec3f, u: vec3f, eps: f32) -> Scatter {
-    var r: Scatter;
-    r.ok = false;
+// A ray arriving along d at surface s, in the terms its BSDF is sampled in: the model with the
+// relative index seen from the ray's side (solid glass hit from behind: inverted), the shading
+// frame on that side (bent towards the ray), the direction back along the ray in it, and the
+// geometric normal on that side.
+struct Arrival {
+    b: Bsdf,
+    frame: mat3x3f,
+    wo: vec3f,
+    n: vec3f,
+}
+
+fn arrival(s: Surface, d: vec3f) -> Arrival {
     let front = dot(s.normal, d) < 0.0;
-    let n = select(-s.normal, s.normal, front);
     let sf = shading_frame(bend_towards(select(-s.shading, s.shading, front), -d));
     var b = surface_bsdf(s);
     if !front && !b.thin {
         b.ior = 1.0 / b.ior;
     }
-    let bs = bsdf_sample(b, to_local(sf, -d), u, TRANSPORT_RADIANCE);
+    return Arrival(b, sf, to_local(sf, -d), select(-s.normal, s.normal, front));
+}
+
+fn scatter_at(s: Surface, d: vec3f, u: vec3f, eps: f32) -> Scatter {
+    var r: Scatter;
+    r.ok = false;
+    let a = arrival(s, d);
+    let n = a.n;
+    let bs = bsdf_sample(a.b, a.wo, u, TRANSPORT_RADIANCE);
     if !bs.ok {
         return r;
     }
-    r.dir = normalize(sf * bs.wi);
+    r.dir = normalize(a.frame * bs.wi);
     let below = dot(n, r.dir) < 0.0;
     if (bs.wi.z < 0.0) != below || dot(n, r.dir) == 0.0 {
         return r;

@@ -42,7 +42,7 @@ use bytemuck::{Pod, Zeroable};
 use crate::error::Result;
 use crate::film::{Film, Show};
 use crate::frame::{FrameBinding, FrameUniforms, pixel_jitter};
-use crate::gpu::{Gpu, buffer_bind_group, compute_pipeline_with, groups, storage_entry, uniform_entry};
+use crate::gpu::{Gpu, buffer_bind_group, groups, storage_entry, uniform_entry};
 use crate::gpu_scene::{GpuScene, PreparedScene};
 use crate::image_io::{DisplayImage, LinearImage};
 use crate::renderer::RenderSettings;
@@ -128,16 +128,8 @@ impl PathTracer {
             buffer_bind_group(device, "path tracer", &layout, &[&film.accumulation, &params, &placeholder]);
         let module = shader::module(device, "path tracer", &source());
         let layouts = [&gpu_scene.layout, &frame.layout, &layout];
-        let trace =
-            compute_pipeline_with(device, "path tracer", &module, "main", &layouts, &gpu_scene.pipeline_constants());
-        let primary = compute_pipeline_with(
-            device,
-            "path tracer primary hits",
-            &module,
-            "primary_hits",
-            &layouts,
-            &gpu_scene.pipeline_constants(),
-        );
+        let trace = gpu_scene.compute_pipeline(device, "path tracer", &module, "main", &layouts);
+        let primary = gpu_scene.compute_pipeline(device, "path tracer primary hits", &module, "primary_hits", &layouts);
         Ok(PathTracer {
             gpu: gpu.clone(),
             settings,

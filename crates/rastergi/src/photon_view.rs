@@ -5,7 +5,7 @@
 use crate::film::Film;
 use crate::frame::FrameBinding;
 use crate::gbuffer::{GBUFFER_FILM_WGSL, GBufferPass, gbuffer_film_bind_group, gbuffer_film_layout};
-use crate::gpu::{Gpu, compute_pipeline_with, dispatch_pixels};
+use crate::gpu::{Gpu, dispatch_pixels};
 use crate::gpu_scene::GpuScene;
 use crate::photons::gpu::GpuPhotonMap;
 use crate::photons::map::LOOKUP_WGSL;
@@ -52,13 +52,12 @@ impl PhotonViewPass {
         let module = shader::module(device, label, &source());
         let layout = gbuffer_film_layout(device, label);
         let bind_group = gbuffer_film_bind_group(device, label, &layout, gbuffer, film);
-        let pipeline = compute_pipeline_with(
+        let pipeline = scene.compute_pipeline(
             device,
             label,
             &module,
             entry,
             &[&scene.layout, &frame.layout, &layout, &map.bind_layout],
-            &scene.pipeline_constants(),
         );
         Self { pipeline, bind_group, profiler: gpu.profiler.clone(), label }
     }

@@ -15,7 +15,7 @@
 use crate::film::Film;
 use crate::frame::FrameBinding;
 use crate::gbuffer::{GBUFFER_FILM_WGSL, GBufferPass, gbuffer_film_bind_group, gbuffer_film_layout};
-use crate::gpu::{Gpu, compute_pipeline_with, dispatch_pixels};
+use crate::gpu::{Gpu, dispatch_pixels};
 use crate::gpu_scene::GpuScene;
 use crate::profile::{Profiler, compute_pass};
 use crate::shader;
@@ -37,13 +37,12 @@ impl SpecularPass {
         let module = shader::module(device, "specular chains", &source());
         let layout = gbuffer_film_layout(device, "specular chains");
         let bind_group = gbuffer_film_bind_group(device, "specular chains", &layout, gbuffer, film);
-        let pipeline = compute_pipeline_with(
+        let pipeline = scene.compute_pipeline(
             device,
             "specular chains",
             &module,
             "main",
             &[&scene.layout, &frame.layout, &layout],
-            &scene.pipeline_constants(),
         );
         Self { pipeline, bind_group, profiler: gpu.profiler.clone() }
     }

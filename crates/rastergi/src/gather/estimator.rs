@@ -29,7 +29,7 @@ use crate::error::Result;
 use crate::film::Film;
 use crate::frame::FrameBinding;
 use crate::gbuffer::GBufferPass;
-use crate::gpu::{Gpu, compute_pipeline_with};
+use crate::gpu::Gpu;
 use crate::gpu_scene::GpuScene;
 use crate::photons::gpu::GpuPhotonMap;
 use crate::photons::map::LOOKUP_WGSL;
@@ -129,9 +129,7 @@ impl GatherSetup<'_> {
     ) -> [wgpu::ComputePipeline; N] {
         let module = shader::module(device, label, &estimate_source(pieces));
         let layouts = [&self.scene.layout, &self.frame.layout, own, &self.map.bind_layout];
-        entries.map(|entry| {
-            compute_pipeline_with(device, label, &module, entry, &layouts, &self.scene.pipeline_constants())
-        })
+        entries.map(|entry| self.scene.compute_pipeline(device, label, &module, entry, &layouts))
     }
 }
 

@@ -20,7 +20,7 @@ use glam::UVec3;
 use super::map::{GridSpec, MAX_SEPARATORS, MapLayout, PhotonMap, Separator, TABLE_WGSL, TrianglePlane};
 use super::{MAX_BOUNCES, PhotonSettings};
 use crate::error::Result;
-use crate::gpu::{Gpu, buffer_bind_group, compute_pipeline_with, storage_entry, uniform_entry};
+use crate::gpu::{Gpu, buffer_bind_group, storage_entry, uniform_entry};
 use crate::gpu_scene::{GpuScene, PreparedScene};
 use crate::profile::compute_pass;
 use crate::shader;
@@ -249,22 +249,8 @@ impl GpuPhotonMap {
         });
         let module = shader::module(device, "photon trace", &trace_source());
         let layouts = [&scene.layout, &trace_layout];
-        let trace_pipeline = compute_pipeline_with(
-            device,
-            "trace photons",
-            &module,
-            "trace_photons",
-            &layouts,
-            &scene.pipeline_constants(),
-        );
-        let resolve_pipeline = compute_pipeline_with(
-            device,
-            "resolve photon map",
-            &module,
-            "resolve_map",
-            &layouts,
-            &scene.pipeline_constants(),
-        );
+        let trace_pipeline = scene.compute_pipeline(device, "trace photons", &module, "trace_photons", &layouts);
+        let resolve_pipeline = scene.compute_pipeline(device, "resolve photon map", &module, "resolve_map", &layouts);
         let mask = capacity as u32 - 1;
         let max_probe = layout.table.max_probe;
         let params = PhotonParams {

@@ -34,7 +34,10 @@ pub struct MergeArgs {
 
 pub fn run(args: &MergeArgs) -> Result<()> {
     let format = ImageFormat::from_path(&args.out)?;
-    crate::render::check_output_path(&args.out)?;
+    crate::render::check_output_path(&args.out, "--out")?;
+    if let Some(path) = &args.checkpoint {
+        crate::render::check_output_path(path, "--checkpoint")?;
+    }
     let merged = checkpoint::merge(&args.checkpoints)?;
     let image = merged.film.image(args.show.show());
     match format {

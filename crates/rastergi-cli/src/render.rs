@@ -74,9 +74,11 @@ enum Method {
 }
 
 /// Refuses, before any rendering, an output path the image could never be written to.
-pub fn check_output_path(out: &Path) -> Result<()> {
+/// `option` names it in the message (`--out`, `--checkpoint`).
+pub fn check_output_path(out: &Path, option: &str) -> Result<()> {
     if out.is_dir() {
-        anyhow::bail!("{}: is a directory; give --out a file name ending in .exr or .png", out.display());
+        let ending = if option == "--out" { " ending in .exr or .png" } else { "" };
+        anyhow::bail!("{}: is a directory; give {option} a file name{ending}", out.display());
     }
     let dir = match out.parent() {
         Some(dir) if !dir.as_os_str().is_empty() => dir,
@@ -84,7 +86,7 @@ pub fn check_output_path(out: &Path) -> Result<()> {
     };
     if !dir.is_dir() {
         anyhow::bail!(
-            "{}: the directory {} does not exist; create it first or choose another --out",
+            "{}: the directory {} does not exist; create it first or choose another {option}",
             out.display(),
             dir.display()
         );
@@ -119,9 +121,9 @@ fn catch_signals() -> Result<Arc<AtomicUsize>> {
 
 pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     let format = ImageFormat::from_path(&args.out)?;
-    check_output_path(&args.out)?;
+    check_output_path(&args.out, "--out")?;
     if let Some(path) = &args.checkpoint {
-        check_output_path(path).map_err(|e| anyhow::anyhow!("{e}").context("--checkpoint"))?;
+        check_output_path(path, "--checkpoint")?;
     }
     let a = &args.scene;
     let start = Instant::now();
@@ -161,7 +163,6 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
         anyhow::bail!("--method path renders the full image only; drop --show or use --method gather");
     }
     let seed = settings.seed;
-    let photon_blocks = args.method == Method::Gather && settings.photons > 0 && settings.photon_passes != 1;
     let start = Instant::now();
     // `bundle`: the photon-map renderer's gather ray view and directions, for the log.
     let (mut renderer, gather_info): (Box<dyn Progressive>, Option<(u32, GatherDirections)>) = match args.method {
@@ -256,8 +257,7 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
             progress.set_message(format!("error ≈ {:.2} %", 100.0 * e));
         }
         // The halves need a few blocks each before their difference means much.
-        let blocks =
-            if photon_blocks { renderer.progress().photon_pass + 1 } else { done / rastergi::film::BLOCK_ITERATIONS };
+        let blocks = renderer.film().blocks();
         if let (Some(target), Some(e)) = (args.target_error, error)
             && blocks >= 4
             && e <= target

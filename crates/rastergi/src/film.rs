@@ -103,6 +103,8 @@ pub struct Film {
     half_open: bool,
     /// Iterations of odd blocks so far.
     half_samples: u32,
+    /// The block of the latest iteration.
+    block: Option<u32>,
     half_pipelines: [wgpu::ComputePipeline; 2],
     half_bind_group: wgpu::BindGroup,
     linear: wgpu::Buffer,
@@ -156,6 +158,7 @@ impl Film {
             half,
             half_open: false,
             half_samples: 0,
+            block: None,
             half_pipelines,
             half_bind_group,
             linear,
@@ -188,6 +191,13 @@ impl Film {
         if odd {
             self.half_samples += 1;
         }
+        self.block = Some(block);
+    }
+
+    /// The blocks begun so far (blocks are numbered from 0): the error estimate means little
+    /// before each half holds a few.
+    pub fn blocks(&self) -> u32 {
+        self.block.map_or(0, |b| b + 1)
     }
 
     /// The sums and their odd half, read back (for checkpoints, merging and the error
@@ -243,6 +253,7 @@ impl Film {
         self.samples = 0;
         self.half_open = false;
         self.half_samples = 0;
+        self.block = None;
     }
 
     /// Encodes the resolve of the current mean into the linear and display buffers.

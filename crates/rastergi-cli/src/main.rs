@@ -1,16 +1,10 @@
-//! `rastergi`: the command-line front end. All rendering lives in the `rastergi` library.
-
-mod args;
-mod bench;
-mod compare;
-mod export;
-mod merge;
-mod render;
-mod view;
+//! `rastergi`: the command-line front end. All rendering lives in the `rastergi` library; the
+//! subcommands live in this crate's library (`rastergi_cli`), which the Python package shares.
 
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use rastergi_cli::{args, bench, compare, export, merge, render, view};
 
 #[derive(Parser)]
 #[command(

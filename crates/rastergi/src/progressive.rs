@@ -11,7 +11,9 @@ use crate::path_tracer::PathTracer;
 use crate::renderer::{RenderSettings, Renderer};
 use crate::scene::Camera;
 
-pub trait Progressive {
+/// `Send`: a renderer may be built on one thread and used on another (the viewer's builds, the
+/// Python package's renders with the interpreter's lock released).
+pub trait Progressive: Send {
     /// What the renderer is, for tables and logs.
     fn name(&self) -> &'static str;
     fn settings(&self) -> &RenderSettings;

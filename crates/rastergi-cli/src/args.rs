@@ -137,7 +137,7 @@ impl GatherDirectionsArg {
 
 /// The options `render` and `view` share: the scene and its camera, the renderer's settings,
 /// what is shown and the GPU.
-#[derive(Args, Debug)]
+#[derive(Args, Clone, Debug)]
 pub struct SceneArgs {
     /// The scene: built in (`cornell`, `atrium`, `spheres:N` for about N triangles), a Wavefront .obj file or a glTF 2.0 .gltf/.glb file.
     pub scene: String,

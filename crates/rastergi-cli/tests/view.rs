@@ -78,10 +78,15 @@ fn screenshots(dir: &Path, stdout: &str) -> Vec<Shot> {
         .collect()
 }
 
-/// A headless render of `iterations` with `extra` options (camera, seed, show).
+/// A headless render of the Cornell box, `iterations` with `extra` options (camera, seed, show).
 fn render(dir: &Path, out: &str, seed: u32, iterations: u32, extra: &[String]) -> LinearImage {
+    render_scene(dir, "cornell", out, seed, iterations, extra)
+}
+
+/// [`render`] of any scene.
+fn render_scene(dir: &Path, scene: &str, out: &str, seed: u32, iterations: u32, extra: &[String]) -> LinearImage {
     let (seed, iterations) = (seed.to_string(), iterations.to_string());
-    let mut args = vec!["render", "cornell", "--seed", &seed, "--iterations", &iterations, "--out", out];
+    let mut args = vec!["render", scene, "--seed", &seed, "--iterations", &iterations, "--out", out];
     args.extend_from_slice(SIZE);
     args.extend_from_slice(PHOTONS);
     args.extend(extra.iter().map(String::as_str));
@@ -221,6 +226,44 @@ fn turning_the_sun_re_traces_and_shows_what_a_render_with_that_sun_shows() {
     }
     let (a, b) = (read_exr(&shots[0].exr).unwrap(), read_exr(&shots[1].exr).unwrap());
     assert!(compare(&a, &b, None).relative_rmse > 0.05, "turning the sun changes the light");
+}
+
+#[test]
+fn the_panels_actions_switch_the_method_the_gather_and_the_scene_as_render_options_do() {
+    // The panel's widgets give these actions (`view::panel`'s tests click them); here a
+    // script gives them. A renderer built for new settings starts afresh with the seed, so
+    // its image is the one `render` gives with the same options, bit for bit.
+    const SEED: u32 = 3;
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let script = "method path\nafter 4 iterations: screenshot\nmethod gather\ngather trace\n\
+                  gather-directions shared\ndirections 2\nafter 4 iterations: screenshot\nopen rooms\n\
+                  after 2 iterations: screenshot\nquit\n";
+    std::fs::write(d.join("script.txt"), script).unwrap();
+    let seed = SEED.to_string();
+    let mut args = vec!["cornell", "--seed", &seed, "--script", "script.txt"];
+    args.extend_from_slice(SIZE);
+    args.extend_from_slice(PHOTONS);
+    let run = view(d, &args);
+    run.check_success("view");
+    let shots = screenshots(d, &run.stdout);
+    assert_eq!(shots.len(), 3, "{}", run.stdout);
+    let gather = ["--gather", "trace", "--gather-directions", "shared", "--directions", "2"];
+    let cases = [
+        ("cornell", 4, vec!["--method", "path"]),
+        ("cornell", 4, gather.to_vec()),
+        // The opened scene keeps the gather settings; its camera is the rooms' own.
+        ("rooms", 2, gather.to_vec()),
+    ];
+    for (i, ((scene, iterations, options), shot)) in cases.into_iter().zip(&shots).enumerate() {
+        assert_eq!((shot.iterations, shot.size), (iterations, (64, 64)));
+        let mut options: Vec<String> = options.into_iter().map(String::from).collect();
+        options.extend(shot.camera.iter().cloned());
+        let rendered = render_scene(d, scene, &format!("{i}.exr"), SEED, iterations, &options);
+        let c = compare(&read_exr(&shot.exr).unwrap(), &rendered, None);
+        assert!(c.relative_rmse < 1e-6, "screenshot {i} ({scene} {options:?}) differs from the render's: {c:?}");
+    }
+    assert_ne!(shots[2].camera, shots[0].camera, "the opened scene brings its camera");
 }
 
 #[test]

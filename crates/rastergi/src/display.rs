@@ -295,9 +295,24 @@ impl WindowSurface {
     pub fn present(
         &mut self,
         gpu: &Gpu,
+        enc: wgpu::CommandEncoder,
+        film: Option<&Film>,
+        overlay: &[String],
+    ) -> Result<Presented> {
+        self.present_with(gpu, enc, film, overlay, |_, _, _| {})
+    }
+
+    /// [`present`](Self::present), with `draw_over` encoding more drawing (a user interface)
+    /// over the image before it is shown: it gets the encoder, the swapchain image's view
+    /// (whose contents it must load, not clear) and its size. It is not called when no image
+    /// could be acquired.
+    pub fn present_with(
+        &mut self,
+        gpu: &Gpu,
         mut enc: wgpu::CommandEncoder,
         film: Option<&Film>,
         overlay: &[String],
+        draw_over: impl FnOnce(&mut wgpu::CommandEncoder, &wgpu::TextureView, (u32, u32)),
     ) -> Result<Presented> {
         // Outdated: reconfigure and try once more. Suboptimal: show it, reconfigure after.
         let mut acquired = None;
@@ -325,6 +340,7 @@ impl WindowSurface {
         };
         let view = texture.texture.create_view(&Default::default());
         self.pass.encode(gpu, &mut enc, &view, self.size(), film, overlay);
+        draw_over(&mut enc, &view, self.size());
         gpu.queue.submit([enc.finish()]);
         gpu.queue.present(texture);
         if suboptimal {

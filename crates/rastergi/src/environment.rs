@@ -113,6 +113,19 @@ impl Environment {
         Ok(Environment { width, height, texels, row_cdf, column_cdf, cell_pmf, integral: integral.as_vec3() })
     }
 
+    /// This environment with its radiance scaled by `factor` (finite, ≥ 0): the sampling
+    /// distribution is unchanged (it is proportional to the radiance), the texels and the
+    /// integral are × `factor`; × 0 gives a black environment with no distribution, as
+    /// [`Environment::new`] builds it.
+    pub fn scaled(&self, factor: f32) -> Environment {
+        if factor > 0.0 && self.integral.max_element() > 0.0 {
+            let texels = self.texels.iter().map(|t| *t * factor).collect();
+            return Environment { texels, integral: self.integral * factor, ..self.clone() };
+        }
+        let texels = self.texels.iter().map(|t| *t * factor.max(0.0)).collect();
+        Environment::new(self.width, self.height, texels).expect("the same size and finite values")
+    }
+
     /// A constant environment of radiance `l` (a uniform sky).
     pub fn constant(l: Vec3) -> Environment {
         Environment::new(2, 3, vec![l; 6]).expect("a valid constant environment")
@@ -333,6 +346,25 @@ mod tests {
             }
         }
         Environment::new(w, h, t).unwrap()
+    }
+
+    #[test]
+    fn a_scaled_environment_is_the_one_built_from_scaled_radiance() {
+        let e = sky();
+        for factor in [0.0f32, 0.25, 3.0] {
+            let texels = e.texels.iter().map(|t| *t * factor).collect();
+            let built = Environment::new(e.width, e.height, texels).unwrap();
+            let scaled = e.scaled(factor);
+            assert_eq!(scaled.texels, built.texels, "× {factor}");
+            assert!(scaled.integral.abs_diff_eq(built.integral, 1e-5 * built.integral.max_element()), "× {factor}");
+            for (a, b) in [
+                (&scaled.row_cdf, &built.row_cdf),
+                (&scaled.column_cdf, &built.column_cdf),
+                (&scaled.cell_pmf, &built.cell_pmf),
+            ] {
+                assert!(a.iter().zip(b).all(|(x, y)| (x - y).abs() <= 1e-6), "× {factor}");
+            }
+        }
     }
 
     #[test]

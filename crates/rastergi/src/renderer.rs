@@ -24,7 +24,7 @@ use crate::scene::{Camera, Scene};
 use crate::specular::SpecularPass;
 
 /// Settings of a render.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct RenderSettings {
     pub width: u32,
     pub height: u32,

@@ -1,6 +1,7 @@
-//! The winit application of `rastergi view`: the window and its surface, renderers built on
-//! a worker thread, the frame loop (held keys, script steps, batched iterations, resolve,
-//! overlay, present), resizes and screenshots. Input is interpreted by [`super::controls`].
+//! The winit application of `rastergi view`: the window and its surface, renderers (and
+//! scenes opened meanwhile) built on a worker thread, the frame loop (held keys, script
+//! steps, batched iterations, resolve, the panel, present), resizes and screenshots. Input is
+//! interpreted by [`super::controls`]; the panel by [`super::panel`].
 
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -9,8 +10,11 @@ use anyhow::{Result, anyhow};
 use rastergi::camera_control::CameraControl;
 use rastergi::display::{Presented, WindowSurface};
 use rastergi::film::Show;
+use rastergi::gather::GatherMethod;
 use rastergi::gpu::{Gpu, GpuOptions};
-use rastergi::renderer::{RenderSettings, Renderer, default_bundle};
+use rastergi::path_tracer::PathTracer;
+use rastergi::progressive::Progressive;
+use rastergi::renderer::{RenderSettings, Renderer};
 use rastergi::scene::{Light, Scene};
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
@@ -20,8 +24,9 @@ use winit::keyboard::{Key as LogicalKey, KeyCode, NamedKey, PhysicalKey};
 use winit::window::{Window, WindowId};
 
 use super::controls::{Controls, Key, Response, SunAngles, camera_options, show_name};
+use super::panel::{self, Figures, PanelPainter, PanelState};
 use super::screenshots::Screenshots;
-use super::script::{Action, Step, When};
+use super::script::{Action, Engine, Step, When};
 use crate::args::SceneArgs;
 
 /// GPU time aimed at per displayed frame: iterations are batched up to this.
@@ -62,7 +67,7 @@ fn key_of(event: &KeyEvent) -> Option<Key> {
             KeyCode::KeyL => Some(Key::SunEast),
             KeyCode::KeyI => Some(Key::SunHigher),
             KeyCode::KeyK => Some(Key::SunLower),
-            KeyCode::KeyH | KeyCode::F1 => Some(Key::ToggleOverlay),
+            KeyCode::KeyH | KeyCode::F1 => Some(Key::TogglePanel),
             KeyCode::Escape => Some(Key::Quit),
             _ => None,
         };
@@ -101,7 +106,7 @@ impl Rate {
 /// least one where `limit` > 0), then waits for them and sets `batch` (the next frame's
 /// limit) to as many as fit in the budget at this frame's time per iteration, 1 to
 /// [`MAX_BATCH`]. Returns how many ran. `rastergi bench frames` runs the same.
-pub fn iterate_frame(renderer: &mut Renderer, limit: u32, batch: &mut u32) -> Result<u32> {
+pub fn iterate_frame(renderer: &mut dyn Progressive, limit: u32, batch: &mut u32) -> Result<u32> {
     let start = Instant::now();
     let mut done = 0;
     while done < limit {
@@ -119,9 +124,53 @@ pub fn iterate_frame(renderer: &mut Renderer, limit: u32, batch: &mut u32) -> Re
     Ok(done)
 }
 
-/// A renderer being built on a worker thread.
+/// The renderer the viewer runs: the photon map and gather, or the reference path tracer.
+pub enum Active {
+    PhotonMap(Box<Renderer>),
+    PathTracer(Box<PathTracer>),
+}
+
+impl Active {
+    fn get(&self) -> &dyn Progressive {
+        match self {
+            Active::PhotonMap(r) => r.as_ref(),
+            Active::PathTracer(r) => r.as_ref(),
+        }
+    }
+
+    fn get_mut(&mut self) -> &mut dyn Progressive {
+        match self {
+            Active::PhotonMap(r) => r.as_mut(),
+            Active::PathTracer(r) => r.as_mut(),
+        }
+    }
+}
+
+/// What a renderer is built from besides the scene's geometry: the viewer rebuilds its
+/// renderer when the wanted one differs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Build {
+    settings: RenderSettings,
+    engine: Engine,
+    sun: Option<SunAngles>,
+    env_scale: Option<f32>,
+    /// Which scene: counts the scenes opened.
+    scene: u64,
+}
+
+/// A scene opened by a build, with its fitted photon settings.
+pub struct Opened {
+    name: String,
+    scene: Arc<Scene>,
+    photons: u32,
+    grid: u32,
+    sun: Option<SunAngles>,
+    env_scale: Option<f32>,
+}
+
+/// A renderer being built on a worker thread (with the scene it opened, if it opened one).
 pub enum UserEvent {
-    Built { generation: u64, result: Result<Renderer, String> },
+    Built { generation: u64, result: Result<(Active, Build, Option<Opened>), String> },
 }
 
 /// The script's progress.
@@ -134,23 +183,44 @@ struct ScriptRun {
     resizing: Option<((u32, u32), Instant)>,
 }
 
-/// The viewer: its window, GPU, renderer, controls and script.
+/// The egui panel: its context, window-input state, GPU painter and own state.
+struct Panel {
+    ctx: egui::Context,
+    input: egui_winit::State,
+    painter: PanelPainter,
+    state: PanelState,
+}
+
+/// The live figures the panel shows, refreshed about once a second.
+#[derive(Default)]
+struct Measured {
+    at: Option<Instant>,
+    error: Option<f64>,
+    memory: Option<u64>,
+    /// (iterations, estimated error) since the last restart.
+    history: Vec<(u32, f64)>,
+}
+
+/// The viewer: its window, GPU, renderer, controls, panel and script.
 pub struct App {
-    args_scene: String,
+    /// The command line's scene options (a scene opened later gets them too, but the camera).
+    args: SceneArgs,
+    scene_name: String,
     scene: Arc<Scene>,
+    scene_id: u64,
     base: RenderSettings,
     gpu_options: GpuOptions,
     proxy: EventLoopProxy<UserEvent>,
     window: Option<Arc<Window>>,
     gpu: Option<Gpu>,
     surface: Option<WindowSurface>,
-    renderer: Option<Renderer>,
+    panel: Option<Panel>,
+    renderer: Option<(Active, Build)>,
     /// The generation of the build in flight, if any; results of older ones are dropped.
     building: Option<u64>,
-    /// The sun of the build in flight and of the current renderer.
-    building_sun: Option<SunAngles>,
-    renderer_sun: Option<SunAngles>,
     generation: u64,
+    /// A scene to open once no build is in flight.
+    pending_open: Option<String>,
     controls: Controls,
     /// The window's inner size (0 while minimised on some platforms).
     size: (u32, u32),
@@ -164,6 +234,7 @@ pub struct App {
     last_frame: Instant,
     batch: u32,
     rate: Rate,
+    measured: Measured,
     title_at: Instant,
     status: String,
     script: Option<ScriptRun>,
@@ -184,13 +255,14 @@ impl App {
         proxy: EventLoopProxy<UserEvent>,
     ) -> App {
         let camera = CameraControl::new(&scene.camera, &scene.bounds());
-        let sun = last_sun(&scene).map(SunAngles::of_direction);
-        let mut controls =
-            Controls::new(camera, a.show.show(), a.exposure.unwrap_or(0.0), base.photons, base.grid_resolution);
-        controls.sun = sun;
+        let mut controls = Controls::new(camera, a.show.show(), a.exposure.unwrap_or(0.0), &base);
+        controls.sun = last_sun(&scene).map(SunAngles::of_direction);
+        controls.env_scale = env_scale(a, &scene);
         App {
-            args_scene: a.scene.clone(),
+            args: a.clone(),
+            scene_name: a.scene.clone(),
             scene: Arc::new(scene),
+            scene_id: 0,
             controls,
             base,
             gpu_options: a.gpu.options(),
@@ -198,11 +270,11 @@ impl App {
             window: None,
             gpu: None,
             surface: None,
+            panel: None,
             renderer: None,
             building: None,
-            building_sun: sun,
-            renderer_sun: sun,
             generation: 0,
+            pending_open: None,
             size: (a.width, a.height),
             resized_at: None,
             occluded: false,
@@ -212,6 +284,7 @@ impl App {
             last_frame: Instant::now(),
             batch: 1,
             rate: Rate { since: Instant::now(), count: 0, per_second: 0.0 },
+            measured: Measured::default(),
             title_at: Instant::now(),
             status: String::new(),
             script: steps.map(|steps| ScriptRun { steps, next: 0, last: Instant::now(), resizing: None }),
@@ -236,53 +309,100 @@ impl App {
         event_loop.exit();
     }
 
-    /// The settings a renderer for the current window and controls would have.
-    fn wanted(&self) -> RenderSettings {
-        RenderSettings {
-            width: self.size.0,
-            height: self.size.1,
-            photons: self.controls.photons,
-            grid_resolution: self.controls.grid,
-            ..self.base.clone()
+    /// The renderer the current window and controls ask for.
+    fn wanted(&self) -> Build {
+        Build {
+            settings: self.controls.settings(&self.base, self.size.0, self.size.1),
+            engine: self.controls.engine,
+            sun: self.controls.sun,
+            env_scale: self.controls.env_scale,
+            scene: self.scene_id,
         }
     }
 
-    /// Whether the current renderer (if any) was built with `settings` and the controls' sun.
-    fn renderer_matches(&self, s: &RenderSettings) -> bool {
-        self.renderer_sun == self.controls.sun
-            && self.renderer.as_ref().is_some_and(|r| {
-                let t = r.settings();
-                (t.width, t.height, t.photons, t.grid_resolution) == (s.width, s.height, s.photons, s.grid_resolution)
-            })
+    /// Whether the current renderer (if any) is the one wanted.
+    fn renderer_matches(&self, wanted: &Build) -> bool {
+        self.renderer.as_ref().is_some_and(|(_, built)| built == wanted)
     }
 
-    /// Starts building a renderer with the wanted settings on a worker thread.
-    fn start_build(&mut self) {
+    /// Whether the current renderer is the wanted one and nothing is about to replace it.
+    fn settled(&self) -> bool {
+        self.building.is_none() && self.pending_open.is_none() && self.renderer_matches(&self.wanted())
+    }
+
+    /// Starts building the wanted renderer on a worker thread; with `open`, for that scene
+    /// (loaded there too, its photons and grid fitted as on the command line).
+    fn start_build(&mut self, open: Option<String>) {
         let Some(gpu) = self.gpu.clone() else { return };
-        let settings = self.wanted();
-        if settings.width == 0 || settings.height == 0 {
+        let mut wanted = self.wanted();
+        if wanted.settings.width == 0 || wanted.settings.height == 0 {
             return;
         }
         self.generation += 1;
         self.building = Some(self.generation);
         self.resized_at = None;
         let generation = self.generation;
-        let mut scene = (*self.scene).clone();
-        scene.camera = self.controls.camera.camera();
-        self.building_sun = self.controls.sun;
-        if let (Some(sun), Some(Light::Distant { direction, .. })) =
-            (self.controls.sun, scene.lights.iter_mut().rev().find(|l| matches!(l, Light::Distant { .. })))
-        {
-            *direction = sun.direction();
-        }
+        let current = (self.scene.clone(), self.controls.camera.camera());
+        let args = open.as_ref().map(|name| SceneArgs {
+            scene: name.clone(),
+            eye: None,
+            target: None,
+            up: None,
+            fov: None,
+            camera: None,
+            ..self.args.clone()
+        });
+        self.status = match &open {
+            Some(name) => format!("opening {name}..."),
+            None if wanted.engine == Engine::PathTracer => "starting the path tracer...".into(),
+            None => format!("tracing {} photons...", wanted.settings.photons),
+        };
+        let loaded_scale = self.args.env_scale;
         let proxy = self.proxy.clone();
-        self.status = format!("tracing {} photons...", settings.photons);
         std::thread::spawn(move || {
+            let build = std::panic::AssertUnwindSafe(|| -> Result<(Active, Build, Option<Opened>)> {
+                let (scene, opened) = match args {
+                    Some(a) => {
+                        let mut scene = a.load_scene()?;
+                        // The camera as the controls will hold it, so that it does not
+                        // restart the image when the renderer arrives.
+                        scene.camera = CameraControl::new(&scene.camera, &scene.bounds()).camera();
+                        let fitted = a.settings(&scene, 1, 1, true);
+                        let opened = Opened {
+                            name: a.scene.clone(),
+                            photons: fitted.photons,
+                            grid: fitted.grid_resolution,
+                            sun: last_sun(&scene).map(SunAngles::of_direction),
+                            env_scale: env_scale(&a, &scene).and(wanted.env_scale),
+                            scene: Arc::new(scene),
+                        };
+                        (wanted.settings.photons, wanted.settings.grid_resolution) = (opened.photons, opened.grid);
+                        (wanted.sun, wanted.env_scale) = (opened.sun, opened.env_scale);
+                        wanted.scene += 1;
+                        ((*opened.scene).clone(), Some(opened))
+                    }
+                    None => {
+                        let (scene, camera) = current;
+                        let mut scene = (*scene).clone();
+                        scene.camera = camera;
+                        (scene, None)
+                    }
+                };
+                let scene = prepare(scene, &wanted, loaded_scale);
+                let active = match wanted.engine {
+                    Engine::PhotonMap => {
+                        Active::PhotonMap(Box::new(Renderer::new(&gpu, &scene, wanted.settings.clone())?))
+                    }
+                    Engine::PathTracer => {
+                        Active::PathTracer(Box::new(PathTracer::new(&gpu, &scene, wanted.settings.clone())?))
+                    }
+                };
+                Ok((active, wanted, opened))
+            });
             // A panic (wgpu reports validation errors so) must still answer, or the viewer
             // would wait forever; the panic message itself is already on stderr.
-            let build = std::panic::AssertUnwindSafe(|| Renderer::new(&gpu, &scene, settings));
             let result = match std::panic::catch_unwind(build) {
-                Ok(built) => built.map_err(|e| e.to_string()),
+                Ok(built) => built.map_err(|e| format!("{e:#}")),
                 Err(_) => Err("building the renderer failed (see the message above)".to_owned()),
             };
             // The viewer may have closed meanwhile; then nobody is listening.
@@ -307,10 +427,16 @@ impl App {
         }
         if r.retrace {
             // Applied by about_to_wait once no build is in flight.
-            self.status = format!("photons {}, grid {}: re-tracing", self.controls.photons, self.controls.grid);
-            if let Some(s) = self.controls.sun.filter(|&s| Some(s) != self.renderer_sun) {
+            self.status = "re-building the renderer".into();
+            if let Some(s) =
+                self.controls.sun.filter(|&s| self.renderer.as_ref().is_some_and(|(_, b)| b.sun != Some(s)))
+            {
                 self.status = format!("sun {:.0}°, {:.0}°: re-tracing", s.azimuth, s.elevation);
             }
+        }
+        if let Some(name) = r.open {
+            self.status = format!("opening {name}...");
+            self.pending_open = Some(name);
         }
         if r.screenshot {
             self.screenshot();
@@ -323,20 +449,30 @@ impl App {
     /// Gives the renderer the controls' camera if it has another one (restarting the image).
     fn sync_camera(&mut self) -> Result<()> {
         let camera = self.controls.camera.camera();
-        if let Some(renderer) = &mut self.renderer
-            && renderer.camera() != camera
-        {
-            renderer.set_camera(camera)?;
+        if let Some((active, _)) = &mut self.renderer {
+            let r = active.get_mut();
+            if r.camera() != camera {
+                r.set_camera(camera)?;
+            }
         }
         Ok(())
     }
 
+    /// What the image shows: the controls' choice where the renderer has it, else the full image.
+    fn shown(&self) -> Show {
+        match &self.renderer {
+            Some((active, _)) if !active.get().has(self.controls.show) => Show::Full,
+            _ => self.controls.show,
+        }
+    }
+
     fn screenshot(&mut self) {
-        let Some(renderer) = &self.renderer else {
+        let show = self.shown();
+        let Some((active, _)) = &self.renderer else {
             self.status = "no image yet to save".into();
             return;
         };
-        let (show, exposure) = (self.controls.show, self.controls.exposure);
+        let (renderer, exposure) = (active.get(), self.controls.exposure);
         match self.screenshots.save(renderer, show, exposure) {
             Ok((png, exr)) => {
                 println!(
@@ -363,7 +499,7 @@ impl App {
     /// size and settings is ready.
     fn run_script(&mut self, event_loop: &ActiveEventLoop) {
         loop {
-            let ready = self.building.is_none() && self.renderer_matches(&self.wanted());
+            let ready = self.settled();
             let Some(run) = &mut self.script else { return };
             if let Some((size, since)) = run.resizing {
                 if ready && self.size == size {
@@ -376,11 +512,11 @@ impl App {
                     return;
                 }
             }
-            let Some(step) = run.steps.get(run.next).copied() else { return };
+            let Some(step) = run.steps.get(run.next).cloned() else { return };
             if !ready {
                 return;
             }
-            let samples = self.renderer.as_ref().map_or(0, |r| r.samples());
+            let samples = self.renderer.as_ref().map_or(0, |(r, _)| r.get().samples());
             let due = match step.when {
                 When::Now => true,
                 When::Iterations(n) => samples >= n,
@@ -407,7 +543,7 @@ impl App {
     /// The most iterations this frame may run: the script's next `after N iterations` must
     /// find exactly N.
     fn iteration_limit(&self) -> u32 {
-        let samples = self.renderer.as_ref().map_or(0, |r| r.samples());
+        let samples = self.renderer.as_ref().map_or(0, |(r, _)| r.get().samples());
         match &self.script {
             Some(run) if run.resizing.is_none() => match run.steps.get(run.next) {
                 Some(Step { when: When::Iterations(n), .. }) => n.saturating_sub(samples),
@@ -421,17 +557,44 @@ impl App {
     /// time per iteration, at least one, stopping where the script waits for a count. Only a
     /// renderer that fits the window and is not about to be replaced iterates.
     fn iterate_batch(&mut self) -> Result<()> {
-        let current = self.building.is_none() && self.renderer_matches(&self.wanted());
+        let current = self.settled();
         let limit = self.batch.min(self.iteration_limit());
-        let Some(renderer) = self.renderer.as_mut().filter(|_| current) else { return Ok(()) };
-        let done = iterate_frame(renderer, limit, &mut self.batch)?;
+        let Some((active, _)) = self.renderer.as_mut().filter(|_| current) else { return Ok(()) };
+        let done = iterate_frame(active.get_mut(), limit, &mut self.batch)?;
         if done > 0 {
             self.rate.add(done);
         }
         Ok(())
     }
 
-    /// One displayed frame: input over time, script, iterations, resolve, draw, present.
+    /// Refreshes the panel's figures about once a second: the estimated error (a read-back of
+    /// the film), its history since the restart, and the device's allocated memory.
+    fn measure(&mut self) -> Result<()> {
+        if self.measured.at.is_some_and(|t| t.elapsed() < Duration::from_secs(1)) {
+            return Ok(());
+        }
+        self.measured.at = Some(Instant::now());
+        let Some((active, _)) = &self.renderer else { return Ok(()) };
+        let r = active.get();
+        let samples = r.samples();
+        let history = &mut self.measured.history;
+        if history.last().is_some_and(|&(n, _)| n > samples) {
+            history.clear();
+        }
+        self.measured.error = r.film_state()?.error_estimate();
+        if let Some(e) = self.measured.error
+            && history.last().is_none_or(|&(n, _)| n < samples)
+        {
+            history.push((samples, e));
+        }
+        if let Some(gpu) = &self.gpu {
+            self.measured.memory =
+                gpu.device.generate_allocator_report().map(|r| r.allocations.iter().map(|a| a.size).sum());
+        }
+        Ok(())
+    }
+
+    /// One displayed frame: input over time, script, iterations, resolve, panel, draw, present.
     fn frame(&mut self, event_loop: &ActiveEventLoop) {
         let now = Instant::now();
         // A stall (a slow build, a dragged window) must not turn into a long flight.
@@ -448,17 +611,41 @@ impl App {
         if let Err(e) = self.iterate_batch() {
             return self.fail(event_loop, e);
         }
-
-        let overlay = if self.controls.overlay { self.overlay_lines() } else { Vec::new() };
-        let mut enc = gpu.device.create_command_encoder(&Default::default());
-        if let Some(renderer) = &self.renderer {
-            renderer.encode_resolve(&mut enc, self.controls.show, self.controls.exposure);
+        let panel_shown = self.controls.panel && self.panel.is_some();
+        if panel_shown && let Err(e) = self.measure() {
+            return self.fail(event_loop, e);
         }
-        let Some(surface) = &mut self.surface else { return };
-        match surface.present(&gpu, enc, self.renderer.as_ref().map(|r| r.film()), &overlay) {
+        let (panel_output, actions) = match panel_shown.then(|| self.run_panel()).flatten() {
+            Some((output, actions)) => (Some(output), actions),
+            None => (None, Vec::new()),
+        };
+        let show = self.shown();
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        if let Some((active, _)) = &self.renderer {
+            active.get().encode_resolve(&mut enc, show, self.controls.exposure);
+        }
+        let (Some(surface), Some(window)) = (&mut self.surface, &self.window) else { return };
+        let film = self.renderer.as_ref().map(|(r, _)| r.get().film());
+        let presented = match (panel_output, &mut self.panel) {
+            (Some(mut output), Some(panel)) => {
+                panel.input.handle_platform_output(window, std::mem::take(&mut output.platform_output));
+                let (ctx, painter) = (&panel.ctx, &mut panel.painter);
+                surface.present_with(&gpu, enc, film, &[], |enc, view, size| {
+                    painter.encode(&gpu, ctx, output, enc, view, size)
+                })
+            }
+            _ => surface.present(&gpu, enc, film, &[]),
+        };
+        match presented {
             Ok(Presented::Shown) => self.retry_at = None,
             Ok(Presented::Skipped) => self.retry_at = Some(Instant::now() + Duration::from_millis(100)),
             Err(e) => return self.fail(event_loop, e.into()),
+        }
+        // The panel's actions act from the next frame, as a script's do.
+        for action in actions {
+            log::info!("panel: {action:?}");
+            let r = self.controls.action(&action, self.size.1 as f32);
+            self.apply(event_loop, r);
         }
         if self.title_at.elapsed() >= Duration::from_millis(500) {
             self.title_at = Instant::now();
@@ -468,47 +655,89 @@ impl App {
         }
     }
 
+    /// Runs the panel's egui pass: its output, for drawing, and the actions its widgets gave.
+    fn run_panel(&mut self) -> Option<(egui::FullOutput, Vec<Action>)> {
+        let window = self.window.clone()?;
+        let renderer = self.renderer.as_ref().map(|(active, _)| active.get());
+        let photon_map = match &self.renderer {
+            Some((Active::PhotonMap(r), _)) => Some(r),
+            _ => None,
+        };
+        let size = renderer.map_or(self.size, |r| (r.settings().width, r.settings().height));
+        let figures = Figures {
+            scene: &self.scene_name,
+            size,
+            samples: renderer.map_or(0, |r| r.samples()),
+            iterations_per_second: self.rate.per_second,
+            error: self.measured.error,
+            photon_pass: photon_map.filter(|r| r.settings().photons > 0).map(|r| r.photon_pass()),
+            gather_in_use: photon_map.map(|r| r.gather_method()).filter(|&g| g != GatherMethod::Auto),
+            memory: self.measured.memory,
+            history: &self.measured.history,
+            status: &self.status,
+        };
+        let panel = self.panel.as_mut()?;
+        let raw = panel.input.take_egui_input(&window);
+        let mut actions = Vec::new();
+        let output = panel.ctx.run_pass(raw, |ctx| {
+            actions = panel::window(ctx, &self.controls, &figures, &mut panel.state);
+        });
+        Some((output, actions))
+    }
+
     fn title(&self) -> String {
-        let samples = self.renderer.as_ref().map_or(0, |r| r.samples());
+        let samples = self.renderer.as_ref().map_or(0, |(r, _)| r.get().samples());
         format!(
             "rastergi - {} - {} iterations, {:.1}/s - {} - {}",
-            self.args_scene,
+            self.scene_name,
             samples,
             self.rate.per_second,
-            show_name(self.controls.show),
+            show_name(self.shown()),
             self.controls.camera.mode.name()
         )
     }
 
-    fn overlay_lines(&self) -> Vec<String> {
-        let c = &self.controls;
-        let s = self.renderer.as_ref().map_or_else(|| self.wanted(), |r| r.settings().clone());
-        // The renderer's own bundle: 0 in the settings is fitted to the scene as well.
-        let fitted = self.renderer.as_ref().map_or(0, |r| r.bundle());
-        let bundle = if fitted > 0 {
-            fitted
-        } else if s.bundle == 0 {
-            default_bundle(s.width, s.height)
-        } else {
-            s.bundle
-        };
-        let samples = self.renderer.as_ref().map_or(0, |r| r.samples());
-        let size = (s.width, s.height);
-        let mut lines = vec![
-            format!("{}  {}x{}  {} mode", self.args_scene, size.0, size.1, c.camera.mode.name()),
-            format!("iterations {samples}  ({:.1}/s, {} per frame)", self.rate.per_second, self.batch),
-            format!("photons {}  grid {}  bundle {}", c.photons, c.grid, bundle),
-            format!("show {} [1-4]  exposure {:+.1} EV [+/-]", show_name(c.show), c.exposure),
-        ];
-        if let Some(sun) = c.sun {
-            lines.push(format!("sun azimuth {:.0}  elevation {:.0} [J/L I/K]", sun.azimuth, sun.elevation));
-        }
-        if !self.status.is_empty() {
-            lines.push(self.status.clone());
-        }
-        lines.push("WASDQE drag scroll  Tab mode  P save  H hide".into());
-        lines
+    /// The controls back to the settings of the renderer that stays (its build failed).
+    fn revert_controls(&mut self) {
+        let Some((_, b)) = &self.renderer else { return };
+        let c = &mut self.controls;
+        (c.photons, c.grid, c.photon_passes) =
+            (b.settings.photons, b.settings.grid_resolution, b.settings.photon_passes);
+        (c.gather, c.gather_directions, c.directions) =
+            (b.settings.gather, b.settings.gather_directions, b.settings.directions);
+        (c.engine, c.sun, c.env_scale) = (b.engine, b.sun, b.env_scale);
     }
+}
+
+/// Whether `a` and `b` differ in the image size alone.
+fn same_but_size(a: &Build, b: &Build) -> bool {
+    let mut a = a.clone();
+    (a.settings.width, a.settings.height) = (b.settings.width, b.settings.height);
+    a == *b
+}
+
+/// The scene as a build wants it: its sun (the last distant light) turned to the wanted
+/// angles and its environment map scaled to the wanted `--env-scale` (it was loaded at
+/// `loaded_scale`).
+fn prepare(mut scene: Scene, wanted: &Build, loaded_scale: f32) -> Scene {
+    if let (Some(sun), Some(Light::Distant { direction, .. })) =
+        (wanted.sun, scene.lights.iter_mut().rev().find(|l| matches!(l, Light::Distant { .. })))
+    {
+        *direction = sun.direction();
+    }
+    if let (Some(scale), Some(env)) = (wanted.env_scale, &scene.environment)
+        && scale != loaded_scale
+        && loaded_scale > 0.0
+    {
+        scene.environment = Some(Arc::new(env.scaled(scale / loaded_scale)));
+    }
+    scene
+}
+
+/// The environment scale the panel can change: `--env-scale` where the scene has an
+/// environment map that is not black.
+fn env_scale(a: &SceneArgs, scene: &Scene) -> Option<f32> {
+    scene.environment.as_ref().filter(|e| !e.is_dark() && a.env_scale > 0.0).map(|_| a.env_scale)
 }
 
 /// The direction of the scene's last distant light (the viewer's sun), if any.
@@ -525,7 +754,7 @@ impl ApplicationHandler<UserEvent> for App {
             return;
         }
         let attributes = Window::default_attributes()
-            .with_title(format!("rastergi - {}", self.args_scene))
+            .with_title(format!("rastergi - {}", self.scene_name))
             .with_inner_size(PhysicalSize::new(self.size.0, self.size.1));
         let window = match event_loop.create_window(attributes) {
             Ok(w) => Arc::new(w),
@@ -538,13 +767,25 @@ impl ApplicationHandler<UserEvent> for App {
         let display = event_loop.owned_display_handle();
         match WindowSurface::open(&self.gpu_options, display, window.clone(), self.size.0, self.size.1) {
             Ok((gpu, surface)) => {
+                let ctx = egui::Context::default();
+                let max_texture_side = gpu.device.limits().max_texture_dimension_2d as usize;
+                let input = egui_winit::State::new(
+                    ctx.clone(),
+                    egui::ViewportId::ROOT,
+                    &window,
+                    Some(window.scale_factor() as f32),
+                    window.theme(),
+                    Some(max_texture_side),
+                );
+                let painter = PanelPainter::new(&gpu.device, surface.format());
+                self.panel = Some(Panel { ctx, input, painter, state: PanelState::default() });
                 self.gpu = Some(gpu);
                 self.surface = Some(surface);
             }
             Err(e) => return self.fail(event_loop, e.into()),
         }
         self.window = Some(window);
-        self.start_build();
+        self.start_build(None);
         self.redraw();
     }
 
@@ -555,10 +796,19 @@ impl ApplicationHandler<UserEvent> for App {
         }
         self.building = None;
         match result {
-            Ok(renderer) => {
+            Ok((active, build, opened)) => {
                 self.status.clear();
-                self.renderer = Some(renderer);
-                self.renderer_sun = self.building_sun;
+                if let Some(o) = opened {
+                    log::info!("opened {}: {} triangles", o.name, o.scene.triangles.len());
+                    self.controls.set_home(CameraControl::new(&o.scene.camera, &o.scene.bounds()));
+                    debug_assert_eq!(self.controls.camera.camera(), o.scene.camera, "a stable camera");
+                    (self.controls.photons, self.controls.grid) = (o.photons, o.grid);
+                    (self.controls.sun, self.controls.env_scale) = (o.sun, o.env_scale);
+                    (self.scene_name, self.scene, self.scene_id) = (o.name, o.scene, build.scene);
+                    self.title_at = Instant::now() - Duration::from_secs(1);
+                }
+                self.measured = Measured::default();
+                self.renderer = Some((active, build));
                 if let Some(run) = &mut self.script {
                     run.last = Instant::now();
                 }
@@ -567,11 +817,8 @@ impl ApplicationHandler<UserEvent> for App {
             Err(e) => {
                 // Keep the image that works; go back to its settings.
                 eprintln!("warning: {e}");
-                self.status = format!("re-trace failed: {e}");
-                if let Some(r) = &self.renderer {
-                    self.controls.photons = r.settings().photons;
-                    self.controls.grid = r.settings().grid_resolution;
-                }
+                self.status = format!("failed: {e}");
+                self.revert_controls();
             }
         }
         if let Err(e) = self.sync_camera() {
@@ -583,6 +830,20 @@ impl ApplicationHandler<UserEvent> for App {
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
         let viewport_height = self.size.1 as f32;
+        // The panel sees the event first; what it takes (a click on it, typing into it) does
+        // not reach the camera or the keys.
+        let (mut to_panel, mut pointer_on_panel, mut typing) = (false, false, false);
+        if let (Some(panel), Some(window)) = (&mut self.panel, &self.window)
+            && self.controls.panel
+        {
+            let r = panel.input.on_window_event(window, &event);
+            if r.repaint {
+                window.request_redraw();
+            }
+            to_panel = r.consumed;
+            pointer_on_panel = panel.ctx.egui_wants_pointer_input();
+            typing = panel.ctx.egui_wants_keyboard_input();
+        }
         match event {
             WindowEvent::CloseRequested | WindowEvent::Destroyed => event_loop.exit(),
             WindowEvent::Resized(size) => {
@@ -605,12 +866,14 @@ impl ApplicationHandler<UserEvent> for App {
             }
             WindowEvent::Focused(false) => self.controls.release_keys(),
             WindowEvent::ModifiersChanged(m) => self.controls.keys.fast = m.state().shift_key(),
+            WindowEvent::KeyboardInput { event, .. } if typing && event.state == ElementState::Pressed => {}
             WindowEvent::KeyboardInput { event, .. } => {
                 if let Some(key) = key_of(&event) {
                     let r = self.controls.key(key, event.state == ElementState::Pressed, event.repeat);
                     self.apply(event_loop, r);
                 }
             }
+            WindowEvent::MouseInput { state: ElementState::Pressed, .. } if to_panel || pointer_on_panel => {}
             WindowEvent::MouseInput { state, button, .. } => {
                 let pressed = state == ElementState::Pressed;
                 match button {
@@ -631,12 +894,17 @@ impl ApplicationHandler<UserEvent> for App {
                 self.cursor = Some(p);
             }
             WindowEvent::CursorLeft { .. } => self.cursor = None,
+            WindowEvent::MouseWheel { .. } if to_panel || pointer_on_panel => {}
             WindowEvent::MouseWheel { delta, .. } => {
                 let steps = match delta {
                     MouseScrollDelta::LineDelta(_, y) => y,
                     MouseScrollDelta::PixelDelta(p) => p.y as f32 / 40.0,
                 };
                 let r = self.controls.scroll(steps);
+                self.apply(event_loop, r);
+            }
+            WindowEvent::DroppedFile(path) => {
+                let r = self.controls.action(&Action::Open(path.display().to_string()), viewport_height);
                 self.apply(event_loop, r);
             }
             WindowEvent::RedrawRequested => self.frame(event_loop),
@@ -654,9 +922,16 @@ impl ApplicationHandler<UserEvent> for App {
             event_loop.set_control_flow(ControlFlow::Wait);
             return;
         }
-        // Replace the renderer when the window size or the photon settings changed, once the
-        // size has settled and no other build is in flight.
-        if self.building.is_none() && self.gpu.is_some() && !self.renderer_matches(&self.wanted()) {
+        // Open a scene asked for, or replace the renderer when the window size or the
+        // settings changed (once the size has settled), when no other build is in flight.
+        if self.building.is_none()
+            && self.gpu.is_some()
+            && let Some(name) = self.pending_open.take()
+        {
+            self.start_build(Some(name));
+        }
+        let wanted = self.wanted();
+        if self.building.is_none() && self.gpu.is_some() && !self.renderer_matches(&wanted) {
             let settle = self.resized_at.map(|t| t + RESIZE_SETTLE);
             match settle {
                 Some(at) if Instant::now() < at => {
@@ -665,21 +940,17 @@ impl ApplicationHandler<UserEvent> for App {
                 }
                 _ => {
                     // A new size alone keeps the scene and its photon map: only the
-                    // size-dependent passes are rebuilt. New photon settings re-trace.
-                    let wanted = self.wanted();
-                    let same_map = self.renderer_sun == self.controls.sun
-                        && self.renderer.as_ref().is_some_and(|r| {
-                            let t = r.settings();
-                            (t.photons, t.grid_resolution) == (wanted.photons, wanted.grid_resolution)
-                        });
-                    match self.renderer.as_mut() {
-                        Some(r) if same_map => {
+                    // size-dependent passes of the photon map renderer are rebuilt.
+                    let size = (wanted.settings.width, wanted.settings.height);
+                    match &mut self.renderer {
+                        Some((Active::PhotonMap(r), built)) if same_but_size(built, &wanted) => {
                             self.resized_at = None;
-                            if let Err(e) = r.resize(wanted.width, wanted.height) {
+                            if let Err(e) = r.resize(size.0, size.1) {
                                 return self.fail(event_loop, e.into());
                             }
+                            *built = wanted;
                         }
-                        _ => self.start_build(),
+                        _ => self.start_build(None),
                     }
                 }
             }
@@ -693,7 +964,7 @@ impl ApplicationHandler<UserEvent> for App {
             return;
         }
         if self.building.is_some() {
-            // The finished build wakes the loop; keep the title's and overlay's status fresh.
+            // The finished build wakes the loop; keep the title's and the panel's status fresh.
             event_loop.set_control_flow(ControlFlow::WaitUntil(Instant::now() + Duration::from_millis(250)));
             self.redraw();
             return;

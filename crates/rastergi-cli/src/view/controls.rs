@@ -1,13 +1,15 @@
 //! The viewer's input handling, free of any window so that it is unit-tested: the keys that
 //! mean something ([`Key`]), the interactive state ([`Controls`]: camera controller, held
-//! keys, what is shown, exposure, photon settings, overlay) and what an input asks of the
+//! keys, what is shown, exposure, renderer settings, panel) and what an input asks of the
 //! application ([`Response`]); also the camera and the shown image as text.
 
 use rastergi::camera_control::{CameraControl, Mode, MoveKeys};
 use rastergi::film::Show;
+use rastergi::gather::{GatherDirections, GatherMethod};
+use rastergi::renderer::RenderSettings;
 use rastergi::scene::Camera;
 
-use super::script::Action;
+use super::script::{Action, Engine};
 
 /// A key that means something to the viewer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -34,7 +36,7 @@ pub enum Key {
     SunHigher,
     SunLower,
     Screenshot,
-    ToggleOverlay,
+    TogglePanel,
     Quit,
 }
 
@@ -67,12 +69,14 @@ impl SunAngles {
 pub const SUN_STEP: f32 = 5.0;
 
 /// What the application must do after an input.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Response {
     /// The camera moved: restart the accumulation.
     pub camera_moved: bool,
-    /// The photon settings changed: build a new renderer (new photon map).
+    /// The renderer's settings changed: build a new renderer (new photon map).
     pub retrace: bool,
+    /// Open this scene (a built-in name or a file) in place of the current one.
+    pub open: Option<String>,
     pub screenshot: bool,
     pub quit: bool,
 }
@@ -81,8 +85,8 @@ pub struct Response {
 pub const EXPOSURE_STEP: f32 = 0.5;
 
 /// The viewer's interactive state, free of any window: the camera controller, held keys,
-/// what is shown and the photon settings. Inputs come in as [`Key`]s, drags and scrolls and
-/// return what the application must do.
+/// what is shown and the renderer's settings. Inputs come in as [`Key`]s, drags, scrolls and
+/// [`Action`]s (a script's or the panel's) and return what the application must do.
 #[derive(Clone, Debug)]
 pub struct Controls {
     pub camera: CameraControl,
@@ -90,25 +94,77 @@ pub struct Controls {
     pub keys: MoveKeys,
     pub show: Show,
     pub exposure: f32,
+    pub engine: Engine,
     pub photons: u32,
     pub grid: u32,
+    pub photon_passes: u32,
+    pub gather: GatherMethod,
+    pub gather_directions: GatherDirections,
+    pub directions: u32,
     /// The scene's sun (its last distant light), if it has one.
     pub sun: Option<SunAngles>,
-    pub overlay: bool,
+    /// The environment map's radiance scale, if the scene has one that can be scaled.
+    pub env_scale: Option<f32>,
+    /// The control panel is shown (H).
+    pub panel: bool,
 }
 
 impl Controls {
-    pub fn new(camera: CameraControl, show: Show, exposure: f32, photons: u32, grid: u32) -> Controls {
+    /// Controls starting at `camera` (also the Home position), showing `show` at `exposure`,
+    /// with the renderer settings of `settings`.
+    pub fn new(camera: CameraControl, show: Show, exposure: f32, settings: &RenderSettings) -> Controls {
         Controls {
             home: camera.clone(),
             camera,
             keys: MoveKeys::default(),
             show,
             exposure,
-            photons,
-            grid,
+            engine: Engine::PhotonMap,
+            photons: settings.photons,
+            grid: settings.grid_resolution,
+            photon_passes: settings.photon_passes,
+            gather: settings.gather,
+            gather_directions: settings.gather_directions,
+            directions: settings.directions,
             sun: None,
-            overlay: true,
+            env_scale: None,
+            panel: true,
+        }
+    }
+
+    /// A new scene's camera (also the new Home), keeping the camera's mode and speed factor
+    /// relative to the scene's size.
+    pub fn set_home(&mut self, camera: CameraControl) {
+        let mode = self.camera.mode;
+        self.home = camera.clone();
+        self.camera = camera;
+        if self.camera.mode != mode {
+            self.camera.toggle_mode();
+        }
+    }
+
+    /// Back to the starting camera, keeping the mode and speed; whether the camera moved.
+    fn home(&mut self) -> bool {
+        let (mode, speed) = (self.camera.mode, self.camera.speed);
+        let moved = self.camera.camera() != self.home.camera();
+        self.camera = self.home.clone();
+        (self.camera.mode, self.camera.speed) = (mode, speed);
+        moved
+    }
+
+    /// The settings of the renderer these controls ask for: `base` with the controls'
+    /// photon map, gather and directions, at `width × height`.
+    pub fn settings(&self, base: &RenderSettings, width: u32, height: u32) -> RenderSettings {
+        RenderSettings {
+            width,
+            height,
+            photons: self.photons,
+            grid_resolution: self.grid,
+            photon_passes: self.photon_passes,
+            gather: self.gather,
+            gather_directions: self.gather_directions,
+            directions: self.directions,
+            ..base.clone()
         }
     }
 
@@ -141,12 +197,7 @@ impl Controls {
             }
             _ if repeat => {}
             Key::ToggleMode => self.camera.toggle_mode(),
-            Key::Home => {
-                let (mode, speed) = (self.camera.mode, self.camera.speed);
-                r.camera_moved = self.camera.camera() != self.home.camera();
-                self.camera = self.home.clone();
-                (self.camera.mode, self.camera.speed) = (mode, speed);
-            }
+            Key::Home => r.camera_moved = self.home(),
             Key::Show(show) => self.show = show,
             Key::FewerPhotons => r.retrace = self.set_photons(self.photons / 2),
             Key::MorePhotons => r.retrace = self.set_photons(self.photons.saturating_mul(2)),
@@ -157,7 +208,7 @@ impl Controls {
             Key::SunHigher => r.retrace = self.turn_sun(0.0, SUN_STEP),
             Key::SunLower => r.retrace = self.turn_sun(0.0, -SUN_STEP),
             Key::Screenshot => r.screenshot = true,
-            Key::ToggleOverlay => self.overlay = !self.overlay,
+            Key::TogglePanel => self.panel = !self.panel,
             Key::Quit => r.quit = true,
             _ => {}
         }
@@ -212,7 +263,9 @@ impl Controls {
         self.keys = MoveKeys::default();
     }
 
-    /// A script action that the controls handle (camera, show, exposure, photon settings).
+    /// An action of a script or the panel: the camera, what is shown, the renderer's settings
+    /// (a change asks for a new renderer), a scene to open, a screenshot, quit. (`resize` is
+    /// the window's: the application handles it.)
     pub fn action(&mut self, action: &Action, viewport_height: f32) -> Response {
         let mut r = Response::default();
         let c = &mut self.camera;
@@ -236,6 +289,24 @@ impl Controls {
             Action::Photons(n) => r.retrace = self.set_photons(n),
             Action::Grid(n) => r.retrace = self.set_grid(n),
             Action::Sun { azimuth, elevation } => r.retrace = self.set_sun(SunAngles { azimuth, elevation }),
+            Action::PhotonPasses(n) => r.retrace = std::mem::replace(&mut self.photon_passes, n) != n,
+            Action::EnvScale(s) => {
+                let s = s.max(0.0);
+                r.retrace = self.env_scale.is_some_and(|old| old != s);
+                if let Some(scale) = &mut self.env_scale {
+                    *scale = s;
+                }
+            }
+            Action::Method(e) => r.retrace = std::mem::replace(&mut self.engine, e) != e,
+            Action::Gather(g) => r.retrace = std::mem::replace(&mut self.gather, g) != g,
+            Action::GatherDirections(d) => r.retrace = std::mem::replace(&mut self.gather_directions, d) != d,
+            Action::Directions(n) => {
+                let n = n.clamp(1, rastergi::gather::MAX_DIRECTIONS);
+                r.retrace = std::mem::replace(&mut self.directions, n) != n;
+            }
+            Action::Speed(s) => self.camera.speed = s.max(1e-6),
+            Action::Home => r.camera_moved = self.home(),
+            Action::Open(ref name) => r.open = Some(name.clone()),
             Action::Screenshot => r.screenshot = true,
             Action::Quit => r.quit = true,
             Action::Resize { .. } => {}
@@ -270,7 +341,8 @@ mod tests {
     fn controls() -> Controls {
         let camera = Camera { eye: Vec3::new(0.0, 0.0, 3.9), target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 39.3077 };
         let bounds = Aabb { min: Vec3::splat(-1.0), max: Vec3::splat(1.0) };
-        Controls::new(CameraControl::new(&camera, &bounds), Show::Full, 0.0, 1 << 20, 64)
+        let settings = RenderSettings { photons: 1 << 20, grid_resolution: 64, ..Default::default() };
+        Controls::new(CameraControl::new(&camera, &bounds), Show::Full, 0.0, &settings)
     }
 
     #[test]
@@ -288,7 +360,7 @@ mod tests {
     }
 
     #[test]
-    fn show_exposure_mode_and_overlay_keys_do_not_restart() {
+    fn show_exposure_mode_and_panel_keys_do_not_restart() {
         let mut c = controls();
         let camera = c.camera.camera();
         for key in [
@@ -297,12 +369,12 @@ mod tests {
             Key::ExposureUp,
             Key::ExposureDown,
             Key::ToggleMode,
-            Key::ToggleOverlay,
+            Key::TogglePanel,
             Key::Fast,
         ] {
             assert_eq!(c.key(key, true, false), Response::default(), "{key:?}");
         }
-        assert_eq!((c.show, c.exposure, c.camera.mode, c.overlay), (Show::PhotonMap, 0.5, Mode::Orbit, false));
+        assert_eq!((c.show, c.exposure, c.camera.mode, c.panel), (Show::PhotonMap, 0.5, Mode::Orbit, false));
         assert_eq!(c.camera.camera(), camera);
         assert_eq!(c.action(&Action::Show(Show::Direct), 64.0), Response::default());
         assert_eq!(c.action(&Action::Mode { orbit: false }, 64.0), Response::default());
@@ -341,6 +413,39 @@ mod tests {
         assert!(c.action(&Action::Photons(7), 64.0).retrace && c.photons == 7);
         assert!(!c.action(&Action::Photons(7), 64.0).retrace);
         assert!(c.key(Key::Screenshot, true, false).screenshot && c.key(Key::Quit, true, false).quit);
+    }
+
+    #[test]
+    fn renderer_actions_ask_for_a_new_renderer_only_when_they_change_a_setting() {
+        let mut c = controls();
+        let base = RenderSettings::default();
+        let before = c.settings(&base, 64, 48);
+        let changes = [
+            Action::Method(Engine::PathTracer),
+            Action::Gather(GatherMethod::Lists),
+            Action::GatherDirections(GatherDirections::Shared),
+            Action::Directions(7),
+            Action::PhotonPasses(3),
+        ];
+        for a in &changes {
+            assert!(c.action(a, 64.0).retrace, "{a:?}");
+            assert!(!c.action(a, 64.0).retrace, "{a:?} again");
+        }
+        let after = c.settings(&base, 64, 48);
+        assert_eq!((after.width, after.height, after.photons), (64, 48, before.photons));
+        assert_eq!(
+            (after.gather, after.gather_directions, after.directions, after.photon_passes),
+            (GatherMethod::Lists, GatherDirections::Shared, 7, 3)
+        );
+        assert_eq!(c.engine, Engine::PathTracer);
+        assert!(!c.action(&Action::EnvScale(2.0), 64.0).retrace, "no environment, nothing to scale");
+        c.env_scale = Some(1.0);
+        assert!(c.action(&Action::EnvScale(2.0), 64.0).retrace && c.env_scale == Some(2.0));
+        let r = c.action(&Action::Open("atrium".into()), 64.0);
+        assert_eq!((r.open.as_deref(), r.retrace), (Some("atrium"), false));
+        let camera = c.camera.camera();
+        assert_eq!(c.action(&Action::Speed(3.0), 64.0), Response::default());
+        assert_eq!((c.camera.speed, c.camera.camera()), (3.0, camera));
     }
 
     #[test]

@@ -4,27 +4,31 @@
 //!
 //! The loop, per displayed frame: apply held keys and the script's due steps to the camera;
 //! if the camera moved, `Renderer::set_camera` restarts the image; run as many iterations as
-//! fit in [`app::FRAME_BUDGET`] of GPU time (at least one); resolve the film and draw it with the
-//! overlay ([`rastergi::display`]); present. Building a renderer (photon tracing) runs on a
-//! worker thread so the window stays live meanwhile; a new photon count or grid
-//! builds a new renderer at the window's size (the film is the window's size) and shows the
+//! fit in [`app::FRAME_BUDGET`] of GPU time (at least one); resolve the film and draw it
+//! ([`rastergi::display`]) with the control panel over it; present. Building a renderer
+//! (photon tracing, or opening a scene) runs on a worker thread so the window stays live
+//! meanwhile; new settings build a new renderer at the window's size (the film is the window's size) and shows the
 //! old image, scaled, until it is ready. A resize alone keeps the scene and photon map and
 //! rebuilds only the size-dependent passes (`Renderer::resize`). While the window is minimised, occluded or zero-sized
 //! the loop waits for events and renders nothing.
 //!
-//! The overlay (top left; H hides it) shows the iterations, iterations per second, photons,
-//! grid and bundle resolution, what is shown, the exposure and the drag mode; the window title
-//! repeats the main figures. It is drawn with a small bitmap font in the display shader: the
-//! egui-wgpu releases built on wgpu 30 require Rust 1.95, above this project's 1.88.
+//! The control panel ([`panel`], egui drawn by egui-wgpu on the same device over the image;
+//! H hides it) opens scenes (a path, the built-in list, a file browser, or a file dropped on
+//! the window), switches between the photon map and the path tracer, sets the gather, the
+//! photon map, the sun, the environment's scale, the camera and the display, and shows the
+//! iterations per second, the estimated error, the photon pass, the GPU memory and a
+//! convergence plot. Each of its widgets gives a script [`script::Action`], applied as a
+//! script's is; the window title repeats the main figures.
 //!
 //! Scripts (`--script`) are described in [`script`].
 //!
 //! The parts: [`controls`] (window-free input handling: keys, drags, script actions and what
 //! each asks of the application), [`app`] (the winit application: window, renderer builds,
-//! the frame loop), [`screenshots`] and [`script`].
+//! the frame loop), [`panel`], [`screenshots`] and [`script`].
 
 mod app;
 mod controls;
+mod panel;
 mod screenshots;
 mod script;
 
@@ -56,7 +60,7 @@ Keys and mouse:
   , .               halve / double the photon grid resolution (re-traces)
   J L / I K         turn the sun (the scene's distant light): azimuth / elevation by 5 degrees (re-traces)
   P                 screenshot: rastergi-NNNN.png (as shown) and .exr (linear)
-  H                 hide / show the overlay
+  H                 hide / show the control panel
   Esc               quit
 Any camera move restarts the accumulation; the photon map is kept.\n"
     };
@@ -86,8 +90,11 @@ Script (--script FILE): one action per line, optionally after a condition; # com
   after T s: ACTION            T seconds after the previous line
   ACTION                       right after the previous line
 Actions: move R,U,F | look YAW,PITCH | orbit YAW,PITCH | pan X,Y | zoom STEPS |
-  mode fly|orbit | show full|direct|indirect|photon-map | exposure EV | photons N |
-  grid N | sun AZIMUTH,ELEVATION | resize W,H | screenshot | quit
+  mode fly|orbit | speed S | home | show full|direct|indirect|photon-map | exposure EV |
+  photons N | grid N | passes N | sun AZIMUTH,ELEVATION | env-scale S | method gather|path |
+  gather auto|raster|lists|trace | gather-directions per-pixel|shared | directions N |
+  open SCENE | resize W,H | screenshot | quit
+The control panel's widgets act through the same actions.
 Each screenshot prints its files and the camera as render options to stdout."
 );
 

@@ -31,9 +31,22 @@
 //! | `show full\|direct\|indirect\|photon-map` | what the image shows (no restart) |
 //! | `exposure EV` | sets the display exposure in stops |
 //! | `photons N` / `grid N` | re-traces the photon map with N photons / N grid cells |
+//! | `passes N` | photon passes (0: no limit; 1: one fixed map), re-traces |
+//! | `sun AZIMUTH,ELEVATION` | puts the scene's sun (its last distant light) there, re-traces |
+//! | `env-scale S` | scales the environment map's radiance (as `--env-scale`), re-traces |
+//! | `method gather\|path` | the photon map + final gather, or the reference path tracer |
+//! | `gather auto\|raster\|lists\|trace` | the final gather's implementation |
+//! | `gather-directions per-pixel\|shared` | whose directions the traced gather casts |
+//! | `directions N` | gather directions per iteration (1 to 16) |
+//! | `speed S` | the camera's flying speed, scene units per second |
+//! | `home` | back to the starting camera |
+//! | `open SCENE` | opens another scene (built in or a file), as the panel's Open does |
 //! | `resize W,H` | asks for a W×H window; waits until the image has that size |
 //! | `screenshot` | saves `rastergi-NNNN.png` and `.exr` as the P key does |
 //! | `quit` | closes the viewer |
+//!
+//! The control panel acts through the same actions: every setting it changes is one of them,
+//! so a script reproduces what a click does.
 //!
 //! A script that ends without `quit` leaves the viewer running. Every error names the file
 //! and line.
@@ -43,6 +56,7 @@ use std::time::Duration;
 
 use anyhow::{Context, Result, bail};
 use rastergi::film::Show;
+use rastergi::gather::{GatherDirections, GatherMethod};
 
 /// When a step runs.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -55,7 +69,18 @@ pub enum When {
     Elapsed(Duration),
 }
 
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// Which renderer the viewer runs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Engine {
+    /// The photon map and the final gather.
+    #[default]
+    PhotonMap,
+    /// The reference path tracer.
+    PathTracer,
+}
+
+/// Something done to the viewer: by a script line, or by the control panel.
+#[derive(Clone, Debug, PartialEq)]
 pub enum Action {
     Move {
         right: f32,
@@ -89,6 +114,20 @@ pub enum Action {
         azimuth: f32,
         elevation: f32,
     },
+    /// Photon passes (0: no limit).
+    PhotonPasses(u32),
+    /// The environment's radiance scale (as `--env-scale`).
+    EnvScale(f32),
+    Method(Engine),
+    Gather(GatherMethod),
+    GatherDirections(GatherDirections),
+    /// Gather directions per iteration.
+    Directions(u32),
+    /// Camera speed in scene units per second.
+    Speed(f32),
+    Home,
+    /// Opens a scene: a built-in name or a file.
+    Open(String),
     Resize {
         width: u32,
         height: u32,
@@ -97,7 +136,7 @@ pub enum Action {
     Quit,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Step {
     pub when: When,
     pub action: Action,
@@ -159,8 +198,8 @@ fn parse_when(condition: &str) -> Result<When> {
     }
 }
 
-const ACTIONS: &str =
-    "move, look, orbit, pan, zoom, mode, show, exposure, photons, grid, sun, resize, screenshot, quit";
+const ACTIONS: &str = "move, look, orbit, pan, zoom, mode, show, exposure, photons, grid, passes, sun, env-scale, \
+                       method, gather, gather-directions, directions, speed, home, open, resize, screenshot, quit";
 
 fn parse_action(action: &str) -> Result<Action> {
     let (name, args) = match action.split_once(char::is_whitespace) {
@@ -206,6 +245,36 @@ fn parse_action(action: &str) -> Result<Action> {
             let [azimuth, elevation] = numbers::<2>(args, "AZIMUTH,ELEVATION")?;
             Action::Sun { azimuth, elevation }
         }
+        "passes" => Action::PhotonPasses(count(args, "passes", 0, u32::MAX)?),
+        "env-scale" => match numbers::<1>(args, "SCALE")?[0] {
+            s if s >= 0.0 => Action::EnvScale(s),
+            _ => bail!("'env-scale' takes a number ≥ 0"),
+        },
+        "method" => Action::Method(match args {
+            "gather" => Engine::PhotonMap,
+            "path" => Engine::PathTracer,
+            _ => bail!("'method' takes 'gather' or 'path'"),
+        }),
+        "gather" => Action::Gather(match args {
+            "auto" => GatherMethod::Auto,
+            "raster" => GatherMethod::Raster,
+            "lists" => GatherMethod::Lists,
+            "trace" => GatherMethod::Trace,
+            _ => bail!("'gather' takes auto, raster, lists or trace"),
+        }),
+        "gather-directions" => Action::GatherDirections(match args {
+            "per-pixel" => GatherDirections::PerPixel,
+            "shared" => GatherDirections::Shared,
+            _ => bail!("'gather-directions' takes per-pixel or shared"),
+        }),
+        "directions" => Action::Directions(count(args, "directions", 1, rastergi::gather::MAX_DIRECTIONS)?),
+        "speed" => match numbers::<1>(args, "SPEED")?[0] {
+            s if s > 0.0 => Action::Speed(s),
+            _ => bail!("'speed' takes a positive number of scene units per second"),
+        },
+        "home" => none(Action::Home)?,
+        "open" if args.is_empty() => bail!("'open' takes a scene: a built-in name or a file"),
+        "open" => Action::Open(args.to_owned()),
         "resize" => {
             let [width, height] = numbers::<2>(args, "W,H")?;
             let side = |v: f32| (1.0..=16384.0).contains(&v) && v.fract() == 0.0;
@@ -252,7 +321,7 @@ mod tests {
              exposure -1.5\nquit\n",
         )
         .unwrap();
-        let got: Vec<(When, Action, usize)> = steps.iter().map(|s| (s.when, s.action, s.line)).collect();
+        let got: Vec<(When, Action, usize)> = steps.iter().map(|s| (s.when, s.action.clone(), s.line)).collect();
         assert_eq!(
             got[..5],
             [
@@ -264,7 +333,7 @@ mod tests {
             ]
         );
         assert_eq!(
-            steps[5..].iter().map(|s| s.action).collect::<Vec<_>>(),
+            steps[5..].iter().map(|s| s.action.clone()).collect::<Vec<_>>(),
             [
                 Action::Photons(4096),
                 Action::Grid(32),
@@ -274,6 +343,30 @@ mod tests {
                 Action::Look { yaw_deg: 1.0, pitch_deg: 2.0 },
                 Action::Exposure(-1.5),
                 Action::Quit
+            ]
+        );
+    }
+
+    #[test]
+    fn the_panels_actions_parse() {
+        let steps = parse(
+            "method path\nmethod gather\ngather trace\ngather-directions shared\ndirections 2\npasses 0\n\
+             env-scale 0.5\nspeed 2\nhome\nopen scenes/my room.obj\n",
+        )
+        .unwrap();
+        assert_eq!(
+            steps.into_iter().map(|s| s.action).collect::<Vec<_>>(),
+            [
+                Action::Method(Engine::PathTracer),
+                Action::Method(Engine::PhotonMap),
+                Action::Gather(GatherMethod::Trace),
+                Action::GatherDirections(GatherDirections::Shared),
+                Action::Directions(2),
+                Action::PhotonPasses(0),
+                Action::EnvScale(0.5),
+                Action::Speed(2.0),
+                Action::Home,
+                Action::Open("scenes/my room.obj".into()),
             ]
         );
     }
@@ -291,6 +384,12 @@ mod tests {
             ("screenshot now", "line 1", "takes no arguments"),
             ("grid 0", "line 1", "from 1 to 1024"),
             ("resize 0,10", "line 1", "between 1 and 16384"),
+            ("method raytrace", "line 1", "'gather' or 'path'"),
+            ("gather fast", "line 1", "auto, raster, lists or trace"),
+            ("directions 17", "line 1", "from 1 to 16"),
+            ("speed 0", "line 1", "positive"),
+            ("env-scale -1", "line 1", "≥ 0"),
+            ("open", "line 1", "takes a scene"),
         ];
         for (text, line, message) in cases {
             let e = format!("{:#}", parse(text).unwrap_err());

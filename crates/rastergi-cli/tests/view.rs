@@ -231,13 +231,13 @@ fn turning_the_sun_re_traces_and_shows_what_a_render_with_that_sun_shows() {
 #[test]
 fn the_panels_actions_switch_the_method_the_gather_and_the_scene_as_render_options_do() {
     // The panel's widgets give these actions (`view::panel`'s tests click them); here a
-    // script gives them. A renderer built for new settings starts afresh with the seed, so
+    // script gives them, a scene that does not exist among them. A renderer built for new settings starts afresh with the seed, so
     // its image is the one `render` gives with the same options, bit for bit.
     const SEED: u32 = 3;
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let script = "method path\nafter 4 iterations: screenshot\nmethod gather\ngather trace\n\
-                  gather-directions shared\ndirections 2\nafter 4 iterations: screenshot\nopen rooms\n\
+                  gather-directions shared\ndirections 2\nafter 4 iterations: screenshot\nopen no-such.obj\nopen rooms\n\
                   after 2 iterations: screenshot\nquit\n";
     std::fs::write(d.join("script.txt"), script).unwrap();
     let seed = SEED.to_string();
@@ -264,6 +264,10 @@ fn the_panels_actions_switch_the_method_the_gather_and_the_scene_as_render_optio
         assert!(c.relative_rmse < 1e-6, "screenshot {i} ({scene} {options:?}) differs from the render's: {c:?}");
     }
     assert_ne!(shots[2].camera, shots[0].camera, "the opened scene brings its camera");
+    // A scene that cannot be opened is one warning; the viewer goes on with the one it has.
+    let warning: Vec<&str> = run.stderr.lines().filter(|l| l.contains("no-such.obj")).collect();
+    assert_eq!(warning.len(), 1, "{}", run.stderr);
+    assert!(warning[0].starts_with("warning: ") && warning[0].contains("no-such.obj"), "{}", warning[0]);
 }
 
 #[test]

@@ -196,6 +196,8 @@ struct Panel {
 struct Measured {
     at: Option<Instant>,
     error: Option<f64>,
+    /// The film holds too few blocks for the estimate to mean much yet.
+    rough: bool,
     memory: Option<u64>,
     /// (iterations, estimated error) since the last restart.
     history: Vec<(u32, f64)>,
@@ -582,7 +584,10 @@ impl App {
             history.clear();
         }
         self.measured.error = r.film_state()?.error_estimate();
-        if let Some(e) = self.measured.error
+        // As for `render --target-error`: the halves need a few blocks each before their
+        // difference means much.
+        self.measured.rough = r.film().blocks() < 4;
+        if let Some(e) = self.measured.error.filter(|_| !self.measured.rough)
             && history.last().is_none_or(|&(n, _)| n < samples)
         {
             history.push((samples, e));
@@ -670,6 +675,7 @@ impl App {
             samples: renderer.map_or(0, |r| r.samples()),
             iterations_per_second: self.rate.per_second,
             error: self.measured.error,
+            error_is_rough: self.measured.rough,
             photon_pass: photon_map.filter(|r| r.settings().photons > 0).map(|r| r.photon_pass()),
             gather_in_use: photon_map.map(|r| r.gather_method()).filter(|&g| g != GatherMethod::Auto),
             memory: self.measured.memory,

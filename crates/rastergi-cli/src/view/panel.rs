@@ -39,6 +39,8 @@ pub struct Figures<'a> {
     pub iterations_per_second: f64,
     /// The relative RMSE estimated without a reference (two halves of the iterations).
     pub error: Option<f64>,
+    /// Too few blocks of iterations yet for the estimate to mean much.
+    pub error_is_rough: bool,
     /// The photon pass the map is in (photon map renderer).
     pub photon_pass: Option<u32>,
     /// The gather implementation in use (what `auto` chose, once it has).
@@ -136,7 +138,8 @@ pub fn contents(ui: &mut Ui, c: &Controls, f: &Figures, state: &mut PanelState) 
 fn figures(ui: &mut Ui, f: &Figures) {
     ui.label(RichText::new(format!("{}  {}x{}", f.scene, f.size.0, f.size.1)).strong());
     ui.label(format!("{} iterations  {:.1}/s", f.samples, f.iterations_per_second));
-    let error = f.error.map_or("-".to_owned(), |e| format!("{:.2} %", 100.0 * e));
+    let rough = if f.error_is_rough { " (rough: few iterations yet)" } else { "" };
+    let error = f.error.map_or("-".to_owned(), |e| format!("{:.2} %{rough}", 100.0 * e));
     ui.label(format!("estimated error {error}"))
         .on_hover_text("relative RMSE estimated without a reference, from two independent halves of the iterations");
     let mut line = Vec::new();
@@ -188,8 +191,10 @@ fn convergence_plot(ui: &mut Ui, history: &[(u32, f64)]) {
             rect.bottom() - 4.0 - (rect.height() - 8.0) * ((y - y0) / (y1 - y0)) as f32,
         )
     };
+    // The slope line starts where it leaves the plot (at its top or its left edge).
     let (xl, yl) = points[points.len() - 1];
-    let slope = [to_screen(x0, yl + 0.5 * (xl - x0)), to_screen(xl, yl)];
+    let xs = x0.max(xl - 2.0 * (y1 - yl));
+    let slope = [to_screen(xs, yl + 0.5 * (xl - xs)), to_screen(xl, yl)];
     painter.line_segment(slope, Stroke::new(1.0, Color32::from_gray(90)));
     let line: Vec<egui::Pos2> = points.iter().map(|&(x, y)| to_screen(x, y)).collect();
     painter.add(egui::Shape::line(line, Stroke::new(1.5, Color32::LIGHT_GREEN)));
@@ -477,6 +482,7 @@ mod tests {
                     samples: 16,
                     iterations_per_second: 10.0,
                     error: Some(0.05),
+                    error_is_rough: false,
                     photon_pass: Some(0),
                     gather_in_use: Some(GatherMethod::Trace),
                     memory: Some(64 << 20),

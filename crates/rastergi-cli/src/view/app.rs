@@ -676,7 +676,9 @@ impl App {
             iterations_per_second: self.rate.per_second,
             error: self.measured.error,
             error_is_rough: self.measured.rough,
-            photon_pass: photon_map.filter(|r| r.settings().photons > 0).map(|r| r.photon_pass()),
+            photon_pass: photon_map
+                .filter(|r| r.settings().photons > 0)
+                .map(|r| (r.photon_pass(), r.settings().photons)),
             gather_in_use: photon_map.map(|r| r.gather_method()).filter(|&g| g != GatherMethod::Auto),
             memory: self.measured.memory,
             history: &self.measured.history,

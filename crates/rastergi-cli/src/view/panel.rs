@@ -41,8 +41,9 @@ pub struct Figures<'a> {
     pub error: Option<f64>,
     /// Too few blocks of iterations yet for the estimate to mean much.
     pub error_is_rough: bool,
-    /// The photon pass the map is in (photon map renderer).
-    pub photon_pass: Option<u32>,
+    /// The photon pass the map is in (0-based) and the photons each pass traces (photon map
+    /// renderer).
+    pub photon_pass: Option<(u32, u32)>,
     /// The gather implementation in use (what `auto` chose, once it has).
     pub gather_in_use: Option<GatherMethod>,
     /// GPU memory allocated on the device, bytes, where the backend reports it.
@@ -143,8 +144,8 @@ fn figures(ui: &mut Ui, f: &Figures) {
     ui.label(format!("estimated error {error}"))
         .on_hover_text("relative RMSE estimated without a reference, from two independent halves of the iterations");
     let mut line = Vec::new();
-    if let Some(pass) = f.photon_pass {
-        line.push(format!("photon pass {}", pass + 1));
+    if let Some((pass, photons)) = f.photon_pass {
+        ui.label(format!("photons {} ({photons} in each of {} passes)", photons as u64 * (pass as u64 + 1), pass + 1));
     }
     if let Some(g) = f.gather_in_use {
         line.push(format!("gather {}", gather_name(g)));
@@ -483,7 +484,7 @@ mod tests {
                     iterations_per_second: 10.0,
                     error: Some(0.05),
                     error_is_rough: false,
-                    photon_pass: Some(0),
+                    photon_pass: Some((0, 1 << 16)),
                     gather_in_use: Some(GatherMethod::Trace),
                     memory: Some(64 << 20),
                     history: &history,

@@ -1,13 +1,13 @@
 #!/usr/bin/env bash
 # Installs what rastergi needs on a fresh Debian or Ubuntu machine: a C toolchain and
 # pkg-config, Mesa's Vulkan drivers (lavapipe runs the GPU code on the CPU when there is no
-# GPU), the X11 libraries of the viewer's window and Xvfb for its tests, and Rust >= 1.88
+# GPU), the X11 libraries of the viewer's window and Xvfb for its tests, and Rust >= 1.95
 # with rustfmt and clippy, and Ray in a Python virtual environment (scripts/ray_render.py).
 # Safe to run again: it installs only what is missing. Afterwards,
 # in a new shell or after `. ~/.cargo/env`: cargo test --release
 set -euo pipefail
 
-MIN_RUST=1.88
+MIN_RUST=1.95
 PACKAGES=(build-essential pkg-config mesa-vulkan-drivers libvulkan1 curl ca-certificates
     # The viewer's window (`rastergi view`): the X11 libraries winit loads at run time, and
     # Xvfb + xauth (for xvfb-run) so its tests run without a display.

@@ -2,7 +2,8 @@
 # Installs what rastergi needs on a fresh Debian or Ubuntu machine: a C toolchain and
 # pkg-config, Mesa's Vulkan drivers (lavapipe runs the GPU code on the CPU when there is no
 # GPU), the X11 libraries of the viewer's window and Xvfb for its tests, and Rust >= 1.95
-# with rustfmt and clippy, and Ray in a Python virtual environment (scripts/ray_render.py).
+# with rustfmt and clippy, and a Python virtual environment with Ray (scripts/ray_render.py)
+# and maturin, pytest and numpy (the Python package, python/).
 # Safe to run again: it installs only what is missing. Afterwards,
 # in a new shell or after `. ~/.cargo/env`: cargo test --release
 set -euo pipefail
@@ -83,19 +84,30 @@ if command -v rustup >/dev/null 2>&1; then
 fi
 say "ready: $(rustc --version), $(cargo --version)"
 
-# Ray, for scripts/ray_render.py (long renders over a cluster) and its test: in a virtual
-# environment of its own, so the system's Python is left alone.
+# A Python virtual environment of rastergi's own, so the system's Python is left alone: Ray,
+# for scripts/ray_render.py (long renders over a cluster) and its test; maturin, pytest and
+# numpy, for the Python package (python/) and its tests.
 RAY_VENV="$HOME/.local/share/rastergi/venv"
-if [ -x "$RAY_VENV/bin/python" ] && "$RAY_VENV/bin/python" -c "import ray" 2>/dev/null; then
-    say "Ray present in $RAY_VENV"
-else
+if [ ! -x "$RAY_VENV/bin/python" ]; then
     command -v python3 >/dev/null 2>&1 || die "python3 is missing; install it (apt-get install python3 python3-venv)"
     if ! python3 -c "import ensurepip, venv" 2>/dev/null; then
         command -v apt-get >/dev/null 2>&1 || die "python3 cannot make virtual environments; install its venv module"
         as_root env DEBIAN_FRONTEND=noninteractive apt-get install -qq -y --no-install-recommends python3-venv >/dev/null
     fi
-    say "installing Ray into $RAY_VENV"
+    say "creating a virtual environment in $RAY_VENV"
     python3 -m venv "$RAY_VENV" || die "could not create a virtual environment in $RAY_VENV"
+fi
+if "$RAY_VENV/bin/python" -c "import ray" 2>/dev/null; then
+    say "Ray present in $RAY_VENV"
+else
+    say "installing Ray into $RAY_VENV"
     "$RAY_VENV/bin/python" -m pip install --quiet --disable-pip-version-check "ray>=2.40" ||
         die "could not install Ray (pip install ray) into $RAY_VENV"
+fi
+if "$RAY_VENV/bin/python" -c "import maturin, pytest, numpy" 2>/dev/null; then
+    say "maturin, pytest and numpy present in $RAY_VENV"
+else
+    say "installing maturin, pytest and numpy into $RAY_VENV (the Python package's build and tests)"
+    "$RAY_VENV/bin/python" -m pip install --quiet --disable-pip-version-check "maturin>=1.5,<2" pytest numpy ||
+        die "could not install maturin, pytest and numpy (pip install maturin pytest numpy) into $RAY_VENV"
 fi

@@ -20,10 +20,12 @@ use indicatif::{ProgressBar, ProgressStyle};
 use rastergi::checkpoint::Checkpoint;
 use rastergi::fit;
 use rastergi::gather::GatherDirections;
+use rastergi::gpu::Gpu;
 use rastergi::image_io::{ImageFormat, write_exr, write_png};
 use rastergi::path_tracer::PathTracer;
 use rastergi::progressive::Progressive;
-use rastergi::renderer::Renderer;
+use rastergi::renderer::{RenderSettings, Renderer};
+use rastergi::scene::Scene;
 
 use crate::args::{SceneArgs, ShowArg, gpu_profiled, print_profile};
 
@@ -67,10 +69,47 @@ pub struct RenderArgs {
     profile: bool,
 }
 
+/// Which renderer makes the image.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
-enum Method {
+pub enum Method {
+    /// The photon map + rasterized final gather ([`Renderer`]).
     Gather,
+    /// The reference path tracer ([`PathTracer`]).
     Path,
+}
+
+impl Method {
+    /// The name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Gather => "gather",
+            Method::Path => "path",
+        }
+    }
+}
+
+/// Refuses a view the method does not render (the path tracer renders the full image only).
+pub fn check_method_show(method: Method, show: ShowArg) -> Result<()> {
+    if method == Method::Path && !matches!(show, ShowArg::Full) {
+        anyhow::bail!("--method path renders the full image only; drop --show or use --method gather");
+    }
+    Ok(())
+}
+
+/// A renderer, and for the photon-map renderer its gather ray view and directions (for the log).
+pub type Built = (Box<dyn Progressive>, Option<(u32, GatherDirections)>);
+
+/// The renderer of `method` for `scene` (BVH, upload, the first photon map). `render` and the
+/// Python package build theirs here, so the same options give the same image.
+pub fn new_renderer(gpu: &Gpu, scene: &Scene, settings: RenderSettings, method: Method) -> Result<Built> {
+    Ok(match method {
+        Method::Gather => {
+            let r = Renderer::new(gpu, scene, settings)?;
+            let info = (r.bundle(), r.gather_directions());
+            (Box::new(r), Some(info))
+        }
+        Method::Path => (Box::new(PathTracer::new(gpu, scene, settings)?), None),
+    })
 }
 
 /// Refuses, before any rendering, an output path the image could never be written to.
@@ -142,12 +181,8 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
         anyhow::bail!("--checkpoint-every must be a number of seconds ≥ 0, got {}", args.checkpoint_every);
     }
     let settings = a.settings(&scene, a.width, a.height, matches!(a.show, ShowArg::PhotonMap));
-    let method = match args.method {
-        Method::Gather => "gather",
-        Method::Path => "path",
-    };
     let mut fingerprint = settings.fingerprint();
-    fingerprint.insert(0, ("method".to_owned(), method.to_owned()));
+    fingerprint.insert(0, ("method".to_owned(), args.method.name().to_owned()));
     let scene_hash = scene.content_hash();
     let resume = match &args.resume {
         Some(path) => {
@@ -159,20 +194,10 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     };
     let caught = catch_signals()?;
     let gpu = gpu_profiled(&a.gpu, args.profile)?;
-    if args.method == Method::Path && !matches!(a.show, ShowArg::Full) {
-        anyhow::bail!("--method path renders the full image only; drop --show or use --method gather");
-    }
+    check_method_show(args.method, a.show)?;
     let seed = settings.seed;
     let start = Instant::now();
-    // `bundle`: the photon-map renderer's gather ray view and directions, for the log.
-    let (mut renderer, gather_info): (Box<dyn Progressive>, Option<(u32, GatherDirections)>) = match args.method {
-        Method::Gather => {
-            let r = Renderer::new(&gpu, &scene, settings)?;
-            let info = (r.bundle(), r.gather_directions());
-            (Box::new(r), Some(info))
-        }
-        Method::Path => (Box::new(PathTracer::new(&gpu, &scene, settings)?), None),
-    };
+    let (mut renderer, gather_info) = new_renderer(&gpu, &scene, settings, args.method)?;
     if let Some(c) = &resume {
         renderer.resume(&c.progress, &c.film)?;
         log::info!("resumed {} iterations", c.film.samples);

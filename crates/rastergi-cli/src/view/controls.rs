@@ -307,6 +307,7 @@ impl Controls {
             Action::Speed(s) => self.camera.speed = s.max(1e-6),
             Action::Home => r.camera_moved = self.home(),
             Action::Open(ref name) => r.open = Some(name.clone()),
+            Action::Panel(on) => self.panel = on,
             Action::Screenshot => r.screenshot = true,
             Action::Quit => r.quit = true,
             Action::Resize { .. } => {}

@@ -93,7 +93,7 @@ Actions: move R,U,F | look YAW,PITCH | orbit YAW,PITCH | pan X,Y | zoom STEPS |
   mode fly|orbit | speed S | home | show full|direct|indirect|photon-map | exposure EV |
   photons N | grid N | passes N | sun AZIMUTH,ELEVATION | env-scale S | method gather|path |
   gather auto|raster|lists|trace | gather-directions per-pixel|shared | directions N |
-  open SCENE | resize W,H | screenshot | quit
+  open SCENE | panel on|off | resize W,H | screenshot | quit
 The control panel's widgets act through the same actions.
 Each screenshot prints its files and the camera as render options to stdout."
 );

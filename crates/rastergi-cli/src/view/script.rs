@@ -41,6 +41,7 @@
 //! | `speed S` | the camera's flying speed, scene units per second |
 //! | `home` | back to the starting camera |
 //! | `open SCENE` | opens another scene (built in or a file), as the panel's Open does |
+//! | `panel on\|off` | shows or hides the control panel (as H) |
 //! | `resize W,H` | asks for a W×H window; waits until the image has that size |
 //! | `screenshot` | saves `rastergi-NNNN.png` and `.exr` as the P key does |
 //! | `quit` | closes the viewer |
@@ -128,6 +129,8 @@ pub enum Action {
     Home,
     /// Opens a scene: a built-in name or a file.
     Open(String),
+    /// Shows or hides the control panel.
+    Panel(bool),
     Resize {
         width: u32,
         height: u32,
@@ -199,7 +202,7 @@ fn parse_when(condition: &str) -> Result<When> {
 }
 
 const ACTIONS: &str = "move, look, orbit, pan, zoom, mode, show, exposure, photons, grid, passes, sun, env-scale, \
-                       method, gather, gather-directions, directions, speed, home, open, resize, screenshot, quit";
+                       method, gather, gather-directions, directions, speed, home, open, panel, resize, screenshot, quit";
 
 fn parse_action(action: &str) -> Result<Action> {
     let (name, args) = match action.split_once(char::is_whitespace) {
@@ -275,6 +278,11 @@ fn parse_action(action: &str) -> Result<Action> {
         "home" => none(Action::Home)?,
         "open" if args.is_empty() => bail!("'open' takes a scene: a built-in name or a file"),
         "open" => Action::Open(args.to_owned()),
+        "panel" => Action::Panel(match args {
+            "on" => true,
+            "off" => false,
+            _ => bail!("'panel' takes 'on' or 'off'"),
+        }),
         "resize" => {
             let [width, height] = numbers::<2>(args, "W,H")?;
             let side = |v: f32| (1.0..=16384.0).contains(&v) && v.fract() == 0.0;
@@ -351,7 +359,7 @@ mod tests {
     fn the_panels_actions_parse() {
         let steps = parse(
             "method path\nmethod gather\ngather trace\ngather-directions shared\ndirections 2\npasses 0\n\
-             env-scale 0.5\nspeed 2\nhome\nopen scenes/my room.obj\n",
+             env-scale 0.5\nspeed 2\nhome\nopen scenes/my room.obj\npanel off\n",
         )
         .unwrap();
         assert_eq!(
@@ -367,6 +375,7 @@ mod tests {
                 Action::Speed(2.0),
                 Action::Home,
                 Action::Open("scenes/my room.obj".into()),
+                Action::Panel(false),
             ]
         );
     }
@@ -390,6 +399,7 @@ mod tests {
             ("speed 0", "line 1", "positive"),
             ("env-scale -1", "line 1", "≥ 0"),
             ("open", "line 1", "takes a scene"),
+            ("panel hidden", "line 1", "'on' or 'off'"),
         ];
         for (text, line, message) in cases {
             let e = format!("{:#}", parse(text).unwrap_err());

@@ -98,7 +98,7 @@ else
     B_INFO=10      # adapter query
     B_PHOTONS=30   # 4 GPU runs of 4 M photons, then the CPU twin once (a few s on 8+ cores)
     B_GATHER=45    # 2 sizes x 3 gathers: a renderer each (4 M photons), 2 + 16 iterations
-    B_FRAMES=30    # set-up and warm-up, then 2 x 8 s
+    B_FRAMES=30    # set-up and warm-up, then 3 x 6 s (panel shown, hidden, one iteration per frame)
     B_REF=55       # each of the two reference renders: 50 s of path tracing + set-up
     B_COMPARE=5    # the two halves of the reference against each other
     B_CONVERGE=45  # 15 s each for the renderer and the path tracer, + set-up and read-backs
@@ -107,7 +107,7 @@ else
     B_MEMORY=20    # one renderer at 1920x1080, grid 128, bundle 2048, auto's trial iterations
     PHOTONS=(--photons 4194304 --repeats 3)
     GATHER=(--sizes 512,1024 --iterations 16)
-    FRAMES=(--width 1920 --height 1080 --seconds 8)
+    FRAMES=(--width 1920 --height 1080 --seconds 6)
     SIZE=1024 REF_SECONDS=50 CONVERGE_SECONDS=15 MITSUBA_SECONDS=8
     MEMORY=()
 fi

@@ -81,8 +81,8 @@ fn quick_report_has_every_section_with_its_command_and_figures() {
     check_figures(&report, "Photons", "M photons/s", 2);
     // Two sizes × three gathers.
     check_figures(&report, "Gather", "directions/s", 6);
-    // Batched and one iteration per frame.
-    check_figures(&report, "Viewer loop", "frames/s", 2);
+    // Batched with the panel, without it, and one iteration per frame.
+    check_figures(&report, "Viewer loop", "frames/s", 3);
     check_figures(&report, "Viewer loop", "iterations/s", 2);
     // The reference's noise and the last error of the renderer and of the path tracer.
     check_figures(&report, "Convergence", "%** of the converged image", 1);

@@ -381,9 +381,27 @@ impl OffscreenTarget {
 
     /// What [`WindowSurface::present`] does, onto the texture: submits `enc` followed by
     /// drawing `film` and `overlay`.
-    pub fn draw(&mut self, gpu: &Gpu, mut enc: wgpu::CommandEncoder, film: Option<&Film>, overlay: &[String]) {
+    pub fn draw(&mut self, gpu: &Gpu, enc: wgpu::CommandEncoder, film: Option<&Film>, overlay: &[String]) {
+        self.draw_with(gpu, enc, film, overlay, |_, _, _| {});
+    }
+
+    /// What [`WindowSurface::present_with`] does, onto the texture.
+    pub fn draw_with(
+        &mut self,
+        gpu: &Gpu,
+        mut enc: wgpu::CommandEncoder,
+        film: Option<&Film>,
+        overlay: &[String],
+        draw_over: impl FnOnce(&mut wgpu::CommandEncoder, &wgpu::TextureView, (u32, u32)),
+    ) {
         self.pass.encode(gpu, &mut enc, &self.view, self.size, film, overlay);
+        draw_over(&mut enc, &self.view, self.size);
         gpu.queue.submit([enc.finish()]);
+    }
+
+    /// The texture's format (a user interface drawn over it must target it).
+    pub fn format(&self) -> wgpu::TextureFormat {
+        self.pass.format()
     }
 }
 

@@ -1,20 +1,23 @@
 //! `rastergi bench frames`: frames per second of the viewer's frame loop, without a window.
 //!
-//! A frame does the viewer's per-frame GPU work: its batch of iterations
+//! A frame does the viewer's per-frame work: its batch of iterations
 //! ([`crate::view::iterate_frame`]: as many as fit in [`FRAME_BUDGET`] at the last frame's
-//! time per iteration, 1 to [`MAX_BATCH`]), the resolve of the display image and the display
-//! pass with a four-line overlay, drawn into a texture of the window's size instead of a
-//! swapchain image ([`OffscreenTarget`]): nothing is presented, so there is no vsync and the
-//! figure is what the GPU sustains. The renderer has the viewer's settings (photons and grid
-//! fitted to the scene, the photon-map view accumulated, `--gather auto`).
+//! time per iteration, 1 to [`MAX_BATCH`]), the resolve of the display image, the display
+//! pass and the control panel (its egui pass, tessellation and egui-wgpu drawing), into a
+//! texture of the window's size instead of a swapchain image ([`OffscreenTarget`]): nothing
+//! is presented, so there is no vsync and the figure is what the GPU sustains. The renderer
+//! has the viewer's settings (photons and grid fitted to the scene, the photon-map view
+//! accumulated, `--gather auto`).
 //!
-//! Two phases of `--seconds` each, after a warm-up that lets `auto` choose its gather: the
-//! viewer's batched loop, then one iteration per frame (a viewer that shows every iteration).
+//! Three phases of `--seconds` each, after a warm-up that lets `auto` choose its gather: the
+//! viewer's batched loop with the panel, the same without it (H), then one iteration per
+//! frame (a viewer that shows every iteration) with the panel.
 
 use std::time::Instant;
 
 use anyhow::Result;
 use clap::Args;
+use rastergi::camera_control::CameraControl;
 use rastergi::display::OffscreenTarget;
 use rastergi::film::Show;
 use rastergi::fit;
@@ -24,6 +27,8 @@ use rastergi::renderer::{RenderSettings, Renderer};
 
 use super::load_valid_scene;
 use crate::args::{GatherArg, GpuArgs, gpu};
+use crate::view::controls::Controls;
+use crate::view::panel::{self, Figures, PanelPainter, PanelState};
 use crate::view::{FRAME_BUDGET, MAX_BATCH, iterate_frame};
 
 #[derive(Args, Debug)]
@@ -52,38 +57,71 @@ pub struct FramesArgs {
     gpu: GpuArgs,
 }
 
-/// The headless viewer: renderer, offscreen window and the batch of the next frame.
+/// The viewer's control panel without a window: egui fed an empty input of the window's
+/// size each frame, drawn as the viewer draws it.
+struct HeadlessPanel {
+    ctx: egui::Context,
+    painter: PanelPainter,
+    state: PanelState,
+    controls: Controls,
+}
+
+/// The headless viewer: renderer, offscreen window, panel and the batch of the next frame.
 struct Loop {
     gpu: Gpu,
     renderer: Renderer,
     target: OffscreenTarget,
+    panel: HeadlessPanel,
     batch: u32,
 }
 
 impl Loop {
     /// One frame with at most `limit` iterations (the viewer's batch where `limit` is
-    /// `u32::MAX`); returns the iterations it ran.
-    fn frame(&mut self, limit: u32) -> Result<u32> {
+    /// `u32::MAX`), the panel drawn or not; returns the iterations it ran.
+    fn frame(&mut self, limit: u32, with_panel: bool) -> Result<u32> {
         let done = iterate_frame(&mut self.renderer, self.batch.min(limit), &mut self.batch)?;
-        let overlay = vec![
-            format!("bench frames  {}x{}", self.renderer.settings().width, self.renderer.settings().height),
-            format!("iterations {}  ({} per frame)", self.renderer.samples(), done),
-            format!("gather {:?}", self.renderer.gather_method()),
-            "show full [1-4]  exposure +0.0 EV [+/-]".to_owned(),
-        ];
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
         self.renderer.encode_resolve(&mut enc, Show::Full, 0.0);
-        self.target.draw(&self.gpu, enc, Some(self.renderer.film()), &overlay);
+        let film = Some(self.renderer.film());
+        if !with_panel {
+            self.target.draw(&self.gpu, enc, film, &[]);
+            return Ok(done);
+        }
+        let r = &self.renderer;
+        let (w, h) = (r.settings().width, r.settings().height);
+        let figures = Figures {
+            scene: "bench frames",
+            size: (w, h),
+            samples: r.samples(),
+            iterations_per_second: 0.0,
+            error: None,
+            error_is_rough: true,
+            photon_pass: Some((r.photon_pass(), r.settings().photons)),
+            gather_in_use: Some(r.gather_method()),
+            memory: None,
+            history: &[],
+            status: "",
+        };
+        let p = &mut self.panel;
+        let input = egui::RawInput {
+            screen_rect: Some(egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(w as f32, h as f32))),
+            ..Default::default()
+        };
+        let output = p.ctx.run_pass(input, |ctx| {
+            panel::window(ctx, &p.controls, &figures, &mut p.state);
+        });
+        let (gpu, ctx, painter) = (&self.gpu, &p.ctx, &mut p.painter);
+        self.target.draw_with(gpu, enc, film, &[], |enc, view, size| painter.encode(gpu, ctx, output, enc, view, size));
         Ok(done)
     }
 
     /// Frames for `seconds` with at most `limit` iterations each: (frames, iterations,
     /// seconds). The last frame's display work is waited for.
-    fn run(&mut self, seconds: f64, limit: u32) -> Result<(u32, u32, f64)> {
+    fn run(&mut self, seconds: f64, limit: u32, with_panel: bool) -> Result<(u32, u32, f64)> {
         let start = Instant::now();
         let (mut frames, mut iterations) = (0, 0);
         while frames == 0 || start.elapsed().as_secs_f64() < seconds {
-            iterations += self.frame(limit)?;
+            iterations += self.frame(limit, with_panel)?;
             frames += 1;
         }
         self.gpu.wait()?;
@@ -107,10 +145,13 @@ pub fn run(a: &FramesArgs) -> Result<()> {
         ..Default::default()
     };
     let start = Instant::now();
+    let controls = Controls::new(CameraControl::new(&scene.camera, &scene.bounds()), Show::Full, 0.0, &settings);
     let renderer = Renderer::new(&gpu, &scene, settings)?;
     renderer.wait()?;
     let setup = start.elapsed().as_secs_f64();
     let target = OffscreenTarget::new(&gpu, a.width, a.height)?;
+    let painter = PanelPainter::new(&gpu.device, target.format());
+    let panel = HeadlessPanel { ctx: egui::Context::default(), painter, state: PanelState::default(), controls };
     println!(
         "viewer frame loop (no window): {} at {}x{} on {} ({:?}), {photons} photons, grid {grid}, bundle {}",
         a.scene,
@@ -121,17 +162,17 @@ pub fn run(a: &FramesArgs) -> Result<()> {
         renderer.bundle()
     );
     println!(
-        "  a frame: iterations batched to {} ms (1 to {MAX_BATCH}), resolve, display pass into an offscreen {}x{} texture; no present, no vsync",
+        "  a frame: iterations batched to {} ms (1 to {MAX_BATCH}), resolve, display pass and the control panel into an offscreen {}x{} texture; no present, no vsync",
         FRAME_BUDGET.as_millis(),
         a.width,
         a.height
     );
-    let mut l = Loop { gpu, renderer, target, batch: 1 };
+    let mut l = Loop { gpu, renderer, target, panel, batch: 1 };
     // Warm-up: `auto` times its gathers on the first iterations; the batch size settles.
     let start = Instant::now();
     let mut warm = 0;
     while warm < 3 || (l.renderer.photon_map().is_some() && l.renderer.gather_method() == GatherMethod::Auto) {
-        l.frame(u32::MAX)?;
+        l.frame(u32::MAX, true)?;
         warm += 1;
     }
     l.gpu.wait()?;
@@ -140,8 +181,15 @@ pub fn run(a: &FramesArgs) -> Result<()> {
         start.elapsed().as_secs_f64(),
         l.renderer.gather_method()
     );
-    for (name, limit) in [("viewer's batches", u32::MAX), ("one iteration per frame", 1)] {
-        let (frames, iterations, seconds) = l.run(a.seconds, limit)?;
+    let phases = [
+        ("viewer's batches", u32::MAX, true),
+        ("the same, panel hidden", u32::MAX, false),
+        ("one iteration per frame", 1, true),
+    ];
+    let mut rates = Vec::new();
+    for (name, limit, with_panel) in phases {
+        let (frames, iterations, seconds) = l.run(a.seconds, limit, with_panel)?;
+        rates.push((seconds / frames as f64, iterations as f64 / seconds));
         println!(
             "  {name:<24} {:>8.2} frames/s  {:>8.2} iterations/s  ({frames} frames, {iterations} iterations in {seconds:.2} s; {:.1} ms per frame)",
             frames as f64 / seconds,
@@ -149,5 +197,10 @@ pub fn run(a: &FramesArgs) -> Result<()> {
             1e3 * seconds / frames as f64
         );
     }
+    println!(
+        "  the panel, batched, shown vs hidden: {:+.1} ms per frame, iterations/s x {:.3}",
+        1e3 * (rates[0].0 - rates[1].0),
+        rates[0].1 / rates[1].1
+    );
     Ok(())
 }

@@ -27,8 +27,8 @@
 //! the frame loop), [`panel`], [`screenshots`] and [`script`].
 
 mod app;
-mod controls;
-mod panel;
+pub(crate) mod controls;
+pub(crate) mod panel;
 mod screenshots;
 mod script;
 

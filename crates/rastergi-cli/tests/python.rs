@@ -5,8 +5,10 @@
 //! come from scripts/setup.sh (the virtual environment under ~/.local/share/rastergi, or
 //! RASTERGI_PYTHON).
 
+mod common;
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Output};
 use std::time::Instant;
 
 fn repo() -> PathBuf {
@@ -15,22 +17,7 @@ fn repo() -> PathBuf {
 
 /// A Python with maturin, pytest and numpy.
 fn python() -> String {
-    let mut candidates = Vec::new();
-    if let Ok(p) = std::env::var("RASTERGI_PYTHON") {
-        candidates.push(p);
-    }
-    if let Some(home) = std::env::var_os("HOME") {
-        candidates.push(Path::new(&home).join(".local/share/rastergi/venv/bin/python").to_string_lossy().into_owned());
-    }
-    for c in &candidates {
-        let ok = Command::new(c).args(["-c", "import maturin, pytest, numpy"]).stderr(Stdio::null()).status();
-        if ok.is_ok_and(|s| s.success()) {
-            return c.clone();
-        }
-    }
-    panic!(
-        "no Python with maturin, pytest and numpy among {candidates:?}: run `bash scripts/setup.sh`, which installs them"
-    );
+    common::python_importing("maturin, pytest, numpy", false)
 }
 
 fn show(what: &str, out: &Output) -> String {

@@ -16,21 +16,7 @@ const TIMEOUT: Duration = Duration::from_secs(600);
 
 /// A Python that imports Ray.
 fn python() -> String {
-    let mut candidates = Vec::new();
-    if let Ok(p) = std::env::var("RASTERGI_PYTHON") {
-        candidates.push(p);
-    }
-    if let Some(home) = std::env::var_os("HOME") {
-        candidates.push(Path::new(&home).join(".local/share/rastergi/venv/bin/python").to_string_lossy().into_owned());
-    }
-    candidates.push("python3".to_owned());
-    for c in &candidates {
-        let ok = Command::new(c).args(["-c", "import ray"]).stderr(Stdio::null()).status();
-        if ok.is_ok_and(|s| s.success()) {
-            return c.clone();
-        }
-    }
-    panic!("no Python with Ray among {candidates:?}: run scripts/setup.sh, which installs it");
+    common::python_importing("ray", true)
 }
 
 fn script() -> PathBuf {

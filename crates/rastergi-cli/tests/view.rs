@@ -78,6 +78,20 @@ fn screenshots(dir: &Path, stdout: &str) -> Vec<Shot> {
         .collect()
 }
 
+/// The Cornell box in the viewer (64², few photons) with `seed`, driven by `script` in `d`,
+/// which must succeed: its run and screenshots.
+fn scripted_view(d: &Path, script: &str, seed: u32) -> (Run, Vec<Shot>) {
+    std::fs::write(d.join("script.txt"), script).unwrap();
+    let seed = seed.to_string();
+    let mut args = vec!["cornell", "--seed", &seed, "--script", "script.txt"];
+    args.extend_from_slice(SIZE);
+    args.extend_from_slice(PHOTONS);
+    let run = view(d, &args);
+    run.check_success("view");
+    let shots = screenshots(d, &run.stdout);
+    (run, shots)
+}
+
 /// A headless render of the Cornell box, `iterations` with `extra` options (camera, seed, show).
 fn render(dir: &Path, out: &str, seed: u32, iterations: u32, extra: &[String]) -> LinearImage {
     render_scene(dir, "cornell", out, seed, iterations, extra)
@@ -113,15 +127,8 @@ fn screenshots_after_a_scripted_move_match_headless_renders_of_the_same_view() {
     let script = format!(
         "after {N} iterations: orbit 8,4\nafter {N} iterations: exposure 1\nscreenshot\nshow direct\nscreenshot\nquit\n"
     );
-    std::fs::write(d.join("script.txt"), script).unwrap();
-    let seed = SEED.to_string();
-    let mut args = vec!["cornell", "--seed", &seed, "--script", "script.txt"];
-    args.extend_from_slice(SIZE);
-    args.extend_from_slice(PHOTONS);
-    let run = view(d, &args);
-    run.check_success("view");
+    let (run, shots) = scripted_view(d, &script, SEED);
     assert!(run.stdout.contains("Keys and mouse:"), "the keys are printed at start:\n{}", run.stdout);
-    let shots = screenshots(d, &run.stdout);
     assert_eq!(shots.len(), 2, "{}", run.stdout);
     assert_eq!(std::fs::read(d.join("rastergi-0001.png")).unwrap(), b"an earlier screenshot");
     let names: Vec<_> = shots.iter().map(|s| s.png.file_name().unwrap().to_str().unwrap().to_owned()).collect();
@@ -239,14 +246,7 @@ fn the_panels_actions_switch_the_method_the_gather_and_the_scene_as_render_optio
     let script = "method path\nafter 4 iterations: screenshot\nmethod gather\ngather trace\n\
                   gather-directions shared\ndirections 2\nafter 4 iterations: screenshot\nopen no-such.obj\nopen rooms\n\
                   after 2 iterations: screenshot\nquit\n";
-    std::fs::write(d.join("script.txt"), script).unwrap();
-    let seed = SEED.to_string();
-    let mut args = vec!["cornell", "--seed", &seed, "--script", "script.txt"];
-    args.extend_from_slice(SIZE);
-    args.extend_from_slice(PHOTONS);
-    let run = view(d, &args);
-    run.check_success("view");
-    let shots = screenshots(d, &run.stdout);
+    let (run, shots) = scripted_view(d, script, SEED);
     assert_eq!(shots.len(), 3, "{}", run.stdout);
     let gather = ["--gather", "trace", "--gather-directions", "shared", "--directions", "2"];
     let cases = [

@@ -78,3 +78,27 @@ pub fn run(dir: &Path, program: &str, args: &[&str], env: &[(&str, Option<&str>)
 pub fn rastergi(dir: &Path, args: &[&str], timeout: Duration) -> Run {
     run(dir, env!("CARGO_BIN_EXE_rastergi"), args, &[], timeout)
 }
+
+/// The first Python that imports `modules` (comma-separated, e.g. "maturin, pytest") among
+/// `RASTERGI_PYTHON`, the virtual environment `scripts/setup.sh` makes
+/// (`~/.local/share/rastergi/venv`) and `python3` where `system` is set; without one, a panic
+/// that says to run the set-up.
+pub fn python_importing(modules: &str, system: bool) -> String {
+    let mut candidates = Vec::new();
+    if let Ok(p) = std::env::var("RASTERGI_PYTHON") {
+        candidates.push(p);
+    }
+    if let Some(home) = std::env::var_os("HOME") {
+        candidates.push(Path::new(&home).join(".local/share/rastergi/venv/bin/python").to_string_lossy().into_owned());
+    }
+    if system {
+        candidates.push("python3".to_owned());
+    }
+    for c in &candidates {
+        let ok = Command::new(c).args(["-c", &format!("import {modules}")]).stderr(Stdio::null()).status();
+        if ok.is_ok_and(|s| s.success()) {
+            return c.clone();
+        }
+    }
+    panic!("no Python importing {modules} among {candidates:?}: run `bash scripts/setup.sh`, which installs them");
+}

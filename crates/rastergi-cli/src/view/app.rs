@@ -26,8 +26,9 @@ use winit::window::{Window, WindowId};
 use super::controls::{Controls, Key, Response, SunAngles, camera_options, show_name};
 use super::panel::{self, Figures, PanelPainter, PanelState};
 use super::screenshots::Screenshots;
-use super::script::{Action, Engine, Step, When};
+use super::script::{Action, Step, When};
 use crate::args::SceneArgs;
+use crate::render::Method;
 
 /// GPU time aimed at per displayed frame: iterations are batched up to this.
 pub const FRAME_BUDGET: Duration = Duration::from_millis(30);
@@ -151,7 +152,7 @@ impl Active {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Build {
     settings: RenderSettings,
-    engine: Engine,
+    method: Method,
     sun: Option<SunAngles>,
     env_scale: Option<f32>,
     /// Which scene: counts the scenes opened.
@@ -315,7 +316,7 @@ impl App {
     fn wanted(&self) -> Build {
         Build {
             settings: self.controls.settings(&self.base, self.size.0, self.size.1),
-            engine: self.controls.engine,
+            method: self.controls.method,
             sun: self.controls.sun,
             env_scale: self.controls.env_scale,
             scene: self.scene_id,
@@ -356,7 +357,7 @@ impl App {
         });
         self.status = match &open {
             Some(name) => format!("opening {name}..."),
-            None if wanted.engine == Engine::PathTracer => "starting the path tracer...".into(),
+            None if wanted.method == Method::Path => "starting the path tracer...".into(),
             None => format!("tracing {} photons...", wanted.settings.photons),
         };
         let loaded_scale = self.args.env_scale;
@@ -391,11 +392,11 @@ impl App {
                     }
                 };
                 let scene = prepare(scene, &wanted, loaded_scale);
-                let active = match wanted.engine {
-                    Engine::PhotonMap => {
+                let active = match wanted.method {
+                    Method::Gather => {
                         Active::PhotonMap(Box::new(Renderer::new(&gpu, &scene, wanted.settings.clone())?))
                     }
-                    Engine::PathTracer => {
+                    Method::Path => {
                         Active::PathTracer(Box::new(PathTracer::new(&gpu, &scene, wanted.settings.clone())?))
                     }
                 };
@@ -713,7 +714,7 @@ impl App {
             (b.settings.photons, b.settings.grid_resolution, b.settings.photon_passes);
         (c.gather, c.gather_directions, c.directions) =
             (b.settings.gather, b.settings.gather_directions, b.settings.directions);
-        (c.engine, c.sun, c.env_scale) = (b.engine, b.sun, b.env_scale);
+        (c.method, c.sun, c.env_scale) = (b.method, b.sun, b.env_scale);
     }
 }
 

@@ -9,7 +9,8 @@ use rastergi::gather::{GatherDirections, GatherMethod};
 use rastergi::renderer::RenderSettings;
 use rastergi::scene::Camera;
 
-use super::script::{Action, Engine};
+use super::script::Action;
+use crate::render::Method;
 
 /// A key that means something to the viewer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -94,7 +95,7 @@ pub struct Controls {
     pub keys: MoveKeys,
     pub show: Show,
     pub exposure: f32,
-    pub engine: Engine,
+    pub method: Method,
     pub photons: u32,
     pub grid: u32,
     pub photon_passes: u32,
@@ -119,7 +120,7 @@ impl Controls {
             keys: MoveKeys::default(),
             show,
             exposure,
-            engine: Engine::PhotonMap,
+            method: Method::Gather,
             photons: settings.photons,
             grid: settings.grid_resolution,
             photon_passes: settings.photon_passes,
@@ -132,8 +133,8 @@ impl Controls {
         }
     }
 
-    /// A new scene's camera (also the new Home), keeping the camera's mode and speed factor
-    /// relative to the scene's size.
+    /// A new scene's camera (also the new Home), its speed fitted to that scene; the drag
+    /// mode stays.
     pub fn set_home(&mut self, camera: CameraControl) {
         let mode = self.camera.mode;
         self.home = camera.clone();
@@ -297,7 +298,7 @@ impl Controls {
                     *scale = s;
                 }
             }
-            Action::Method(e) => r.retrace = std::mem::replace(&mut self.engine, e) != e,
+            Action::Method(e) => r.retrace = std::mem::replace(&mut self.method, e) != e,
             Action::Gather(g) => r.retrace = std::mem::replace(&mut self.gather, g) != g,
             Action::GatherDirections(d) => r.retrace = std::mem::replace(&mut self.gather_directions, d) != d,
             Action::Directions(n) => {
@@ -422,7 +423,7 @@ mod tests {
         let base = RenderSettings::default();
         let before = c.settings(&base, 64, 48);
         let changes = [
-            Action::Method(Engine::PathTracer),
+            Action::Method(Method::Path),
             Action::Gather(GatherMethod::Lists),
             Action::GatherDirections(GatherDirections::Shared),
             Action::Directions(7),
@@ -438,7 +439,7 @@ mod tests {
             (after.gather, after.gather_directions, after.directions, after.photon_passes),
             (GatherMethod::Lists, GatherDirections::Shared, 7, 3)
         );
-        assert_eq!(c.engine, Engine::PathTracer);
+        assert_eq!(c.method, Method::Path);
         assert!(!c.action(&Action::EnvScale(2.0), 64.0).retrace, "no environment, nothing to scale");
         c.env_scale = Some(1.0);
         assert!(c.action(&Action::EnvScale(2.0), 64.0).retrace && c.env_scale == Some(2.0));

@@ -10,13 +10,16 @@
 
 use std::path::{Path, PathBuf};
 
+use clap::ValueEnum;
 use egui::{Color32, ComboBox, RichText, Slider, Stroke, Ui};
 use egui_wgpu::wgpu;
 use rastergi::film::Show;
 use rastergi::gather::{GatherDirections, GatherMethod, MAX_DIRECTIONS};
 
 use super::controls::{Controls, SunAngles, show_name};
-use super::script::{Action, Engine};
+use super::script::Action;
+use crate::args::GatherArg;
+use crate::render::Method;
 
 /// The built-in scenes the panel offers (`spheres:N` takes a count, so it is typed).
 const BUILTINS: [&str; 4] = ["cornell", "atrium", "rooms", "rooms:closed"];
@@ -118,7 +121,7 @@ pub fn contents(ui: &mut Ui, c: &Controls, f: &Figures, state: &mut PanelState) 
     ui.separator();
     egui::CollapsingHeader::new("Scene").default_open(true).show(ui, |ui| scene(ui, f, state, &mut out));
     egui::CollapsingHeader::new("Renderer").default_open(true).show(ui, |ui| renderer(ui, c, &mut out));
-    if c.engine == Engine::PhotonMap {
+    if c.method == Method::Gather {
         egui::CollapsingHeader::new("Photon map").default_open(true).show(ui, |ui| photon_map(ui, c, &mut out));
     }
     if c.sun.is_some() || c.env_scale.is_some() {
@@ -265,20 +268,20 @@ fn scene(ui: &mut Ui, f: &Figures, state: &mut PanelState, out: &mut Vec<Action>
 }
 
 fn renderer(ui: &mut Ui, c: &Controls, out: &mut Vec<Action>) {
-    let mut engine = c.engine;
+    let mut method = c.method;
     ui.horizontal(|ui| {
-        ui.radio_value(&mut engine, Engine::PhotonMap, "photon map + gather");
-        ui.radio_value(&mut engine, Engine::PathTracer, "path tracer");
+        ui.radio_value(&mut method, Method::Gather, "photon map + gather");
+        ui.radio_value(&mut method, Method::Path, "path tracer");
     });
-    if engine != c.engine {
-        out.push(Action::Method(engine));
+    if method != c.method {
+        out.push(Action::Method(method));
     }
-    if c.engine != Engine::PhotonMap {
+    if c.method != Method::Gather {
         return;
     }
     let mut gather = c.gather;
     ComboBox::from_label("gather").selected_text(gather_name(gather)).show_ui(ui, |ui| {
-        for g in [GatherMethod::Auto, GatherMethod::Raster, GatherMethod::Lists, GatherMethod::Trace] {
+        for g in GatherArg::value_variants().iter().map(|a| a.method()) {
             ui.selectable_value(&mut gather, g, gather_name(g));
         }
     });
@@ -369,7 +372,7 @@ fn display(ui: &mut Ui, c: &Controls, out: &mut Vec<Action>) {
     let mut show = c.show;
     ui.horizontal_wrapped(|ui| {
         for s in [Show::Full, Show::Direct, Show::Indirect, Show::PhotonMap] {
-            ui.add_enabled_ui(s == Show::Full || c.engine == Engine::PhotonMap, |ui| {
+            ui.add_enabled_ui(s == Show::Full || c.method == Method::Gather, |ui| {
                 ui.radio_value(&mut show, s, show_name(s));
             });
         }
@@ -384,13 +387,9 @@ fn display(ui: &mut Ui, c: &Controls, out: &mut Vec<Action>) {
 }
 
 /// The name of a gather implementation as `--gather` spells it.
-pub fn gather_name(g: GatherMethod) -> &'static str {
-    match g {
-        GatherMethod::Auto => "auto",
-        GatherMethod::Raster => "raster",
-        GatherMethod::Lists => "lists",
-        GatherMethod::Trace => "trace",
-    }
+pub fn gather_name(g: GatherMethod) -> String {
+    let arg = GatherArg::value_variants().iter().find(|a| a.method() == g);
+    arg.and_then(|a| a.to_possible_value()).map_or_else(|| format!("{g:?}"), |v| v.get_name().to_owned())
 }
 
 /// egui-wgpu on the viewer's device: draws the panel's output over the swapchain image.
@@ -505,7 +504,7 @@ mod tests {
         h.run();
         h.get_by_label("path tracer").click();
         h.run();
-        assert_eq!(h.state().actions, [Action::Method(Engine::PathTracer)]);
+        assert_eq!(h.state().actions, [Action::Method(Method::Path)]);
         assert!(h.query_by_label("photons").is_none(), "no photon map settings for the path tracer");
         h.get_by_label("photon map + gather").click();
         h.run();
@@ -518,7 +517,7 @@ mod tests {
         assert_eq!(
             h.state().actions[1..],
             [
-                Action::Method(Engine::PhotonMap),
+                Action::Method(Method::Gather),
                 Action::GatherDirections(GatherDirections::Shared),
                 Action::Screenshot,
                 Action::Show(Show::Indirect),

@@ -56,8 +56,12 @@ use std::path::Path;
 use std::time::Duration;
 
 use anyhow::{Context, Result, bail};
+use clap::ValueEnum;
 use rastergi::film::Show;
 use rastergi::gather::{GatherDirections, GatherMethod};
+
+use crate::args::{GatherArg, GatherDirectionsArg, ShowArg};
+use crate::render::Method;
 
 /// When a step runs.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -68,16 +72,6 @@ pub enum When {
     Iterations(u32),
     /// This long after the previous step ran.
     Elapsed(Duration),
-}
-
-/// Which renderer the viewer runs.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Engine {
-    /// The photon map and the final gather.
-    #[default]
-    PhotonMap,
-    /// The reference path tracer.
-    PathTracer,
 }
 
 /// Something done to the viewer: by a script line, or by the control panel.
@@ -119,7 +113,7 @@ pub enum Action {
     PhotonPasses(u32),
     /// The environment's radiance scale (as `--env-scale`).
     EnvScale(f32),
-    Method(Engine),
+    Method(Method),
     Gather(GatherMethod),
     GatherDirections(GatherDirections),
     /// Gather directions per iteration.
@@ -235,13 +229,7 @@ fn parse_action(action: &str) -> Result<Action> {
             "orbit" => Action::Mode { orbit: true },
             _ => bail!("'mode' takes 'fly' or 'orbit'"),
         },
-        "show" => Action::Show(match args {
-            "full" => Show::Full,
-            "direct" => Show::Direct,
-            "indirect" => Show::Indirect,
-            "photon-map" => Show::PhotonMap,
-            _ => bail!("'show' takes full, direct, indirect or photon-map"),
-        }),
+        "show" => Action::Show(choice::<ShowArg>(name, args)?.show()),
         "photons" => Action::Photons(count(args, "photons", 1, u32::MAX)?),
         "grid" => Action::Grid(count(args, "grid", 1, 1024)?),
         "sun" => {
@@ -253,23 +241,9 @@ fn parse_action(action: &str) -> Result<Action> {
             s if s >= 0.0 => Action::EnvScale(s),
             _ => bail!("'env-scale' takes a number ≥ 0"),
         },
-        "method" => Action::Method(match args {
-            "gather" => Engine::PhotonMap,
-            "path" => Engine::PathTracer,
-            _ => bail!("'method' takes 'gather' or 'path'"),
-        }),
-        "gather" => Action::Gather(match args {
-            "auto" => GatherMethod::Auto,
-            "raster" => GatherMethod::Raster,
-            "lists" => GatherMethod::Lists,
-            "trace" => GatherMethod::Trace,
-            _ => bail!("'gather' takes auto, raster, lists or trace"),
-        }),
-        "gather-directions" => Action::GatherDirections(match args {
-            "per-pixel" => GatherDirections::PerPixel,
-            "shared" => GatherDirections::Shared,
-            _ => bail!("'gather-directions' takes per-pixel or shared"),
-        }),
+        "method" => Action::Method(choice(name, args)?),
+        "gather" => Action::Gather(choice::<GatherArg>(name, args)?.method()),
+        "gather-directions" => Action::GatherDirections(choice::<GatherDirectionsArg>(name, args)?.directions()),
         "directions" => Action::Directions(count(args, "directions", 1, rastergi::gather::MAX_DIRECTIONS)?),
         "speed" => match numbers::<1>(args, "SPEED")?[0] {
             s if s > 0.0 => Action::Speed(s),
@@ -295,6 +269,21 @@ fn parse_action(action: &str) -> Result<Action> {
         "quit" => none(Action::Quit)?,
         other => bail!("unknown action '{other}' (expected one of: {ACTIONS})"),
     })
+}
+
+/// One of the values the command line's option of that kind takes (`--show`, `--method`,
+/// `--gather`, `--gather-directions`), spelled as there.
+fn choice<T: ValueEnum>(name: &str, args: &str) -> Result<T> {
+    if let Ok(v) = T::from_str(args, false) {
+        return Ok(v);
+    }
+    let names: Vec<String> =
+        T::value_variants().iter().filter_map(|v| v.to_possible_value()).map(|v| v.get_name().to_owned()).collect();
+    match names.as_slice() {
+        [a, b] => bail!("'{name}' takes '{a}' or '{b}'"),
+        [first @ .., last] => bail!("'{name}' takes {} or {last}", first.join(", ")),
+        [] => unreachable!("a value enum has values"),
+    }
 }
 
 /// `N` comma-separated finite numbers.
@@ -365,8 +354,8 @@ mod tests {
         assert_eq!(
             steps.into_iter().map(|s| s.action).collect::<Vec<_>>(),
             [
-                Action::Method(Engine::PathTracer),
-                Action::Method(Engine::PhotonMap),
+                Action::Method(Method::Path),
+                Action::Method(Method::Gather),
                 Action::Gather(GatherMethod::Trace),
                 Action::GatherDirections(GatherDirections::Shared),
                 Action::Directions(2),

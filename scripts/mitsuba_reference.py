@@ -752,7 +752,10 @@ def bsdf_of(material):
     model, name = material["model"], material["name"]
     kd, emits = material["kd"], max(material["ke"]) > 0
     if model["kind"] == "diffuse":
-        return {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": rgb(kd)}}
+        diffuse = {"type": "diffuse", "reflectance": rgb(kd)}
+        if not material.get("two_sided", True):
+            return diffuse  # glTF's one-sided surfaces: black from behind in both renderers
+        return {"type": "twosided", "bsdf": diffuse}
     if model["kind"] == "glass":
         if emits:
             raise SceneError(f"material '{name}' is glass (illum) and emits (Ke); an emitting "
@@ -1090,13 +1093,21 @@ def load_scene(mi, args, spp):
         camera = scene_camera(args, CORNELL_CAMERA)
         return mi.load_dict(add_lights(mi, cornell_scene_dict(mi, args.width, args.height,
                                                               args.max_depth, spp, camera), args))
-    if not args.scene.lower().endswith(".obj"):
+    if not args.scene.lower().endswith((".obj", ".gltf", ".glb")):
         raise SceneError(f"unknown scene '{args.scene}': use the built-in 'cornell' "
-                         "or a path to a .obj file")
+                         "or a path to a .obj, .gltf or .glb file")
     if not os.path.isfile(args.scene):
         raise SceneError(f"{args.scene}: no such file")
-    groups = load_obj(args.scene)
-    camera = scene_camera(args, framing_camera(*bounds(groups)))
+    file_lights = []
+    if args.scene.lower().endswith(".obj"):
+        groups, file_camera = load_obj(args.scene), None
+    else:
+        from mitsuba_gltf import GltfError, load_gltf
+        try:
+            groups, file_lights, file_camera = load_gltf(args.scene)
+        except GltfError as e:
+            raise SceneError(str(e))
+    camera = scene_camera(args, file_camera or framing_camera(*bounds(groups)))
     if not args.quiet:
         for material, triangles, normals, uvs in groups:
             kd, ke = (", ".join(f"{v:.7g}" for v in material[k]) for k in ("kd", "ke"))
@@ -1110,16 +1121,22 @@ def load_scene(mi, args, spp):
                     + (f" x {opacity[2]:g}" if opacity[2] != 1 else "") + " (vt as u, 1 - v)")
             bsdf = ("" if material["model"]["kind"] == "diffuse" else
                     f", {describe_bsdf(bsdf_of(material))}")
+            sides = ", one-sided" if not material.get("two_sided", True) else ""
             print(f"  {material['name']}: {len(triangles)} triangles, Kd ({kd}), Ke ({ke}), "
-                  f"{shading}{mask}{bsdf}", file=sys.stderr)
+                  f"{shading}{mask}{bsdf}{sides}", file=sys.stderr)
+        for light in file_lights:
+            print(f"  light from the file: {light['type']} "
+                  f"{ {k: v for k, v in light.items() if k != 'to_world'} }", file=sys.stderr)
         print(f"  integrator: {obj_integrator(groups)}", file=sys.stderr)
         print(f"  camera: eye {camera['eye']}, target {camera['target']}, up "
               f"{camera['up']}, fov {camera['fov']}", file=sys.stderr)
     with tempfile.TemporaryDirectory(prefix="rastergi-mitsuba-") as mesh_dir:
         # Mitsuba reads the meshes while loading; the files can go afterwards.
-        return mi.load_dict(add_lights(mi, obj_scene_dict(mi, groups, camera, args.width,
-                                                          args.height, args.max_depth, spp,
-                                                          mesh_dir), args))
+        d = obj_scene_dict(mi, groups, camera, args.width, args.height, args.max_depth, spp,
+                           mesh_dir)
+        for k, light in enumerate(file_lights):
+            d[f"file_light_{k}"] = light
+        return mi.load_dict(add_lights(mi, d, args))
 
 
 def render(mi, args):
@@ -1229,7 +1246,8 @@ def main():
     p = argparse.ArgumentParser(description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--scene", default="cornell",
-                   help="the built-in 'cornell' (default) or a Wavefront .obj file (+ .mtl)")
+                   help="the built-in 'cornell' (default), a Wavefront .obj file (+ .mtl) or a glTF "
+                        ".gltf/.glb file (scripts/mitsuba_gltf.py)")
     p.add_argument("--eye", type=parse_vec3, help="camera position x,y,z (as rastergi's --eye)")
     p.add_argument("--target", type=parse_vec3, help="point looked at, x,y,z")
     p.add_argument("--up", type=parse_vec3, help="camera up vector x,y,z")

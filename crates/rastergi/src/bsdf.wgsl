@@ -146,13 +146,65 @@ fn layer_fresnel(b: Bsdf, c: f32) -> f32 {
     return b.specular * (f0 + (1.0 - f0) * schlick_weight(c));
 }
 
+// The GGX lobe's directional albedo tables (bsdf/albedo.rs, GpuGgxAlbedo): cell k = α·N + μ
+// holds (E₁, E₅) at k and k + 1; means[j] (Ē₁, Ē₅) at α cells j and j + 1. Bound by the pass
+// as `ggx_table` (the scene's binding 13).
+struct GgxAlbedoTable {
+    cells: array<vec4f, GGX_ALBEDO_CELLS>,
+    means: array<vec4f, GGX_ALBEDO_N>,
+}
+
+// (E₁, E₅) of the GGX lobe at cos θ_o = mu and alpha, bilinear between cells
+// (GgxAlbedo::at).
+fn ggx_albedo(mu: f32, alpha: f32) -> vec2f {
+    let n = GGX_ALBEDO_N;
+    let tx = clamp(mu, 0.0, 1.0) * f32(n - 1u);
+    let ty = clamp(alpha, 0.0, 1.0) * f32(n - 1u);
+    let i = min(u32(tx), n - 2u);
+    let j = min(u32(ty), n - 2u);
+    let fx = tx - f32(i);
+    let a = ggx_table.cells[j * n + i];
+    let b = ggx_table.cells[(j + 1u) * n + i];
+    let lo = a.xy + (a.zw - a.xy) * fx;
+    let hi = b.xy + (b.zw - b.xy) * fx;
+    return lo + (hi - lo) * (ty - f32(j));
+}
+
+// (Ē₁, Ē₅) at alpha, linear between cells (GgxAlbedo::mean_at).
+fn ggx_albedo_mean(alpha: f32) -> vec2f {
+    let t = clamp(alpha, 0.0, 1.0) * f32(GGX_ALBEDO_N - 1u);
+    let j = min(u32(t), GGX_ALBEDO_N - 2u);
+    let m = ggx_table.means[j];
+    return m.xy + (m.zw - m.xy) * (t - f32(j));
+}
+
+// The specular layer's directional albedo E_L(cos) (Bsdf::layer_albedo).
+fn layer_albedo(b: Bsdf, c: f32) -> f32 {
+    if bsdf_is_smooth(b) {
+        return layer_fresnel(b, c);
+    }
+    let f0 = layer_f0(b);
+    let e = ggx_albedo(c, b.alpha);
+    return b.specular * (f0 * e.x + (1.0 - f0) * e.y);
+}
+
+// The layer's cosine-weighted mean albedo Ē_L (Bsdf::layer_mean_albedo).
+fn layer_mean_albedo(b: Bsdf) -> f32 {
+    let f0 = layer_f0(b);
+    if bsdf_is_smooth(b) {
+        return b.specular * (f0 + (1.0 - f0) / 21.0);
+    }
+    let m = ggx_albedo_mean(b.alpha);
+    return b.specular * (f0 * m.x + (1.0 - f0) * m.y);
+}
+
+// The share the layer leaves to the diffuse base (Bsdf::diffuse_share): energy-conserving,
+// (1 − E_L(cos_o))(1 − E_L(cos_i)) / (1 − Ē_L).
 fn diffuse_share(b: Bsdf, cos_o: f32, cos_i: f32) -> f32 {
     if b.specular == 0.0 {
         return 1.0;
     }
-    let f0 = layer_f0(b);
-    let m = b.specular * (f0 + (1.0 - f0) / 21.0);
-    return (1.0 - layer_fresnel(b, cos_o)) * (1.0 - layer_fresnel(b, cos_i)) / (1.0 - m);
+    return (1.0 - layer_albedo(b, cos_o)) * (1.0 - layer_albedo(b, cos_i)) / (1.0 - layer_mean_albedo(b));
 }
 
 // The lobes' probabilities (metal, layer, diffuse, glass) for |cos θ_o|.
@@ -423,11 +475,20 @@ fn to_local(f: mat3x3f, v: vec3f) -> vec3f {
 }
 
 // The albedo of a Lambertian surface standing in for b where the final gather's rays and the
-// photon map's lookups meet it (Bsdf::diffuse_equivalent): c for the metal and the diffuse base
-// (the specular layer's share included), the hemispherical reflectance F̄ for glass.
-fn bsdf_diffuse_equivalent(b: Bsdf) -> vec3f {
+// photon map's lookups meet it, seen from ω_o at cosine cos_o (Bsdf::diffuse_equivalent): the
+// directional albedo of the metal and of the opaque dielectric, the hemispherical reflectance
+// F̄ for glass.
+fn bsdf_diffuse_equivalent(b: Bsdf, cos_o_in: f32) -> vec3f {
+    let cos_o = min(abs(cos_o_in), 1.0);
     let f0 = layer_f0(b);
     let mean_f = f0 + (1.0 - f0) / 21.0;
     let opaque = (1.0 - b.metallic) * (1.0 - b.transmission);
-    return b.metallic * b.base + opaque * b.base + vec3f((1.0 - b.metallic) * b.transmission * mean_f);
+    var metal = schlick(b.base, cos_o);
+    if !bsdf_is_smooth(b) {
+        let e = ggx_albedo(cos_o, b.alpha);
+        metal = b.base * e.x + (vec3f(1.0) - b.base) * e.y;
+    }
+    let layer = layer_albedo(b, cos_o);
+    let dielectric = vec3f(layer) + (1.0 - layer) * b.base;
+    return b.metallic * metal + opaque * dielectric + vec3f((1.0 - b.metallic) * b.transmission * mean_f);
 }

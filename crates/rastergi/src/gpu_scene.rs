@@ -416,6 +416,11 @@ impl GpuScene {
             contents: bytemuck::bytes_of(&env_uniform),
             usage: wgpu::BufferUsages::UNIFORM,
         });
+        let ggx_buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("scene ggx albedo"),
+            contents: bytemuck::bytes_of(&crate::bsdf::ggx_albedo().gpu()),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
         let vis = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
         // The BVH and the lights serve compute passes only: the raster stages (which pull
         // vertices and discard holes) see five storage buffers of the scene, well under the
@@ -457,6 +462,9 @@ impl GpuScene {
                 storage_entry::<[f32; 9]>(10, wgpu::ShaderStages::COMPUTE, true),
                 storage_entry::<[f32; 12]>(11, wgpu::ShaderStages::COMPUTE, true),
                 storage_entry::<GpuMaterialMaps>(12, vis, true),
+                // The GGX albedo tables of the scattering model, for compute passes: a uniform
+                // buffer here (any visibility) crashed lavapipe (Mesa 22.3) in the raster gather.
+                storage_entry::<crate::bsdf::albedo::GpuGgxAlbedo>(13, compute, true),
             ],
         });
         // The buffers' bindings, in the order of `buffers`.
@@ -469,6 +477,7 @@ impl GpuScene {
         entries.push(wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&texture_view) });
         entries.push(wgpu::BindGroupEntry { binding: 6, resource: wgpu::BindingResource::Sampler(&sampler) });
         entries.push(wgpu::BindGroupEntry { binding: 9, resource: env_uniform_buffer.as_entire_binding() });
+        entries.push(wgpu::BindGroupEntry { binding: 13, resource: ggx_buffer.as_entire_binding() });
         let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("scene"),
             layout: &layout,

@@ -107,6 +107,8 @@ struct PunctualLight {
 @group(0) @binding(11) var<storage, read> tangents: array<f32>;
 // The materials' textures, at the materials' indices.
 @group(0) @binding(12) var<storage, read> material_maps: array<MaterialMaps>;
+// The GGX lobe's albedo tables of the scattering model (bsdf.wgsl, bsdf/albedo.rs).
+@group(0) @binding(13) var<storage, read> ggx_table: GgxAlbedoTable;
 
 // The random stream of stochastic opacity (passes_through): each entry point that finds
 // surfaces sets it from its iteration's seed, so that the holes of a semi-transparent
@@ -435,13 +437,14 @@ fn surface_is_lambertian(s: Surface) -> bool {
     return !SCENE_BSDF || (s.flags & MATERIAL_LAMBERTIAN) != 0u;
 }
 
-// The albedo with which a point reflects the photon map's irradiance: ρ, or the diffuse
-// equivalent of a glossy or specular surface (bsdf_diffuse_equivalent, an approximation).
-fn surface_rho(s: Surface) -> vec3f {
+// The albedo with which a point reflects the photon map's irradiance towards wo (a unit
+// vector away from the surface): ρ, or the diffuse equivalent of a glossy or specular surface
+// seen from wo (bsdf_diffuse_equivalent, an approximation).
+fn surface_rho(s: Surface, wo: vec3f) -> vec3f {
     if surface_is_lambertian(s) {
         return s.albedo;
     }
-    return bsdf_diffuse_equivalent(surface_bsdf(s));
+    return bsdf_diffuse_equivalent(surface_bsdf(s), dot(s.shading, wo));
 }
 
 // A ray arriving along d at surface s, scattered by its BSDF from three uniforms u (radiance

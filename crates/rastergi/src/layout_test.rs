@@ -119,6 +119,7 @@ fn twins() -> Vec<Twin> {
         twin!(DisplayUniforms, "Display", [image_size, target_size, decode_srgb, text_cols, text_rows, text_scale]),
         twin!(TrianglePlane, "TrianglePlane", [normal, offset, bins]),
         twin!(PathParams, "PathParams", [light_weight, light_count, max_bounces, rr_start]),
+        twin!(crate::bsdf::albedo::GpuGgxAlbedo, "GgxAlbedoTable", [cells, means]),
     ]
 }
 

@@ -12,7 +12,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let p = visible_point_at(gid.xy);
     var radiance = vec3f(0.0);
     if p.ok {
-        radiance = surface_rho(p.x) / PI * photon_irradiance(p.x.pos, p.x.tri, !p.front);
+        radiance = surface_rho(p.x, normalize(p.eye - p.x.pos)) / PI * photon_irradiance(p.x.pos, p.x.tri, !p.front);
     }
     film_add(FILM_PHOTON_VIEW, gid.xy, p.weight * (radiance));
 }
@@ -31,6 +31,6 @@ fn caustics(@builtin(global_invocation_id) gid: vec3u) {
     if !p.ok {
         return;
     }
-    let radiance = surface_rho(p.x) / PI * caustic_irradiance(p.x.pos, p.x.tri, !p.front);
+    let radiance = surface_rho(p.x, normalize(p.eye - p.x.pos)) / PI * caustic_irradiance(p.x.pos, p.x.tri, !p.front);
     film_add(FILM_INDIRECT, gid.xy, p.weight * radiance);
 }

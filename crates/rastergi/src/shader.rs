@@ -58,6 +58,8 @@ pub fn constants() -> String {
         ("LIGHT_POINT", LIGHT_POINT),
         ("LIGHT_SPOT", LIGHT_SPOT),
         ("LIGHT_DISTANT", LIGHT_DISTANT),
+        ("GGX_ALBEDO_N", crate::bsdf::albedo::N as u32),
+        ("GGX_ALBEDO_CELLS", (crate::bsdf::albedo::N * crate::bsdf::albedo::N) as u32),
     ];
     let f32s = [("OFFSET_STEP", OFFSET_STEP), ("MIN_LOOKUP_AREA", MIN_LOOKUP_AREA)];
     let mut s = String::from("// Generated from the Rust constants (shader.rs).\n");

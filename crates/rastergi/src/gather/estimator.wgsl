@@ -4,7 +4,7 @@
 
 // L(h → x) for the hit point h on triangle tri at barycentrics b, seen along w from x:
 // ρ_h/π · E(h) on the side of h facing x (ρ_h the diffuse equivalent of a glossy or
-// specular h: bsdf_diffuse_equivalent, an approximation), zero from the back of a one-sided h. E(h) is the
+// specular h seen from x: bsdf_diffuse_equivalent, an approximation), zero from the back of a one-sided h. E(h) is the
 // photon map's, or — for a map of indirect light only — the map's plus the direct irradiance
 // from one light sample with a shadow ray (hit_direct): sample j (the gather direction's
 // sample index) of the pixel's sequence.
@@ -67,7 +67,7 @@ fn gather_radiance(w0: vec3f, tri0: u32, hit0: vec3f, b0: vec2f, pixel: u32, j: 
         let ns_h = bend_towards(select(-s_h.shading, s_h.shading, front_h), -w);
         e += hit_direct(hit, select(-n_h, n_h, front_h), ns_h, tri, pixel, j);
     }
-    return seen + weight * surface_rho(s_h) / PI * e;
+    return seen + weight * surface_rho(s_h, -w) / PI * e;
 }
 
 // f(ω_eye, w) at the visible point x: ρ_x/π for a Lambertian surface, else the BSDF's

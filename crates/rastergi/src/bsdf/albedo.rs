@@ -1,0 +1,155 @@
+//! The directional albedo of the GGX microfacet lobe, tabulated once: what a rough specular
+//! lobe reflects in all, so that the diffuse base under glTF's dielectric layer takes exactly
+//! the energy the layer leaves (energy-conserving layering, Kulla & Conty 2017, "Revisiting
+//! Physically Based Shading at Imageworks", §"Energy conservation of layered materials").
+//!
+//! With Schlick's Fresnel F(μ_h) = f₀ + (1 − f₀)(1 − μ_h)⁵ (μ_h = ω_o·h), the lobe's albedo
+//! for ω_o at cos θ_o = μ is linear in f₀:
+//!
+//! ```text
+//! E(μ) = ∫ F(ω_o·h) D(h) G₁(ω_o) G₁(ω_i) / (4 μ cos θ_i) cos θ_i dω_i = f₀·E₁(μ, α) + (1 − f₀)·E₅(μ, α)
+//! E₁ = ∫ D G₁ G₁ / (4 μ) dω_i,   E₅ = ∫ (1 − ω_o·h)⁵ D G₁ G₁ / (4 μ) dω_i
+//! ```
+//!
+//! and its cosine-weighted mean Ē = 2∫₀¹ E(μ) μ dμ likewise. Both integrals are computed by
+//! sampling the distribution of visible normals (Heitz 2018), whose weight for the reflected
+//! direction is exactly F·G₁(ω_i), on a stratified 64 × 64 grid of (u₁, u₂) per table cell.
+//! The tables hold [`N`] × [`N`] cells, μ and α each uniform on [0, 1] (α = 0 is the mirror
+//! limit: E₁ = 1, E₅ = (1 − μ)⁵), read bilinearly; Ē is integrated from the interpolated
+//! table itself, so that ∫(1 − E(μ_i))·cos θ_i/π dω_i / (1 − Ē) is exactly 1 and the layer's
+//! white furnace errs only by the interpolation at μ_o. The WGSL twin reads the same numbers
+//! from a storage buffer ([`GpuGgxAlbedo`], the scene's binding 13).
+
+use std::sync::OnceLock;
+
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+
+use super::{ggx_g1, vndf_sample};
+
+/// Cells along μ and along α.
+pub const N: usize = 32;
+/// Strata per axis of the (u₁, u₂) grid of each cell's integral.
+const STRATA: usize = 64;
+
+/// E₁ and E₅ at every (μ, α) cell (index α·N + μ), and their cosine-weighted means at every α.
+pub struct GgxAlbedo {
+    pub e: Vec<[f32; 2]>,
+    pub mean: Vec<[f32; 2]>,
+}
+
+/// μ or α of grid index i: i/(N − 1).
+fn grid(i: usize) -> f32 {
+    i as f32 / (N - 1) as f32
+}
+
+/// (E₁, E₅) for cos θ_o = μ and α by VNDF sampling (f32 throughout, summed in f64).
+fn integrate(mu: f32, alpha: f32) -> [f32; 2] {
+    // Just off the grazing and the mirror limits, where the integrands are continuous.
+    let mu = mu.max(1e-4);
+    let alpha = alpha.max(1e-4);
+    let wo = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
+    let (mut e1, mut e5) = (0.0f64, 0.0f64);
+    for a in 0..STRATA {
+        for b in 0..STRATA {
+            let u1 = (a as f32 + 0.5) / STRATA as f32;
+            let u2 = (b as f32 + 0.5) / STRATA as f32;
+            let h = vndf_sample(wo, alpha, u1, u2);
+            let wi = 2.0 * wo.dot(h) * h - wo;
+            if wi.z <= 0.0 {
+                continue;
+            }
+            let g = ggx_g1(wi, h, alpha) as f64;
+            let m = (1.0 - wo.dot(h)).clamp(0.0, 1.0) as f64;
+            e1 += g;
+            e5 += g * m.powi(5);
+        }
+    }
+    let n = (STRATA * STRATA) as f64;
+    [(e1 / n) as f32, (e5 / n) as f32]
+}
+
+impl GgxAlbedo {
+    fn compute() -> Self {
+        let mut e = vec![[0.0f32; 2]; N * N];
+        for j in 0..N {
+            for i in 0..N {
+                e[j * N + i] = if j == 0 {
+                    // The mirror limit: every ray reflects, F at μ itself.
+                    [1.0, (1.0 - grid(i)).powi(5)]
+                } else {
+                    integrate(grid(i), grid(j))
+                };
+            }
+        }
+        let mut table = GgxAlbedo { e, mean: vec![[0.0; 2]; N] };
+        // 2∫ E(μ) μ dμ of the interpolated table, by the midpoint rule on a fine grid.
+        const STEPS: usize = 4096;
+        for j in 0..N {
+            let (mut m1, mut m5) = (0.0f64, 0.0f64);
+            for k in 0..STEPS {
+                let mu = (k as f32 + 0.5) / STEPS as f32;
+                let [a, b] = table.at(mu, grid(j));
+                m1 += a as f64 * mu as f64;
+                m5 += b as f64 * mu as f64;
+            }
+            let scale = 2.0 / STEPS as f64;
+            table.mean[j] = [(m1 * scale) as f32, (m5 * scale) as f32];
+        }
+        table
+    }
+
+    /// (E₁, E₅) at cos θ_o = `mu` and `alpha`, bilinear between cells (clamped to [0, 1]).
+    pub fn at(&self, mu: f32, alpha: f32) -> [f32; 2] {
+        let (i, fx) = cell(mu);
+        let (j, fy) = cell(alpha);
+        let lerp = |a: [f32; 2], b: [f32; 2], t: f32| [a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t];
+        let lo = lerp(self.e[j * N + i], self.e[j * N + i + 1], fx);
+        let hi = lerp(self.e[(j + 1) * N + i], self.e[(j + 1) * N + i + 1], fx);
+        lerp(lo, hi, fy)
+    }
+
+    /// (Ē₁, Ē₅) at `alpha`, linear between cells: exactly the mean of [`Self::at`] over μ.
+    pub fn mean_at(&self, alpha: f32) -> [f32; 2] {
+        let (j, t) = cell(alpha);
+        let (a, b) = (self.mean[j], self.mean[j + 1]);
+        [a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t]
+    }
+
+    /// The GPU form, bsdf.wgsl's `GgxAlbedoTable` (bound as the scene's `ggx_table`).
+    pub fn gpu(&self) -> GpuGgxAlbedo {
+        let mut g = GpuGgxAlbedo::zeroed();
+        for k in 0..N * N {
+            let next = if k % N < N - 1 { k + 1 } else { k };
+            let (a, b) = (self.e[k], self.e[next]);
+            g.cells[k] = [a[0], a[1], b[0], b[1]];
+        }
+        for j in 0..N {
+            let (a, b) = (self.mean[j], self.mean[(j + 1).min(N - 1)]);
+            g.means[j] = [a[0], a[1], b[0], b[1]];
+        }
+        g
+    }
+}
+
+/// The tables on the GPU (a storage buffer, the scene's binding 13): cell k = α·N + μ holds (E₁, E₅) at k and at k + 1 (the
+/// next μ, the pair a bilinear read needs from one row), mean j (Ē₁, Ē₅) at α cells j and j + 1.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub struct GpuGgxAlbedo {
+    pub cells: [[f32; 4]; N * N],
+    pub means: [[f32; 4]; N],
+}
+
+/// The cell of x ∈ [0, 1] on the grid and the fraction within it.
+fn cell(x: f32) -> (usize, f32) {
+    let t = x.clamp(0.0, 1.0) * (N - 1) as f32;
+    let i = (t as usize).min(N - 2);
+    (i, t - i as f32)
+}
+
+/// The tables, computed on first use.
+pub fn ggx_albedo() -> &'static GgxAlbedo {
+    static TABLE: OnceLock<GgxAlbedo> = OnceLock::new();
+    TABLE.get_or_init(GgxAlbedo::compute)
+}

@@ -53,7 +53,7 @@ POINT_CHILD_T = (0.6, 1.0, 0.4)
 POINT_WORLD = (0.8, 2.2, -0.8)
 POINT_COLOR, POINT_INTENSITY = (1.0, 0.9, 0.8), 6.0
 SUN_ELEVATION, SUN_AZIMUTH = 35.0, 12.0  # degrees; azimuth about +y from the +x axis
-SUN_COLOR, SUN_INTENSITY = (1.0, 0.95, 0.9), 4.0
+SUN_COLOR, SUN_INTENSITY = (1.0, 0.95, 0.9), 30.0
 CAMERA_EYE, CAMERA_TARGET, CAMERA_YFOV = (1.6, 1.5, 1.8), (-0.8, 1.0, -1.0), 1.25
 
 

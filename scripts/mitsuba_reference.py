@@ -2,7 +2,9 @@
 """Render Mitsuba 3 reference images of rastergi scenes.
 
 Any scene rastergi renders: the built-in Cornell box (`--scene cornell`, the
-default) or a Wavefront OBJ + MTL file (`--scene PATH.obj`), seen by rastergi's
+default), a Wavefront OBJ + MTL file (`--scene PATH.obj`) or a glTF 2.0 file of
+Lambertian materials (`--scene PATH.gltf|.glb`, read by scripts/mitsuba_gltf.py with
+its lights and camera; one-sided where the material is not `doubleSided`), seen by rastergi's
 camera (or the one given by --eye/--target/--up/--fov), rendered with
 Mitsuba's `path` integrator and a box pixel filter, and written as a linear
 float32 RGB OpenEXR (3 channels R, G, B, no alpha; row 0 of the image is the

@@ -100,21 +100,6 @@ fn material_scene(name: &str, camera: rastergi::scene::Camera) -> rastergi::scen
     scene
 }
 
-/// The settings the command line fits to `scene` (grid, photons) at `size`², the traced
-/// gather, seed `seed`: how users render.
-fn fitted_settings(scene: &rastergi::scene::Scene, size: u32, seed: u32) -> rastergi::renderer::RenderSettings {
-    let grid = rastergi::fit::grid_resolution(&scene.bounds());
-    rastergi::renderer::RenderSettings {
-        width: size,
-        height: size,
-        seed,
-        grid_resolution: grid,
-        photons: rastergi::fit::photon_count(scene, grid),
-        gather: rastergi::gather::GatherMethod::Trace,
-        ..Default::default()
-    }
-}
-
 /// The stage's camera (scripts/make_material_scenes.py, tests/data/README.md).
 fn stage_camera() -> rastergi::scene::Camera {
     rastergi::scene::Camera {
@@ -359,8 +344,8 @@ fn photon_map_and_gather_on_spheres_of_each_material_match_mitsuba() {
     for kind in ["metal_rough", "mix", "mirror", "glass", "rough_glass"] {
         let scene = material_scene(&format!("mat_{kind}"), stage_camera());
         let grid = rastergi::fit::grid_resolution(&scene.bounds());
-        let a = common::render(&gpu, &scene, fitted_settings(&scene, 64, 1), 256, Show::Full);
-        let b = common::render(&gpu, &scene, fitted_settings(&scene, 64, 2), 256, Show::Full);
+        let a = common::render(&gpu, &scene, common::fitted_settings(&scene, 64, 1), 256, Show::Full);
+        let b = common::render(&gpu, &scene, common::fitted_settings(&scene, 64, 2), 256, Show::Full);
         let stem = format!("mat_{kind}_path_64");
         let probe = rastergi::image_io::read_exr(&common::data(&format!("{stem}_a.exr"))).unwrap();
         let mask = emitter_mask(&probe, 3.0);
@@ -390,8 +375,8 @@ fn cornell_box_with_glass_and_mirror_spheres_matches_mitsuba_caustic_included() 
     let scene = material_scene("cornell_spheres", camera);
     let gpu = common::gpu();
     let grid = rastergi::fit::grid_resolution(&scene.bounds());
-    let a = common::render(&gpu, &scene, fitted_settings(&scene, 128, 1), 256, Show::Full);
-    let b = common::render(&gpu, &scene, fitted_settings(&scene, 128, 2), 256, Show::Full);
+    let a = common::render(&gpu, &scene, common::fitted_settings(&scene, 128, 1), 256, Show::Full);
+    let b = common::render(&gpu, &scene, common::fitted_settings(&scene, 128, 2), 256, Show::Full);
     let stem = "cornell_spheres_path_128";
     let ref_a = rastergi::image_io::read_exr(&common::data(&format!("{stem}_a.exr"))).unwrap();
     let ref_b = rastergi::image_io::read_exr(&common::data(&format!("{stem}_b.exr"))).unwrap();
@@ -450,8 +435,8 @@ fn a_polished_sphere_reflects_the_stage_as_the_path_tracer_shows_it() {
     let mask = emitter_mask(&ra, 3.0);
     let reference = common::average(&ra, &rb);
     let ref_noise = rmse(&ra, &rb, Some(&mask)) / 2.0;
-    let a = common::render(&gpu, &scene, fitted_settings(&scene, 64, 1), 256, Show::Full);
-    let b = common::render(&gpu, &scene, fitted_settings(&scene, 64, 2), 256, Show::Full);
+    let a = common::render(&gpu, &scene, common::fitted_settings(&scene, 64, 1), 256, Show::Full);
+    let b = common::render(&gpu, &scene, common::fitted_settings(&scene, 64, 2), 256, Show::Full);
     let (c, noise, bias) = common::against_reference(&a, &b, &reference, ref_noise, Some(&mask));
     check_against_reference("polished sphere", &c, noise, bias);
 }

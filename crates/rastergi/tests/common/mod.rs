@@ -39,6 +39,21 @@ pub fn path_trace(gpu: &Gpu, scene: &Scene, settings: RenderSettings, iterations
     pt.read_linear().expect("readback")
 }
 
+/// The settings the command line fits to `scene` (grid, photons) at `size`², the traced
+/// gather, seed `seed`: how users render.
+pub fn fitted_settings(scene: &Scene, size: u32, seed: u32) -> RenderSettings {
+    let grid = rastergi::fit::grid_resolution(&scene.bounds());
+    RenderSettings {
+        width: size,
+        height: size,
+        seed,
+        grid_resolution: grid,
+        photons: rastergi::fit::photon_count(scene, grid),
+        gather: rastergi::gather::GatherMethod::Trace,
+        ..Default::default()
+    }
+}
+
 pub fn data(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(name)
 }
@@ -134,16 +149,7 @@ pub fn image_matches_mitsuba(
 ) {
     let gpu = gpu();
     let grid = rastergi::fit::grid_resolution(&scene.bounds());
-    let settings = |seed| RenderSettings {
-        width: 128,
-        height: 128,
-        seed,
-        grid_resolution: grid,
-        photons: rastergi::fit::photon_count(scene, grid),
-        gather: rastergi::gather::GatherMethod::Trace,
-        hit_light,
-        ..Default::default()
-    };
+    let settings = |seed| RenderSettings { hit_light, ..fitted_settings(scene, 128, seed) };
     let a = render(&gpu, scene, settings(1), iterations, show);
     let b = render(&gpu, scene, settings(2), iterations, show);
     // Emitter pixels (over 3 in the reference, and their neighbours) left out where asked.

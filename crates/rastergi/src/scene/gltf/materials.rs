@@ -1,0 +1,176 @@
+//! Materials: glTF's metallic-roughness model, its extensions (emissive strength, ior,
+//! transmission, volume, specular), alpha modes, normal maps and textures with their
+//! KHR_texture_transform.
+
+use super::*;
+
+impl Loader<'_> {
+    /// The scene material of a glTF material, created on first use.
+    pub(super) fn material(&mut self, m: &::gltf::Material) -> Res<u32> {
+        if let Some(&id) = self.materials.get(&m.index()) {
+            return Ok(id);
+        }
+        let material = match m.index() {
+            None => Material::diffuse("default", Vec3::splat(DEFAULT_ALBEDO)),
+            Some(index) => {
+                let what = named("material", index, m.name());
+                let pbr = m.pbr_metallic_roughness();
+                let mut texture = |info: Option<(::gltf::Texture, UvTransform)>, linear: bool| match info {
+                    Some((t, transform)) => self
+                        .texture(&t, linear)
+                        .map(|texture| Some(TextureRef { texture, transform }))
+                        .map_err(|e| format!("{what}: {e}")),
+                    None => Ok(None),
+                };
+                let base = texture(pbr.base_color_texture().map(|i| (i.texture(), info_transform(&i))), false)?;
+                let emission = Vec3::from(m.emissive_factor()) * m.emissive_strength().unwrap_or(1.0);
+                let emissive = m.emissive_texture().filter(|_| emission.max_element() > 0.0);
+                let emission_texture = texture(emissive.map(|i| (i.texture(), info_transform(&i))), false)?;
+                let normal = m.normal_texture();
+                let normal_scale = normal.as_ref().map_or(1.0, |n| n.scale());
+                let normal_texture = texture(normal.map(|n| (n.texture(), normal_transform(&n))), true)?;
+                let alpha_mode = match m.alpha_mode() {
+                    ::gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
+                    ::gltf::material::AlphaMode::Mask => AlphaMode::Mask { cutoff: m.alpha_cutoff().unwrap_or(0.5) },
+                    ::gltf::material::AlphaMode::Blend => AlphaMode::Blend,
+                };
+                if let AlphaMode::Mask { cutoff } = alpha_mode
+                    && !(cutoff.is_finite() && cutoff >= 0.0)
+                {
+                    return Err(format!("{what}: alphaCutoff {cutoff} is not a non-negative number"));
+                }
+                let opacity = pbr.base_color_factor()[3];
+                if !(0.0..=1.0).contains(&opacity) {
+                    return Err(format!("{what}: baseColorFactor's alpha {opacity} is outside [0, 1]"));
+                }
+                let metal_rough = pbr.metallic_roughness_texture().map(|i| (i.texture(), info_transform(&i)));
+                let metal_rough_texture = texture(metal_rough, true)?;
+                let unit = |name: &str, v: f32| -> Res<f32> {
+                    if (0.0..=1.0).contains(&v) { Ok(v) } else { Err(format!("{what}: {name} {v} is outside [0, 1]")) }
+                };
+                let metallic = unit("metallicFactor", pbr.metallic_factor())?;
+                let roughness = unit("roughnessFactor", pbr.roughness_factor())?;
+                let transmission = m.transmission();
+                if transmission.as_ref().is_some_and(|t| t.transmission_texture().is_some()) {
+                    log::warn!("{what}: transmissionTexture is not read; its transmissionFactor applies everywhere");
+                }
+                let transmission = unit("transmissionFactor", transmission.map_or(0.0, |t| t.transmission_factor()))?;
+                let ior = m.ior().unwrap_or(1.5);
+                if !(ior.is_finite() && (ior == 0.0 || ior >= 1.0)) {
+                    return Err(format!("{what}: ior {ior} is not 0 or at least 1"));
+                }
+                // ior 0 is the extension's "infinite": a perfect reflector; clamped to 10⁴.
+                let ior = if ior == 0.0 { 1e4 } else { ior };
+                let specular = m.specular();
+                if specular.as_ref().is_some_and(|s| {
+                    s.specular_color_factor() != [1.0; 3]
+                        || s.specular_texture().is_some()
+                        || s.specular_color_texture().is_some()
+                }) {
+                    log::warn!(
+                        "{what}: KHR_materials_specular's colour and textures are not read; its specularFactor is"
+                    );
+                }
+                let specular = unit("specularFactor", specular.map_or(1.0, |s| s.specular_factor()))?;
+                // A volume makes the glass a refracting solid; thickness 0 (its default) or no
+                // volume: thin-walled, as the extension says.
+                let thin = m.volume().is_none_or(|v| v.thickness_factor() <= 0.0);
+                Material {
+                    albedo_texture: base.map(|t| t.texture),
+                    albedo_transform: base.map_or(UvTransform::IDENTITY, |t| t.transform),
+                    emission,
+                    emission_texture,
+                    opacity,
+                    opacity_texture: base.filter(|_| alpha_mode != AlphaMode::Opaque),
+                    alpha_mode,
+                    normal_texture,
+                    normal_scale,
+                    metallic,
+                    roughness,
+                    metal_rough_texture,
+                    specular,
+                    ior,
+                    transmission,
+                    thin,
+                    two_sided: m.double_sided(),
+                    ..Material::diffuse(
+                        &m.name().map_or_else(|| format!("material {index}"), str::to_owned),
+                        Vec3::from_slice(&pbr.base_color_factor()[..3]),
+                    )
+                }
+            }
+        };
+        let id = self.scene.add_material(material);
+        self.materials.insert(m.index(), id);
+        Ok(id)
+    }
+
+    /// The scene texture of a glTF texture's image (sRGB colour, or `linear` data), decoded on
+    /// first use.
+    pub(super) fn texture(&mut self, texture: &::gltf::Texture, linear: bool) -> Res<usize> {
+        let sampler = texture.sampler();
+        use ::gltf::texture::WrappingMode::Repeat;
+        if (sampler.wrap_s() != Repeat || sampler.wrap_t() != Repeat)
+            && !std::mem::replace(&mut self.warned_sampler, true)
+        {
+            log::warn!("textures are always sampled with repeat addressing; clamped and mirrored samplers are ignored");
+        }
+        let image = texture.source();
+        if let Some(&t) = self.textures.get(&(image.index(), linear)) {
+            return Ok(t);
+        }
+        let what = named("image", image.index(), image.name());
+        let bytes: Vec<u8> = match image.source() {
+            ::gltf::image::Source::View { view, .. } => {
+                let buffer = &self.buffers[view.buffer().index()];
+                let range = view.offset().checked_add(view.length()).filter(|&end| end <= buffer.len());
+                let end = range.ok_or_else(|| format!("{what}: its bufferView runs past the end of its buffer"))?;
+                buffer[view.offset()..end].to_vec()
+            }
+            ::gltf::image::Source::Uri { uri, .. } => read_uri(&self.dir, uri).map_err(|e| format!("{what}: {e}"))?,
+        };
+        let name = image.name().map_or_else(|| format!("image {}", image.index()), str::to_owned);
+        let decoded = Texture::decode(&name, &bytes).map_err(|e| format!("{what} {e}"))?;
+        let t = self.scene.add_texture(if linear { decoded.into_linear() } else { decoded });
+        self.textures.insert((image.index(), linear), t);
+        Ok(t)
+    }
+}
+
+/// KHR_texture_transform's affine map, T(offset) · R(rotation) · S(scale): (u, v) ↦
+/// (c·sx·u + s·sy·v + ox, −s·sx·u + c·sy·v + oy) with c, s the rotation's cosine and sine.
+pub fn texture_transform(offset: [f32; 2], rotation: f32, scale: [f32; 2]) -> UvTransform {
+    let (s, c) = rotation.sin_cos();
+    UvTransform([[c * scale[0], s * scale[1], offset[0]], [-s * scale[0], c * scale[1], offset[1]]])
+}
+
+pub(super) fn info_transform(info: &::gltf::texture::Info) -> UvTransform {
+    info.texture_transform().map_or(UvTransform::IDENTITY, |t| texture_transform(t.offset(), t.rotation(), t.scale()))
+}
+
+/// The normal texture's KHR_texture_transform (the `gltf` crate leaves it unparsed there).
+pub(super) fn normal_transform(n: &::gltf::material::NormalTexture) -> UvTransform {
+    parsed_normal_transform(n).map_or(UvTransform::IDENTITY, |t| texture_transform(t.offset.0, t.rotation.0, t.scale.0))
+}
+
+pub(super) fn parsed_normal_transform(
+    n: &::gltf::material::NormalTexture,
+) -> Option<::gltf::json::extensions::texture::TextureTransform> {
+    let value = n.extension_value("KHR_texture_transform")?;
+    ::gltf::json::deserialize::from_value(value.clone())
+        .map_err(|e| log::warn!("a normal texture's KHR_texture_transform is not valid ({e}); it is ignored"))
+        .ok()
+}
+
+/// The TEXCOORD sets a material's textures read (base colour, emissive, normal map,
+/// metallic-roughness), each
+/// overridden by its KHR_texture_transform's texCoord.
+pub(super) fn texture_sets(m: &::gltf::Material) -> Vec<u32> {
+    let info = |i: ::gltf::texture::Info| i.texture_transform().and_then(|t| t.tex_coord()).unwrap_or(i.tex_coord());
+    let base = m.pbr_metallic_roughness().base_color_texture().map(info);
+    let emissive = m.emissive_texture().map(info);
+    let normal =
+        m.normal_texture().map(|n| parsed_normal_transform(&n).and_then(|t| t.tex_coord).unwrap_or(n.tex_coord()));
+    let metal_rough = m.pbr_metallic_roughness().metallic_roughness_texture().map(info);
+    base.into_iter().chain(emissive).chain(normal).chain(metal_rough).collect()
+}

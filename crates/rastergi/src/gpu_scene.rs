@@ -12,6 +12,7 @@ use wgpu::util::DeviceExt;
 use crate::environment::{Environment, GpuEnvironment};
 use crate::gpu::{Gpu, storage_entry, uniform_entry};
 use crate::lights::{LightEntry, LightTable};
+use crate::limits::check_storage_buffer;
 use crate::scene::{Aabb, AlphaMode, Material, Scene, TextureRef, UvTransform};
 use crate::textures::TextureArray;
 
@@ -342,8 +343,8 @@ impl GpuScene {
     /// Uploads `prepared`, after checking that its buffers fit the device (see [`crate::limits`]).
     pub fn new(gpu: &Gpu, prepared: &PreparedScene) -> Result<GpuScene> {
         let limits = gpu.device.limits();
-        crate::limits::check_scene(&limits, &prepared.scene)?;
-        crate::limits::check_bvh_nodes(&limits, prepared.bvh.nodes.len())?;
+        check_scene(&limits, &prepared.scene)?;
+        check_bvh_nodes(&limits, prepared.bvh.nodes.len())?;
         let s = &prepared.scene;
         let triangles: Vec<GpuTriangle> = s
             .triangles
@@ -501,5 +502,67 @@ impl GpuScene {
             caustics: s.materials.iter().any(Material::passes_rays),
             has_bsdfs: !s.materials.iter().all(Material::is_lambertian),
         })
+    }
+}
+
+const FEWER_TRIANGLES: &str =
+    "use a scene with fewer triangles (or a GPU with larger storage buffers: `rastergi info` shows the limit)";
+
+/// The scene's buffers (`gpu_scene.rs`) that the triangle, material and emitter counts fix:
+/// checked before the BVH is built, so an impossible scene fails at once.
+pub fn check_scene_buffers(limits: &wgpu::Limits, triangles: usize, materials: usize, lights: usize) -> Result<()> {
+    let fewer = FEWER_TRIANGLES;
+    let triangle_stride = std::mem::size_of::<GpuTriangle>() as u64;
+    let material_stride = std::mem::size_of::<GpuMaterial>() as u64;
+    let light_stride = std::mem::size_of::<crate::lights::LightEntry>() as u64;
+    let what = format!("the scene's {triangles} triangles");
+    check_storage_buffer(limits, &what, triangles as u64, triangle_stride, fewer)?;
+    // `3 · triangles` vertices are drawn by one non-indexed draw call.
+    if triangles as u64 * 3 > u32::MAX as u64 {
+        return Err(crate::error::Error::Limits(format!(
+            "{what} are more than one draw call can hold (1 431 655 765); {fewer}"
+        )));
+    }
+    check_storage_buffer(limits, "the scene's materials", materials as u64, material_stride, "use fewer materials")?;
+    check_storage_buffer(limits, "the scene's emissive triangles", lights as u64, light_stride, "use fewer emitters")
+}
+
+/// [`check_scene_buffers`] for `scene`, with its triangle count bounding its emitters'.
+pub fn check_scene(limits: &wgpu::Limits, scene: &crate::scene::Scene) -> Result<()> {
+    check_scene_buffers(limits, scene.triangles.len(), scene.materials.len(), scene.triangles.len())
+}
+
+/// The BVH's node buffer, once the BVH is built (about one node per triangle, at most 2·n − 1).
+pub fn check_bvh_nodes(limits: &wgpu::Limits, nodes: usize) -> Result<()> {
+    let stride = std::mem::size_of::<crate::bvh::BvhNode>() as u64;
+    check_storage_buffer(limits, &format!("the scene's {nodes} BVH nodes"), nodes as u64, stride, FEWER_TRIANGLES)
+}
+
+#[cfg(test)]
+mod limit_tests {
+    use super::*;
+
+    fn limits(binding_mib: u64) -> wgpu::Limits {
+        wgpu::Limits {
+            max_storage_buffer_binding_size: binding_mib << 20,
+            max_buffer_size: 2 * (binding_mib << 20),
+            ..wgpu::Limits::default()
+        }
+    }
+
+    #[test]
+    fn a_scene_whose_triangles_exceed_the_binding_limit_is_refused_with_the_sizes() {
+        // 48 bytes per triangle: 128 MiB hold 2 796 202 triangles.
+        let l = limits(128);
+        assert!(check_scene_buffers(&l, 2_796_202, 10, 2).is_ok());
+        let e = check_scene_buffers(&l, 2_796_203, 10, 2).unwrap_err().to_string();
+        println!("{e}");
+        assert!(e.contains("2796203 triangles") && e.contains("fewer triangles"), "{e}");
+        // One triangle over: the sizes in bytes, since both round to 128 MiB.
+        assert!(e.contains("134217744 bytes") && e.contains("134217728 bytes"), "{e}");
+        // 32 bytes per node: 128 MiB hold 4 194 304 nodes.
+        assert!(check_bvh_nodes(&l, 4_194_304).is_ok());
+        let e = check_bvh_nodes(&l, 4_194_305).unwrap_err().to_string();
+        assert!(e.contains("4194305 BVH nodes") && e.contains("134217728 bytes"), "{e}");
     }
 }

@@ -100,7 +100,7 @@ impl PathTracer {
         scene.validate()?;
         let (width, height) = (settings.width, settings.height);
         let film = Film::new(gpu, width, height)?;
-        crate::limits::check_scene(&gpu.device.limits(), scene)?;
+        crate::gpu_scene::check_scene(&gpu.device.limits(), scene)?;
         let prepared = PreparedScene::new(scene);
         prepared.textures.check_limits(gpu)?;
         let light_weight = prepared.lights.weight as f32;

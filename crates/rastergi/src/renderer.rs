@@ -203,10 +203,10 @@ impl Renderer {
         gpu.check_image_size(settings.width, settings.height, crate::film::COMPONENTS * 16)?;
         // Fail on a scene, photon grid or bundle too large for this GPU before the BVH is built.
         let limits = gpu.device.limits();
-        crate::limits::check_scene(&limits, scene)?;
+        crate::gpu_scene::check_scene(&limits, scene)?;
         let detail_bundle = crate::fit::detail_bundle(scene);
         if settings.photons > 0 {
-            crate::limits::check_photon_grid(&limits, &GridSpec::new(&scene.bounds(), settings.grid_resolution))?;
+            crate::photons::map::check_photon_grid(&limits, &GridSpec::new(&scene.bounds(), settings.grid_resolution))?;
             if settings.gather != GatherMethod::Trace {
                 crate::limits::check_bundle(&limits, settings.bundle_for(detail_bundle))?;
             }

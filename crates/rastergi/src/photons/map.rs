@@ -51,6 +51,7 @@ pub use super::separators::{MAX_SEPARATORS, MIN_REGION, Separator, Separators, r
 pub use super::table::{EMPTY, SlotTable};
 use crate::consts::CAUSTIC_CELL;
 pub use crate::consts::MIN_LOOKUP_AREA;
+use crate::limits::{check_storage_buffer, mib};
 use crate::scene::{Aabb, Scene, triangle_normal};
 
 /// The slot table's search in WGSL (`find_slot`, the twin of [`SlotTable::find`]). The GPU
@@ -330,7 +331,7 @@ impl MapLayout {
         let mut resolution = resolution.max(1);
         loop {
             let grid = GridSpec::new(bounds, resolution);
-            crate::limits::check_photon_grid(limits, &grid)?;
+            check_photon_grid(limits, &grid)?;
             let h = grid.cell as f64;
             // Both sides of every triangle, at most; twice that with caustic twins.
             let twins = if scene.materials.iter().any(crate::scene::Material::passes_rays) { 2.0 } else { 1.0 };
@@ -352,7 +353,7 @@ impl MapLayout {
                     layout.separators.table.len(),
                     start.elapsed().as_secs_f64()
                 );
-                crate::limits::check_photon_slots(limits, &layout).map(|()| layout)
+                check_photon_slots(limits, &layout).map(|()| layout)
             } else {
                 Err(crate::Error::Limits(format!(
                     "the photon map of a grid of {resolution} cells would need about {:.0} slots, more than this GPU binds",
@@ -497,8 +498,51 @@ impl PhotonMap {
     }
 }
 
+/// The photon grid: its cells must have 31-bit indices (the first word of a slot's key; its
+/// top bit marks caustic twins, `CAUSTIC_CELL`).
+pub fn check_photon_grid(_limits: &wgpu::Limits, grid: &GridSpec) -> crate::error::Result<()> {
+    let d = grid.dims;
+    if grid.cell_count() >= crate::consts::CAUSTIC_CELL as u64 {
+        return Err(crate::error::Error::Limits(format!(
+            "a photon grid of {}x{}x{} cells has more than 2^31 cells; choose a smaller --grid",
+            d.x, d.y, d.z
+        )));
+    }
+    Ok(())
+}
+
+/// The photon map's slots (`photons/gpu.rs`): per table entry 64-bit counters for three
+/// channels (one binding of 8 bytes per entry for each), the lookup values (16 bytes), the keys
+/// (8) and the areas (4), each against the binding limit, and all of them against the largest
+/// buffer.
+pub fn check_photon_slots(limits: &wgpu::Limits, layout: &MapLayout) -> crate::error::Result<()> {
+    let d = layout.grid.dims;
+    let entries = layout.table.capacity() as u64;
+    let what = format!("the {} slots of a photon grid of {}x{}x{} cells", layout.table.len(), d.x, d.y, d.z);
+    for (part, stride) in [("counters", 8), ("lookup values", 16), ("keys", 8)] {
+        check_storage_buffer(limits, &format!("the {part} of {what}"), entries, stride, "choose a smaller --grid")?;
+    }
+    let total = entries * 24;
+    if total > limits.max_buffer_size {
+        return Err(crate::error::Error::Limits(format!(
+            "the counters of {what} need {} in one buffer, more than this GPU's {}; choose a smaller --grid",
+            mib(total),
+            mib(limits.max_buffer_size)
+        )));
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
+    fn limits(binding_mib: u64) -> wgpu::Limits {
+        wgpu::Limits {
+            max_storage_buffer_binding_size: binding_mib << 20,
+            max_buffer_size: 2 * (binding_mib << 20),
+            ..wgpu::Limits::default()
+        }
+    }
+
     use super::*;
     use crate::sampling::{Rng, uniform_sphere};
     use crate::scene::{Camera, Material, cornell_box, triangle_area};
@@ -670,7 +714,7 @@ mod tests {
         let coarse = MapLayout::within(&scene, &scene.bounds(), 256, &tight).unwrap();
         let used = coarse.grid.dims.max_element();
         assert!(used < 256 && 256 % used == 0, "{used}");
-        assert!(crate::limits::check_photon_slots(&tight, &coarse).is_ok());
+        assert!(check_photon_slots(&tight, &coarse).is_ok());
         assert!(coarse.table.capacity() as u64 * 16 <= 1 << 20);
         // The coarser map is a whole map: every triangle's area is in it.
         let total: f64 = coarse.area.iter().sum();
@@ -700,5 +744,33 @@ mod tests {
         }
         let e = map.irradiance(Vec3::new(0.5, 2.3, 2.5), triangle_normal(&s.triangles[4]));
         assert!((e[0] - 3.0).abs() < 1e-9, "{e:?}");
+    }
+
+    #[test]
+    fn photon_cells_need_31_bit_indices_and_the_slots_must_fit_the_bindings() {
+        let bounds = crate::scene::Aabb { min: glam::Vec3::ZERO, max: glam::Vec3::ONE };
+        let l = limits(128);
+        // 1280³ = 2.10·10⁹ cells fit 31 bits (the top bit marks caustic twins), 1300³ = 2.20·10⁹
+        // do not.
+        assert!(check_photon_grid(&l, &GridSpec::new(&bounds, 1280)).is_ok());
+        let e = check_photon_grid(&l, &GridSpec::new(&bounds, 1300)).unwrap_err().to_string();
+        assert!(e.contains("1300x1300x1300") && e.contains("--grid"), "{e}");
+        // The largest per-entry binding is the lookup values' 16 bytes; all counters share a
+        // buffer of 24 bytes per entry.
+        let scene = crate::scene::cornell_box();
+        let layout = MapLayout::new(&scene, &GridSpec::new(&scene.bounds(), 32));
+        let entries = layout.table.capacity() as u64;
+        let fits = wgpu::Limits {
+            max_storage_buffer_binding_size: entries * 16,
+            max_buffer_size: entries * 24,
+            ..Default::default()
+        };
+        assert!(check_photon_slots(&fits, &layout).is_ok());
+        let narrow = wgpu::Limits { max_storage_buffer_binding_size: entries * 16 - 4, ..fits.clone() };
+        let e = check_photon_slots(&narrow, &layout).unwrap_err().to_string();
+        assert!(e.contains("lookup values") && e.contains("32x32x32") && e.contains("--grid"), "{e}");
+        let short = wgpu::Limits { max_buffer_size: entries * 24 - 1, ..fits };
+        let e = check_photon_slots(&short, &layout).unwrap_err().to_string();
+        assert!(e.contains("one buffer"), "{e}");
     }
 }

@@ -270,5 +270,4 @@ impl Loader<'_> {
         }
         crate::scene::tangents::mikktspace(triangles, uvs, normals)
     }
-
 }

@@ -72,8 +72,8 @@ use super::{AlphaMode, Camera, Light, Material, Scene, Texture, TextureRef, UvTr
 use crate::error::{Error, Result};
 
 use file::{check_before_validation, describe_gltf_error, load_buffer, read_uri, split_glb};
-use materials::texture_sets;
 use lights::punctual_light;
+use materials::texture_sets;
 use meshes::Primitive;
 
 /// Most triangles a glTF scene may expand to (instances included).
@@ -340,7 +340,6 @@ impl<'a> Loader<'a> {
         let world = placed(index).ok_or_else(|| format!("{what} is not used by any node of the displayed scene"))?;
         camera_from(world, p.yfov()).map(Some).map_err(|e| format!("{what}: {e}"))
     }
-
 }
 
 /// A node's local transform: its matrix, or translation × rotation × scale.

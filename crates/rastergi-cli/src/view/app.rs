@@ -13,183 +13,32 @@ use rastergi::film::Show;
 use rastergi::gather::GatherMethod;
 use rastergi::gpu::{Gpu, GpuOptions};
 use rastergi::path_tracer::PathTracer;
-use rastergi::progressive::Progressive;
 use rastergi::renderer::{RenderSettings, Renderer};
-use rastergi::scene::{Light, Scene};
+use rastergi::scene::Scene;
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
-use winit::event::{ElementState, KeyEvent, MouseButton, MouseScrollDelta, WindowEvent};
+use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoopProxy};
-use winit::keyboard::{Key as LogicalKey, KeyCode, NamedKey, PhysicalKey};
 use winit::window::{Window, WindowId};
 
-use super::controls::{Controls, Key, Response, SunAngles, camera_options, show_name};
-use super::panel::{self, Figures, PanelPainter, PanelState};
+use super::build::{Build, Opened, env_scale, last_sun, prepare, same_but_size};
+use super::controls::{Controls, Response, SunAngles, camera_options, show_name};
+use super::frames::{Active, Rate, iterate_frame};
+use super::keys::key_of;
+use super::panel::{self, Figures, Panel, PanelPainter, PanelState};
 use super::screenshots::Screenshots;
-use super::script::{Action, Step, When};
+use super::script::{Action, ScriptRun, Step, When};
 use crate::args::SceneArgs;
 use crate::render::Method;
 
-/// GPU time aimed at per displayed frame: iterations are batched up to this.
-pub const FRAME_BUDGET: Duration = Duration::from_millis(30);
-/// Most iterations in one frame (keeps a frame short when iterations are very cheap).
-pub const MAX_BATCH: u32 = 64;
 /// A resize rebuilds the size-dependent passes once the window size has been still this long.
 const RESIZE_SETTLE: Duration = Duration::from_millis(150);
 /// How long a script's `resize` may wait for the window to take the new size.
 const RESIZE_TIMEOUT: Duration = Duration::from_secs(10);
 
-/// The viewer's meaning of a keyboard event: movement by key position (WASD wherever the
-/// layout puts those letters), the rest by position or by the character typed.
-fn key_of(event: &KeyEvent) -> Option<Key> {
-    if let PhysicalKey::Code(code) = event.physical_key {
-        let key = match code {
-            KeyCode::KeyW | KeyCode::ArrowUp => Some(Key::Forward),
-            KeyCode::KeyS | KeyCode::ArrowDown => Some(Key::Back),
-            KeyCode::KeyA | KeyCode::ArrowLeft => Some(Key::Left),
-            KeyCode::KeyD | KeyCode::ArrowRight => Some(Key::Right),
-            KeyCode::KeyE | KeyCode::PageUp => Some(Key::Up),
-            KeyCode::KeyQ | KeyCode::PageDown => Some(Key::Down),
-            KeyCode::ShiftLeft | KeyCode::ShiftRight => Some(Key::Fast),
-            KeyCode::Tab => Some(Key::ToggleMode),
-            KeyCode::Home => Some(Key::Home),
-            KeyCode::Digit1 | KeyCode::Numpad1 => Some(Key::Show(Show::Full)),
-            KeyCode::Digit2 | KeyCode::Numpad2 => Some(Key::Show(Show::Direct)),
-            KeyCode::Digit3 | KeyCode::Numpad3 => Some(Key::Show(Show::Indirect)),
-            KeyCode::Digit4 | KeyCode::Numpad4 => Some(Key::Show(Show::PhotonMap)),
-            KeyCode::NumpadAdd => Some(Key::ExposureUp),
-            KeyCode::NumpadSubtract => Some(Key::ExposureDown),
-            KeyCode::BracketLeft => Some(Key::FewerPhotons),
-            KeyCode::BracketRight => Some(Key::MorePhotons),
-            KeyCode::Comma => Some(Key::CoarserGrid),
-            KeyCode::Period => Some(Key::FinerGrid),
-            KeyCode::KeyP => Some(Key::Screenshot),
-            KeyCode::KeyJ => Some(Key::SunWest),
-            KeyCode::KeyL => Some(Key::SunEast),
-            KeyCode::KeyI => Some(Key::SunHigher),
-            KeyCode::KeyK => Some(Key::SunLower),
-            KeyCode::KeyH | KeyCode::F1 => Some(Key::TogglePanel),
-            KeyCode::Escape => Some(Key::Quit),
-            _ => None,
-        };
-        if key.is_some() {
-            return key;
-        }
-    }
-    match &event.logical_key {
-        LogicalKey::Character(c) if c == "+" || c == "=" => Some(Key::ExposureUp),
-        LogicalKey::Character(c) if c == "-" || c == "_" => Some(Key::ExposureDown),
-        LogicalKey::Named(NamedKey::Escape) => Some(Key::Quit),
-        _ => None,
-    }
-}
-
-/// Iterations per second over the last half second or more.
-struct Rate {
-    since: Instant,
-    count: u32,
-    per_second: f64,
-}
-
-impl Rate {
-    fn add(&mut self, iterations: u32) {
-        self.count += iterations;
-        let dt = self.since.elapsed().as_secs_f64();
-        if dt >= 0.5 {
-            self.per_second = self.count as f64 / dt;
-            self.since = Instant::now();
-            self.count = 0;
-        }
-    }
-}
-
-/// One frame's iterations: up to `limit`, stopping once [`FRAME_BUDGET`] has passed (so at
-/// least one where `limit` > 0), then waits for them and sets `batch` (the next frame's
-/// limit) to as many as fit in the budget at this frame's time per iteration, 1 to
-/// [`MAX_BATCH`]. Returns how many ran. `rastergi bench frames` runs the same.
-pub fn iterate_frame(renderer: &mut dyn Progressive, limit: u32, batch: &mut u32) -> Result<u32> {
-    let start = Instant::now();
-    let mut done = 0;
-    while done < limit {
-        renderer.iterate()?;
-        done += 1;
-        if start.elapsed() >= FRAME_BUDGET {
-            break;
-        }
-    }
-    if done > 0 {
-        renderer.wait()?;
-        let per_iteration = start.elapsed().as_secs_f64() / done as f64;
-        *batch = ((FRAME_BUDGET.as_secs_f64() / per_iteration.max(1e-6)) as u32).clamp(1, MAX_BATCH);
-    }
-    Ok(done)
-}
-
-/// The renderer the viewer runs: the photon map and gather, or the reference path tracer.
-pub enum Active {
-    PhotonMap(Box<Renderer>),
-    PathTracer(Box<PathTracer>),
-}
-
-impl Active {
-    fn get(&self) -> &dyn Progressive {
-        match self {
-            Active::PhotonMap(r) => r.as_ref(),
-            Active::PathTracer(r) => r.as_ref(),
-        }
-    }
-
-    fn get_mut(&mut self) -> &mut dyn Progressive {
-        match self {
-            Active::PhotonMap(r) => r.as_mut(),
-            Active::PathTracer(r) => r.as_mut(),
-        }
-    }
-}
-
-/// What a renderer is built from besides the scene's geometry: the viewer rebuilds its
-/// renderer when the wanted one differs.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Build {
-    settings: RenderSettings,
-    method: Method,
-    sun: Option<SunAngles>,
-    env_scale: Option<f32>,
-    /// Which scene: counts the scenes opened.
-    scene: u64,
-}
-
-/// A scene opened by a build, with its fitted photon settings.
-pub struct Opened {
-    name: String,
-    scene: Arc<Scene>,
-    photons: u32,
-    grid: u32,
-    sun: Option<SunAngles>,
-    env_scale: Option<f32>,
-}
-
 /// A renderer being built on a worker thread (with the scene it opened, if it opened one).
 pub enum UserEvent {
     Built { generation: u64, result: Result<(Active, Build, Option<Opened>), String> },
-}
-
-/// The script's progress.
-struct ScriptRun {
-    steps: Vec<Step>,
-    next: usize,
-    /// When the previous step ran.
-    last: Instant,
-    /// A `resize` waiting for the image to take that size, and since when.
-    resizing: Option<((u32, u32), Instant)>,
-}
-
-/// The egui panel: its context, window-input state, GPU painter and own state.
-struct Panel {
-    ctx: egui::Context,
-    input: egui_winit::State,
-    painter: PanelPainter,
-    state: PanelState,
 }
 
 /// The live figures the panel shows, refreshed about once a second.
@@ -716,45 +565,6 @@ impl App {
             (b.settings.gather, b.settings.gather_directions, b.settings.directions);
         (c.method, c.sun, c.env_scale) = (b.method, b.sun, b.env_scale);
     }
-}
-
-/// Whether `a` and `b` differ in the image size alone.
-fn same_but_size(a: &Build, b: &Build) -> bool {
-    let mut a = a.clone();
-    (a.settings.width, a.settings.height) = (b.settings.width, b.settings.height);
-    a == *b
-}
-
-/// The scene as a build wants it: its sun (the last distant light) turned to the wanted
-/// angles and its environment map scaled to the wanted `--env-scale` (it was loaded at
-/// `loaded_scale`).
-fn prepare(mut scene: Scene, wanted: &Build, loaded_scale: f32) -> Scene {
-    if let (Some(sun), Some(Light::Distant { direction, .. })) =
-        (wanted.sun, scene.lights.iter_mut().rev().find(|l| matches!(l, Light::Distant { .. })))
-    {
-        *direction = sun.direction();
-    }
-    if let (Some(scale), Some(env)) = (wanted.env_scale, &scene.environment)
-        && scale != loaded_scale
-        && loaded_scale > 0.0
-    {
-        scene.environment = Some(Arc::new(env.scaled(scale / loaded_scale)));
-    }
-    scene
-}
-
-/// The environment scale the panel can change: `--env-scale` where the scene has an
-/// environment map that is not black.
-fn env_scale(a: &SceneArgs, scene: &Scene) -> Option<f32> {
-    scene.environment.as_ref().filter(|e| !e.is_dark() && a.env_scale > 0.0).map(|_| a.env_scale)
-}
-
-/// The direction of the scene's last distant light (the viewer's sun), if any.
-fn last_sun(scene: &Scene) -> Option<glam::Vec3> {
-    scene.lights.iter().rev().find_map(|l| match l {
-        Light::Distant { direction, .. } => Some(*direction),
-        _ => None,
-    })
 }
 
 impl ApplicationHandler<UserEvent> for App {

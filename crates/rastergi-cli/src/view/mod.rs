@@ -4,7 +4,7 @@
 //!
 //! The loop, per displayed frame: apply held keys and the script's due steps to the camera;
 //! if the camera moved, `Renderer::set_camera` restarts the image; run as many iterations as
-//! fit in [`app::FRAME_BUDGET`] of GPU time (at least one); resolve the film and draw it
+//! fit in [`frames::FRAME_BUDGET`] of GPU time (at least one); resolve the film and draw it
 //! ([`rastergi::display`]) with the control panel over it; present. Building a renderer
 //! (photon tracing, or opening a scene) runs on a worker thread so the window stays live
 //! meanwhile; new settings build a new renderer at the window's size (the film is the window's size) and shows the
@@ -27,7 +27,10 @@
 //! the frame loop), [`panel`], [`screenshots`] and [`script`].
 
 mod app;
+mod build;
 pub(crate) mod controls;
+mod frames;
+mod keys;
 pub(crate) mod panel;
 mod screenshots;
 mod script;
@@ -40,7 +43,7 @@ use winit::event_loop::EventLoop;
 
 use crate::args::SceneArgs;
 use app::{App, UserEvent};
-pub use app::{FRAME_BUDGET, MAX_BATCH, iterate_frame};
+pub use frames::{FRAME_BUDGET, MAX_BATCH, iterate_frame};
 use screenshots::Screenshots;
 
 /// The keys and mouse bindings (a macro so that `--help` can join it to the script text).

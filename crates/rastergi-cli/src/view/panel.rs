@@ -447,6 +447,14 @@ impl PanelPainter {
     }
 }
 
+/// The egui panel: its context, window-input state, GPU painter and own state.
+pub(super) struct Panel {
+    pub(super) ctx: egui::Context,
+    pub(super) input: egui_winit::State,
+    pub(super) painter: PanelPainter,
+    pub(super) state: PanelState,
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

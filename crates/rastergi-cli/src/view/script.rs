@@ -53,7 +53,7 @@
 //! and line.
 
 use std::path::Path;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
 use clap::ValueEnum;
@@ -304,6 +304,16 @@ fn count(args: &str, name: &str, min: u32, max: u32) -> Result<u32> {
         Ok(n) if (min..=max).contains(&n) => Ok(n),
         _ => bail!("'{name}' takes a whole number from {min} to {max}"),
     }
+}
+
+/// The script's progress.
+pub(super) struct ScriptRun {
+    pub(super) steps: Vec<Step>,
+    pub(super) next: usize,
+    /// When the previous step ran.
+    pub(super) last: Instant,
+    /// A `resize` waiting for the image to take that size, and since when.
+    pub(super) resizing: Option<((u32, u32), Instant)>,
 }
 
 #[cfg(test)]

@@ -542,13 +542,7 @@ pub fn check_bvh_nodes(limits: &wgpu::Limits, nodes: usize) -> Result<()> {
 mod limit_tests {
     use super::*;
 
-    fn limits(binding_mib: u64) -> wgpu::Limits {
-        wgpu::Limits {
-            max_storage_buffer_binding_size: binding_mib << 20,
-            max_buffer_size: 2 * (binding_mib << 20),
-            ..wgpu::Limits::default()
-        }
-    }
+    use crate::limits::test_limits as limits;
 
     #[test]
     fn a_scene_whose_triangles_exceed_the_binding_limit_is_refused_with_the_sizes() {

@@ -52,17 +52,20 @@ pub fn check_bundle(limits: &wgpu::Limits, bundle: u32) -> Result<()> {
     check_storage_buffer(limits, &what, bundle as u64 * bundle as u64, 4, "choose a smaller --bundle")
 }
 
+/// Limits of `binding_mib` MiB per storage binding and twice that per buffer, for tests.
+#[cfg(test)]
+pub(crate) fn test_limits(binding_mib: u64) -> wgpu::Limits {
+    wgpu::Limits {
+        max_storage_buffer_binding_size: binding_mib << 20,
+        max_buffer_size: 2 * (binding_mib << 20),
+        ..wgpu::Limits::default()
+    }
+}
+
 #[cfg(test)]
 mod tests {
+    use super::test_limits as limits;
     use super::*;
-
-    fn limits(binding_mib: u64) -> wgpu::Limits {
-        wgpu::Limits {
-            max_storage_buffer_binding_size: binding_mib << 20,
-            max_buffer_size: 2 * (binding_mib << 20),
-            ..wgpu::Limits::default()
-        }
-    }
 
     #[test]
     fn the_smaller_of_binding_and_buffer_limits_applies() {

@@ -535,13 +535,7 @@ pub fn check_photon_slots(limits: &wgpu::Limits, layout: &MapLayout) -> crate::e
 
 #[cfg(test)]
 mod tests {
-    fn limits(binding_mib: u64) -> wgpu::Limits {
-        wgpu::Limits {
-            max_storage_buffer_binding_size: binding_mib << 20,
-            max_buffer_size: 2 * (binding_mib << 20),
-            ..wgpu::Limits::default()
-        }
-    }
+    use crate::limits::test_limits as limits;
 
     use super::*;
     use crate::sampling::{Rng, uniform_sphere};

@@ -4,8 +4,9 @@
 //! generates must hold the Rust values in every shader. Members whose names start with `_`
 //! are padding on both sides and are matched by size alone.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::mem::{offset_of, size_of};
+use std::path::Path;
 
 use crate::bvh::BvhNode;
 use crate::display::DisplayUniforms;
@@ -221,4 +222,63 @@ fn every_shader_holds_the_rust_constants() {
             assert_eq!(constants.get(name), Some(value), "{label}: {name}");
         }
     }
+}
+
+/// The WGSL entry points (`@compute`, `@vertex`, `@fragment`) of every file under `src/`, as
+/// (file relative to `src/`, function name).
+fn entry_points_in_the_code() -> BTreeSet<(String, String)> {
+    fn walk(dir: &Path, root: &Path, out: &mut BTreeSet<(String, String)>) {
+        for entry in std::fs::read_dir(dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                walk(&path, root, out);
+            } else if path.extension().is_some_and(|e| e == "wgsl") {
+                let text = std::fs::read_to_string(&path).unwrap();
+                let file = path.strip_prefix(root).unwrap().to_string_lossy().replace('\\', "/");
+                let mut pending = false;
+                for line in text.lines().map(str::trim) {
+                    if line.starts_with("//") {
+                        continue;
+                    }
+                    pending |= ["@compute", "@vertex", "@fragment"].iter().any(|a| line.contains(a));
+                    if pending && let Some(rest) = line.split_once("fn ").map(|(_, r)| r) {
+                        let name = rest.split('(').next().unwrap().trim().to_owned();
+                        out.insert((file.clone(), name));
+                        pending = false;
+                    }
+                }
+            }
+        }
+    }
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut out = BTreeSet::new();
+    walk(&root, &root, &mut out);
+    out
+}
+
+/// The entry points docs/design.md's "Where each pass lives" names: cells of the form
+/// `` `file.wgsl`: `a`, `b` ``.
+fn entry_points_in_the_design_page() -> BTreeSet<(String, String)> {
+    let design = include_str!("../../../docs/design.md");
+    let section = design.split("## Where each pass lives").nth(1).expect("the section").split("\n## ").next().unwrap();
+    let mut out = BTreeSet::new();
+    for cell in section.lines().filter(|l| l.starts_with('|')).flat_map(|l| l.split('|')) {
+        if let Some((file, entries)) = cell.trim().split_once(".wgsl`:") {
+            let file = format!("{}.wgsl", file.trim_start_matches('`'));
+            for e in entries.split(',') {
+                out.insert((file.clone(), e.trim().trim_matches('`').to_owned()));
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn the_design_page_names_every_wgsl_entry_point_and_each_exists() {
+    let (code, page) = (entry_points_in_the_code(), entry_points_in_the_design_page());
+    assert!(code.len() >= 20, "the scan found only {code:?}");
+    let missing: Vec<_> = code.difference(&page).collect();
+    let stale: Vec<_> = page.difference(&code).collect();
+    assert!(missing.is_empty(), "entry points docs/design.md does not name: {missing:?}");
+    assert!(stale.is_empty(), "docs/design.md names entry points the code lacks: {stale:?}");
 }

@@ -419,7 +419,13 @@ impl GpuScene {
         });
         let ggx_buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("scene ggx albedo"),
-            contents: bytemuck::bytes_of(&crate::bsdf::ggx_albedo().gpu()),
+            // Read only where some material is not Lambertian (SCENE_BSDF): other scenes
+            // neither compute the table nor read it.
+            contents: bytemuck::bytes_of(&if prepared.scene.materials.iter().all(Material::is_lambertian) {
+                crate::bsdf::albedo::GpuGgxAlbedo::zeroed()
+            } else {
+                crate::bsdf::ggx_albedo().gpu()
+            }),
             usage: wgpu::BufferUsages::STORAGE,
         });
         let vis = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;

@@ -13,7 +13,7 @@
 //!
 //! and its cosine-weighted mean Ē = 2∫₀¹ E(μ) μ dμ likewise. Both integrals are computed by
 //! sampling the distribution of visible normals (Heitz 2018), whose weight for the reflected
-//! direction is exactly F·G₁(ω_i), on a stratified 64 × 64 grid of (u₁, u₂) per table cell.
+//! direction is exactly F·G₁(ω_i), on a stratified 64 × 64 grid of (u₁, u₂) per table cell (in parallel over the cells).
 //! The tables hold [`N`] × [`N`] cells, μ and α each uniform on [0, 1] (α = 0 is the mirror
 //! limit: E₁ = 1, E₅ = (1 − μ)⁵), read bilinearly; Ē is integrated from the interpolated
 //! table itself, so that ∫(1 − E(μ_i))·cos θ_i/π dω_i / (1 − Ē) is exactly 1 and the layer's
@@ -24,6 +24,7 @@ use std::sync::OnceLock;
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
+use rayon::prelude::*;
 
 use super::{ggx_g1, vndf_sample};
 
@@ -71,17 +72,18 @@ fn integrate(mu: f32, alpha: f32) -> [f32; 2] {
 
 impl GgxAlbedo {
     fn compute() -> Self {
-        let mut e = vec![[0.0f32; 2]; N * N];
-        for j in 0..N {
-            for i in 0..N {
-                e[j * N + i] = if j == 0 {
+        let e: Vec<[f32; 2]> = (0..N * N)
+            .into_par_iter()
+            .map(|k| {
+                let (i, j) = (k % N, k / N);
+                if j == 0 {
                     // The mirror limit: every ray reflects, F at μ itself.
                     [1.0, (1.0 - grid(i)).powi(5)]
                 } else {
                     integrate(grid(i), grid(j))
-                };
-            }
-        }
+                }
+            })
+            .collect();
         let mut table = GgxAlbedo { e, mean: vec![[0.0; 2]; N] };
         // 2∫ E(μ) μ dμ of the interpolated table, by the midpoint rule on a fine grid.
         const STEPS: usize = 4096;

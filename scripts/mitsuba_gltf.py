@@ -73,8 +73,12 @@ def _buffers(doc, directory, bin_chunk, path):
             data = base64.b64decode(uri.split(",", 1)[1])
         else:
             from urllib.parse import unquote
-            with open(os.path.join(directory, unquote(uri)), "rb") as f:
-                data = f.read()
+            name = os.path.join(directory, unquote(uri))
+            try:
+                with open(name, "rb") as f:
+                    data = f.read()
+            except OSError as e:
+                raise GltfError(f"{path}: buffer {i} ({name}) cannot be read: {e}")
         out.append(data)
     return out
 
@@ -165,10 +169,13 @@ def load_gltf(path):
             data = f.read()
     except OSError as e:
         raise GltfError(f"{path}: cannot be read: {e}")
-    if data[:4] == b"glTF":
-        doc, bin_chunk = _split_glb(data, path)
-    else:
-        doc, bin_chunk = json.loads(data.decode("utf-8")), None
+    try:
+        if data[:4] == b"glTF":
+            doc, bin_chunk = _split_glb(data, path)
+        else:
+            doc, bin_chunk = json.loads(data.decode("utf-8")), None
+    except (ValueError, struct.error) as e:  # JSONDecodeError and UnicodeDecodeError too
+        raise GltfError(f"{path}: not a valid glTF file ({e})")
     buffers = _buffers(doc, os.path.dirname(path), bin_chunk, path)
     nodes = doc.get("nodes", [])
     scenes = doc.get("scenes", [])

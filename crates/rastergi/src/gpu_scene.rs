@@ -346,6 +346,7 @@ impl GpuScene {
         check_scene(&limits, &prepared.scene)?;
         check_bvh_nodes(&limits, prepared.bvh.nodes.len())?;
         let s = &prepared.scene;
+        let has_bsdfs = !s.materials.iter().all(Material::is_lambertian);
         let triangles: Vec<GpuTriangle> = s
             .triangles
             .iter()
@@ -421,7 +422,7 @@ impl GpuScene {
             label: Some("scene ggx albedo"),
             // Read only where some material is not Lambertian (SCENE_BSDF): other scenes
             // neither compute the table nor read it.
-            contents: bytemuck::bytes_of(&if prepared.scene.materials.iter().all(Material::is_lambertian) {
+            contents: bytemuck::bytes_of(&if !has_bsdfs {
                 crate::bsdf::albedo::GpuGgxAlbedo::zeroed()
             } else {
                 crate::bsdf::ggx_albedo().gpu()
@@ -506,7 +507,7 @@ impl GpuScene {
                 .sum(),
             eye_chains: s.materials.iter().any(|m| m.passes_rays() || m.has_delta_lobe()),
             caustics: s.materials.iter().any(Material::passes_rays),
-            has_bsdfs: !s.materials.iter().all(Material::is_lambertian),
+            has_bsdfs,
         })
     }
 }

@@ -591,8 +591,7 @@ pub fn on_gpu(
     gpu: &crate::gpu::Gpu,
     queries: &[(Bsdf, Vec3, Vec3, [f32; 3], Transport)],
 ) -> crate::Result<Vec<GpuAnswer>> {
-    use crate::gpu::{compute_pipeline, groups, storage_entry};
-    use wgpu::util::DeviceExt;
+    use crate::gpu::storage_entry;
     let device = &gpu.device;
     let input: Vec<[f32; 20]> = queries
         .iter()
@@ -625,28 +624,8 @@ pub fn on_gpu(
     let size = (queries.len() as u64 * 64).max(64);
     let output = gpu.zeroed_buffer("bsdf answers", size, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
     let c = wgpu::ShaderStages::COMPUTE;
-    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("bsdf"),
-        entries: &[
-            storage_entry::<[f32; 20]>(0, c, true),
-            storage_entry::<[f32; 16]>(1, c, false),
-            storage_entry::<albedo::GpuGgxAlbedo>(2, c, true),
-        ],
-    });
-    let table = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("bsdf ggx albedo"),
-        contents: bytemuck::bytes_of(&ggx_albedo().gpu()),
-        usage: wgpu::BufferUsages::STORAGE,
-    });
-    let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("bsdf"),
-        layout: &layout,
-        entries: &[
-            wgpu::BindGroupEntry { binding: 0, resource: input.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 1, resource: output.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 2, resource: table.as_entire_binding() },
-        ],
-    });
+    let table =
+        gpu.storage_buffer("bsdf ggx albedo", bytemuck::bytes_of(&ggx_albedo().gpu()), wgpu::BufferUsages::empty());
     let main = "
         struct Query { v: array<f32, 20> }
         struct Answer { v: array<f32, 16> }
@@ -674,16 +653,17 @@ pub fn on_gpu(
         }";
     let source = crate::shader::compose(&[crate::shader::SAMPLING, crate::shader::BSDF, main]);
     let module = crate::shader::module(device, "bsdf", &source);
-    let pipeline = compute_pipeline(device, "bsdf", &module, "main", &[&layout]);
-    let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("bsdf") });
-    {
-        let mut pass =
-            enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("bsdf"), timestamp_writes: None });
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &bind_group, &[]);
-        pass.dispatch_workgroups(groups(queries.len() as u32, 64), 1, 1);
-    }
-    gpu.queue.submit([enc.finish()]);
+    gpu.run_once(
+        "bsdf",
+        &module,
+        &[
+            storage_entry::<[f32; 20]>(0, c, true),
+            storage_entry::<[f32; 16]>(1, c, false),
+            storage_entry::<albedo::GpuGgxAlbedo>(2, c, true),
+        ],
+        &[input.as_entire_binding(), output.as_entire_binding(), table.as_entire_binding()],
+        queries.len() as u32,
+    );
     let bytes = gpu.read_buffer(&output, size)?;
     let answers: &[[f32; 16]] = bytemuck::cast_slice(&bytes);
     Ok(answers[..queries.len()]

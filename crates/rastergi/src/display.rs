@@ -16,7 +16,7 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::error::{Error, Result};
 use crate::film::Film;
-use crate::gpu::{Gpu, GpuOptions, storage_entry, uniform_entry};
+use crate::gpu::{Gpu, GpuOptions, bind_group, bind_group_layout, storage_entry, uniform_entry};
 use crate::shader;
 
 /// Re-exported so front ends can hand over a window without a direct wgpu dependency.
@@ -95,15 +95,16 @@ impl DisplayPass {
     pub fn new(gpu: &Gpu, format: wgpu::TextureFormat) -> DisplayPass {
         let device = &gpu.device;
         let f = wgpu::ShaderStages::FRAGMENT;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("display"),
-            entries: &[
+        let layout = bind_group_layout(
+            device,
+            "display",
+            &[
                 uniform_entry::<DisplayUniforms>(0, f),
                 storage_entry::<u32>(1, f, true),
                 storage_entry::<u32>(2, f, true),
                 storage_entry::<u32>(3, f, true),
             ],
-        });
+        );
         let module = shader::module(device, "display", SOURCE);
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("display"),
@@ -176,16 +177,17 @@ impl DisplayPass {
         gpu.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
         let image = film.map_or(&self.no_image, |f| f.display_buffer()).clone();
         if self.bound.as_ref().is_none_or(|(b, _)| *b != image) {
-            let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("display"),
-                layout: &self.layout,
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: self.uniforms.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 1, resource: image.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 2, resource: self.font.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 3, resource: self.text.as_entire_binding() },
+            let bind_group = bind_group(
+                &gpu.device,
+                "display",
+                &self.layout,
+                &[
+                    self.uniforms.as_entire_binding(),
+                    image.as_entire_binding(),
+                    self.font.as_entire_binding(),
+                    self.text.as_entire_binding(),
                 ],
-            });
+            );
             self.bound = Some((image, bind_group));
         }
         let (_, bind_group) = self.bound.as_ref().expect("bound just above");

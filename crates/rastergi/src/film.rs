@@ -34,7 +34,7 @@
 use bytemuck::{Pod, Zeroable};
 
 use crate::error::Result;
-use crate::gpu::{Gpu, buffer_bind_group, compute_pipeline, groups, storage_entry, uniform_entry};
+use crate::gpu::{Gpu, bind_group_layout, buffer_bind_group, compute_pipeline, groups, storage_entry, uniform_entry};
 use crate::image_io::{DisplayImage, LinearImage};
 use crate::shader;
 
@@ -129,23 +129,25 @@ impl Film {
         );
         let device = &gpu.device;
         let c = wgpu::ShaderStages::COMPUTE;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("resolve"),
-            entries: &[
+        let layout = bind_group_layout(
+            device,
+            "resolve",
+            &[
                 uniform_entry::<ResolveUniforms>(0, c),
                 storage_entry::<[f32; 4]>(1, c, true),
                 storage_entry::<[f32; 4]>(2, c, false),
                 storage_entry::<u32>(3, c, false),
             ],
-        });
+        );
         let bind_group = buffer_bind_group(device, "resolve", &layout, &[&uniforms, &accumulation, &linear, &display]);
         let module = shader::module(device, "resolve", &resolve_source());
         let pipeline = compute_pipeline(device, "resolve", &module, "main", &[&layout]);
         let half = gpu.zeroed_buffer("film odd half", COMPONENTS * pixels * 16, rw);
-        let half_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("film half"),
-            entries: &[storage_entry::<[f32; 4]>(0, c, true), storage_entry::<[f32; 4]>(1, c, false)],
-        });
+        let half_layout = bind_group_layout(
+            device,
+            "film half",
+            &[storage_entry::<[f32; 4]>(0, c, true), storage_entry::<[f32; 4]>(1, c, false)],
+        );
         let half_bind_group = buffer_bind_group(device, "film half", &half_layout, &[&accumulation, &half]);
         let half_module = shader::module(device, "film half", include_str!("film_half.wgsl"));
         let half_pipelines = ["open_block", "close_block"]

@@ -4,7 +4,7 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec2, Vec3};
 
-use crate::gpu::{Gpu, buffer_bind_group, storage_entry, uniform_entry};
+use crate::gpu::{Gpu, bind_group_layout, buffer_bind_group, storage_entry, uniform_entry};
 use crate::gpu_scene::GpuScene;
 use crate::sampling::{pcg_hash, sobol_owen_2d, stream, unit_f32};
 use crate::scene::{Aabb, Camera};
@@ -123,13 +123,11 @@ impl FrameBinding {
             wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         );
         let vis = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
-        let layout = gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("frame"),
-            entries: &[
-                uniform_entry::<FrameUniforms>(0, vis),
-                storage_entry::<[f32; 4]>(1, wgpu::ShaderStages::COMPUTE, false),
-            ],
-        });
+        let layout = bind_group_layout(
+            &gpu.device,
+            "frame",
+            &[uniform_entry::<FrameUniforms>(0, vis), storage_entry::<[f32; 4]>(1, wgpu::ShaderStages::COMPUTE, false)],
+        );
         let eye_paths = gpu.zeroed_buffer("eye paths", EYE_PATH_BYTES, wgpu::BufferUsages::STORAGE);
         let bind_group = buffer_bind_group(&gpu.device, "frame", &layout, &[&buffer, &eye_paths]);
         Self { buffer, eye_paths, layout, bind_group }

@@ -9,7 +9,7 @@
 use crate::error::Result;
 use crate::film::Film;
 use crate::frame::FrameBinding;
-use crate::gpu::{Gpu, scene_raster_pipeline, storage_entry, uint_texture_entry};
+use crate::gpu::{Gpu, bind_group, bind_group_layout, scene_raster_pipeline, storage_entry, uint_texture_entry};
 use crate::gpu_scene::GpuScene;
 use crate::shader;
 
@@ -105,13 +105,14 @@ pub const GBUFFER_FILM_WGSL: &str = include_str!("gbuffer_film.wgsl");
 
 /// Layout of a per-pixel pass's own group: the G-buffer (binding 0) and the film (binding 1).
 pub fn gbuffer_film_layout(device: &wgpu::Device, label: &str) -> wgpu::BindGroupLayout {
-    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some(label),
-        entries: &[
+    bind_group_layout(
+        device,
+        label,
+        &[
             uint_texture_entry(0, wgpu::ShaderStages::COMPUTE),
             storage_entry::<[f32; 4]>(1, wgpu::ShaderStages::COMPUTE, false),
         ],
-    })
+    )
 }
 
 pub fn gbuffer_film_bind_group(
@@ -121,12 +122,10 @@ pub fn gbuffer_film_bind_group(
     gbuffer: &GBufferPass,
     film: &Film,
 ) -> wgpu::BindGroup {
-    device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some(label),
+    bind_group(
+        device,
+        label,
         layout,
-        entries: &[
-            wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&gbuffer.view) },
-            wgpu::BindGroupEntry { binding: 1, resource: film.accumulation.as_entire_binding() },
-        ],
-    })
+        &[wgpu::BindingResource::TextureView(&gbuffer.view), film.accumulation.as_entire_binding()],
+    )
 }

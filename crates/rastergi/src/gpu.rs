@@ -273,6 +273,33 @@ impl Gpu {
     }
 }
 
+impl Gpu {
+    /// Runs `module`'s entry point `main` (`@workgroup_size(64)`, bind group 0 = `resources` on
+    /// a layout of `entries`) over `n` invocations, submits and waits for nothing: the GPU side
+    /// of a CPU twin's test, read back with [`Gpu::read_buffer`].
+    pub fn run_once(
+        &self,
+        label: &str,
+        module: &wgpu::ShaderModule,
+        entries: &[wgpu::BindGroupLayoutEntry],
+        resources: &[wgpu::BindingResource],
+        n: u32,
+    ) {
+        let layout = bind_group_layout(&self.device, label, entries);
+        let group = bind_group(&self.device, label, &layout, resources);
+        let pipeline = compute_pipeline(&self.device, label, module, "main", &[&layout]);
+        let mut enc = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+        {
+            let mut pass =
+                enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes: None });
+            pass.set_pipeline(&pipeline);
+            pass.set_bind_group(0, &group, &[]);
+            pass.dispatch_workgroups(groups(n, 64), 1, 1);
+        }
+        self.queue.submit([enc.finish()]);
+    }
+}
+
 /// Bind-group-layout entry for a storage buffer holding `T`s (an array of them or one): wgpu
 /// refuses a bound buffer smaller than one `T`, and a shader whose type there is larger.
 pub fn storage_entry<T>(binding: u32, visibility: wgpu::ShaderStages, read_only: bool) -> wgpu::BindGroupLayoutEntry {
@@ -338,6 +365,55 @@ pub fn uniform_entry<T>(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::B
     }
 }
 
+/// A bind group layout of `entries` (each names its binding).
+pub fn bind_group_layout(
+    device: &wgpu::Device,
+    label: &str,
+    entries: &[wgpu::BindGroupLayoutEntry],
+) -> wgpu::BindGroupLayout {
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries })
+}
+
+/// Bind-group-layout entry for a filterable float 2D array texture (the scene's textures).
+pub fn texture_array_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: true },
+            view_dimension: wgpu::TextureViewDimension::D2Array,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+/// Bind-group-layout entry for a filtering sampler.
+pub fn sampler_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+        count: None,
+    }
+}
+
+/// Bind group whose entries are `resources`, at bindings 0, 1, 2, … (the order of the
+/// layout's entries and of the shader's `@binding`s).
+pub fn bind_group(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    resources: &[wgpu::BindingResource],
+) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry> = resources
+        .iter()
+        .enumerate()
+        .map(|(i, r)| wgpu::BindGroupEntry { binding: i as u32, resource: r.clone() })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout, entries: &entries })
+}
+
 /// Bind group whose entries are `buffers` bound whole, at bindings 0, 1, 2, …
 pub fn buffer_bind_group(
     device: &wgpu::Device,
@@ -345,12 +421,8 @@ pub fn buffer_bind_group(
     layout: &wgpu::BindGroupLayout,
     buffers: &[&wgpu::Buffer],
 ) -> wgpu::BindGroup {
-    let entries: Vec<wgpu::BindGroupEntry> = buffers
-        .iter()
-        .enumerate()
-        .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
-        .collect();
-    device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout, entries: &entries })
+    let resources: Vec<wgpu::BindingResource> = buffers.iter().map(|b| b.as_entire_binding()).collect();
+    bind_group(device, label, layout, &resources)
 }
 
 /// A pipeline layout of bind groups 0, 1, … = `layouts`.

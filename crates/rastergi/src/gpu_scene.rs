@@ -10,7 +10,7 @@ use crate::error::Result;
 use wgpu::util::DeviceExt;
 
 use crate::environment::{Environment, GpuEnvironment};
-use crate::gpu::{Gpu, storage_entry, uniform_entry};
+use crate::gpu::{Gpu, bind_group_layout, sampler_entry, storage_entry, texture_array_entry, uniform_entry};
 use crate::lights::{LightEntry, LightTable};
 use crate::limits::check_storage_buffer;
 use crate::scene::{Aabb, AlphaMode, Material, Scene, TextureRef, UvTransform};
@@ -434,30 +434,17 @@ impl GpuScene {
         // vertices and discard holes) see five storage buffers of the scene, well under the
         // count at which lavapipe loses fragment writes (below).
         let compute = wgpu::ShaderStages::COMPUTE;
-        let layout = gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("scene"),
-            entries: &[
+        let layout = bind_group_layout(
+            &gpu.device,
+            "scene",
+            &[
                 storage_entry::<GpuTriangle>(0, vis, true),
                 storage_entry::<GpuMaterial>(1, vis, true),
                 storage_entry::<crate::bvh::BvhNode>(2, compute, true),
                 storage_entry::<crate::lights::LightEntry>(3, compute, true),
                 storage_entry::<[f32; 2]>(4, vis, true),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 5,
-                    visibility: vis,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                        view_dimension: wgpu::TextureViewDimension::D2Array,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 6,
-                    visibility: vis,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                    count: None,
-                },
+                texture_array_entry(5, vis),
+                sampler_entry(6, vis),
                 storage_entry::<crate::lights::PunctualLight>(7, compute, true),
                 // The environment, the shading normals and the tangents are read by compute
                 // passes only, and
@@ -474,7 +461,7 @@ impl GpuScene {
                 // buffer here (any visibility) crashed lavapipe (Mesa 22.3) in the raster gather.
                 storage_entry::<crate::bsdf::albedo::GpuGgxAlbedo>(13, compute, true),
             ],
-        });
+        );
         // The buffers' bindings, in the order of `buffers`.
         const BUFFER_BINDINGS: [u32; 10] = [0, 1, 2, 3, 4, 7, 8, 10, 11, 12];
         let mut entries: Vec<wgpu::BindGroupEntry> = buffers

@@ -42,7 +42,7 @@ use bytemuck::{Pod, Zeroable};
 use crate::error::Result;
 use crate::film::{Film, Show};
 use crate::frame::{FrameBinding, FrameUniforms, pixel_jitter};
-use crate::gpu::{Gpu, buffer_bind_group, groups, storage_entry, uniform_entry};
+use crate::gpu::{Gpu, bind_group_layout, buffer_bind_group, groups, storage_entry, uniform_entry};
 use crate::gpu_scene::{GpuScene, PreparedScene};
 use crate::image_io::{DisplayImage, LinearImage};
 use crate::renderer::RenderSettings;
@@ -109,14 +109,15 @@ impl PathTracer {
 
         let device = &gpu.device;
         let c = wgpu::ShaderStages::COMPUTE;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("path tracer"),
-            entries: &[
+        let layout = bind_group_layout(
+            device,
+            "path tracer",
+            &[
                 storage_entry::<[f32; 4]>(0, c, false),
                 uniform_entry::<PathParams>(1, c),
                 storage_entry::<[u32; 4]>(2, c, false),
             ],
-        });
+        );
         let params = gpu.zeroed_buffer(
             "path tracer params",
             std::mem::size_of::<PathParams>() as u64,

@@ -8,7 +8,7 @@ use glam::Vec3;
 
 pub use crate::consts::stream;
 use crate::error::Result;
-use crate::gpu::{Gpu, compute_pipeline, groups, storage_entry};
+use crate::gpu::{Gpu, storage_entry};
 
 /// One round of the PCG permutation, also used as an integer hash.
 #[inline]
@@ -163,18 +163,6 @@ pub fn sobol_owen_on_gpu(gpu: &Gpu, queries: &[(u32, u32)]) -> Result<Vec<[u32; 
     let size = (queries.len() as u64 * 8).max(8);
     let output = gpu.zeroed_buffer("sobol points", size, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
     let c = wgpu::ShaderStages::COMPUTE;
-    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("sobol points"),
-        entries: &[storage_entry::<[u32; 2]>(0, c, true), storage_entry::<[u32; 2]>(1, c, false)],
-    });
-    let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("sobol points"),
-        layout: &layout,
-        entries: &[
-            wgpu::BindGroupEntry { binding: 0, resource: input.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 1, resource: output.as_entire_binding() },
-        ],
-    });
     let main = "
         @group(0) @binding(0) var<storage, read> queries: array<vec2u>;
         @group(0) @binding(1) var<storage, read_write> points: array<vec2u>;
@@ -187,16 +175,13 @@ pub fn sobol_owen_on_gpu(gpu: &Gpu, queries: &[(u32, u32)]) -> Result<Vec<[u32; 
         }";
     let source = crate::shader::compose(&[crate::shader::SAMPLING, main]);
     let module = crate::shader::module(device, "sobol points", &source);
-    let pipeline = compute_pipeline(device, "sobol points", &module, "main", &[&layout]);
-    let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("sobol points") });
-    {
-        let mut pass = enc
-            .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("sobol points"), timestamp_writes: None });
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &bind_group, &[]);
-        pass.dispatch_workgroups(groups(queries.len() as u32, 64), 1, 1);
-    }
-    gpu.queue.submit([enc.finish()]);
+    gpu.run_once(
+        "sobol points",
+        &module,
+        &[storage_entry::<[u32; 2]>(0, c, true), storage_entry::<[u32; 2]>(1, c, false)],
+        &[input.as_entire_binding(), output.as_entire_binding()],
+        queries.len() as u32,
+    );
     let bytes = gpu.read_buffer(&output, size)?;
     let points: &[[u32; 2]] = bytemuck::cast_slice(&bytes);
     Ok(points[..queries.len()].to_vec())

@@ -33,7 +33,7 @@
 use glam::{Vec2, Vec3, Vec4};
 
 use crate::error::{Error, Result};
-use crate::gpu::{Gpu, compute_pipeline, groups, storage_entry};
+use crate::gpu::{Gpu, sampler_entry, storage_entry, texture_array_entry};
 use crate::scene::Texture;
 use crate::shader;
 
@@ -342,39 +342,6 @@ pub fn sample_on_gpu(gpu: &Gpu, array: &TextureArray, queries: &[(u32, Vec2, f32
     let size = (queries.len() as u64 * 16).max(16);
     let output = gpu.zeroed_buffer("texture samples", size, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
     let c = wgpu::ShaderStages::COMPUTE;
-    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("texture samples"),
-        entries: &[
-            wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: c,
-                ty: wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                    view_dimension: wgpu::TextureViewDimension::D2Array,
-                    multisampled: false,
-                },
-                count: None,
-            },
-            wgpu::BindGroupLayoutEntry {
-                binding: 1,
-                visibility: c,
-                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                count: None,
-            },
-            storage_entry::<[f32; 4]>(2, c, true),
-            storage_entry::<[f32; 4]>(3, c, false),
-        ],
-    });
-    let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("texture samples"),
-        layout: &layout,
-        entries: &[
-            wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&view) },
-            wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&sampler) },
-            wgpu::BindGroupEntry { binding: 2, resource: input.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 3, resource: output.as_entire_binding() },
-        ],
-    });
     let source = "
         @group(0) @binding(0) var textures: texture_2d_array<f32>;
         @group(0) @binding(1) var texture_sampler: sampler;
@@ -389,18 +356,23 @@ pub fn sample_on_gpu(gpu: &Gpu, array: &TextureArray, queries: &[(u32, Vec2, f32
             samples[gid.x] = textureSampleLevel(textures, texture_sampler, q.xy, u32(q.w), q.z);
         }";
     let module = shader::module(device, "texture samples", source);
-    let pipeline = compute_pipeline(device, "texture samples", &module, "main", &[&layout]);
-    let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("texture samples") });
-    {
-        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("texture samples"),
-            timestamp_writes: None,
-        });
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &bind_group, &[]);
-        pass.dispatch_workgroups(groups(queries.len() as u32, 64), 1, 1);
-    }
-    gpu.queue.submit([enc.finish()]);
+    gpu.run_once(
+        "texture samples",
+        &module,
+        &[
+            texture_array_entry(0, c),
+            sampler_entry(1, c),
+            storage_entry::<[f32; 4]>(2, c, true),
+            storage_entry::<[f32; 4]>(3, c, false),
+        ],
+        &[
+            wgpu::BindingResource::TextureView(&view),
+            wgpu::BindingResource::Sampler(&sampler),
+            input.as_entire_binding(),
+            output.as_entire_binding(),
+        ],
+        queries.len() as u32,
+    );
     let bytes = gpu.read_buffer(&output, size)?;
     let samples: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
     Ok(samples[..queries.len()].iter().map(|s| Vec3::new(s[0], s[1], s[2])).collect())

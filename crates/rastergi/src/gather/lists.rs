@@ -17,7 +17,9 @@ use super::Gather;
 use super::estimator::{GatherInputs, GatherSetup, GatherUniforms, RAY_VIEW_LOOKUP};
 use super::ray_view::{ray_view_module, ray_view_pipeline, texel_size};
 use crate::error::{Error, Result};
-use crate::gpu::{Gpu, dispatch_pixels, storage_entry, uint_texture_entry, uniform_entry};
+use crate::gpu::{
+    Gpu, bind_group, bind_group_layout, dispatch_pixels, storage_entry, uint_texture_entry, uniform_entry,
+};
 use crate::gpu_scene::GpuScene;
 use crate::profile::{Profiler, compute_pass};
 
@@ -77,46 +79,50 @@ impl ListGather {
         let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
         let f = wgpu::ShaderStages::FRAGMENT;
         let c = wgpu::ShaderStages::COMPUTE;
-        let fill_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("gather list fill"),
-            entries: &[
+        let fill_layout = bind_group_layout(
+            device,
+            "gather list fill",
+            &[
                 uniform_entry::<GatherUniforms>(0, vf),
                 storage_entry::<u32>(1, f, false),
                 storage_entry::<[u32; 2]>(2, f, false),
                 storage_entry::<u32>(3, f, false),
             ],
-        });
-        let fill_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("gather list fill"),
-            layout: &fill_layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: heads.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: nodes.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 3, resource: node_count.as_entire_binding() },
+        );
+        let fill_group = bind_group(
+            device,
+            "gather list fill",
+            &fill_layout,
+            &[
+                uniforms.as_entire_binding(),
+                heads.as_entire_binding(),
+                nodes.as_entire_binding(),
+                node_count.as_entire_binding(),
             ],
-        });
-        let project_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("gather list project"),
-            entries: &[
+        );
+        let project_layout = bind_group_layout(
+            device,
+            "gather list project",
+            &[
                 uniform_entry::<GatherUniforms>(0, c),
                 uint_texture_entry(1, c),
                 storage_entry::<u32>(2, c, true),
                 storage_entry::<[u32; 2]>(3, c, true),
                 storage_entry::<[f32; 4]>(4, c, false),
             ],
-        });
-        let project_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("gather list project"),
-            layout: &project_layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&setup.gbuffer.view) },
-                wgpu::BindGroupEntry { binding: 2, resource: heads.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 3, resource: nodes.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 4, resource: setup.film.accumulation.as_entire_binding() },
+        );
+        let project_group = bind_group(
+            device,
+            "gather list project",
+            &project_layout,
+            &[
+                uniforms.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&setup.gbuffer.view),
+                heads.as_entire_binding(),
+                nodes.as_entire_binding(),
+                setup.film.accumulation.as_entire_binding(),
             ],
-        });
+        );
 
         let module = ray_view_module(device);
         let fill_pipeline = ray_view_pipeline(

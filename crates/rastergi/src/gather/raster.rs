@@ -23,7 +23,9 @@ use super::Gather;
 use super::estimator::{GatherInputs, GatherSetup, GatherUniforms, RAY_VIEW_LOOKUP, submit_and_renew};
 use super::ray_view::{DEPTH_FORMAT, ray_view_module, ray_view_pipeline};
 use crate::error::Result;
-use crate::gpu::{Gpu, dispatch_pixels, storage_entry, uint_texture_entry, uniform_entry};
+use crate::gpu::{
+    Gpu, bind_group, bind_group_layout, dispatch_pixels, storage_entry, uint_texture_entry, uniform_entry,
+};
 use crate::gpu_scene::GpuScene;
 use crate::profile::{Profiler, compute_pass};
 
@@ -94,21 +96,24 @@ impl RasterGather {
         let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
         let c = wgpu::ShaderStages::COMPUTE;
         let tex_entry = uint_texture_entry;
-        let count_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("gather count"),
-            entries: &[
+        let count_layout = bind_group_layout(
+            device,
+            "gather count",
+            &[
                 uniform_entry::<GatherUniforms>(0, vf),
                 storage_entry::<u32>(1, wgpu::ShaderStages::FRAGMENT, false),
                 storage_entry::<u32>(2, wgpu::ShaderStages::FRAGMENT, false),
             ],
-        });
-        let peel_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("gather peel"),
-            entries: &[uniform_entry::<GatherUniforms>(0, vf), tex_entry(1, wgpu::ShaderStages::FRAGMENT)],
-        });
-        let project_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("gather project"),
-            entries: &[
+        );
+        let peel_layout = bind_group_layout(
+            device,
+            "gather peel",
+            &[uniform_entry::<GatherUniforms>(0, vf), tex_entry(1, wgpu::ShaderStages::FRAGMENT)],
+        );
+        let project_layout = bind_group_layout(
+            device,
+            "gather project",
+            &[
                 uniform_entry::<GatherUniforms>(0, c),
                 tex_entry(1, c),
                 tex_entry(2, c),
@@ -116,39 +121,35 @@ impl RasterGather {
                 storage_entry::<[f32; 4]>(4, c, false),
                 storage_entry::<[u32; 2]>(5, c, false),
             ],
-        });
-        let count_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("gather count"),
-            layout: &count_layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: counts.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: max_count.as_entire_binding() },
-            ],
-        });
+        );
+        let count_group = bind_group(
+            device,
+            "gather count",
+            &count_layout,
+            &[uniforms.as_entire_binding(), counts.as_entire_binding(), max_count.as_entire_binding()],
+        );
         let peel_group = |prev: &wgpu::TextureView| {
-            device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("gather peel"),
-                layout: &peel_layout,
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(prev) },
-                ],
-            })
+            bind_group(
+                device,
+                "gather peel",
+                &peel_layout,
+                &[uniforms.as_entire_binding(), wgpu::BindingResource::TextureView(prev)],
+            )
         };
         let project_group = |layer: &wgpu::TextureView| {
-            device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("gather project"),
-                layout: &project_layout,
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&gbuffer.view) },
-                    wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(layer) },
-                    wgpu::BindGroupEntry { binding: 3, resource: found.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 4, resource: film.accumulation.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 5, resource: behind.as_entire_binding() },
+            bind_group(
+                device,
+                "gather project",
+                &project_layout,
+                &[
+                    uniforms.as_entire_binding(),
+                    wgpu::BindingResource::TextureView(&gbuffer.view),
+                    wgpu::BindingResource::TextureView(layer),
+                    found.as_entire_binding(),
+                    film.accumulation.as_entire_binding(),
+                    behind.as_entire_binding(),
                 ],
-            })
+            )
         };
         let peel_groups = [peel_group(&layers[1]), peel_group(&layers[0])];
         let project_groups = [project_group(&layers[0]), project_group(&layers[1])];

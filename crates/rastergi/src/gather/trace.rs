@@ -16,7 +16,9 @@
 use super::Gather;
 use super::estimator::{GatherInputs, GatherSetup, GatherUniforms};
 use crate::error::Result;
-use crate::gpu::{Gpu, dispatch_pixels, storage_entry, uint_texture_entry, uniform_entry};
+use crate::gpu::{
+    Gpu, bind_group, bind_group_layout, dispatch_pixels, storage_entry, uint_texture_entry, uniform_entry,
+};
 use crate::profile::{Profiler, compute_pass};
 
 pub struct TraceGather {
@@ -29,23 +31,21 @@ impl TraceGather {
     pub fn new(gpu: &Gpu, setup: &GatherSetup, uniforms: &wgpu::Buffer) -> TraceGather {
         let device = &gpu.device;
         let c = wgpu::ShaderStages::COMPUTE;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("gather trace"),
-            entries: &[
-                uniform_entry::<GatherUniforms>(0, c),
-                uint_texture_entry(1, c),
-                storage_entry::<[f32; 4]>(2, c, false),
+        let layout = bind_group_layout(
+            device,
+            "gather trace",
+            &[uniform_entry::<GatherUniforms>(0, c), uint_texture_entry(1, c), storage_entry::<[f32; 4]>(2, c, false)],
+        );
+        let bind_group = bind_group(
+            device,
+            "gather trace",
+            &layout,
+            &[
+                uniforms.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&setup.gbuffer.view),
+                setup.film.accumulation.as_entire_binding(),
             ],
-        });
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("gather trace"),
-            layout: &layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&setup.gbuffer.view) },
-                wgpu::BindGroupEntry { binding: 2, resource: setup.film.accumulation.as_entire_binding() },
-            ],
-        });
+        );
         let pipeline = setup.estimate_pipeline(device, "gather trace", &[include_str!("trace.wgsl")], &layout);
         TraceGather { pipeline, bind_group, profiler: gpu.profiler.clone() }
     }

@@ -20,7 +20,7 @@ use glam::UVec3;
 use super::map::{GridSpec, MAX_SEPARATORS, MapLayout, PhotonMap, Separator, TABLE_WGSL, TrianglePlane};
 use super::{MAX_BOUNCES, PhotonSettings};
 use crate::error::Result;
-use crate::gpu::{Gpu, buffer_bind_group, storage_entry, uniform_entry};
+use crate::gpu::{Gpu, bind_group, bind_group_layout, buffer_bind_group, storage_entry, uniform_entry};
 use crate::gpu_scene::{GpuScene, PreparedScene};
 use crate::profile::compute_pass;
 use crate::shader;
@@ -209,9 +209,10 @@ impl GpuPhotonMap {
         );
 
         let c = wgpu::ShaderStages::COMPUTE;
-        let trace_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("photon trace"),
-            entries: &[
+        let trace_layout = bind_group_layout(
+            device,
+            "photon trace",
+            &[
                 uniform_entry::<PhotonParams>(0, c),
                 storage_entry::<u32>(1, c, false),
                 storage_entry::<u32>(2, c, false),
@@ -223,7 +224,7 @@ impl GpuPhotonMap {
                 storage_entry::<[u32; 2]>(8, c, true),
                 storage_entry::<[Separator; MAX_SEPARATORS]>(9, c, true),
             ],
-        });
+        );
         let channel = |c: u64| {
             wgpu::BindingResource::Buffer(wgpu::BufferBinding {
                 buffer: &tally,
@@ -231,22 +232,23 @@ impl GpuPhotonMap {
                 size: std::num::NonZeroU64::new(channel_bytes),
             })
         };
-        let trace_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("photon trace"),
-            layout: &trace_layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: params_buffer.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: channel(0) },
-                wgpu::BindGroupEntry { binding: 2, resource: channel(1) },
-                wgpu::BindGroupEntry { binding: 3, resource: channel(2) },
-                wgpu::BindGroupEntry { binding: 4, resource: area_buffer.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 5, resource: slots.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 6, resource: keys.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 7, resource: planes.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 8, resource: sep_keys.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 9, resource: sep_planes.as_entire_binding() },
+        let trace_group = bind_group(
+            device,
+            "photon trace",
+            &trace_layout,
+            &[
+                params_buffer.as_entire_binding(),
+                channel(0),
+                channel(1),
+                channel(2),
+                area_buffer.as_entire_binding(),
+                slots.as_entire_binding(),
+                keys.as_entire_binding(),
+                planes.as_entire_binding(),
+                sep_keys.as_entire_binding(),
+                sep_planes.as_entire_binding(),
             ],
-        });
+        );
         let module = shader::module(device, "photon trace", &trace_source());
         let layouts = [&scene.layout, &trace_layout];
         let trace_pipeline = scene.compute_pipeline(device, "trace photons", &module, "trace_photons", &layouts);
@@ -410,9 +412,10 @@ fn lookup_binding(
     );
     gpu.queue.write_buffer(&uniforms, 0, bytemuck::bytes_of(u));
     let vis = wgpu::ShaderStages::COMPUTE | wgpu::ShaderStages::FRAGMENT;
-    let layout = gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("photon map lookup"),
-        entries: &[
+    let layout = bind_group_layout(
+        &gpu.device,
+        "photon map lookup",
+        &[
             storage_entry::<[f32; 4]>(0, vis, true),
             uniform_entry::<PhotonGridUniforms>(1, vis),
             storage_entry::<[u32; 2]>(2, vis, true),
@@ -420,7 +423,7 @@ fn lookup_binding(
             storage_entry::<[u32; 2]>(4, vis, true),
             storage_entry::<[Separator; MAX_SEPARATORS]>(5, vis, true),
         ],
-    });
+    );
     let bind_group = buffer_bind_group(
         &gpu.device,
         "photon map lookup",

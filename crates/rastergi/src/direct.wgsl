@@ -5,10 +5,7 @@
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3u) {
-    if any(gid.xy >= frame.resolution) {
-        return;
-    }
-    start_alpha_stream();
+    if !begin_pixel(gid.xy) { return; }
     let p = visible_point_at(gid.xy);
     var radiance = vec3f(0.0);
     if !p.seen {

@@ -30,6 +30,21 @@ fn start_alpha_stream() {
     alpha_seed = pcg_hash(frame.seed ^ pcg_hash(frame.iteration));
 }
 
+// Begins the invocation of pixel `xy` in a pass of 8×8 workgroups: false where the workgroups
+// overhang the image (the invocation returns at once); inside, starts the alpha stream.
+fn begin_pixel(xy: vec2u) -> bool {
+    if any(xy >= frame.resolution) {
+        return false;
+    }
+    start_alpha_stream();
+    return true;
+}
+
+// The row-major index of pixel `xy` in the film and the per-pixel buffers.
+fn pixel_index(xy: vec2u) -> u32 {
+    return xy.y * frame.resolution.x + xy.x;
+}
+
 // The unit direction of the camera ray through the point p (in pixels, from the top-left
 // corner) of the jittered view. Clip (x, y, 0, 1) is the point at infinity in reversed-Z, so
 // the inverse view-projection maps it to the homogeneous world point (direction, 0), the same

@@ -175,11 +175,8 @@ fn path_radiance(origin: vec3f, dir: vec3f, xy: vec2u, rng: ptr<function, u32>) 
 // One path per pixel through this iteration's jittered pixel position, added to the film.
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3u) {
-    if any(gid.xy >= frame.resolution) {
-        return;
-    }
-    start_alpha_stream();
-    let pixel = gid.y * frame.resolution.x + gid.x;
+    if !begin_pixel(gid.xy) { return; }
+    let pixel = pixel_index(gid.xy);
     var rng = rng_new(frame.seed ^ STREAM_PATH, pixel, frame.iteration);
     let radiance = path_radiance(frame.eye, camera_direction(gid.xy), gid.xy, &rng);
     // The path tracer has one component: the full image (resolved by Show::Full).
@@ -189,11 +186,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
 // The first surface hit by each camera ray, in the G-buffer's format (gbuffer.wgsl).
 @compute @workgroup_size(8, 8)
 fn primary_hits(@builtin(global_invocation_id) gid: vec3u) {
-    if any(gid.xy >= frame.resolution) {
-        return;
-    }
-    start_alpha_stream();
-    let pixel = gid.y * frame.resolution.x + gid.x;
+    if !begin_pixel(gid.xy) { return; }
+    let pixel = pixel_index(gid.xy);
     let hit = trace(frame.eye, camera_direction(gid.xy), 0.0, FAR, NO_TRIANGLE, NO_TRIANGLE, false);
     var v = vec4u(0u);
     if hit.tri != NO_TRIANGLE {

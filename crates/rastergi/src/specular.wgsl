@@ -16,11 +16,8 @@ const MAX_CHAIN: u32 = 16u;
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3u) {
-    if any(gid.xy >= frame.resolution) {
-        return;
-    }
-    start_alpha_stream();
-    let pixel = gid.y * frame.resolution.x + gid.x;
+    if !begin_pixel(gid.xy) { return; }
+    let pixel = pixel_index(gid.xy);
     let base = 3u * pixel;
     let g = textureLoad(gbuffer, gid.xy, 0);
     eye_paths[base] = vec4f(frame.eye, 0.0);

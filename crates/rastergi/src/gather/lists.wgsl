@@ -11,10 +11,7 @@
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3u) {
-    if any(gid.xy >= frame.resolution) {
-        return;
-    }
-    start_alpha_stream();
+    if !begin_pixel(gid.xy) { return; }
     let p = visible_point_at(gid.xy);
     // Both sides of the ray view serve: points below ω gather along −ω, whose nearest surface
     // is in the same texel's list (the projection along ±ω is the same).
@@ -45,6 +42,6 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         film_add(FILM_DIRECT, gid.xy, p.weight * (escape_estimate(p, cos_x, w) / f32(gather.count)));
         return;
     }
-    let pixel = gid.y * frame.resolution.x + gid.x;
+    let pixel = pixel_index(gid.xy);
     film_add(FILM_INDIRECT, gid.xy, p.weight * (texel_estimate(p, cos_x, w, best_tri, best, pixel) / f32(gather.count)));
 }

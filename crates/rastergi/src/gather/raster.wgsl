@@ -17,11 +17,8 @@
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3u) {
-    if any(gid.xy >= frame.resolution) {
-        return;
-    }
-    start_alpha_stream();
-    let pixel = gid.y * frame.resolution.x + gid.x;
+    if !begin_pixel(gid.xy) { return; }
+    let pixel = pixel_index(gid.xy);
     if found[pixel] != 0u {
         return;
     }
@@ -76,11 +73,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
 // of x's texel lies behind x or is x's own, none was empty).
 @compute @workgroup_size(8, 8)
 fn resolve_behind(@builtin(global_invocation_id) gid: vec3u) {
-    if any(gid.xy >= frame.resolution) {
-        return;
-    }
-    start_alpha_stream();
-    let pixel = gid.y * frame.resolution.x + gid.x;
+    if !begin_pixel(gid.xy) { return; }
+    let pixel = pixel_index(gid.xy);
     let b = behind[pixel];
     if b.x != 0u {
         let p = visible_point_at(gid.xy);

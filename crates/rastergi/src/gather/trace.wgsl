@@ -13,12 +13,9 @@
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3u) {
-    if any(gid.xy >= frame.resolution) {
-        return;
-    }
-    start_alpha_stream();
+    if !begin_pixel(gid.xy) { return; }
     let p = visible_point_at(gid.xy);
-    let pixel = gid.y * frame.resolution.x + gid.x;
+    let pixel = pixel_index(gid.xy);
     let per_pixel = gather.per_pixel != 0u;
     let seed = pixel_seed(gather.pixel_key, gid.x, gid.y);
     var sum = vec3f(0.0);

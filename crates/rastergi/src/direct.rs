@@ -31,11 +31,10 @@
 
 use crate::film::Film;
 use crate::frame::FrameBinding;
-use crate::gbuffer::{GBUFFER_FILM_WGSL, GBufferPass, gbuffer_film_bind_group, gbuffer_film_layout};
-use crate::gpu::{Gpu, dispatch_pixels};
+use crate::gbuffer::{GBUFFER_FILM_WGSL, GBufferPass, PixelPass, PixelShader};
+use crate::gpu::Gpu;
 use crate::gpu_scene::GpuScene;
 use crate::lights::LightTable;
-use crate::profile::{Profiler, compute_pass};
 use crate::sampling::{pcg_hash, pixel_seed, sobol_owen_2d, stream, unit_f32};
 use crate::shader;
 
@@ -75,41 +74,10 @@ pub fn source() -> String {
     shader::per_pixel(&[GBUFFER_FILM_WGSL, include_str!("direct.wgsl")])
 }
 
-pub struct DirectPass {
-    pipeline: wgpu::ComputePipeline,
-    bind_group: wgpu::BindGroup,
-    profiler: Option<Profiler>,
-}
-
-impl DirectPass {
-    pub fn new(gpu: &Gpu, scene: &GpuScene, frame: &FrameBinding, gbuffer: &GBufferPass, film: &Film) -> Self {
-        let device = &gpu.device;
-        let module = shader::module(device, "direct", &source());
-        let layout = gbuffer_film_layout(device, "direct");
-        let bind_group = gbuffer_film_bind_group(device, "direct", &layout, gbuffer, film);
-        let pipeline =
-            scene.compute_pipeline(device, "direct", &module, "main", &[&scene.layout, &frame.layout, &layout]);
-        Self { pipeline, bind_group, profiler: gpu.profiler.clone() }
-    }
-
-    /// Reads: scene, frame, G-buffer. Adds to: the film's direct component.
-    pub fn encode(
-        &self,
-        enc: &mut wgpu::CommandEncoder,
-        scene: &GpuScene,
-        frame: &FrameBinding,
-        width: u32,
-        height: u32,
-    ) {
-        let mut pass = compute_pass(enc, self.profiler.as_ref(), "direct");
-        dispatch_pixels(
-            &mut pass,
-            &self.pipeline,
-            &[&scene.bind_group, &frame.bind_group, &self.bind_group],
-            width,
-            height,
-        );
-    }
+/// The direct pass. Reads: scene, frame, G-buffer. Adds to: the film's direct component.
+pub fn pass(gpu: &Gpu, scene: &GpuScene, frame: &FrameBinding, gbuffer: &GBufferPass, film: &Film) -> PixelPass {
+    let shader = PixelShader { label: "direct", source: &source(), entry: "main" };
+    PixelPass::new(gpu, (scene, frame), (gbuffer, film), shader, &[])
 }
 
 #[cfg(test)]

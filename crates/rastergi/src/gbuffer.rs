@@ -9,8 +9,11 @@
 use crate::error::Result;
 use crate::film::Film;
 use crate::frame::FrameBinding;
-use crate::gpu::{Gpu, bind_group, bind_group_layout, scene_raster_pipeline, storage_entry, uint_texture_entry};
+use crate::gpu::{
+    Gpu, bind_group, bind_group_layout, dispatch_pixels, scene_raster_pipeline, storage_entry, uint_texture_entry,
+};
 use crate::gpu_scene::GpuScene;
+use crate::profile::{Profiler, compute_pass};
 use crate::shader;
 
 /// The pass's composed shader.
@@ -100,32 +103,70 @@ impl GBufferPass {
     }
 }
 
-/// The WGSL of [`gbuffer_film_layout`]'s bindings (`gbuffer`, `film`).
+/// The WGSL of a [`PixelPass`]'s bind group 2 (`gbuffer`, `film`).
 pub const GBUFFER_FILM_WGSL: &str = include_str!("gbuffer_film.wgsl");
 
-/// Layout of a per-pixel pass's own group: the G-buffer (binding 0) and the film (binding 1).
-pub fn gbuffer_film_layout(device: &wgpu::Device, label: &str) -> wgpu::BindGroupLayout {
-    bind_group_layout(
-        device,
-        label,
-        &[
-            uint_texture_entry(0, wgpu::ShaderStages::COMPUTE),
-            storage_entry::<[f32; 4]>(1, wgpu::ShaderStages::COMPUTE, false),
-        ],
-    )
+/// A compute pass run once per eye pixel, in 8×8 workgroups (`begin_pixel` in `frame.wgsl`):
+/// bind group 0 is the scene, 1 the frame, 2 the G-buffer and the film (`gbuffer_film.wgsl`),
+/// 3, … whatever else its shader declares. The direct light, the specular chains, the photon
+/// view and the caustic term are such passes.
+pub struct PixelPass {
+    pipeline: wgpu::ComputePipeline,
+    bind_group: wgpu::BindGroup,
+    profiler: Option<Profiler>,
+    label: &'static str,
 }
 
-pub fn gbuffer_film_bind_group(
-    device: &wgpu::Device,
-    label: &str,
-    layout: &wgpu::BindGroupLayout,
-    gbuffer: &GBufferPass,
-    film: &Film,
-) -> wgpu::BindGroup {
-    bind_group(
-        device,
-        label,
-        layout,
-        &[wgpu::BindingResource::TextureView(&gbuffer.view), film.accumulation.as_entire_binding()],
-    )
+/// A [`PixelPass`]'s shader: the composed `source`, its entry point `entry`, and the label of
+/// its pipeline and of its timings (`--profile`).
+pub struct PixelShader<'a> {
+    pub label: &'static str,
+    pub source: &'a str,
+    pub entry: &'a str,
+}
+
+impl PixelPass {
+    /// `more_layouts`: the layouts of bind groups 3, … of `shader`.
+    pub fn new(
+        gpu: &Gpu,
+        (scene, frame): (&GpuScene, &FrameBinding),
+        (gbuffer, film): (&GBufferPass, &Film),
+        shader: PixelShader,
+        more_layouts: &[&wgpu::BindGroupLayout],
+    ) -> PixelPass {
+        let device = &gpu.device;
+        let label = shader.label;
+        let module = shader::module(device, label, shader.source);
+        let layout = bind_group_layout(
+            device,
+            label,
+            &[
+                uint_texture_entry(0, wgpu::ShaderStages::COMPUTE),
+                storage_entry::<[f32; 4]>(1, wgpu::ShaderStages::COMPUTE, false),
+            ],
+        );
+        let resources = [wgpu::BindingResource::TextureView(&gbuffer.view), film.accumulation.as_entire_binding()];
+        let bind_group = bind_group(device, label, &layout, &resources);
+        let layouts: Vec<&wgpu::BindGroupLayout> =
+            [&scene.layout, &frame.layout, &layout].into_iter().chain(more_layouts.iter().copied()).collect();
+        let pipeline = scene.compute_pipeline(device, label, &module, shader.entry, &layouts);
+        PixelPass { pipeline, bind_group, profiler: gpu.profiler.clone(), label }
+    }
+
+    /// Runs the pass over a `width × height` image; `more_groups`: bind groups 3, ….
+    pub fn encode(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        (scene, frame): (&GpuScene, &FrameBinding),
+        more_groups: &[&wgpu::BindGroup],
+        width: u32,
+        height: u32,
+    ) {
+        let mut pass = compute_pass(enc, self.profiler.as_ref(), self.label);
+        let groups: Vec<&wgpu::BindGroup> = [&scene.bind_group, &frame.bind_group, &self.bind_group]
+            .into_iter()
+            .chain(more_groups.iter().copied())
+            .collect();
+        dispatch_pixels(&mut pass, &self.pipeline, &groups, width, height);
+    }
 }

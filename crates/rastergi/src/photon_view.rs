@@ -4,12 +4,11 @@
 
 use crate::film::Film;
 use crate::frame::FrameBinding;
-use crate::gbuffer::{GBUFFER_FILM_WGSL, GBufferPass, gbuffer_film_bind_group, gbuffer_film_layout};
-use crate::gpu::{Gpu, dispatch_pixels};
+use crate::gbuffer::{GBUFFER_FILM_WGSL, GBufferPass, PixelPass, PixelShader};
+use crate::gpu::Gpu;
 use crate::gpu_scene::GpuScene;
 use crate::photons::gpu::GpuPhotonMap;
 use crate::photons::map::LOOKUP_WGSL;
-use crate::profile::{Profiler, compute_pass};
 use crate::shader;
 
 /// The pass's composed shader.
@@ -17,14 +16,7 @@ pub fn source() -> String {
     shader::per_pixel(&[GBUFFER_FILM_WGSL, LOOKUP_WGSL, include_str!("photon_view.wgsl")])
 }
 
-pub struct PhotonViewPass {
-    pipeline: wgpu::ComputePipeline,
-    bind_group: wgpu::BindGroup,
-    profiler: Option<Profiler>,
-    label: &'static str,
-}
-
-/// What a [`PhotonViewPass`] adds to the film.
+/// What a photon-view [`pass`] adds to the film.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PhotonView {
     /// ρ/π · E(x) of the whole map → the photon-view component (`--show photon-map`).
@@ -34,47 +26,22 @@ pub enum PhotonView {
     Caustics,
 }
 
-impl PhotonViewPass {
-    pub fn new(
-        gpu: &Gpu,
-        scene: &GpuScene,
-        frame: &FrameBinding,
-        gbuffer: &GBufferPass,
-        film: &Film,
-        map: &GpuPhotonMap,
-        view: PhotonView,
-    ) -> Self {
-        let device = &gpu.device;
-        let (label, entry) = match view {
-            PhotonView::Map => ("photon view", "main"),
-            PhotonView::Caustics => ("caustics", "caustics"),
-        };
-        let module = shader::module(device, label, &source());
-        let layout = gbuffer_film_layout(device, label);
-        let bind_group = gbuffer_film_bind_group(device, label, &layout, gbuffer, film);
-        let pipeline = scene.compute_pipeline(
-            device,
-            label,
-            &module,
-            entry,
-            &[&scene.layout, &frame.layout, &layout, &map.bind_layout],
-        );
-        Self { pipeline, bind_group, profiler: gpu.profiler.clone(), label }
-    }
-
-    /// Reads: scene, frame, G-buffer, photon map. Adds to: the film's photon-map component, or
-    /// its indirect component (caustics).
-    pub fn encode(
-        &self,
-        enc: &mut wgpu::CommandEncoder,
-        scene: &GpuScene,
-        frame: &FrameBinding,
-        map: &GpuPhotonMap,
-        width: u32,
-        height: u32,
-    ) {
-        let mut pass = compute_pass(enc, self.profiler.as_ref(), self.label);
-        let bind_groups = [&scene.bind_group, &frame.bind_group, &self.bind_group, &map.bind_group];
-        dispatch_pixels(&mut pass, &self.pipeline, &bind_groups, width, height);
-    }
+/// The photon-view pass of `view`. Reads: scene, frame, G-buffer, photon map (bind group 3:
+/// encode it with `&[&map.bind_group]`). Adds to: the film's photon-map component, or its
+/// indirect component (caustics).
+pub fn pass(
+    gpu: &Gpu,
+    scene: &GpuScene,
+    frame: &FrameBinding,
+    gbuffer: &GBufferPass,
+    film: &Film,
+    map: &GpuPhotonMap,
+    view: PhotonView,
+) -> PixelPass {
+    let (label, entry) = match view {
+        PhotonView::Map => ("photon view", "main"),
+        PhotonView::Caustics => ("caustics", "caustics"),
+    };
+    let shader = PixelShader { label, source: &source(), entry };
+    PixelPass::new(gpu, (scene, frame), (gbuffer, film), shader, &[&map.bind_layout])
 }

@@ -4,24 +4,22 @@
 use glam::{Vec2, Vec3};
 
 use crate::checkpoint::Progress;
-use crate::direct::DirectPass;
 use crate::error::Result;
 use crate::film::{Film, FilmState, Show};
 use crate::frame::{FrameBinding, FrameUniforms, pixel_jitter};
 use crate::gather::{
     DirectionSampler, FixedSample, GatherDirections, GatherFrame, GatherMethod, GatherPass, GatherSetup, HitLight,
 };
-use crate::gbuffer::GBufferPass;
+use crate::gbuffer::{GBufferPass, PixelPass};
 use crate::gpu::Gpu;
 use crate::gpu_scene::{GpuScene, PreparedScene};
 use crate::image_io::{DisplayImage, LinearImage};
-use crate::photon_view::{PhotonView, PhotonViewPass};
+use crate::photon_view::PhotonView;
 use crate::photons::PhotonSettings;
 use crate::photons::gpu::GpuPhotonMap;
 use crate::photons::map::GridSpec;
 use crate::photons::passes::{DEFAULT_PASS_ITERATIONS, PhotonPasses, fitted_pass_iterations};
 use crate::scene::{Camera, Scene};
-use crate::specular::SpecularPass;
 
 /// Settings of a render.
 #[derive(Clone, Debug, PartialEq)]
@@ -136,10 +134,10 @@ impl Default for RenderSettings {
 /// The passes whose resources depend on the image size.
 struct ImagePasses {
     gbuffer: GBufferPass,
-    specular: Option<SpecularPass>,
-    direct: DirectPass,
-    photon_view: Option<PhotonViewPass>,
-    caustics: Option<PhotonViewPass>,
+    specular: Option<PixelPass>,
+    direct: PixelPass,
+    photon_view: Option<PixelPass>,
+    caustics: Option<PixelPass>,
     gather: Option<GatherPass>,
     film: Film,
 }
@@ -157,17 +155,17 @@ impl ImagePasses {
         let (width, height) = (settings.width, settings.height);
         let film = Film::new(gpu, width, height)?;
         let gbuffer = GBufferPass::new(gpu, scene, frame, width, height);
-        let specular = scene.eye_chains.then(|| SpecularPass::new(gpu, scene, frame, &gbuffer, &film));
-        let direct = DirectPass::new(gpu, scene, frame, &gbuffer, &film);
+        let specular = scene.eye_chains.then(|| crate::specular::pass(gpu, scene, frame, &gbuffer, &film));
+        let direct = crate::direct::pass(gpu, scene, frame, &gbuffer, &film);
         let photon_view = match map {
             Some(map) if settings.show_photon_map => {
-                Some(PhotonViewPass::new(gpu, scene, frame, &gbuffer, &film, map, PhotonView::Map))
+                Some(crate::photon_view::pass(gpu, scene, frame, &gbuffer, &film, map, PhotonView::Map))
             }
             _ => None,
         };
         let caustics = match map {
             Some(map) if scene.caustics => {
-                Some(PhotonViewPass::new(gpu, scene, frame, &gbuffer, &film, map, PhotonView::Caustics))
+                Some(crate::photon_view::pass(gpu, scene, frame, &gbuffer, &film, map, PhotonView::Caustics))
             }
             _ => None,
         };
@@ -368,17 +366,17 @@ impl Renderer {
         //    mirrors and glass to the first surface that is not purely specular.
         self.passes.gbuffer.encode(&mut enc, &self.scene, &self.frame);
         if let Some(specular) = &self.passes.specular {
-            specular.encode(&mut enc, &self.scene, &self.frame, w, h);
+            specular.encode(&mut enc, (&self.scene, &self.frame), &[], w, h);
         }
         // 2. Emission + direct light with soft shadows → film (direct component).
-        self.passes.direct.encode(&mut enc, &self.scene, &self.frame, w, h);
+        self.passes.direct.encode(&mut enc, (&self.scene, &self.frame), &[], w, h);
         // Debug view: the photon map's radiance at the visible points → film (photon view).
         if let (Some(view), Some(map)) = (&self.passes.photon_view, map) {
-            view.encode(&mut enc, &self.scene, &self.frame, map, w, h);
+            view.encode(&mut enc, (&self.scene, &self.frame), &[&map.bind_group], w, h);
         }
         // 3. Caustics: the light that came through mirrors and glass, from the caustic map.
         if let (Some(caustics), Some(map)) = (&self.passes.caustics, map) {
-            caustics.encode(&mut enc, &self.scene, &self.frame, map, w, h);
+            caustics.encode(&mut enc, (&self.scene, &self.frame), &[&map.bind_group], w, h);
         }
         // 4. Final gather along the iteration's directions for every visible point → film (indirect).
         if let (Some(gather), Some(map)) = (&mut self.passes.gather, map) {

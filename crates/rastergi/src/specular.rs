@@ -14,10 +14,9 @@
 
 use crate::film::Film;
 use crate::frame::FrameBinding;
-use crate::gbuffer::{GBUFFER_FILM_WGSL, GBufferPass, gbuffer_film_bind_group, gbuffer_film_layout};
-use crate::gpu::{Gpu, dispatch_pixels};
+use crate::gbuffer::{GBUFFER_FILM_WGSL, GBufferPass, PixelPass, PixelShader};
+use crate::gpu::Gpu;
 use crate::gpu_scene::GpuScene;
-use crate::profile::{Profiler, compute_pass};
 use crate::shader;
 
 /// The pass's composed shader.
@@ -25,45 +24,9 @@ pub fn source() -> String {
     shader::per_pixel(&[GBUFFER_FILM_WGSL, include_str!("specular.wgsl")])
 }
 
-pub struct SpecularPass {
-    pipeline: wgpu::ComputePipeline,
-    bind_group: wgpu::BindGroup,
-    profiler: Option<Profiler>,
-}
-
-impl SpecularPass {
-    pub fn new(gpu: &Gpu, scene: &GpuScene, frame: &FrameBinding, gbuffer: &GBufferPass, film: &Film) -> Self {
-        let device = &gpu.device;
-        let module = shader::module(device, "specular chains", &source());
-        let layout = gbuffer_film_layout(device, "specular chains");
-        let bind_group = gbuffer_film_bind_group(device, "specular chains", &layout, gbuffer, film);
-        let pipeline = scene.compute_pipeline(
-            device,
-            "specular chains",
-            &module,
-            "main",
-            &[&scene.layout, &frame.layout, &layout],
-        );
-        Self { pipeline, bind_group, profiler: gpu.profiler.clone() }
-    }
-
-    /// Reads: scene, frame, G-buffer. Writes: the eye paths. Adds to: the film's direct
-    /// component (the environment seen through the chains).
-    pub fn encode(
-        &self,
-        enc: &mut wgpu::CommandEncoder,
-        scene: &GpuScene,
-        frame: &FrameBinding,
-        width: u32,
-        height: u32,
-    ) {
-        let mut pass = compute_pass(enc, self.profiler.as_ref(), "specular chains");
-        dispatch_pixels(
-            &mut pass,
-            &self.pipeline,
-            &[&scene.bind_group, &frame.bind_group, &self.bind_group],
-            width,
-            height,
-        );
-    }
+/// The specular-chain pass. Reads: scene, frame, G-buffer. Writes: the eye paths. Adds to: the
+/// film's direct component (the environment seen through the chains).
+pub fn pass(gpu: &Gpu, scene: &GpuScene, frame: &FrameBinding, gbuffer: &GBufferPass, film: &Film) -> PixelPass {
+    let shader = PixelShader { label: "specular chains", source: &source(), entry: "main" };
+    PixelPass::new(gpu, (scene, frame), (gbuffer, film), shader, &[])
 }

@@ -51,10 +51,11 @@ Plain Python, standard library only (the PNG is written by hand with zlib and st
     python3 scripts/make_alpha_card_scene.py                  # into crates/rastergi/tests/data/obj
     python3 scripts/make_alpha_card_scene.py --out-dir DIR
 """
-import argparse
 import os
 import struct
 import zlib
+
+from obj_geometry import cross, num, out_dir_args, sub
 
 MASK_ROWS = [  # row 0 = the top of the image; '#' solid (255), '.' hole (0)
     "########",
@@ -137,25 +138,8 @@ def read_png_grey8(data):
             if raw[i * stride] == 0]
 
 
-def sub(a, b):
-    return tuple(x - y for x, y in zip(a, b))
-
-
-def cross(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def num(x):
-    return f"{x:.9g}"
-
-
 def main():
-    p = argparse.ArgumentParser(description=__doc__,
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
-    here = os.path.dirname(os.path.abspath(__file__))
-    p.add_argument("--out-dir", default=os.path.relpath(os.path.join(
-        here, "..", "crates", "rastergi", "tests", "data", "obj")))
-    args = p.parse_args()
+    args = out_dir_args(__doc__)
 
     h, c = FLOOR_HALF, CARD_HALF
     floor = [(-h, 0.0, h), (h, 0.0, h), (h, 0.0, -h), (-h, 0.0, -h)]

@@ -39,9 +39,10 @@ no dependencies.
     python3 scripts/make_material_scenes.py                  # into crates/rastergi/tests/data/obj
     python3 scripts/make_material_scenes.py --out-dir DIR
 """
-import argparse
 import math
 import os
+
+from obj_geometry import add, cross, dot, normal, num, out_dir_args, scale, sub, uv_sphere
 
 SEGMENTS = 48  # around the y axis
 RINGS = 24  # bands from the upper pole to the lower one
@@ -99,39 +100,6 @@ CORNELL_SPHERES = [("glass", (0.335, -1.0 + CORNELL_RADIUS, 0.38)),  # the small
                    ("mirror", (-0.33, -1.0 + CORNELL_RADIUS, -0.28))]  # the large box's
 
 
-def clean(x):
-    """Rounding residue of sin/cos (1e-16 for an exact 0) written as 0."""
-    return 0.0 if abs(x) < 1e-12 else x
-
-
-def num(x):
-    return f"{clean(x):.9g}"
-
-
-def add(a, b):
-    return tuple(x + y for x, y in zip(a, b))
-
-
-def sub(a, b):
-    return tuple(x - y for x, y in zip(a, b))
-
-
-def scale(s, a):
-    return tuple(s * x for x in a)
-
-
-def cross(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def dot(a, b):
-    return sum(x * y for x, y in zip(a, b))
-
-
-def normal(a, b, c):
-    return cross(sub(b, a), sub(c, a))
-
-
 def quad(c, u, v):
     """cornell.rs's quad: the corners of c ± u ± v, counter-clockwise about u x v."""
     return [sub(sub(c, u), v), sub(add(c, u), v), add(add(c, u), v), add(sub(c, u), v)]
@@ -139,30 +107,8 @@ def quad(c, u, v):
 
 def sphere(centre, radius):
     """The vertices of a UV sphere and its triangles (0-based indices), outward."""
-    dirs = [(0.0, 1.0, 0.0)]  # upper pole
-    for i in range(1, RINGS):
-        th = math.pi * i / RINGS
-        for j in range(SEGMENTS):
-            ph = 2 * math.pi * j / SEGMENTS
-            dirs.append((clean(math.sin(th) * math.sin(ph)), clean(math.cos(th)),
-                         clean(math.sin(th) * math.cos(ph))))
-    dirs.append((0.0, -1.0, 0.0))  # lower pole
-    top, bottom = 0, len(dirs) - 1
-
-    def ring(i, j):  # vertex j of ring i (1 .. RINGS-1)
-        return 1 + (i - 1) * SEGMENTS + j % SEGMENTS
-
-    tris = []
-    for j in range(SEGMENTS):
-        tris.append((top, ring(1, j), ring(1, j + 1)))
-        for i in range(1, RINGS - 1):
-            a, b = ring(i, j), ring(i, j + 1)
-            c, d = ring(i + 1, j), ring(i + 1, j + 1)
-            tris.append((a, c, d))
-            tris.append((a, d, b))
-        tris.append((ring(RINGS - 1, j), bottom, ring(RINGS - 1, j + 1)))
+    dirs, tris = uv_sphere(RINGS, SEGMENTS)
     points = [add(centre, scale(radius, d)) for d in dirs]
-    assert len(points) == 2 + (RINGS - 1) * SEGMENTS and len(tris) == 2 * SEGMENTS * (RINGS - 1)
     for t in tris:  # counter-clockwise seen from outside
         a, b, c = (points[k] for k in t)
         centroid = scale(1 / 3, add(add(a, b), c))
@@ -248,12 +194,7 @@ def cornell_obj():
 
 
 def main():
-    p = argparse.ArgumentParser(description=__doc__,
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
-    here = os.path.dirname(os.path.abspath(__file__))
-    p.add_argument("--out-dir", default=os.path.relpath(os.path.join(
-        here, "..", "crates", "rastergi", "tests", "data", "obj")))
-    args = p.parse_args()
+    args = out_dir_args(__doc__)
     os.makedirs(args.out_dir, exist_ok=True)
 
     for name, (description, sphere_mtl) in SPHERE_MATERIALS.items():

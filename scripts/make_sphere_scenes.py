@@ -16,9 +16,9 @@ README.md). Plain Python, no dependencies.
     python3 scripts/make_sphere_scenes.py                  # into crates/rastergi/tests/data/obj
     python3 scripts/make_sphere_scenes.py --out-dir DIR
 """
-import argparse
-import math
 import os
+
+from obj_geometry import cross, dot, num, out_dir_args, sub, uv_sphere
 
 RADIUS = 0.7
 CENTRE = (0.0, 0.7, 0.0)
@@ -36,65 +36,12 @@ Kd 0.8 0.5 0.3
 """
 
 
-def clean(x):
-    """Rounding residue of sin/cos (1e-16 for an exact 0) written as 0."""
-    return 0.0 if abs(x) < 1e-12 else x
-
-
-def num(x):
-    return f"{clean(x):.9g}"
-
-
-def sphere():
-    """Unit radial directions of the sphere's vertices and its triangles (0-based indices)."""
-    dirs = [(0.0, 1.0, 0.0)]  # upper pole
-    for i in range(1, RINGS):
-        th = math.pi * i / RINGS
-        for j in range(SEGMENTS):
-            ph = 2 * math.pi * j / SEGMENTS
-            dirs.append((clean(math.sin(th) * math.sin(ph)), clean(math.cos(th)),
-                         clean(math.sin(th) * math.cos(ph))))
-    dirs.append((0.0, -1.0, 0.0))  # lower pole
-    top, bottom = 0, len(dirs) - 1
-
-    def ring(i, j):  # vertex j of ring i (1 .. RINGS-1)
-        return 1 + (i - 1) * SEGMENTS + j % SEGMENTS
-
-    tris = []
-    for j in range(SEGMENTS):
-        tris.append((top, ring(1, j), ring(1, j + 1)))
-        for i in range(1, RINGS - 1):
-            a, b = ring(i, j), ring(i, j + 1)
-            c, d = ring(i + 1, j), ring(i + 1, j + 1)
-            tris.append((a, c, d))
-            tris.append((a, d, b))
-        tris.append((ring(RINGS - 1, j), bottom, ring(RINGS - 1, j + 1)))
-    return dirs, tris
-
-
-def sub(a, b):
-    return tuple(x - y for x, y in zip(a, b))
-
-
-def cross(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def dot(a, b):
-    return sum(x * y for x, y in zip(a, b))
-
-
 def main():
-    p = argparse.ArgumentParser(description=__doc__,
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
-    here = os.path.dirname(os.path.abspath(__file__))
-    p.add_argument("--out-dir", default=os.path.relpath(os.path.join(
-        here, "..", "crates", "rastergi", "tests", "data", "obj")))
-    args = p.parse_args()
+    args = out_dir_args(__doc__)
 
     h = FLOOR_HALF
     floor = [(-h, 0.0, h), (h, 0.0, h), (h, 0.0, -h), (-h, 0.0, -h)]
-    dirs, tris = sphere()
+    dirs, tris = uv_sphere(RINGS, SEGMENTS)
     points = [tuple(c + RADIUS * d for c, d in zip(CENTRE, dv)) for dv in dirs]
 
     # Counter-clockwise seen from outside: every face normal points away from the centre,
@@ -105,7 +52,6 @@ def main():
         a, b, c = (points[k] for k in t)
         centroid = tuple((x + y + z) / 3 for x, y, z in zip(a, b, c))
         assert dot(cross(sub(b, a), sub(c, a)), sub(centroid, CENTRE)) > 0, t
-    assert len(points) == 2 + (RINGS - 1) * SEGMENTS and len(tris) == 2 * SEGMENTS * (RINGS - 1)
     assert all(abs(dot(d, d) - 1) < 1e-15 for d in dirs)
 
     os.makedirs(args.out_dir, exist_ok=True)

@@ -9,7 +9,7 @@ use rastergi::gpu_scene::{GpuScene, PreparedScene};
 use rastergi::metrics::{compare, emitter_mask, masked_mean, rmse};
 use rastergi::photons::map::{GridSpec, PhotonMap};
 use rastergi::photons::{PhotonSettings, cpu, gpu::GpuPhotonMap};
-use rastergi::renderer::{RenderSettings, Renderer};
+use rastergi::renderer::RenderSettings;
 use rastergi::scene::{Camera, Material, Scene, cornell_box};
 
 fn gpu_map(gpu: &rastergi::gpu::Gpu, scene: &Scene, settings: &PhotonSettings) -> PhotonMap {
@@ -163,37 +163,17 @@ fn a_thin_wall_keeps_the_dark_room_dark_right_up_to_the_wall() {
 fn photon_view_lookup_on_the_gpu_equals_the_cpu_lookup() {
     let gpu = common::gpu();
     let scene = cornell_box();
-    let settings = RenderSettings {
-        width: 48,
-        height: 48,
-        photons: 1 << 16,
-        grid_resolution: 16,
-        show_photon_map: true,
-        ..Default::default()
-    };
-    let mut r = Renderer::new(&gpu, &scene, settings).unwrap();
-    r.iterate().unwrap();
-    let img = r.read_linear(Show::PhotonMap).unwrap();
-    let gbuffer = r.read_gbuffer().unwrap();
-    let map = r.photon_map().unwrap().read(&gpu).unwrap();
-    let prepared = PreparedScene::new(&scene);
+    let (img, prepared, pixels) = common::photon_view_pixels(&gpu, &scene, 48);
     let mut checked = 0;
-    for (i, &g) in gbuffer.iter().enumerate() {
-        let Some(v) = common::VisiblePoint::decode(&prepared.scene, g) else {
-            continue;
-        };
-        let (t, p, n) = (v.tri, v.pos, v.normal);
-        if n.dot(scene.camera.eye - p) <= 0.0 {
-            continue;
-        }
-        let albedo = prepared.scene.material_of(t).albedo;
-        let e = map.irradiance_on(t, false, p);
+    for p in pixels.iter().filter(|p| !p.back) {
+        let albedo = prepared.scene.material_of(p.point.tri).albedo;
         for c in 0..3 {
-            let expected = albedo[c] as f64 / std::f64::consts::PI * e[c];
+            let expected = albedo[c] as f64 / std::f64::consts::PI * p.irradiance[c];
+            let got = img.pixels[p.pixel][c] as f64;
             assert!(
-                (img.pixels[i][c] as f64 - expected).abs() <= 1e-4 * expected.max(1e-3),
-                "pixel {i} channel {c}: {} vs {expected}",
-                img.pixels[i][c]
+                (got - expected).abs() <= 1e-4 * expected.max(1e-3),
+                "pixel {} channel {c}: {got} vs {expected}",
+                p.pixel
             );
         }
         checked += 1;

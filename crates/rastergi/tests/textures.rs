@@ -194,37 +194,20 @@ fn photon_view_of_the_textured_room_equals_the_cpu_lookup_per_pixel() {
     // contrast (a factor of 4) at most pixels of the floor.
     let gpu = common::gpu();
     let scene = textured_room();
-    let settings = RenderSettings {
-        width: 64,
-        height: 64,
-        photons: 1 << 16,
-        grid_resolution: 16,
-        show_photon_map: true,
-        ..Default::default()
-    };
-    let mut r = Renderer::new(&gpu, &scene, settings).unwrap();
-    r.iterate().unwrap();
-    let img = r.read_linear(Show::PhotonMap).unwrap();
-    let gbuffer = r.read_gbuffer().unwrap();
-    let map = r.photon_map().unwrap().read(&gpu).unwrap();
-    let prepared = PreparedScene::new(&scene);
+    let (img, prepared, pixels) = common::photon_view_pixels(&gpu, &scene, 64);
     let (mut checked, mut textured, mut worst) = (0, 0, 0.0f64);
-    for (i, &g) in gbuffer.iter().enumerate() {
-        let Some(v) = common::VisiblePoint::decode(&prepared.scene, g) else {
-            continue;
-        };
-        let (t, p) = (v.tri, v.pos);
-        let back = v.normal.dot(scene.camera.eye - p) <= 0.0;
-        let albedo = prepared.albedo_at(t, v.b1, v.b2, v.lod);
-        let e = map.irradiance_on(t, back, p);
+    for p in &pixels {
+        let v = &p.point;
+        let albedo = prepared.albedo_at(v.tri, v.b1, v.b2, v.lod);
         for c in 0..3 {
-            let expected = albedo[c] as f64 / PI * e[c];
-            let err = (img.pixels[i][c] as f64 - expected).abs() / expected.max(1e-3);
+            let expected = albedo[c] as f64 / PI * p.irradiance[c];
+            let got = img.pixels[p.pixel][c] as f64;
+            let err = (got - expected).abs() / expected.max(1e-3);
             worst = worst.max(err);
-            assert!(err <= 1e-2, "pixel {i} channel {c}: {} vs {expected}", img.pixels[i][c]);
+            assert!(err <= 1e-2, "pixel {} channel {c}: {got} vs {expected}", p.pixel);
         }
         checked += 1;
-        textured += prepared.scene.material_of(t).albedo_texture.is_some() as usize;
+        textured += prepared.scene.material_of(v.tri).albedo_texture.is_some() as usize;
     }
     println!("{checked} pixels ({textured} textured): largest relative difference {worst:.2e}");
     assert!(textured > 1000, "too few textured pixels ({textured})");

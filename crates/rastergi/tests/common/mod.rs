@@ -118,6 +118,50 @@ impl VisiblePoint {
     }
 }
 
+/// A pixel of a photon-map view and what it must equal: the visible point it shows, whether
+/// the camera sees that point's back, and E(x) on that side from the CPU read of the GPU's map.
+pub struct PhotonViewPixel {
+    pub pixel: usize,
+    pub point: VisiblePoint,
+    pub back: bool,
+    pub irradiance: [f64; 3],
+}
+
+/// One iteration of `scene`'s photon-map view (`--show photon-map`; 2^16 photons, a 16³ grid)
+/// at `size`², the scene as the renderer prepared it (triangles in BVH order), and every pixel
+/// that sees a surface.
+pub fn photon_view_pixels(
+    gpu: &Gpu,
+    scene: &Scene,
+    size: u32,
+) -> (LinearImage, rastergi::gpu_scene::PreparedScene, Vec<PhotonViewPixel>) {
+    let settings = RenderSettings {
+        width: size,
+        height: size,
+        photons: 1 << 16,
+        grid_resolution: 16,
+        show_photon_map: true,
+        ..Default::default()
+    };
+    let mut r = Renderer::new(gpu, scene, settings).unwrap();
+    r.iterate().unwrap();
+    let img = r.read_linear(Show::PhotonMap).unwrap();
+    let gbuffer = r.read_gbuffer().unwrap();
+    let map = r.photon_map().unwrap().read(gpu).unwrap();
+    let prepared = rastergi::gpu_scene::PreparedScene::new(scene);
+    let pixels = gbuffer
+        .iter()
+        .enumerate()
+        .filter_map(|(pixel, &g)| {
+            let point = VisiblePoint::decode(&prepared.scene, g)?;
+            let back = point.normal.dot(scene.camera.eye - point.pos) <= 0.0;
+            let irradiance = map.irradiance_on(point.tri, back, point.pos);
+            Some(PhotonViewPixel { pixel, point, back, irradiance })
+        })
+        .collect();
+    (img, prepared, pixels)
+}
+
 /// Renders `scene` at 128² with the settings the command line fits to it (grid, photons,
 /// photon passes), the traced gather and `hit_light`, twice (seeds 1 and 2, `iterations`
 /// each), and compares their mean with the committed Mitsuba pair `stem`_{a,b} (emitter

@@ -80,23 +80,11 @@ impl Bvh {
     }
 
     /// Closest hit with t in (t_min, t_max), skipping triangle `skip` (BVH order; `u32::MAX`
-    /// skips none). `triangles` must be in BVH order.
-    pub fn intersect(
-        &self,
-        triangles: &[[Vec3; 3]],
-        o: Vec3,
-        d: Vec3,
-        t_min: f32,
-        t_max: f32,
-        skip: u32,
-    ) -> Option<Hit> {
-        self.intersect_where(triangles, o, d, t_min, t_max, skip, |_| true)
-    }
-
-    /// [`Bvh::intersect`] counting only the hits that `solid` accepts (the others, holes of a
-    /// cut-out or of a stochastic surface, are passed through), as `trace` in `bvh.wgsl`.
+    /// skips none), counting only the hits that `solid` accepts (the others, holes of a
+    /// cut-out or of a stochastic surface, are passed through; `|_| true` for none), as `trace`
+    /// in `bvh.wgsl`. `triangles` must be in BVH order.
     #[allow(clippy::too_many_arguments)]
-    pub fn intersect_where(
+    pub fn intersect(
         &self,
         triangles: &[[Vec3; 3]],
         o: Vec3,
@@ -379,7 +367,7 @@ mod tests {
             let d = uniform_sphere(rng.next_f32(), rng.next_f32());
             let t_max = if rng.next_f32() < 0.3 { 3.0 } else { f32::INFINITY };
             let expected = brute_force(&tris, o, d, t_max);
-            let got = bvh.intersect(&tris, o, d, 0.0, t_max, u32::MAX);
+            let got = bvh.intersect(&tris, o, d, 0.0, t_max, u32::MAX, |_| true);
             match (expected, got) {
                 (None, None) => {}
                 (Some((t, i)), Some(h)) => {
@@ -422,7 +410,7 @@ mod tests {
     fn degenerate_inputs_build() {
         let same = vec![[Vec3::ZERO, Vec3::X, Vec3::Y]; 100];
         let bvh = Bvh::build(&same);
-        assert!(bvh.intersect(&same, Vec3::new(0.2, 0.2, 1.0), -Vec3::Z, 0.0, 10.0, u32::MAX).is_some());
+        assert!(bvh.intersect(&same, Vec3::new(0.2, 0.2, 1.0), -Vec3::Z, 0.0, 10.0, u32::MAX, |_| true).is_some());
         let one = vec![[Vec3::ZERO, Vec3::X, Vec3::Y]];
         assert_eq!(Bvh::build(&one).nodes.len(), 1);
     }

@@ -141,7 +141,7 @@ impl Film {
         );
         let bind_group = buffer_bind_group(device, "resolve", &layout, &[&uniforms, &accumulation, &linear, &display]);
         let module = shader::module(device, "resolve", &resolve_source());
-        let pipeline = compute_pipeline(device, "resolve", &module, "main", &[&layout]);
+        let pipeline = compute_pipeline(device, "resolve", &module, "main", &[&layout], &[]);
         let half = gpu.zeroed_buffer("film odd half", COMPONENTS * pixels * 16, rw);
         let half_layout = bind_group_layout(
             device,
@@ -151,7 +151,7 @@ impl Film {
         let half_bind_group = buffer_bind_group(device, "film half", &half_layout, &[&accumulation, &half]);
         let half_module = shader::module(device, "film half", include_str!("film_half.wgsl"));
         let half_pipelines = ["open_block", "close_block"]
-            .map(|entry| compute_pipeline(device, "film half", &half_module, entry, &[&half_layout]));
+            .map(|entry| compute_pipeline(device, "film half", &half_module, entry, &[&half_layout], &[]));
         Ok(Film {
             width,
             height,

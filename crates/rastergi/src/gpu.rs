@@ -287,7 +287,7 @@ impl Gpu {
     ) {
         let layout = bind_group_layout(&self.device, label, entries);
         let group = bind_group(&self.device, label, &layout, resources);
-        let pipeline = compute_pipeline(&self.device, label, module, "main", &[&layout]);
+        let pipeline = compute_pipeline(&self.device, label, module, "main", &[&layout], &[]);
         let mut enc = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
         {
             let mut pass =
@@ -478,20 +478,10 @@ pub fn scene_raster_pipeline(
     })
 }
 
-/// A compute pipeline for `module`'s entry point `entry`, with bind groups `layouts`.
+/// A compute pipeline for `module`'s entry point `entry`, with bind groups `layouts` and values
+/// for the shader's pipeline-overridable constants (`override` declarations; none: `&[]`), e.g.
+/// [`crate::gpu_scene::GpuScene::pipeline_constants`].
 pub fn compute_pipeline(
-    device: &wgpu::Device,
-    label: &str,
-    module: &wgpu::ShaderModule,
-    entry: &str,
-    layouts: &[&wgpu::BindGroupLayout],
-) -> wgpu::ComputePipeline {
-    compute_pipeline_with(device, label, module, entry, layouts, &[])
-}
-
-/// [`compute_pipeline`] with values for the shader's pipeline-overridable constants
-/// (`override` declarations), e.g. [`crate::gpu_scene::GpuScene::pipeline_constants`].
-pub fn compute_pipeline_with(
     device: &wgpu::Device,
     label: &str,
     module: &wgpu::ShaderModule,

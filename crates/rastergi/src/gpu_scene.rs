@@ -337,7 +337,7 @@ impl GpuScene {
         entry: &str,
         layouts: &[&wgpu::BindGroupLayout],
     ) -> wgpu::ComputePipeline {
-        crate::gpu::compute_pipeline_with(device, label, module, entry, layouts, &self.pipeline_constants())
+        crate::gpu::compute_pipeline(device, label, module, entry, layouts, &self.pipeline_constants())
     }
 
     /// Uploads `prepared`, after checking that its buffers fit the device (see [`crate::limits`]).

@@ -51,7 +51,7 @@ fn mismatches_against_cpu_raycast(method: GatherMethod, directions: GatherDirect
         let cos = n.dot(direction);
         let mut e3 = [0.0f64; 3];
         if cos > 0.0
-            && let Some(hit) = prepared.bvh.intersect(&s.triangles, x, direction, eps, f32::INFINITY, t as u32)
+            && let Some(hit) = prepared.bvh.intersect(&s.triangles, x, direction, eps, f32::INFINITY, t as u32, |_| true)
         {
             let ht = s.triangles[hit.triangle as usize];
             if triangle_normal(&ht).dot(direction) < 0.0 {

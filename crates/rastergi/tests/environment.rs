@@ -259,7 +259,7 @@ fn courtyard() -> Scene {
 fn the_courtyards_direct_light_matches_mitsubas_at_depth_two() {
     // The direct component holds all of the sky's direct light: the direct pass's share and the
     // gather's escaping rays' (MIS), so it is Mitsuba's max_depth 2 (references: seeds 13|14).
-    common::image_matches_mitsuba(
+    common::matches_mitsuba(
         "courtyard + sky, direct",
         &courtyard(),
         rastergi::gather::HitLight::Map,
@@ -288,6 +288,8 @@ fn a_courtyard_under_a_sky_with_a_sun_matches_mitsuba() {
         256,
         "courtyard_env_path_128",
         false,
+        Show::Full,
+        None,
     );
 }
 

@@ -51,7 +51,8 @@ fn mismatches_against_cpu_raycast(method: GatherMethod, directions: GatherDirect
         let cos = n.dot(direction);
         let mut e3 = [0.0f64; 3];
         if cos > 0.0
-            && let Some(hit) = prepared.bvh.intersect(&s.triangles, x, direction, eps, f32::INFINITY, t as u32, |_| true)
+            && let Some(hit) =
+                prepared.bvh.intersect(&s.triangles, x, direction, eps, f32::INFINITY, t as u32, |_| true)
         {
             let ht = s.triangles[hit.triangle as usize];
             if triangle_normal(&ht).dot(direction) < 0.0 {
@@ -280,10 +281,7 @@ fn converged_cornell_box(hit_light: HitLight) {
     // Two seeds differ in every random choice — gather directions, jitter, light samples and
     // the photon map itself — so their difference measures all of our noise.
     let (c, noise, bias) = common::against_reference(&a, &b, &reference, ref_noise, Some(&mask));
-    println!(
-        "{hit_light:?}: relative RMSE {:.4} = noise {noise:.4} ⊕ bias {bias:.4}; block-mean error {:.4}; mean ratio {:?}",
-        c.relative_rmse, c.block_mean_error, c.mean_ratio
-    );
+    common::print_agreement(&format!("{hit_light:?}"), &c, noise, bias);
     // Targets of the design: 5 % relative RMSE and 1.5 % block-mean error at 128² within a
     // test-sized run. What is not noise is the photon map's error read at the secondary
     // points (and the ray view's texel sampling): it cannot exceed the error of the same map

@@ -249,6 +249,8 @@ fn the_cornell_box_with_a_point_light_and_the_sun_through_its_open_front_matches
         256,
         "cornell_lights_path_128",
         true,
+        Show::Full,
+        None,
     );
 }
 
@@ -270,5 +272,7 @@ fn the_cornell_box_with_a_hard_edged_spot_matches_mitsuba() {
         256,
         "cornell_spot_path_128",
         true,
+        Show::Full,
+        None,
     );
 }

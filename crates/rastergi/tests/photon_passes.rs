@@ -88,7 +88,7 @@ fn doorway_rooms_match_mitsuba_within_noise() {
     // same within noise; the Cornell box and the small object test that mode.)
     // The bounds (5 %, 1.5 %) were set for 256² at 1024 iterations; at 128² with
     // 2 × 256 the noise is about the same per pixel.
-    common::matches_mitsuba("rooms", &rooms(true), HitLight::Map, 256, "rooms_path_128", false);
+    common::matches_mitsuba("rooms", &rooms(true), HitLight::Map, 256, "rooms_path_128", false, Show::Full, None);
 }
 
 #[test]
@@ -113,5 +113,5 @@ fn small_object(hit_light: HitLight) {
         up: glam::Vec3::Y,
         fov_y_deg: 40.0,
     };
-    common::matches_mitsuba("small object", &scene, hit_light, 128, "small_object_path_128", false);
+    common::matches_mitsuba("small object", &scene, hit_light, 128, "small_object_path_128", false, Show::Full, None);
 }

@@ -6,7 +6,7 @@ mod common;
 use glam::Vec3;
 use rastergi::film::Show;
 use rastergi::gpu_scene::{GpuScene, PreparedScene};
-use rastergi::metrics::{compare, emitter_mask, masked_mean, rmse};
+use rastergi::metrics::emitter_mask;
 use rastergi::photons::map::{GridSpec, PhotonMap};
 use rastergi::photons::{PhotonSettings, cpu, gpu::GpuPhotonMap};
 use rastergi::renderer::RenderSettings;
@@ -59,22 +59,29 @@ fn add_room(s: &mut Scene, lo: Vec3, hi: Vec3, m: u32) {
     s.add_quad([c(1., 0., 0.), c(1., 0., 1.), c(1., 1., 1.), c(1., 1., 0.)], m); // right, -x
 }
 
+/// The emitted power of [`closed_box`] of albedo `a`, and its photon map for `settings` (on a
+/// grid of `settings.grid_resolution` cells along the box) traced on the GPU and by the CPU twin.
+fn closed_box_maps(a: f64, settings: PhotonSettings) -> (glam::DVec3, [(&'static str, PhotonMap); 2]) {
+    let gpu = common::gpu();
+    let scene = closed_box(a as f32);
+    let grid = GridSpec::new(&scene.bounds(), settings.grid_resolution);
+    let cpu_map = cpu::trace(&PreparedScene::new(&scene), &grid, &settings);
+    (scene.emitted_power().as_dvec3(), [("gpu", gpu_map(&gpu, &scene, &settings)), ("cpu", cpu_map)])
+}
+
 #[test]
 fn closed_box_average_irradiance_matches_power_over_area_times_one_minus_albedo() {
-    let gpu = common::gpu();
     let a = 0.5f64;
-    let scene = closed_box(a as f32);
     let n = 1u32 << 20;
-    let settings = PhotonSettings { count: n, seed: 5, grid_resolution: 16, ..Default::default() };
-    let power = scene.emitted_power().as_dvec3();
+    let (power, maps) =
+        closed_box_maps(a, PhotonSettings { count: n, seed: 5, grid_resolution: 16, indirect_only: false });
     // Every surface side that reflects: 6 walls of area 4, both sides of the 0.4×0.4 light.
     let area = 24.0 + 2.0 * 0.16;
     // Each photon deposits Φ at every hit and survives with probability a at flux Φ·a/a:
     // the number of hits K is geometric, E[K] = 1/(1−a), Var[K] = a/(1−a)², so the total's
     // relative standard deviation is sqrt(a/N).
     let sigma = (a / n as f64).sqrt();
-    let cpu_map = cpu::trace(&PreparedScene::new(&scene), &GridSpec::new(&scene.bounds(), 16), &settings);
-    for (name, map) in [("gpu", gpu_map(&gpu, &scene, &settings)), ("cpu", cpu_map)] {
+    for (name, map) in maps {
         assert!((total_area(&map) - area).abs() < 1e-4, "{name}: map area {} vs {area}", total_area(&map));
         let flux = map.total_flux();
         for c in 0..3 {
@@ -196,27 +203,16 @@ fn photon_map_view_of_the_cornell_box_matches_mitsuba_up_to_the_grid_bias() {
     };
     let a = common::render(&gpu, &scene, settings(1), 16, Show::PhotonMap);
     let b = common::render(&gpu, &scene, settings(2), 16, Show::PhotonMap);
-    let ours = common::average(&a, &b);
     let probe = rastergi::image_io::read_exr(&common::data("cornell_path_128_a.exr")).unwrap();
     let mask = emitter_mask(&probe, 3.0);
     let (reference, ref_noise) = common::reference_pair("cornell_path_128", Some(&mask));
-    let mean = masked_mean(&reference, Some(&mask));
-    let noise = (rmse(&a, &b, Some(&mask)).powi(2) / 4.0 + ref_noise.powi(2)).sqrt() / mean;
-    let c = compare(&ours, &reference, Some(&mask));
-    let bias = (c.relative_rmse.powi(2) - noise.powi(2)).max(0.0).sqrt();
-    println!(
-        "relative RMSE {:.4} = noise {noise:.4} ⊕ bias {bias:.4}; block-mean error {:.4}; mean ratio {:?}",
-        c.relative_rmse, c.block_mean_error, c.mean_ratio
-    );
+    let (c, noise, bias) = common::against_reference(&a, &b, &reference, ref_noise, Some(&mask));
+    common::print_agreement("photon view", &c, noise, bias);
     // The map is read at the visible points themselves here (the final gather hides most of
     // its error): what remains beyond the photon noise is the grid's blur of shadow edges,
     // corners and contact regions, a few percent at 32 cells across the box; the image's
     // energy must agree to 1 % and 16×16 block means to 1.5 %.
-    assert!(bias < 0.05, "grid bias {bias}");
-    assert!(c.block_mean_error < 0.015, "block-mean error {}", c.block_mean_error);
-    for r in c.mean_ratio {
-        assert!((r - 1.0).abs() < 0.01, "mean ratio {:?}", c.mean_ratio);
-    }
+    common::assert_agreement(&c, bias, 0.05, 0.015, 0.01);
 }
 
 #[test]
@@ -225,15 +221,12 @@ fn an_indirect_only_map_holds_the_albedo_times_the_full_maps_energy() {
     // gather's hits): in the closed box of albedo a, each photon's hits after the first
     // number K − 1 with E[K − 1] = a/(1−a), so the map's total is Φ·a/(1−a) — a times the full
     // map's. Var[K − 1] = a/(1−a)² again: relative standard deviation sqrt(1/(aN)).
-    let gpu = common::gpu();
     let a = 0.5f64;
-    let scene = closed_box(a as f32);
     let n = 1u32 << 20;
-    let settings = PhotonSettings { count: n, seed: 6, grid_resolution: 16, indirect_only: true };
-    let power = scene.emitted_power().as_dvec3();
+    let (power, maps) =
+        closed_box_maps(a, PhotonSettings { count: n, seed: 6, grid_resolution: 16, indirect_only: true });
     let sigma = (1.0 / (a * n as f64)).sqrt();
-    let cpu_map = cpu::trace(&PreparedScene::new(&scene), &GridSpec::new(&scene.bounds(), 16), &settings);
-    for (name, map) in [("gpu", gpu_map(&gpu, &scene, &settings)), ("cpu", cpu_map)] {
+    for (name, map) in maps {
         let flux = map.total_flux();
         for c in 0..3 {
             let expected = power[c] * a / (1.0 - a);

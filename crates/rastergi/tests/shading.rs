@@ -171,7 +171,7 @@ fn a_smooth_low_poly_sphere_matches_mitsuba() {
     let left_out = keep.iter().filter(|&&k| !k).count();
     println!("smooth sphere: {left_out} silhouette pixels left out");
     assert!(left_out < 400, "{left_out}");
-    common::image_matches_mitsuba(
+    common::matches_mitsuba(
         "smooth sphere",
         &scene,
         rastergi::gather::HitLight::Map,
@@ -192,6 +192,8 @@ fn the_same_sphere_flat_matches_mitsuba() {
         256,
         "sphere_flat_path_128",
         false,
+        Show::Full,
+        None,
     );
 }
 

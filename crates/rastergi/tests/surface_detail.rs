@@ -57,7 +57,7 @@ fn an_alpha_card_with_holes_matches_mitsuba() {
     scene.lights.push(Light::Point { position: Vec3::new(0.15, 2.2, 0.1), intensity: Vec3::splat(6.0) });
     let modes: Vec<AlphaMode> = scene.materials.iter().map(|m| m.alpha_mode).collect();
     assert_eq!(modes.iter().filter(|&&m| m == AlphaMode::Blend).count(), 2, "{modes:?}");
-    common::image_matches_mitsuba(
+    common::matches_mitsuba(
         "alpha card",
         &scene,
         rastergi::gather::HitLight::Map,

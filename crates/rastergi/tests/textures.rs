@@ -13,7 +13,7 @@ use glam::{Vec2, Vec3};
 use rastergi::film::Show;
 use rastergi::gpu::Gpu;
 use rastergi::gpu_scene::{GpuScene, PreparedScene};
-use rastergi::metrics::{compare, emitter_mask, masked_mean, rmse};
+use rastergi::metrics::{emitter_mask, rmse};
 use rastergi::photons::map::PhotonMap;
 use rastergi::photons::{PhotonSettings, cpu, gpu::GpuPhotonMap};
 use rastergi::renderer::{RenderSettings, Renderer};
@@ -266,24 +266,15 @@ fn textured_room_render_matches_the_path_tracer_within_noise_and_grid_bias() {
     let pa = common::path_trace(&gpu, &scene, settings(3), 2 * n);
     let pb = common::path_trace(&gpu, &scene, settings(4), 2 * n);
     println!("renders {rendered:?}, path tracer {:?}", start.elapsed() - rendered);
-    let (ours, reference) = (common::average(&a, &b), common::average(&pa, &pb));
+    let reference = common::average(&pa, &pb);
     let mask = emitter_mask(&reference, 3.0);
-    let mean = masked_mean(&reference, Some(&mask));
-    let noise = ((rmse(&a, &b, Some(&mask)).powi(2) + rmse(&pa, &pb, Some(&mask)).powi(2)) / 4.0).sqrt() / mean;
-    let c = compare(&ours, &reference, Some(&mask));
-    let bias = (c.relative_rmse.powi(2) - noise.powi(2)).max(0.0).sqrt();
-    println!(
-        "relative RMSE {:.4} = noise {noise:.4} ⊕ bias {bias:.4}; block-mean error {:.4}; mean ratio {:?}",
-        c.relative_rmse, c.block_mean_error, c.mean_ratio
-    );
+    let ref_noise = rmse(&pa, &pb, Some(&mask)) / 2.0;
+    let (c, noise, bias) = common::against_reference(&a, &b, &reference, ref_noise, Some(&mask));
+    common::print_agreement("textured room", &c, noise, bias);
     // Both read the same texels: the same filtered texture at the visible points (the
     // G-buffer's λ, the path tracer's ray differentials) and the unfiltered texture at every
     // later point. What is not noise is the photon map's error read at the gather's secondary
     // points, bounded as for the Cornell box (gather.rs) by the map's error read at the visible
     // points themselves: a few percent at 32 cells.
-    assert!(bias < 0.03, "bias {bias}");
-    assert!(c.block_mean_error < 0.02, "block-mean error {}", c.block_mean_error);
-    for r in c.mean_ratio {
-        assert!((r - 1.0).abs() < 0.015, "mean ratio {:?}", c.mean_ratio);
-    }
+    common::assert_agreement(&c, bias, 0.03, 0.02, 0.015);
 }

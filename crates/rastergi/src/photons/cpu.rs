@@ -97,8 +97,7 @@ fn trace_photon(
             let u = alpha_uniform(h.triangle, h.b1, h.b2, alpha_seed);
             !prepared.passes_through(h.triangle as usize, h.b1, h.b2, u)
         };
-        let Some(hit) = prepared.bvh.intersect(&scene.triangles, origin, dir, eps, f32::INFINITY, skip, solid)
-        else {
+        let Some(hit) = prepared.bvh.intersect(&scene.triangles, origin, dir, eps, f32::INFINITY, skip, solid) else {
             break;
         };
         let tri = &scene.triangles[hit.triangle as usize];

@@ -85,6 +85,53 @@ pub fn against_reference(
     (c, noise, bias)
 }
 
+/// Prints what [`against_reference`] found, on one line after `label`.
+pub fn print_agreement(label: &str, c: &rastergi::metrics::Comparison, noise: f64, bias: f64) {
+    println!(
+        "{label}: relative RMSE {:.4} = noise {noise:.4} ⊕ bias {bias:.4}; block-mean error {:.4}; mean ratio {:.4?}",
+        c.relative_rmse, c.block_mean_error, c.mean_ratio
+    );
+}
+
+/// Asserts an agreement found by [`against_reference`]: the bias beyond noise under
+/// `max_bias`, the block-mean error under `max_block`, every channel's mean ratio within
+/// `max_ratio` of 1.
+pub fn assert_agreement(c: &rastergi::metrics::Comparison, bias: f64, max_bias: f64, max_block: f64, max_ratio: f64) {
+    assert!(bias < max_bias, "bias {bias}");
+    assert!(c.block_mean_error < max_block, "block-mean error {}", c.block_mean_error);
+    for r in c.mean_ratio {
+        assert!((r - 1.0).abs() < max_ratio, "mean ratio {:?}", c.mean_ratio);
+    }
+}
+
+/// Two unbiased estimates of one image, our renders `a`, `b` (independent seeds) against a
+/// reference pair's mean of RMS noise `ref_noise`: their RMS difference is the root sum of
+/// squares of the noises, so the relative RMSE must stay under 1.1× that noise (10 % margin
+/// for the noise estimates' own error), and the 16×16 block means, whose noise shrinks 16×
+/// (|N(0, σ)| averages σ·√(2/π)), under 2× theirs. Returns the comparison and the noise.
+pub fn assert_within_combined_noise(
+    a: &LinearImage,
+    b: &LinearImage,
+    reference: &LinearImage,
+    ref_noise: f64,
+    mask: Option<&[bool]>,
+) -> (rastergi::metrics::Comparison, f64) {
+    let (c, noise, _) = against_reference(a, b, reference, ref_noise, mask);
+    let mean = rastergi::metrics::masked_mean(reference, mask);
+    println!(
+        "relative RMSE {:.4} (noise predicts {noise:.4}: ours {:.4}, the reference {:.4}), block-mean error {:.5}, mean ratio {:.5?}",
+        c.relative_rmse,
+        rastergi::metrics::rmse(a, b, mask) / 2.0 / mean,
+        ref_noise / mean,
+        c.block_mean_error,
+        c.mean_ratio
+    );
+    assert!(c.relative_rmse < 1.1 * noise, "relative RMSE {} vs noise {noise}", c.relative_rmse);
+    let block = noise / 16.0 * (2.0 / std::f64::consts::PI).sqrt();
+    assert!(c.block_mean_error < 2.0 * block, "block-mean error {} vs noise {block}", c.block_mean_error);
+    (c, noise)
+}
+
 pub fn average(a: &LinearImage, b: &LinearImage) -> LinearImage {
     LinearImage {
         width: a.width,
@@ -166,22 +213,11 @@ pub fn photon_view_pixels(
 /// photon passes), the traced gather and `hit_light`, twice (seeds 1 and 2, `iterations`
 /// each), and compares their mean with the committed Mitsuba pair `stem`_{a,b} (emitter
 /// pixels left out where `mask_emitters`): relative RMSE under 5 %, block-mean error under
-/// 1.5 %, channel means within 1 %.
-pub fn matches_mitsuba(
-    label: &str,
-    scene: &Scene,
-    hit_light: rastergi::gather::HitLight,
-    iterations: u32,
-    stem: &str,
-    mask_emitters: bool,
-) {
-    image_matches_mitsuba(label, scene, hit_light, iterations, stem, mask_emitters, Show::Full, None)
-}
-
-/// [`matches_mitsuba`] for the image `show` (a direct-light reference for Show::Direct), over
-/// the pixels `keep` keeps (all where `None`; emitters left out as well where asked).
+/// 1.5 %, channel means within 1 %. The image compared is `show` (`Show::Full`; a direct-light
+/// reference for `Show::Direct`), over the pixels `keep` keeps (all where `None`; emitters
+/// left out as well where asked).
 #[allow(clippy::too_many_arguments)]
-pub fn image_matches_mitsuba(
+pub fn matches_mitsuba(
     label: &str,
     scene: &Scene,
     hit_light: rastergi::gather::HitLight,
@@ -206,10 +242,7 @@ pub fn image_matches_mitsuba(
     let mask = mask.as_deref();
     let (reference, ref_noise) = reference_pair(stem, mask);
     let (c, noise, bias) = against_reference(&a, &b, &reference, ref_noise, mask);
-    println!(
-        "{label} (grid {grid}), {hit_light:?}: relative RMSE {:.4} = noise {noise:.4} ⊕ bias {bias:.4}; block-mean error {:.4}; mean ratio {:?}",
-        c.relative_rmse, c.block_mean_error, c.mean_ratio
-    );
+    print_agreement(&format!("{label} (grid {grid}), {hit_light:?}"), &c, noise, bias);
     assert!(c.relative_rmse < 0.05, "{label}: relative RMSE {}", c.relative_rmse);
     assert!(c.block_mean_error < 0.015, "{label}: block-mean error {}", c.block_mean_error);
     for r in c.mean_ratio {

@@ -180,6 +180,29 @@ impl Bvh {
         }
     }
 
+    /// The tree's surface-area-heuristic cost, the expected work of a ray that crosses the root's
+    /// box in units of one triangle test: Σ over interior nodes of (A(n)/A(root))·C_trav plus Σ
+    /// over leaves of (A(l)/A(root))·N_l·C_tri, with the build's C_trav = C_tri = 1.
+    pub fn sah_cost(&self) -> f64 {
+        let area = |n: &BvhNode| {
+            let e = (Vec3::from(n.max) - Vec3::from(n.min)).max(Vec3::ZERO).as_dvec3();
+            2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
+        };
+        let root = area(&self.nodes[0]);
+        if root <= 0.0 {
+            return 0.0;
+        }
+        let cost: f64 = self
+            .nodes
+            .iter()
+            .map(|n| {
+                let c = if n.count > 0 { n.count as f64 * COST_TRIANGLE as f64 } else { COST_TRAVERSAL as f64 };
+                area(n) * c
+            })
+            .sum();
+        cost / root
+    }
+
     /// Depth of the tree (a leaf alone has depth 1).
     pub fn depth(&self) -> usize {
         fn rec(nodes: &[BvhNode], i: usize) -> usize {

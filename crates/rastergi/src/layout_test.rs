@@ -121,6 +121,8 @@ fn twins() -> Vec<Twin> {
         twin!(TrianglePlane, "TrianglePlane", [normal, offset, bins]),
         twin!(PathParams, "PathParams", [light_weight, light_count, max_bounces, rr_start]),
         twin!(crate::bsdf::albedo::GpuGgxAlbedo, "GgxAlbedoTable", [cells, means]),
+        twin!(crate::rays::GpuRay, "Ray", [origin, t_min, dir, t_max, skip, any_hit]),
+        twin!(crate::rays::GpuRayHit, "RayHit", [t, tri, b1, b2]),
     ]
 }
 
@@ -139,6 +141,7 @@ fn shaders() -> Vec<(&'static str, String)> {
         ("resolve", crate::film::resolve_source()),
         ("display", crate::display::SOURCE.to_string()),
         ("path tracer", crate::path_tracer::source()),
+        ("rays", crate::rays::source()),
     ]
 }
 

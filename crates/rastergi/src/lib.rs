@@ -37,6 +37,7 @@ pub mod photon_view;
 pub mod photons;
 pub mod profile;
 pub mod progressive;
+pub mod rays;
 pub mod renderer;
 pub mod sampling;
 pub mod scene;

@@ -4,8 +4,8 @@
 //! One module per subcommand: [`photons`] (GPU against CPU photon tracing), [`gather`] (the
 //! three final-gather implementations, and the time to a target error), [`converge`] (error
 //! against time for the renderer, the path tracer and Mitsuba 3), [`frames`] (the viewer's
-//! frame loop without a window), [`bvh`] (scene loading and BVH build) and [`memory`] (the
-//! GPU memory of a render).
+//! frame loop without a window), [`bvh`] (scene loading and BVH build), [`rays`] (rays per
+//! second of each kind, GPU and CPU twin) and [`memory`] (the GPU memory of a render).
 
 mod bvh;
 mod converge;
@@ -13,6 +13,7 @@ mod frames;
 mod gather;
 mod memory;
 mod photons;
+mod rays;
 
 use std::time::Duration;
 
@@ -38,6 +39,9 @@ pub enum BenchCommand {
     Bvh(bvh::BvhArgs),
     /// GPU memory of a render (the device allocator's report), by resource.
     Memory(memory::MemoryArgs),
+    /// Rays per second of each kind the renderer casts (camera, shadow, bounce, gather, photon)
+    /// on the GPU kernel and the CPU twin, hit for hit, and the BVH's build time, SAH cost and size.
+    Rays(rays::RaysArgs),
 }
 
 pub fn run(command: &BenchCommand) -> Result<()> {
@@ -48,6 +52,7 @@ pub fn run(command: &BenchCommand) -> Result<()> {
         BenchCommand::Frames(a) => frames::run(a),
         BenchCommand::Bvh(a) => bvh::run(a),
         BenchCommand::Memory(a) => memory::run(a),
+        BenchCommand::Rays(a) => rays::run(a),
     }
 }
 

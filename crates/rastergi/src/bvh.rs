@@ -11,6 +11,8 @@ use glam::Vec3;
 
 use crate::scene::Aabb;
 
+pub mod wide;
+
 const BINS: usize = 16;
 const MAX_LEAF: usize = 8;
 const COST_TRAVERSAL: f32 = 1.0;

@@ -1,4 +1,8 @@
-// BVH traversal: the twin of Bvh::intersect / Bvh::occluded in bvh.rs.
+// BVH traversal: the twin of Bvh::intersect / Bvh::occluded in bvh.rs (the same hits), step for
+// step that of intersect_wide in bvh/wide.rs (the 4-wide tree the scene binds).
+
+// The sort key of a child slot the ray does not enter.
+const NOT_ENTERED: f32 = 3.0e38;
 
 struct RayHit {
     t: f32,
@@ -30,17 +34,6 @@ fn intersect_triangle(t: Triangle, o: vec3f, d: vec3f) -> vec3f {
     return vec3f(dot(e2, q) * inv_det, b1, b2);
 }
 
-// Entry distance into a node's box, or -1 when it does not overlap [t_min, t_max].
-fn slab(n: BvhNode, o: vec3f, inv: vec3f, t_min: f32, t_max: f32) -> f32 {
-    let t0 = (n.min - o) * inv;
-    let t1 = (n.max - o) * inv;
-    let tn = min(t0, t1);
-    let tf = max(t0, t1);
-    let near = max(max(max(tn.x, tn.y), tn.z), t_min);
-    let far = min(min(min(tf.x, tf.y), tf.z), t_max);
-    return select(-1.0, near, near <= far);
-}
-
 // Closest hit in (t_min, t_max), skipping triangles skip_a and skip_b and the points where a
 // material lets the ray through (passes_through: cut-outs and stochastic opacity); any_hit:
 // stop at the first. Returns tri = NO_TRIANGLE on a miss.
@@ -70,7 +63,10 @@ fn trace(o: vec3f, d: vec3f, t_min: f32, t_max: f32, skip_a: u32, skip_b: u32, a
 }
 
 // The closest (any_hit: the first found) triangle hit in (t_min, t_max) other than skip_a,
-// skip_b and skip_c, holes or not.
+// skip_b and skip_c, holes or not: the 4-wide tree (bvh/wide.rs, whose intersect_wide is this
+// loop's CPU twin), each node's four boxes slab-tested at once; its leaves' triangles tested
+// first (a hit shortens the ray), then its interior children pushed farthest first, so the
+// nearest is walked next.
 fn traverse(o: vec3f, d: vec3f, t_min: f32, t_max: f32, skip_a: u32, skip_b: u32, skip_c: u32, any_hit: bool) -> RayHit {
     var hit = RayHit(t_max, NO_TRIANGLE, 0.0, 0.0);
     let inv = 1.0 / d;
@@ -79,50 +75,57 @@ fn traverse(o: vec3f, d: vec3f, t_min: f32, t_max: f32, skip_a: u32, skip_b: u32
     var node = 0u;
     loop {
         let n = bvh_nodes[node];
-        var descend = false;
-        if n.count > 0u {
-            for (var i = n.offset; i < n.offset + n.count; i++) {
-                if i == skip_a || i == skip_b || i == skip_c {
+        let t0x = (n.lo_x - o.x) * inv.x;
+        let t1x = (n.hi_x - o.x) * inv.x;
+        let t0y = (n.lo_y - o.y) * inv.y;
+        let t1y = (n.hi_y - o.y) * inv.y;
+        let t0z = (n.lo_z - o.z) * inv.z;
+        let t1z = (n.hi_z - o.z) * inv.z;
+        let near = max(max(min(t0x, t1x), min(t0y, t1y)), max(min(t0z, t1z), vec4f(t_min)));
+        let far = min(min(max(t0x, t1x), max(t0y, t1y)), max(t0z, t1z));
+        let leaves = (n.count != vec4u(0u)) & (n.count != vec4u(NO_CHILD)) & (near <= min(far, vec4f(hit.t)));
+        if any(leaves) {
+            for (var i = 0u; i < 4u; i++) {
+                if !leaves[i] || near[i] > hit.t {
                     continue;
                 }
-                let r = intersect_triangle(triangles[i], o, d);
-                if r.x > t_min && r.x < hit.t {
-                    hit = RayHit(r.x, i, r.y, r.z);
-                    if any_hit {
-                        return hit;
+                let first = n.child[i];
+                for (var k = first; k < first + n.count[i]; k++) {
+                    if k == skip_a || k == skip_b || k == skip_c {
+                        continue;
+                    }
+                    let r = intersect_triangle(triangles[k], o, d);
+                    if r.x > t_min && r.x < hit.t {
+                        hit = RayHit(r.x, k, r.y, r.z);
+                        if any_hit {
+                            return hit;
+                        }
                     }
                 }
             }
-        } else {
-            let l = node + 1u;
-            let r = n.offset;
-            let tl = slab(bvh_nodes[l], o, inv, t_min, hit.t);
-            let tr = slab(bvh_nodes[r], o, inv, t_min, hit.t);
-            if tl >= 0.0 && tr >= 0.0 {
-                if tl <= tr {
-                    stack[sp] = r;
-                    node = l;
-                } else {
-                    stack[sp] = l;
-                    node = r;
-                }
-                sp += 1u;
-                descend = true;
-            } else if tl >= 0.0 {
-                node = l;
-                descend = true;
-            } else if tr >= 0.0 {
-                node = r;
-                descend = true;
-            }
         }
-        if !descend {
-            if sp == 0u {
-                break;
-            }
-            sp -= 1u;
-            node = stack[sp];
+        // The interior children the ray enters before its current end, sorted by entry
+        // distance (a sorting network on the four slots; a slot left out sorts last).
+        let inner = (n.count == vec4u(0u)) & (near <= min(far, vec4f(hit.t)));
+        var k = select(vec4f(NOT_ENTERED), near, inner);
+        var c = n.child;
+        if k.y < k.x { k = k.yxzw; c = c.yxzw; }
+        if k.w < k.z { k = k.xywz; c = c.xywz; }
+        if k.z < k.x { k = k.zyxw; c = c.zyxw; }
+        if k.w < k.y { k = k.xwzy; c = c.xwzy; }
+        if k.z < k.y { k = k.xzyw; c = c.xzyw; }
+        if k.w < NOT_ENTERED { stack[sp] = c.w; sp += 1u; }
+        if k.z < NOT_ENTERED { stack[sp] = c.z; sp += 1u; }
+        if k.y < NOT_ENTERED { stack[sp] = c.y; sp += 1u; }
+        if k.x < NOT_ENTERED {
+            node = c.x;
+            continue;
         }
+        if sp == 0u {
+            break;
+        }
+        sp -= 1u;
+        node = stack[sp];
     }
     return hit;
 }

@@ -5,7 +5,8 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3, Vec4};
 
-use crate::bvh::{Bvh, BvhNode};
+use crate::bvh::Bvh;
+use crate::bvh::wide::WideNode;
 use crate::error::Result;
 use wgpu::util::DeviceExt;
 
@@ -344,7 +345,8 @@ impl GpuScene {
     pub fn new(gpu: &Gpu, prepared: &PreparedScene) -> Result<GpuScene> {
         let limits = gpu.device.limits();
         check_scene(&limits, &prepared.scene)?;
-        check_bvh_nodes(&limits, prepared.bvh.nodes.len())?;
+        let nodes = prepared.bvh.wide();
+        check_bvh_nodes(&limits, nodes.len())?;
         let s = &prepared.scene;
         let has_bsdfs = !s.materials.iter().all(Material::is_lambertian);
         let triangles: Vec<GpuTriangle> = s
@@ -388,7 +390,6 @@ impl GpuScene {
         if punctual.is_empty() {
             punctual.push(bytemuck::Zeroable::zeroed());
         }
-        let nodes: &[BvhNode] = &prepared.bvh.nodes;
         let env = s.environment.as_deref();
         let env_data = env.map_or(vec![0.0f32; 4], Environment::gpu_data);
         crate::limits::check_storage_buffer(
@@ -404,7 +405,7 @@ impl GpuScene {
         let buffers = [
             gpu.storage_buffer("scene triangles", bytemuck::cast_slice(&triangles), none),
             gpu.storage_buffer("scene materials", bytemuck::cast_slice(&materials), none),
-            gpu.storage_buffer("scene bvh nodes", bytemuck::cast_slice(nodes), none),
+            gpu.storage_buffer("scene bvh nodes", bytemuck::cast_slice(&nodes), none),
             gpu.storage_buffer("scene lights", bytemuck::cast_slice(&lights), none),
             gpu.storage_buffer("scene texture coordinates", bytemuck::cast_slice(&uvs), none),
             gpu.storage_buffer("scene punctual lights", bytemuck::cast_slice(&punctual), none),
@@ -440,7 +441,7 @@ impl GpuScene {
             &[
                 storage_entry::<GpuTriangle>(0, vis, true),
                 storage_entry::<GpuMaterial>(1, vis, true),
-                storage_entry::<crate::bvh::BvhNode>(2, compute, true),
+                storage_entry::<WideNode>(2, compute, true),
                 storage_entry::<crate::lights::LightEntry>(3, compute, true),
                 storage_entry::<[f32; 2]>(4, vis, true),
                 texture_array_entry(5, vis),
@@ -526,9 +527,9 @@ pub fn check_scene(limits: &wgpu::Limits, scene: &crate::scene::Scene) -> Result
     check_scene_buffers(limits, scene.triangles.len(), scene.materials.len(), scene.triangles.len())
 }
 
-/// The BVH's node buffer, once the BVH is built (about one node per triangle, at most 2·n − 1).
+/// The wide BVH's node buffer, once the BVH is built (about one node per four leaves).
 pub fn check_bvh_nodes(limits: &wgpu::Limits, nodes: usize) -> Result<()> {
-    let stride = std::mem::size_of::<crate::bvh::BvhNode>() as u64;
+    let stride = std::mem::size_of::<WideNode>() as u64;
     check_storage_buffer(limits, &format!("the scene's {nodes} BVH nodes"), nodes as u64, stride, FEWER_TRIANGLES)
 }
 
@@ -548,9 +549,9 @@ mod limit_tests {
         assert!(e.contains("2796203 triangles") && e.contains("fewer triangles"), "{e}");
         // One triangle over: the sizes in bytes, since both round to 128 MiB.
         assert!(e.contains("134217744 bytes") && e.contains("134217728 bytes"), "{e}");
-        // 32 bytes per node: 128 MiB hold 4 194 304 nodes.
-        assert!(check_bvh_nodes(&l, 4_194_304).is_ok());
-        let e = check_bvh_nodes(&l, 4_194_305).unwrap_err().to_string();
-        assert!(e.contains("4194305 BVH nodes") && e.contains("134217728 bytes"), "{e}");
+        // 128 bytes per node: 128 MiB hold 1 048 576 nodes.
+        assert!(check_bvh_nodes(&l, 1_048_576).is_ok());
+        let e = check_bvh_nodes(&l, 1_048_577).unwrap_err().to_string();
+        assert!(e.contains("1048577 BVH nodes") && e.contains("134217728 bytes"), "{e}");
     }
 }

@@ -58,11 +58,17 @@ struct MaterialMaps {
     metal_rough_map: TextureSlot,
 }
 
-struct BvhNode {
-    min: vec3f,
-    offset: u32,
-    max: vec3f,
-    count: u32,
+// A node of the 4-wide BVH (bvh/wide.rs, WideNode): child i's box by axis, and child[i] a
+// node (count[i] = 0), the first of a leaf's count[i] triangles, or unused (NO_CHILD).
+struct WideNode {
+    lo_x: vec4f,
+    hi_x: vec4f,
+    lo_y: vec4f,
+    hi_y: vec4f,
+    lo_z: vec4f,
+    hi_z: vec4f,
+    child: vec4u,
+    count: vec4u,
 }
 
 // A light of the distribution (lights.rs): `triangle` is the emissive triangle, or
@@ -88,7 +94,7 @@ struct PunctualLight {
 
 @group(0) @binding(0) var<storage, read> triangles: array<Triangle>;
 @group(0) @binding(1) var<storage, read> materials: array<Material>;
-@group(0) @binding(2) var<storage, read> bvh_nodes: array<BvhNode>;
+@group(0) @binding(2) var<storage, read> bvh_nodes: array<WideNode>;
 @group(0) @binding(3) var<storage, read> lights: array<LightEntry>;
 // The point, spot and distant lights (one zero light when the scene has none).
 @group(0) @binding(7) var<storage, read> punctual: array<PunctualLight>;

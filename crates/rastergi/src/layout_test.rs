@@ -8,7 +8,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::mem::{offset_of, size_of};
 use std::path::Path;
 
-use crate::bvh::BvhNode;
+use crate::bvh::wide::WideNode;
 use crate::display::DisplayUniforms;
 use crate::environment::GpuEnvironment;
 use crate::film::ResolveUniforms;
@@ -76,7 +76,7 @@ fn twins() -> Vec<Twin> {
             "MaterialMaps",
             [alpha_cutoff, normal_scale, albedo_map, emission_map, opacity_map, normal_map, metal_rough_map]
         ),
-        twin!(BvhNode, "BvhNode", [min, offset, max, count]),
+        twin!(WideNode, "WideNode", [lo_x, hi_x, lo_y, hi_y, lo_z, hi_z, child, count]),
         twin!(LightEntry, "LightEntry", [triangle, cdf, pmf, area]),
         twin!(
             PunctualLight,

@@ -58,6 +58,7 @@ pub fn constants() -> String {
         ("LIGHT_POINT", LIGHT_POINT),
         ("LIGHT_SPOT", LIGHT_SPOT),
         ("LIGHT_DISTANT", LIGHT_DISTANT),
+        ("NO_CHILD", crate::bvh::wide::NO_CHILD),
         ("GGX_ALBEDO_N", crate::bsdf::albedo::N as u32),
         ("GGX_ALBEDO_CELLS", (crate::bsdf::albedo::N * crate::bsdf::albedo::N) as u32),
     ];

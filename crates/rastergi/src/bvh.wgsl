@@ -47,7 +47,7 @@ fn trace(o: vec3f, d: vec3f, t_min: f32, t_max: f32, skip_a: u32, skip_b: u32, a
     var first = any_hit;
     for (var k = 0u; k < MAX_HOLE_CROSSINGS; k++) {
         let hit = traverse(o, d, lo, t_max, skip_a, skip_b, passed, first);
-        if hit.tri == NO_TRIANGLE || (triangles[hit.tri].flags & TRIANGLE_HAS_HOLES) == 0u
+        if !SCENE_HOLES || hit.tri == NO_TRIANGLE || (triangles[hit.tri].flags & TRIANGLE_HAS_HOLES) == 0u
             || !passes_through(hit.tri, hit.b1, hit.b2, 0.0) {
             return hit;
         }

@@ -316,6 +316,12 @@ pub struct GpuScene {
     pub caustics: bool,
     /// Whether some material is not Lambertian ([`Material::is_lambertian`]).
     pub has_bsdfs: bool,
+    /// Some material reads a texture (`SCENE_TEXTURES`).
+    pub has_textures: bool,
+    /// Some triangle has shading normals at its corners (`SCENE_NORMALS`).
+    pub has_normals: bool,
+    /// Some material may let rays through: a cut-out or a stochastic surface (`SCENE_HOLES`).
+    pub has_holes: bool,
 }
 
 impl GpuScene {
@@ -323,9 +329,15 @@ impl GpuScene {
     /// pipeline whose shader reads the scene: a scene without glossy or specular materials,
     /// or without surfaces that pass rays, gets kernels without the branches that serve them
     /// (the same results: those branches are never taken there; smaller kernels run faster).
-    pub fn pipeline_constants(&self) -> [(&'static str, f64); 2] {
+    pub fn pipeline_constants(&self) -> [(&'static str, f64); 5] {
         let flag = |b: bool| if b { 1.0 } else { 0.0 };
-        [("SCENE_BSDF", flag(self.has_bsdfs)), ("SCENE_PASSES_RAYS", flag(self.eye_chains))]
+        [
+            ("SCENE_BSDF", flag(self.has_bsdfs)),
+            ("SCENE_PASSES_RAYS", flag(self.eye_chains)),
+            ("SCENE_TEXTURES", flag(self.has_textures)),
+            ("SCENE_NORMALS", flag(self.has_normals)),
+            ("SCENE_HOLES", flag(self.has_holes)),
+        ]
     }
 
     /// A compute pipeline for `module`'s entry point `entry` (a shader that reads this scene),
@@ -496,6 +508,9 @@ impl GpuScene {
             eye_chains: s.materials.iter().any(|m| m.passes_rays() || m.has_delta_lobe()),
             caustics: s.materials.iter().any(Material::passes_rays),
             has_bsdfs,
+            has_textures: s.materials.iter().any(|m| m.texture_refs().next().is_some()),
+            has_normals: !s.normals.is_empty(),
+            has_holes: s.materials.iter().any(Material::has_holes),
         })
     }
 }

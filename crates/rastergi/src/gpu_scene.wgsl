@@ -7,6 +7,12 @@ override SCENE_BSDF: bool = true;
 // Some material passes eye and gather rays (Material::passes_rays: the eye's and the
 // gather's specular chains, the photon map's caustic twins):
 override SCENE_PASSES_RAYS: bool = true;
+// Some material reads a texture (MATERIAL_TEXTURED):
+override SCENE_TEXTURES: bool = true;
+// Some triangle has shading normals at its corners:
+override SCENE_NORMALS: bool = true;
+// Some material may let rays through (a cut-out or a stochastic surface, TRIANGLE_HAS_HOLES):
+override SCENE_HOLES: bool = true;
 
 // flags: TRIANGLE_HAS_HOLES where the material may let rays through.
 struct Triangle {
@@ -186,17 +192,19 @@ fn slot_sample(s: TextureSlot, uv: vec2f, lod: f32) -> vec4f {
 // where the triangle has none or they cancel), perturbed by the material's normal map
 // (PreparedScene::shading_normal_at); `textured`: the material reads some texture.
 fn shading_normal(tri: u32, b1: f32, b2: f32, n: vec3f, mi: u32, textured: bool, uv: vec2f) -> vec3f {
-    let i = 9u * min(tri, arrayLength(&normals) / 9u - 1u);
-    var v = vec3f(0.0);
     let w = vec3f(1.0 - b1 - b2, b1, b2);
-    for (var k = 0u; k < 3u; k++) {
-        v += w[k] * vec3f(normals[i + 3u * k], normals[i + 3u * k + 1u], normals[i + 3u * k + 2u]);
-    }
-    let len = length(v);
     var ns = n;
-    if len >= 1e-6 {
-        v /= len;
-        ns = select(-v, v, dot(v, n) >= 0.0);
+    if SCENE_NORMALS {
+        let i = 9u * min(tri, arrayLength(&normals) / 9u - 1u);
+        var v = vec3f(0.0);
+        for (var k = 0u; k < 3u; k++) {
+            v += w[k] * vec3f(normals[i + 3u * k], normals[i + 3u * k + 1u], normals[i + 3u * k + 2u]);
+        }
+        let len = length(v);
+        if len >= 1e-6 {
+            v /= len;
+            ns = select(-v, v, dot(v, n) >= 0.0);
+        }
     }
     if !textured {
         return ns;
@@ -244,6 +252,9 @@ fn surface_opacity(mi: u32, opacity: f32, uv: vec2f, lod: f32) -> f32 {
 // it (PreparedScene::passes_through): through a cut-out where α < its cutoff; through a
 // stochastic surface where a uniform hashed from the point and alpha_seed is ≥ α.
 fn passes_through(tri: u32, b1: f32, b2: f32, lod: f32) -> bool {
+    if !SCENE_HOLES {
+        return false;
+    }
     let mi = triangles[tri].material;
     let m = materials[mi];
     if (m.flags & (MATERIAL_ALPHA_MASK | MATERIAL_ALPHA_BLEND)) == 0u {
@@ -263,7 +274,7 @@ fn passes_through(tri: u32, b1: f32, b2: f32, lod: f32) -> bool {
 fn emitter_radiance(tri: u32, b1: f32, b2: f32) -> vec3f {
     let mi = triangles[tri].material;
     let m = materials[mi];
-    if (m.flags & (MATERIAL_TEXTURED | MATERIAL_ALPHA_MASK | MATERIAL_ALPHA_BLEND)) == 0u {
+    if !(SCENE_TEXTURES || SCENE_HOLES) || (m.flags & (MATERIAL_TEXTURED | MATERIAL_ALPHA_MASK | MATERIAL_ALPHA_BLEND)) == 0u {
         return m.emission;
     }
     let uv = surface_uv(tri, b1, b2);
@@ -339,7 +350,7 @@ fn surface_at(tri: u32, b1: f32, b2: f32, lod: f32) -> Surface {
     let t = triangles[tri];
     let mi = t.material;
     let m = materials[mi];
-    let textured = (m.flags & MATERIAL_TEXTURED) != 0u;
+    let textured = SCENE_TEXTURES && (m.flags & MATERIAL_TEXTURED) != 0u;
     var uv = vec2f(0.0);
     if textured {
         uv = surface_uv(tri, b1, b2);

@@ -5,6 +5,8 @@
 #
 #   Adapter       rastergi info
 #   Photons       photons/s, GPU against the CPU twin (bench photons)
+#   Rays          rays/s of each kind the passes cast, GPU kernel against the CPU twin, on
+#                 the Cornell box and a 1 M-triangle mesh (bench rays)
 #   Gather        directions/s of each gather (raster, lists, trace) at 512² and 1024²
 #   Viewer loop   frames/s and iterations/s of the viewer's frame loop at 1920×1080, no
 #                 window (bench frames)
@@ -26,7 +28,7 @@
 #                  the build's target/release/rastergi)
 #
 # Time: each step has a budget (below, in seconds) and is stopped if it runs past it, so the
-# full report takes at most the sum of the budgets, 415 s, plus the build. The budgets fit
+# full report takes at most the sum of the budgets, 455 s, plus the build. The budgets fit
 # a real GPU: the steps with fixed work (photons, gather, memory) need a few seconds there,
 # and the others run for a given time (--seconds, --max-seconds) chosen within them. In
 # --quick mode the budgets are only caps against a hang. A step that fails or is stopped is
@@ -86,8 +88,10 @@ started=$(date +%s)
 if [ "$quick" = 1 ]; then
     mode="quick (tiny sizes and runs of a second or two, for CI and lavapipe: its figures are no performance figures)"
     # Steps and their caps (s): every one takes a few seconds on lavapipe.
-    B_INFO=60 B_PHOTONS=60 B_GATHER=120 B_FRAMES=60 B_REF=60 B_COMPARE=60 B_CONVERGE=60 B_MITSUBA=120 B_MEMORY=60
+    B_INFO=60 B_PHOTONS=60 B_RAYS=30 B_GATHER=120 B_FRAMES=60 B_REF=60 B_COMPARE=60 B_CONVERGE=60 B_MITSUBA=120 B_MEMORY=60
     PHOTONS=(--photons 65536 --grid 32 --repeats 1)
+    RAYS=(--size 32 --repeats 1)
+    RAYS_MESH=spheres:20000
     GATHER=(--sizes 64,128 --iterations 4 --bundle 256 --photons 65536 --grid 32)
     FRAMES=(--width 160 --height 90 --seconds 1 --photons 65536 --grid 32)
     SIZE=64 REF_SECONDS=3 CONVERGE_SECONDS=2 MITSUBA_SECONDS=2
@@ -97,6 +101,7 @@ else
     # Budgets (s), 415 in all:
     B_INFO=10      # adapter query
     B_PHOTONS=30   # 4 GPU runs of 4 M photons, then the CPU twin once (a few s on 8+ cores)
+    B_RAYS=20      # each of 2 scenes: 5 kinds x 4 GPU runs of 1 M rays + the CPU twin once each
     B_GATHER=45    # 2 sizes x 3 gathers: a renderer each (4 M photons), 2 + 16 iterations
     B_FRAMES=30    # set-up and warm-up, then 3 x 6 s (panel shown, hidden, one iteration per frame)
     B_REF=55       # each of the two reference renders: 50 s of path tracing + set-up
@@ -106,6 +111,8 @@ else
     #                plus its process start-up (JIT) for each of ~12 runs
     B_MEMORY=20    # one renderer at 1920x1080, grid 128, bundle 2048, auto's trial iterations
     PHOTONS=(--photons 4194304 --repeats 3)
+    RAYS=(--size 1024 --repeats 3)
+    RAYS_MESH=spheres:1000000
     GATHER=(--sizes 512,1024 --iterations 16)
     FRAMES=(--width 1920 --height 1080 --seconds 6)
     SIZE=1024 REF_SECONDS=50 CONVERGE_SECONDS=15 MITSUBA_SECONDS=8
@@ -191,6 +198,11 @@ fi
 report "## Photons" ""
 report "Photon tracing into the photon map, photons/s on the GPU against the CPU twin (rayon)." ""
 step "photons" "$B_PHOTONS" "$binary" bench photons "${PHOTONS[@]}" || true
+
+report "## Rays" ""
+report "Rays/s of each kind the passes cast, the GPU kernel (trace of bvh.wgsl) against the CPU twin (rayon), hit for hit." ""
+step "rays: cornell" "$B_RAYS" "$binary" bench rays cornell "${RAYS[@]}" || true
+step "rays: $RAYS_MESH" "$B_RAYS" "$binary" bench rays "$RAYS_MESH" "${RAYS[@]}" || true
 
 report "## Gather" ""
 report "Final-gather directions/s of the three implementations (4 directions per iteration)." ""

@@ -11,8 +11,8 @@ use std::time::Duration;
 const TIMEOUT: Duration = Duration::from_secs(300);
 
 /// The report's sections by heading, in order.
-const SECTIONS: [&str; 8] =
-    ["Adapter", "Photons", "Gather", "Viewer loop", "Convergence", "Mitsuba", "Memory", "Summary"];
+const SECTIONS: [&str; 9] =
+    ["Adapter", "Photons", "Rays", "Gather", "Viewer loop", "Convergence", "Mitsuba", "Memory", "Summary"];
 
 /// The text of the section `## name` (up to the next heading).
 fn section<'a>(report: &'a str, name: &str) -> &'a str {
@@ -68,6 +68,7 @@ fn quick_report_has_every_section_with_its_command_and_figures() {
     for (name, command) in [
         ("Adapter", "rastergi info"),
         ("Photons", "rastergi bench photons"),
+        ("Rays", "rastergi bench rays cornell"),
         ("Gather", "rastergi bench gather"),
         ("Viewer loop", "rastergi bench frames"),
         ("Convergence", "rastergi render cornell --method path"),
@@ -79,6 +80,8 @@ fn quick_report_has_every_section_with_its_command_and_figures() {
 
     assert!(section(&report, "Adapter").contains("backend:"), "{report}");
     check_figures(&report, "Photons", "M photons/s", 2);
+    // Five kinds of rays in each of two scenes.
+    check_figures(&report, "Rays", "M rays/s", 10);
     // Two sizes × three gathers.
     check_figures(&report, "Gather", "directions/s", 6);
     // Batched with the panel, without it, and one iteration per frame.

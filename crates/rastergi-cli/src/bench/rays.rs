@@ -103,15 +103,11 @@ pub fn run(a: &RaysArgs) -> Result<()> {
         triangle_bytes as f64 / (1 << 20) as f64
     );
     println!("  GPU: {} ({:?}); CPU twin: {threads} threads (rayon)", gpu.info.name, gpu.info.backend);
-    println!(
-        "  {:<8} {:<34} {:>9} {:>13} {:>13} {:>8} {:>12}",
-        "kind", "", "rays", "GPU Mrays/s", "CPU Mrays/s", "GPU/CPU", "disagreeing"
-    );
     for f in &figures {
         println!(
-            "  {:<8} {:<34} {:>9} {:>13.3} {:>13.3} {:>7.2}x {:>12}",
+            "  {:<7} {:<35} {:>8} rays: GPU {:>8.3} M rays/s, CPU {:>8.3} M rays/s (GPU/CPU {:.2}x), {} disagree",
             f.kind.name(),
-            f.kind.description(),
+            format!("({})", f.kind.description()),
             f.rays,
             f.rays as f64 / f.gpu_s / 1e6,
             f.rays as f64 / f.cpu_s / 1e6,

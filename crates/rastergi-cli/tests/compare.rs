@@ -117,16 +117,7 @@ fn gaussian_noise_of_known_level_is_reported_within_sampling_error() {
     let dir = tempfile::tempdir().unwrap();
     let (w, h, sigma) = (64u32, 64u32, 0.05f64);
     let reference = ramp(w, h);
-    // splitmix64 uniforms, Box–Muller normals.
-    let mut state = 12345u64;
-    let mut uniform = move || {
-        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    };
-    let mut normal = move || (-2.0 * (1.0 - uniform()).ln()).sqrt() * (std::f64::consts::TAU * uniform()).cos();
+    let mut normal = rastergi::sampling::gaussian_deviates(12345);
     write(dir.path(), "ref.exr", &reference);
     write(dir.path(), "noisy.exr", &map(&reference, |p| p.map(|v| v + (sigma * normal()) as f32)));
     let run = rastergi(dir.path(), &["compare", "noisy.exr", "ref.exr"]);

@@ -121,7 +121,7 @@ fn twins() -> Vec<Twin> {
         twin!(TrianglePlane, "TrianglePlane", [normal, offset, bins]),
         twin!(PathParams, "PathParams", [light_weight, light_count, max_bounces, rr_start]),
         twin!(crate::bsdf::albedo::GpuGgxAlbedo, "GgxAlbedoTable", [cells, means]),
-        twin!(crate::rays::GpuRay, "Ray", [origin, t_min, dir, t_max, skip, any_hit]),
+        twin!(crate::rays::GpuRay, "Ray", [origin, dir, skip_any]),
         twin!(crate::rays::GpuRayHit, "RayHit", [t, tri, b1, b2]),
     ]
 }

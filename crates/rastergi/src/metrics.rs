@@ -259,27 +259,11 @@ mod tests {
         assert!((rmse(&a, &r, None) - d).abs() < 1e-6);
     }
 
-    /// Standard normal deviates: splitmix64 and the Box–Muller transform.
-    fn gaussians(seed: u64) -> impl FnMut() -> f64 {
-        let mut state = seed;
-        let mut uniform = move || {
-            state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = state;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-        };
-        move || {
-            let (u1, u2) = (1.0 - uniform(), uniform());
-            (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
-        }
-    }
-
     #[test]
     fn gaussian_noise_of_known_level_is_measured_within_sampling_error() {
         let (w, h, sigma) = (64u32, 64u32, 0.05f64);
         let r = ramp(w, h);
-        let mut normal = gaussians(7);
+        let mut normal = crate::sampling::gaussian_deviates(7);
         let a = map(&r, |p| p.map(|v| v + (sigma * normal()) as f32));
         let c = compare(&a, &r, None);
         let mean = ramp_mean(w, h);

@@ -29,18 +29,35 @@ use crate::gpu_scene::{GpuScene, PreparedScene, alpha_uniform};
 use crate::sampling::{Rng, cosine_hemisphere, uniform_triangle};
 use crate::scene::{Camera, triangle_normal};
 
-/// `Ray` in `rays.wgsl`: origin, distances (t_min, t_max), the triangle to skip (`u32::MAX`
-/// for none) and whether any hit answers (a shadow ray) or only the closest.
+/// `Ray` in `rays.wgsl`, packed in three vectors.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
 pub struct GpuRay {
-    pub origin: [f32; 3],
-    pub t_min: f32,
-    pub dir: [f32; 3],
-    pub t_max: f32,
-    pub skip: u32,
-    pub any_hit: u32,
-    pub _pad: [u32; 2],
+    /// The origin (xyz) and the least distance t_min (w).
+    pub origin: [f32; 4],
+    /// The unit direction (xyz) and the greatest distance t_max (w).
+    pub dir: [f32; 4],
+    /// The triangle to skip (`u32::MAX` for none), 1 where any hit answers (a shadow ray) and
+    /// 0 where only the closest does, two zeros.
+    pub skip_any: [u32; 4],
+}
+
+impl GpuRay {
+    fn new(origin: Vec3, dir: Vec3, (t_min, t_max): (f32, f32), skip: u32, any_hit: bool) -> GpuRay {
+        GpuRay {
+            origin: origin.extend(t_min).into(),
+            dir: dir.extend(t_max).into(),
+            skip_any: [skip, any_hit as u32, 0, 0],
+        }
+    }
+
+    fn o(&self) -> Vec3 {
+        Vec3::from_slice(&self.origin[..3])
+    }
+
+    fn d(&self) -> Vec3 {
+        Vec3::from_slice(&self.dir[..3])
+    }
 }
 
 /// `RayHit` of `bvh.wgsl` as the ray kernel writes it: distance, triangle (`u32::MAX` for a
@@ -133,14 +150,8 @@ pub fn make_rays(
     let scene = &prepared.scene;
     let eps = prepared.ray_epsilon();
     let pixels = tile_order(width, height);
-    let ray = |origin: Vec3, dir: Vec3, t_min: f32, t_max: f32, skip: u32, any_hit: bool| GpuRay {
-        origin: origin.into(),
-        t_min,
-        dir: dir.into(),
-        t_max,
-        skip,
-        any_hit: any_hit as u32,
-        _pad: [0; 2],
+    let ray = |o: Vec3, d: Vec3, t_min: f32, t_max: f32, skip: u32, any_hit: bool| {
+        GpuRay::new(o, d, (t_min, t_max), skip, any_hit)
     };
     let primary: Vec<GpuRay> = pixels
         .iter()
@@ -177,12 +188,12 @@ pub fn make_rays(
         .filter(|(_, (h, _))| h.tri != u32::MAX)
         .filter_map(|(i, (h, r))| {
             let tri = &scene.triangles[h.tri as usize];
-            let d = Vec3::from(r.dir);
+            let d = r.d();
             let mut n = triangle_normal(tri);
             if n.dot(d) > 0.0 {
                 n = -n;
             }
-            let x = Vec3::from(r.origin) + d * h.t + n * eps;
+            let x = r.o() + d * h.t + n * eps;
             let mut rng = Rng::new(seed, i as u32, 2);
             match kind {
                 RayKind::Shadow => {
@@ -231,15 +242,8 @@ pub fn trace_cpu(prepared: &PreparedScene, rays: &[GpuRay]) -> Vec<GpuRayHit> {
                 let u = alpha_uniform(h.triangle, h.b1, h.b2, 0);
                 !prepared.passes_through(h.triangle as usize, h.b1, h.b2, u)
             };
-            let hit = prepared.bvh.intersect(
-                &scene.triangles,
-                Vec3::from(r.origin),
-                Vec3::from(r.dir),
-                r.t_min,
-                r.t_max,
-                r.skip,
-                solid,
-            );
+            let (t_min, t_max) = (r.origin[3], r.dir[3]);
+            let hit = prepared.bvh.intersect(&scene.triangles, r.o(), r.d(), t_min, t_max, r.skip_any[0], solid);
             hit.map_or(GpuRayHit::MISS, |h| GpuRayHit { t: h.t, tri: h.triangle, b1: h.b1, b2: h.b2 })
         })
         .collect()
@@ -332,7 +336,7 @@ pub fn disagreements(rays: &[GpuRay], gpu: &[GpuRayHit], cpu: &[GpuRayHit]) -> u
         .zip(gpu.iter().zip(cpu))
         .filter(|(r, (g, c))| {
             let (g_hit, c_hit) = (g.tri != u32::MAX, c.tri != u32::MAX);
-            if r.any_hit != 0 || !g_hit || !c_hit {
+            if r.skip_any[1] != 0 || !g_hit || !c_hit {
                 return g_hit != c_hit;
             }
             g.tri != c.tri && (g.t - c.t).abs() > 1e-5 * c.t.abs().max(1e-3)

@@ -1,14 +1,11 @@
 // Ray kernel of `rastergi bench rays` (rays.rs): one invocation per ray, traced by `trace`
 // (bvh.wgsl) exactly as the passes call it. The alpha stream keeps its seed 0 (the CPU twin's).
 
+// origin: xyz and t_min; dir: xyz and t_max; skip_any: the triangle to skip, any hit (1).
 struct Ray {
-    origin: vec3f,
-    t_min: f32,
-    dir: vec3f,
-    t_max: f32,
-    skip: u32,
-    any_hit: u32,
-    _pad: vec2u,
+    origin: vec4f,
+    dir: vec4f,
+    skip_any: vec4u,
 }
 
 @group(1) @binding(0) var<storage, read> rays: array<Ray>;
@@ -21,7 +18,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u, @builtin(num_workgroups) n: v
         return;
     }
     let r = rays[i];
-    var hit = trace(r.origin, r.dir, r.t_min, r.t_max, r.skip, NO_TRIANGLE, r.any_hit != 0u);
+    var hit = trace(r.origin.xyz, r.dir.xyz, r.origin.w, r.dir.w, r.skip_any.x, NO_TRIANGLE, r.skip_any.y != 0u);
     if hit.tri == NO_TRIANGLE {
         hit = RayHit(0.0, NO_TRIANGLE, 0.0, 0.0);
     }

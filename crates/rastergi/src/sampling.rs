@@ -149,6 +149,23 @@ pub fn unit_f32(x: u32) -> f32 {
     (x >> 8) as f32 * (1.0 / 16_777_216.0)
 }
 
+/// Standard normal deviates from `seed` (splitmix64 uniforms, the Box–Muller transform): noise
+/// of a known level for the tests of error metrics.
+pub fn gaussian_deviates(seed: u64) -> impl FnMut() -> f64 {
+    let mut state = seed;
+    let mut uniform = move || {
+        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    };
+    move || {
+        let (u1, u2) = (1.0 - uniform(), uniform());
+        (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+    }
+}
+
 /// The scramble seed of pixel (x, y) for a frame's `key`; mirrors `pixel_seed` in WGSL.
 pub fn pixel_seed(key: u32, x: u32, y: u32) -> u32 {
     pcg_hash(x ^ pcg_hash(y ^ key))

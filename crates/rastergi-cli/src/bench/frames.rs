@@ -33,14 +33,8 @@ use crate::view::{FRAME_BUDGET, MAX_BATCH, iterate_frame};
 
 #[derive(Args, Debug)]
 pub struct FramesArgs {
-    #[arg(default_value = "cornell")]
-    scene: String,
-    /// The window's width in pixels.
-    #[arg(long, default_value_t = 1920)]
-    width: u32,
-    /// The window's height in pixels.
-    #[arg(long, default_value_t = 1080)]
-    height: u32,
+    #[command(flatten)]
+    window: super::WindowArgs,
     /// Timed seconds of each phase (batched, then one iteration per frame).
     #[arg(long, default_value_t = 10.0)]
     seconds: f64,
@@ -131,13 +125,13 @@ impl Loop {
 
 pub fn run(a: &FramesArgs) -> Result<()> {
     anyhow::ensure!(a.seconds.is_finite() && a.seconds > 0.0, "--seconds must be positive, got {}", a.seconds);
-    let scene = load_valid_scene(&a.scene)?;
+    let scene = load_valid_scene(&a.window.scene)?;
     let gpu = gpu(&a.gpu)?;
     let grid = a.grid.unwrap_or_else(|| fit::grid_resolution(&scene.bounds()));
     let photons = a.photons.unwrap_or_else(|| fit::photon_count(&scene, grid));
     let settings = RenderSettings {
-        width: a.width,
-        height: a.height,
+        width: a.window.width,
+        height: a.window.height,
         photons,
         grid_resolution: grid,
         show_photon_map: true,
@@ -149,14 +143,14 @@ pub fn run(a: &FramesArgs) -> Result<()> {
     let renderer = Renderer::new(&gpu, &scene, settings)?;
     renderer.wait()?;
     let setup = start.elapsed().as_secs_f64();
-    let target = OffscreenTarget::new(&gpu, a.width, a.height)?;
+    let target = OffscreenTarget::new(&gpu, a.window.width, a.window.height)?;
     let painter = PanelPainter::new(&gpu.device, target.format());
     let panel = HeadlessPanel { ctx: egui::Context::default(), painter, state: PanelState::default(), controls };
     println!(
         "viewer frame loop (no window): {} at {}x{} on {} ({:?}), {photons} photons, grid {grid}, bundle {}",
-        a.scene,
-        a.width,
-        a.height,
+        a.window.scene,
+        a.window.width,
+        a.window.height,
         gpu.info.name,
         gpu.info.backend,
         renderer.bundle()
@@ -164,8 +158,8 @@ pub fn run(a: &FramesArgs) -> Result<()> {
     println!(
         "  a frame: iterations batched to {} ms (1 to {MAX_BATCH}), resolve, display pass and the control panel into an offscreen {}x{} texture; no present, no vsync",
         FRAME_BUDGET.as_millis(),
-        a.width,
-        a.height
+        a.window.width,
+        a.window.height
     );
     let mut l = Loop { gpu, renderer, target, panel, batch: 1 };
     // Warm-up: `auto` times its gathers on the first iterations; the batch size settles.

@@ -11,12 +11,8 @@ use crate::args::{GatherArg, GpuArgs, gpu};
 
 #[derive(Args, Debug)]
 pub struct MemoryArgs {
-    #[arg(default_value = "cornell")]
-    scene: String,
-    #[arg(long, default_value_t = 1920)]
-    width: u32,
-    #[arg(long, default_value_t = 1080)]
-    height: u32,
+    #[command(flatten)]
+    window: super::WindowArgs,
     /// Photon grid cells along the scene's longest axis.
     #[arg(long, default_value_t = 128)]
     grid: u32,
@@ -35,15 +31,15 @@ pub struct MemoryArgs {
 }
 
 pub fn run(a: &MemoryArgs) -> Result<()> {
-    let scene = load_valid_scene(&a.scene)?;
+    let scene = load_valid_scene(&a.window.scene)?;
     let gpu = gpu(&a.gpu)?;
     println!(
         "GPU memory: {} at {}x{}, grid {}, bundle {}², gather {:?}, on {} ({:?})",
-        a.scene, a.width, a.height, a.grid, a.bundle, a.gather, gpu.info.name, gpu.info.backend
+        a.window.scene, a.window.width, a.window.height, a.grid, a.bundle, a.gather, gpu.info.name, gpu.info.backend
     );
     let settings = RenderSettings {
-        width: a.width,
-        height: a.height,
+        width: a.window.width,
+        height: a.window.height,
         photons: a.photons,
         grid_resolution: a.grid,
         bundle: a.bundle,

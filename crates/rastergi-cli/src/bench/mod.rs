@@ -56,6 +56,21 @@ pub fn run(command: &BenchCommand) -> Result<()> {
     }
 }
 
+/// The scene and the window size of the benchmarks that measure a full-HD viewer (`frames`,
+/// `memory`).
+#[derive(clap::Args, Debug)]
+pub struct WindowArgs {
+    /// The scene: built in (`cornell`, `atrium`, `spheres:N`) or a file.
+    #[arg(default_value = "cornell")]
+    pub scene: String,
+    /// The window's width in pixels.
+    #[arg(long, default_value_t = 1920)]
+    pub width: u32,
+    /// The window's height in pixels.
+    #[arg(long, default_value_t = 1080)]
+    pub height: u32,
+}
+
 /// The scene of that name (built in or a file), validated.
 fn load_valid_scene(name: &str) -> Result<Scene> {
     let scene = load_scene(name)?;

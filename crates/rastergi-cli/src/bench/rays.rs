@@ -65,6 +65,8 @@ pub fn run(a: &RaysArgs) -> Result<()> {
         figures.push(KindFigures { kind, rays: rays.len(), gpu_s: median(times).as_secs_f64(), cpu_s, disagree });
     }
     let node_bytes = std::mem::size_of_val(bvh.nodes.as_slice());
+    let wide = bvh.wide();
+    let wide_bytes = std::mem::size_of_val(wide.as_slice());
     let triangle_bytes = scene.triangles.len() * std::mem::size_of::<rastergi::gpu_scene::GpuTriangle>();
     let threads = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
     if a.json {
@@ -82,24 +84,27 @@ pub fn run(a: &RaysArgs) -> Result<()> {
             })
             .collect();
         println!(
-            "{{\"scene\":{:?},\"triangles\":{},\"gpu\":{:?},\"cpu_threads\":{threads},\"bvh\":{{\"build_s\":{build_s:.4},\"prepare_s\":{prepare_s:.4},\"nodes\":{},\"depth\":{},\"sah_cost\":{:.3},\"node_bytes\":{node_bytes},\"triangle_bytes\":{triangle_bytes}}},\"kinds\":[{}]}}",
+            "{{\"scene\":{:?},\"triangles\":{},\"gpu\":{:?},\"cpu_threads\":{threads},\"bvh\":{{\"build_s\":{build_s:.4},\"prepare_s\":{prepare_s:.4},\"nodes\":{},\"depth\":{},\"sah_cost\":{:.3},\"node_bytes\":{node_bytes},\"wide_nodes\":{},\"wide_node_bytes\":{wide_bytes},\"triangle_bytes\":{triangle_bytes}}},\"kinds\":[{}]}}",
             a.scene,
             scene.triangles.len(),
             format!("{} ({:?})", gpu.info.name, gpu.info.backend),
             bvh.nodes.len(),
             bvh.depth(),
             bvh.sah_cost(),
+            wide.len(),
             kinds.join(",")
         );
         return Ok(());
     }
     println!("rays: {} ({} triangles), {}² rays per kind", a.scene, scene.triangles.len(), a.size);
     println!(
-        "  BVH: built in {build_s:.3} s (scene prepared in {prepare_s:.3} s), {} nodes, depth {}, SAH cost {:.2}, {:.1} MiB of nodes + {:.1} MiB of triangles",
+        "  BVH: built in {build_s:.3} s (scene prepared in {prepare_s:.3} s), {} binary nodes ({:.1} MiB; the CPU's), depth {}, SAH cost {:.2}; {} 4-wide nodes ({:.1} MiB; the GPU's), {:.1} MiB of triangles",
         bvh.nodes.len(),
+        node_bytes as f64 / (1 << 20) as f64,
         bvh.depth(),
         bvh.sah_cost(),
-        node_bytes as f64 / (1 << 20) as f64,
+        wide.len(),
+        wide_bytes as f64 / (1 << 20) as f64,
         triangle_bytes as f64 / (1 << 20) as f64
     );
     println!("  GPU: {} ({:?}); CPU twin: {threads} threads (rayon)", gpu.info.name, gpu.info.backend);

@@ -12,7 +12,9 @@
 //!   closest hit (incoherent: the path tracer's and the photons' later bounces);
 //! * gather: from each visible point along one direction shared by the whole batch, on the
 //!   side of ±ω above the surface, closest hit (the traced gather's shared directions);
-//! * photon: from the lights, as the photon pass emits them, closest hit.
+//! * photon: from the lights, as the photon pass emits them, closest hit;
+//! * sorted bounce: the bounce rays reordered by direction octant, then by their origins'
+//!   Morton order in the scene's bounds (what sorting incoherent rays for coherence buys).
 //!
 //! Rays are laid out in the order of the passes' 8×8 workgroups (tile by tile), so that a
 //! workgroup of the ray kernel holds the rays one workgroup of a pass casts.
@@ -83,10 +85,12 @@ pub enum RayKind {
     Bounce,
     Gather,
     Photon,
+    SortedBounce,
 }
 
 impl RayKind {
-    pub const ALL: [RayKind; 5] = [RayKind::Camera, RayKind::Shadow, RayKind::Bounce, RayKind::Gather, RayKind::Photon];
+    pub const ALL: [RayKind; 6] =
+        [RayKind::Camera, RayKind::Shadow, RayKind::Bounce, RayKind::Gather, RayKind::Photon, RayKind::SortedBounce];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -95,6 +99,7 @@ impl RayKind {
             RayKind::Bounce => "bounce",
             RayKind::Gather => "gather",
             RayKind::Photon => "photon",
+            RayKind::SortedBounce => "sorted",
         }
     }
 
@@ -106,6 +111,7 @@ impl RayKind {
             RayKind::Bounce => "incoherent, closest hit",
             RayKind::Gather => "one shared direction, closest hit",
             RayKind::Photon => "from the lights, closest hit",
+            RayKind::SortedBounce => "the bounce rays sorted, closest hit",
         }
     }
 }
@@ -147,6 +153,11 @@ pub fn make_rays(
     kind: RayKind,
     seed: u32,
 ) -> Vec<GpuRay> {
+    if kind == RayKind::SortedBounce {
+        let mut rays = make_rays(prepared, camera, (width, height), RayKind::Bounce, seed);
+        sort_for_coherence(&mut rays, &prepared.bounds);
+        return rays;
+    }
     let scene = &prepared.scene;
     let eps = prepared.ray_epsilon();
     let pixels = tile_order(width, height);
@@ -229,6 +240,28 @@ pub fn make_rays(
             }
         })
         .collect()
+}
+
+/// Sorts `rays` by the octant of their direction, then by the Morton code of their origin in
+/// `bounds` (10 bits per axis): neighbours then start near each other and go the same way.
+pub fn sort_for_coherence(rays: &mut [GpuRay], bounds: &crate::scene::Aabb) {
+    fn spread(v: u32) -> u64 {
+        // The 10 bits of v, two zero bits after each.
+        let mut x = (v & 0x3ff) as u64;
+        x = (x | (x << 16)) & 0x0300_00ff;
+        x = (x | (x << 8)) & 0x0300_f00f;
+        x = (x | (x << 4)) & 0x030c_30c3;
+        x = (x | (x << 2)) & 0x0924_9249;
+        x
+    }
+    let extent = bounds.extent().max(Vec3::splat(1e-30));
+    let key = |r: &GpuRay| {
+        let d = r.d();
+        let octant = (d.x < 0.0) as u64 | ((d.y < 0.0) as u64) << 1 | ((d.z < 0.0) as u64) << 2;
+        let c = ((r.o() - bounds.min) / extent).clamp(Vec3::ZERO, Vec3::ONE) * 1023.0;
+        octant << 30 | spread(c.x as u32) << 2 | spread(c.y as u32) << 1 | spread(c.z as u32)
+    };
+    rays.sort_by_cached_key(key);
 }
 
 /// The CPU twin: each ray's hit by [`Bvh::intersect`] (holes and stochastic opacity passed
@@ -342,4 +375,40 @@ pub fn disagreements(rays: &[GpuRay], gpu: &[GpuRayHit], cpu: &[GpuRayHit]) -> u
             g.tri != c.tri && (g.t - c.t).abs() > 1e-5 * c.t.abs().max(1e-3)
         })
         .count()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sorting_for_coherence_permutes_the_rays_into_octants_then_morton_order() {
+        let bounds = crate::scene::Aabb { min: Vec3::splat(-1.0), max: Vec3::splat(1.0) };
+        let mut rays: Vec<GpuRay> = (0..500u32)
+            .map(|i| {
+                let mut r = Rng::new(4, i, 0);
+                let o = Vec3::new(r.next_f32(), r.next_f32(), r.next_f32()) * 2.0 - 1.0;
+                let d = crate::sampling::uniform_sphere(r.next_f32(), r.next_f32());
+                GpuRay::new(o, d, (0.0, 1.0), i, false)
+            })
+            .collect();
+        let before: Vec<u32> = rays.iter().map(|r| r.skip_any[0]).collect();
+        let mean_step = |rays: &[GpuRay]| rays.windows(2).map(|w| w[0].o().distance(w[1].o())).sum::<f32>() / 499.0;
+        let unsorted = mean_step(&rays);
+        sort_for_coherence(&mut rays, &bounds);
+        let mut after: Vec<u32> = rays.iter().map(|r| r.skip_any[0]).collect();
+        after.sort();
+        assert_eq!(after, (0..500).collect::<Vec<_>>(), "not a permutation of {before:?}");
+        let octant = |r: &GpuRay| {
+            let d = r.d();
+            (d.x < 0.0) as u32 | ((d.y < 0.0) as u32) << 1 | ((d.z < 0.0) as u32) << 2
+        };
+        assert!(rays.windows(2).all(|w| octant(&w[0]) <= octant(&w[1])));
+        // Within an octant the Morton order keeps neighbours close: the mean step between
+        // consecutive origins is about half that of the unsorted rays (measured 0.65 against
+        // 1.32, the mean distance of two random points in the cube), though eight octants
+        // share the 500 points.
+        let sorted = mean_step(&rays);
+        assert!(sorted < 0.6 * unsorted, "mean step {sorted} against {unsorted} unsorted");
+    }
 }

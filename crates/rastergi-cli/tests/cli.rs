@@ -264,6 +264,19 @@ fn bench_memory_reports_the_allocations_and_their_total() {
     }
 }
 
+#[test]
+fn bench_rays_refuses_a_batch_beyond_the_gpus_buffers_before_making_it() {
+    let dir = tempfile::tempdir().unwrap();
+    // 8192² rays of 48 bytes are 3 GiB: past lavapipe's 128 MiB binding (and most GPUs'),
+    // refused in one line before 67 M rays are made on the CPU.
+    let run = rastergi(dir.path(), &["bench", "rays", "cornell", "--size", "8192"]);
+    assert!(!run.status.success());
+    assert!(run.stderr.contains("the rays need") && run.stderr.contains("--size"), "{}", run.stderr);
+    assert!(!run.stderr.contains("panicked"), "{}", run.stderr);
+    let run = rastergi(dir.path(), &["bench", "rays", "cornell", "--size", "0"]);
+    assert!(!run.status.success() && run.stderr.contains("--size"), "{}", run.stderr);
+}
+
 /// A 4 m square floor at y = 0 facing up (grey 0.5, no light), as OBJ in `dir`.
 fn floor_obj(dir: &Path) -> &'static str {
     std::fs::write(dir.join("floor.obj"), "v -2 0 -2\nv 2 0 -2\nv 2 0 2\nv -2 0 2\nf 1 3 2\nf 1 4 3\n").unwrap();

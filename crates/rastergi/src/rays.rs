@@ -224,8 +224,9 @@ pub fn make_rays(
                             let y = Vec3::from(p.position);
                             Some(ray(x, (y - x).normalize(), eps, (y - x).length() * (1.0 - 1e-4), h.tri, true))
                         }
-                        // A distant light or the environment: towards it, unbounded.
+                        // A distant light: towards it, unbounded.
                         Some(p) => Some(ray(x, -Vec3::from(p.direction), eps, f32::INFINITY, h.tri, true)),
+                        // The environment: a cosine-distributed direction, unbounded.
                         None => Some(ray(x, cosine_hemisphere(n, u1, u2), eps, f32::INFINITY, h.tri, true)),
                     }
                 }

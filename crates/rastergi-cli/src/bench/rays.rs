@@ -19,7 +19,7 @@ pub struct RaysArgs {
     #[arg(default_value = "cornell")]
     scene: String,
     /// The camera's image is SIZE × SIZE pixels: one ray of each kind per pixel.
-    #[arg(long, default_value_t = 256)]
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=16384))]
     size: u32,
     /// Timed GPU runs per kind (the median is reported), after one warm-up run.
     #[arg(long, default_value_t = 3)]
@@ -49,6 +49,16 @@ pub fn run(a: &RaysArgs) -> Result<()> {
     let t = Instant::now();
     let bvh = rastergi::bvh::Bvh::build(&scene.triangles);
     let build_s = t.elapsed().as_secs_f64();
+    // Before any ray is made: a batch the GPU cannot bind is refused in one line.
+    let ray_bytes = std::mem::size_of::<rastergi::rays::GpuRay>() as u64;
+    let count = a.size as u64 * a.size as u64;
+    rastergi::limits::check_storage_buffer(
+        &gpu.device.limits(),
+        "the rays",
+        count,
+        ray_bytes,
+        "choose a smaller --size",
+    )?;
     let gs = GpuScene::new(&gpu, &prepared)?;
     let caster = RayCaster::new(&gpu, &gs);
     let mut figures = Vec::new();

@@ -64,17 +64,18 @@ struct MaterialMaps {
     metal_rough_map: TextureSlot,
 }
 
-// A node of the 4-wide BVH (bvh/wide.rs, WideNode): child i's box by axis, and child[i] a
-// node (count[i] = 0), the first of a leaf's count[i] triangles, or unused (NO_CHILD).
+// A compressed node of the 4-wide BVH (bvh/wide.rs, WideNode): axis a's grid step is
+// bitcast<f32>(byte a of exponents << 23); child i's box is origin + byte i of lo (of hi) · step;
+// byte i of counts is 0 for an interior child (child[i] a node), a leaf's triangle count
+// (child[i] its first triangle), or NO_CHILD & 255 for an unused slot.
 struct WideNode {
-    lo_x: vec4f,
-    hi_x: vec4f,
-    lo_y: vec4f,
-    hi_y: vec4f,
-    lo_z: vec4f,
-    hi_z: vec4f,
+    origin: vec3f,
+    exponents: u32,
+    lo: vec3u,
+    counts: u32,
+    hi: vec3u,
+    _pad: u32,
     child: vec4u,
-    count: vec4u,
 }
 
 // A light of the distribution (lights.rs): `triangle` is the emissive triangle, or

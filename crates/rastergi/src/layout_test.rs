@@ -76,7 +76,7 @@ fn twins() -> Vec<Twin> {
             "MaterialMaps",
             [alpha_cutoff, normal_scale, albedo_map, emission_map, opacity_map, normal_map, metal_rough_map]
         ),
-        twin!(WideNode, "WideNode", [lo_x, hi_x, lo_y, hi_y, lo_z, hi_z, child, count]),
+        twin!(WideNode, "WideNode", [origin, exponents, lo, counts, hi, child]),
         twin!(LightEntry, "LightEntry", [triangle, cdf, pmf, area]),
         twin!(
             PunctualLight,

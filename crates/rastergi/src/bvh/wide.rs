@@ -6,49 +6,125 @@
 //! Collapse: a binary interior node's children replace it; while fewer than four, the interior
 //! child of largest surface area is replaced by its two children. Leaves stay the binary
 //! tree's (the same triangle ranges, in BVH order), so the triangles need no second order.
+//!
+//! Compression (Ylitie et al. 2017, "Efficient incoherent ray traversal on GPUs through
+//! compressed wide BVHs"): a node stores its box's low corner p and, per axis, a power-of-two
+//! step s = 2^e; child i's box is p + q·s with 8-bit grid coordinates q, rounded outwards so
+//! that the decoded box contains the child's exact one. As q ≤ 255 has 8 significant bits, q·s
+//! is exact in f32 and the decoded corner p + q·s is rounded once: the GPU and its CPU twin
+//! decode the same box bit for bit, fused multiply-add or not. A node is 64 bytes (15 words
+//! read) instead of 128: on lavapipe, whose storage-buffer loads run lane by lane, the words
+//! read per node are what a traversal step costs.
 
 use bytemuck::{Pod, Zeroable};
-use glam::{Vec3, Vec4};
+use glam::{UVec4, Vec3, Vec4};
 
 use super::{Bvh, BvhNode, Hit, intersect_triangle};
 
-/// Marks an unused child slot in [`WideNode::count`].
+/// Marks an unused child slot (its count byte in [`WideNode::counts`] is `NO_CHILD & 0xff`).
 pub const NO_CHILD: u32 = u32::MAX;
+/// The count byte of an unused slot.
+const NO_CHILD_BYTE: u32 = NO_CHILD & 0xff;
 
-/// A node of the 4-wide tree (`WideNode` in `gpu_scene.wgsl`). Child `i`'s box is
-/// (lo_x[i], lo_y[i], lo_z[i]) – (hi_x[i], hi_y[i], hi_z[i]); `count[i]` is 0 for an interior
-/// child (`child[i]` indexes the wide nodes), the triangle count of a leaf (triangles
-/// `child[i] ..`, BVH order), or [`NO_CHILD`] for an unused slot (which the traversal skips by
-/// its count; its box is the point at +∞).
+/// A compressed node of the 4-wide tree (`WideNode` in `gpu_scene.wgsl`; module docs).
+/// Axis a's step is s_a = f32::from_bits(byte a of `exponents` << 23), and child i's box is
+/// origin[a] + byte i of lo[a] · s_a – origin[a] + byte i of hi[a] · s_a. Byte i of `counts` is
+/// 0 for an interior child (`child[i]` indexes the wide nodes), the triangle count of a leaf
+/// (triangles `child[i] ..`, BVH order), or `NO_CHILD & 0xff` for an unused slot (which the
+/// traversal skips by its count).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
 pub struct WideNode {
-    pub lo_x: [f32; 4],
-    pub hi_x: [f32; 4],
-    pub lo_y: [f32; 4],
-    pub hi_y: [f32; 4],
-    pub lo_z: [f32; 4],
-    pub hi_z: [f32; 4],
+    pub origin: [f32; 3],
+    pub exponents: u32,
+    pub lo: [u32; 3],
+    pub counts: u32,
+    pub hi: [u32; 3],
+    pub _pad: u32,
     pub child: [u32; 4],
-    pub count: [u32; 4],
+}
+
+/// The four bytes of `w`, lowest first.
+fn bytes(w: u32) -> UVec4 {
+    (UVec4::splat(w) >> UVec4::new(0, 8, 16, 24)) & UVec4::splat(0xff)
 }
 
 impl WideNode {
-    const EMPTY: WideNode = WideNode {
-        lo_x: [f32::INFINITY; 4],
-        hi_x: [f32::INFINITY; 4],
-        lo_y: [f32::INFINITY; 4],
-        hi_y: [f32::INFINITY; 4],
-        lo_z: [f32::INFINITY; 4],
-        hi_z: [f32::INFINITY; 4],
-        child: [0; 4],
-        count: [NO_CHILD; 4],
-    };
+    /// Per child, 0 (interior), a leaf's triangle count, or [`NO_CHILD`].
+    pub fn count(&self) -> [u32; 4] {
+        bytes(self.counts).to_array().map(|c| if c == NO_CHILD_BYTE { NO_CHILD } else { c })
+    }
 
-    fn set(&mut self, i: usize, b: &BvhNode, child: u32, count: u32) {
-        (self.lo_x[i], self.lo_y[i], self.lo_z[i]) = (b.min[0], b.min[1], b.min[2]);
-        (self.hi_x[i], self.hi_y[i], self.hi_z[i]) = (b.max[0], b.max[1], b.max[2]);
-        (self.child[i], self.count[i]) = (child, count);
+    /// The grid step of each axis.
+    pub fn steps(&self) -> Vec3 {
+        let e = bytes(self.exponents);
+        Vec3::new(f32::from_bits(e.x << 23), f32::from_bits(e.y << 23), f32::from_bits(e.z << 23))
+    }
+
+    /// The children's decoded boxes, by axis: (lo, hi) of x, y and z.
+    pub fn boxes(&self) -> [(Vec4, Vec4); 3] {
+        let s = self.steps();
+        let decode = |a: usize, q: u32| Vec4::splat(self.origin[a]) + bytes(q).as_vec4() * s[a];
+        [0, 1, 2].map(|a| (decode(a, self.lo[a]), decode(a, self.hi[a])))
+    }
+
+    /// The node of `slots` (child box, child index, count): boxes rounded outwards onto the
+    /// grid of step 2^e per axis from the children's common low corner, with e the smallest
+    /// that spans the children on 255 steps.
+    fn new(slots: &[(BvhNode, u32, u32)]) -> WideNode {
+        assert!(slots.len() <= 4);
+        let mut n = WideNode { counts: NO_CHILD, ..WideNode::zeroed() };
+        if slots.is_empty() {
+            return n;
+        }
+        let lo = slots.iter().fold(Vec3::INFINITY, |m, (b, ..)| m.min(b.min.into()));
+        let hi = slots.iter().fold(Vec3::NEG_INFINITY, |m, (b, ..)| m.max(b.max.into()));
+        n.origin = lo.into();
+        for a in 0..3 {
+            let (biased, q) = quantize_axis(lo[a], hi[a], slots.iter().map(|(b, ..)| (b.min[a], b.max[a])));
+            n.exponents |= biased << (8 * a);
+            for (i, (q_lo, q_hi)) in q.into_iter().enumerate() {
+                n.lo[a] |= q_lo << (8 * i);
+                n.hi[a] |= q_hi << (8 * i);
+            }
+        }
+        for (i, &(_, child, count)) in slots.iter().enumerate() {
+            assert!(count < NO_CHILD_BYTE, "a leaf of {count} triangles does not fit a count byte");
+            n.child[i] = child;
+            n.counts = n.counts & !(0xff << (8 * i)) | count << (8 * i);
+        }
+        n
+    }
+}
+
+/// One axis of a node: the biased exponent of its step and each child's grid interval
+/// [q_lo, q_hi], with p + q_lo·s ≤ lo and p + q_hi·s ≥ hi in f32 (p = `origin`).
+fn quantize_axis(origin: f32, top: f32, children: impl Iterator<Item = (f32, f32)> + Clone) -> (u32, Vec<(u32, u32)>) {
+    let extent = (top - origin).max(0.0);
+    // The smallest normal power of two with 255 steps spanning the extent (1 if it is 0),
+    // then larger where outward rounding of the high corners needs it.
+    let mut e = if extent > 0.0 { ((extent / 255.0).log2().ceil() as i32).clamp(-126, 127) } else { -126 };
+    loop {
+        let s = 2f32.powi(e);
+        let decode = |q: u32| origin + q as f32 * s;
+        let q: Vec<(u32, u32)> = children
+            .clone()
+            .map(|(lo, hi)| {
+                let mut q_lo = (((lo - origin) / s).floor().max(0.0) as u32).min(255);
+                while q_lo > 0 && decode(q_lo) > lo {
+                    q_lo -= 1;
+                }
+                let mut q_hi = ((hi - origin) / s).ceil().max(0.0) as u32;
+                while q_hi <= 255 && decode(q_hi) < hi {
+                    q_hi += 1;
+                }
+                (q_lo, q_hi)
+            })
+            .collect();
+        if q.iter().all(|&(_, q_hi)| q_hi <= 255) || e == 127 {
+            return ((e + 127) as u32, q.into_iter().map(|(l, h)| (l, h.min(255))).collect());
+        }
+        e += 1;
     }
 }
 
@@ -60,15 +136,13 @@ fn area(n: &BvhNode) -> f32 {
 impl Bvh {
     /// The tree collapsed to four children per node (module docs); node 0 is the root.
     pub fn wide(&self) -> Vec<WideNode> {
-        let mut out = vec![WideNode::EMPTY];
         let root = &self.nodes[0];
         if root.count > 0 || self.nodes.len() == 1 {
             // One leaf (or the empty scene's single empty node).
-            if root.count > 0 {
-                out[0].set(0, root, root.offset, root.count);
-            }
-            return out;
+            let slots = if root.count > 0 { vec![(*root, root.offset, root.count)] } else { Vec::new() };
+            return vec![WideNode::new(&slots)];
         }
+        let mut out = vec![WideNode::zeroed()];
         self.collapse(0, 0, &mut out);
         out
     }
@@ -87,17 +161,19 @@ impl Bvh {
             slots.swap_remove(k);
             slots.extend(children(s));
         }
-        for (i, &s) in slots.iter().enumerate() {
+        let mut entries = Vec::with_capacity(4);
+        for &s in &slots {
             let b = self.nodes[s];
             if b.count > 0 {
-                out[at].set(i, &b, b.offset, b.count);
+                entries.push((b, b.offset, b.count));
             } else {
                 let index = out.len();
-                out.push(WideNode::EMPTY);
-                out[at].set(i, &b, index as u32, 0);
+                out.push(WideNode::zeroed());
+                entries.push((b, index as u32, 0));
                 self.collapse(s, index, out);
             }
         }
+        out[at] = WideNode::new(&entries);
     }
 }
 
@@ -117,14 +193,16 @@ pub fn intersect_wide(
     let mut node = 0usize;
     loop {
         let n = &nodes[node];
-        let (t0x, t1x) = ((Vec4::from(n.lo_x) - o.x) * inv.x, (Vec4::from(n.hi_x) - o.x) * inv.x);
-        let (t0y, t1y) = ((Vec4::from(n.lo_y) - o.y) * inv.y, (Vec4::from(n.hi_y) - o.y) * inv.y);
-        let (t0z, t1z) = ((Vec4::from(n.lo_z) - o.z) * inv.z, (Vec4::from(n.hi_z) - o.z) * inv.z);
+        let [(lo_x, hi_x), (lo_y, hi_y), (lo_z, hi_z)] = n.boxes();
+        let (t0x, t1x) = ((lo_x - o.x) * inv.x, (hi_x - o.x) * inv.x);
+        let (t0y, t1y) = ((lo_y - o.y) * inv.y, (hi_y - o.y) * inv.y);
+        let (t0z, t1z) = ((lo_z - o.z) * inv.z, (hi_z - o.z) * inv.z);
+        let counts = n.count();
         let near = t0x.min(t1x).max(t0y.min(t1y)).max(t0z.min(t1z)).max(Vec4::splat(t_min));
         let far = t0x.max(t1x).min(t0y.max(t1y)).min(t0z.max(t1z));
         // Leaves first: their hits shorten the ray before the interior children are ordered.
         for i in 0..4 {
-            let count = n.count[i];
+            let count = counts[i];
             if count == 0 || count == NO_CHILD || near[i] > far[i].min(t_far) {
                 continue;
             }
@@ -142,7 +220,7 @@ pub fn intersect_wide(
             }
         }
         let mut inner: Vec<(f32, usize)> = (0..4)
-            .filter(|&i| n.count[i] == 0 && near[i] <= far[i].min(t_far))
+            .filter(|&i| counts[i] == 0 && near[i] <= far[i].min(t_far))
             .map(|i| (near[i], n.child[i] as usize))
             .collect();
         // Farthest pushed first: the nearest is popped next.
@@ -179,9 +257,10 @@ mod tests {
             let wide = bvh.wide();
             let mut covered = vec![0u32; n as usize];
             for w in &wide {
+                let count = w.count();
                 for i in 0..4 {
-                    if w.count[i] != 0 && w.count[i] != NO_CHILD {
-                        (w.child[i]..w.child[i] + w.count[i]).for_each(|t| covered[t as usize] += 1);
+                    if count[i] != 0 && count[i] != NO_CHILD {
+                        (w.child[i]..w.child[i] + count[i]).for_each(|t| covered[t as usize] += 1);
                     }
                 }
             }
@@ -189,12 +268,83 @@ mod tests {
             // Every node but the root is some node's child, once.
             let mut parents = vec![0u32; wide.len()];
             for w in &wide {
-                (0..4).filter(|&i| w.count[i] == 0).for_each(|i| parents[w.child[i] as usize] += 1);
+                let count = w.count();
+                (0..4).filter(|&i| count[i] == 0).for_each(|i| parents[w.child[i] as usize] += 1);
             }
             assert_eq!(parents[0], 0);
             assert!(parents[1..].iter().all(|&p| p == 1), "{n} triangles");
             let binary_interior = bvh.nodes.iter().filter(|b| b.count == 0).count();
             assert!(wide.len() <= binary_interior.max(1), "{} wide nodes for {binary_interior} binary", wide.len());
+        }
+    }
+
+    /// The triangles under child `i` of wide node `w`.
+    fn under(wide: &[WideNode], w: usize, i: usize) -> Vec<u32> {
+        let (count, child) = (wide[w].count()[i], wide[w].child[i]);
+        match count {
+            0 => (0..4).flat_map(|j| under(wide, child as usize, j)).collect(),
+            NO_CHILD => Vec::new(),
+            n => (child..child + n).collect(),
+        }
+    }
+
+    #[test]
+    fn decoded_child_boxes_contain_their_triangles_and_are_tight_to_a_grid_step() {
+        // A soup far from the origin (large exponents, coarse f32 spacing), one at small
+        // scale, and flat boxes (walls on axis planes: zero extent on one axis).
+        let far: Vec<[Vec3; 3]> = soup(2000, 3).iter().map(|t| t.map(|v| v * 40.0 + Vec3::splat(9000.0))).collect();
+        let small: Vec<[Vec3; 3]> = soup(500, 4).iter().map(|t| t.map(|v| v * 1e-3)).collect();
+        let flat: Vec<[Vec3; 3]> = soup(300, 6).iter().map(|t| t.map(|v| Vec3::new(v.x, 0.25, v.z))).collect();
+        for tris in [far, small, flat] {
+            let bvh = Bvh::build(&tris);
+            let tris = bvh.permute(&tris);
+            let wide = bvh.wide();
+            for (w, node) in wide.iter().enumerate() {
+                let boxes = node.boxes();
+                let step = node.steps();
+                for i in 0..4 {
+                    let inside = under(&wide, w, i);
+                    if inside.is_empty() {
+                        continue;
+                    }
+                    let points = inside.iter().flat_map(|&t| tris[t as usize]);
+                    let (lo, hi) = points.fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), p| (l.min(p), h.max(p)));
+                    for a in 0..3 {
+                        let (q_lo, q_hi) = (boxes[a].0[i], boxes[a].1[i]);
+                        assert!(
+                            q_lo <= lo[a] && q_hi >= hi[a],
+                            "node {w} child {i} axis {a}: [{q_lo}, {q_hi}] misses [{}, {}]",
+                            lo[a],
+                            hi[a]
+                        );
+                        // Rounded outwards by less than a step (plus the f32 rounding of p + q·s).
+                        let slack = step[a] as f64 + 2.0 * (f32::EPSILON * hi[a].abs().max(lo[a].abs())) as f64;
+                        assert!(
+                            lo[a] as f64 - q_lo as f64 <= slack && q_hi as f64 - hi[a] as f64 <= slack,
+                            "node {w} child {i} axis {a}: loose"
+                        );
+                    }
+                }
+                // The step is the smallest power of two spanning the node on 255 steps, or the next.
+                let (lo, hi) = (0..4).filter(|&i| !under(&wide, w, i).is_empty()).fold(
+                    (Vec3::INFINITY, Vec3::NEG_INFINITY),
+                    |(l, h), i| {
+                        let b = node.boxes();
+                        (
+                            l.min(Vec3::new(b[0].0[i], b[1].0[i], b[2].0[i])),
+                            h.max(Vec3::new(b[0].1[i], b[1].1[i], b[2].1[i])),
+                        )
+                    },
+                );
+                for a in 0..3 {
+                    let extent = hi[a] - lo[a];
+                    assert!(
+                        step[a] <= (4.0 * extent / 255.0).max(f32::MIN_POSITIVE),
+                        "node {w} axis {a}: step {} for extent {extent}",
+                        step[a]
+                    );
+                }
+            }
         }
     }
 

@@ -24,9 +24,24 @@
 //! needs total internal reflection, which Schlick's form at the outer angle does not give. The
 //! microfacet distribution is GGX (Trowbridge–Reitz) with α = roughness², and the shadowing
 //! is Smith's separable form G = G₁(ω_o)·G₁(ω_i), G₁ = 2 cos θ/(cos θ + √(α² + (1 − α²) cos² θ)),
-//! which is glTF's `V_GGX` and Mitsuba 3's `ggx` microfacets. Single scattering only: rough
-//! GGX loses the energy that bounces between microfacets (no multiple-scattering
-//! compensation; the white-furnace test states how much).
+//! which is glTF's `V_GGX` and Mitsuba 3's `ggx` microfacets.
+//!
+//! Rough GGX's single scattering loses the light that bounces between microfacets before it
+//! leaves (a white metal of roughness 1 reflects 0.69 at normal incidence). The metal gets it
+//! back by Kulla & Conty's energy compensation (2017, "Revisiting Physically Based Shading at
+//! Imageworks"), a second, diffuse-like lobe
+//!
+//! ```text
+//! M_ms = F_ms · (1 − E(μ_o))(1 − E(μ_i)) / (π (1 − Ē)),   F_ms = F̄² Ē / (1 − F̄ (1 − Ē)),   F̄ = c + (1 − c)/21
+//! ```
+//!
+//! with E = E₁ the single-scattering albedo of a white metal ([`albedo`]), Ē its
+//! cosine-weighted mean and F̄ the cosine-weighted mean of Schlick's Fresnel term: reciprocal,
+//! and a white metal reflects E(μ_o) + (1 − E(μ_o)) = 1 at every angle and roughness; a
+//! coloured one gains the light that the series of inner bounces F̄^k keeps. The layer needs
+//! none (its base takes what it leaves, `diffuse_share`); glass is still single scattering.
+//! [`Bsdf::multiple_scattering`] off is the single-scattering model (Mitsuba 3's
+//! `roughconductor`, which the reference images use: `--single-scattering`).
 //!
 //! Below [`SMOOTH_ALPHA`] the microfacet lobes are perfectly specular (Dirac deltas):
 //! [`Bsdf::eval`] and [`Bsdf::pdf`] leave them out and only [`Bsdf::sample`] produces them.
@@ -66,6 +81,8 @@ pub struct Bsdf {
     pub transmission: f32,
     /// Thin-walled glass: no refraction, a slab.
     pub thin: bool,
+    /// The rough metal's energy compensation (module docs); off: single scattering only.
+    pub multiple_scattering: bool,
 }
 
 /// What a sampled or evaluated direction carries: radiance (eye paths; a refracted ray's
@@ -206,14 +223,23 @@ fn mirror_z(w: Vec3) -> Vec3 {
 impl Bsdf {
     /// A Lambertian surface of albedo ρ.
     pub fn diffuse(albedo: Vec3) -> Self {
-        Self { base: albedo, metallic: 0.0, alpha: 1.0, specular: 0.0, ior: 1.5, transmission: 0.0, thin: false }
+        Self {
+            base: albedo,
+            metallic: 0.0,
+            alpha: 1.0,
+            specular: 0.0,
+            ior: 1.5,
+            transmission: 0.0,
+            thin: false,
+            multiple_scattering: true,
+        }
     }
 
     /// The albedo of a Lambertian surface standing in for this model where the final gather's
     /// rays and the photon map's lookups meet it, seen from ω_o at cosine `cos_o` (an
     /// approximation, stated in docs/design.md): the model's directional albedo ∫f·cos θ_i dω_i
     /// towards ω_o — what it reflects towards ω_o under uniform incident light — for the metal
-    /// (Schlick's F₀ = c: c·E₁ + (1 − c)·E₅, [`albedo`]) and the opaque dielectric
+    /// (Schlick's F₀ = c: c·E₁ + (1 − c)·E₅, [`albedo`], plus F_ms·(1 − E₁) compensated) and the opaque dielectric
     /// (E_L(μ_o) + (1 − E_L(μ_o))·c, exact for the energy-conserving layer); the
     /// hemispherical reflectance F̄ = f₀ + (1 − f₀)/21 for glass (the light it transmits is
     /// not seen there). Until issue 34 this was c for the metal and the dielectric, which
@@ -227,7 +253,7 @@ impl Bsdf {
             schlick(self.base, cos_o)
         } else {
             let [e1, e5] = ggx_albedo().at(cos_o, self.alpha);
-            self.base * e1 + (Vec3::ONE - self.base) * e5
+            self.base * e1 + (Vec3::ONE - self.base) * e5 + self.ms_fresnel() * self.ms_loss(cos_o)
         };
         let layer = self.layer_albedo(cos_o);
         let dielectric = Vec3::splat(layer) + (1.0 - layer) * self.base;
@@ -248,6 +274,38 @@ impl Bsdf {
 
     fn smooth(&self) -> bool {
         self.alpha < SMOOTH_ALPHA
+    }
+
+    /// Whether the metal lobe has its multiple-scattering lobe (module docs): compensated,
+    /// rough and partly metallic.
+    fn compensates(&self) -> bool {
+        self.multiple_scattering && !self.smooth() && self.metallic > 0.0
+    }
+
+    /// F_ms = F̄²Ē/(1 − F̄(1 − Ē)) of the multiple-scattering lobe, F̄ = c + (1 − c)/21 and
+    /// Ē = Ē₁(α): the albedo it adds is F_ms·(1 − E₁(μ_o)). Zero where it is off.
+    fn ms_fresnel(&self) -> Vec3 {
+        if !self.compensates() {
+            return Vec3::ZERO;
+        }
+        let e_avg = ggx_albedo().mean_at(self.alpha)[0];
+        let f_avg = self.base + (Vec3::ONE - self.base) / 21.0;
+        f_avg * f_avg * e_avg / (Vec3::ONE - f_avg * (1.0 - e_avg))
+    }
+
+    /// 1 − E₁(μ, α): what single scattering loses for a direction at cosine `cos`.
+    fn ms_loss(&self, cos: f32) -> f32 {
+        (1.0 - ggx_albedo().at(cos, self.alpha)[0]).max(0.0)
+    }
+
+    /// M_ms(ω_o, ω_i) = F_ms(1 − E₁(μ_o))(1 − E₁(μ_i)) / (π(1 − Ē₁)), for cosines on the lobe's side.
+    fn ms_eval(&self, cos_o: f32, cos_i: f32) -> Vec3 {
+        if !self.compensates() {
+            return Vec3::ZERO;
+        }
+        let e_avg = ggx_albedo().mean_at(self.alpha)[0];
+        self.ms_fresnel()
+            * (self.ms_loss(cos_o) * self.ms_loss(cos_i) / (std::f32::consts::PI * (1.0 - e_avg).max(1e-6)))
     }
 
     /// f₀ of the dielectric layer, ((η − 1)/(η + 1))².
@@ -303,7 +361,8 @@ impl Bsdf {
 
     /// The probabilities of picking each lobe for ω_o at |cos θ_o| = `cos_o`, in lobe order;
     /// all zero when nothing scatters. They depend on ω_o alone, so [`Self::pdf`] can give
-    /// the density of any ω_i.
+    /// the density of any ω_i. The cosine-distributed lobe serves the diffuse base and the
+    /// metal's multiple-scattering lobe, weighted by what each reflects.
     fn lobe_probabilities(&self, cos_o: f32) -> [f32; 4] {
         let m = self.metallic;
         let opaque = (1.0 - m) * (1.0 - self.transmission);
@@ -311,7 +370,7 @@ impl Bsdf {
         let w = [
             m * mean(schlick(self.base, cos_o)),
             opaque * fs,
-            opaque * (1.0 - fs) * mean(self.base),
+            opaque * (1.0 - fs) * mean(self.base) + m * mean(self.ms_fresnel()) * self.ms_loss(cos_o),
             (1.0 - m) * self.transmission,
         ];
         let total: f32 = w.iter().sum();
@@ -414,6 +473,7 @@ impl Bsdf {
         let h = (o + i).normalize();
         let vh = o.dot(h);
         f += opaque * self.base * self.diffuse_share(o.z, i.z) / std::f32::consts::PI;
+        f += self.metallic * self.ms_eval(o.z, i.z);
         let fs = self.layer_fresnel(vh);
         if !self.smooth() {
             let a = self.alpha;
@@ -616,7 +676,7 @@ pub fn on_gpu(
                 u[1],
                 u[2],
                 if *t == Transport::Radiance { 0.0 } else { 1.0 },
-                0.0,
+                if b.multiple_scattering { 1.0 } else { 0.0 },
             ]
         })
         .collect();
@@ -638,7 +698,7 @@ pub fn on_gpu(
                 return;
             }
             let q = queries[gid.x].v;
-            let b = Bsdf(vec3f(q[0], q[1], q[2]), q[3], q[4], q[5], q[6], q[7], q[8] > 0.5);
+            let b = Bsdf(vec3f(q[0], q[1], q[2]), q[3], q[4], q[5], q[6], q[7], q[8] > 0.5, q[19] > 0.5);
             let wo = vec3f(q[9], q[10], q[11]);
             let wi = vec3f(q[12], q[13], q[14]);
             let t = u32(q[18]);

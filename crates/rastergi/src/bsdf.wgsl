@@ -14,6 +14,8 @@ struct Bsdf {
     ior: f32,
     transmission: f32,
     thin: bool,
+    // The rough metal's energy compensation (Bsdf::multiple_scattering).
+    multiple_scattering: bool,
 }
 
 struct BsdfSample {
@@ -146,20 +148,20 @@ fn layer_fresnel(b: Bsdf, c: f32) -> f32 {
     return b.specular * (f0 + (1.0 - f0) * schlick_weight(c));
 }
 
-// The GGX lobe's directional albedo tables (bsdf/albedo.rs, GpuGgxAlbedo): cell k = α·N + μ
-// holds (E₁, E₅) at k and k + 1; means[j] (Ē₁, Ē₅) at α cells j and j + 1. Bound by the pass
+// The GGX lobe's directional albedo tables (bsdf/albedo.rs, GpuGgxAlbedo): cell k = √α·N + μ
+// holds (E₁, E₅) at k and k + 1; means[j] (Ē₁, Ē₅) at √α cells j and j + 1. Bound by the pass
 // as `ggx_table` (the scene's binding 13).
 struct GgxAlbedoTable {
     cells: array<vec4f, GGX_ALBEDO_CELLS>,
     means: array<vec4f, GGX_ALBEDO_N>,
 }
 
-// (E₁, E₅) of the GGX lobe at cos θ_o = mu and alpha, bilinear between cells
+// (E₁, E₅) of the GGX lobe at cos θ_o = mu and alpha, bilinear in (μ, √α) between cells
 // (GgxAlbedo::at).
 fn ggx_albedo(mu: f32, alpha: f32) -> vec2f {
     let n = GGX_ALBEDO_N;
     let tx = clamp(mu, 0.0, 1.0) * f32(n - 1u);
-    let ty = clamp(alpha, 0.0, 1.0) * f32(n - 1u);
+    let ty = sqrt(clamp(alpha, 0.0, 1.0)) * f32(n - 1u);
     let i = min(u32(tx), n - 2u);
     let j = min(u32(ty), n - 2u);
     let fx = tx - f32(i);
@@ -172,10 +174,39 @@ fn ggx_albedo(mu: f32, alpha: f32) -> vec2f {
 
 // (Ē₁, Ē₅) at alpha, linear between cells (GgxAlbedo::mean_at).
 fn ggx_albedo_mean(alpha: f32) -> vec2f {
-    let t = clamp(alpha, 0.0, 1.0) * f32(GGX_ALBEDO_N - 1u);
+    let t = sqrt(clamp(alpha, 0.0, 1.0)) * f32(GGX_ALBEDO_N - 1u);
     let j = min(u32(t), GGX_ALBEDO_N - 2u);
     let m = ggx_table.means[j];
     return m.xy + (m.zw - m.xy) * (t - f32(j));
+}
+
+// Whether the metal has its multiple-scattering lobe (Bsdf::compensates).
+fn bsdf_compensates(b: Bsdf) -> bool {
+    return b.multiple_scattering && !bsdf_is_smooth(b) && b.metallic > 0.0;
+}
+
+// F_ms = F̄²Ē/(1 − F̄(1 − Ē)), F̄ = c + (1 − c)/21, Ē = Ē₁(α) (Bsdf::ms_fresnel); zero where off.
+fn ms_fresnel(b: Bsdf) -> vec3f {
+    if !bsdf_compensates(b) {
+        return vec3f(0.0);
+    }
+    let e_avg = ggx_albedo_mean(b.alpha).x;
+    let f_avg = b.base + (vec3f(1.0) - b.base) / 21.0;
+    return f_avg * f_avg * e_avg / (vec3f(1.0) - f_avg * (1.0 - e_avg));
+}
+
+// 1 − E₁(cos, α) (Bsdf::ms_loss).
+fn ms_loss(b: Bsdf, c: f32) -> f32 {
+    return max(1.0 - ggx_albedo(c, b.alpha).x, 0.0);
+}
+
+// M_ms = F_ms(1 − E₁(μ_o))(1 − E₁(μ_i)) / (π(1 − Ē₁)) (Bsdf::ms_eval).
+fn ms_eval(b: Bsdf, cos_o: f32, cos_i: f32) -> vec3f {
+    if !bsdf_compensates(b) {
+        return vec3f(0.0);
+    }
+    let e_avg = ggx_albedo_mean(b.alpha).x;
+    return ms_fresnel(b) * (ms_loss(b, cos_o) * ms_loss(b, cos_i) / (PI * max(1.0 - e_avg, 1e-6)));
 }
 
 // The specular layer's directional albedo E_L(cos) (Bsdf::layer_albedo).
@@ -207,13 +238,14 @@ fn diffuse_share(b: Bsdf, cos_o: f32, cos_i: f32) -> f32 {
     return (1.0 - layer_albedo(b, cos_o)) * (1.0 - layer_albedo(b, cos_i)) / (1.0 - layer_mean_albedo(b));
 }
 
-// The lobes' probabilities (metal, layer, diffuse, glass) for |cos θ_o|.
+// The lobes' probabilities (metal, layer, cosine-distributed: diffuse base and the metal's
+// multiple scattering, glass) for |cos θ_o|.
 fn lobe_probabilities(b: Bsdf, cos_o: f32) -> vec4f {
     let m = b.metallic;
     let opaque = (1.0 - m) * (1.0 - b.transmission);
     let fs = layer_fresnel(b, cos_o);
-    let w = vec4f(m * mean3(schlick(b.base, cos_o)), opaque * fs, opaque * (1.0 - fs) * mean3(b.base),
-        (1.0 - m) * b.transmission);
+    let w = vec4f(m * mean3(schlick(b.base, cos_o)), opaque * fs,
+        opaque * (1.0 - fs) * mean3(b.base) + m * mean3(ms_fresnel(b)) * ms_loss(b, cos_o), (1.0 - m) * b.transmission);
     let total = w.x + w.y + w.z + w.w;
     if total > 0.0 {
         return w / total;
@@ -327,6 +359,7 @@ fn bsdf_eval(b: Bsdf, wo: vec3f, wi: vec3f, transport: u32) -> vec3f {
     let h = normalize(o + i);
     let vh = dot(o, h);
     f += opaque * b.base * (diffuse_share(b, o.z, i.z) / PI);
+    f += b.metallic * ms_eval(b, o.z, i.z);
     if !bsdf_is_smooth(b) {
         let a = b.alpha;
         let spec = ggx_d(h, a) * ggx_g1(o, h, a) * ggx_g1(i, h, a) / (4.0 * o.z * i.z);
@@ -486,7 +519,7 @@ fn bsdf_diffuse_equivalent(b: Bsdf, cos_o_in: f32) -> vec3f {
     var metal = schlick(b.base, cos_o);
     if !bsdf_is_smooth(b) {
         let e = ggx_albedo(cos_o, b.alpha);
-        metal = b.base * e.x + (vec3f(1.0) - b.base) * e.y;
+        metal = b.base * e.x + (vec3f(1.0) - b.base) * e.y + ms_fresnel(b) * ms_loss(b, cos_o);
     }
     let layer = layer_albedo(b, cos_o);
     let dielectric = vec3f(layer) + (1.0 - layer) * b.base;

@@ -17,6 +17,9 @@ pub const MATERIAL_TEXTURED: u32 = 8;
 pub const MATERIAL_THIN: u32 = 16;
 /// Material flag: it scatters as a plain Lambertian surface (f = ρ/π), the fast path.
 pub const MATERIAL_LAMBERTIAN: u32 = 32;
+/// Material flag: rough metal without its multiple-scattering compensation
+/// ([`crate::bsdf::Bsdf::multiple_scattering`] off).
+pub const MATERIAL_SINGLE_SCATTERING: u32 = 64;
 /// Most holes a ray passes through before it counts as stopped (`trace` in `bvh.wgsl`).
 pub const MAX_HOLE_CROSSINGS: u32 = 256;
 /// A texture slot without a texture.

@@ -97,7 +97,8 @@ impl GpuMaterial {
                 | alpha
                 | if m.texture_refs().next().is_some() { MATERIAL_TEXTURED } else { 0 }
                 | if m.thin { MATERIAL_THIN } else { 0 }
-                | if m.is_lambertian() { MATERIAL_LAMBERTIAN } else { 0 },
+                | if m.is_lambertian() { MATERIAL_LAMBERTIAN } else { 0 }
+                | if m.multiple_scattering { 0 } else { MATERIAL_SINGLE_SCATTERING },
             emission: m.emission.into(),
             opacity: m.opacity,
             metallic: m.metallic,
@@ -124,8 +125,8 @@ impl GpuMaterial {
 }
 
 pub use crate::consts::{
-    MATERIAL_ALPHA_BLEND, MATERIAL_ALPHA_MASK, MATERIAL_LAMBERTIAN, MATERIAL_TEXTURED, MATERIAL_THIN,
-    MATERIAL_TWO_SIDED, NO_TEXTURE, TRIANGLE_HAS_HOLES,
+    MATERIAL_ALPHA_BLEND, MATERIAL_ALPHA_MASK, MATERIAL_LAMBERTIAN, MATERIAL_SINGLE_SCATTERING, MATERIAL_TEXTURED,
+    MATERIAL_THIN, MATERIAL_TWO_SIDED, NO_TEXTURE, TRIANGLE_HAS_HOLES,
 };
 
 /// A scene prepared for rendering: triangles permuted into BVH order, with the BVH and the

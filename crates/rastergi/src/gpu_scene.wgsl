@@ -393,7 +393,7 @@ fn surface_at(tri: u32, b1: f32, b2: f32, lod: f32) -> Surface {
 fn surface_bsdf(s: Surface) -> Bsdf {
     let r = clamp(s.roughness, 0.0, 1.0);
     return Bsdf(s.albedo, clamp(s.metallic, 0.0, 1.0), r * r, s.specular, s.ior, s.transmission,
-        (s.flags & MATERIAL_THIN) != 0u);
+        (s.flags & MATERIAL_THIN) != 0u, (s.flags & MATERIAL_SINGLE_SCATTERING) == 0u);
 }
 
 // Whether the surface scatters by Dirac deltas alone (a perfect mirror or smooth glass, no

@@ -336,10 +336,19 @@ fn a_glossy_floor_under_a_constant_sky_reflects_l_times_its_directional_albedo()
     let l = Vec3::new(1.0, 0.6, 0.3);
     let metal = Material { metallic: 1.0, roughness: 0.5, ..Material::diffuse("metal", Vec3::new(0.9, 0.7, 0.5)) };
     let layered = Material { specular: 1.0, roughness: 0.4, ..Material::diffuse("layered", Vec3::new(0.2, 0.5, 0.8)) };
+    // A white furnace: a white metal of roughness 1 reflects all of the sky with its
+    // multiple-scattering compensation (0.31–0.53 of it by single scattering alone).
+    let white = Material { metallic: 1.0, roughness: 1.0, ..Material::diffuse("white rough metal", Vec3::ONE) };
     let cosines = floor_pixel_cosines();
     let (lo, hi) = cosines.iter().fold((1.0f32, 0.0f32), |(a, b), &c| (a.min(c), b.max(c)));
-    for material in [metal, layered] {
+    for material in [metal, layered, white] {
         let b = material.bsdf(material.albedo, Vec3::ONE);
+        if material.name.starts_with("white") {
+            for c in [lo, hi] {
+                let a = directional_albedo(&b, c);
+                assert!((a - Vec3::ONE).abs().max_element() < 0.01, "white metal at cos {c}: albedo {a}");
+            }
+        }
         // a(cos θ_o) on 17 points spanning the pixels' cosines, linearly interpolated.
         let table: Vec<Vec3> = (0..17).map(|k| directional_albedo(&b, lo + (hi - lo) * k as f32 / 16.0)).collect();
         let a = |c: f32| {

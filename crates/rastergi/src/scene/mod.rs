@@ -132,6 +132,9 @@ pub struct Material {
     pub transmission: f32,
     /// Thin-walled glass (glTF transmission without `KHR_materials_volume`): no refraction.
     pub thin: bool,
+    /// Rough metal with its multiple-scattering energy compensation ([`crate::bsdf`]); false:
+    /// single scattering, the model of Mitsuba 3's `roughconductor` ([`Scene::single_scattering`]).
+    pub multiple_scattering: bool,
 }
 
 impl Material {
@@ -156,6 +159,7 @@ impl Material {
             ior: 1.5,
             transmission: 0.0,
             thin: false,
+            multiple_scattering: true,
         }
     }
 
@@ -171,6 +175,7 @@ impl Material {
             ior: self.ior,
             transmission: self.transmission,
             thin: self.thin,
+            multiple_scattering: self.multiple_scattering,
         }
     }
 
@@ -433,6 +438,12 @@ impl Scene {
             section("sky", bytemuck::cast_slice(&env.texels));
         }
         h.digest()
+    }
+
+    /// Every material without the rough metal's multiple-scattering compensation: the
+    /// single-scattering model of Mitsuba 3's `roughconductor`, for comparisons with it.
+    pub fn single_scattering(&mut self) {
+        self.materials.iter_mut().for_each(|m| m.multiple_scattering = false);
     }
 
     /// Adds a material and returns its index.

@@ -565,9 +565,9 @@ mod limit_tests {
         assert!(e.contains("2796203 triangles") && e.contains("fewer triangles"), "{e}");
         // One triangle over: the sizes in bytes, since both round to 128 MiB.
         assert!(e.contains("134217744 bytes") && e.contains("134217728 bytes"), "{e}");
-        // 128 bytes per node: 128 MiB hold 1 048 576 nodes.
-        assert!(check_bvh_nodes(&l, 1_048_576).is_ok());
-        let e = check_bvh_nodes(&l, 1_048_577).unwrap_err().to_string();
-        assert!(e.contains("1048577 BVH nodes") && e.contains("134217728 bytes"), "{e}");
+        // 64 bytes per compressed node: 128 MiB hold 2 097 152 nodes.
+        assert!(check_bvh_nodes(&l, 2_097_152).is_ok());
+        let e = check_bvh_nodes(&l, 2_097_153).unwrap_err().to_string();
+        assert!(e.contains("2097153 BVH nodes") && e.contains("134217728 bytes"), "{e}");
     }
 }

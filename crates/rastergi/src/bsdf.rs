@@ -27,7 +27,7 @@
 //! which is glTF's `V_GGX` and Mitsuba 3's `ggx` microfacets.
 //!
 //! Rough GGX's single scattering loses the light that bounces between microfacets before it
-//! leaves (a white metal of roughness 1 reflects 0.69 at normal incidence). The metal gets it
+//! leaves (a white metal of roughness 1 reflects 0.31 at normal incidence). The metal gets it
 //! back by Kulla & Conty's energy compensation (2017, "Revisiting Physically Based Shading at
 //! Imageworks"), a second, diffuse-like lobe
 //!

@@ -76,6 +76,10 @@ pub struct Bsdf {
     /// Weight s of the dielectric specular layer (`KHR_materials_specular`'s specularFactor;
     /// 0: a plain Lambertian surface).
     pub specular: f32,
+    /// The layer's colour at normal incidence (`KHR_materials_specular`'s specularColorFactor):
+    /// its F₀ = min(f₀(η)·colour, 1) per channel, F₉₀ = 1 (white: glTF's default). Glass keeps
+    /// its exact Fresnel term of η.
+    pub specular_color: Vec3,
     /// Index of refraction η of the dielectric (layer and glass).
     pub ior: f32,
     pub transmission: f32,
@@ -228,6 +232,7 @@ impl Bsdf {
             metallic: 0.0,
             alpha: 1.0,
             specular: 0.0,
+            specular_color: Vec3::ONE,
             ior: 1.5,
             transmission: 0.0,
             thin: false,
@@ -235,9 +240,10 @@ impl Bsdf {
         }
     }
 
-    /// The albedo of a Lambertian surface standing in for this model where the final gather's
-    /// rays and the photon map's lookups meet it, seen from ω_o at cosine `cos_o` (an
-    /// approximation, stated in docs/design.md): the model's directional albedo ∫f·cos θ_i dω_i
+    /// The albedo of a Lambertian surface standing in for this model where the photon map is
+    /// read at a visible point (the photon-map view, the caustics pass; the gather's hits
+    /// follow the glossy lobes instead, [`Self::lambertian_albedo`]), seen from ω_o at cosine
+    /// `cos_o` (an approximation, stated in docs/design.md): the model's directional albedo ∫f·cos θ_i dω_i
     /// towards ω_o — what it reflects towards ω_o under uniform incident light — for the metal
     /// (Schlick's F₀ = c: c·E₁ + (1 − c)·E₅, [`albedo`], plus F_ms·(1 − E₁) compensated) and the opaque dielectric
     /// (E_L(μ_o) + (1 − E_L(μ_o))·c, exact for the energy-conserving layer); the
@@ -246,7 +252,7 @@ impl Bsdf {
     /// counted a rough white metal's lost energy as reflected (0.31 at roughness 1).
     pub fn diffuse_equivalent(&self, cos_o: f32) -> Vec3 {
         let cos_o = cos_o.abs().min(1.0);
-        let f0 = self.layer_f0();
+        let f0 = self.ior_f0();
         let mean_f = f0 + (1.0 - f0) / 21.0;
         let opaque = (1.0 - self.metallic) * (1.0 - self.transmission);
         let metal = if self.smooth() {
@@ -256,8 +262,23 @@ impl Bsdf {
             self.base * e1 + (Vec3::ONE - self.base) * e5 + self.ms_fresnel() * self.ms_loss(cos_o)
         };
         let layer = self.layer_albedo(cos_o);
-        let dielectric = Vec3::splat(layer) + (1.0 - layer) * self.base;
+        let dielectric = layer + (Vec3::ONE - layer) * self.base;
         self.metallic * metal + opaque * dielectric + Vec3::splat((1.0 - self.metallic) * self.transmission * mean_f)
+    }
+
+    /// The albedo a(μ_o) of the model's Lambertian part f_L(ω_o, ω_i) = a(μ_o)/π, which the
+    /// photon map answers for exactly where the final gather's rays meet the surface (its
+    /// irradiance E gives ∫f_L L cos θ_i dω_i = a/π·E); the gather follows the rest, f − f_L,
+    /// by sampling the model (docs/design.md). a is the albedo of the cosine lobes: the
+    /// diffuse base under the layer, (1 − m)(1 − t)·(1 − E_L(μ_o))·c, and the metal's
+    /// multiple scattering, m·F_ms·(1 − E₁(μ_o)) — each lobe's ∫·cos θ_i dω_i, since
+    /// ∫(1 − E(μ))2μ dμ = 1 − Ē. The rest then reflects nothing on average where the light
+    /// is uniform; on a Lambertian surface it is zero.
+    pub fn lambertian_albedo(&self, cos_o: f32) -> Vec3 {
+        let cos_o = cos_o.abs().min(1.0);
+        let opaque = (1.0 - self.metallic) * (1.0 - self.transmission);
+        let base = if self.specular == 0.0 { Vec3::ONE } else { Vec3::ONE - self.layer_albedo(cos_o) };
+        opaque * base * self.base + self.metallic * self.ms_fresnel() * self.ms_loss(cos_o)
     }
 
     /// Whether the model is plain Lambertian (f = c/π).
@@ -308,38 +329,43 @@ impl Bsdf {
             * (self.ms_loss(cos_o) * self.ms_loss(cos_i) / (std::f32::consts::PI * (1.0 - e_avg).max(1e-6)))
     }
 
-    /// f₀ of the dielectric layer, ((η − 1)/(η + 1))².
-    fn layer_f0(&self) -> f32 {
+    /// f₀ of the dielectric, ((η − 1)/(η + 1))².
+    fn ior_f0(&self) -> f32 {
         let r = (self.ior - 1.0) / (self.ior + 1.0);
         r * r
     }
 
-    /// The layer's Fresnel weight s·F_s(cos).
-    fn layer_fresnel(&self, cos: f32) -> f32 {
-        self.specular * schlick(Vec3::splat(self.layer_f0()), cos).x
+    /// F₀ of the layer, min(f₀·colour, 1) per channel (`KHR_materials_specular`).
+    fn layer_f0(&self) -> Vec3 {
+        (self.ior_f0() * self.specular_color).min(Vec3::ONE)
+    }
+
+    /// The layer's Fresnel weight s·F_s(cos), F_s = F₀ + (1 − F₀)(1 − cos)⁵.
+    fn layer_fresnel(&self, cos: f32) -> Vec3 {
+        self.specular * schlick(self.layer_f0(), cos)
     }
 
     /// What the specular layer reflects in all for ω_o at cosine `cos`, its directional albedo
-    /// E_L(μ) = s·(f₀E₁(μ, α) + (1 − f₀)E₅(μ, α)) ([`albedo`]); sF(μ) when smooth (a
-    /// mirror reflects its Fresnel term).
-    fn layer_albedo(&self, cos: f32) -> f32 {
+    /// E_L(μ) = s·(F₀E₁(μ, α) + (1 − F₀)E₅(μ, α)) ([`albedo`]) per channel; sF(μ) when smooth
+    /// (a mirror reflects its Fresnel term).
+    fn layer_albedo(&self, cos: f32) -> Vec3 {
         if self.smooth() {
             return self.layer_fresnel(cos);
         }
         let f0 = self.layer_f0();
         let [e1, e5] = ggx_albedo().at(cos, self.alpha);
-        self.specular * (f0 * e1 + (1.0 - f0) * e5)
+        self.specular * (f0 * e1 + (Vec3::ONE - f0) * e5)
     }
 
-    /// The layer's cosine-weighted mean albedo Ē_L = 2∫E_L(μ)μ dμ; sF̄ = s(f₀ + (1 − f₀)/21)
+    /// The layer's cosine-weighted mean albedo Ē_L = 2∫E_L(μ)μ dμ; sF̄ = s(F₀ + (1 − F₀)/21)
     /// when smooth.
-    fn layer_mean_albedo(&self) -> f32 {
+    fn layer_mean_albedo(&self) -> Vec3 {
         let f0 = self.layer_f0();
         if self.smooth() {
-            return self.specular * (f0 + (1.0 - f0) / 21.0);
+            return self.specular * (f0 + (Vec3::ONE - f0) / 21.0);
         }
         let [m1, m5] = ggx_albedo().mean_at(self.alpha);
-        self.specular * (f0 * m1 + (1.0 - f0) * m5)
+        self.specular * (f0 * m1 + (Vec3::ONE - f0) * m5)
     }
 
     /// The share of the light that the specular layer leaves to the diffuse base, for the
@@ -352,11 +378,12 @@ impl Bsdf {
     /// glTF dielectric of roughness 1 reflected 0.974 at normal incidence and 0.62 at 80°, and
     /// a room of such walls came out 10 % darker than Lambertian ones (issue 34). glTF's own
     /// form, (1 − sF(ω_o·h)), gains up to 22 % at grazing angles.
-    fn diffuse_share(&self, cos_o: f32, cos_i: f32) -> f32 {
+    fn diffuse_share(&self, cos_o: f32, cos_i: f32) -> Vec3 {
         if self.specular == 0.0 {
-            return 1.0;
+            return Vec3::ONE;
         }
-        (1.0 - self.layer_albedo(cos_o)) * (1.0 - self.layer_albedo(cos_i)) / (1.0 - self.layer_mean_albedo())
+        (Vec3::ONE - self.layer_albedo(cos_o)) * (Vec3::ONE - self.layer_albedo(cos_i))
+            / (Vec3::ONE - self.layer_mean_albedo())
     }
 
     /// The probabilities of picking each lobe for ω_o at |cos θ_o| = `cos_o`, in lobe order;
@@ -369,8 +396,8 @@ impl Bsdf {
         let fs = self.layer_fresnel(cos_o);
         let w = [
             m * mean(schlick(self.base, cos_o)),
-            opaque * fs,
-            opaque * (1.0 - fs) * mean(self.base) + m * mean(self.ms_fresnel()) * self.ms_loss(cos_o),
+            opaque * mean(fs),
+            opaque * mean((Vec3::ONE - fs) * self.base) + m * mean(self.ms_fresnel()) * self.ms_loss(cos_o),
             (1.0 - m) * self.transmission,
         ];
         let total: f32 = w.iter().sum();
@@ -478,7 +505,7 @@ impl Bsdf {
         if !self.smooth() {
             let a = self.alpha;
             let spec = ggx_d(h, a) * ggx_g1(o, h, a) * ggx_g1(i, h, a) / (4.0 * o.z * i.z);
-            f += spec * (self.metallic * schlick(self.base, vh) + Vec3::splat(opaque * fs));
+            f += spec * (self.metallic * schlick(self.base, vh) + opaque * fs);
         }
         f
     }
@@ -536,7 +563,7 @@ impl Bsdf {
             let weight = if lobe == METAL {
                 self.metallic * schlick(self.base, o.z)
             } else {
-                Vec3::splat((1.0 - self.metallic) * (1.0 - self.transmission) * self.layer_fresnel(o.z))
+                (1.0 - self.metallic) * (1.0 - self.transmission) * self.layer_fresnel(o.z)
             };
             let wi = Vec3::new(-o.x, -o.y, o.z) * side;
             return Some(BsdfSample { wi, weight: weight / p[lobe], pdf: p[lobe], delta: true });
@@ -643,6 +670,8 @@ pub struct GpuAnswer {
     pub eval: Vec3,
     pub pdf: f32,
     pub sample: Option<BsdfSample>,
+    /// `bsdf_lambertian_albedo(b, ω_o.z)`.
+    pub lambertian_albedo: Vec3,
 }
 
 /// `bsdf_eval`, `bsdf_pdf` and `bsdf_sample` of `bsdf.wgsl` for each (model, ω_o, ω_i,
@@ -653,7 +682,7 @@ pub fn on_gpu(
 ) -> crate::Result<Vec<GpuAnswer>> {
     use crate::gpu::storage_entry;
     let device = &gpu.device;
-    let input: Vec<[f32; 20]> = queries
+    let input: Vec<[f32; 23]> = queries
         .iter()
         .map(|(b, wo, wi, u, t)| {
             [
@@ -677,6 +706,9 @@ pub fn on_gpu(
                 u[2],
                 if *t == Transport::Radiance { 0.0 } else { 1.0 },
                 if b.multiple_scattering { 1.0 } else { 0.0 },
+                b.specular_color.x,
+                b.specular_color.y,
+                b.specular_color.z,
             ]
         })
         .collect();
@@ -687,7 +719,7 @@ pub fn on_gpu(
     let table =
         gpu.storage_buffer("bsdf ggx albedo", bytemuck::bytes_of(&ggx_albedo().gpu()), wgpu::BufferUsages::empty());
     let main = "
-        struct Query { v: array<f32, 20> }
+        struct Query { v: array<f32, 23> }
         struct Answer { v: array<f32, 16> }
         @group(0) @binding(0) var<storage, read> queries: array<Query>;
         @group(0) @binding(1) var<storage, read_write> answers: array<Answer>;
@@ -698,7 +730,7 @@ pub fn on_gpu(
                 return;
             }
             let q = queries[gid.x].v;
-            let b = Bsdf(vec3f(q[0], q[1], q[2]), q[3], q[4], q[5], q[6], q[7], q[8] > 0.5, q[19] > 0.5);
+            let b = Bsdf(vec3f(q[0], q[1], q[2]), q[3], q[4], q[5], vec3f(q[20], q[21], q[22]), q[6], q[7], q[8] > 0.5, q[19] > 0.5);
             let wo = vec3f(q[9], q[10], q[11]);
             let wi = vec3f(q[12], q[13], q[14]);
             let t = u32(q[18]);
@@ -709,6 +741,8 @@ pub fn on_gpu(
             a[4] = s.wi.x; a[5] = s.wi.y; a[6] = s.wi.z;
             a[7] = s.weight.x; a[8] = s.weight.y; a[9] = s.weight.z; a[10] = s.pdf;
             a[11] = select(0.0, 1.0, s.delta); a[12] = select(0.0, 1.0, s.ok);
+            let la = bsdf_lambertian_albedo(b, wo.z);
+            a[13] = la.x; a[14] = la.y; a[15] = la.z;
             answers[gid.x] = Answer(a);
         }";
     let source = crate::shader::compose(&[crate::shader::SAMPLING, crate::shader::BSDF, main]);
@@ -717,7 +751,7 @@ pub fn on_gpu(
         "bsdf",
         &module,
         &[
-            storage_entry::<[f32; 20]>(0, c, true),
+            storage_entry::<[f32; 23]>(0, c, true),
             storage_entry::<[f32; 16]>(1, c, false),
             storage_entry::<albedo::GpuGgxAlbedo>(2, c, true),
         ],
@@ -737,6 +771,7 @@ pub fn on_gpu(
                 pdf: a[10],
                 delta: a[11] > 0.5,
             }),
+            lambertian_albedo: Vec3::new(a[13], a[14], a[15]),
         })
         .collect())
 }

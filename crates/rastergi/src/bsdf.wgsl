@@ -11,6 +11,8 @@ struct Bsdf {
     metallic: f32,
     alpha: f32,
     specular: f32,
+    // The layer's colour at normal incidence: F₀ = min(f₀(η)·colour, 1) (Bsdf::specular_color).
+    specular_color: vec3f,
     ior: f32,
     transmission: f32,
     thin: bool,
@@ -138,14 +140,19 @@ fn mirror_z(w: vec3f) -> vec3f {
     return vec3f(w.x, w.y, -w.z);
 }
 
-fn layer_f0(b: Bsdf) -> f32 {
+// f₀ of the dielectric, ((η − 1)/(η + 1))² (Bsdf::ior_f0).
+fn ior_f0(b: Bsdf) -> f32 {
     let r = (b.ior - 1.0) / (b.ior + 1.0);
     return r * r;
 }
 
-fn layer_fresnel(b: Bsdf, c: f32) -> f32 {
-    let f0 = layer_f0(b);
-    return b.specular * (f0 + (1.0 - f0) * schlick_weight(c));
+// The layer's F₀ = min(f₀·colour, 1) (Bsdf::layer_f0).
+fn layer_f0(b: Bsdf) -> vec3f {
+    return min(ior_f0(b) * b.specular_color, vec3f(1.0));
+}
+
+fn layer_fresnel(b: Bsdf, c: f32) -> vec3f {
+    return b.specular * schlick(layer_f0(b), c);
 }
 
 // The GGX lobe's directional albedo tables (bsdf/albedo.rs, GpuGgxAlbedo): cell k = √α·N + μ
@@ -210,32 +217,32 @@ fn ms_eval(b: Bsdf, cos_o: f32, cos_i: f32) -> vec3f {
 }
 
 // The specular layer's directional albedo E_L(cos) (Bsdf::layer_albedo).
-fn layer_albedo(b: Bsdf, c: f32) -> f32 {
+fn layer_albedo(b: Bsdf, c: f32) -> vec3f {
     if bsdf_is_smooth(b) {
         return layer_fresnel(b, c);
     }
     let f0 = layer_f0(b);
     let e = ggx_albedo(c, b.alpha);
-    return b.specular * (f0 * e.x + (1.0 - f0) * e.y);
+    return b.specular * (f0 * e.x + (vec3f(1.0) - f0) * e.y);
 }
 
 // The layer's cosine-weighted mean albedo Ē_L (Bsdf::layer_mean_albedo).
-fn layer_mean_albedo(b: Bsdf) -> f32 {
+fn layer_mean_albedo(b: Bsdf) -> vec3f {
     let f0 = layer_f0(b);
     if bsdf_is_smooth(b) {
-        return b.specular * (f0 + (1.0 - f0) / 21.0);
+        return b.specular * (f0 + (vec3f(1.0) - f0) / 21.0);
     }
     let m = ggx_albedo_mean(b.alpha);
-    return b.specular * (f0 * m.x + (1.0 - f0) * m.y);
+    return b.specular * (f0 * m.x + (vec3f(1.0) - f0) * m.y);
 }
 
 // The share the layer leaves to the diffuse base (Bsdf::diffuse_share): energy-conserving,
 // (1 − E_L(cos_o))(1 − E_L(cos_i)) / (1 − Ē_L).
-fn diffuse_share(b: Bsdf, cos_o: f32, cos_i: f32) -> f32 {
+fn diffuse_share(b: Bsdf, cos_o: f32, cos_i: f32) -> vec3f {
     if b.specular == 0.0 {
-        return 1.0;
+        return vec3f(1.0);
     }
-    return (1.0 - layer_albedo(b, cos_o)) * (1.0 - layer_albedo(b, cos_i)) / (1.0 - layer_mean_albedo(b));
+    return (vec3f(1.0) - layer_albedo(b, cos_o)) * (vec3f(1.0) - layer_albedo(b, cos_i)) / (vec3f(1.0) - layer_mean_albedo(b));
 }
 
 // The lobes' probabilities (metal, layer, cosine-distributed: diffuse base and the metal's
@@ -244,8 +251,8 @@ fn lobe_probabilities(b: Bsdf, cos_o: f32) -> vec4f {
     let m = b.metallic;
     let opaque = (1.0 - m) * (1.0 - b.transmission);
     let fs = layer_fresnel(b, cos_o);
-    let w = vec4f(m * mean3(schlick(b.base, cos_o)), opaque * fs,
-        opaque * (1.0 - fs) * mean3(b.base) + m * mean3(ms_fresnel(b)) * ms_loss(b, cos_o), (1.0 - m) * b.transmission);
+    let w = vec4f(m * mean3(schlick(b.base, cos_o)), opaque * mean3(fs),
+        opaque * mean3((vec3f(1.0) - fs) * b.base) + m * mean3(ms_fresnel(b)) * ms_loss(b, cos_o), (1.0 - m) * b.transmission);
     let total = w.x + w.y + w.z + w.w;
     if total > 0.0 {
         return w / total;
@@ -363,7 +370,7 @@ fn bsdf_eval(b: Bsdf, wo: vec3f, wi: vec3f, transport: u32) -> vec3f {
     if !bsdf_is_smooth(b) {
         let a = b.alpha;
         let spec = ggx_d(h, a) * ggx_g1(o, h, a) * ggx_g1(i, h, a) / (4.0 * o.z * i.z);
-        f += spec * (b.metallic * schlick(b.base, vh) + vec3f(opaque * layer_fresnel(b, vh)));
+        f += spec * (b.metallic * schlick(b.base, vh) + opaque * layer_fresnel(b, vh));
     }
     return f;
 }
@@ -429,7 +436,7 @@ fn bsdf_sample(b: Bsdf, wo: vec3f, u: vec3f, transport: u32) -> BsdfSample {
     if lobe == 2u {
         wi = cosine_hemisphere(vec3f(0.0, 0.0, 1.0), u.y, u.z);
     } else if bsdf_is_smooth(b) {
-        var w = vec3f((1.0 - b.metallic) * (1.0 - b.transmission) * layer_fresnel(b, o.z));
+        var w = (1.0 - b.metallic) * (1.0 - b.transmission) * layer_fresnel(b, o.z);
         if lobe == 0u {
             w = b.metallic * schlick(b.base, o.z);
         }
@@ -507,13 +514,26 @@ fn to_local(f: mat3x3f, v: vec3f) -> vec3f {
     return vec3f(dot(v, f[0]), dot(v, f[1]), dot(v, f[2]));
 }
 
-// The albedo of a Lambertian surface standing in for b where the final gather's rays and the
-// photon map's lookups meet it, seen from ω_o at cosine cos_o (Bsdf::diffuse_equivalent): the
+// The albedo a(μ_o) of the model's Lambertian part f_L = a/π, which the photon map answers
+// for exactly at the gather's hits (Bsdf::lambertian_albedo): the cosine lobes' albedo,
+// (1 − m)(1 − t)(1 − E_L(μ_o))·c + m·F_ms·(1 − E₁(μ_o)).
+fn bsdf_lambertian_albedo(b: Bsdf, cos_o_in: f32) -> vec3f {
+    let cos_o = min(abs(cos_o_in), 1.0);
+    let opaque = (1.0 - b.metallic) * (1.0 - b.transmission);
+    var base = vec3f(1.0);
+    if b.specular != 0.0 {
+        base = vec3f(1.0) - layer_albedo(b, cos_o);
+    }
+    return opaque * base * b.base + b.metallic * ms_fresnel(b) * ms_loss(b, cos_o);
+}
+
+// The albedo of a Lambertian surface standing in for b where the photon map is read at a
+// visible point (photon_view.wgsl; the gather's hits follow the glossy lobes), seen from ω_o at cosine cos_o (Bsdf::diffuse_equivalent): the
 // directional albedo of the metal and of the opaque dielectric, the hemispherical reflectance
 // F̄ for glass.
 fn bsdf_diffuse_equivalent(b: Bsdf, cos_o_in: f32) -> vec3f {
     let cos_o = min(abs(cos_o_in), 1.0);
-    let f0 = layer_f0(b);
+    let f0 = ior_f0(b);
     let mean_f = f0 + (1.0 - f0) / 21.0;
     let opaque = (1.0 - b.metallic) * (1.0 - b.transmission);
     var metal = schlick(b.base, cos_o);
@@ -522,6 +542,6 @@ fn bsdf_diffuse_equivalent(b: Bsdf, cos_o_in: f32) -> vec3f {
         metal = b.base * e.x + (vec3f(1.0) - b.base) * e.y + ms_fresnel(b) * ms_loss(b, cos_o);
     }
     let layer = layer_albedo(b, cos_o);
-    let dielectric = vec3f(layer) + (1.0 - layer) * b.base;
+    let dielectric = layer + (vec3f(1.0) - layer) * b.base;
     return b.metallic * metal + opaque * dielectric + vec3f((1.0 - b.metallic) * b.transmission * mean_f);
 }

@@ -27,8 +27,13 @@ pub struct GpuTriangle {
     /// [`TRIANGLE_HAS_HOLES`] where the material may let rays through.
     pub flags: u32,
     pub v2: [f32; 3],
-    pub _pad1: u32,
+    /// The triangle's entry in the light table where it emits, else [`NO_LIGHT`]: the density
+    /// with which light samples find its points, for multiple importance sampling.
+    pub light: u32,
 }
+
+/// [`GpuTriangle::light`] of a triangle that is not in the light table.
+pub const NO_LIGHT: u32 = u32::MAX;
 
 /// `TextureSlot` in `gpu_scene.wgsl`: a texture a material reads, the layer of the texture
 /// array ([`NO_TEXTURE`] for none) and the rows (`u`, `v`) of its [`UvTransform`].
@@ -66,7 +71,11 @@ pub struct GpuMaterial {
     pub specular: f32,
     pub ior: f32,
     pub transmission: f32,
-    pub _pad: [u32; 3],
+    /// [`Material::medium`]: σ inside solid glass.
+    pub attenuation: [f32; 3],
+    /// [`Material::specular_color`].
+    pub specular_color: [f32; 3],
+    pub _pad: u32,
 }
 
 /// `MaterialMaps` in `gpu_scene.wgsl`: a material's textures and their parameters, at the
@@ -106,7 +115,9 @@ impl GpuMaterial {
             specular: m.specular,
             ior: m.ior,
             transmission: m.transmission,
-            _pad: [0; 3],
+            attenuation: m.medium().into(),
+            specular_color: m.specular_color.into(),
+            _pad: 0,
         };
         let maps = GpuMaterialMaps {
             alpha_cutoff,
@@ -323,6 +334,8 @@ pub struct GpuScene {
     pub has_normals: bool,
     /// Some material may let rays through: a cut-out or a stochastic surface (`SCENE_HOLES`).
     pub has_holes: bool,
+    /// Some solid glass attenuates the light inside it (`SCENE_MEDIA`, [`Material::medium`]).
+    pub has_media: bool,
 }
 
 impl GpuScene {
@@ -330,7 +343,7 @@ impl GpuScene {
     /// pipeline whose shader reads the scene: a scene without glossy or specular materials,
     /// or without surfaces that pass rays, gets kernels without the branches that serve them
     /// (the same results: those branches are never taken there; smaller kernels run faster).
-    pub fn pipeline_constants(&self) -> [(&'static str, f64); 5] {
+    pub fn pipeline_constants(&self) -> [(&'static str, f64); 6] {
         let flag = |b: bool| if b { 1.0 } else { 0.0 };
         [
             ("SCENE_BSDF", flag(self.has_bsdfs)),
@@ -338,6 +351,7 @@ impl GpuScene {
             ("SCENE_TEXTURES", flag(self.has_textures)),
             ("SCENE_NORMALS", flag(self.has_normals)),
             ("SCENE_HOLES", flag(self.has_holes)),
+            ("SCENE_MEDIA", flag(self.has_media)),
         ]
     }
 
@@ -362,17 +376,24 @@ impl GpuScene {
         check_bvh_nodes(&limits, nodes.len())?;
         let s = &prepared.scene;
         let has_bsdfs = !s.materials.iter().all(Material::is_lambertian);
+        let mut light_of = vec![NO_LIGHT; s.triangles.len()];
+        for (k, e) in prepared.lights.entries.iter().enumerate() {
+            if let Some(l) = light_of.get_mut(e.triangle as usize) {
+                *l = k as u32;
+            }
+        }
         let triangles: Vec<GpuTriangle> = s
             .triangles
             .iter()
             .zip(&s.material_ids)
-            .map(|(t, &m)| GpuTriangle {
+            .zip(&light_of)
+            .map(|((t, &m), &light)| GpuTriangle {
                 v0: t[0].into(),
                 material: m,
                 v1: t[1].into(),
                 flags: if s.materials[m as usize].has_holes() { TRIANGLE_HAS_HOLES } else { 0 },
                 v2: t[2].into(),
-                _pad1: 0,
+                light,
             })
             .collect();
         let (materials, maps): (Vec<GpuMaterial>, Vec<GpuMaterialMaps>) =
@@ -512,6 +533,7 @@ impl GpuScene {
             has_textures: s.materials.iter().any(|m| m.texture_refs().next().is_some()),
             has_normals: !s.normals.is_empty(),
             has_holes: s.materials.iter().any(Material::has_holes),
+            has_media: s.materials.iter().any(|m| m.medium() != Vec3::ZERO),
         })
     }
 }

@@ -13,6 +13,8 @@ override SCENE_TEXTURES: bool = true;
 override SCENE_NORMALS: bool = true;
 // Some material may let rays through (a cut-out or a stochastic surface, TRIANGLE_HAS_HOLES):
 override SCENE_HOLES: bool = true;
+// Some solid glass attenuates the light inside it (Material::medium):
+override SCENE_MEDIA: bool = true;
 
 // flags: TRIANGLE_HAS_HOLES where the material may let rays through.
 struct Triangle {
@@ -21,8 +23,11 @@ struct Triangle {
     v1: vec3f,
     flags: u32,
     v2: vec3f,
-    _pad1: u32,
+    // Its entry in `lights` where it emits, else NO_LIGHT (GpuTriangle::light).
+    light: u32,
 }
+
+const NO_LIGHT: u32 = 0xffffffffu;
 
 // A texture a material reads: its layer in `textures` (NO_TEXTURE for none) and the affine
 // map of the triangle's texture coordinates onto it, (dot(u, (uv, 1)), dot(v, (uv, 1))).
@@ -46,9 +51,11 @@ struct Material {
     specular: f32,
     ior: f32,
     transmission: f32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
+    // σ inside solid glass (Material::medium), per channel.
+    attenuation: array<f32, 3>,
+    // The layer's colour at normal incidence (Material::specular_color).
+    specular_color: vec3f,
+    _pad: u32,
 }
 
 // A material's textures and their parameters (gpu_scene.rs, GpuMaterialMaps).
@@ -150,6 +157,7 @@ struct Surface {
     specular: f32,
     ior: f32,
     transmission: f32,
+    specular_color: vec3f,
 }
 
 // Vertex `vi` of the scene drawn as one non-indexed triangle list (vertex pulling in the
@@ -376,6 +384,7 @@ fn surface_at(tri: u32, b1: f32, b2: f32, lod: f32) -> Surface {
     s.metallic = m.metallic;
     s.roughness = m.roughness;
     s.specular = m.specular;
+    s.specular_color = m.specular_color;
     s.ior = m.ior;
     s.transmission = m.transmission;
     if textured {
@@ -392,7 +401,7 @@ fn surface_at(tri: u32, b1: f32, b2: f32, lod: f32) -> Surface {
 // The model at a surface point (PreparedScene::bsdf_at).
 fn surface_bsdf(s: Surface) -> Bsdf {
     let r = clamp(s.roughness, 0.0, 1.0);
-    return Bsdf(s.albedo, clamp(s.metallic, 0.0, 1.0), r * r, s.specular, s.ior, s.transmission,
+    return Bsdf(s.albedo, clamp(s.metallic, 0.0, 1.0), r * r, s.specular, s.specular_color, s.ior, s.transmission,
         (s.flags & MATERIAL_THIN) != 0u, (s.flags & MATERIAL_SINGLE_SCATTERING) == 0u);
 }
 
@@ -477,6 +486,9 @@ struct Scatter {
     origin: vec3f,
     delta: bool,
     ok: bool,
+    // The density the direction was drawn with and its |cos θ| to the shading normal.
+    pdf: f32,
+    cos: f32,
 }
 
 // A ray arriving along d at surface s, in the terms its BSDF is sampled in: the model with the
@@ -501,9 +513,13 @@ fn arrival(s: Surface, d: vec3f) -> Arrival {
 }
 
 fn scatter_at(s: Surface, d: vec3f, u: vec3f, eps: f32) -> Scatter {
+    return scatter_from(s.pos, arrival(s, d), u, eps);
+}
+
+// scatter_at for the arrival a at the surface point pos.
+fn scatter_from(pos: vec3f, a: Arrival, u: vec3f, eps: f32) -> Scatter {
     var r: Scatter;
     r.ok = false;
-    let a = arrival(s, d);
     let n = a.n;
     let bs = bsdf_sample(a.b, a.wo, u, TRANSPORT_RADIANCE);
     if !bs.ok {
@@ -515,8 +531,10 @@ fn scatter_at(s: Surface, d: vec3f, u: vec3f, eps: f32) -> Scatter {
         return r;
     }
     r.weight = bs.weight;
-    r.origin = s.pos + select(n, -n, below) * eps;
+    r.origin = pos + select(n, -n, below) * eps;
     r.delta = bs.delta;
+    r.pdf = bs.pdf;
+    r.cos = abs(bs.wi.z);
     r.ok = true;
     return r;
 }
@@ -728,6 +746,32 @@ struct LightSample {
     // Probability density of `pos` per unit area: pmf(triangle) / area(triangle).
     pdf_area: f32,
     tri: u32,
+}
+
+// Beer–Lambert inside solid glass (Material::segment_transmittance): exp(−σt) for a segment of
+// length t that ends on triangle tri's back face arriving along d — it ran inside the solid
+// that face bounds — and 1 elsewhere (in air, thin or clear glass). Media do not nest.
+fn segment_transmittance(tri: u32, d: vec3f, t: f32) -> vec3f {
+    if !SCENE_MEDIA {
+        return vec3f(1.0);
+    }
+    let tr = triangles[tri];
+    let m = materials[tr.material];
+    let sigma = vec3f(m.attenuation[0], m.attenuation[1], m.attenuation[2]);
+    if all(sigma == vec3f(0.0)) || dot(d, triangle_normal(tr)) <= 0.0 {
+        return vec3f(1.0);
+    }
+    return exp(-sigma * t);
+}
+
+// The density per unit area with which light samples (sample_light_at) find points of the
+// emissive triangle tri: pmf / area of its entry; 0 for a triangle not in the light table.
+fn emitter_pdf_area(tri: u32) -> f32 {
+    let e = triangles[tri].light;
+    if e == NO_LIGHT {
+        return 0.0;
+    }
+    return lights[e].pmf / lights[e].area;
 }
 
 // A point uniformly (u1, u2) on the emissive triangle of light entry `entry`.

@@ -64,12 +64,24 @@ fn twins() -> Vec<Twin> {
             "Environment",
             [disc_centre, disc_radius, width, height, pmf, row_cdf, column_cdf, cell_pmf]
         ),
-        twin!(GpuTriangle, "Triangle", [v0, material, v1, flags, v2]),
+        twin!(GpuTriangle, "Triangle", [v0, material, v1, flags, v2, light]),
         twin!(GpuTextureSlot, "TextureSlot", [u, layer, v]),
         twin!(
             GpuMaterial,
             "Material",
-            [albedo, flags, emission, opacity, metallic, roughness, specular, ior, transmission]
+            [
+                albedo,
+                flags,
+                emission,
+                opacity,
+                metallic,
+                roughness,
+                specular,
+                ior,
+                transmission,
+                attenuation,
+                specular_color
+            ]
         ),
         twin!(
             GpuMaterialMaps,

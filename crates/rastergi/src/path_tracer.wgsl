@@ -73,6 +73,7 @@ fn path_radiance(origin: vec3f, dir: vec3f, xy: vec2u, rng: ptr<function, u32>) 
             }
             break;
         }
+        throughput *= segment_transmittance(hit.tri, d, hit.t);
         var lod = 0.0;
         if bounce == 0u && (materials[triangles[hit.tri].material].flags & MATERIAL_TEXTURED) != 0u {
             lod = primary_lod(hit.tri, xy);

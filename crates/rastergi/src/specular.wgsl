@@ -60,6 +60,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             film_add(FILM_DIRECT, gid.xy, throughput * env_radiance(d));
             break;
         }
+        throughput *= segment_transmittance(hit.tri, d, hit.t);
         s = surface_at(hit.tri, hit.b1, hit.b2, 0.0);
         hit_g = vec4u(hit.tri + 1u, bitcast<u32>(hit.b1), bitcast<u32>(hit.b2), 0u);
     }

@@ -23,6 +23,12 @@ fn plastic(base: Vec3, roughness: f32) -> Bsdf {
     Bsdf { alpha: roughness * roughness, specular: 1.0, ..Bsdf::diffuse(base) }
 }
 
+/// A layer tinted by `KHR_materials_specular`'s colour (3, 1, 0.25) at weight 0.8, η 1.5:
+/// F₀ = min(0.04·colour, 1) = (0.12, 0.04, 0.01).
+fn tinted_plastic(base: Vec3, roughness: f32) -> Bsdf {
+    Bsdf { specular: 0.8, specular_color: Vec3::new(3.0, 1.0, 0.25), ..plastic(base, roughness) }
+}
+
 fn glass(roughness: f32, thin: bool) -> Bsdf {
     Bsdf { transmission: 1.0, alpha: roughness * roughness, specular: 1.0, thin, ..Bsdf::diffuse(Vec3::ONE) }
 }
@@ -134,6 +140,7 @@ fn cases() -> Vec<(&'static str, Bsdf, Vec3)> {
         ("thin glass 0.6", glass(0.6, true)),
         ("half glass", Bsdf { transmission: 0.5, ..plastic(c, 0.7) }),
         ("smooth plastic", plastic(c, 0.0)),
+        ("tinted plastic", tinted_plastic(c, 0.5)),
     ] {
         for wo in [dir(10.0, 30.0), dir(60.0, 200.0), dir(150.0, 80.0)] {
             v.push((name, b, wo));
@@ -290,6 +297,13 @@ fn white_furnace() {
                 (layer - Vec3::ONE).abs().max_element() < 0.01 + 3.0 * se,
                 "layer r {r} at {theta}°: {layer} ± {se}"
             );
+            // A tinted layer (KHR_materials_specular's colour; F₀ of one channel clamped at 1)
+            // over white conserves energy channel by channel too.
+            let (tinted, se) = albedo(tinted_plastic(white, r));
+            assert!(
+                (tinted - Vec3::ONE).abs().max_element() < 0.01 + 3.0 * se,
+                "tinted layer r {r} at {theta}°: {tinted} ± {se}"
+            );
         }
     }
     println!(
@@ -431,4 +445,62 @@ fn a_lambertian_model_evaluates_to_albedo_over_pi() {
     // Both on the back side: a two-sided surface reflects alike; opposite sides: nothing.
     assert_eq!(b.eval(-dir(30.0, 10.0), -dir(70.0, 250.0), Transport::Radiance), f);
     assert_eq!(b.eval(dir(30.0, 10.0), -dir(70.0, 250.0), Transport::Radiance), Vec3::ZERO);
+}
+
+/// The Lambertian part's albedo a(μ_o) (what the photon map answers for at the gather's hits)
+/// against a quadrature of the cosine lobes it stands for — the base under the layer and the
+/// metal's multiple scattering, c(1 − m)(1 − t)·share/π + m·M_ms — at every roughness and
+/// angle: a(μ_o) = ∫(those lobes)·cos θ_i dω_i, so the rest f − a/π reflects the model's
+/// glossy lobes' albedo. A Lambertian model is all Lambertian part.
+#[test]
+fn the_lambertian_part_reflects_what_the_cosine_lobes_do() {
+    let c = Vec3::new(0.9, 0.6, 0.3);
+    for roughness in [0.0, 0.1, 0.3, 0.6, 1.0] {
+        let a2 = roughness * roughness;
+        for b in [
+            plastic(c, roughness),
+            metal(c, roughness),
+            Bsdf { metallic: 0.4, specular: 0.7, ..plastic(c, roughness) },
+            Bsdf { transmission: 0.5, ..plastic(c, roughness) },
+            Bsdf { alpha: a2, ..Bsdf::diffuse(c) },
+            tinted_plastic(c, roughness),
+        ] {
+            for theta in [0.0f32, 30.0, 60.0, 80.0, 88.0] {
+                let wo = dir(theta, 10.0);
+                let n = 1024;
+                let mut sum = Vec3::ZERO.as_dvec3();
+                for i in 0..n {
+                    let mu = (i as f32 + 0.5) / n as f32;
+                    let opaque = (1.0 - b.metallic) * (1.0 - b.transmission);
+                    let lobes = opaque * b.base * b.diffuse_share(wo.z, mu) / std::f32::consts::PI
+                        + b.metallic * b.ms_eval(wo.z, mu);
+                    // ∫ over φ gives 2π; dω = dμ dφ.
+                    sum += (lobes * mu * 2.0 * std::f32::consts::PI / n as f32).as_dvec3();
+                }
+                let a = b.lambertian_albedo(wo.z);
+                assert!(
+                    (a.as_dvec3() - sum).abs().max_element() < 1e-4,
+                    "{b:?} at {theta}°: a {a} vs quadrature {sum}"
+                );
+            }
+        }
+    }
+    let d = Bsdf::diffuse(c);
+    assert_eq!(d.lambertian_albedo(0.3), c);
+}
+
+/// A smooth tinted layer over black reflects what glTF's specular extension says at normal
+/// incidence and in the mean: its delta lobe carries s·F₀ with F₀ = min(f₀(η)·colour, 1) per
+/// channel at cos θ = 1 (Schlick), and the F₉₀ = s at grazing angles whatever the colour.
+#[test]
+fn a_tinted_layer_reflects_its_colour_at_normal_incidence() {
+    let b = tinted_plastic(Vec3::ZERO, 0.0);
+    let f0 = ((1.5f32 - 1.0) / 2.5).powi(2);
+    for (cos, want) in [(1.0f32, 0.8 * (Vec3::new(3.0, 1.0, 0.25) * f0).min(Vec3::ONE)), (0.0, Vec3::splat(0.8))] {
+        let wo = Vec3::new((1.0 - cos * cos).max(0.0).sqrt(), 0.0, cos.max(1e-6));
+        // Every sample of the black-based layer is its delta lobe.
+        let s = b.sample(wo, [0.5, 0.5, 0.5], Transport::Radiance).expect("a sample");
+        assert!(s.delta);
+        assert!((s.weight - want).abs().max_element() < 1e-4, "cos {cos}: {} vs {want}", s.weight);
+    }
 }

@@ -2,72 +2,168 @@
 // (raster.wgsl), the list walk (lists.wgsl) and the traced gather (trace.wgsl). A visible
 // point gathers where it is `ok` (visible_point.wgsl).
 
-// L(h → x) for the hit point h on triangle tri at barycentrics b, seen along w from x:
-// ρ_h/π · E(h) on the side of h facing x (ρ_h the diffuse equivalent of a glossy or
-// specular h seen from x: bsdf_diffuse_equivalent, an approximation), zero from the back of a one-sided h. E(h) is the
-// photon map's, or — for a map of indirect light only — the map's plus the direct irradiance
-// from one light sample with a shadow ray (hit_direct): sample j (the gather direction's
-// sample index) of the pixel's sequence.
-fn gather_radiance(w0: vec3f, tri0: u32, hit0: vec3f, b0: vec2f, pixel: u32, j: u32) -> vec3f {
+// L(h → x) for the hit point h on triangle tri at barycentrics b, seen along w from x (zero
+// from the back of a one-sided h; h's own emission is direct light at x, the direct pass's).
+// E(h) is the photon map's irradiance on the side of h facing x — for a map of indirect light
+// only, the map's plus the direct irradiance from one light sample with a shadow ray (sample
+// j of the pixel's sequence at the first surface, hit_light_choice; the chain's stream after).
+//   Lambertian h:  L = ρ_h/π · E(h).
+//   Elsewhere the model splits f = f_L + f_R (bsdf_lambertian_albedo): the map answers for
+//   its Lambertian part f_L = a(μ_o)/π exactly, a/π · E(h); the rest f_R = f − f_L (the
+//   glossy and specular lobes, and what the cosine lobes' angular shape adds to f_L) is
+//   followed: a direction drawn from the whole model (density p), weight f_R·|cos θ|/p,
+//   Russian roulette by its largest channel, to the next surface, where the same holds and
+//   its emission counts (light that reached h from an emitter); a ray that escapes adds the
+//   sky. Punctual and distant lights, which no ray meets, add f_R·e·|cos θ| by h's light
+//   sample. The estimate is unbiased for ∫f L cos θ dω at h given the map's E, so it
+//   converges with the map to the path tracer's answer (issue 31; before, a glossy h was a
+//   Lambertian surface of its directional albedo, bsdf_diffuse_equivalent: biased however
+//   long it rendered).
+// Through perfect mirrors and glass the ray goes on (one direction drawn from the BSDF at
+// each, as the eye's chains do). Light that reaches x from the lights or the sky through
+// smooth surfaces alone is the caustic map's (the caustics pass), so such a chain that escapes
+// or meets an emitter adds nothing here. 16 surfaces at most.
+fn gather_radiance(x: vec3f, w0: vec3f, tri0: u32, hit0: vec3f, b0: vec2f, pixel: u32, j: u32) -> vec3f {
     var w = w0;
     var tri = tri0;
     var hit = hit0;
     var b = b0;
-    // Through perfect mirrors and glass the ray goes on (one direction drawn from the BSDF at
-    // each, as the eye's chains do) to the first other surface. Light that reaches x from the
-    // lights or the sky through smooth surfaces alone is the caustic map's (the caustics pass),
-    // so such a chain that escapes or meets an emitter adds nothing here.
-    var weight = vec3f(1.0);
+    // The throughput from x's estimate to the current surface (signed: f_R may be negative),
+    // from x's own segment on (inside solid glass it is attenuated).
+    var weight = segment_transmittance(tri, w, distance(x, hit));
     // Whether every surface passed so far scattered by a delta lobe: then the light the chain
-    // meets from the lights and the sky is the caustic map's; through rough glass it is not,
-    // and the chain adds it here (no light sample finds it).
+    // meets from the lights and the sky is the caustic map's; through rough glass or off a
+    // surface the map answers for in part it is not, and the chain adds it here (no light
+    // sample and no caustic photon holds that light).
     var delta_only = true;
-    var seen = vec3f(0.0);
-    if SCENE_PASSES_RAYS && frame.eye_chains != 0u {
-        var rng = rng_new(frame.seed ^ STREAM_GATHER_CHAIN, pixel, j);
-        for (var k = 0u; ; k++) {
-            let s = surface_at(tri, b.x, b.y, 0.0);
-            if !surface_passes_rays(s) {
-                if !delta_only && dot(s.normal, w) < 0.0 {
-                    seen = weight * s.emission;
+    // Whether the light sample of the next stop is the pixel's (the first stop) or the chain's.
+    var first_stop = true;
+    // The density with which the last direction was drawn at a stop that took a light sample
+    // (0: none, or a delta lobe), and the distance it went: emitters it meets and the sky are
+    // weighted against that light sample by the power heuristic, as in the path tracer.
+    var last_pdf = 0.0;
+    var last_t = 0.0;
+    var radiance = vec3f(0.0);
+    let chains = SCENE_PASSES_RAYS && frame.eye_chains != 0u;
+    var rng = rng_new(frame.seed ^ STREAM_GATHER_CHAIN, pixel, j);
+    for (var k = 0u; k <= 16u; k++) {
+        let s = surface_at(tri, b.x, b.y, 0.0);
+        let front = dot(w, s.normal) < 0.0;
+        let a = arrival(s, w);
+        var la = vec3f(0.0);
+        let stop = !(chains && surface_passes_rays(s));
+        if stop {
+            if !delta_only && front && any(s.emission > vec3f(0.0)) {
+                var mis = 1.0;
+                if last_pdf > 0.0 {
+                    mis = power_heuristic(last_pdf, emitter_pdf_area(tri) * last_t * last_t / dot(-w, s.normal));
                 }
+                radiance += weight * s.emission * mis;
+            }
+            if !front && (s.flags & MATERIAL_TWO_SIDED) == 0u {
+                return radiance;
+            }
+            let lambertian = surface_is_lambertian(s);
+            var e = photon_irradiance(hit, tri, !front);
+            // The light sample: for the Lambertian part where the map holds indirect light
+            // only, and for f_R where it is a punctual or distant light.
+            if has_lights() && (photon_grid.indirect_only != 0u || !lambertian) {
+                var c: LightChoice;
+                if first_stop {
+                    c = hit_light_choice(pixel, j);
+                } else {
+                    c = light_choice(rng_f32(&rng), rng_f32(&rng), rng_f32(&rng));
+                }
+                let l = sample_light_at(hit + a.n * frame.ray_epsilon, c);
+                let cos_l = dot(a.frame[2], l.dir);
+                let lit = photon_grid.indirect_only != 0u && dot(a.n, l.dir) > 0.0 && cos_l > 0.0;
+                if (lit || !lambertian) && any(l.e > vec3f(0.0)) {
+                    let side = select(-a.n, a.n, dot(a.n, l.dir) >= 0.0);
+                    if !occluded(hit + side * frame.ray_epsilon, l.dir, frame.ray_epsilon, l.dist * (1.0 - 1e-4), tri, l.tri) {
+                        if lit {
+                            e += l.e * cos_l;
+                        }
+                        if !lambertian {
+                            radiance += weight * rest_light(a, l);
+                        }
+                    }
+                }
+            }
+            first_stop = false;
+            if lambertian {
+                return radiance + weight * s.albedo / PI * e;
+            }
+            la = bsdf_lambertian_albedo(a.b, a.wo.z);
+            radiance += weight * la / PI * e;
+        }
+        if k == 16u {
+            break;
+        }
+        // On: a direction from the model; at a stop, weighted by f_R, with Russian roulette.
+        let u = vec3f(rng_f32(&rng), rng_f32(&rng), rng_f32(&rng));
+        let sc = scatter_from(s.pos, a, u, frame.ray_epsilon);
+        if !sc.ok {
+            break;
+        }
+        var wr = sc.weight;
+        if !sc.delta && dot(sc.dir, a.n) > 0.0 {
+            wr -= la / PI * (sc.cos / sc.pdf);
+        }
+        if stop || !delta_only {
+            let q = min(max(max(abs(wr.x), abs(wr.y)), abs(wr.z)), 1.0);
+            if rng_f32(&rng) >= q {
                 break;
             }
-            if k == 16u {
-                return vec3f(0.0);
-            }
-            let sc = scatter_at(s, w, vec3f(rng_f32(&rng), rng_f32(&rng), rng_f32(&rng)), frame.ray_epsilon);
-            if !sc.ok {
-                return vec3f(0.0);
-            }
-            weight *= sc.weight;
-            delta_only = delta_only && sc.delta;
-            let o = sc.origin;
-            let wi = sc.dir;
-            let h = trace(o, wi, frame.ray_epsilon, 3.0e38, tri, NO_TRIANGLE, false);
-            if h.tri == NO_TRIANGLE {
-                return select(weight * env_radiance(wi), vec3f(0.0), delta_only);
-            }
-            w = wi;
-            tri = h.tri;
-            hit = o + wi * h.t;
-            b = vec2f(h.b1, h.b2);
+            wr /= q;
         }
+        weight *= wr;
+        delta_only = delta_only && sc.delta && !stop;
+        // The density of the direction for the weights against the light sample taken here
+        // (only at a stop that is not Lambertian: the only ones that go on).
+        last_pdf = select(0.0, sc.pdf, stop && !sc.delta && has_lights());
+        let h = trace(sc.origin, sc.dir, frame.ray_epsilon, 3.0e38, tri, NO_TRIANGLE, false);
+        if h.tri == NO_TRIANGLE {
+            if !delta_only && has_environment() {
+                var mis = 1.0;
+                if last_pdf > 0.0 {
+                    mis = power_heuristic(last_pdf, environment.pmf * env_pdf(sc.dir));
+                }
+                radiance += weight * env_radiance(sc.dir) * mis;
+            }
+            break;
+        }
+        last_t = h.t;
+        weight *= segment_transmittance(h.tri, sc.dir, h.t);
+        w = sc.dir;
+        tri = h.tri;
+        hit = sc.origin + sc.dir * h.t;
+        b = vec2f(h.b1, h.b2);
     }
-    let t = triangles[tri];
-    let n_h = triangle_normal(t);
-    let front_h = dot(w, n_h) < 0.0;
-    if !front_h && (materials[t.material].flags & MATERIAL_TWO_SIDED) == 0u {
+    return radiance;
+}
+
+// The light sample l (unoccluded) reflected by f_R = f − f_L at the arrival a
+// (gather_radiance): f_R·e·|cos θ_i|, weighted against the model's sampling of the same
+// direction by the power heuristic where that can find it (an emissive triangle: its area
+// density to solid angle; the sky: l.pdf); a punctual or distant light has weight 1. Zero
+// where the direction's geometric and shading sides disagree.
+fn rest_light(a: Arrival, l: LightRay) -> vec3f {
+    let wi = to_local(a.frame, l.dir);
+    if (wi.z < 0.0) != (dot(a.n, l.dir) < 0.0) || wi.z == 0.0 {
         return vec3f(0.0);
     }
-    // ρ_h at the hit point itself, unfiltered (level 0), like every secondary point.
-    let s_h = surface_at(tri, b.x, b.y, 0.0);
-    var e = photon_irradiance(hit, tri, !front_h);
-    if photon_grid.indirect_only != 0u {
-        let ns_h = bend_towards(select(-s_h.shading, s_h.shading, front_h), -w);
-        e += hit_direct(hit, select(-n_h, n_h, front_h), ns_h, tri, pixel, j);
+    var f = bsdf_eval(a.b, a.wo, wi, TRANSPORT_RADIANCE);
+    if wi.z > 0.0 {
+        f -= bsdf_lambertian_albedo(a.b, a.wo.z) / PI;
     }
-    return seen + weight * surface_rho(s_h, -w) / PI * e;
+    var mis = 1.0;
+    if l.pdf > 0.0 {
+        mis = power_heuristic(l.pdf, bsdf_pdf(a.b, a.wo, wi));
+    } else if l.tri != NO_TRIANGLE {
+        let cos_y = -dot(triangle_normal(triangles[l.tri]), l.dir);
+        mis = power_heuristic(emitter_pdf_area(l.tri) * l.dist * l.dist / cos_y, bsdf_pdf(a.b, a.wo, wi));
+    }
+    return f * l.e * (abs(wi.z) * mis);
 }
 
 // f(ω_eye, w) at the visible point x: ρ_x/π for a Lambertian surface, else the BSDF's
@@ -94,7 +190,7 @@ fn gather_cosine(p: VisiblePoint, w: vec3f) -> f32 {
 // 1/2π): f(ω_eye, w) · L(h → x) · cos θ_x · 2π, cos θ_x = gather_cosine (the shading
 // normal's); f = ρ_x/π on a Lambertian surface.
 fn gather_estimate(p: VisiblePoint, cos_x: f32, w: vec3f, tri: u32, hit: vec3f, b: vec2f, pixel: u32, j: u32) -> vec3f {
-    return visible_f(p, w) * gather_radiance(w, tri, hit, b, pixel, j) * (cos_x * 2.0 * PI);
+    return visible_f(p, w) * gather_radiance(p.x.pos, w, tri, hit, b, pixel, j) * (cos_x * 2.0 * PI);
 }
 
 // The side of shared direction ω that x gathers along: ω, or −ω where ω lies below x's surface.
@@ -156,18 +252,14 @@ fn escape_estimate(p: VisiblePoint, cos_x: f32, w: vec3f) -> vec3f {
     return escape_estimate_weighted(p, visible_f(p, w) * (cos_x * 2.0 * PI), w);
 }
 
-// Direct irradiance at h (side normal n, shading normal ns) from one light sample (light_sample_irradiance):
+// The light sample at the gather's first hit for the pixel's direction with sample index j:
 // sample j of the pixel's own Owen-scrambled Sobol' sequence (light_sample_uniforms, as the
-// direct pass draws them), whose seed depends on (seed, pixel) only. j is the gather
-// direction's sample index i·K + k, so an iteration's K hits take an aligned block of the
-// sequence and the iterations keep stratifying it; the index shuffle of sobol_owen_2d keeps
-// it independent of the per-pixel directions, which use the same indices with other seeds.
-fn hit_direct(h: vec3f, n: vec3f, ns: vec3f, tri: u32, pixel: u32, j: u32) -> vec3f {
-    if !has_lights() {
-        return vec3f(0.0);
-    }
+// direct pass draws them), whose seed depends on (seed, pixel) only. j is i·K + k, so an
+// iteration's K hits take an aligned block of the sequence and the iterations keep
+// stratifying it; the index shuffle of sobol_owen_2d keeps it independent of the per-pixel
+// directions, which use the same indices with other seeds.
+fn hit_light_choice(pixel: u32, j: u32) -> LightChoice {
     let xy = vec2u(pixel % frame.resolution.x, pixel / frame.resolution.x);
     let seed = pixel_seed(pcg_hash(frame.seed ^ STREAM_HIT_LIGHT), xy.x, xy.y);
-    let c = light_sample_uniforms(j, seed);
-    return light_sample_irradiance(h + n * frame.ray_epsilon, n, ns, tri, frame.ray_epsilon, c);
+    return light_sample_uniforms(j, seed);
 }

@@ -46,7 +46,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         // Nearest hit at t > ε, x's own triangle excluded (the raster gather's plane test).
         let h = trace(p.x.pos, w, frame.ray_epsilon, 3.0e38, p.x.tri, NO_TRIANGLE, false);
         if h.tri != NO_TRIANGLE {
-            sum += weight * gather_radiance(w, h.tri, p.x.pos + w * h.t, vec2f(h.b1, h.b2), pixel, j);
+            sum += weight * gather_radiance(p.x.pos, w, h.tri, p.x.pos + w * h.t, vec2f(h.b1, h.b2), pixel, j);
         } else {
             sky += escape_estimate_weighted(p, weight, w);
         }

@@ -103,6 +103,7 @@ fn trace_photon(
         let tri = &scene.triangles[hit.triangle as usize];
         let material = scene.material_of(hit.triangle as usize);
         let n = triangle_normal(tri);
+        flux *= material.segment_transmittance(dir, n, hit.t);
         let front = n.dot(dir) < 0.0;
         // Glass is entered and left by either face.
         if !front && !material.two_sided && material.transmission <= 0.0 {

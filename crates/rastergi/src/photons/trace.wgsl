@@ -135,6 +135,7 @@ fn trace_photons(@builtin(global_invocation_id) gid: vec3u) {
         if hit.tri == NO_TRIANGLE {
             break;
         }
+        flux *= segment_transmittance(hit.tri, dir, hit.t);
         // The texel's albedo, unfiltered (level 0): photons sample the texture point-wise.
         let s = surface_at(hit.tri, hit.b1, hit.b2, 0.0);
         let front = dot(s.normal, dir) < 0.0;

@@ -18,7 +18,7 @@ use super::{Camera, Material, Scene, cornell_box};
 use crate::error::{Error, Result};
 
 /// The built-in scene names, as shown in help texts and error messages.
-pub const BUILTIN_NAMES: &str = "cornell, atrium, spheres:N (about N triangles), rooms, rooms:closed";
+pub const BUILTIN_NAMES: &str = "cornell, atrium, spheres:N (about N triangles), rooms, rooms:closed, glossy-room";
 
 /// Largest triangle count `spheres:N` accepts: 2²⁸ triangles are 16 GiB of corners, far
 /// past what any GPU binds as one buffer, so larger requests are typos.
@@ -32,6 +32,7 @@ pub fn builtin(name: &str) -> Result<Option<Scene>> {
         None if name == "cornell" => Ok(Some(cornell_box())),
         None if name == "atrium" => Ok(Some(atrium())),
         None if name == "rooms" => Ok(Some(rooms(true))),
+        None if name == "glossy-room" => Ok(Some(glossy_room())),
         Some(("rooms", "closed")) => Ok(Some(rooms(false))),
         Some(("spheres", count)) => {
             let n: usize = count
@@ -112,6 +113,89 @@ pub fn rooms(doorway: bool) -> Scene {
         -Vec3::Y,
         light,
     );
+    s
+}
+
+/// A room 4 × 2.5 × 3 m with a rough metal floor (roughness 0.3) and a table with a polished
+/// top (a dielectric layer of roughness 0.1 over dark wood) on metal legs, lit by a 0.8 × 0.8 m
+/// light on the ceiling; white walls, one red and one green. Light the floor and the table
+/// reflect glossily reaches the walls and the ceiling: the scene of issue 31's gather test.
+pub fn glossy_room() -> Scene {
+    let camera =
+        Camera { eye: Vec3::new(1.7, 1.5, 1.3), target: Vec3::new(-0.3, 0.6, -0.5), up: Vec3::Y, fov_y_deg: 60.0 };
+    let mut s = Scene::new(camera);
+    let white = s.add_material(Material::diffuse("white", Vec3::splat(0.75)));
+    let red = s.add_material(Material::diffuse("red", Vec3::new(0.63, 0.07, 0.05)));
+    let green = s.add_material(Material::diffuse("green", Vec3::new(0.12, 0.45, 0.09)));
+    let floor = s.add_material(Material {
+        metallic: 1.0,
+        roughness: 0.3,
+        ..Material::diffuse("rough metal floor", Vec3::new(0.91, 0.78, 0.55))
+    });
+    let top = s.add_material(Material {
+        specular: 1.0,
+        roughness: 0.1,
+        ..Material::diffuse("polished table top", Vec3::new(0.30, 0.14, 0.06))
+    });
+    let legs = s.add_material(Material {
+        metallic: 1.0,
+        roughness: 0.4,
+        ..Material::diffuse("table legs", Vec3::new(0.9, 0.9, 0.9))
+    });
+    let light =
+        s.add_material(Material { emission: Vec3::splat(10.0), ..Material::diffuse("light", Vec3::splat(0.75)) });
+    let (lo, hi) = (Vec3::new(-2.0, 0.0, -1.5), Vec3::new(2.0, 2.5, 1.5));
+    let c = |x: f32, y: f32, z: f32| Vec3::new(x, y, z);
+    // The shell, facing in: floor, ceiling, back (z = lo), front (z = hi), left red, right green.
+    add_quad_facing(
+        &mut s,
+        [c(lo.x, 0.0, lo.z), c(hi.x, 0.0, lo.z), c(hi.x, 0.0, hi.z), c(lo.x, 0.0, hi.z)],
+        Vec3::Y,
+        floor,
+    );
+    add_quad_facing(
+        &mut s,
+        [c(lo.x, hi.y, lo.z), c(hi.x, hi.y, lo.z), c(hi.x, hi.y, hi.z), c(lo.x, hi.y, hi.z)],
+        -Vec3::Y,
+        white,
+    );
+    add_quad_facing(
+        &mut s,
+        [c(lo.x, 0.0, lo.z), c(hi.x, 0.0, lo.z), c(hi.x, hi.y, lo.z), c(lo.x, hi.y, lo.z)],
+        Vec3::Z,
+        white,
+    );
+    add_quad_facing(
+        &mut s,
+        [c(lo.x, 0.0, hi.z), c(hi.x, 0.0, hi.z), c(hi.x, hi.y, hi.z), c(lo.x, hi.y, hi.z)],
+        -Vec3::Z,
+        white,
+    );
+    add_quad_facing(
+        &mut s,
+        [c(lo.x, 0.0, lo.z), c(lo.x, 0.0, hi.z), c(lo.x, hi.y, hi.z), c(lo.x, hi.y, lo.z)],
+        Vec3::X,
+        red,
+    );
+    add_quad_facing(
+        &mut s,
+        [c(hi.x, 0.0, lo.z), c(hi.x, 0.0, hi.z), c(hi.x, hi.y, hi.z), c(hi.x, hi.y, lo.z)],
+        -Vec3::X,
+        green,
+    );
+    // The table: a top 1.4 × 0.05 × 0.8 m at 0.75 m on four legs 5 cm square.
+    let (t_lo, t_hi) = (c(-1.2, 0.70, -0.9), c(0.2, 0.75, -0.1));
+    add_box(&mut s, t_lo, t_hi, top);
+    for (x, z) in [
+        (t_lo.x + 0.05, t_lo.z + 0.05),
+        (t_hi.x - 0.10, t_lo.z + 0.05),
+        (t_lo.x + 0.05, t_hi.z - 0.10),
+        (t_hi.x - 0.10, t_hi.z - 0.10),
+    ] {
+        add_box(&mut s, c(x, 0.0, z), c(x + 0.05, t_lo.y, z + 0.05), legs);
+    }
+    let y = hi.y - 0.01;
+    add_quad_facing(&mut s, [c(-0.9, y, -0.4), c(-0.1, y, -0.4), c(-0.1, y, 0.4), c(-0.9, y, 0.4)], -Vec3::Y, light);
     s
 }
 

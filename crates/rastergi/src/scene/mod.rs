@@ -126,12 +126,20 @@ pub struct Material {
     /// Weight of the dielectric specular layer (`KHR_materials_specular`'s specularFactor):
     /// 1 for glTF materials, 0 for a plain Lambertian surface.
     pub specular: f32,
+    /// The layer's colour at normal incidence (`KHR_materials_specular`'s
+    /// specularColorFactor; [`crate::bsdf::Bsdf::specular_color`]): white by default.
+    pub specular_color: Vec3,
     /// Index of refraction (`KHR_materials_ior`, MTL `Ni`).
     pub ior: f32,
     /// `KHR_materials_transmission`'s factor: the share of the dielectric that is glass.
     pub transmission: f32,
     /// Thin-walled glass (glTF transmission without `KHR_materials_volume`): no refraction.
     pub thin: bool,
+    /// The attenuation coefficient σ (per unit length, per channel) inside solid glass
+    /// (`KHR_materials_volume`: σ = −ln(attenuationColor)/attenuationDistance): light that
+    /// crosses a length t of it is scaled by exp(−σt) (Beer–Lambert). Zero: clear. Read where
+    /// the glass is a solid (not `thin`) and transmits; media do not nest.
+    pub attenuation: Vec3,
     /// Rough metal with its multiple-scattering energy compensation ([`crate::bsdf`]); false:
     /// single scattering, the model of Mitsuba 3's `roughconductor` ([`Scene::single_scattering`]).
     pub multiple_scattering: bool,
@@ -156,11 +164,30 @@ impl Material {
             roughness: 1.0,
             metal_rough_texture: None,
             specular: 0.0,
+            specular_color: Vec3::ONE,
             ior: 1.5,
             transmission: 0.0,
             thin: false,
+            attenuation: Vec3::ZERO,
             multiple_scattering: true,
         }
+    }
+
+    /// The attenuation coefficient that applies inside this material ([`Self::attenuation`]
+    /// where it is solid glass, else zero).
+    pub fn medium(&self) -> Vec3 {
+        if self.thin || self.transmission <= 0.0 { Vec3::ZERO } else { self.attenuation.max(Vec3::ZERO) }
+    }
+
+    /// Beer–Lambert along a segment of length `t` that ends on a surface of this material
+    /// arriving along `d` at geometric normal `n`: exp(−σt) where the segment ran inside the
+    /// solid it bounds (it meets the back face), else 1 (`segment_transmittance` in WGSL).
+    pub fn segment_transmittance(&self, d: Vec3, n: Vec3, t: f32) -> Vec3 {
+        let sigma = self.medium();
+        if sigma == Vec3::ZERO || d.dot(n) <= 0.0 {
+            return Vec3::ONE;
+        }
+        (-sigma * t).exp()
     }
 
     /// The scattering model with base colour `base` (the albedo × its texel) and the
@@ -172,6 +199,7 @@ impl Material {
             metallic: (self.metallic * mr.z).clamp(0.0, 1.0),
             alpha: r * r,
             specular: self.specular,
+            specular_color: self.specular_color,
             ior: self.ior,
             transmission: self.transmission,
             thin: self.thin,

@@ -1,5 +1,5 @@
 //! Materials: glTF's metallic-roughness model, its extensions (emissive strength, ior,
-//! transmission, volume, specular), alpha modes, normal maps and textures with their
+//! transmission, volume with its attenuation, specular), alpha modes, normal maps and textures with their
 //! KHR_texture_transform.
 
 use super::*;
@@ -62,19 +62,38 @@ impl Loader<'_> {
                 // ior 0 is the extension's "infinite": a perfect reflector; clamped to 10⁴.
                 let ior = if ior == 0.0 { 1e4 } else { ior };
                 let specular = m.specular();
-                if specular.as_ref().is_some_and(|s| {
-                    s.specular_color_factor() != [1.0; 3]
-                        || s.specular_texture().is_some()
-                        || s.specular_color_texture().is_some()
-                }) {
+                if specular
+                    .as_ref()
+                    .is_some_and(|s| s.specular_texture().is_some() || s.specular_color_texture().is_some())
+                {
                     log::warn!(
-                        "{what}: KHR_materials_specular's colour and textures are not read; its specularFactor is"
+                        "{what}: KHR_materials_specular's textures are not read; its specularFactor and specularColorFactor are"
                     );
+                }
+                let specular_color = Vec3::from(specular.as_ref().map_or([1.0; 3], |s| s.specular_color_factor()));
+                if !(specular_color.is_finite() && specular_color.min_element() >= 0.0) {
+                    return Err(format!("{what}: specularColorFactor {specular_color} is not a non-negative colour"));
                 }
                 let specular = unit("specularFactor", specular.map_or(1.0, |s| s.specular_factor()))?;
                 // A volume makes the glass a refracting solid; thickness 0 (its default) or no
                 // volume: thin-walled, as the extension says.
                 let thin = m.volume().is_none_or(|v| v.thickness_factor() <= 0.0);
+                // Beer–Lambert inside the solid: σ = −ln(attenuationColor)/attenuationDistance
+                // (the extension's definition; distance +∞, its default, is clear glass). The
+                // thickness itself (and its texture) is for renderers without the geometry.
+                let attenuation = match m.volume() {
+                    Some(v) if !thin => {
+                        let (d, c) = (v.attenuation_distance(), Vec3::from(v.attenuation_color()));
+                        if d.is_nan() || d <= 0.0 {
+                            return Err(format!("{what}: attenuationDistance {d} is not positive"));
+                        }
+                        if !(c.min_element() >= 0.0 && c.max_element() <= 1.0) {
+                            return Err(format!("{what}: attenuationColor {c} is outside [0, 1]"));
+                        }
+                        if d.is_infinite() { Vec3::ZERO } else { -c.max(Vec3::splat(1e-30)).ln() / d }
+                    }
+                    _ => Vec3::ZERO,
+                };
                 Material {
                     albedo_texture: base.map(|t| t.texture),
                     albedo_transform: base.map_or(UvTransform::IDENTITY, |t| t.transform),
@@ -89,9 +108,11 @@ impl Loader<'_> {
                     roughness,
                     metal_rough_texture,
                     specular,
+                    specular_color,
                     ior,
                     transmission,
                     thin,
+                    attenuation,
                     two_sided: m.double_sided(),
                     ..Material::diffuse(
                         &m.name().map_or_else(|| format!("material {index}"), str::to_owned),

@@ -14,10 +14,13 @@
 //! - **Materials** (glTF's metallic-roughness model, [`crate::bsdf`]): base colour =
 //!   baseColorFactor.rgb × baseColorTexture (sRGB); metallicFactor and roughnessFactor ×
 //!   metallicRoughnessTexture's B and G (linear); `KHR_materials_specular`'s specularFactor
-//!   (its colour and textures are not read, with a warning), `KHR_materials_ior`,
+//!   and specularColorFactor (the layer's F₀ = min(f₀(η)·colour, 1); its textures are not
+//!   read, with a warning), `KHR_materials_ior`,
 //!   `KHR_materials_transmission`'s factor (its texture is not read, with a warning) and
 //!   `KHR_materials_volume` (a thickness > 0 makes the glass a refracting solid; without a
-//!   volume it is thin-walled, as the extension says; attenuation is not read);
+//!   volume it is thin-walled, as the extension says; its attenuationColor and
+//!   attenuationDistance give the solid's Beer–Lambert attenuation σ = −ln(c)/d,
+//!   [`super::Material::attenuation`]);
 //!   emitted radiance = emissiveFactor × KHR_materials_emissive_strength × emissiveTexture
 //!   (sRGB, per texel); `doubleSided` → two-sided reflection (glTF's default is one-sided).
 //!   `alphaMode` MASK (a cut-out at `alphaCutoff`, default 0.5) and BLEND (stochastic

@@ -583,7 +583,7 @@ impl Bsdf {
     }
 
     fn sample_glass(&self, wo: Vec3, u0: f32, u1: f32, u2: f32, p: f32, transport: Transport) -> Option<BsdfSample> {
-        let scale = 1.0 - self.metallic;
+        let scale = (1.0 - self.metallic) * self.transmission;
         if self.smooth() {
             let cos_o = wo.z;
             if self.thin {

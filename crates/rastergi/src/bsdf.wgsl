@@ -451,7 +451,7 @@ fn bsdf_sample(b: Bsdf, wo: vec3f, u: vec3f, transport: u32) -> BsdfSample {
 }
 
 fn sample_glass(b: Bsdf, wo: vec3f, u0: f32, u1: f32, u2: f32, p: f32, transport: u32) -> BsdfSample {
-    let scale = 1.0 - b.metallic;
+    let scale = (1.0 - b.metallic) * b.transmission;
     if bsdf_is_smooth(b) {
         if b.thin {
             let r = slab_reflectance(fresnel_dielectric(abs(wo.z), b.ior));

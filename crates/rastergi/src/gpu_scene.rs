@@ -91,6 +91,10 @@ pub struct GpuMaterialMaps {
     pub opacity_map: GpuTextureSlot,
     pub normal_map: GpuTextureSlot,
     pub metal_rough_map: GpuTextureSlot,
+    /// transmissionTexture (R), specularTexture (A), specularColorTexture (RGB).
+    pub transmission_map: GpuTextureSlot,
+    pub specular_map: GpuTextureSlot,
+    pub specular_color_map: GpuTextureSlot,
 }
 
 impl GpuMaterial {
@@ -130,6 +134,9 @@ impl GpuMaterial {
             opacity_map: GpuTextureSlot::new(m.opacity_texture),
             normal_map: GpuTextureSlot::new(m.normal_texture),
             metal_rough_map: GpuTextureSlot::new(m.metal_rough_texture),
+            transmission_map: GpuTextureSlot::new(m.transmission_texture),
+            specular_map: GpuTextureSlot::new(m.specular_texture),
+            specular_color_map: GpuTextureSlot::new(m.specular_color_texture),
         };
         (material, maps)
     }
@@ -226,8 +233,14 @@ impl PreparedScene {
     /// at `lod` (`surface_bsdf(surface_at(…))` in WGSL).
     pub fn bsdf_at(&self, tri: usize, b1: f32, b2: f32, lod: f32) -> crate::bsdf::Bsdf {
         let m = self.scene.material_of(tri);
-        let mr = m.metal_rough_texture.map_or(Vec3::ONE, |t| self.texel(t, tri, b1, b2, 0.0).truncate());
-        m.bsdf(self.albedo_at(tri, b1, b2, lod), mr)
+        let texel = |t: Option<TextureRef>| t.map(|t| self.texel(t, tri, b1, b2, 0.0));
+        let texels = crate::scene::Texels {
+            metal_rough: texel(m.metal_rough_texture).map_or(Vec3::ONE, |t| t.truncate()),
+            transmission: texel(m.transmission_texture).map_or(1.0, |t| t.x),
+            specular: texel(m.specular_texture).map_or(1.0, |t| t.w),
+            specular_color: texel(m.specular_color_texture).map_or(Vec3::ONE, |t| t.truncate()),
+        };
+        m.bsdf(self.albedo_at(tri, b1, b2, lod), &texels)
     }
 
     /// The emitted radiance at barycentrics (b1, b2) of triangle `tri` (`surface_at(…).emission`).

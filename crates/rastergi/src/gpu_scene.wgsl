@@ -69,6 +69,10 @@ struct MaterialMaps {
     normal_map: TextureSlot,
     // Linear: roughness × G, metallic × B.
     metal_rough_map: TextureSlot,
+    // Linear: transmission × R; specular × A; sRGB: specular colour × RGB.
+    transmission_map: TextureSlot,
+    specular_map: TextureSlot,
+    specular_color_map: TextureSlot,
 }
 
 // A compressed node of the 4-wide BVH (bvh/wide.rs, WideNode): axis a's grid step is
@@ -388,11 +392,23 @@ fn surface_at(tri: u32, b1: f32, b2: f32, lod: f32) -> Surface {
     s.ior = m.ior;
     s.transmission = m.transmission;
     if textured {
-        let map = material_maps[mi].metal_rough_map;
-        if map.layer != NO_TEXTURE {
-            let mr = slot_sample(map, uv, 0.0);
+        let mr_map = material_maps[mi].metal_rough_map;
+        if mr_map.layer != NO_TEXTURE {
+            let mr = slot_sample(mr_map, uv, 0.0);
             s.roughness *= mr.g;
             s.metallic *= mr.b;
+        }
+        let t_map = material_maps[mi].transmission_map;
+        if t_map.layer != NO_TEXTURE {
+            s.transmission = clamp(s.transmission * slot_sample(t_map, uv, 0.0).r, 0.0, 1.0);
+        }
+        let s_map = material_maps[mi].specular_map;
+        if s_map.layer != NO_TEXTURE {
+            s.specular = clamp(s.specular * slot_sample(s_map, uv, 0.0).a, 0.0, 1.0);
+        }
+        let c_map = material_maps[mi].specular_color_map;
+        if c_map.layer != NO_TEXTURE {
+            s.specular_color *= slot_sample(c_map, uv, 0.0).rgb;
         }
     }
     return s;

@@ -86,7 +86,18 @@ fn twins() -> Vec<Twin> {
         twin!(
             GpuMaterialMaps,
             "MaterialMaps",
-            [alpha_cutoff, normal_scale, albedo_map, emission_map, opacity_map, normal_map, metal_rough_map]
+            [
+                alpha_cutoff,
+                normal_scale,
+                albedo_map,
+                emission_map,
+                opacity_map,
+                normal_map,
+                metal_rough_map,
+                transmission_map,
+                specular_map,
+                specular_color_map
+            ]
         ),
         twin!(WideNode, "WideNode", [origin, exponents, lo, counts, hi, child]),
         twin!(LightEntry, "LightEntry", [triangle, cdf, pmf, area]),

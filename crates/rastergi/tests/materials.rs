@@ -225,9 +225,13 @@ fn mtl_materials_map_to_the_model() {
 fn gltf_materials_map_to_the_model() {
     use serde_json::json;
     let dir = tempfile::tempdir().unwrap();
-    let positions: Vec<f32> = vec![0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+    // Three corners, then their texture coordinates (all zero).
+    let positions: Vec<f32> = vec![0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
     let bytes: Vec<u8> = bytemuck::cast_slice(&positions).to_vec();
     std::fs::write(dir.path().join("t.bin"), &bytes).unwrap();
+    // One texel, (R, G, B, A) = (51, 255, 187, 102): transmission × 0.2 (R, linear), specular ×
+    // 0.4 (A, linear), specular colour × sRGB⁻¹(0.2, 1, 0.733).
+    image::RgbaImage::from_pixel(1, 1, image::Rgba([51, 255, 187, 102])).save(dir.path().join("t.png")).unwrap();
     let materials = json!([
         { "name": "default" },
         { "name": "rough plastic", "pbrMetallicRoughness": { "metallicFactor": 0.0, "roughnessFactor": 0.25 } },
@@ -240,19 +244,26 @@ fn gltf_materials_map_to_the_model() {
           "extensions": { "KHR_materials_transmission": { "transmissionFactor": 1.0 },
                           "KHR_materials_volume": { "thicknessFactor": 1.0 } } },
         { "name": "window", "pbrMetallicRoughness": { "metallicFactor": 0.0 },
-          "extensions": { "KHR_materials_transmission": { "transmissionFactor": 0.9 } } },
+          "extensions": { "KHR_materials_transmission": { "transmissionFactor": 0.9,
+                                                          "transmissionTexture": { "index": 0 } } } },
         { "name": "matte", "extensions": { "KHR_materials_specular": { "specularFactor": 0.0 } } },
         { "name": "tinted", "extensions": { "KHR_materials_specular": { "specularFactor": 0.5,
-                                                                       "specularColorFactor": [2.0, 1.0, 0.5] } } }
+                                                                       "specularColorFactor": [2.0, 1.0, 0.5],
+                                                                       "specularTexture": { "index": 0 },
+                                                                       "specularColorTexture": { "index": 0 } } } }
     ]);
-    let primitives: Vec<_> = (0..7).map(|i| json!({ "attributes": { "POSITION": 0 }, "material": i })).collect();
+    let primitives: Vec<_> =
+        (0..7).map(|i| json!({ "attributes": { "POSITION": 0, "TEXCOORD_0": 1 }, "material": i })).collect();
     let doc = json!({
         "asset": { "version": "2.0" },
         "extensionsUsed": ["KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume", "KHR_materials_specular"],
         "buffers": [{ "uri": "t.bin", "byteLength": bytes.len() }],
-        "bufferViews": [{ "buffer": 0, "byteOffset": 0, "byteLength": bytes.len() }],
-        "accessors": [{ "bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0] }],
+        "bufferViews": [{ "buffer": 0, "byteOffset": 0, "byteLength": 36 }, { "buffer": 0, "byteOffset": 36, "byteLength": 24 }],
+        "accessors": [{ "bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0] },
+                      { "bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2" }],
         "materials": materials,
+        "images": [{ "uri": "t.png" }],
+        "textures": [{ "source": 0 }],
         "meshes": [{ "primitives": primitives }],
         "nodes": [{ "mesh": 0 }],
         "scenes": [{ "nodes": [0] }],
@@ -279,6 +290,20 @@ fn gltf_materials_map_to_the_model() {
     assert_eq!(m("matte").specular_color, Vec3::ONE);
     let t = m("tinted");
     assert_eq!((t.specular, t.specular_color), (0.5, Vec3::new(2.0, 1.0, 0.5)));
+    // The textures multiply the factors at every point (the triangles' texture coordinates are
+    // all zero; one texel).
+    assert!(w.transmission_texture.is_some() && t.specular_texture.is_some() && t.specular_color_texture.is_some());
+    let prepared = rastergi::gpu_scene::PreparedScene::new(&scene);
+    let at = |name: &str| {
+        let k = prepared.scene.material_ids.iter().position(|&i| prepared.scene.materials[i as usize].name == name);
+        prepared.bsdf_at(k.unwrap(), 0.3, 0.3, 0.0)
+    };
+    assert!((at("window").transmission - 0.9 * 0.2).abs() < 1e-3, "{:?}", at("window"));
+    let tb = at("tinted");
+    let srgb = |c: f32| rastergi::textures::srgb_to_linear((c * 255.0).round() as u8);
+    let want = Vec3::new(2.0 * srgb(0.2), srgb(1.0), 0.5 * srgb(187.0 / 255.0));
+    assert!((tb.specular - 0.5 * 0.4).abs() < 1e-3, "{tb:?}");
+    assert!((tb.specular_color - want).abs().max_element() < 2e-3, "{tb:?} vs {want}");
     assert_eq!(w.attenuation, Vec3::ZERO);
     // A distance that is not positive is refused with one line naming the material.
     let mut bad = doc.clone();
@@ -305,7 +330,20 @@ fn photons_pass_a_thin_glass_pane_as_the_slab_formula_says() {
     };
     let r = rastergi::bsdf::fresnel_dielectric(1.0, 1.5);
     let transmitted = 1.0 - 2.0 * r / (1.0 + r);
-    photons_under_glass(pane, None, Vec3::splat(transmitted));
+    photons_under_glass(pane.clone(), None, None, Vec3::splat(transmitted));
+    // A transmissionTexture (linear R = 128/255 everywhere) scales the glass's share: the
+    // rest of the pane is its opaque layer over a white base, which reflects, so the floor
+    // receives t·(1 − R').
+    let t = 128.0 / 255.0;
+    let texture = rastergi::scene::Texture {
+        name: "transmission".into(),
+        width: 1,
+        height: 1,
+        texels: vec![[128, 0, 0, 255]],
+        linear: true,
+    };
+    let textured = Material { transmission_texture: Some(rastergi::scene::TextureRef::new(0)), ..pane };
+    photons_under_glass(textured, None, Some(texture), Vec3::splat(t * transmitted));
 }
 
 /// A solid glass slab 0.5 thick (η 1.5) whose volume attenuates (`KHR_materials_volume`,
@@ -323,7 +361,7 @@ fn photons_through_attenuating_solid_glass_fall_as_beer_lambert_says() {
         attenuation: sigma,
         ..Material::diffuse("tinted glass", Vec3::ONE)
     };
-    photons_under_glass(slab, Some(0.5), slab_transmittance(sigma, 0.5));
+    photons_under_glass(slab, Some(0.5), None, slab_transmittance(sigma, 0.5));
 }
 
 /// What a slab of thickness d (η 1.5, attenuation σ) transmits at normal incidence, all
@@ -356,16 +394,25 @@ fn add_box(s: &mut rastergi::scene::Scene, lo: Vec3, hi: Vec3, material: u32) {
 }
 
 /// A black floor 4 × 4 at y = 0 under `glass` — a pane 2 × 2 at y = 1, or a slab 2 × 2 of
-/// thickness `slab` below y = 1 — and a sun straight down: the photon map's irradiance (GPU
+/// thickness `slab` below y = 1 — (with the scene's texture 0 where given) and a sun straight
+/// down: the photon map's irradiance (GPU
 /// and CPU twin) under the glass is `transmitted` and beside it 1, within 4 standard errors
 /// of the photons' own noise.
-fn photons_under_glass(glass: rastergi::scene::Material, slab: Option<f32>, transmitted: Vec3) {
+fn photons_under_glass(
+    glass: rastergi::scene::Material,
+    slab: Option<f32>,
+    texture: Option<rastergi::scene::Texture>,
+    transmitted: Vec3,
+) {
     use rastergi::gpu_scene::{GpuScene, PreparedScene};
     use rastergi::photons::map::GridSpec;
     use rastergi::photons::{PhotonSettings, cpu, gpu::GpuPhotonMap};
     use rastergi::scene::{Camera, Light, Material, Scene};
     let camera = Camera { eye: Vec3::new(0.0, 3.0, 0.001), target: Vec3::ZERO, up: Vec3::Z, fov_y_deg: 60.0 };
     let mut s = Scene::new(camera);
+    if let Some(t) = texture {
+        s.add_texture(t);
+    }
     let floor = s.add_material(Material::diffuse("floor", Vec3::ZERO));
     let glass = s.add_material(glass);
     let quad = |h: f32, y: f32| [Vec3::new(-h, y, h), Vec3::new(h, y, h), Vec3::new(h, y, -h), Vec3::new(-h, y, -h)];

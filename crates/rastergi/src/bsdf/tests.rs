@@ -262,6 +262,10 @@ fn white_furnace() {
             ("smooth specular layer over diffuse", plastic(white, 0.0)),
             ("glass", glass(0.0, false)),
             ("thin glass", glass(0.0, true)),
+            // Half glass, half a smooth layer over white: each half lossless, weighted by its
+            // share (the glass's delta lobes carry (1 − m)·t of the energy, not 1 − m).
+            ("half smooth glass", Bsdf { transmission: 0.5, ..plastic(white, 0.0) }),
+            ("half smooth thin glass", Bsdf { transmission: 0.5, thin: true, ..plastic(white, 0.0) }),
         ] {
             for w in [wo, -wo] {
                 let (a, se) = albedo_by_sampling(&b, w, 200_000, Transport::Importance);

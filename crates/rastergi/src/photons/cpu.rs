@@ -105,8 +105,14 @@ fn trace_photon(
         let n = triangle_normal(tri);
         flux *= material.segment_transmittance(dir, n, hit.t);
         let front = n.dot(dir) < 0.0;
-        // Glass is entered and left by either face.
-        if !front && !material.two_sided && material.transmission <= 0.0 {
+        // Glass is entered and left by either face (the transmission at the point: its
+        // factor × transmissionTexture, as surface_at reads it).
+        if !front
+            && !material.two_sided
+            && (material.transmission <= 0.0
+                || material.transmission_texture.is_some()
+                    && prepared.bsdf_at(hit.triangle as usize, hit.b1, hit.b2, 0.0).transmission <= 0.0)
+        {
             break;
         }
         let n = if front { n } else { -n };

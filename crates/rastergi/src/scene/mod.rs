@@ -129,10 +129,16 @@ pub struct Material {
     /// The layer's colour at normal incidence (`KHR_materials_specular`'s
     /// specularColorFactor; [`crate::bsdf::Bsdf::specular_color`]): white by default.
     pub specular_color: Vec3,
+    /// `KHR_materials_specular`'s specularTexture (linear, A × `specular`) and
+    /// specularColorTexture (sRGB, RGB × `specular_color`).
+    pub specular_texture: Option<TextureRef>,
+    pub specular_color_texture: Option<TextureRef>,
     /// Index of refraction (`KHR_materials_ior`, MTL `Ni`).
     pub ior: f32,
     /// `KHR_materials_transmission`'s factor: the share of the dielectric that is glass.
     pub transmission: f32,
+    /// `KHR_materials_transmission`'s transmissionTexture (linear, R × `transmission`).
+    pub transmission_texture: Option<TextureRef>,
     /// Thin-walled glass (glTF transmission without `KHR_materials_volume`): no refraction.
     pub thin: bool,
     /// The attenuation coefficient σ (per unit length, per channel) inside solid glass
@@ -165,8 +171,11 @@ impl Material {
             metal_rough_texture: None,
             specular: 0.0,
             specular_color: Vec3::ONE,
+            specular_texture: None,
+            specular_color_texture: None,
             ior: 1.5,
             transmission: 0.0,
+            transmission_texture: None,
             thin: false,
             attenuation: Vec3::ZERO,
             multiple_scattering: true,
@@ -190,18 +199,18 @@ impl Material {
         (-sigma * t).exp()
     }
 
-    /// The scattering model with base colour `base` (the albedo × its texel) and the
-    /// metallic-roughness texel `mr` (G roughness, B metallic; ones without a texture).
-    pub fn bsdf(&self, base: Vec3, mr: Vec3) -> crate::bsdf::Bsdf {
-        let r = (self.roughness * mr.y).clamp(0.0, 1.0);
+    /// The scattering model with base colour `base` (the albedo × its texel) and the texels
+    /// of its other textures at the point ([`Texels`]: ones without them).
+    pub fn bsdf(&self, base: Vec3, t: &Texels) -> crate::bsdf::Bsdf {
+        let r = (self.roughness * t.metal_rough.y).clamp(0.0, 1.0);
         crate::bsdf::Bsdf {
             base,
-            metallic: (self.metallic * mr.z).clamp(0.0, 1.0),
+            metallic: (self.metallic * t.metal_rough.z).clamp(0.0, 1.0),
             alpha: r * r,
-            specular: self.specular,
-            specular_color: self.specular_color,
+            specular: (self.specular * t.specular).clamp(0.0, 1.0),
+            specular_color: self.specular_color * t.specular_color,
             ior: self.ior,
-            transmission: self.transmission,
+            transmission: (self.transmission * t.transmission).clamp(0.0, 1.0),
             thin: self.thin,
             multiple_scattering: self.multiple_scattering,
         }
@@ -209,7 +218,8 @@ impl Material {
 
     /// Whether eye and gather rays go on through it rather than stop (`surface_passes_rays` in
     /// WGSL, [`crate::specular`]): no diffuse base, and perfectly specular — a smooth metal — or
-    /// glass, rough or smooth; or one whose roughness a texture sets. Scenes with such
+    /// glass, rough or smooth; or one whose roughness a texture sets (a transmissionTexture only
+    /// lowers the transmission below its factor, so the factor decides). Scenes with such
     /// materials get the eye's specular chains and the photon map's caustic twins.
     pub fn passes_rays(&self) -> bool {
         let opaque = (1.0 - self.metallic.clamp(0.0, 1.0)) * (1.0 - self.transmission);
@@ -255,6 +265,26 @@ impl Material {
             .chain(self.opacity_texture)
             .chain(self.normal_texture)
             .chain(self.metal_rough_texture)
+            .chain(self.transmission_texture)
+            .chain(self.specular_texture)
+            .chain(self.specular_color_texture)
+    }
+}
+
+/// What a material's textures other than the base colour's say at a point, each the factor its
+/// texture multiplies (ones where it has none): the metallic-roughness texel (G roughness, B
+/// metallic), transmissionTexture's R, specularTexture's A and specularColorTexture's RGB.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Texels {
+    pub metal_rough: Vec3,
+    pub transmission: f32,
+    pub specular: f32,
+    pub specular_color: Vec3,
+}
+
+impl Default for Texels {
+    fn default() -> Self {
+        Self { metal_rough: Vec3::ONE, transmission: 1.0, specular: 1.0, specular_color: Vec3::ONE }
     }
 }
 

@@ -51,9 +51,8 @@ impl Loader<'_> {
                 let metallic = unit("metallicFactor", pbr.metallic_factor())?;
                 let roughness = unit("roughnessFactor", pbr.roughness_factor())?;
                 let transmission = m.transmission();
-                if transmission.as_ref().is_some_and(|t| t.transmission_texture().is_some()) {
-                    log::warn!("{what}: transmissionTexture is not read; its transmissionFactor applies everywhere");
-                }
+                let transmission_info = transmission.as_ref().and_then(|t| t.transmission_texture());
+                let transmission_texture = texture(transmission_info.map(|i| (i.texture(), info_transform(&i))), true)?;
                 let transmission = unit("transmissionFactor", transmission.map_or(0.0, |t| t.transmission_factor()))?;
                 let ior = m.ior().unwrap_or(1.5);
                 if !(ior.is_finite() && (ior == 0.0 || ior >= 1.0)) {
@@ -62,14 +61,10 @@ impl Loader<'_> {
                 // ior 0 is the extension's "infinite": a perfect reflector; clamped to 10⁴.
                 let ior = if ior == 0.0 { 1e4 } else { ior };
                 let specular = m.specular();
-                if specular
-                    .as_ref()
-                    .is_some_and(|s| s.specular_texture().is_some() || s.specular_color_texture().is_some())
-                {
-                    log::warn!(
-                        "{what}: KHR_materials_specular's textures are not read; its specularFactor and specularColorFactor are"
-                    );
-                }
+                let specular_info = specular.as_ref().and_then(|s| s.specular_texture());
+                let specular_texture = texture(specular_info.map(|i| (i.texture(), info_transform(&i))), true)?;
+                let color_info = specular.as_ref().and_then(|s| s.specular_color_texture());
+                let specular_color_texture = texture(color_info.map(|i| (i.texture(), info_transform(&i))), false)?;
                 let specular_color = Vec3::from(specular.as_ref().map_or([1.0; 3], |s| s.specular_color_factor()));
                 if !(specular_color.is_finite() && specular_color.min_element() >= 0.0) {
                     return Err(format!("{what}: specularColorFactor {specular_color} is not a non-negative colour"));
@@ -109,8 +104,11 @@ impl Loader<'_> {
                     metal_rough_texture,
                     specular,
                     specular_color,
+                    specular_texture,
+                    specular_color_texture,
                     ior,
                     transmission,
+                    transmission_texture,
                     thin,
                     attenuation,
                     two_sided: m.double_sided(),
@@ -184,7 +182,7 @@ pub(super) fn parsed_normal_transform(
 }
 
 /// The TEXCOORD sets a material's textures read (base colour, emissive, normal map,
-/// metallic-roughness), each
+/// metallic-roughness, transmission, specular, specular colour), each
 /// overridden by its KHR_texture_transform's texCoord.
 pub(super) fn texture_sets(m: &::gltf::Material) -> Vec<u32> {
     let info = |i: ::gltf::texture::Info| i.texture_transform().and_then(|t| t.tex_coord()).unwrap_or(i.tex_coord());
@@ -193,5 +191,8 @@ pub(super) fn texture_sets(m: &::gltf::Material) -> Vec<u32> {
     let normal =
         m.normal_texture().map(|n| parsed_normal_transform(&n).and_then(|t| t.tex_coord).unwrap_or(n.tex_coord()));
     let metal_rough = m.pbr_metallic_roughness().metallic_roughness_texture().map(info);
-    base.into_iter().chain(emissive).chain(normal).chain(metal_rough).collect()
+    let transmission = m.transmission().and_then(|t| t.transmission_texture()).map(info);
+    let specular = m.specular().and_then(|s| s.specular_texture()).map(info);
+    let specular_color = m.specular().and_then(|s| s.specular_color_texture()).map(info);
+    [base, emissive, normal, metal_rough, transmission, specular, specular_color].into_iter().flatten().collect()
 }

@@ -14,9 +14,9 @@
 //! - **Materials** (glTF's metallic-roughness model, [`crate::bsdf`]): base colour =
 //!   baseColorFactor.rgb × baseColorTexture (sRGB); metallicFactor and roughnessFactor ×
 //!   metallicRoughnessTexture's B and G (linear); `KHR_materials_specular`'s specularFactor
-//!   and specularColorFactor (the layer's F₀ = min(f₀(η)·colour, 1); its textures are not
-//!   read, with a warning), `KHR_materials_ior`,
-//!   `KHR_materials_transmission`'s factor (its texture is not read, with a warning) and
+//!   × specularTexture's A and specularColorFactor × specularColorTexture (sRGB) (the layer's
+//!   F₀ = min(f₀(η)·colour, 1)), `KHR_materials_ior`,
+//!   `KHR_materials_transmission`'s factor × transmissionTexture's R (linear) and
 //!   `KHR_materials_volume` (a thickness > 0 makes the glass a refracting solid; without a
 //!   volume it is thin-walled, as the extension says; its attenuationColor and
 //!   attenuationDistance give the solid's Beer–Lambert attenuation σ = −ln(c)/d,

@@ -372,27 +372,6 @@ fn slab_transmittance(sigma: Vec3, d: f32) -> Vec3 {
     (1.0 - r).powi(2) * a / (Vec3::ONE - r * r * a * a)
 }
 
-/// Quads of an axis-aligned box, front faces outwards.
-fn add_box(s: &mut rastergi::scene::Scene, lo: Vec3, hi: Vec3, material: u32) {
-    for axis in 0..3 {
-        let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
-        for (side, at) in [(-1.0f32, lo[axis]), (1.0, hi[axis])] {
-            let corner = |a: f32, b: f32| {
-                let mut p = Vec3::ZERO;
-                p[axis] = at;
-                p[u] = a;
-                p[v] = b;
-                p
-            };
-            let mut q = [corner(lo[u], lo[v]), corner(hi[u], lo[v]), corner(hi[u], hi[v]), corner(lo[u], hi[v])];
-            if (q[1] - q[0]).cross(q[2] - q[0]).dot(Vec3::AXES[axis] * side) < 0.0 {
-                q.reverse();
-            }
-            s.add_quad(q, material);
-        }
-    }
-}
-
 /// A black floor 4 × 4 at y = 0 under `glass` — a pane 2 × 2 at y = 1, or a slab 2 × 2 of
 /// thickness `slab` below y = 1 — (with the scene's texture 0 where given) and a sun straight
 /// down: the photon map's irradiance (GPU
@@ -419,7 +398,9 @@ fn photons_under_glass(
     s.add_quad(quad(2.0, 0.0), floor);
     match slab {
         None => s.add_quad(quad(1.0, 1.0), glass),
-        Some(d) => add_box(&mut s, Vec3::new(-1.0, 1.0 - d, -1.0), Vec3::new(1.0, 1.0, 1.0), glass),
+        Some(d) => {
+            rastergi::scene::generate::add_box(&mut s, Vec3::new(-1.0, 1.0 - d, -1.0), Vec3::new(1.0, 1.0, 1.0), glass)
+        }
     }
     s.lights.push(Light::Distant { direction: -Vec3::Y, irradiance: Vec3::ONE, angular_radius: 0.0 });
     let settings = PhotonSettings { count: 1 << 20, seed: 5, grid_resolution: 8, ..Default::default() };
@@ -476,7 +457,7 @@ fn the_eye_sees_through_attenuating_solid_glass_as_beer_lambert_says() {
         attenuation: sigma,
         ..Material::diffuse("tinted glass", Vec3::ONE)
     });
-    add_box(&mut s, Vec3::new(-5.0, -5.0, -d / 2.0), Vec3::new(5.0, 5.0, d / 2.0), glass);
+    rastergi::scene::generate::add_box(&mut s, Vec3::new(-5.0, -5.0, -d / 2.0), Vec3::new(5.0, 5.0, d / 2.0), glass);
     let l = Vec3::new(1.0, 0.8, 0.6);
     s.environment = Some(std::sync::Arc::new(Environment::constant(l)));
     let r = rastergi::bsdf::fresnel_dielectric(1.0, 1.5);

@@ -197,11 +197,18 @@ fn photon_tracer_and_its_cpu_twin_read_the_same_specular_texels() {
     for m in &mut flat.materials {
         (m.specular_texture, m.specular_color_texture) = (None, None);
     }
-    let f = cpu::trace(&PreparedScene::new(&flat), c.grid(), &settings);
+    assert_changes_the_map(&flat, &c, &settings, diff, total, "without the specular textures");
+}
+
+/// The CPU map of `flat` (a scene without some of `c`'s textures) against `c`: it must differ
+/// clearly — over 10× the twins' difference `diff` (both relative to `total`) — or the twins'
+/// agreement would not see those textures read at the wrong place.
+fn assert_changes_the_map(flat: &Scene, c: &PhotonMap, settings: &PhotonSettings, diff: f64, total: f64, what: &str) {
+    let f = cpu::trace(&PreparedScene::new(flat), c.grid(), settings);
     let flat_diff: f64 =
         (0..f.flux.len()).map(|s| (0..3).map(|ch| (f.flux[s][ch] - c.flux[s][ch]).abs()).sum::<f64>()).sum();
-    println!("without the specular textures: relative L1 difference {:.3}", flat_diff / total);
-    assert!(flat_diff / total > 10.0 * diff / total, "the specular textures barely change the photon map");
+    println!("{what}: relative L1 difference {:.3}", flat_diff / total);
+    assert!(flat_diff / total > 10.0 * diff / total, "{what}: the map barely changes");
 }
 
 #[test]
@@ -215,7 +222,7 @@ fn photon_tracer_and_its_cpu_twin_read_the_same_texels() {
     let gpu = common::gpu();
     let scene = textured_room();
     let settings = PhotonSettings { count: 1 << 18, seed: 9, grid_resolution: 16, ..Default::default() };
-    let (g, c, diff, total) = same_seed_maps(&gpu, &scene, &settings);
+    let (_, c, diff, total) = same_seed_maps(&gpu, &scene, &settings);
     // The same scene with the textures' mean colours instead: the maps must differ clearly,
     // or the comparison above would not see a texture read at the wrong place.
     let mut flat = scene.clone();
@@ -226,11 +233,7 @@ fn photon_tracer_and_its_cpu_twin_read_the_same_texels() {
             m.albedo *= mean / tex.texels.len() as f32;
         }
     }
-    let f = cpu::trace(&PreparedScene::new(&flat), g.grid(), &settings);
-    let flat_diff: f64 =
-        (0..f.flux.len()).map(|s| (0..3).map(|ch| (f.flux[s][ch] - c.flux[s][ch]).abs()).sum::<f64>()).sum();
-    println!("untextured map: relative L1 difference {:.3}", flat_diff / total);
-    assert!(flat_diff / total > 10.0 * diff / total, "textures barely change the photon map");
+    assert_changes_the_map(&flat, &c, &settings, diff, total, "untextured map");
 }
 
 #[test]

@@ -58,7 +58,7 @@ fn add_quad_facing(scene: &mut Scene, mut q: [Vec3; 4], outward: Vec3, material:
 }
 
 /// An axis-aligned box, its faces looking outwards.
-fn add_box(scene: &mut Scene, lo: Vec3, hi: Vec3, material: u32) {
+pub fn add_box(scene: &mut Scene, lo: Vec3, hi: Vec3, material: u32) {
     add_box_facing(scene, lo, hi, material, 1.0);
 }
 

@@ -46,6 +46,32 @@
 //! Below [`SMOOTH_ALPHA`] the microfacet lobes are perfectly specular (Dirac deltas):
 //! [`Bsdf::eval`] and [`Bsdf::pdf`] leave them out and only [`Bsdf::sample`] produces them.
 //!
+//! A clear coat (`KHR_materials_clearcoat`: weight k, its own roughness α_c, η = 1.5) lies over
+//! all of that, f_base above:
+//!
+//! ```text
+//! f = k·F_k(ω_o·h)·D_c(h) G₁(ω_o) G₁(ω_i) / (4 |cos θ_o| |cos θ_i|) + (1 − k·E_k(μ_v))·f_base,
+//!     F_k = 0.04 + 0.96 (1 − ω_o·h)⁵,   E_k(μ) = 0.04·E₁(μ, α_c) + 0.96·E₅(μ, α_c)
+//! ```
+//!
+//! with μ_v the cosine of the direction the light leaves by (ω_o for radiance, ω_i for the
+//! photons' importance: the adjoint). The model under the coat gets what the coat does not
+//! reflect towards the viewer, its directional albedo k·E_k (Schlick's kF_k(μ_v) when smooth),
+//! so a coat over any white model reflects k·E_k + (1 − k·E_k) = 1: energy is conserved at
+//! every roughness, as in OpenPBR's and Cycles' albedo scaling. glTF's text scales the base
+//! by (1 − k·F_k(N·V)), the same form with the Fresnel term in place of the albedo, which
+//! loses what a rough coat's single scattering does not reflect. The factor depends on μ_v
+//! alone, so the coated model is not reciprocal; importance transport uses the adjoint
+//! (μ_v = μ_i), so photons scatter as the light does and every renderer solves the same
+//! transport, and the coated base's Lambertian part keeps the form a(μ_o)/π the photon map
+//! answers for. What albedo scaling gives up: a single beam of light is conserved only on
+//! average — one at normal incidence loses k(Ē_k − E_k(1)) (about 5 % of k for a smooth
+//! coat), one at grazing incidence, which the coat mostly reflects, gains up to k(1 − Ē_k).
+//! Uniform light (the white furnace) returns exactly what it brings. A reciprocal form,
+//! (1 − kE_k(μ_o))(1 − kE_k(μ_i))/(1 − kĒ_k), is exact only over a Lambertian base: over
+//! glTF's layered default it lost 9 % at 80°. The coat shares the base's shading normal
+//! (clearcoatNormalTexture is not read).
+//!
 //! Directions are unit vectors pointing away from the surface, in the shading frame
 //! ([`Frame`]): z is the front face's shading normal. Opaque lobes and thin glass reflect on
 //! the side ω_o lies on (the caller decides whether a back face reflects at all); solid glass
@@ -63,6 +89,9 @@ pub use albedo::ggx_albedo;
 
 /// GGX α below which the microfacet lobes are perfectly specular (roughness < 0.032).
 pub const SMOOTH_ALPHA: f32 = 1e-3;
+
+/// F₀ of the clear coat: η = 1.5, which `KHR_materials_clearcoat` fixes.
+pub const COAT_F0: f32 = 0.04;
 
 /// The scattering parameters at a point.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -87,6 +116,11 @@ pub struct Bsdf {
     pub thin: bool,
     /// The rough metal's energy compensation (module docs); off: single scattering only.
     pub multiple_scattering: bool,
+    /// Weight k of the clear coat over everything else (`KHR_materials_clearcoat`'s
+    /// clearcoatFactor; 0: none).
+    pub clearcoat: f32,
+    /// The coat's GGX α = clearcoatRoughness².
+    pub clearcoat_alpha: f32,
 }
 
 /// What a sampled or evaluated direction carries: radiance (eye paths; a refracted ray's
@@ -108,7 +142,7 @@ pub struct BsdfSample {
     pub delta: bool,
 }
 
-/// The lobes, in the order [`Bsdf::sample`] picks from.
+/// The lobes under the coat, in the order [`Bsdf::sample`] picks from (after the coat).
 const METAL: usize = 0;
 const LAYER: usize = 1;
 const DIFFUSE: usize = 2;
@@ -237,6 +271,8 @@ impl Bsdf {
             transmission: 0.0,
             thin: false,
             multiple_scattering: true,
+            clearcoat: 0.0,
+            clearcoat_alpha: 0.0,
         }
     }
 
@@ -263,7 +299,11 @@ impl Bsdf {
         };
         let layer = self.layer_albedo(cos_o);
         let dielectric = layer + (Vec3::ONE - layer) * self.base;
-        self.metallic * metal + opaque * dielectric + Vec3::splat((1.0 - self.metallic) * self.transmission * mean_f)
+        let under = self.metallic * metal
+            + opaque * dielectric
+            + Vec3::splat((1.0 - self.metallic) * self.transmission * mean_f);
+        let coat = self.coat_albedo(cos_o);
+        Vec3::splat(coat) + (1.0 - coat) * under
     }
 
     /// The albedo a(μ_o) of the model's Lambertian part f_L(ω_o, ω_i) = a(μ_o)/π, which the
@@ -272,29 +312,78 @@ impl Bsdf {
     /// by sampling the model (docs/design.md). a is the albedo of the cosine lobes: the
     /// diffuse base under the layer, (1 − m)(1 − t)·(1 − E_L(μ_o))·c, and the metal's
     /// multiple scattering, m·F_ms·(1 − E₁(μ_o)) — each lobe's ∫·cos θ_i dω_i, since
-    /// ∫(1 − E(μ))2μ dμ = 1 − Ē. The rest then reflects nothing on average where the light
-    /// is uniform; on a Lambertian surface it is zero.
+    /// ∫(1 − E(μ))2μ dμ = 1 − Ē — under a coat scaled by what it leaves, 1 − k·E_k(μ_o). The
+    /// rest then reflects nothing on average where the light is uniform; on a Lambertian
+    /// surface it is zero.
     pub fn lambertian_albedo(&self, cos_o: f32) -> Vec3 {
         let cos_o = cos_o.abs().min(1.0);
         let opaque = (1.0 - self.metallic) * (1.0 - self.transmission);
         let base = if self.specular == 0.0 { Vec3::ONE } else { Vec3::ONE - self.layer_albedo(cos_o) };
-        opaque * base * self.base + self.metallic * self.ms_fresnel() * self.ms_loss(cos_o)
+        (opaque * base * self.base + self.metallic * self.ms_fresnel() * self.ms_loss(cos_o))
+            * (1.0 - self.coat_albedo(cos_o))
+    }
+
+    /// Whether eye and gather rays pass it rather than stop (`surface_passes_rays` in WGSL): no
+    /// diffuse base, and glass, or smooth under a smooth coat or none.
+    pub fn passes_rays(&self) -> bool {
+        let opaque = (1.0 - self.metallic.clamp(0.0, 1.0)) * (1.0 - self.transmission);
+        opaque <= 0.0 && (self.transmission > 0.0 || (self.alpha < SMOOTH_ALPHA && !self.rough_coat()))
     }
 
     /// Whether the model is plain Lambertian (f = c/π).
-    /// Whether eye and gather rays pass it rather than stop (`surface_passes_rays` in WGSL): no
-    /// diffuse base, and smooth or glass.
-    pub fn passes_rays(&self) -> bool {
-        let opaque = (1.0 - self.metallic.clamp(0.0, 1.0)) * (1.0 - self.transmission);
-        opaque <= 0.0 && (self.alpha < SMOOTH_ALPHA || self.transmission > 0.0)
-    }
-
     pub fn is_lambertian(&self) -> bool {
-        self.metallic == 0.0 && self.transmission == 0.0 && self.specular == 0.0
+        self.metallic == 0.0 && self.transmission == 0.0 && self.specular == 0.0 && self.clearcoat <= 0.0
     }
 
     fn smooth(&self) -> bool {
         self.alpha < SMOOTH_ALPHA
+    }
+
+    fn coat_smooth(&self) -> bool {
+        self.clearcoat_alpha < SMOOTH_ALPHA
+    }
+
+    /// Whether a coat with a glossy (not perfectly specular) lobe lies on top.
+    fn rough_coat(&self) -> bool {
+        self.clearcoat > 0.0 && !self.coat_smooth()
+    }
+
+    /// What the coat reflects in all for a direction at cosine `cos`, its directional albedo
+    /// k·E_k(μ) = k(F₀E₁(μ, α_c) + (1 − F₀)E₅(μ, α_c)), F₀ = [`COAT_F0`]; kF_k(μ) when smooth.
+    /// Zero without a coat.
+    fn coat_albedo(&self, cos: f32) -> f32 {
+        if self.clearcoat <= 0.0 {
+            return 0.0;
+        }
+        let cos = cos.abs().min(1.0);
+        if self.coat_smooth() {
+            return self.clearcoat * schlick(Vec3::splat(COAT_F0), cos).x;
+        }
+        let [e1, e5] = ggx_albedo().at(cos, self.clearcoat_alpha);
+        self.clearcoat * (COAT_F0 * e1 + (1.0 - COAT_F0) * e5)
+    }
+
+    /// The share of the model under the coat, 1 − k·E_k(μ_v), μ_v the cosine of the direction
+    /// the light leaves by: ω_o for radiance, ω_i for importance (the adjoint; module docs).
+    fn coat_scale(&self, wo: Vec3, wi: Vec3, transport: Transport) -> f32 {
+        let view = if transport == Transport::Radiance { wo } else { wi };
+        1.0 - self.coat_albedo(view.z)
+    }
+
+    /// The coat's glossy lobe k·F_k(ω_o·h)·D G₁ G₁/(4 cos θ_o cos θ_i), on ω_o's side; zero
+    /// when smooth (a delta, sampled only) or absent.
+    fn coat_eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        if !self.rough_coat() {
+            return Vec3::ZERO;
+        }
+        let (o, i) = if wo.z < 0.0 { (-wo, -wi) } else { (wo, wi) };
+        if o.z <= 0.0 || i.z <= 0.0 {
+            return Vec3::ZERO;
+        }
+        let h = (o + i).normalize();
+        let a = self.clearcoat_alpha;
+        let spec = ggx_d(h, a) * ggx_g1(o, h, a) * ggx_g1(i, h, a) / (4.0 * o.z * i.z);
+        Vec3::splat(self.clearcoat * schlick(Vec3::splat(COAT_F0), o.dot(h)).x * spec)
     }
 
     /// Whether the metal lobe has its multiple-scattering lobe (module docs): compensated,
@@ -386,11 +475,13 @@ impl Bsdf {
             / (Vec3::ONE - self.layer_mean_albedo())
     }
 
-    /// The probabilities of picking each lobe for ω_o at |cos θ_o| = `cos_o`, in lobe order;
-    /// all zero when nothing scatters. They depend on ω_o alone, so [`Self::pdf`] can give
-    /// the density of any ω_i. The cosine-distributed lobe serves the diffuse base and the
-    /// metal's multiple-scattering lobe, weighted by what each reflects.
-    fn lobe_probabilities(&self, cos_o: f32) -> [f32; 4] {
+    /// The probabilities of picking the coat and each lobe under it for ω_o at |cos θ_o| =
+    /// `cos_o`, in lobe order; all zero when nothing scatters. They depend on ω_o alone, so
+    /// [`Self::pdf`] can give the density of any ω_i. The cosine-distributed lobe serves the
+    /// diffuse base and the metal's multiple-scattering lobe, weighted by what each reflects;
+    /// the coat is weighted by its Fresnel term kF_k(cos θ_o), the lobes under it by what it
+    /// leaves them.
+    fn lobe_probabilities(&self, cos_o: f32) -> (f32, [f32; 4]) {
         let m = self.metallic;
         let opaque = (1.0 - m) * (1.0 - self.transmission);
         let fs = self.layer_fresnel(cos_o);
@@ -400,8 +491,14 @@ impl Bsdf {
             opaque * mean((Vec3::ONE - fs) * self.base) + m * mean(self.ms_fresnel()) * self.ms_loss(cos_o),
             (1.0 - m) * self.transmission,
         ];
-        let total: f32 = w.iter().sum();
-        if total > 0.0 { w.map(|x| x / total) } else { [0.0; 4] }
+        let coat = if self.clearcoat > 0.0 { self.clearcoat * schlick(Vec3::splat(COAT_F0), cos_o).x } else { 0.0 };
+        let under: f32 = w.iter().sum::<f32>() * (1.0 - coat);
+        let total = coat + under;
+        if total <= 0.0 {
+            return (0.0, [0.0; 4]);
+        }
+        let scale = under / total / w.iter().sum::<f32>().max(f32::MIN_POSITIVE);
+        (coat / total, w.map(|x| x * scale))
     }
 
     /// A thin slab's pair (ω_o, ω_i) on ω_o's side: ω_o, ω_i reflected through the surface where
@@ -485,8 +582,18 @@ impl Bsdf {
         }
     }
 
-    /// f(ω_o, ω_i) of the non-specular lobes, in the shading frame.
+    /// f(ω_o, ω_i) of the non-specular lobes, in the shading frame: the coat's and, scaled by
+    /// what it leaves, the model's under it.
     pub fn eval(&self, wo: Vec3, wi: Vec3, transport: Transport) -> Vec3 {
+        let under = self.eval_under_coat(wo, wi, transport);
+        if self.clearcoat <= 0.0 {
+            return under;
+        }
+        self.coat_eval(wo, wi) + under * self.coat_scale(wo, wi, transport)
+    }
+
+    /// f_base(ω_o, ω_i): the non-specular lobes under the coat.
+    fn eval_under_coat(&self, wo: Vec3, wi: Vec3, transport: Transport) -> Vec3 {
         let mut f = Vec3::ZERO;
         let opaque = (1.0 - self.metallic) * (1.0 - self.transmission);
         if self.transmission > 0.0 && self.metallic < 1.0 {
@@ -512,31 +619,44 @@ impl Bsdf {
 
     /// The solid-angle density with which [`Self::sample`] draws ω_i (its non-specular lobes).
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        let p = self.lobe_probabilities(wo.z.abs());
+        let (p_coat, p) = self.lobe_probabilities(wo.z.abs());
         let mut pdf = p[GLASS] * self.glass_pdf(wo, wi);
         let (o, i) = if wo.z < 0.0 { (-wo, -wi) } else { (wo, wi) };
         if o.z <= 0.0 || i.z <= 0.0 {
             return pdf;
         }
         pdf += p[DIFFUSE] * i.z / std::f32::consts::PI;
+        let h = (o + i).normalize();
         if !self.smooth() {
-            let h = (o + i).normalize();
             pdf += (p[METAL] + p[LAYER]) * vndf_pdf(o, h, self.alpha) / (4.0 * o.dot(h));
+        }
+        if self.rough_coat() {
+            pdf += p_coat * vndf_pdf(o, h, self.clearcoat_alpha) / (4.0 * o.dot(h));
         }
         pdf
     }
 
-    /// A direction ω_i for ω_o from three uniforms: u0 picks the lobe (and, rescaled, glass's
-    /// reflection or transmission), (u1, u2) the direction in it. None where nothing scatters
-    /// or the sample leaves the lobe's support.
+    /// A direction ω_i for ω_o from three uniforms: u0 picks the lobe (the coat where u0 <
+    /// its probability; then, rescaled, glass's reflection or transmission), (u1, u2) the
+    /// direction in it. None where nothing scatters or the sample leaves the lobe's support.
     pub fn sample(&self, wo: Vec3, u: [f32; 3], transport: Transport) -> Option<BsdfSample> {
         if wo.z == 0.0 {
             return None;
         }
-        let p = self.lobe_probabilities(wo.z.abs());
-        // The lobe whose interval of [0, 1) holds u0 (the last one that can scatter when
+        let (p_coat, p) = self.lobe_probabilities(wo.z.abs());
+        let side = if wo.z < 0.0 { -1.0 } else { 1.0 };
+        let o = wo * side;
+        if u[0] < p_coat {
+            if self.coat_smooth() {
+                let weight = Vec3::splat(self.clearcoat * schlick(Vec3::splat(COAT_F0), o.z).x / p_coat);
+                return Some(BsdfSample { wi: Vec3::new(-o.x, -o.y, o.z) * side, weight, pdf: p_coat, delta: true });
+            }
+            let wi = reflect(o, vndf_sample(o, self.clearcoat_alpha, u[1], u[2]));
+            return if wi.z <= 0.0 { None } else { self.finish_sample(wo, wi * side, transport) };
+        }
+        // The lobe whose interval of [p_coat, 1) holds u0 (the last one that can scatter when
         // rounding leaves u0 past them all).
-        let mut u0 = u[0];
+        let mut u0 = u[0] - p_coat;
         let mut lobe = usize::MAX;
         for (k, &pk) in p.iter().enumerate() {
             if pk > 0.0 {
@@ -552,8 +672,6 @@ impl Bsdf {
         }
         // u0 rescaled to a fresh uniform within the picked lobe's interval.
         let u0 = (u0 / p[lobe]).clamp(0.0, 0.999_999_94);
-        let side = if wo.z < 0.0 { -1.0 } else { 1.0 };
-        let o = wo * side;
         if lobe == GLASS {
             return self.sample_glass(wo, u0, u[1], u[2], p[GLASS], transport);
         }
@@ -566,14 +684,19 @@ impl Bsdf {
                 (1.0 - self.metallic) * (1.0 - self.transmission) * self.layer_fresnel(o.z)
             };
             let wi = Vec3::new(-o.x, -o.y, o.z) * side;
-            return Some(BsdfSample { wi, weight: weight / p[lobe], pdf: p[lobe], delta: true });
+            let weight = weight * self.coat_scale(wo, wi, transport) / p[lobe];
+            return Some(BsdfSample { wi, weight, pdf: p[lobe], delta: true });
         } else {
             reflect(o, vndf_sample(o, self.alpha, u[1], u[2]))
         };
         if wi.z <= 0.0 {
             return None;
         }
-        let wi = wi * side;
+        self.finish_sample(wo, wi * side, transport)
+    }
+
+    /// The sample of a non-specular direction ω_i: its weight f·|cos θ_i|/pdf.
+    fn finish_sample(&self, wo: Vec3, wi: Vec3, transport: Transport) -> Option<BsdfSample> {
         let pdf = self.pdf(wo, wi);
         if pdf <= 0.0 {
             return None;
@@ -586,20 +709,27 @@ impl Bsdf {
         let scale = (1.0 - self.metallic) * self.transmission;
         if self.smooth() {
             let cos_o = wo.z;
+            // The coat's share is alike for ω_o and the mirrored or passing ω_i (|cos| equal).
+            let reflected = scale * self.coat_scale(wo, wo, transport);
             if self.thin {
                 let r = slab_reflectance(fresnel_dielectric(cos_o.abs(), self.ior));
                 return Some(if u0 < r {
-                    BsdfSample { wi: mirror_z(-wo), weight: Vec3::splat(scale / p), pdf: p * r, delta: true }
+                    BsdfSample { wi: mirror_z(-wo), weight: Vec3::splat(reflected / p), pdf: p * r, delta: true }
                 } else {
-                    BsdfSample { wi: -wo, weight: scale * self.base / p, pdf: p * (1.0 - r), delta: true }
+                    BsdfSample { wi: -wo, weight: reflected * self.base / p, pdf: p * (1.0 - r), delta: true }
                 });
             }
             let r = fresnel_dielectric(cos_o, self.ior);
             if u0 < r {
-                return Some(BsdfSample { wi: mirror_z(-wo), weight: Vec3::splat(scale / p), pdf: p * r, delta: true });
+                return Some(BsdfSample {
+                    wi: mirror_z(-wo),
+                    weight: Vec3::splat(reflected / p),
+                    pdf: p * r,
+                    delta: true,
+                });
             }
             let (wi, etap) = refract(wo, Vec3::Z, self.ior)?;
-            let mut weight = scale * self.base / p;
+            let mut weight = scale * self.coat_scale(wo, wi, transport) * self.base / p;
             if transport == Transport::Radiance {
                 weight /= etap * etap;
             }
@@ -632,12 +762,7 @@ impl Bsdf {
                 wi
             }
         };
-        let pdf = self.pdf(wo, wi);
-        if pdf <= 0.0 {
-            return None;
-        }
-        let weight = self.eval(wo, wi, transport) * (wi.z.abs() / pdf);
-        Some(BsdfSample { wi, weight, pdf, delta: false })
+        self.finish_sample(wo, wi, transport)
     }
 }
 
@@ -682,7 +807,7 @@ pub fn on_gpu(
 ) -> crate::Result<Vec<GpuAnswer>> {
     use crate::gpu::storage_entry;
     let device = &gpu.device;
-    let input: Vec<[f32; 23]> = queries
+    let input: Vec<[f32; 25]> = queries
         .iter()
         .map(|(b, wo, wi, u, t)| {
             [
@@ -709,6 +834,8 @@ pub fn on_gpu(
                 b.specular_color.x,
                 b.specular_color.y,
                 b.specular_color.z,
+                b.clearcoat,
+                b.clearcoat_alpha,
             ]
         })
         .collect();
@@ -719,7 +846,7 @@ pub fn on_gpu(
     let table =
         gpu.storage_buffer("bsdf ggx albedo", bytemuck::bytes_of(&ggx_albedo().gpu()), wgpu::BufferUsages::empty());
     let main = "
-        struct Query { v: array<f32, 23> }
+        struct Query { v: array<f32, 25> }
         struct Answer { v: array<f32, 16> }
         @group(0) @binding(0) var<storage, read> queries: array<Query>;
         @group(0) @binding(1) var<storage, read_write> answers: array<Answer>;
@@ -730,7 +857,8 @@ pub fn on_gpu(
                 return;
             }
             let q = queries[gid.x].v;
-            let b = Bsdf(vec3f(q[0], q[1], q[2]), q[3], q[4], q[5], vec3f(q[20], q[21], q[22]), q[6], q[7], q[8] > 0.5, q[19] > 0.5);
+            let b = Bsdf(vec3f(q[0], q[1], q[2]), q[3], q[4], q[5], vec3f(q[20], q[21], q[22]), q[6], q[7], q[8] > 0.5, q[19] > 0.5,
+                q[23], q[24]);
             let wo = vec3f(q[9], q[10], q[11]);
             let wi = vec3f(q[12], q[13], q[14]);
             let t = u32(q[18]);
@@ -751,7 +879,7 @@ pub fn on_gpu(
         "bsdf",
         &module,
         &[
-            storage_entry::<[f32; 23]>(0, c, true),
+            storage_entry::<[f32; 25]>(0, c, true),
             storage_entry::<[f32; 16]>(1, c, false),
             storage_entry::<albedo::GpuGgxAlbedo>(2, c, true),
         ],

@@ -3,6 +3,7 @@
 // frame (z = the front face's shading normal).
 
 const SMOOTH_ALPHA: f32 = 1e-3;
+const COAT_F0: f32 = 0.04;
 const TRANSPORT_RADIANCE: u32 = 0u;
 const TRANSPORT_IMPORTANCE: u32 = 1u;
 
@@ -18,6 +19,9 @@ struct Bsdf {
     thin: bool,
     // The rough metal's energy compensation (Bsdf::multiple_scattering).
     multiple_scattering: bool,
+    // The clear coat over the rest: its weight k and GGX α (0 weight: none).
+    clearcoat: f32,
+    clearcoat_alpha: f32,
 }
 
 struct BsdfSample {
@@ -245,19 +249,73 @@ fn diffuse_share(b: Bsdf, cos_o: f32, cos_i: f32) -> vec3f {
     return (vec3f(1.0) - layer_albedo(b, cos_o)) * (vec3f(1.0) - layer_albedo(b, cos_i)) / (vec3f(1.0) - layer_mean_albedo(b));
 }
 
-// The lobes' probabilities (metal, layer, cosine-distributed: diffuse base and the metal's
-// multiple scattering, glass) for |cos θ_o|.
-fn lobe_probabilities(b: Bsdf, cos_o: f32) -> vec4f {
+// Whether a coat with a glossy (not perfectly specular) lobe lies on top (Bsdf::rough_coat).
+fn rough_coat(b: Bsdf) -> bool {
+    return b.clearcoat > 0.0 && b.clearcoat_alpha >= SMOOTH_ALPHA;
+}
+
+// The coat's directional albedo k·E_k(|cos|), kF_k when smooth, 0 without one
+// (Bsdf::coat_albedo).
+fn coat_albedo(b: Bsdf, cos_in: f32) -> f32 {
+    if b.clearcoat <= 0.0 {
+        return 0.0;
+    }
+    let c = min(abs(cos_in), 1.0);
+    if b.clearcoat_alpha < SMOOTH_ALPHA {
+        return b.clearcoat * schlick(vec3f(COAT_F0), c).x;
+    }
+    let e = ggx_albedo(c, b.clearcoat_alpha);
+    return b.clearcoat * (COAT_F0 * e.x + (1.0 - COAT_F0) * e.y);
+}
+
+// The share of the model under the coat, 1 − k·E_k(μ_v): μ_v of wo for radiance, of wi for
+// importance (Bsdf::coat_scale).
+fn coat_scale(b: Bsdf, wo: vec3f, wi: vec3f, transport: u32) -> f32 {
+    let view = select(wi, wo, transport == TRANSPORT_RADIANCE);
+    return 1.0 - coat_albedo(b, view.z);
+}
+
+// The coat's glossy lobe on wo's side (Bsdf::coat_eval).
+fn coat_eval(b: Bsdf, wo: vec3f, wi: vec3f) -> vec3f {
+    if !rough_coat(b) {
+        return vec3f(0.0);
+    }
+    let o = select(wo, -wo, wo.z < 0.0);
+    let i = select(wi, -wi, wo.z < 0.0);
+    if o.z <= 0.0 || i.z <= 0.0 {
+        return vec3f(0.0);
+    }
+    let h = normalize(o + i);
+    let a = b.clearcoat_alpha;
+    let spec = ggx_d(h, a) * ggx_g1(o, h, a) * ggx_g1(i, h, a) / (4.0 * o.z * i.z);
+    return vec3f(b.clearcoat * schlick(vec3f(COAT_F0), dot(o, h)).x * spec);
+}
+
+// The probabilities of picking the coat and each lobe under it (metal, layer,
+// cosine-distributed: diffuse base and the metal's multiple scattering, glass) for |cos θ_o|
+// (Bsdf::lobe_probabilities).
+struct LobeProbabilities {
+    coat: f32,
+    under: vec4f,
+}
+
+fn lobe_probabilities(b: Bsdf, cos_o: f32) -> LobeProbabilities {
     let m = b.metallic;
     let opaque = (1.0 - m) * (1.0 - b.transmission);
     let fs = layer_fresnel(b, cos_o);
     let w = vec4f(m * mean3(schlick(b.base, cos_o)), opaque * mean3(fs),
         opaque * mean3((vec3f(1.0) - fs) * b.base) + m * mean3(ms_fresnel(b)) * ms_loss(b, cos_o), (1.0 - m) * b.transmission);
-    let total = w.x + w.y + w.z + w.w;
-    if total > 0.0 {
-        return w / total;
+    let sum = w.x + w.y + w.z + w.w;
+    var coat = 0.0;
+    if b.clearcoat > 0.0 {
+        coat = b.clearcoat * schlick(vec3f(COAT_F0), cos_o).x;
     }
-    return vec4f(0.0);
+    let under = sum * (1.0 - coat);
+    let total = coat + under;
+    if total <= 0.0 {
+        return LobeProbabilities(0.0, vec4f(0.0));
+    }
+    return LobeProbabilities(coat / total, w * (under / total / max(sum, 1.17549435e-38)));
 }
 
 // A thin slab's pair (Bsdf::thin_pair): ω_o and ω_i on ω_o's side, ω_i reflected through
@@ -351,8 +409,17 @@ fn glass_pdf(b: Bsdf, wo: vec3f, wi: vec3f) -> f32 {
     return vndf_pdf(wo, h, a) * abs(dot(wi, h)) / (s * s) * (1.0 - r);
 }
 
-// f(wo, wi) of the non-specular lobes (Bsdf::eval).
+// f(wo, wi) of the non-specular lobes: the coat's and, scaled by what it leaves, the model's
+// under it (Bsdf::eval).
 fn bsdf_eval(b: Bsdf, wo: vec3f, wi: vec3f, transport: u32) -> vec3f {
+    let under = eval_under_coat(b, wo, wi, transport);
+    if b.clearcoat <= 0.0 {
+        return under;
+    }
+    return coat_eval(b, wo, wi) + under * coat_scale(b, wo, wi, transport);
+}
+
+fn eval_under_coat(b: Bsdf, wo: vec3f, wi: vec3f, transport: u32) -> vec3f {
     var f = vec3f(0.0);
     let opaque = (1.0 - b.metallic) * (1.0 - b.transmission);
     if b.transmission > 0.0 && b.metallic < 1.0 {
@@ -377,7 +444,8 @@ fn bsdf_eval(b: Bsdf, wo: vec3f, wi: vec3f, transport: u32) -> vec3f {
 
 // The density with which bsdf_sample draws wi (its non-specular lobes; Bsdf::pdf).
 fn bsdf_pdf(b: Bsdf, wo: vec3f, wi: vec3f) -> f32 {
-    let p = lobe_probabilities(b, abs(wo.z));
+    let lp = lobe_probabilities(b, abs(wo.z));
+    let p = lp.under;
     var pdf = p.w * glass_pdf(b, wo, wi);
     let o = select(wo, -wo, wo.z < 0.0);
     let i = select(wi, -wi, wo.z < 0.0);
@@ -385,9 +453,12 @@ fn bsdf_pdf(b: Bsdf, wo: vec3f, wi: vec3f) -> f32 {
         return pdf;
     }
     pdf += p.z * i.z / PI;
+    let h = normalize(o + i);
     if !bsdf_is_smooth(b) {
-        let h = normalize(o + i);
         pdf += (p.x + p.y) * vndf_pdf(o, h, b.alpha) / (4.0 * dot(o, h));
+    }
+    if rough_coat(b) {
+        pdf += lp.coat * vndf_pdf(o, h, b.clearcoat_alpha) / (4.0 * dot(o, h));
     }
     return pdf;
 }
@@ -410,8 +481,23 @@ fn bsdf_sample(b: Bsdf, wo: vec3f, u: vec3f, transport: u32) -> BsdfSample {
     if wo.z == 0.0 {
         return no_sample();
     }
-    let p = lobe_probabilities(b, abs(wo.z));
-    var u0 = u.x;
+    let lp = lobe_probabilities(b, abs(wo.z));
+    let side = select(1.0, -1.0, wo.z < 0.0);
+    let o = wo * side;
+    // u0 < the coat's probability picks the coat.
+    if u.x < lp.coat {
+        if !rough_coat(b) {
+            let w = b.clearcoat * schlick(vec3f(COAT_F0), o.z).x / lp.coat;
+            return BsdfSample(vec3f(-o.x, -o.y, o.z) * side, vec3f(w), lp.coat, true, true);
+        }
+        let wc = reflect_about(o, vndf_sample(o, b.clearcoat_alpha, u.y, u.z));
+        if wc.z <= 0.0 {
+            return no_sample();
+        }
+        return finish_sample(b, wo, wc * side, transport);
+    }
+    let p = lp.under;
+    var u0 = u.x - lp.coat;
     var lobe = 4u;
     for (var k = 0u; k < 4u; k++) {
         if p[k] > 0.0 {
@@ -427,8 +513,6 @@ fn bsdf_sample(b: Bsdf, wo: vec3f, u: vec3f, transport: u32) -> BsdfSample {
     }
     let pl = p[lobe];
     u0 = clamp(u0 / pl, 0.0, 0.99999994);
-    let side = select(1.0, -1.0, wo.z < 0.0);
-    let o = wo * side;
     if lobe == 3u {
         return sample_glass(b, wo, u0, u.y, u.z, pl, transport);
     }
@@ -440,7 +524,8 @@ fn bsdf_sample(b: Bsdf, wo: vec3f, u: vec3f, transport: u32) -> BsdfSample {
         if lobe == 0u {
             w = b.metallic * schlick(b.base, o.z);
         }
-        return BsdfSample(vec3f(-o.x, -o.y, o.z) * side, w / pl, pl, true, true);
+        let wr = vec3f(-o.x, -o.y, o.z) * side;
+        return BsdfSample(wr, w * coat_scale(b, wo, wr, transport) / pl, pl, true, true);
     } else {
         wi = reflect_about(o, vndf_sample(o, b.alpha, u.y, u.z));
     }
@@ -453,22 +538,24 @@ fn bsdf_sample(b: Bsdf, wo: vec3f, u: vec3f, transport: u32) -> BsdfSample {
 fn sample_glass(b: Bsdf, wo: vec3f, u0: f32, u1: f32, u2: f32, p: f32, transport: u32) -> BsdfSample {
     let scale = (1.0 - b.metallic) * b.transmission;
     if bsdf_is_smooth(b) {
+        // The coat's share is alike for wo and the mirrored or passing wi (|cos| equal).
+        let reflected = scale * coat_scale(b, wo, wo, transport);
         if b.thin {
             let r = slab_reflectance(fresnel_dielectric(abs(wo.z), b.ior));
             if u0 < r {
-                return BsdfSample(mirror_z(-wo), vec3f(scale / p), p * r, true, true);
+                return BsdfSample(mirror_z(-wo), vec3f(reflected / p), p * r, true, true);
             }
-            return BsdfSample(-wo, scale * b.base / p, p * (1.0 - r), true, true);
+            return BsdfSample(-wo, reflected * b.base / p, p * (1.0 - r), true, true);
         }
         let r = fresnel_dielectric(wo.z, b.ior);
         if u0 < r {
-            return BsdfSample(mirror_z(-wo), vec3f(scale / p), p * r, true, true);
+            return BsdfSample(mirror_z(-wo), vec3f(reflected / p), p * r, true, true);
         }
         let t = refract_through(wo, vec3f(0.0, 0.0, 1.0), b.ior);
         if t.w == 0.0 {
             return no_sample();
         }
-        var w = scale * b.base / p;
+        var w = scale * coat_scale(b, wo, t.xyz, transport) * b.base / p;
         if transport == TRANSPORT_RADIANCE {
             w /= t.w * t.w;
         }
@@ -516,7 +603,7 @@ fn to_local(f: mat3x3f, v: vec3f) -> vec3f {
 
 // The albedo a(μ_o) of the model's Lambertian part f_L = a/π, which the photon map answers
 // for exactly at the gather's hits (Bsdf::lambertian_albedo): the cosine lobes' albedo,
-// (1 − m)(1 − t)(1 − E_L(μ_o))·c + m·F_ms·(1 − E₁(μ_o)).
+// (1 − m)(1 − t)(1 − E_L(μ_o))·c + m·F_ms·(1 − E₁(μ_o)), under a coat × (1 − k·E_k(μ_o)).
 fn bsdf_lambertian_albedo(b: Bsdf, cos_o_in: f32) -> vec3f {
     let cos_o = min(abs(cos_o_in), 1.0);
     let opaque = (1.0 - b.metallic) * (1.0 - b.transmission);
@@ -524,7 +611,8 @@ fn bsdf_lambertian_albedo(b: Bsdf, cos_o_in: f32) -> vec3f {
     if b.specular != 0.0 {
         base = vec3f(1.0) - layer_albedo(b, cos_o);
     }
-    return opaque * base * b.base + b.metallic * ms_fresnel(b) * ms_loss(b, cos_o);
+    let a = opaque * base * b.base + b.metallic * ms_fresnel(b) * ms_loss(b, cos_o);
+    return a * (1.0 - coat_albedo(b, cos_o));
 }
 
 // The albedo of a Lambertian surface standing in for b where the photon map is read at a
@@ -543,5 +631,7 @@ fn bsdf_diffuse_equivalent(b: Bsdf, cos_o_in: f32) -> vec3f {
     }
     let layer = layer_albedo(b, cos_o);
     let dielectric = layer + (vec3f(1.0) - layer) * b.base;
-    return b.metallic * metal + opaque * dielectric + vec3f((1.0 - b.metallic) * b.transmission * mean_f);
+    let under = b.metallic * metal + opaque * dielectric + vec3f((1.0 - b.metallic) * b.transmission * mean_f);
+    let coat = coat_albedo(b, cos_o);
+    return vec3f(coat) + (1.0 - coat) * under;
 }

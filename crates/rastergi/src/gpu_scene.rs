@@ -75,7 +75,10 @@ pub struct GpuMaterial {
     pub attenuation: [f32; 3],
     /// [`Material::specular_color`].
     pub specular_color: [f32; 3],
-    pub _pad: u32,
+    /// [`Material::clearcoat`], [`Material::clearcoat_roughness`].
+    pub clearcoat: f32,
+    pub clearcoat_roughness: f32,
+    pub _pad: [u32; 3],
 }
 
 /// `MaterialMaps` in `gpu_scene.wgsl`: a material's textures and their parameters, at the
@@ -95,6 +98,9 @@ pub struct GpuMaterialMaps {
     pub transmission_map: GpuTextureSlot,
     pub specular_map: GpuTextureSlot,
     pub specular_color_map: GpuTextureSlot,
+    /// clearcoatTexture (R), clearcoatRoughnessTexture (G).
+    pub clearcoat_map: GpuTextureSlot,
+    pub clearcoat_roughness_map: GpuTextureSlot,
 }
 
 impl GpuMaterial {
@@ -121,7 +127,9 @@ impl GpuMaterial {
             transmission: m.transmission,
             attenuation: m.medium().into(),
             specular_color: m.specular_color.into(),
-            _pad: 0,
+            clearcoat: m.clearcoat,
+            clearcoat_roughness: m.clearcoat_roughness,
+            _pad: [0; 3],
         };
         let maps = GpuMaterialMaps {
             alpha_cutoff,
@@ -137,6 +145,8 @@ impl GpuMaterial {
             transmission_map: GpuTextureSlot::new(m.transmission_texture),
             specular_map: GpuTextureSlot::new(m.specular_texture),
             specular_color_map: GpuTextureSlot::new(m.specular_color_texture),
+            clearcoat_map: GpuTextureSlot::new(m.clearcoat_texture),
+            clearcoat_roughness_map: GpuTextureSlot::new(m.clearcoat_roughness_texture),
         };
         (material, maps)
     }
@@ -239,6 +249,8 @@ impl PreparedScene {
             transmission: texel(m.transmission_texture).map_or(1.0, |t| t.x),
             specular: texel(m.specular_texture).map_or(1.0, |t| t.w),
             specular_color: texel(m.specular_color_texture).map_or(Vec3::ONE, |t| t.truncate()),
+            clearcoat: texel(m.clearcoat_texture).map_or(1.0, |t| t.x),
+            clearcoat_roughness: texel(m.clearcoat_roughness_texture).map_or(1.0, |t| t.y),
         };
         m.bsdf(self.albedo_at(tri, b1, b2, lod), &texels)
     }

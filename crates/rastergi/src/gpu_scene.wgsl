@@ -55,7 +55,10 @@ struct Material {
     attenuation: array<f32, 3>,
     // The layer's colour at normal incidence (Material::specular_color).
     specular_color: vec3f,
-    _pad: u32,
+    // The clear coat's weight and perceptual roughness (Material::clearcoat).
+    clearcoat: f32,
+    clearcoat_roughness: f32,
+    _pad: array<u32, 3>,
 }
 
 // A material's textures and their parameters (gpu_scene.rs, GpuMaterialMaps).
@@ -73,6 +76,9 @@ struct MaterialMaps {
     transmission_map: TextureSlot,
     specular_map: TextureSlot,
     specular_color_map: TextureSlot,
+    // Linear: clear coat × R; its roughness × G.
+    clearcoat_map: TextureSlot,
+    clearcoat_roughness_map: TextureSlot,
 }
 
 // A compressed node of the 4-wide BVH (bvh/wide.rs, WideNode): axis a's grid step is
@@ -162,6 +168,8 @@ struct Surface {
     ior: f32,
     transmission: f32,
     specular_color: vec3f,
+    clearcoat: f32,
+    clearcoat_roughness: f32,
 }
 
 // Vertex `vi` of the scene drawn as one non-indexed triangle list (vertex pulling in the
@@ -391,6 +399,8 @@ fn surface_at(tri: u32, b1: f32, b2: f32, lod: f32) -> Surface {
     s.specular_color = m.specular_color;
     s.ior = m.ior;
     s.transmission = m.transmission;
+    s.clearcoat = m.clearcoat;
+    s.clearcoat_roughness = m.clearcoat_roughness;
     if textured {
         let mr_map = material_maps[mi].metal_rough_map;
         if mr_map.layer != NO_TEXTURE {
@@ -410,6 +420,14 @@ fn surface_at(tri: u32, b1: f32, b2: f32, lod: f32) -> Surface {
         if c_map.layer != NO_TEXTURE {
             s.specular_color *= slot_sample(c_map, uv, 0.0).rgb;
         }
+        let k_map = material_maps[mi].clearcoat_map;
+        if k_map.layer != NO_TEXTURE {
+            s.clearcoat *= slot_sample(k_map, uv, 0.0).r;
+        }
+        let kr_map = material_maps[mi].clearcoat_roughness_map;
+        if kr_map.layer != NO_TEXTURE {
+            s.clearcoat_roughness *= slot_sample(kr_map, uv, 0.0).g;
+        }
     }
     return s;
 }
@@ -417,8 +435,10 @@ fn surface_at(tri: u32, b1: f32, b2: f32, lod: f32) -> Surface {
 // The model at a surface point (PreparedScene::bsdf_at).
 fn surface_bsdf(s: Surface) -> Bsdf {
     let r = clamp(s.roughness, 0.0, 1.0);
+    let rc = clamp(s.clearcoat_roughness, 0.0, 1.0);
     return Bsdf(s.albedo, clamp(s.metallic, 0.0, 1.0), r * r, s.specular, s.specular_color, s.ior, s.transmission,
-        (s.flags & MATERIAL_THIN) != 0u, (s.flags & MATERIAL_SINGLE_SCATTERING) == 0u);
+        (s.flags & MATERIAL_THIN) != 0u, (s.flags & MATERIAL_SINGLE_SCATTERING) == 0u, clamp(s.clearcoat, 0.0, 1.0),
+        rc * rc);
 }
 
 // Whether the surface scatters by Dirac deltas alone (a perfect mirror or smooth glass, no
@@ -426,8 +446,9 @@ fn surface_bsdf(s: Surface) -> Bsdf {
 // gather_radiance).
 fn surface_purely_specular(s: Surface) -> bool {
     let r = clamp(s.roughness, 0.0, 1.0);
+    let rc = clamp(s.clearcoat_roughness, 0.0, 1.0);
     let opaque = (1.0 - clamp(s.metallic, 0.0, 1.0)) * (1.0 - s.transmission);
-    return r * r < SMOOTH_ALPHA && opaque <= 0.0;
+    return r * r < SMOOTH_ALPHA && opaque <= 0.0 && (s.clearcoat <= 0.0 || rc * rc < SMOOTH_ALPHA);
 }
 
 // Whether eye and gather rays go on through the surface rather than stop at it: a purely
@@ -439,7 +460,8 @@ fn surface_passes_rays(s: Surface) -> bool {
 }
 
 // For a ray arriving along d at a surface that scatters by a delta lobe and by others too (a
-// smooth specular layer over a diffuse base, a smooth partly metallic surface): the probability
+// smooth specular layer over a diffuse base, a smooth partly metallic surface, a smooth clear
+// coat over a rough model): the probability
 // pd with which bsdf_sample picks a delta lobe there, and for a uniform u0 the first uniform of
 // a scatter_at that picks the delta lobe u0 falls in where u0 < pd (−1 where u0 ≥ pd: a
 // non-delta lobe). pd = 0 elsewhere (no delta lobe, or one that passes rays anyway).
@@ -454,23 +476,30 @@ fn surface_delta_choice(s: Surface, d: vec3f, u0: f32) -> DeltaChoice {
         return c;
     }
     let a = arrival(s, d);
-    if !bsdf_is_smooth(a.b) {
+    let coat_delta = a.b.clearcoat > 0.0 && !rough_coat(a.b);
+    let base_delta = bsdf_is_smooth(a.b);
+    if !coat_delta && !base_delta {
         return c;
     }
-    let p = lobe_probabilities(a.b, abs(a.wo.z));
-    // The lobes in bsdf_sample's order: metal, layer (delta when smooth), diffuse, glass.
-    c.pd = p.x + p.y + p.w;
-    var rest = u0;
-    var start = 0.0;
+    let lp = lobe_probabilities(a.b, abs(a.wo.z));
+    // The lobes in bsdf_sample's order: the coat (delta when smooth), then metal, layer (delta
+    // when smooth), diffuse, glass.
+    let pc = select(0.0, lp.coat, coat_delta);
+    let p = select(vec4f(0.0), lp.under * vec4f(1.0, 1.0, 0.0, 1.0), base_delta);
+    c.pd = pc + p.x + p.y + p.w;
+    if u0 < pc {
+        c.u = u0;
+        return c;
+    }
+    var rest = u0 - pc;
+    var start = lp.coat;
     for (var k = 0u; k < 4u; k++) {
-        if k != 2u {
-            if rest < p[k] {
-                c.u = start + rest;
-                return c;
-            }
-            rest -= p[k];
+        if rest < p[k] {
+            c.u = start + rest;
+            return c;
         }
-        start += p[k];
+        rest -= p[k];
+        start += lp.under[k];
     }
     return c;
 }

@@ -80,7 +80,9 @@ fn twins() -> Vec<Twin> {
                 ior,
                 transmission,
                 attenuation,
-                specular_color
+                specular_color,
+                clearcoat,
+                clearcoat_roughness
             ]
         ),
         twin!(
@@ -96,7 +98,9 @@ fn twins() -> Vec<Twin> {
                 metal_rough_map,
                 transmission_map,
                 specular_map,
-                specular_color_map
+                specular_color_map,
+                clearcoat_map,
+                clearcoat_roughness_map
             ]
         ),
         twin!(WideNode, "WideNode", [origin, exponents, lo, counts, hi, child]),

@@ -339,18 +339,39 @@ fn a_glossy_floor_under_a_constant_sky_reflects_l_times_its_directional_albedo()
     // A white furnace: a white metal of roughness 1 reflects all of the sky with its
     // multiple-scattering compensation (0.31–0.53 of it by single scattering alone).
     let white = Material { metallic: 1.0, roughness: 1.0, ..Material::diffuse("white rough metal", Vec3::ONE) };
+    // Clear coats (KHR_materials_clearcoat): a rough one over glTF's layered model, a smooth
+    // one over a diffuse base (its delta lobe: the eye's chains and the gather follow it, and
+    // it reflects k·F(μ_o) of the sky, F = 0.04 + 0.96(1 − μ_o)⁵ by the extension's text), and
+    // a rough one over white, which must return the whole sky.
+    let coated = Material {
+        clearcoat: 1.0,
+        clearcoat_roughness: 0.3,
+        specular: 1.0,
+        roughness: 0.4,
+        ..Material::diffuse("coated layered", Vec3::new(0.2, 0.5, 0.8))
+    };
+    let smooth_coat =
+        Material { clearcoat: 0.8, ..Material::diffuse("smooth-coated diffuse", Vec3::new(0.7, 0.3, 0.2)) };
+    let white_coated =
+        Material { clearcoat: 1.0, clearcoat_roughness: 0.5, ..Material::diffuse("white coated", Vec3::ONE) };
     let cosines = floor_pixel_cosines();
     let (lo, hi) = cosines.iter().fold((1.0f32, 0.0f32), |(a, b), &c| (a.min(c), b.max(c)));
-    for material in [metal, layered, white] {
+    for material in [metal, layered, white, coated, smooth_coat, white_coated] {
         let b = material.bsdf(material.albedo, &rastergi::scene::Texels::default());
+        // The smooth coat's delta lobe, which the quadrature of f does not see.
+        let delta = |c: f32| {
+            let smooth = material.clearcoat > 0.0 && material.clearcoat_roughness == 0.0;
+            Vec3::splat(if smooth { material.clearcoat * (0.04 + 0.96 * (1.0 - c).powi(5)) } else { 0.0 })
+        };
+        let albedo = |c: f32| directional_albedo(&b, c) + delta(c);
         if material.name.starts_with("white") {
             for c in [lo, hi] {
-                let a = directional_albedo(&b, c);
-                assert!((a - Vec3::ONE).abs().max_element() < 0.01, "white metal at cos {c}: albedo {a}");
+                let a = albedo(c);
+                assert!((a - Vec3::ONE).abs().max_element() < 0.01, "{} at cos {c}: albedo {a}", material.name);
             }
         }
         // a(cos θ_o) on 17 points spanning the pixels' cosines, linearly interpolated.
-        let table: Vec<Vec3> = (0..17).map(|k| directional_albedo(&b, lo + (hi - lo) * k as f32 / 16.0)).collect();
+        let table: Vec<Vec3> = (0..17).map(|k| albedo(lo + (hi - lo) * k as f32 / 16.0)).collect();
         let a = |c: f32| {
             let t = ((c - lo) / (hi - lo) * 16.0).clamp(0.0, 16.0);
             let k = (t.floor() as usize).min(15);

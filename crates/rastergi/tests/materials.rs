@@ -30,6 +30,11 @@ fn the_gpu_bsdf_agrees_with_its_cpu_twin() {
         Bsdf { transmission: 0.5, metallic: 0.2, alpha: 0.3, specular: 0.7, ..Bsdf::diffuse(c) },
         Bsdf { alpha: 0.2, specular: 0.8, specular_color: Vec3::new(3.0, 1.0, 0.25), ..Bsdf::diffuse(c) },
         Bsdf { alpha: 0.0, specular: 0.8, specular_color: Vec3::new(0.5, 1.0, 30.0), ..Bsdf::diffuse(c) },
+        // Clear coats (KHR_materials_clearcoat): rough over a rough plastic, smooth over a
+        // rough metal, rough over smooth glass.
+        Bsdf { alpha: 0.36, specular: 1.0, clearcoat: 0.8, clearcoat_alpha: 0.09, ..Bsdf::diffuse(c) },
+        Bsdf { metallic: 1.0, alpha: 0.25, specular: 1.0, clearcoat: 1.0, ..Bsdf::diffuse(c) },
+        Bsdf { transmission: 1.0, alpha: 0.0, specular: 1.0, clearcoat: 0.5, clearcoat_alpha: 0.2, ..Bsdf::diffuse(c) },
     ];
     let mut rng = Rng::new(17, 0, 0);
     let mut queries = vec![];
@@ -217,10 +222,29 @@ fn mtl_materials_map_to_the_model() {
     // The stage's walls stay Lambertian.
     let scene = material_scene("mat_glass", stage_camera());
     assert!(scene.materials.iter().filter(|m| m.name != "sphere").all(|m| m.is_lambertian()));
+    // The PBR extension's clear coat, `Pc` and `Pcr` (roughness 0 by default), over any model.
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("c.mtl"),
+        "newmtl paint\nKd 0.8 0.1 0.1\nPr 0.5\nPc 0.9\nPcr 0.2\nnewmtl varnish\nKd 0.5 0.4 0.3\nPc 1\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.path().join("c.obj"),
+        "mtllib c.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl paint\nf 1 2 3\nusemtl varnish\nf 1 3 2\n",
+    )
+    .unwrap();
+    let scene = rastergi::scene::load_obj(&dir.path().join("c.obj")).expect("scene");
+    let m = |name: &str| scene.materials.iter().find(|m| m.name == name).expect("material").clone();
+    let paint = m("paint");
+    assert_eq!((paint.clearcoat, paint.clearcoat_roughness, paint.roughness, paint.specular), (0.9, 0.2, 0.5, 1.0));
+    let varnish = m("varnish");
+    assert_eq!((varnish.clearcoat, varnish.clearcoat_roughness, varnish.metallic), (1.0, 0.0, 0.0));
+    assert!(varnish.has_delta_lobe() && !varnish.is_lambertian());
 }
 
 /// glTF: metallic and roughness factors (default 1, 1), the metallic-roughness texture, the
-/// specular layer, transmission, ior and volume (thin without one).
+/// specular layer, transmission, ior, volume (thin without one) and the clear coat.
 #[test]
 fn gltf_materials_map_to_the_model() {
     use serde_json::json;
@@ -250,13 +274,20 @@ fn gltf_materials_map_to_the_model() {
         { "name": "tinted", "extensions": { "KHR_materials_specular": { "specularFactor": 0.5,
                                                                        "specularColorFactor": [2.0, 1.0, 0.5],
                                                                        "specularTexture": { "index": 0 },
-                                                                       "specularColorTexture": { "index": 0 } } } }
+                                                                       "specularColorTexture": { "index": 0 } } } },
+        { "name": "coated", "extensions": { "KHR_materials_clearcoat": { "clearcoatFactor": 0.8,
+                                                                        "clearcoatRoughnessFactor": 0.5,
+                                                                        "clearcoatTexture": { "index": 0 },
+                                                                        "clearcoatRoughnessTexture": { "index": 0 },
+                                                                        "clearcoatNormalTexture": { "index": 0 } } } },
+        { "name": "varnish", "extensions": { "KHR_materials_clearcoat": { "clearcoatFactor": 1.0 } } }
     ]);
     let primitives: Vec<_> =
-        (0..7).map(|i| json!({ "attributes": { "POSITION": 0, "TEXCOORD_0": 1 }, "material": i })).collect();
+        (0..9).map(|i| json!({ "attributes": { "POSITION": 0, "TEXCOORD_0": 1 }, "material": i })).collect();
     let doc = json!({
         "asset": { "version": "2.0" },
-        "extensionsUsed": ["KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume", "KHR_materials_specular"],
+        "extensionsUsed": ["KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume", "KHR_materials_specular",
+                           "KHR_materials_clearcoat"],
         "buffers": [{ "uri": "t.bin", "byteLength": bytes.len() }],
         "bufferViews": [{ "buffer": 0, "byteOffset": 0, "byteLength": 36 }, { "buffer": 0, "byteOffset": 36, "byteLength": 24 }],
         "accessors": [{ "bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0] },
@@ -305,6 +336,30 @@ fn gltf_materials_map_to_the_model() {
     assert!((tb.specular - 0.5 * 0.4).abs() < 1e-3, "{tb:?}");
     assert!((tb.specular_color - want).abs().max_element() < 2e-3, "{tb:?} vs {want}");
     assert_eq!(w.attenuation, Vec3::ZERO);
+    // KHR_materials_clearcoat: the factors (roughness 0 by default), clearcoatTexture's R and
+    // clearcoatRoughnessTexture's G (linear) multiplying them; no coat without the extension.
+    let c = m("coated");
+    assert_eq!((c.clearcoat, c.clearcoat_roughness), (0.8, 0.5));
+    assert!(c.clearcoat_texture.is_some() && c.clearcoat_roughness_texture.is_some());
+    assert_eq!((m("varnish").clearcoat, m("varnish").clearcoat_roughness), (1.0, 0.0));
+    assert!(m("varnish").has_delta_lobe() && !m("varnish").is_lambertian());
+    assert_eq!(m("matte").clearcoat, 0.0);
+    let cb = at("coated");
+    assert!((cb.clearcoat - 0.8 * 0.2).abs() < 1e-3, "{cb:?}");
+    assert!((cb.clearcoat_alpha - (0.5f32 * 1.0).powi(2)).abs() < 1e-3, "{cb:?}");
+    // A factor outside [0, 1] and a texture that does not exist are refused with one line
+    // naming the material.
+    for (key, value, named) in [
+        ("clearcoatFactor", json!(1.5), "clearcoatFactor"),
+        ("clearcoatRoughnessFactor", json!("rough"), "clearcoatRoughnessFactor"),
+        ("clearcoatTexture", json!({ "index": 7 }), "texture 7"),
+    ] {
+        let mut bad = doc.clone();
+        bad["materials"][7]["extensions"]["KHR_materials_clearcoat"][key] = value;
+        std::fs::write(&path, serde_json::to_vec(&bad).unwrap()).unwrap();
+        let e = rastergi::scene::load_gltf(&path).unwrap_err().to_string();
+        assert!(e.contains(named) && e.contains("coated") && !e.contains('\n'), "{e}");
+    }
     // A distance that is not positive is refused with one line naming the material.
     let mut bad = doc.clone();
     bad["materials"][2]["extensions"]["KHR_materials_volume"]["attenuationDistance"] = json!(0.0);

@@ -29,6 +29,11 @@ fn tinted_plastic(base: Vec3, roughness: f32) -> Bsdf {
     Bsdf { specular: 0.8, specular_color: Vec3::new(3.0, 1.0, 0.25), ..plastic(base, roughness) }
 }
 
+/// `b` under a clear coat of weight k and roughness r (α = r²).
+fn coated(b: Bsdf, k: f32, roughness: f32) -> Bsdf {
+    Bsdf { clearcoat: k, clearcoat_alpha: roughness * roughness, ..b }
+}
+
 fn glass(roughness: f32, thin: bool) -> Bsdf {
     Bsdf { transmission: 1.0, alpha: roughness * roughness, specular: 1.0, thin, ..Bsdf::diffuse(Vec3::ONE) }
 }
@@ -141,6 +146,10 @@ fn cases() -> Vec<(&'static str, Bsdf, Vec3)> {
         ("half glass", Bsdf { transmission: 0.5, ..plastic(c, 0.7) }),
         ("smooth plastic", plastic(c, 0.0)),
         ("tinted plastic", tinted_plastic(c, 0.5)),
+        ("coated plastic", coated(plastic(c, 0.6), 0.8, 0.3)),
+        ("coated metal", coated(metal(c, 0.5), 1.0, 0.2)),
+        ("coated glass", coated(glass(0.6, false), 0.5, 0.4)),
+        ("smooth coat over diffuse", coated(Bsdf::diffuse(c), 1.0, 0.0)),
     ] {
         for wo in [dir(10.0, 30.0), dir(60.0, 200.0), dir(150.0, 80.0)] {
             v.push((name, b, wo));
@@ -232,10 +241,14 @@ fn reflection_is_reciprocal_and_refraction_obeys_the_eta_squared_rule() {
             // f(a → c) η(c)² = f(c → a) η(a)², η(w) the index on w's side: 1 above, η below for
             // a solid (reflection and thin slabs: both 1).
             let eta = |w: Vec3| if b.transmission > 0.0 && !b.thin && w.z < 0.0 { b.ior } else { 1.0 };
+            // A coat scales the model under it by its albedo towards the viewer alone (module
+            // docs): not reciprocal, only its adjoint below holds.
             let lhs = b.eval(a, c, Transport::Radiance) * eta(c).powi(2);
             let rhs = b.eval(c, a, Transport::Radiance) * eta(a).powi(2);
             let scale = lhs.max_element().max(rhs.max_element()).max(1e-3);
-            assert!((lhs - rhs).abs().max_element() < 2e-3 * scale, "{name}: f({a} → {c}) = {lhs}, reversed {rhs}");
+            if b.clearcoat == 0.0 {
+                assert!((lhs - rhs).abs().max_element() < 2e-3 * scale, "{name}: f({a} → {c}) = {lhs}, reversed {rhs}");
+            }
             // Importance transport's BTDF is the adjoint: f*(a → c) = f(c → a).
             let adj = b.eval(a, c, Transport::Importance);
             let rev = b.eval(c, a, Transport::Radiance);
@@ -295,7 +308,32 @@ fn white_furnace() {
             rows.push(format!("θ {theta:>2}°, roughness {r}: specular layer over white diffuse {:.4}", layer.x));
             assert!((layer - d).abs().max_element() < 0.01, "layer {layer} vs diffuse {d}");
         }
+        // A clear coat over white models reflects k·E_k(μ_o) towards the viewer and leaves
+        // them the rest: under uniform light (radiance transport: the coat scales by the
+        // viewer's direction, module docs) 1 in all, at every roughness of the coat and of the
+        // model under it; smooth (k·F_k by its delta lobe), exactly.
+        let radiance = |b: Bsdf| albedo_by_sampling(&b, wo, 200_000, Transport::Radiance);
+        for (name, b) in [("diffuse", Bsdf::diffuse(white)), ("mirror", metal(white, 0.0))] {
+            let (a, se) = radiance(coated(b, 0.7, 0.0));
+            assert!(
+                (a - Vec3::ONE).abs().max_element() < 5.0 * se + 1e-4,
+                "smooth coat over {name} at {theta}°: {a} ± {se}"
+            );
+        }
         for r in [0.05f32, 0.1, 0.2, 0.45, 0.8] {
+            for (name, b) in [
+                ("diffuse", Bsdf::diffuse(white)),
+                ("metal 0.5", metal(white, 0.5)),
+                ("plastic 0.3", plastic(white, 0.3)),
+                ("mirror", metal(white, 0.0)),
+            ] {
+                let (a, se) = radiance(coated(b, 1.0, r));
+                rows.push(format!("θ {theta:>2}°, coat roughness {r}: over white {name} {:.4}", a.x));
+                assert!(
+                    (a - Vec3::ONE).abs().max_element() < 0.01 + 3.0 * se,
+                    "coat r {r} over {name} at {theta}°: {a} ± {se}"
+                );
+            }
             let (layer, se) = albedo(plastic(white, r));
             assert!(
                 (layer - Vec3::ONE).abs().max_element() < 0.01 + 3.0 * se,
@@ -468,6 +506,8 @@ fn the_lambertian_part_reflects_what_the_cosine_lobes_do() {
             Bsdf { transmission: 0.5, ..plastic(c, roughness) },
             Bsdf { alpha: a2, ..Bsdf::diffuse(c) },
             tinted_plastic(c, roughness),
+            coated(plastic(c, roughness), 0.7, 0.5),
+            coated(metal(c, roughness), 1.0, roughness),
         ] {
             for theta in [0.0f32, 30.0, 60.0, 80.0, 88.0] {
                 let wo = dir(theta, 10.0);
@@ -476,8 +516,9 @@ fn the_lambertian_part_reflects_what_the_cosine_lobes_do() {
                 for i in 0..n {
                     let mu = (i as f32 + 0.5) / n as f32;
                     let opaque = (1.0 - b.metallic) * (1.0 - b.transmission);
-                    let lobes = opaque * b.base * b.diffuse_share(wo.z, mu) / std::f32::consts::PI
-                        + b.metallic * b.ms_eval(wo.z, mu);
+                    let lobes = (opaque * b.base * b.diffuse_share(wo.z, mu) / std::f32::consts::PI
+                        + b.metallic * b.ms_eval(wo.z, mu))
+                        * (1.0 - b.coat_albedo(wo.z));
                     // ∫ over φ gives 2π; dω = dμ dφ.
                     sum += (lobes * mu * 2.0 * std::f32::consts::PI / n as f32).as_dvec3();
                 }
@@ -506,5 +547,33 @@ fn a_tinted_layer_reflects_its_colour_at_normal_incidence() {
         let s = b.sample(wo, [0.5, 0.5, 0.5], Transport::Radiance).expect("a sample");
         assert!(s.delta);
         assert!((s.weight - want).abs().max_element() < 1e-4, "cos {cos}: {} vs {want}", s.weight);
+    }
+}
+
+/// A clear coat over black reflects what `KHR_materials_clearcoat` says: smooth, its delta
+/// lobe carries k·F_k(μ) with Schlick's F_k of f₀ 0.04 (k·0.04 at normal incidence, → k at
+/// grazing); rough, its albedo by a quadrature of `eval` is k times the GGX lobe's with that
+/// Fresnel term, f₀E₁ + (1 − f₀)E₅ — computed here from a black metal (E₅) and a white one
+/// (E₁) of the coat's roughness, independently of the coat's code.
+#[test]
+fn a_clear_coat_over_black_reflects_its_fresnel_term() {
+    let black = Bsdf::diffuse(Vec3::ZERO);
+    for cos in [1.0f32, 0.5, 1e-4] {
+        let want = 0.6 * (0.04 + 0.96 * (1.0 - cos).powi(5));
+        let wo = Vec3::new((1.0 - cos * cos).sqrt(), 0.0, cos);
+        let s = coated(black, 0.6, 0.0).sample(wo, [0.3, 0.5, 0.5], Transport::Radiance).expect("a sample");
+        assert!(s.delta && (s.wi - Vec3::new(-wo.x, -wo.y, wo.z)).length() < 1e-6);
+        assert!((s.weight - Vec3::splat(want)).abs().max_element() < 1e-4, "cos {cos}: {} vs {want}", s.weight);
+    }
+    for r in [0.4f32, 0.7, 1.0] {
+        for theta in [0.0f32, 50.0, 75.0] {
+            let wo = dir(theta, 40.0);
+            let single = |c: Vec3| Bsdf { multiple_scattering: false, ..metal(c, r) };
+            let e1 = albedo_by_quadrature(&single(Vec3::ONE), wo, Transport::Radiance).x;
+            let e5 = albedo_by_quadrature(&single(Vec3::ZERO), wo, Transport::Radiance).x;
+            let want = 0.6 * (0.04 * e1 + 0.96 * e5);
+            let got = albedo_by_quadrature(&coated(black, 0.6, r), wo, Transport::Radiance);
+            assert!((got - Vec3::splat(want)).abs().max_element() < 1e-4, "r {r}, θ {theta}°: {got} vs {want}");
+        }
     }
 }

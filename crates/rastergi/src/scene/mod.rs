@@ -149,6 +149,15 @@ pub struct Material {
     /// Rough metal with its multiple-scattering energy compensation ([`crate::bsdf`]); false:
     /// single scattering, the model of Mitsuba 3's `roughconductor` ([`Scene::single_scattering`]).
     pub multiple_scattering: bool,
+    /// The clear coat's weight k (`KHR_materials_clearcoat`'s clearcoatFactor, MTL `Pc`; 0:
+    /// none) and perceptual roughness (clearcoatRoughnessFactor, MTL `Pcr`; its GGX α is the
+    /// square): a dielectric layer of η 1.5 over the rest ([`crate::bsdf`]).
+    pub clearcoat: f32,
+    pub clearcoat_roughness: f32,
+    /// clearcoatTexture (linear, R × `clearcoat`) and clearcoatRoughnessTexture (linear, G ×
+    /// `clearcoat_roughness`).
+    pub clearcoat_texture: Option<TextureRef>,
+    pub clearcoat_roughness_texture: Option<TextureRef>,
 }
 
 impl Material {
@@ -179,6 +188,10 @@ impl Material {
             thin: false,
             attenuation: Vec3::ZERO,
             multiple_scattering: true,
+            clearcoat: 0.0,
+            clearcoat_roughness: 0.0,
+            clearcoat_texture: None,
+            clearcoat_roughness_texture: None,
         }
     }
 
@@ -213,34 +226,45 @@ impl Material {
             transmission: (self.transmission * t.transmission).clamp(0.0, 1.0),
             thin: self.thin,
             multiple_scattering: self.multiple_scattering,
+            clearcoat: (self.clearcoat * t.clearcoat).clamp(0.0, 1.0),
+            clearcoat_alpha: (self.clearcoat_roughness * t.clearcoat_roughness).clamp(0.0, 1.0).powi(2),
         }
     }
 
     /// Whether eye and gather rays go on through it rather than stop (`surface_passes_rays` in
     /// WGSL, [`crate::specular`]): no diffuse base, and perfectly specular — a smooth metal — or
     /// glass, rough or smooth; or one whose roughness a texture sets (a transmissionTexture only
-    /// lowers the transmission below its factor, so the factor decides). Scenes with such
-    /// materials get the eye's specular chains and the photon map's caustic twins.
+    /// lowers the transmission below its factor, so the factor decides); not a smooth metal
+    /// under a rough clear coat. Scenes with such materials get the eye's specular chains and
+    /// the photon map's caustic twins.
     pub fn passes_rays(&self) -> bool {
         let opaque = (1.0 - self.metallic.clamp(0.0, 1.0)) * (1.0 - self.transmission);
+        let rough_coat = self.clearcoat > 0.0
+            && self.clearcoat_texture.is_none()
+            && self.clearcoat_roughness.powi(2) >= crate::bsdf::SMOOTH_ALPHA
+            && self.clearcoat_roughness_texture.is_none();
         opaque <= 0.0
-            && (self.roughness * self.roughness < crate::bsdf::SMOOTH_ALPHA
-                || self.transmission > 0.0
-                || self.metal_rough_texture.is_some())
+            && (self.transmission > 0.0
+                || ((self.roughness * self.roughness < crate::bsdf::SMOOTH_ALPHA
+                    || self.metal_rough_texture.is_some())
+                    && !rough_coat))
     }
 
     /// Whether it has a perfectly specular lobe besides others (polished plastic: a smooth
     /// specular layer over a diffuse base; a smooth, partly metallic surface): the eye's
     /// chains follow that lobe stochastically ([`crate::specular`]). Or may have, where a
-    /// texture sets the roughness.
+    /// texture sets the roughness; or a smooth clear coat (or one a texture may make smooth).
     pub fn has_delta_lobe(&self) -> bool {
         let smooth = self.roughness * self.roughness < crate::bsdf::SMOOTH_ALPHA || self.metal_rough_texture.is_some();
-        smooth && (self.metallic > 0.0 || self.transmission > 0.0 || self.specular > 0.0)
+        let smooth_coat = self.clearcoat > 0.0
+            && (self.clearcoat_roughness.powi(2) < crate::bsdf::SMOOTH_ALPHA
+                || self.clearcoat_roughness_texture.is_some());
+        smooth_coat || (smooth && (self.metallic > 0.0 || self.transmission > 0.0 || self.specular > 0.0))
     }
 
     /// Whether it scatters as a plain Lambertian surface (f = ρ/π).
     pub fn is_lambertian(&self) -> bool {
-        self.metallic == 0.0 && self.transmission == 0.0 && self.specular == 0.0
+        self.metallic == 0.0 && self.transmission == 0.0 && self.specular == 0.0 && self.clearcoat <= 0.0
     }
 
     pub fn is_emitter(&self) -> bool {
@@ -268,23 +292,35 @@ impl Material {
             .chain(self.transmission_texture)
             .chain(self.specular_texture)
             .chain(self.specular_color_texture)
+            .chain(self.clearcoat_texture)
+            .chain(self.clearcoat_roughness_texture)
     }
 }
 
 /// What a material's textures other than the base colour's say at a point, each the factor its
 /// texture multiplies (ones where it has none): the metallic-roughness texel (G roughness, B
-/// metallic), transmissionTexture's R, specularTexture's A and specularColorTexture's RGB.
+/// metallic), transmissionTexture's R, specularTexture's A, specularColorTexture's RGB,
+/// clearcoatTexture's R and clearcoatRoughnessTexture's G.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Texels {
     pub metal_rough: Vec3,
     pub transmission: f32,
     pub specular: f32,
     pub specular_color: Vec3,
+    pub clearcoat: f32,
+    pub clearcoat_roughness: f32,
 }
 
 impl Default for Texels {
     fn default() -> Self {
-        Self { metal_rough: Vec3::ONE, transmission: 1.0, specular: 1.0, specular_color: Vec3::ONE }
+        Self {
+            metal_rough: Vec3::ONE,
+            transmission: 1.0,
+            specular: 1.0,
+            specular_color: Vec3::ONE,
+            clearcoat: 1.0,
+            clearcoat_roughness: 1.0,
+        }
     }
 }
 

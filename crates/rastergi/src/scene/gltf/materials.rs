@@ -1,6 +1,6 @@
 //! Materials: glTF's metallic-roughness model, its extensions (emissive strength, ior,
-//! transmission, volume with its attenuation, specular), alpha modes, normal maps and textures with their
-//! KHR_texture_transform.
+//! transmission, volume with its attenuation, specular, clearcoat), alpha modes, normal maps
+//! and textures with their KHR_texture_transform.
 
 use super::*;
 
@@ -14,6 +14,13 @@ impl Loader<'_> {
             None => Material::diffuse("default", Vec3::splat(DEFAULT_ALBEDO)),
             Some(index) => {
                 let what = named("material", index, m.name());
+                let coat = Clearcoat::of(m).map_err(|e| format!("{what}: {e}"))?;
+                if coat.normal_texture && !std::mem::replace(&mut self.warned_coat_normal, true) {
+                    log::warn!(
+                        "{what}: KHR_materials_clearcoat's clearcoatNormalTexture is ignored; the coat shares the base's shading normal"
+                    );
+                }
+                let document = self.document;
                 let pbr = m.pbr_metallic_roughness();
                 let mut texture = |info: Option<(::gltf::Texture, UvTransform)>, linear: bool| match info {
                     Some((t, transform)) => self
@@ -89,6 +96,20 @@ impl Loader<'_> {
                     }
                     _ => Vec3::ZERO,
                 };
+                let mut coat_texture = |info: Option<::gltf::json::texture::Info>| -> Res<Option<TextureRef>> {
+                    let Some(info) = info else { return Ok(None) };
+                    let t = document.textures().nth(info.index.value()).ok_or_else(|| {
+                        format!(
+                            "{what}: a clearcoat texture names texture {}, which does not exist",
+                            info.index.value()
+                        )
+                    })?;
+                    texture(Some((t, json_info_transform(&info))), true)
+                };
+                let clearcoat_texture = coat_texture(coat.texture)?;
+                let clearcoat_roughness_texture = coat_texture(coat.roughness_texture)?;
+                let clearcoat = unit("clearcoatFactor", coat.factor)?;
+                let clearcoat_roughness = unit("clearcoatRoughnessFactor", coat.roughness)?;
                 Material {
                     albedo_texture: base.map(|t| t.texture),
                     albedo_transform: base.map_or(UvTransform::IDENTITY, |t| t.transform),
@@ -111,6 +132,10 @@ impl Loader<'_> {
                     transmission_texture,
                     thin,
                     attenuation,
+                    clearcoat,
+                    clearcoat_roughness,
+                    clearcoat_texture,
+                    clearcoat_roughness_texture,
                     two_sided: m.double_sided(),
                     ..Material::diffuse(
                         &m.name().map_or_else(|| format!("material {index}"), str::to_owned),
@@ -163,6 +188,70 @@ pub fn texture_transform(offset: [f32; 2], rotation: f32, scale: [f32; 2]) -> Uv
     UvTransform([[c * scale[0], s * scale[1], offset[0]], [-s * scale[0], c * scale[1], offset[1]]])
 }
 
+/// `KHR_materials_clearcoat`, which the `gltf` crate does not parse: its factors (0 by default),
+/// clearcoatTexture (R × factor) and clearcoatRoughnessTexture (G × factor), and whether it
+/// names a clearcoatNormalTexture.
+#[derive(Default)]
+pub(super) struct Clearcoat {
+    pub factor: f32,
+    pub roughness: f32,
+    pub texture: Option<::gltf::json::texture::Info>,
+    pub roughness_texture: Option<::gltf::json::texture::Info>,
+    pub normal_texture: bool,
+}
+
+impl Clearcoat {
+    pub(super) fn of(m: &::gltf::Material) -> Res<Clearcoat> {
+        let Some(v) = m.extension_value("KHR_materials_clearcoat") else { return Ok(Clearcoat::default()) };
+        let number = |key: &str| -> Res<f32> {
+            match v.get(key) {
+                None => Ok(0.0),
+                Some(x) => x
+                    .as_f64()
+                    .map(|x| x as f32)
+                    .ok_or_else(|| format!("KHR_materials_clearcoat's {key} {x} is not a number")),
+            }
+        };
+        let info = |key: &str| -> Res<Option<::gltf::json::texture::Info>> {
+            v.get(key)
+                .map(|x| {
+                    ::gltf::json::deserialize::from_value(x.clone())
+                        .map_err(|e| format!("KHR_materials_clearcoat's {key} is not a texture reference ({e})"))
+                })
+                .transpose()
+        };
+        Ok(Clearcoat {
+            factor: number("clearcoatFactor")?,
+            roughness: number("clearcoatRoughnessFactor")?,
+            texture: info("clearcoatTexture")?,
+            roughness_texture: info("clearcoatRoughnessTexture")?,
+            normal_texture: v.get("clearcoatNormalTexture").is_some(),
+        })
+    }
+
+    /// The TEXCOORD sets its textures read.
+    fn sets(&self) -> impl Iterator<Item = u32> + '_ {
+        [&self.texture, &self.roughness_texture].into_iter().flatten().map(json_info_set)
+    }
+}
+
+/// The KHR_texture_transform of a texture reference read from JSON.
+fn json_info_transform(info: &::gltf::json::texture::Info) -> UvTransform {
+    info.extensions
+        .as_ref()
+        .and_then(|e| e.texture_transform.as_ref())
+        .map_or(UvTransform::IDENTITY, |t| texture_transform(t.offset.0, t.rotation.0, t.scale.0))
+}
+
+/// The TEXCOORD set of a texture reference read from JSON (its transform's texCoord first).
+fn json_info_set(info: &::gltf::json::texture::Info) -> u32 {
+    info.extensions
+        .as_ref()
+        .and_then(|e| e.texture_transform.as_ref())
+        .and_then(|t| t.tex_coord)
+        .unwrap_or(info.tex_coord)
+}
+
 pub(super) fn info_transform(info: &::gltf::texture::Info) -> UvTransform {
     info.texture_transform().map_or(UvTransform::IDENTITY, |t| texture_transform(t.offset(), t.rotation(), t.scale()))
 }
@@ -182,8 +271,8 @@ pub(super) fn parsed_normal_transform(
 }
 
 /// The TEXCOORD sets a material's textures read (base colour, emissive, normal map,
-/// metallic-roughness, transmission, specular, specular colour), each
-/// overridden by its KHR_texture_transform's texCoord.
+/// metallic-roughness, transmission, specular, specular colour, clear coat and its roughness),
+/// each overridden by its KHR_texture_transform's texCoord.
 pub(super) fn texture_sets(m: &::gltf::Material) -> Vec<u32> {
     let info = |i: ::gltf::texture::Info| i.texture_transform().and_then(|t| t.tex_coord()).unwrap_or(i.tex_coord());
     let base = m.pbr_metallic_roughness().base_color_texture().map(info);
@@ -194,5 +283,10 @@ pub(super) fn texture_sets(m: &::gltf::Material) -> Vec<u32> {
     let transmission = m.transmission().and_then(|t| t.transmission_texture()).map(info);
     let specular = m.specular().and_then(|s| s.specular_texture()).map(info);
     let specular_color = m.specular().and_then(|s| s.specular_color_texture()).map(info);
-    [base, emissive, normal, metal_rough, transmission, specular, specular_color].into_iter().flatten().collect()
+    let coat = Clearcoat::of(m).unwrap_or_default();
+    [base, emissive, normal, metal_rough, transmission, specular, specular_color]
+        .into_iter()
+        .flatten()
+        .chain(coat.sets())
+        .collect()
 }

@@ -90,6 +90,7 @@ const SUPPORTED_REQUIRED: &[&str] = &[
     "KHR_materials_ior",
     "KHR_materials_volume",
     "KHR_materials_specular",
+    "KHR_materials_clearcoat",
 ];
 const DEFAULT_ALBEDO: f32 = 0.5;
 
@@ -146,6 +147,7 @@ fn load(path: &Path, bytes: &[u8], options: &GltfOptions) -> Res<Scene> {
         materials: HashMap::new(),
         textures: HashMap::new(),
         warned_sets: false,
+        warned_coat_normal: false,
         camera: None,
         warned_sampler: false,
     };
@@ -179,6 +181,8 @@ struct Loader<'a> {
     camera: Option<Camera>,
     warned_sampler: bool,
     warned_sets: bool,
+    /// Whether a clearcoatNormalTexture has been warned about.
+    warned_coat_normal: bool,
 }
 
 /// A name for an element in messages: `mesh 3 ('Chair')`.

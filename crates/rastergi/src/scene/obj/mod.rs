@@ -22,7 +22,9 @@
 //!   1), and its dielectric specular layer (f₀ from `Ni`, default 1.5: 0.04) unless `Ks 0 0 0`;
 //! - `illum 3` (reflection, ray traced) without `Pm`: a metal, roughness `Pr` (default 0);
 //! - `illum` 4, 6, 7 or 9 (refraction): glass, a refracting solid of index `Ni` (default 1.5)
-//!   tinted by `Tf` (default white), roughness `Pr` (default 0); `Kd` and `Pm` are not used.
+//!   tinted by `Tf` (default white), roughness `Pr` (default 0); `Kd` and `Pm` are not used;
+//! - `Pc k` and `Pcr r` (the same extension's clear coat): a clear coat of weight k and
+//!   roughness r (default 0) over any of the above.
 //!
 //! Values outside their range are clamped with a warning.
 //!
@@ -164,6 +166,8 @@ pub fn load_obj(path: &Path) -> Result<Scene> {
             specular: scattering.specular,
             ior: scattering.ior,
             transmission: scattering.transmission,
+            clearcoat: scattering.clearcoat,
+            clearcoat_roughness: scattering.clearcoat_roughness,
             albedo_texture: albedo_map.map(|t| t.texture),
             albedo_transform: albedo_map.map_or(UvTransform::IDENTITY, |t| t.transform),
             emission,

@@ -32,6 +32,9 @@ pub(super) struct Scattering {
     pub(super) transmission: f32,
     /// The base colour where it is not `Kd` (glass: its tint `Tf`).
     pub(super) base: Option<Vec3>,
+    /// The clear coat `Pc` and its roughness `Pcr` (default 0).
+    pub(super) clearcoat: f32,
+    pub(super) clearcoat_roughness: f32,
 }
 
 impl Scattering {
@@ -52,6 +55,7 @@ impl Scattering {
             }
         };
         let (pm, pr) = (unit("Pm"), unit("Pr"));
+        let (clearcoat, clearcoat_roughness) = (unit("Pc").unwrap_or(0.0), unit("Pcr").unwrap_or(0.0));
         let illum = m.illumination_model;
         let ior = match m.optical_density {
             Some(n) if n.is_finite() && n > 0.0 => n,
@@ -61,8 +65,16 @@ impl Scattering {
             }
             None => 1.5,
         };
-        let lambertian =
-            Scattering { metallic: 0.0, roughness: 1.0, specular: 0.0, ior, transmission: 0.0, base: None };
+        let lambertian = Scattering {
+            metallic: 0.0,
+            roughness: 1.0,
+            specular: 0.0,
+            ior,
+            transmission: 0.0,
+            base: None,
+            clearcoat,
+            clearcoat_roughness,
+        };
         if illum.is_some_and(|i| GLASS_ILLUM.contains(&i)) {
             let tint = m.unknown_param.get("Tf").map(|t| {
                 let v: Vec<f32> = t.split_whitespace().filter_map(|w| w.parse().ok()).collect();

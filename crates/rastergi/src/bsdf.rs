@@ -39,7 +39,21 @@
 //! cosine-weighted mean and F̄ the cosine-weighted mean of Schlick's Fresnel term: reciprocal,
 //! and a white metal reflects E(μ_o) + (1 − E(μ_o)) = 1 at every angle and roughness; a
 //! coloured one gains the light that the series of inner bounces F̄^k keeps. The layer needs
-//! none (its base takes what it leaves, `diffuse_share`); glass is still single scattering.
+//! none (its base takes what it leaves, `diffuse_share`). Rough glass divides its lobes by its
+//! single-scattering albedo E_g for the direction the light leaves by (Turquin 2019's scaling:
+//! the lost energy returned in the shape of the lobes it was lost from),
+//!
+//! ```text
+//! f_G,ms(ω_o, ω_i) = f_G(ω_o, ω_i) / E_g(ω_v),   ω_v = ω_o for radiance, ω_i for importance
+//! ```
+//!
+//! with E_g(ω) the share of the flux arriving from ω that one microfacet reflects or refracts
+//! (tabulated on μ, α, η and the side, [`albedo::GlassAlbedo`]; a thin slab's is E₁). By
+//! reciprocity ∫ f_G(ω_o, ω_i) η(ω_i)² cos θ_i dω_i = η(ω_o)² E_g(ω_o), so uniform light — the
+//! equilibrium radiance η² on each side — is kept exactly at every roughness, from outside and
+//! from inside (where rough glass of η 1.5 keeps 0.42 at roughness 1 by single scattering, the
+//! rest lost to total internal reflection between microfacets); a single beam, as with the
+//! coat, is kept on average. The model is reciprocal no more; importance uses the adjoint.
 //! [`Bsdf::multiple_scattering`] off is the single-scattering model (Mitsuba 3's
 //! `roughconductor`, which the reference images use: `--single-scattering`).
 //!
@@ -386,6 +400,26 @@ impl Bsdf {
         Vec3::splat(self.clearcoat * schlick(Vec3::splat(COAT_F0), o.dot(h)).x * spec)
     }
 
+    /// Whether rough glass's lobes are scaled by 1/E_g of the direction the light leaves by
+    /// (module docs).
+    fn glass_compensates(&self) -> bool {
+        self.multiple_scattering && !self.smooth() && self.transmission > 0.0
+    }
+
+    /// The single-scattering albedo of white rough glass for flux arriving from `w`
+    /// ([`albedo::GlassAlbedo`]: a solid from either side; a thin slab's is the reflection
+    /// lobe's, E₁(|cos θ|), since it passes what it does not reflect along the mirrored lobe).
+    /// A relative index below 1 is the same glass seen from inside (the renderers turn the
+    /// frame towards the arriving ray and invert η there).
+    fn glass_single_albedo(&self, w: Vec3) -> f32 {
+        if self.thin {
+            ggx_albedo().at(w.z.abs(), self.alpha)[0]
+        } else {
+            let (eta, inside) = if self.ior < 1.0 { (1.0 / self.ior, w.z >= 0.0) } else { (self.ior, w.z < 0.0) };
+            albedo::glass_albedo().at(w.z.abs(), self.alpha, eta, inside)
+        }
+    }
+
     /// Whether the metal lobe has its multiple-scattering lobe (module docs): compensated,
     /// rough and partly metallic.
     fn compensates(&self) -> bool {
@@ -534,8 +568,20 @@ impl Bsdf {
         Some((h, etap))
     }
 
-    /// The glass's f: a thin slab alike from both sides, a solid entered from the front.
+    /// The glass's f: a thin slab alike from both sides, a solid entered from the front;
+    /// compensated, divided by the single-scattering albedo E_g of the direction the light
+    /// leaves by (ω_o for radiance, ω_i for importance: module docs).
     fn glass_eval(&self, wo: Vec3, wi: Vec3, transport: Transport) -> Vec3 {
+        let f = self.glass_single_eval(wo, wi, transport);
+        if !self.glass_compensates() || f == Vec3::ZERO {
+            return f;
+        }
+        let view = if transport == Transport::Radiance { wo } else { wi };
+        f / self.glass_single_albedo(view).max(1e-3)
+    }
+
+    /// Walter et al.'s single-scattering glass.
+    fn glass_single_eval(&self, wo: Vec3, wi: Vec3, transport: Transport) -> Vec3 {
         if self.smooth() || wo.z == 0.0 || wi.z == 0.0 {
             return Vec3::ZERO;
         }
@@ -844,7 +890,7 @@ pub fn on_gpu(
     let output = gpu.zeroed_buffer("bsdf answers", size, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
     let c = wgpu::ShaderStages::COMPUTE;
     let table =
-        gpu.storage_buffer("bsdf ggx albedo", bytemuck::bytes_of(&ggx_albedo().gpu()), wgpu::BufferUsages::empty());
+        gpu.storage_buffer("bsdf ggx albedo", bytemuck::bytes_of(&ggx_albedo().gpu(true)), wgpu::BufferUsages::empty());
     let main = "
         struct Query { v: array<f32, 25> }
         struct Answer { v: array<f32, 16> }

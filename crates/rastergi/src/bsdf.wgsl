@@ -165,6 +165,9 @@ fn layer_fresnel(b: Bsdf, c: f32) -> vec3f {
 struct GgxAlbedoTable {
     cells: array<vec4f, GGX_ALBEDO_CELLS>,
     means: array<vec4f, GGX_ALBEDO_N>,
+    // Rough solid glass's single-scattering albedo (albedo.rs, GlassAlbedo): index
+    // ((side·GLASS_ALBEDO_ETAS + η)·N + √α)·N + μ, side 1 inside; zeros where no material needs it.
+    glass: array<f32, GLASS_ALBEDO_CELLS>,
 }
 
 // (E₁, E₅) of the GGX lobe at cos θ_o = mu and alpha, bilinear in (μ, √α) between cells
@@ -189,6 +192,50 @@ fn ggx_albedo_mean(alpha: f32) -> vec2f {
     let j = min(u32(t), GGX_ALBEDO_N - 2u);
     let m = ggx_table.means[j];
     return m.xy + (m.zw - m.xy) * (t - f32(j));
+}
+
+// E_g of glass for flux arriving from w (GlassAlbedo::at, trilinear; Bsdf::glass_single_albedo:
+// a thin slab's is E₁).
+fn glass_single_albedo(b: Bsdf, w: vec3f) -> f32 {
+    let mu = abs(w.z);
+    if b.thin {
+        return ggx_albedo(mu, b.alpha).x;
+    }
+    let n = GGX_ALBEDO_N;
+    let tx = clamp(mu, 0.0, 1.0) * f32(n - 1u);
+    let ty = sqrt(clamp(b.alpha, 0.0, 1.0)) * f32(n - 1u);
+    // A relative index below 1: the glass seen from inside (arrival inverts η there).
+    var eta = b.ior;
+    var inside = w.z < 0.0;
+    if eta < 1.0 {
+        eta = 1.0 / eta;
+        inside = !inside;
+    }
+    let tz = clamp((eta - 1.0) / (GLASS_ALBEDO_ETA_MAX - 1.0), 0.0, 1.0) * f32(GLASS_ALBEDO_ETAS - 1u);
+    let i = min(u32(tx), n - 2u);
+    let j = min(u32(ty), n - 2u);
+    let k = min(u32(tz), GLASS_ALBEDO_ETAS - 2u);
+    let fx = tx - f32(i);
+    let fy = ty - f32(j);
+    var side = 0u;
+    if inside {
+        side = GLASS_ALBEDO_ETAS;
+    }
+    var e = array<f32, 2>();
+    for (var d = 0u; d < 2u; d++) {
+        let r0 = ((side + k + d) * n + j) * n + i;
+        let r1 = r0 + n;
+        let lo = ggx_table.glass[r0] + (ggx_table.glass[r0 + 1u] - ggx_table.glass[r0]) * fx;
+        let hi = ggx_table.glass[r1] + (ggx_table.glass[r1 + 1u] - ggx_table.glass[r1]) * fx;
+        e[d] = lo + (hi - lo) * fy;
+    }
+    return e[0] + (e[1] - e[0]) * (tz - f32(k));
+}
+
+// Whether rough glass's lobes are divided by E_g of the direction the light leaves by
+// (Bsdf::glass_compensates).
+fn glass_compensates(b: Bsdf) -> bool {
+    return b.multiple_scattering && !bsdf_is_smooth(b) && b.transmission > 0.0;
 }
 
 // Whether the metal has its multiple-scattering lobe (Bsdf::compensates).
@@ -357,7 +404,18 @@ fn glass_half(b: Bsdf, wo: vec3f, wi: vec3f) -> vec4f {
     return vec4f(h, etap);
 }
 
+// The glass's f, compensated: divided by E_g of the direction the light leaves by (wo for
+// radiance, wi for importance; Bsdf::glass_eval).
 fn glass_eval(b: Bsdf, wo: vec3f, wi: vec3f, transport: u32) -> vec3f {
+    let f = glass_single_eval(b, wo, wi, transport);
+    if !glass_compensates(b) || all(f == vec3f(0.0)) {
+        return f;
+    }
+    let view = select(wi, wo, transport == TRANSPORT_RADIANCE);
+    return f / max(glass_single_albedo(b, view), 1e-3);
+}
+
+fn glass_single_eval(b: Bsdf, wo: vec3f, wi: vec3f, transport: u32) -> vec3f {
     if bsdf_is_smooth(b) || wo.z == 0.0 || wi.z == 0.0 {
         return vec3f(0.0);
     }

@@ -485,7 +485,7 @@ impl GpuScene {
             contents: bytemuck::bytes_of(&if !has_bsdfs {
                 crate::bsdf::albedo::GpuGgxAlbedo::zeroed()
             } else {
-                crate::bsdf::ggx_albedo().gpu()
+                crate::bsdf::ggx_albedo().gpu(s.materials.iter().any(|m| m.needs_glass_table()))
             }),
             usage: wgpu::BufferUsages::STORAGE,
         });

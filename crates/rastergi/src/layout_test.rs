@@ -147,7 +147,7 @@ fn twins() -> Vec<Twin> {
         twin!(DisplayUniforms, "Display", [image_size, target_size, decode_srgb, text_cols, text_rows, text_scale]),
         twin!(TrianglePlane, "TrianglePlane", [normal, offset, bins]),
         twin!(PathParams, "PathParams", [light_weight, light_count, max_bounces, rr_start]),
-        twin!(crate::bsdf::albedo::GpuGgxAlbedo, "GgxAlbedoTable", [cells, means]),
+        twin!(crate::bsdf::albedo::GpuGgxAlbedo, "GgxAlbedoTable", [cells, means, glass]),
         twin!(crate::rays::GpuRay, "Ray", [origin, dir, skip_any]),
         twin!(crate::rays::GpuRayHit, "RayHit", [t, tri, b1, b2]),
     ]

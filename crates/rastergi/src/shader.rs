@@ -62,8 +62,14 @@ pub fn constants() -> String {
         ("NO_CHILD", crate::bvh::wide::NO_CHILD),
         ("GGX_ALBEDO_N", crate::bsdf::albedo::N as u32),
         ("GGX_ALBEDO_CELLS", (crate::bsdf::albedo::N * crate::bsdf::albedo::N) as u32),
+        ("GLASS_ALBEDO_ETAS", crate::bsdf::albedo::GLASS_ETAS as u32),
+        ("GLASS_ALBEDO_CELLS", crate::bsdf::albedo::GLASS_CELLS as u32),
     ];
-    let f32s = [("OFFSET_STEP", OFFSET_STEP), ("MIN_LOOKUP_AREA", MIN_LOOKUP_AREA)];
+    let f32s = [
+        ("OFFSET_STEP", OFFSET_STEP),
+        ("MIN_LOOKUP_AREA", MIN_LOOKUP_AREA),
+        ("GLASS_ALBEDO_ETA_MAX", crate::bsdf::albedo::GLASS_ETA_MAX),
+    ];
     let mut s = String::from("// Generated from the Rust constants (shader.rs).\n");
     for (name, value) in u32s {
         s += &format!("const {name}: u32 = {value}u;\n");

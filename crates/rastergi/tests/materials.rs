@@ -25,6 +25,8 @@ fn the_gpu_bsdf_agrees_with_its_cpu_twin() {
         Bsdf { alpha: 0.0, specular: 1.0, ..Bsdf::diffuse(c) },
         Bsdf { transmission: 1.0, alpha: 0.09, specular: 1.0, ..Bsdf::diffuse(c) },
         Bsdf { transmission: 1.0, alpha: 0.0, specular: 1.0, ior: 1.33, ..Bsdf::diffuse(c) },
+        // Rough glass as the renderers see it from inside (η inverted), compensated.
+        Bsdf { transmission: 1.0, alpha: 0.5, specular: 1.0, ior: 1.0 / 1.5, ..Bsdf::diffuse(c) },
         Bsdf { transmission: 1.0, alpha: 0.36, specular: 1.0, thin: true, ..Bsdf::diffuse(c) },
         Bsdf { transmission: 1.0, alpha: 0.0, specular: 1.0, thin: true, ..Bsdf::diffuse(c) },
         Bsdf { transmission: 0.5, metallic: 0.2, alpha: 0.3, specular: 0.7, ..Bsdf::diffuse(c) },

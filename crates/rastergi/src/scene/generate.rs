@@ -201,7 +201,7 @@ pub fn glossy_room() -> Scene {
 
 /// A UV sphere: `segments` around the axis, `segments / 2` rings from pole to pole;
 /// `2·segments·(rings − 1)` triangles, front faces outwards, smooth (radial shading normals).
-fn add_sphere(scene: &mut Scene, centre: Vec3, radius: f32, segments: u32, material: u32) {
+pub fn add_sphere(scene: &mut Scene, centre: Vec3, radius: f32, segments: u32, material: u32) {
     let segments = segments.max(3);
     let rings = (segments / 2).max(2);
     let point = |ring: u32, seg: u32| {

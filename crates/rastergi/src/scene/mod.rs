@@ -262,6 +262,15 @@ impl Material {
         smooth_coat || (smooth && (self.metallic > 0.0 || self.transmission > 0.0 || self.specular > 0.0))
     }
 
+    /// Whether its BSDF reads the rough solid glass's albedo table (its energy compensation:
+    /// glass, rough or roughened by a texture, solid, compensated).
+    pub fn needs_glass_table(&self) -> bool {
+        self.transmission > 0.0
+            && !self.thin
+            && self.multiple_scattering
+            && (self.roughness * self.roughness >= crate::bsdf::SMOOTH_ALPHA || self.metal_rough_texture.is_some())
+    }
+
     /// Whether it scatters as a plain Lambertian surface (f = ρ/π).
     pub fn is_lambertian(&self) -> bool {
         self.metallic == 0.0 && self.transmission == 0.0 && self.specular == 0.0 && self.clearcoat <= 0.0

@@ -3,8 +3,8 @@
 # pkg-config, Mesa's Vulkan drivers (lavapipe runs the GPU code on the CPU when there is no
 # GPU), the X11 libraries of the viewer's window and Xvfb for its tests, and Rust >= 1.95
 # with rustfmt and clippy (and, through rustup, the wasm32-unknown-unknown target of the
-# library's web build, which CI builds), and a Python virtual environment with Ray (scripts/ray_render.py)
-# and maturin, pytest and numpy (the Python package, python/).
+# library's web build, which CI builds), and a Python virtual environment with Ray
+# (scripts/ray_render.py) and maturin, pytest and numpy (the Python package, python/).
 # Safe to run again: it installs only what is missing. Afterwards,
 # in a new shell or after `. ~/.cargo/env`: cargo test --release
 set -euo pipefail

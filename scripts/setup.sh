@@ -2,8 +2,9 @@
 # Installs what rastergi needs on a fresh Debian or Ubuntu machine: a C toolchain and
 # pkg-config, Mesa's Vulkan drivers (lavapipe runs the GPU code on the CPU when there is no
 # GPU), the X11 libraries of the viewer's window and Xvfb for its tests, and Rust >= 1.95
-# with rustfmt and clippy, and a Python virtual environment with Ray (scripts/ray_render.py)
-# and maturin, pytest and numpy (the Python package, python/).
+# with rustfmt and clippy (and, through rustup, the wasm32-unknown-unknown target of the
+# library's web build, which CI builds), and a Python virtual environment with Ray
+# (scripts/ray_render.py) and maturin, pytest and numpy (the Python package, python/).
 # Safe to run again: it installs only what is missing. Afterwards,
 # in a new shell or after `. ~/.cargo/env`: cargo test --release
 set -euo pipefail
@@ -81,6 +82,15 @@ if ! version_at_least "$rust_version" "$MIN_RUST"; then
 fi
 if command -v rustup >/dev/null 2>&1; then
     rustup -q component add rustfmt clippy
+    # The library's web build (cargo build --target wasm32-unknown-unknown -p rastergi).
+    if rustup target list --installed | grep -x wasm32-unknown-unknown >/dev/null; then
+        say "wasm32-unknown-unknown target present"
+    else
+        say "adding the wasm32-unknown-unknown target (the library's web build)"
+        rustup -q target add wasm32-unknown-unknown
+    fi
+else
+    say "no rustup: add the wasm32-unknown-unknown target yourself for the web build"
 fi
 say "ready: $(rustc --version), $(cargo --version)"
 

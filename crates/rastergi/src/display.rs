@@ -16,7 +16,7 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::error::{Error, Result};
 use crate::film::Film;
-use crate::gpu::{Gpu, GpuOptions, bind_group, bind_group_layout, storage_entry, uniform_entry};
+use crate::gpu::{Gpu, bind_group, bind_group_layout, storage_entry, uniform_entry};
 use crate::shader;
 
 /// Re-exported so front ends can hand over a window without a direct wgpu dependency.
@@ -229,9 +229,10 @@ impl WindowSurface {
     /// Creates a surface for `window` on `display` (the window system's connection, which
     /// OpenGL needs at instance creation) and opens the best device that can present to it
     /// (a discrete GPU first, as [`Gpu::new`] does), with the surface configured at
-    /// `width × height` (at least 1×1).
+    /// `width × height` (at least 1×1). Blocks until the device is open: native only.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn open<D>(
-        options: &GpuOptions,
+        options: &crate::gpu::GpuOptions,
         display: D,
         window: impl Into<SurfaceTarget<'static>>,
         width: u32,

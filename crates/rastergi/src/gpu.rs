@@ -72,17 +72,35 @@ impl GpuOptions {
 
 impl Gpu {
     /// Opens the best adapter: a discrete GPU if there is one, then integrated, virtual, CPU.
+    /// Blocks until the device is open (native only; [`Gpu::new_async`] everywhere).
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn new(options: &GpuOptions) -> Result<Gpu> {
+        pollster::block_on(Gpu::new_async(options))
+    }
+
+    /// [`Gpu::new`] as a future: what a web page awaits (the browser offers one adapter).
+    pub async fn new_async(options: &GpuOptions) -> Result<Gpu> {
         let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
         desc.backends = options.backends();
-        Gpu::open(&wgpu::Instance::new(desc), options, None)
+        Gpu::open_async(&wgpu::Instance::new(desc), options, None).await
     }
 
     /// Opens the best adapter of `instance` (ranked as in [`Gpu::new`]) among those that can
     /// present to `surface`, if one is given: the one device opener of headless and window use.
+    /// Blocks until the device is open (native only; [`Gpu::open_async`] everywhere).
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn open(instance: &wgpu::Instance, options: &GpuOptions, surface: Option<&wgpu::Surface>) -> Result<Gpu> {
+        pollster::block_on(Gpu::open_async(instance, options, surface))
+    }
+
+    /// [`Gpu::open`] as a future.
+    pub async fn open_async(
+        instance: &wgpu::Instance,
+        options: &GpuOptions,
+        surface: Option<&wgpu::Surface<'_>>,
+    ) -> Result<Gpu> {
         let backends = options.backends();
-        let mut adapters = pollster::block_on(instance.enumerate_adapters(backends));
+        let mut adapters = instance.enumerate_adapters(backends).await;
         if let Some(surface) = surface {
             adapters.retain(|a| a.is_surface_supported(surface));
         }
@@ -98,15 +116,17 @@ impl Gpu {
         if options.profile && required_features.is_empty() {
             log::warn!("{} has no timestamp queries: --profile reports wall-clock time only", info.name);
         }
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-            label: Some("rastergi device"),
-            required_features,
-            required_limits: limits,
-            experimental_features: wgpu::ExperimentalFeatures::disabled(),
-            memory_hints: wgpu::MemoryHints::Performance,
-            trace: wgpu::Trace::Off,
-        }))
-        .map_err(|e| Error::Device(e.to_string()))?;
+        let (device, queue) = adapter
+            .request_device(&wgpu::DeviceDescriptor {
+                label: Some("rastergi device"),
+                required_features,
+                required_limits: limits,
+                experimental_features: wgpu::ExperimentalFeatures::disabled(),
+                memory_hints: wgpu::MemoryHints::Performance,
+                trace: wgpu::Trace::Off,
+            })
+            .await
+            .map_err(|e| Error::Device(e.to_string()))?;
         log::info!("using {} ({:?}, {:?})", info.name, info.backend, info.device_type);
         let profiler = if options.profile { Profiler::new(&device, &queue) } else { None };
         let fault = std::sync::Arc::new(std::sync::Mutex::new(Fault::default()));

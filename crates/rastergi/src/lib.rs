@@ -32,6 +32,7 @@ mod layout_test;
 pub mod lights;
 pub mod limits;
 pub mod metrics;
+mod par;
 pub mod path_tracer;
 pub mod photon_view;
 pub mod photons;

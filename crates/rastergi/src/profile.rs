@@ -78,6 +78,8 @@ impl Profiler {
             mapped_at_creation: false,
         });
         let period = queue.get_timestamp_period();
+        // Natively `Inner` is Send and Sync; wgpu's WebGPU handles are neither (one thread).
+        #[cfg_attr(target_arch = "wasm32", allow(clippy::arc_with_non_send_sync))]
         Some(Profiler(Arc::new(Inner { query_set, resolve, readback, period, state: Mutex::default() })))
     }
 

@@ -12,8 +12,9 @@ use crate::renderer::{RenderSettings, Renderer};
 use crate::scene::Camera;
 
 /// `Send`: a renderer may be built on one thread and used on another (the viewer's builds, the
-/// Python package's renders with the interpreter's lock released).
-pub trait Progressive: Send {
+/// Python package's renders with the interpreter's lock released). On wasm32, where wgpu's
+/// WebGPU handles are not `Send` and there is one thread, no bound ([`wgpu::WasmNotSend`]).
+pub trait Progressive: wgpu::WasmNotSend {
     /// What the renderer is, for tables and logs.
     fn name(&self) -> &'static str;
     fn settings(&self) -> &RenderSettings;

@@ -21,13 +21,13 @@
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
-use rayon::prelude::*;
 
 use crate::bvh::Hit;
 use crate::consts::{LIGHT_POINT, LIGHT_SPOT, PUNCTUAL_LIGHT};
 use crate::error::Result;
 use crate::gpu::{Gpu, bind_group, bind_group_layout, compute_pipeline, groups, storage_entry};
 use crate::gpu_scene::{GpuScene, PreparedScene, alpha_uniform};
+use crate::par::prelude::*;
 use crate::sampling::{Rng, cosine_hemisphere, uniform_triangle};
 use crate::scene::{Camera, triangle_normal};
 

@@ -26,9 +26,9 @@ use std::sync::OnceLock;
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
-use rayon::prelude::*;
 
 use super::{fresnel_dielectric, ggx_g1, reflect, refract, vndf_sample};
+use crate::par::prelude::*;
 
 /// Cells along μ and along α.
 pub const N: usize = 32;

@@ -103,8 +103,9 @@ pub enum HitLight {
 }
 
 /// One way of finding the nearest surface along an iteration's gather directions and adding
-/// the estimate; each implementation owns its loop over the directions.
-pub trait Gather: Send {
+/// the estimate; each implementation owns its loop over the directions. `Send` natively (it
+/// is part of a [`crate::progressive::Progressive`] renderer), no bound on wasm32.
+pub trait Gather: wgpu::WasmNotSend {
     /// Encodes the gather along every direction of `inputs.samples` (each estimate weighted
     /// 1/len) after the work already in `enc`. An implementation that reads a result back may
     /// submit `enc` and go on in a new encoder, which it leaves in `enc`.

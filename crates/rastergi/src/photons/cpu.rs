@@ -1,11 +1,10 @@
 //! The CPU twin of the photon tracer: the same photons, the same map, in f64 with rayon.
 //! Reference in tests, baseline in `rastergi bench photons`.
 
-use rayon::prelude::*;
-
 use super::{MAX_BOUNCES, PhotonSettings, STREAM_PHOTON};
 use crate::bsdf::{Frame, Transport};
 use crate::gpu_scene::{PreparedScene, alpha_uniform};
+use crate::par::prelude::*;
 use crate::photons::map::{GridSpec, MapLayout, PhotonMap};
 use crate::sampling::{Rng, bend_towards, cosine_hemisphere, pcg_hash};
 use crate::scene::triangle_normal;

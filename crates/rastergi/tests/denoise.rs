@@ -1,0 +1,277 @@
+//! The denoiser (`denoise.rs`): the GPU filter against its CPU twin, the convergence rule on
+//! a synthetic image, and the Cornell box against the committed Mitsuba reference.
+
+mod common;
+
+use rastergi::denoise::{DenoiseParams, Denoiser, GUIDE_SLOTS, cpu};
+use rastergi::film::{COMPONENTS, Show};
+use rastergi::image_io::LinearImage;
+use rastergi::metrics::{compare, emitter_mask, rmse};
+use rastergi::renderer::{RenderSettings, Renderer};
+use rastergi::sampling::{pcg_hash, unit_f32};
+use rastergi::scene::cornell_box;
+
+/// A uniform number in [0, 1) from three indices.
+fn hash(a: u32, b: u32, c: u32) -> f32 {
+    unit_f32(pcg_hash(a ^ pcg_hash(b ^ pcg_hash(c))))
+}
+
+/// A synthetic scene of `w × h` pixels: two planes meeting at a vertical edge (different
+/// normals and distances), a checker albedo on the left one, smooth light with a step.
+struct Synthetic {
+    w: u32,
+    h: u32,
+}
+
+impl Synthetic {
+    fn albedo(&self, x: u32, y: u32) -> [f32; 3] {
+        if x < self.w / 2 {
+            if (x / 4 + y / 4) % 2 == 0 { [0.8, 0.2, 0.2] } else { [0.3, 0.7, 0.3] }
+        } else {
+            [0.6, 0.6, 0.6]
+        }
+    }
+
+    fn normal(&self, x: u32) -> [f32; 3] {
+        if x < self.w / 2 { [0.0, 0.0, 1.0] } else { [0.7071, 0.0, 0.7071] }
+    }
+
+    fn depth(&self, x: u32, y: u32) -> f32 {
+        if x < self.w / 2 { 3.0 + 0.002 * y as f32 } else { 2.0 + 0.01 * (x - self.w / 2) as f32 }
+    }
+
+    /// The expected (direct, indirect) light, before the albedo.
+    fn light(&self, x: u32, y: u32) -> ([f32; 3], [f32; 3]) {
+        let fx = x as f32 / self.w as f32;
+        let fy = y as f32 / self.h as f32;
+        let direct = if y < self.h / 3 { [0.1; 3] } else { [1.0 + fx, 1.0 + fx, 0.8 + fy] };
+        (direct, [0.3 + 0.2 * fy, 0.25, 0.2 + 0.1 * fx])
+    }
+
+    /// Film and guide sums of `n` iterations: each adds the expected value times noise of
+    /// relative spread `spread` (direct a tenth of it), as the renderer's passes would.
+    fn render(&self, n: u32, spread: f32, seed: u32) -> (Vec<f32>, Vec<f32>) {
+        let pixels = (self.w * self.h) as usize;
+        let mut film = vec![0.0f32; COMPONENTS as usize * pixels * 4];
+        let mut guides = vec![0.0f32; GUIDE_SLOTS as usize * pixels * 4];
+        let lum = |c: [f32; 3]| c[0] * 0.2126 + c[1] * 0.7152 + c[2] * 0.0722;
+        for y in 0..self.h {
+            for x in 0..self.w {
+                let p = (y * self.w + x) as usize;
+                let a = self.albedo(x, y);
+                let (d, i) = self.light(x, y);
+                let nrm = self.normal(x);
+                let z = self.depth(x, y);
+                for k in 0..n {
+                    let u = |s: u32| 2.0 * hash(seed ^ s, p as u32, k) - 1.0;
+                    let (nd, ni) = (1.0 + 0.1 * spread * u(1) * 1.732, (1.0 + spread * u(2) * 1.732).max(0.0));
+                    let dv = [0, 1, 2].map(|c| a[c] * d[c] * nd);
+                    let iv = [0, 1, 2].map(|c| a[c] * i[c] * ni);
+                    for c in 0..3 {
+                        film[4 * p + c] += dv[c];
+                        film[4 * (pixels + p) + c] += iv[c];
+                        guides[4 * p + c] += a[c];
+                        guides[4 * (pixels + p) + c] += nrm[c];
+                    }
+                    guides[4 * p + 3] += z;
+                    guides[4 * (pixels + p) + 3] += 1.0;
+                    let (ld, li) = (lum(d) * nd, lum(i) * ni);
+                    let m = 4 * (2 * pixels + p);
+                    guides[m] += ld;
+                    guides[m + 1] += ld * ld;
+                    guides[m + 2] += li;
+                    guides[m + 3] += li * li;
+                }
+                for c in 0..3 {
+                    guides[4 * (3 * pixels + p) + c] = film[4 * p + c];
+                    guides[4 * (4 * pixels + p) + c] = film[4 * (pixels + p) + c];
+                }
+            }
+        }
+        (film, guides)
+    }
+
+    /// The expected image.
+    fn truth(&self) -> LinearImage {
+        let mut pixels = Vec::new();
+        for y in 0..self.h {
+            for x in 0..self.w {
+                let a = self.albedo(x, y);
+                let (d, i) = self.light(x, y);
+                pixels.push([0, 1, 2].map(|c| a[c] * (d[c] + i[c])));
+            }
+        }
+        LinearImage { width: self.w, height: self.h, pixels }
+    }
+}
+
+const PIXEL_ANGLE: f32 = 0.02;
+
+fn max_abs_difference(a: &LinearImage, b: &LinearImage) -> f32 {
+    a.pixels.iter().zip(&b.pixels).flat_map(|(p, q)| (0..3).map(move |c| (p[c] - q[c]).abs())).fold(0.0, f32::max)
+}
+
+#[test]
+fn gpu_filter_matches_its_cpu_twin() {
+    let gpu = common::gpu();
+    let s = Synthetic { w: 32, h: 24 };
+    let n = 16;
+    let (film, guides) = s.render(n, 0.5, 7);
+    let params = DenoiseParams::default();
+    let input = cpu::Input {
+        width: s.w,
+        height: s.h,
+        samples: n,
+        guide_samples: n,
+        film: &film,
+        guides: &guides,
+        pixel_angle: PIXEL_ANGLE,
+    };
+    let expected = cpu::denoise(&input, &params);
+    let raw = cpu::raw(&input);
+    let usage = wgpu::BufferUsages::COPY_SRC;
+    let film_buffer = gpu.storage_buffer("film", bytemuck::cast_slice(&film), usage);
+    let guide_buffer = gpu.storage_buffer("guides", bytemuck::cast_slice(&guides), usage);
+    let denoiser = Denoiser::new(&gpu, (s.w, s.h), &film_buffer, &guide_buffer, params.levels);
+    let got = denoiser.apply(&gpu, (n, n), PIXEL_ANGLE, &params).unwrap();
+    let diff = max_abs_difference(&got, &expected);
+    let change = max_abs_difference(&raw, &expected);
+    println!("GPU vs CPU twin: max |difference| {diff:e}; the filter changed pixels by up to {change:.3}");
+    assert!(change > 0.05, "the filter did nothing on the test image ({change})");
+    // f32 with exp/pow/sqrt of a few ulps' difference through five levels: 1e-4 of the
+    // light's scale (about 1).
+    assert!(diff < 1e-4, "GPU and CPU twin differ by {diff}");
+    // Fewer levels: also the same.
+    let two = DenoiseParams { levels: 2, ..params };
+    let got = denoiser.apply(&gpu, (n, n), PIXEL_ANGLE, &two).unwrap();
+    let diff = max_abs_difference(&got, &cpu::denoise(&input, &two));
+    assert!(diff < 1e-4, "2 levels: GPU and CPU twin differ by {diff}");
+}
+
+/// The convergence rule on the synthetic image: at 16 iterations the denoised image is
+/// closer to the expectation than the raw one; as the iterations grow, the denoised image's
+/// difference from the raw one shrinks relative to the raw image's own noise, far under it.
+#[test]
+fn denoised_image_converges_to_the_raw_one() {
+    let s = Synthetic { w: 32, h: 32 };
+    let truth = s.truth();
+    let params = DenoiseParams::default();
+    let mut ratios = Vec::new();
+    for n in [16u32, 256, 4096] {
+        let (film, guides) = s.render(n, 1.0, 3);
+        let input = cpu::Input {
+            width: s.w,
+            height: s.h,
+            samples: n,
+            guide_samples: n,
+            film: &film,
+            guides: &guides,
+            pixel_angle: PIXEL_ANGLE,
+        };
+        let (raw, denoised) = (cpu::raw(&input), cpu::denoise(&input, &params));
+        let (raw_err, den_err, change) =
+            (rmse(&raw, &truth, None), rmse(&denoised, &truth, None), rmse(&denoised, &raw, None));
+        println!(
+            "n {n}: RMSE raw {raw_err:.5}, denoised {den_err:.5}; denoised − raw {change:.5} ({:.3} of the raw noise)",
+            change / raw_err
+        );
+        if n == 16 {
+            assert!(den_err < raw_err, "denoising did not lower the error at 16 iterations");
+        }
+        ratios.push(change / raw_err);
+    }
+    assert!(ratios[2] < ratios[0], "the change relative to the noise does not fall: {ratios:?}");
+    assert!(ratios[2] < 0.5, "at 4096 iterations the denoiser still changes the image by {} of its noise", ratios[2]);
+}
+
+/// The Cornell box at 128² (the references' size): 16 iterations denoised against 256 raw,
+/// both against the committed Mitsuba pair; the emitter's pixels masked as in gather.rs.
+#[test]
+fn cornell_box_16_denoised_iterations_against_256_raw() {
+    let gpu = common::gpu();
+    let scene = cornell_box();
+    let settings = RenderSettings { seed: 5, ..common::fitted_settings(&scene, 128, 5) };
+    let probe = rastergi::image_io::read_exr(&common::data("cornell_path_128_a.exr")).unwrap();
+    let mask = emitter_mask(&probe, 3.0);
+    let (reference, _) = common::reference_pair("cornell_path_128", Some(&mask));
+    let mut r = Renderer::new(&gpu, &scene, settings).unwrap();
+    r.enable_denoiser().unwrap();
+    let start = std::time::Instant::now();
+    for _ in 0..16 {
+        r.iterate().unwrap();
+    }
+    let raw16 = r.read_linear(Show::Full).unwrap();
+    let den16 = r.read_denoised(&DenoiseParams::default()).unwrap();
+    let t16 = start.elapsed().as_secs_f64();
+    for _ in 16..256 {
+        r.iterate().unwrap();
+    }
+    let raw256 = r.read_linear(Show::Full).unwrap();
+    let den256 = r.read_denoised(&DenoiseParams::default()).unwrap();
+    let c = |i: &LinearImage| compare(i, &reference, Some(&mask));
+    let (r16, d16, r256, d256) = (c(&raw16), c(&den16), c(&raw256), c(&den256));
+    for (label, x) in [("raw 16", &r16), ("denoised 16", &d16), ("raw 256", &r256), ("denoised 256", &d256)] {
+        println!(
+            "{label}: relative RMSE {:.4}, block-mean error {:.4}, mean ratio {:.4?}",
+            x.relative_rmse, x.block_mean_error, x.mean_ratio
+        );
+    }
+    println!("16 iterations + denoise: {t16:.1} s");
+    assert!(
+        d16.relative_rmse <= r256.relative_rmse,
+        "16 denoised {} vs 256 raw {}",
+        d16.relative_rmse,
+        r256.relative_rmse
+    );
+}
+
+/// Prints the CPU twin's figures for a few parameter sets on the Cornell box (tuning aid:
+/// `cargo test --release --test denoise -- --ignored --nocapture tune`).
+#[test]
+#[ignore]
+fn tune() {
+    let gpu = common::gpu();
+    let scene = cornell_box();
+    let settings = RenderSettings { seed: 5, ..common::fitted_settings(&scene, 128, 5) };
+    let probe = rastergi::image_io::read_exr(&common::data("cornell_path_128_a.exr")).unwrap();
+    let mask = emitter_mask(&probe, 3.0);
+    let (reference, _) = common::reference_pair("cornell_path_128", Some(&mask));
+    let mut r = Renderer::new(&gpu, &scene, settings).unwrap();
+    r.enable_denoiser().unwrap();
+    let angle = rastergi::denoise::pixel_angle(&r.camera(), 128);
+    let variants = [
+        DenoiseParams::default(),
+        DenoiseParams { filter_direct: false, ..Default::default() },
+        DenoiseParams { sigma_l: 8.0, ..Default::default() },
+        DenoiseParams { sigma_l: 2.0, ..Default::default() },
+        DenoiseParams { variance_scale: 0.25, ..Default::default() },
+        DenoiseParams { sigma_z: 1.0, ..Default::default() },
+        DenoiseParams { sigma_n: 32.0, ..Default::default() },
+        DenoiseParams { levels: 4, ..Default::default() },
+        DenoiseParams { levels: 3, ..Default::default() },
+    ];
+    let mut done = 0;
+    for n in [16u32, 64, 256] {
+        while done < n {
+            r.iterate().unwrap();
+            done += 1;
+        }
+        let film = r.film_state().unwrap();
+        let guides = r.read_guides().unwrap();
+        let input = cpu::Input {
+            width: 128,
+            height: 128,
+            samples: film.samples,
+            guide_samples: guides.samples,
+            film: &film.sums,
+            guides: &guides.sums,
+            pixel_angle: angle,
+        };
+        let c = compare(&cpu::raw(&input), &reference, Some(&mask));
+        println!("n {n} raw: rrmse {:.4} block {:.4}", c.relative_rmse, c.block_mean_error);
+        for v in &variants {
+            let c = compare(&cpu::denoise(&input, v), &reference, Some(&mask));
+            println!("n {n} {v:?}: rrmse {:.4} block {:.4}", c.relative_rmse, c.block_mean_error);
+        }
+    }
+}

@@ -77,6 +77,9 @@ pub const DEMODULATION_MIN: f32 = 0.01;
 pub const VARIANCE_UNKNOWN: f32 = 1.0e20;
 /// ε of the luminance weight: where σ² = 0 only equal luminances are averaged.
 pub const LUMINANCE_EPSILON: f32 = 1.0e-10;
+/// The standard deviation of the difference of two pixels' 3×3-binomial-blurred luminances
+/// in units of one pixel's: √(2 Σ w²) = √2 · 3/8 for independent pixels of equal variance.
+pub const LUMINANCE_NOISE: f32 = std::f32::consts::SQRT_2 * 0.375;
 /// Guards the depth weight's division at distance 0.
 pub const DEPTH_EPSILON: f32 = 1.0e-12;
 
@@ -94,13 +97,11 @@ pub struct DenoiseParams {
     pub levels: u32,
     /// Filter the direct component too (else only the indirect one).
     pub filter_direct: bool,
-    /// Multiplies the variance estimate (1: as estimated).
-    pub variance_scale: f32,
 }
 
 impl Default for DenoiseParams {
     fn default() -> Self {
-        Self { sigma_l: 4.0, sigma_n: 128.0, sigma_z: 4.0, levels: LEVELS, filter_direct: true, variance_scale: 1.0 }
+        Self { sigma_l: 1.5, sigma_n: 128.0, sigma_z: 4.0, levels: 3, filter_direct: true }
     }
 }
 
@@ -117,8 +118,7 @@ pub(crate) struct DenoiseUniforms {
     pub(crate) sigma_z: f32,
     pub(crate) pixel_angle: f32,
     pub(crate) filter_direct: u32,
-    pub(crate) variance_scale: f32,
-    pub(crate) _pad: u32,
+    pub(crate) _pad: [u32; 2],
 }
 
 /// A pixel's angle at the image's centre for `camera` at `height` rows: 2 tan(fov/2)/height.
@@ -130,7 +130,7 @@ pub fn pixel_angle(camera: &Camera, height: u32) -> f32 {
 fn constants() -> String {
     format!(
         "const DEMODULATION_MIN: f32 = {DEMODULATION_MIN:?};\nconst VARIANCE_UNKNOWN: f32 = {VARIANCE_UNKNOWN:?};\n\
-         const LUMINANCE_EPSILON: f32 = {LUMINANCE_EPSILON:?};\nconst DEPTH_EPSILON: f32 = {DEPTH_EPSILON:?};\n{}",
+         const LUMINANCE_EPSILON: f32 = {LUMINANCE_EPSILON:?};\nconst LUMINANCE_NOISE: f32 = {LUMINANCE_NOISE:?};\nconst DEPTH_EPSILON: f32 = {DEPTH_EPSILON:?};\n{}",
         include_str!("denoise_common.wgsl")
     )
 }
@@ -265,7 +265,7 @@ pub struct Denoiser {
     uniforms: Vec<wgpu::Buffer>,
     /// Bind groups per dispatch (the ping-pong of `src` and `dst`).
     groups: Vec<wgpu::BindGroup>,
-    pipelines: [wgpu::ComputePipeline; 3],
+    pipelines: [wgpu::ComputePipeline; 4],
     image: wgpu::Buffer,
     levels: u32,
 }
@@ -285,6 +285,7 @@ impl Denoiser {
         let rw = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
         let ping = [0, 1].map(|_| gpu.zeroed_buffer("denoiser light", 2 * pixels * 16, rw));
         let image = gpu.zeroed_buffer("denoised image", pixels * 16, rw);
+        let lum = gpu.zeroed_buffer("denoiser luminance", pixels * 8, rw);
         let c = wgpu::ShaderStages::COMPUTE;
         let layout = bind_group_layout(
             device,
@@ -296,6 +297,7 @@ impl Denoiser {
                 storage_entry::<[f32; 4]>(3, c, true),
                 storage_entry::<[f32; 4]>(4, c, false),
                 storage_entry::<[f32; 4]>(5, c, false),
+                storage_entry::<[f32; 2]>(6, c, false),
             ],
         );
         let dispatches = levels as usize + 2;
@@ -313,11 +315,11 @@ impl Denoiser {
         let groups = (0..dispatches)
             .map(|d| {
                 let (src, dst) = (&ping[(d + 1) % 2], &ping[d % 2]);
-                buffer_bind_group(device, "denoiser", &layout, &[&uniforms[d], film, guides, src, dst, &image])
+                buffer_bind_group(device, "denoiser", &layout, &[&uniforms[d], film, guides, src, dst, &image, &lum])
             })
             .collect();
         let module = shader::module(device, "denoiser", &filter_source());
-        let pipelines = ["prepare", "atrous", "compose"]
+        let pipelines = ["prepare", "blur_luminance", "atrous", "compose"]
             .map(|entry| compute_pipeline(device, "denoiser", &module, entry, &[&layout], &[]));
         Denoiser { width, height, uniforms, groups, pipelines, image, levels }
     }
@@ -344,14 +346,15 @@ impl Denoiser {
             sigma_z: params.sigma_z,
             pixel_angle,
             filter_direct: params.filter_direct as u32,
-            variance_scale: params.variance_scale,
-            _pad: 0,
+            _pad: [0; 2],
         };
         // Dispatch d runs with group d (src ping[(d + 1) % 2], dst ping[d % 2]) and its own
         // uniforms: prepare (0) writes ping[0], level i (d = i + 1) reads ping[i % 2], and
         // compose (d = levels + 1) reads ping[levels % 2], the last level's output.
         let mut run = |d: usize, pipeline: usize, step: u32| {
-            gpu.queue.write_buffer(&self.uniforms[d], 0, bytemuck::bytes_of(&uniform(step)));
+            if pipeline != 2 {
+                gpu.queue.write_buffer(&self.uniforms[d], 0, bytemuck::bytes_of(&uniform(step)));
+            }
             let mut pass = crate::profile::compute_pass(enc, gpu.profiler.as_ref(), "denoise");
             pass.set_pipeline(&self.pipelines[pipeline]);
             pass.set_bind_group(0, &self.groups[d], &[]);
@@ -360,8 +363,9 @@ impl Denoiser {
         run(0, 0, 0);
         for i in 0..levels {
             run(i + 1, 1, 1 << i);
+            run(i + 1, 2, 1 << i);
         }
-        run(levels + 1, 2, 0);
+        run(levels + 1, 3, 0);
     }
 
     /// The denoised image read back (after [`encode`](Self::encode) was submitted).
@@ -391,8 +395,8 @@ impl Denoiser {
     }
 }
 
-/// The bytes per pixel of the denoiser's GPU storage (guides, ping-pong, image).
-pub const BYTES_PER_PIXEL: u64 = GUIDE_SLOTS * 16 + 2 * 2 * 16 + 16;
+/// The bytes per pixel of the denoiser's GPU storage (guides, ping-pong, image, luminance).
+pub const BYTES_PER_PIXEL: u64 = GUIDE_SLOTS * 16 + 2 * 2 * 16 + 16 + 8;
 
 /// The CPU twin of the filter (`denoise.wgsl`), the same f32 operations in the same order.
 pub mod cpu {
@@ -451,12 +455,7 @@ pub mod cpu {
             let g = input.guide_samples as f32;
             for (c, comp, m1, m2) in [(0, FILM_DIRECT, m[0], m[1]), (1, FILM_INDIRECT, m[2], m[3])] {
                 let f = at(input.film, comp as usize * n + p);
-                src[c * n + p] = [
-                    f[0] / s / a[0],
-                    f[1] / s / a[1],
-                    f[2] / s / a[2],
-                    params.variance_scale * variance_of_mean(m1, m2, g),
-                ];
+                src[c * n + p] = [f[0] / s / a[0], f[1] / s / a[1], f[2] / s / a[2], variance_of_mean(m1, m2, g)];
             }
         }
         let guide = |p: usize| {
@@ -472,6 +471,27 @@ pub mod cpu {
         for level in 0..params.levels {
             let step = 1i32 << level;
             let mut dst = vec![[0.0f32; 4]; 2 * n];
+            // The level's luminance guide: the 3×3 binomial blur of each component's luminance.
+            let mut lum = vec![[0.0f32; 2]; n];
+            for y in 0..h {
+                for x in 0..w {
+                    let (mut sum, mut wsum) = ([0.0f32; 2], 0.0f32);
+                    for dy in -1..=1i32 {
+                        for dx in -1..=1i32 {
+                            let (qx, qy) = (x + dx, y + dy);
+                            if qx >= 0 && qy >= 0 && qx < w && qy < h {
+                                let wt = BINOMIAL3[(dx + 1) as usize] * BINOMIAL3[(dy + 1) as usize];
+                                let k = (qy * w + qx) as usize;
+                                let (d, i) = (src[k], src[n + k]);
+                                sum[0] += wt * luminance([d[0], d[1], d[2]]);
+                                sum[1] += wt * luminance([i[0], i[1], i[2]]);
+                                wsum += wt;
+                            }
+                        }
+                    }
+                    lum[(y * w + x) as usize] = [sum[0] / wsum, sum[1] / wsum];
+                }
+            }
             for y in 0..h {
                 for x in 0..w {
                     let p = (y * w + x) as usize;
@@ -490,10 +510,9 @@ pub mod cpu {
                         }
                         sum / wsum
                     };
-                    let (cd, ci) = (src[p], src[n + p]);
-                    let (ld, li) = (luminance([cd[0], cd[1], cd[2]]), luminance([ci[0], ci[1], ci[2]]));
-                    let sd = params.sigma_l * blurred(0).sqrt() + LUMINANCE_EPSILON;
-                    let si = params.sigma_l * blurred(1).sqrt() + LUMINANCE_EPSILON;
+                    let (ld, li) = (lum[p][0], lum[p][1]);
+                    let sd = params.sigma_l * LUMINANCE_NOISE * blurred(0).sqrt() + LUMINANCE_EPSILON;
+                    let si = params.sigma_l * LUMINANCE_NOISE * blurred(1).sqrt() + LUMINANCE_EPSILON;
                     let (mut sum_d, mut sum_i) = ([0.0f32; 3], [0.0f32; 3]);
                     let (mut var_d, mut var_i, mut w_d, mut w_i) = (0.0f32, 0.0f32, 0.0f32, 0.0f32);
                     for j in -2..=2i32 {
@@ -516,8 +535,9 @@ pub mod cpu {
                                 geometric = wn * wz;
                             }
                             let gd = if params.filter_direct || k == p { geometric } else { 0.0 };
-                            let wd = hk * gd * (-(luminance([qd[0], qd[1], qd[2]]) - ld).abs() / sd).exp();
-                            let wi = hk * geometric * (-(luminance([qi[0], qi[1], qi[2]]) - li).abs() / si).exp();
+                            let (lqd, lqi) = (lum[k][0], lum[k][1]);
+                            let wd = hk * gd * (-(lqd - ld).abs() / sd).exp();
+                            let wi = hk * geometric * (-(lqi - li).abs() / si).exp();
                             for c in 0..3 {
                                 sum_d[c] += wd * qd[c];
                                 sum_i[c] += wi * qi[c];

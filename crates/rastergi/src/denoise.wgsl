@@ -18,9 +18,8 @@ struct Denoise {
     pixel_angle: f32,
     // 1: filter the direct component too.
     filter_direct: u32,
-    // Multiplies the variance estimate.
-    variance_scale: f32,
     _pad0: u32,
+    _pad1: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: Denoise;
@@ -29,6 +28,8 @@ struct Denoise {
 @group(0) @binding(3) var<storage, read> src: array<vec4f>;
 @group(0) @binding(4) var<storage, read_write> dst: array<vec4f>;
 @group(0) @binding(5) var<storage, read_write> image: array<vec4f>;
+// The level's luminance guide: (direct, indirect) luminance of `src` blurred 3×3.
+@group(0) @binding(6) var<storage, read_write> lum: array<vec2f>;
 
 fn pixel_count() -> u32 {
     return params.resolution.x * params.resolution.y;
@@ -59,9 +60,8 @@ fn prepare(@builtin(global_invocation_id) gid: vec3u) {
     let a = demodulation(mean_albedo(p));
     let m = guides[2u * n + p];
     let g = f32(params.guide_samples);
-    let vs = params.variance_scale;
-    dst[p] = vec4f(film[FILM_DIRECT * n + p].rgb / s / a, vs * variance_of_mean(m.x, m.y, g));
-    dst[n + p] = vec4f(film[FILM_INDIRECT * n + p].rgb / s / a, vs * variance_of_mean(m.z, m.w, g));
+    dst[p] = vec4f(film[FILM_DIRECT * n + p].rgb / s / a, variance_of_mean(m.x, m.y, g));
+    dst[n + p] = vec4f(film[FILM_INDIRECT * n + p].rgb / s / a, variance_of_mean(m.z, m.w, g));
 }
 
 // The guides of pixel p: unit mean normal (0 where never seen) and mean distance.
@@ -106,6 +106,32 @@ fn blurred_variance(xy: vec2i, c: u32) -> f32 {
 }
 
 const BINOMIAL3 = array<f32, 3>(0.25, 0.5, 0.25);
+
+// The luminance guide of the level: the luminances of `src` blurred by the 3×3 binomial
+// kernel, so that the edge-stopping compares local means, not single noisy values.
+@compute @workgroup_size(8, 8)
+fn blur_luminance(@builtin(global_invocation_id) gid: vec3u) {
+    if any(gid.xy >= params.resolution) {
+        return;
+    }
+    let n = pixel_count();
+    let res = vec2i(params.resolution);
+    let xy = vec2i(gid.xy);
+    var sum = vec2f(0.0);
+    var wsum = 0.0;
+    for (var dy = -1; dy <= 1; dy++) {
+        for (var dx = -1; dx <= 1; dx++) {
+            let q = xy + vec2i(dx, dy);
+            if all(q >= vec2i(0)) && all(q < res) {
+                let w = BINOMIAL3[dx + 1] * BINOMIAL3[dy + 1];
+                let k = u32(q.y * res.x + q.x);
+                sum += w * vec2f(luminance(src[k].rgb), luminance(src[n + k].rgb));
+                wsum += w;
+            }
+        }
+    }
+    lum[gid.y * params.resolution.x + gid.x] = sum / wsum;
+}
 const B3 = array<f32, 5>(0.0625, 0.25, 0.375, 0.25, 0.0625);
 
 @compute @workgroup_size(8, 8)
@@ -118,12 +144,10 @@ fn atrous(@builtin(global_invocation_id) gid: vec3u) {
     let xy = vec2i(gid.xy);
     let p = gid.y * params.resolution.x + gid.x;
     let gp = guide(p);
-    let cd = src[p];
-    let ci = src[n + p];
-    let ld = luminance(cd.rgb);
-    let li = luminance(ci.rgb);
-    let sd = params.sigma_l * sqrt(blurred_variance(xy, 0u)) + LUMINANCE_EPSILON;
-    let si = params.sigma_l * sqrt(blurred_variance(xy, 1u)) + LUMINANCE_EPSILON;
+    let ld = lum[p].x;
+    let li = lum[p].y;
+    let sd = params.sigma_l * LUMINANCE_NOISE * sqrt(blurred_variance(xy, 0u)) + LUMINANCE_EPSILON;
+    let si = params.sigma_l * LUMINANCE_NOISE * sqrt(blurred_variance(xy, 1u)) + LUMINANCE_EPSILON;
     var sum_d = vec3f(0.0);
     var sum_i = vec3f(0.0);
     var var_d = 0.0;
@@ -151,8 +175,8 @@ fn atrous(@builtin(global_invocation_id) gid: vec3u) {
                 geometric = wn * wz;
             }
             let gd = select(0.0, geometric, params.filter_direct != 0u || k == p);
-            let wd = h * gd * exp(-abs(luminance(qd.rgb) - ld) / sd);
-            let wi = h * geometric * exp(-abs(luminance(qi.rgb) - li) / si);
+            let wd = h * gd * exp(-abs(lum[k].x - ld) / sd);
+            let wi = h * geometric * exp(-abs(lum[k].y - li) / si);
             sum_d += wd * qd.rgb;
             sum_i += wi * qi.rgb;
             var_d += wd * wd * qd.w;

@@ -23,24 +23,29 @@
 //!
 //! The film's two halves (film.rs) give the same quantity without the per-iteration moments
 //! but need two blocks of 16 iterations or photon passes each before they say anything; a
-//! denoiser is wanted most before that, at 16 iterations of one block. The iterations' light
-//! samples and gather directions are stratified (Sobol'), so σ² over-estimates the variance of
-//! the mean (by the factor the halves' notes measure for blocks of single iterations): the
-//! filter errs on the side of smoothing, and σ² still falls as 1/n.
+//! denoiser is wanted most before that, at 16 iterations of one block. Where the iterations'
+//! samples are stratified (Sobol') σ² over-estimates the variance of the mean and the filter
+//! errs on the side of smoothing; on the Cornell box the raw image's error fell as 1/√n from 16
+//! to 256 iterations (0.0671 → 0.0164), so the over-estimate is small there. Either way σ²
+//! falls as 1/n.
 //!
 //! **The filter** (`denoise.wgsl`, CPU twin [`cpu`]). Per component c the light
-//! L = (S_c/n) / a, a the mean albedo's demodulation, and σ² are filtered by [`LEVELS`] levels
-//! of the 5×5 B3-spline kernel h = (1, 4, 6, 4, 1)/16 with holes, step 2^i at level i:
+//! L = (S_c/n) / a, a the mean albedo's demodulation, and σ² are filtered by
+//! [`DenoiseParams::levels`] (3; at most [`LEVELS`]) levels of the 5×5 B3-spline kernel h = (1, 4, 6, 4, 1)/16 with holes, step 2^i at level i:
 //!
 //! ```text
 //!   L'(p) = Σ_q w(p,q) L(q) / Σ_q w(p,q),   σ'²(p) = Σ_q w(p,q)² σ²(q) / (Σ_q w(p,q))²
 //!   w(p,q) = h(q−p) · w_n · w_z · w_l
 //!   w_n = max(0, n_p·n_q)^σ_n
 //!   w_z = exp(−|z_p − z_q| / (σ_z · z_p · θ · |q − p|))      θ: a pixel's angle
-//!   w_l = exp(−|Y(L_p) − Y(L_q)| / (σ_l · √(g₃ ⊛ σ²)(p) + ε))
+//!   w_l = exp(−|Ȳ_p − Ȳ_q| / (σ_l · c · √(g₃ ⊛ σ²)(p) + ε)),   Ȳ = g₃ ⊛ Y(L)
 //! ```
 //!
-//! (w = h at q = p; g₃ the 3×3 binomial blur.) The depth weight compares the distance's change
+//! (w = h at q = p; g₃ the 3×3 binomial blur, `blur_luminance`; c = [`LUMINANCE_NOISE`], the
+//! standard deviation of Ȳ_p − Ȳ_q in units of one pixel's, so σ_l counts standard deviations
+//! of what is compared.) Comparing blurred luminances keeps the edge-stopping from following
+//! the noise: on the Cornell box at 16 iterations the error against the reference fell from
+//! 0.0366 to 0.0287 with it (σ_l = 2 without c). The depth weight compares the distance's change
 //! with what a surface facing the camera changes over |q − p| pixels: σ_z = 4 lets planes
 //! through up to about 76° from the view direction (slope tan θ ≤ 4) and stops at
 //! silhouettes. The result is a · (L'_direct + L'_indirect). The direct component's variance
@@ -50,8 +55,9 @@
 //! **Convergence.** σ² → 0 as n grows, so w_l(p,q) → 0 for every q whose light differs from
 //! p's: the filter tends to the identity wherever the image has any detail, and in flat
 //! regions it averages equal values. The denoised image converges to the raw one; the
-//! denoiser adds no bias in the limit (`convergence_rule` test, tests/denoise.rs at 1024
-//! iterations).
+//! denoiser adds no bias in the limit (tests/denoise.rs: a synthetic image to 4096
+//! iterations; the Cornell box at 1024, where the denoised image differs from the raw one by
+//! less than the raw image's noise).
 
 use bytemuck::{Pod, Zeroable};
 

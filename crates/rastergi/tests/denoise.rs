@@ -26,14 +26,18 @@ struct Synthetic {
 impl Synthetic {
     fn albedo(&self, x: u32, y: u32) -> [f32; 3] {
         if x < self.w / 2 {
-            if (x / 4 + y / 4) % 2 == 0 { [0.8, 0.2, 0.2] } else { [0.3, 0.7, 0.3] }
+            if (x / 4 + y / 4).is_multiple_of(2) { [0.8, 0.2, 0.2] } else { [0.3, 0.7, 0.3] }
         } else {
             [0.6, 0.6, 0.6]
         }
     }
 
     fn normal(&self, x: u32) -> [f32; 3] {
-        if x < self.w / 2 { [0.0, 0.0, 1.0] } else { [0.7071, 0.0, 0.7071] }
+        if x < self.w / 2 {
+            [0.0, 0.0, 1.0]
+        } else {
+            [std::f32::consts::FRAC_1_SQRT_2, 0.0, std::f32::consts::FRAC_1_SQRT_2]
+        }
     }
 
     fn depth(&self, x: u32, y: u32) -> f32 {
@@ -325,5 +329,37 @@ fn tune() {
             let change = rmse(&den, &raw, Some(&mask)) / mean;
             println!("n {n} {v:?}: rrmse {:.4} block {:.4} change {change:.4}", c.relative_rmse, c.block_mean_error);
         }
+    }
+}
+
+/// The cost of one application at 256² and 1080p on this machine's GPU (synthetic sums; the
+/// filter's work does not depend on the content): `cargo test --release --test denoise --
+/// --ignored --nocapture cost`.
+#[test]
+#[ignore]
+fn cost_per_application() {
+    let gpu = common::gpu();
+    for (w, h) in [(256u32, 256u32), (1920, 1080)] {
+        let s = Synthetic { w, h };
+        let (film, guides) = s.render(2, 0.5, 1);
+        let usage = wgpu::BufferUsages::COPY_SRC;
+        let film_buffer = gpu.storage_buffer("film", bytemuck::cast_slice(&film), usage);
+        let guide_buffer = gpu.storage_buffer("guides", bytemuck::cast_slice(&guides), usage);
+        let params = DenoiseParams::default();
+        let denoiser = Denoiser::new(&gpu, (w, h), &film_buffer, &guide_buffer, params.levels);
+        let run = || {
+            let mut enc = gpu.device.create_command_encoder(&Default::default());
+            denoiser.encode(&gpu, &mut enc, (2, 2), PIXEL_ANGLE, &params);
+            gpu.queue.submit([enc.finish()]);
+            gpu.wait().unwrap();
+        };
+        run();
+        let reps = 3;
+        let start = std::time::Instant::now();
+        for _ in 0..reps {
+            run();
+        }
+        let ms = 1e3 * start.elapsed().as_secs_f64() / reps as f64;
+        println!("{w}x{h}: {ms:.1} ms per application ({} levels)", params.levels);
     }
 }

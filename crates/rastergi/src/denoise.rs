@@ -73,8 +73,10 @@ use crate::shader;
 
 /// Guide slots per pixel: slot k of pixel p at `k·W·H + p` (vec4 each): 0 albedo sum and
 /// distance sum, 1 normal sum and coverage count, 2 the moments (m₁, m₂) of the direct and
-/// the indirect component, 3 and 4 the film's direct and indirect sums at the last iteration.
-pub const GUIDE_SLOTS: u64 = 5;
+/// the indirect component. A second buffer keeps the film's direct and indirect sums at the
+/// last iteration (two slots); the two stay under the largest binding where the film does
+/// (48 bytes a pixel: 1920×1080 in lavapipe's 128 MiB).
+pub const GUIDE_SLOTS: u64 = 3;
 /// À-trous levels (steps 1, 2, 4, 8, 16: a 125-pixel-wide footprint).
 pub const LEVELS: u32 = 5;
 /// Albedo channels at most this are not divided by (emitters, the background, black).
@@ -155,6 +157,8 @@ pub fn filter_source() -> String {
 /// other passes.
 pub struct Guides {
     pub buffer: wgpu::Buffer,
+    /// The film's direct and indirect sums at the last iteration.
+    previous: wgpu::Buffer,
     pass: PixelPass,
     bind_group: wgpu::BindGroup,
     /// Iterations in the sums (fewer than the film's after a resume).
@@ -169,16 +173,18 @@ impl Guides {
         let pixels = width as u64 * height as u64;
         let rw = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
         let buffer = gpu.zeroed_buffer("denoiser guides", GUIDE_SLOTS * pixels * 16, rw);
+        let previous = gpu.zeroed_buffer("denoiser previous sums", 2 * pixels * 16, rw);
+        let c = wgpu::ShaderStages::COMPUTE;
         let layout = bind_group_layout(
             &gpu.device,
             "denoiser guides",
-            &[storage_entry::<[f32; 4]>(0, wgpu::ShaderStages::COMPUTE, false)],
+            &[storage_entry::<[f32; 4]>(0, c, false), storage_entry::<[f32; 4]>(1, c, false)],
         );
-        let bind_group = buffer_bind_group(&gpu.device, "denoiser guides", &layout, &[&buffer]);
+        let bind_group = buffer_bind_group(&gpu.device, "denoiser guides", &layout, &[&buffer, &previous]);
         let source = guides_source();
         let shader = PixelShader { label: "denoiser guides", source: &source, entry: "accumulate_guides" };
         let pass = PixelPass::new(gpu, (scene, frame), (gbuffer, film), shader, &[&layout]);
-        Guides { buffer, pass, bind_group, samples: 0, width, height }
+        Guides { buffer, previous, pass, bind_group, samples: 0, width, height }
     }
 
     /// Reads: the visible points, the film. Writes: the guides. After the iteration's passes.
@@ -191,6 +197,7 @@ impl Guides {
     pub fn clear(&mut self, gpu: &Gpu) {
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         enc.clear_buffer(&self.buffer, 0, None);
+        enc.clear_buffer(&self.previous, 0, None);
         gpu.queue.submit([enc.finish()]);
         self.samples = 0;
     }
@@ -202,7 +209,7 @@ impl Guides {
         let component = self.width as u64 * self.height as u64 * 16;
         debug_assert_eq!((FILM_DIRECT, FILM_INDIRECT), (0, 1));
         let mut enc = gpu.device.create_command_encoder(&Default::default());
-        enc.copy_buffer_to_buffer(&film.accumulation, 0, &self.buffer, 3 * component, 2 * component);
+        enc.copy_buffer_to_buffer(&film.accumulation, 0, &self.previous, 0, 2 * component);
         gpu.queue.submit([enc.finish()]);
     }
 
@@ -401,8 +408,11 @@ impl Denoiser {
     }
 }
 
-/// The bytes per pixel of the denoiser's GPU storage (guides, ping-pong, image, luminance).
-pub const BYTES_PER_PIXEL: u64 = GUIDE_SLOTS * 16 + 2 * 2 * 16 + 16 + 8;
+/// The bytes per pixel of the denoiser's GPU storage (guides, previous sums, ping-pong, image,
+/// luminance).
+pub const BYTES_PER_PIXEL: u64 = GUIDE_SLOTS * 16 + 2 * 16 + 2 * 2 * 16 + 16 + 8;
+/// The largest of the denoiser's buffers per pixel (the guides; the ping-pong buffers 32).
+pub const LARGEST_BUFFER_PER_PIXEL: u64 = GUIDE_SLOTS * 16;
 
 /// The CPU twin of the filter (`denoise.wgsl`), the same f32 operations in the same order.
 pub mod cpu {

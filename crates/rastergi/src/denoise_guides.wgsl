@@ -2,9 +2,11 @@
 // to the film, the sums of the visible point's albedo, distance, shading normal and coverage,
 // and the first two moments of the iteration's demodulated luminance of the direct and the
 // indirect component (the iteration's value is the film's sum less the sum at the previous
-// iteration, kept here). Slot k of pixel p at k·W·H + p; the including pass binds `film`.
+// iteration, kept in `previous`). Slot k of pixel p at k·W·H + p; the including pass binds
+// `film`.
 
 @group(3) @binding(0) var<storage, read_write> guides: array<vec4f>;
+@group(3) @binding(1) var<storage, read_write> previous: array<vec4f>;
 
 @compute @workgroup_size(8, 8)
 fn accumulate_guides(@builtin(global_invocation_id) gid: vec3u) {
@@ -30,9 +32,9 @@ fn accumulate_guides(@builtin(global_invocation_id) gid: vec3u) {
     let direct = film[film_slot(FILM_DIRECT, p, n)].rgb;
     let indirect = film[film_slot(FILM_INDIRECT, p, n)].rgb;
     let a = demodulation(albedo);
-    let ld = luminance((direct - guides[3u * n + p].rgb) / a);
-    let li = luminance((indirect - guides[4u * n + p].rgb) / a);
-    guides[3u * n + p] = vec4f(direct, 0.0);
-    guides[4u * n + p] = vec4f(indirect, 0.0);
+    let ld = luminance((direct - previous[p].rgb) / a);
+    let li = luminance((indirect - previous[n + p].rgb) / a);
+    previous[p] = vec4f(direct, 0.0);
+    previous[n + p] = vec4f(indirect, 0.0);
     guides[2u * n + p] += vec4f(ld, ld * ld, li, li * li);
 }

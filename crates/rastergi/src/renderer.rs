@@ -186,7 +186,7 @@ impl ImagePasses {
     fn enable_denoiser(&mut self, gpu: &Gpu, scene: &GpuScene, frame: &FrameBinding) -> Result<()> {
         if self.denoise.is_none() {
             let (w, h) = (self.film.width, self.film.height);
-            gpu.check_image_size(w, h, crate::denoise::BYTES_PER_PIXEL)?;
+            gpu.check_image_size(w, h, crate::denoise::LARGEST_BUFFER_PER_PIXEL)?;
             let guides = Guides::new(gpu, (scene, frame), &self.gbuffer, &self.film);
             let denoiser = Denoiser::new(gpu, (w, h), &self.film.accumulation, &guides.buffer, crate::denoise::LEVELS);
             self.denoise = Some((guides, denoiser));
@@ -490,7 +490,7 @@ impl Renderer {
     /// the others; the image itself is unchanged) so that [`read_denoised`](Self::read_denoised),
     /// [`read_guides`](Self::read_guides) can be called. Enable it before the first iteration:
     /// the guides hold the iterations since. Fails where the image's extra buffers
-    /// ([`crate::denoise::BYTES_PER_PIXEL`]) exceed the GPU's limits.
+    /// ([`crate::denoise::LARGEST_BUFFER_PER_PIXEL`]) exceed the GPU's limits.
     pub fn enable_denoiser(&mut self) -> Result<()> {
         self.passes.enable_denoiser(&self.gpu, &self.scene, &self.frame)?;
         self.denoise = true;

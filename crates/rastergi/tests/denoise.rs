@@ -86,10 +86,6 @@ impl Synthetic {
                     guides[m + 2] += li;
                     guides[m + 3] += li * li;
                 }
-                for c in 0..3 {
-                    guides[4 * (3 * pixels + p) + c] = film[4 * p + c];
-                    guides[4 * (4 * pixels + p) + c] = film[4 * (pixels + p) + c];
-                }
             }
         }
         (film, guides)

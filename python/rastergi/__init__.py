@@ -138,8 +138,9 @@ def render(scene: Union[str, "os.PathLike[str]"], width: int = 256, height: int 
     ``hit_light``, ``show`` (``"full"``, ``"direct"``, ``"indirect"``, ``"photon-map"``),
     ``eye``, ``target``, ``up``, ``fov``, ``camera``, ``sun``, ``sun_size``, ``point``, ``spot``,
     ``env``, ``env_scale``, ``light_samples``, ``photon_passes``, ``pass_iterations``,
-    ``bundle``, ``backend`` and ``method`` (``"gather"`` or ``"path"``, the reference path
-    tracer).
+    ``bundle``, ``backend``, ``method`` (``"gather"`` or ``"path"``, the reference path
+    tracer) and ``denoise`` (``True``: the image denoised as ``rastergi render --denoise``
+    writes it; gather method, full image).
 
     Returns a float32 array of shape (height, width, 3): linear RGB radiance, row 0 at the top.
     """

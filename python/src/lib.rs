@@ -44,6 +44,9 @@ struct RenderOptions {
     /// `gather` (photon map + final gather) or `path` (the reference path tracer).
     #[arg(long, value_enum, default_value_t = Method::Gather)]
     method: Method,
+    /// Return the denoised image (`rastergi render --denoise`; gather method, full image).
+    #[arg(long)]
+    denoise: bool,
 }
 
 /// The error as the command line prints it, without its `error: `: one line.
@@ -91,11 +94,19 @@ fn parse(argv: Vec<String>) -> PyResult<RenderOptions> {
 /// Loads the scene and builds the renderer as `rastergi render` does (the photon map traced).
 fn build(o: &RenderOptions) -> Result<Box<dyn Progressive>, PyErr> {
     cli_render::check_method_show(o.method, o.scene.show).map_err(value_err)?;
+    if o.denoise && (o.method != Method::Gather || !matches!(o.scene.show, ShowArg::Full)) {
+        return Err(PyValueError::new_err("denoise needs method='gather' and the full image (no show)"));
+    }
     let a = &o.scene;
     let scene = a.load_scene().map_err(py_err)?;
     let settings = a.settings(&scene, a.width, a.height, matches!(a.show, ShowArg::PhotonMap));
     let gpu = rastergi_cli::args::gpu(&a.gpu).map_err(py_err)?;
-    let (renderer, _) = cli_render::new_renderer(&gpu, &scene, settings, o.method).map_err(py_err)?;
+    let (mut renderer, _) = cli_render::new_renderer(&gpu, &scene, settings, o.method).map_err(py_err)?;
+    if o.denoise
+        && let Some(r) = renderer.as_renderer_mut()
+    {
+        r.enable_denoiser().map_err(|e| py_err(e.into()))?;
+    }
     renderer.wait().map_err(|e| py_err(e.into()))?;
     Ok(renderer)
 }
@@ -169,7 +180,13 @@ fn render<'py>(py: Python<'py>, argv: Vec<String>) -> PyResult<Bound<'py, PyArra
     let mut renderer = py.detach(|| build(&o))?;
     in_chunks(py, o.iterations, |k| iterations(renderer.as_mut(), k))?;
     let show = o.scene.show.show();
-    let image = py.detach(move || renderer.read_linear(show)).map_err(|e| py_err(e.into()))?;
+    let denoise = o.denoise;
+    let image = py
+        .detach(move || match renderer.as_renderer().filter(|_| denoise) {
+            Some(r) => r.read_denoised(&rastergi::denoise::DenoiseParams::default()),
+            None => renderer.read_linear(show),
+        })
+        .map_err(|e| py_err(e.into()))?;
     to_numpy(py, image)
 }
 

@@ -18,6 +18,7 @@ use anyhow::Result;
 use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 use rastergi::checkpoint::Checkpoint;
+use rastergi::denoise::DenoiseParams;
 use rastergi::fit;
 use rastergi::gather::GatherDirections;
 use rastergi::gpu::Gpu;
@@ -67,6 +68,25 @@ pub struct RenderArgs {
     /// Print the GPU time of every pass (timestamp queries): the set-up's and the iterations'.
     #[arg(long)]
     profile: bool,
+    /// Denoise the accumulated image (edge-avoiding à-trous filter guided by albedo, normal and
+    /// depth, README "Denoiser"): --out gets the denoised image and NAME.raw.EXT beside it the
+    /// raw one (what --out holds without --denoise). Gather method, full image only.
+    #[arg(long)]
+    denoise: bool,
+    /// Also write the mean albedo of the visible points here (.exr linear, .png sRGB): a guide
+    /// for external denoisers (OIDN, OptiX). Gather method only.
+    #[arg(long, value_name = "FILE")]
+    albedo: Option<PathBuf>,
+    /// Also write the mean world-space shading normal of the visible points here (.exr, unit
+    /// vectors facing the eye, 0 where nothing is seen): a guide for external denoisers.
+    #[arg(long, value_name = "FILE")]
+    normal: Option<PathBuf>,
+}
+
+/// Where `--denoise` writes the raw image: `NAME.raw.EXT` beside `out`.
+pub fn raw_path(out: &Path) -> PathBuf {
+    let ext = out.extension().map(|e| e.to_string_lossy().into_owned()).unwrap_or_default();
+    out.with_extension(format!("raw.{ext}"))
 }
 
 /// Which renderer makes the image.
@@ -161,6 +181,23 @@ fn catch_signals() -> Result<Arc<AtomicUsize>> {
 pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     let format = ImageFormat::from_path(&args.out)?;
     check_output_path(&args.out, "--out")?;
+    let guides_wanted = args.denoise || args.albedo.is_some() || args.normal.is_some();
+    if guides_wanted && args.method != Method::Gather {
+        anyhow::bail!("--denoise, --albedo and --normal need --method gather");
+    }
+    if args.denoise && !matches!(args.scene.show, ShowArg::Full) {
+        anyhow::bail!("--denoise applies to the full image; drop --show");
+    }
+    if let Some(path) = &args.albedo {
+        ImageFormat::from_path(path)?;
+        check_output_path(path, "--albedo")?;
+    }
+    if let Some(path) = &args.normal {
+        if ImageFormat::from_path(path)? != ImageFormat::Exr {
+            anyhow::bail!("{}: --normal writes signed vectors: give it a .exr file", path.display());
+        }
+        check_output_path(path, "--normal")?;
+    }
     if let Some(path) = &args.checkpoint {
         check_output_path(path, "--checkpoint")?;
     }
@@ -198,6 +235,9 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     let seed = settings.seed;
     let start = Instant::now();
     let (mut renderer, gather_info) = new_renderer(&gpu, &scene, settings, args.method)?;
+    if guides_wanted && let Some(r) = renderer.as_renderer_mut() {
+        r.enable_denoiser()?;
+    }
     if let Some(c) = &resume {
         renderer.resume(&c.progress, &c.film)?;
         log::info!("resumed {} iterations", c.film.samples);
@@ -316,8 +356,30 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
 
     let show = a.show.show();
     let linear = renderer.read_linear(show)?;
+    let denoised = match renderer.as_renderer().filter(|_| args.denoise) {
+        Some(r) => Some(r.read_denoised(&DenoiseParams::default())?),
+        None => None,
+    };
+    // With --denoise the raw image goes beside --out, the denoised one to --out.
+    let raw_out = if args.denoise { raw_path(&args.out) } else { args.out.clone() };
+    if let Some(r) = renderer.as_renderer().filter(|_| args.albedo.is_some() || args.normal.is_some()) {
+        let guides = r.read_guides()?;
+        if let Some(path) = &args.albedo {
+            let albedo = guides.albedo();
+            match ImageFormat::from_path(path)? {
+                ImageFormat::Exr => write_exr(path, &albedo)?,
+                _ => write_png(path, &rastergi::image_io::display_encode(&albedo, 0.0))?,
+            }
+        }
+        if let Some(path) = &args.normal {
+            write_exr(path, &guides.normal())?;
+        }
+    }
     if format == ImageFormat::Exr {
-        write_exr(&args.out, &linear)?;
+        write_exr(&raw_out, &linear)?;
+        if let Some(d) = &denoised {
+            write_exr(&args.out, d)?;
+        }
     } else {
         let exposure = a.exposure.unwrap_or_else(|| {
             let fitted = fit::exposure(&linear);
@@ -329,7 +391,10 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
             fitted
         });
         let display = renderer.read_display(show, exposure)?;
-        write_png(&args.out, &display)?;
+        write_png(&raw_out, &display)?;
+        if let Some(d) = &denoised {
+            write_png(&args.out, &rastergi::image_io::display_encode(d, exposure))?;
+        }
     }
     let error_text = error.map_or(String::new(), |e| format!(", estimated error {:.2} %", 100.0 * e));
     let saved = args.checkpoint.as_ref().map_or(String::new(), |p| format!("; checkpoint {}", p.display()));

@@ -431,3 +431,34 @@ fn point_and_spot_options_light_the_floor_below_them() {
         assert!(!dir.path().join("x.png").exists());
     }
 }
+
+#[test]
+fn denoise_writes_the_denoised_image_to_out_and_the_raw_one_beside_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = ["render", "cornell", "--width", "32", "--height", "32", "--iterations", "8", "--gather", "trace"];
+    let plain = rastergi(dir.path(), &[&args[..], &["--out", "plain.exr"]].concat());
+    assert!(plain.status.success(), "{}", plain.stderr);
+    let extra = ["--denoise", "--albedo", "a.png", "--normal", "n.exr", "--out", "d.exr"];
+    let run = rastergi(dir.path(), &[&args[..], &extra[..]].concat());
+    assert!(run.status.success(), "{}", run.stderr);
+    assert_eq!(files_in(dir.path()), ["a.png", "d.exr", "d.raw.exr", "n.exr", "plain.exr"]);
+    let read = |name: &str| rastergi::image_io::read_exr(&dir.path().join(name)).unwrap();
+    // The raw image is the one a render without --denoise writes; the denoised one differs.
+    assert_eq!(read("d.raw.exr").pixels, read("plain.exr").pixels);
+    assert_ne!(read("d.exr").pixels, read("plain.exr").pixels);
+    // The normals are unit vectors where a surface is seen, 0 elsewhere; the box fills most
+    // of the image.
+    let lengths: Vec<f32> =
+        read("n.exr").pixels.iter().map(|n| (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt()).collect();
+    assert!(lengths.iter().all(|l| *l == 0.0 || (l - 1.0).abs() < 1e-3), "{lengths:?}");
+    assert!(lengths.iter().filter(|l| **l > 0.0).count() > 32 * 32 / 2, "{lengths:?}");
+    // One-line refusals, before rendering (billions of iterations would hit the timeout).
+    let long = ["render", "cornell", "--iterations", "4000000000"];
+    let path = rastergi(dir.path(), &[&long[..], &["--method", "path", "--denoise", "--out", "p.exr"]].concat());
+    assert!(path.error_line().contains("--method gather"), "{}", path.stderr);
+    let png = rastergi(dir.path(), &[&long[..], &["--normal", "n.png", "--out", "q.exr"]].concat());
+    assert!(png.error_line().contains(".exr"), "{}", png.stderr);
+    let show = rastergi(dir.path(), &[&long[..], &["--show", "direct", "--denoise", "--out", "s.exr"]].concat());
+    assert!(show.error_line().contains("--show"), "{}", show.stderr);
+    assert_eq!(files_in(dir.path()).len(), 5);
+}

@@ -144,6 +144,11 @@ fn twins() -> Vec<Twin> {
             [origin, cell, dims, mask, max_probe, sep_mask, sep_max_probe, indirect_only]
         ),
         twin!(ResolveUniforms, "Resolve", [resolution, samples, show, scale]),
+        twin!(
+            crate::denoise::DenoiseUniforms,
+            "Denoise",
+            [resolution, samples, guide_samples, step, sigma_l, sigma_n, sigma_z, pixel_angle, filter_direct]
+        ),
         twin!(DisplayUniforms, "Display", [image_size, target_size, decode_srgb, text_cols, text_rows, text_scale]),
         twin!(TrianglePlane, "TrianglePlane", [normal, offset, bins]),
         twin!(PathParams, "PathParams", [light_weight, light_count, max_bounces, rr_start]),
@@ -166,6 +171,8 @@ fn shaders() -> Vec<(&'static str, String)> {
         ("gather trace", estimate_source(&[include_str!("gather/trace.wgsl")])),
         ("photon trace", crate::photons::gpu::trace_source()),
         ("resolve", crate::film::resolve_source()),
+        ("denoiser guides", crate::denoise::guides_source()),
+        ("denoiser", crate::denoise::filter_source()),
         ("display", crate::display::SOURCE.to_string()),
         ("path tracer", crate::path_tracer::source()),
         ("rays", crate::rays::source()),

@@ -15,6 +15,7 @@ pub mod bvh;
 pub mod camera_control;
 pub mod checkpoint;
 pub mod consts;
+pub mod denoise;
 pub mod direct;
 pub mod display;
 pub mod environment;

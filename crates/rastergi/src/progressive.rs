@@ -47,6 +47,14 @@ pub trait Progressive: wgpu::WasmNotSend {
     /// Continues from a checkpoint's state: the next iteration is the one the checkpointed
     /// render would have run next.
     fn resume(&mut self, progress: &Progress, film: &FilmState) -> Result<()>;
+    /// The photon-map renderer behind this one (its denoiser, [`Renderer::enable_denoiser`]);
+    /// `None` for the path tracer.
+    fn as_renderer(&self) -> Option<&Renderer> {
+        None
+    }
+    fn as_renderer_mut(&mut self) -> Option<&mut Renderer> {
+        None
+    }
 }
 
 impl Progressive for Renderer {
@@ -97,6 +105,12 @@ impl Progressive for Renderer {
     }
     fn resume(&mut self, progress: &Progress, film: &FilmState) -> Result<()> {
         Renderer::resume(self, progress, film)
+    }
+    fn as_renderer(&self) -> Option<&Renderer> {
+        Some(self)
+    }
+    fn as_renderer_mut(&mut self) -> Option<&mut Renderer> {
+        Some(self)
     }
 }
 

@@ -4,6 +4,7 @@
 use glam::{Vec2, Vec3};
 
 use crate::checkpoint::Progress;
+use crate::denoise::{DenoiseParams, Denoiser, GuideState, Guides};
 use crate::error::Result;
 use crate::film::{Film, FilmState, Show};
 use crate::frame::{FrameBinding, FrameUniforms, pixel_jitter};
@@ -140,6 +141,8 @@ struct ImagePasses {
     caustics: Option<PixelPass>,
     gather: Option<GatherPass>,
     film: Film,
+    /// The denoiser's guides and filter, once enabled ([`Renderer::enable_denoiser`]).
+    denoise: Option<(Guides, Denoiser)>,
 }
 
 impl ImagePasses {
@@ -177,7 +180,18 @@ impl ImagePasses {
             }
             None => None,
         };
-        Ok(ImagePasses { gbuffer, specular, direct, photon_view, caustics, gather, film })
+        Ok(ImagePasses { gbuffer, specular, direct, photon_view, caustics, gather, film, denoise: None })
+    }
+
+    fn enable_denoiser(&mut self, gpu: &Gpu, scene: &GpuScene, frame: &FrameBinding) -> Result<()> {
+        if self.denoise.is_none() {
+            let (w, h) = (self.film.width, self.film.height);
+            gpu.check_image_size(w, h, crate::denoise::LARGEST_BUFFER_PER_PIXEL)?;
+            let guides = Guides::new(gpu, (scene, frame), &self.gbuffer, &self.film);
+            let denoiser = Denoiser::new(gpu, (w, h), &self.film.accumulation, &guides.buffer, crate::denoise::LEVELS);
+            self.denoise = Some((guides, denoiser));
+        }
+        Ok(())
     }
 }
 
@@ -192,6 +206,8 @@ pub struct Renderer {
     passes: ImagePasses,
     /// The scene's part of the default bundle ([`crate::fit::detail_bundle`]).
     detail_bundle: u32,
+    /// The denoiser's guides are accumulated ([`Renderer::enable_denoiser`]).
+    denoise: bool,
 }
 
 impl Renderer {
@@ -251,6 +267,7 @@ impl Renderer {
             photons,
             passes,
             detail_bundle,
+            denoise: false,
         })
     }
 
@@ -272,6 +289,9 @@ impl Renderer {
             sampler,
         )?;
         self.settings = settings;
+        if self.denoise {
+            self.passes.enable_denoiser(&self.gpu, &self.scene, &self.frame)?;
+        }
         self.reset();
         Ok(())
     }
@@ -321,6 +341,9 @@ impl Renderer {
     /// Discards the accumulated iterations.
     pub fn reset(&mut self) {
         self.passes.film.clear(&self.gpu);
+        if let Some((guides, _)) = &mut self.passes.denoise {
+            guides.clear(&self.gpu);
+        }
         if let Some(gather) = &mut self.passes.gather {
             gather.restart();
         }
@@ -383,7 +406,12 @@ impl Renderer {
             let f = GatherFrame { scene: &self.scene, frame: &self.frame, map, width: w, height: h };
             gather.encode(&self.gpu, &mut enc, &f, iteration, self.settings.directions, &fixed)?;
         }
-        // 5. Accumulate: every pass above added its estimate to the film's sums.
+        // 5. Denoiser guides (when enabled): the visible points' albedo, normal, distance and
+        //    the moments of what this iteration added to the film.
+        if let Some((guides, _)) = &mut self.passes.denoise {
+            guides.encode(&mut enc, (&self.scene, &self.frame));
+        }
+        // 6. Accumulate: every pass above added its estimate to the film's sums.
         self.gpu.queue.submit([enc.finish()]);
         self.passes.film.samples += 1;
         if let Some(p) = self.gpu.profiler.as_ref().filter(|p| p.half_full()) {
@@ -417,7 +445,11 @@ impl Renderer {
         if let (Some(gather), Some((method, directions))) = (&mut self.passes.gather, progress.gather) {
             gather.choose_as(method, directions)?;
         }
-        self.passes.film.restore(&self.gpu, film)
+        self.passes.film.restore(&self.gpu, film)?;
+        if let Some((guides, _)) = &mut self.passes.denoise {
+            guides.restart_from(&self.gpu, &self.passes.film);
+        }
+        Ok(())
     }
 
     /// The photon map of the current pass, if the render has one.
@@ -452,6 +484,44 @@ impl Renderer {
 
     pub fn read_display(&self, show: Show, exposure: f32) -> Result<DisplayImage> {
         self.passes.film.read_display(&self.gpu, show, exposure)
+    }
+
+    /// Accumulates the denoiser's guides from the next iteration on (a per-pixel pass after
+    /// the others; the image itself is unchanged) so that [`read_denoised`](Self::read_denoised),
+    /// [`read_guides`](Self::read_guides) can be called. Enable it before the first iteration:
+    /// the guides hold the iterations since. Fails where the image's extra buffers
+    /// ([`crate::denoise::LARGEST_BUFFER_PER_PIXEL`]) exceed the GPU's limits.
+    pub fn enable_denoiser(&mut self) -> Result<()> {
+        self.passes.enable_denoiser(&self.gpu, &self.scene, &self.frame)?;
+        self.denoise = true;
+        Ok(())
+    }
+
+    fn denoiser(&self) -> Result<&(Guides, Denoiser)> {
+        self.passes.denoise.as_ref().ok_or_else(|| {
+            crate::error::Error::Gpu("the denoiser was not enabled (Renderer::enable_denoiser)".to_owned())
+        })
+    }
+
+    /// The denoised full image ([`crate::denoise`]), linear RGB.
+    pub fn read_denoised(&self, params: &DenoiseParams) -> Result<LinearImage> {
+        let (guides, denoiser) = self.denoiser()?;
+        let angle = crate::denoise::pixel_angle(&self.camera, self.settings.height);
+        denoiser.apply(&self.gpu, (self.passes.film.samples, guides.samples), angle, params)
+    }
+
+    /// Encodes the denoiser into `enc` without reading it back (timing).
+    pub fn encode_denoise(&self, enc: &mut wgpu::CommandEncoder, params: &DenoiseParams) -> Result<()> {
+        let (guides, denoiser) = self.denoiser()?;
+        let angle = crate::denoise::pixel_angle(&self.camera, self.settings.height);
+        denoiser.encode(&self.gpu, enc, (self.passes.film.samples, guides.samples), angle, params);
+        Ok(())
+    }
+
+    /// The denoiser's guide sums read back: the albedo and normal AOVs
+    /// ([`GuideState::albedo`], [`GuideState::normal`]).
+    pub fn read_guides(&self) -> Result<GuideState> {
+        self.denoiser()?.0.read(&self.gpu)
     }
 
     /// Raw G-buffer texels `(triangle + 1, b1 bits, b2 bits, texture level of detail bits)`,

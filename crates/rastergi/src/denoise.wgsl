@@ -1,0 +1,201 @@
+// The denoiser's filter (denoise.rs): prepare (film sums and guides → demodulated light and
+// the variance of its mean, per component), one à-trous level per dispatch (step
+// params.step), compose (remodulate, add the components). Buffers `src` and `dst` hold
+// (light rgb, variance) of the direct component of pixel p at p and of the indirect at W·H + p.
+// The CPU twin is denoise::cpu; keep the two the same operations.
+
+struct Denoise {
+    resolution: vec2u,
+    // Iterations in the film's sums and in the guides' (fewer after a resume).
+    samples: u32,
+    guide_samples: u32,
+    // The à-trous level's step in pixels.
+    step: u32,
+    sigma_l: f32,
+    sigma_n: f32,
+    sigma_z: f32,
+    // 2 tan(fov_y/2) / height: a pixel's angle at the image's centre.
+    pixel_angle: f32,
+    // 1: filter the direct component too.
+    filter_direct: u32,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+@group(0) @binding(0) var<uniform> params: Denoise;
+@group(0) @binding(1) var<storage, read> film: array<vec4f>;
+@group(0) @binding(2) var<storage, read> guides: array<vec4f>;
+@group(0) @binding(3) var<storage, read> src: array<vec4f>;
+@group(0) @binding(4) var<storage, read_write> dst: array<vec4f>;
+@group(0) @binding(5) var<storage, read_write> image: array<vec4f>;
+// The level's luminance guide: (direct, indirect) luminance of `src` blurred 3×3.
+@group(0) @binding(6) var<storage, read_write> lum: array<vec2f>;
+
+fn pixel_count() -> u32 {
+    return params.resolution.x * params.resolution.y;
+}
+
+// The mean albedo of pixel p over the guides' iterations (0 where unseen).
+fn mean_albedo(p: u32) -> vec3f {
+    return guides[p].rgb / f32(max(params.guide_samples, 1u));
+}
+
+// The variance of the mean of n values with sum m1 and sum of squares m2: the sample
+// variance over n. Unknown (VARIANCE_UNKNOWN) below two values.
+fn variance_of_mean(m1: f32, m2: f32, n: f32) -> f32 {
+    if n < 2.0 {
+        return VARIANCE_UNKNOWN;
+    }
+    return max(m2 - m1 * m1 / n, 0.0) / (n * (n - 1.0));
+}
+
+@compute @workgroup_size(8, 8)
+fn prepare(@builtin(global_invocation_id) gid: vec3u) {
+    if any(gid.xy >= params.resolution) {
+        return;
+    }
+    let n = pixel_count();
+    let p = gid.y * params.resolution.x + gid.x;
+    let s = f32(max(params.samples, 1u));
+    let a = demodulation(mean_albedo(p));
+    let m = guides[2u * n + p];
+    let g = f32(params.guide_samples);
+    dst[p] = vec4f(film[FILM_DIRECT * n + p].rgb / s / a, variance_of_mean(m.x, m.y, g));
+    dst[n + p] = vec4f(film[FILM_INDIRECT * n + p].rgb / s / a, variance_of_mean(m.z, m.w, g));
+}
+
+// The guides of pixel p: unit mean normal (0 where never seen) and mean distance.
+struct Guide {
+    normal: vec3f,
+    depth: f32,
+}
+
+fn guide(p: u32) -> Guide {
+    let n = pixel_count();
+    let g0 = guides[p];
+    let g1 = guides[n + p];
+    var out: Guide;
+    out.normal = vec3f(0.0);
+    out.depth = 0.0;
+    let len = length(g1.xyz);
+    if g1.w > 0.0 && len > 0.0 {
+        out.normal = g1.xyz / len;
+        out.depth = g0.w / g1.w;
+    }
+    return out;
+}
+
+// The variance of component c (0 direct, 1 indirect) at pixel xy blurred by the 3×3 binomial
+// kernel (clamped to the image).
+fn blurred_variance(xy: vec2i, c: u32) -> f32 {
+    let n = pixel_count();
+    let res = vec2i(params.resolution);
+    var sum = 0.0;
+    var wsum = 0.0;
+    for (var dy = -1; dy <= 1; dy++) {
+        for (var dx = -1; dx <= 1; dx++) {
+            let q = xy + vec2i(dx, dy);
+            if all(q >= vec2i(0)) && all(q < res) {
+                let w = BINOMIAL3[dx + 1] * BINOMIAL3[dy + 1];
+                sum += w * src[c * n + u32(q.y * res.x + q.x)].w;
+                wsum += w;
+            }
+        }
+    }
+    return sum / wsum;
+}
+
+const BINOMIAL3 = array<f32, 3>(0.25, 0.5, 0.25);
+
+// The luminance guide of the level: the luminances of `src` blurred by the 3×3 binomial
+// kernel, so that the edge-stopping compares local means, not single noisy values.
+@compute @workgroup_size(8, 8)
+fn blur_luminance(@builtin(global_invocation_id) gid: vec3u) {
+    if any(gid.xy >= params.resolution) {
+        return;
+    }
+    let n = pixel_count();
+    let res = vec2i(params.resolution);
+    let xy = vec2i(gid.xy);
+    var sum = vec2f(0.0);
+    var wsum = 0.0;
+    for (var dy = -1; dy <= 1; dy++) {
+        for (var dx = -1; dx <= 1; dx++) {
+            let q = xy + vec2i(dx, dy);
+            if all(q >= vec2i(0)) && all(q < res) {
+                let w = BINOMIAL3[dx + 1] * BINOMIAL3[dy + 1];
+                let k = u32(q.y * res.x + q.x);
+                sum += w * vec2f(luminance(src[k].rgb), luminance(src[n + k].rgb));
+                wsum += w;
+            }
+        }
+    }
+    lum[gid.y * params.resolution.x + gid.x] = sum / wsum;
+}
+const B3 = array<f32, 5>(0.0625, 0.25, 0.375, 0.25, 0.0625);
+
+@compute @workgroup_size(8, 8)
+fn atrous(@builtin(global_invocation_id) gid: vec3u) {
+    if any(gid.xy >= params.resolution) {
+        return;
+    }
+    let n = pixel_count();
+    let res = vec2i(params.resolution);
+    let xy = vec2i(gid.xy);
+    let p = gid.y * params.resolution.x + gid.x;
+    let gp = guide(p);
+    let ld = lum[p].x;
+    let li = lum[p].y;
+    let sd = params.sigma_l * LUMINANCE_NOISE * sqrt(blurred_variance(xy, 0u)) + LUMINANCE_EPSILON;
+    let si = params.sigma_l * LUMINANCE_NOISE * sqrt(blurred_variance(xy, 1u)) + LUMINANCE_EPSILON;
+    var sum_d = vec3f(0.0);
+    var sum_i = vec3f(0.0);
+    var var_d = 0.0;
+    var var_i = 0.0;
+    var w_d = 0.0;
+    var w_i = 0.0;
+    let step = i32(params.step);
+    for (var j = -2; j <= 2; j++) {
+        for (var i = -2; i <= 2; i++) {
+            let q = xy + step * vec2i(i, j);
+            if any(q < vec2i(0)) || any(q >= res) {
+                continue;
+            }
+            let k = u32(q.y * res.x + q.x);
+            let h = B3[i + 2] * B3[j + 2];
+            let qd = src[k];
+            let qi = src[n + k];
+            var geometric = 1.0;
+            if k != p {
+                let gq = guide(k);
+                let cosine = dot(gp.normal, gq.normal);
+                let wn = select(0.0, pow(cosine, params.sigma_n), cosine > 0.0);
+                let scale = gp.depth * params.pixel_angle * f32(step) * length(vec2f(f32(i), f32(j)));
+                let wz = exp(-abs(gp.depth - gq.depth) / (params.sigma_z * scale + DEPTH_EPSILON));
+                geometric = wn * wz;
+            }
+            let gd = select(0.0, geometric, params.filter_direct != 0u || k == p);
+            let wd = h * gd * exp(-abs(lum[k].x - ld) / sd);
+            let wi = h * geometric * exp(-abs(lum[k].y - li) / si);
+            sum_d += wd * qd.rgb;
+            sum_i += wi * qi.rgb;
+            var_d += wd * wd * qd.w;
+            var_i += wi * wi * qi.w;
+            w_d += wd;
+            w_i += wi;
+        }
+    }
+    dst[p] = vec4f(sum_d / w_d, var_d / (w_d * w_d));
+    dst[n + p] = vec4f(sum_i / w_i, var_i / (w_i * w_i));
+}
+
+@compute @workgroup_size(8, 8)
+fn compose(@builtin(global_invocation_id) gid: vec3u) {
+    if any(gid.xy >= params.resolution) {
+        return;
+    }
+    let n = pixel_count();
+    let p = gid.y * params.resolution.x + gid.x;
+    let a = demodulation(mean_albedo(p));
+    image[p] = vec4f(a * (src[p].rgb + src[n + p].rgb), 1.0);
+}

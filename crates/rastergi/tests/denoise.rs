@@ -1,0 +1,389 @@
+//! The denoiser (`denoise.rs`): the GPU filter against its CPU twin, the convergence rule on
+//! a synthetic image, and the Cornell box against the committed Mitsuba reference.
+
+mod common;
+
+use rastergi::denoise::{DenoiseParams, Denoiser, GUIDE_SLOTS, cpu};
+use rastergi::film::{COMPONENTS, Show};
+use rastergi::image_io::LinearImage;
+use rastergi::metrics::{compare, emitter_mask, rmse};
+use rastergi::renderer::{RenderSettings, Renderer};
+use rastergi::sampling::{pcg_hash, unit_f32};
+use rastergi::scene::cornell_box;
+
+/// A uniform number in [0, 1) from three indices.
+fn hash(a: u32, b: u32, c: u32) -> f32 {
+    unit_f32(pcg_hash(a ^ pcg_hash(b ^ pcg_hash(c))))
+}
+
+/// A synthetic scene of `w × h` pixels: two planes meeting at a vertical edge (different
+/// normals and distances), a checker albedo on the left one, smooth light with a step.
+struct Synthetic {
+    w: u32,
+    h: u32,
+}
+
+impl Synthetic {
+    fn albedo(&self, x: u32, y: u32) -> [f32; 3] {
+        if x < self.w / 2 {
+            if (x / 4 + y / 4).is_multiple_of(2) { [0.8, 0.2, 0.2] } else { [0.3, 0.7, 0.3] }
+        } else {
+            [0.6, 0.6, 0.6]
+        }
+    }
+
+    fn normal(&self, x: u32) -> [f32; 3] {
+        if x < self.w / 2 {
+            [0.0, 0.0, 1.0]
+        } else {
+            [std::f32::consts::FRAC_1_SQRT_2, 0.0, std::f32::consts::FRAC_1_SQRT_2]
+        }
+    }
+
+    fn depth(&self, x: u32, y: u32) -> f32 {
+        if x < self.w / 2 { 3.0 + 0.002 * y as f32 } else { 2.0 + 0.01 * (x - self.w / 2) as f32 }
+    }
+
+    /// The expected (direct, indirect) light, before the albedo.
+    fn light(&self, x: u32, y: u32) -> ([f32; 3], [f32; 3]) {
+        let fx = x as f32 / self.w as f32;
+        let fy = y as f32 / self.h as f32;
+        let direct = if y < self.h / 3 { [0.1; 3] } else { [1.0 + fx, 1.0 + fx, 0.8 + fy] };
+        (direct, [0.3 + 0.2 * fy, 0.25, 0.2 + 0.1 * fx])
+    }
+
+    /// Film and guide sums of `n` iterations: each adds the expected value times noise of
+    /// relative spread `spread` (direct a tenth of it), as the renderer's passes would.
+    fn render(&self, n: u32, spread: f32, seed: u32) -> (Vec<f32>, Vec<f32>) {
+        let pixels = (self.w * self.h) as usize;
+        let mut film = vec![0.0f32; COMPONENTS as usize * pixels * 4];
+        let mut guides = vec![0.0f32; GUIDE_SLOTS as usize * pixels * 4];
+        let lum = |c: [f32; 3]| c[0] * 0.2126 + c[1] * 0.7152 + c[2] * 0.0722;
+        for y in 0..self.h {
+            for x in 0..self.w {
+                let p = (y * self.w + x) as usize;
+                let a = self.albedo(x, y);
+                let (d, i) = self.light(x, y);
+                let nrm = self.normal(x);
+                let z = self.depth(x, y);
+                for k in 0..n {
+                    let u = |s: u32| 2.0 * hash(seed ^ s, p as u32, k) - 1.0;
+                    let (nd, ni) = (1.0 + 0.1 * spread * u(1) * 1.732, (1.0 + spread * u(2) * 1.732).max(0.0));
+                    let dv = [0, 1, 2].map(|c| a[c] * d[c] * nd);
+                    let iv = [0, 1, 2].map(|c| a[c] * i[c] * ni);
+                    for c in 0..3 {
+                        film[4 * p + c] += dv[c];
+                        film[4 * (pixels + p) + c] += iv[c];
+                        guides[4 * p + c] += a[c];
+                        guides[4 * (pixels + p) + c] += nrm[c];
+                    }
+                    guides[4 * p + 3] += z;
+                    guides[4 * (pixels + p) + 3] += 1.0;
+                    let (ld, li) = (lum(d) * nd, lum(i) * ni);
+                    let m = 4 * (2 * pixels + p);
+                    guides[m] += ld;
+                    guides[m + 1] += ld * ld;
+                    guides[m + 2] += li;
+                    guides[m + 3] += li * li;
+                }
+            }
+        }
+        (film, guides)
+    }
+
+    /// The expected image.
+    fn truth(&self) -> LinearImage {
+        let mut pixels = Vec::new();
+        for y in 0..self.h {
+            for x in 0..self.w {
+                let a = self.albedo(x, y);
+                let (d, i) = self.light(x, y);
+                pixels.push([0, 1, 2].map(|c| a[c] * (d[c] + i[c])));
+            }
+        }
+        LinearImage { width: self.w, height: self.h, pixels }
+    }
+}
+
+const PIXEL_ANGLE: f32 = 0.02;
+
+/// The pixels of `reference` (kept by `mask`) whose largest relative difference from a
+/// 4-neighbour is among the highest tenth: edges, corners, shadow boundaries.
+fn high_gradient_mask(reference: &LinearImage, mask: &[bool]) -> Vec<bool> {
+    let (w, h) = (reference.width as i32, reference.height as i32);
+    let lum = |x: i32, y: i32| {
+        let p = reference.pixels[(y.clamp(0, h - 1) * w + x.clamp(0, w - 1)) as usize];
+        0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]
+    };
+    let gradient: Vec<f32> = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .map(|(x, y)| {
+            let c = lum(x, y);
+            let d = [(1, 0), (-1, 0), (0, 1), (0, -1)].map(|(dx, dy)| (lum(x + dx, y + dy) - c).abs());
+            d.into_iter().fold(0.0, f32::max) / c.max(1e-3)
+        })
+        .collect();
+    let mut kept: Vec<f32> = gradient.iter().zip(mask).filter(|(_, m)| **m).map(|(g, _)| *g).collect();
+    kept.sort_by(f32::total_cmp);
+    let threshold = kept[kept.len() * 9 / 10];
+    gradient.iter().zip(mask).map(|(g, m)| *m && *g >= threshold).collect()
+}
+
+fn max_abs_difference(a: &LinearImage, b: &LinearImage) -> f32 {
+    a.pixels.iter().zip(&b.pixels).flat_map(|(p, q)| (0..3).map(move |c| (p[c] - q[c]).abs())).fold(0.0, f32::max)
+}
+
+#[test]
+fn gpu_filter_matches_its_cpu_twin() {
+    let gpu = common::gpu();
+    let s = Synthetic { w: 32, h: 24 };
+    let n = 16;
+    let (film, guides) = s.render(n, 0.5, 7);
+    let params = DenoiseParams::default();
+    let input = cpu::Input {
+        width: s.w,
+        height: s.h,
+        samples: n,
+        guide_samples: n,
+        film: &film,
+        guides: &guides,
+        pixel_angle: PIXEL_ANGLE,
+    };
+    let expected = cpu::denoise(&input, &params);
+    let raw = cpu::raw(&input);
+    let usage = wgpu::BufferUsages::COPY_SRC;
+    let film_buffer = gpu.storage_buffer("film", bytemuck::cast_slice(&film), usage);
+    let guide_buffer = gpu.storage_buffer("guides", bytemuck::cast_slice(&guides), usage);
+    let denoiser = Denoiser::new(&gpu, (s.w, s.h), &film_buffer, &guide_buffer, params.levels);
+    let got = denoiser.apply(&gpu, (n, n), PIXEL_ANGLE, &params).unwrap();
+    let diff = max_abs_difference(&got, &expected);
+    let change = max_abs_difference(&raw, &expected);
+    println!("GPU vs CPU twin: max |difference| {diff:e}; the filter changed pixels by up to {change:.3}");
+    assert!(change > 0.05, "the filter did nothing on the test image ({change})");
+    // f32 with exp/pow/sqrt of a few ulps' difference through five levels: 1e-4 of the
+    // light's scale (about 1).
+    assert!(diff < 1e-4, "GPU and CPU twin differ by {diff}");
+    // Fewer levels: also the same.
+    let two = DenoiseParams { levels: 2, ..params };
+    let got = denoiser.apply(&gpu, (n, n), PIXEL_ANGLE, &two).unwrap();
+    let diff = max_abs_difference(&got, &cpu::denoise(&input, &two));
+    assert!(diff < 1e-4, "2 levels: GPU and CPU twin differ by {diff}");
+}
+
+/// The convergence rule on the synthetic image: at 16 iterations the denoised image is
+/// closer to the expectation than the raw one; as the iterations grow, the denoised image's
+/// difference from the raw one shrinks relative to the raw image's own noise, far under it.
+#[test]
+fn denoised_image_converges_to_the_raw_one() {
+    let s = Synthetic { w: 32, h: 32 };
+    let truth = s.truth();
+    let params = DenoiseParams::default();
+    let mut ratios = Vec::new();
+    for n in [16u32, 256, 4096] {
+        let (film, guides) = s.render(n, 1.0, 3);
+        let input = cpu::Input {
+            width: s.w,
+            height: s.h,
+            samples: n,
+            guide_samples: n,
+            film: &film,
+            guides: &guides,
+            pixel_angle: PIXEL_ANGLE,
+        };
+        let (raw, denoised) = (cpu::raw(&input), cpu::denoise(&input, &params));
+        let (raw_err, den_err, change) =
+            (rmse(&raw, &truth, None), rmse(&denoised, &truth, None), rmse(&denoised, &raw, None));
+        println!(
+            "n {n}: RMSE raw {raw_err:.5}, denoised {den_err:.5}; denoised − raw {change:.5} ({:.3} of the raw noise)",
+            change / raw_err
+        );
+        if n == 16 {
+            assert!(den_err < raw_err, "denoising did not lower the error at 16 iterations");
+        }
+        ratios.push(change / raw_err);
+    }
+    assert!(ratios[2] < ratios[0], "the change relative to the noise does not fall: {ratios:?}");
+    assert!(ratios[2] < 0.5, "at 4096 iterations the denoiser still changes the image by {} of its noise", ratios[2]);
+}
+
+/// The Cornell box at 128² (the references' size) against the committed Mitsuba pair, the
+/// emitter's pixels masked as in gather.rs: 16 iterations denoised against 16, 64 and 256 raw;
+/// then the convergence rule: at 1024 iterations the denoised image differs from the raw one
+/// by less than the raw image's own noise (the film halves' estimate; at 256 iterations the
+/// render has had one photon pass, one block, and the halves say nothing). About 140 s on
+/// lavapipe.
+///
+/// Measured (lavapipe, seed 5): relative RMSE raw 16 0.0671, 64 0.0282, 256 0.0164, 1024
+/// 0.0092; denoised 16 0.0295 (block-mean error 0.0037; raw 256: 0.0028), 256 0.0157, 1024
+/// 0.0109; at 1024 denoised − raw 0.0071, the raw noise 0.0085. The issue's goal, denoised 16
+/// no worse than raw 256, is not met: 16 denoised iterations are worth about 64 raw.
+#[test]
+fn cornell_box_denoised_against_raw_and_the_convergence_rule() {
+    let gpu = common::gpu();
+    let scene = cornell_box();
+    let settings = RenderSettings { seed: 5, ..common::fitted_settings(&scene, 128, 5) };
+    let probe = rastergi::image_io::read_exr(&common::data("cornell_path_128_a.exr")).unwrap();
+    let mask = emitter_mask(&probe, 3.0);
+    let (reference, _) = common::reference_pair("cornell_path_128", Some(&mask));
+    let edges = high_gradient_mask(&reference, &mask);
+    let mut r = Renderer::new(&gpu, &scene, settings).unwrap();
+    r.enable_denoiser().unwrap();
+    let params = DenoiseParams::default();
+    let c = |i: &LinearImage| compare(i, &reference, Some(&mask));
+    let mut done = 0;
+    let mut figures = Vec::new();
+    for n in [16u32, 64, 256, 1024] {
+        while done < n {
+            r.iterate().unwrap();
+            done += 1;
+            if done % 64 == 0 {
+                r.wait().unwrap();
+            }
+        }
+        let raw = r.read_linear(Show::Full).unwrap();
+        let den = r.read_denoised(&params).unwrap();
+        let (cr, cd) = (c(&raw), c(&den));
+        let mean = rastergi::metrics::masked_mean(&raw, Some(&mask));
+        let change = rmse(&den, &raw, Some(&mask)) / mean;
+        let noise = r.film_state().unwrap().error_estimate();
+        let (er, ed) = (compare(&raw, &reference, Some(&edges)), compare(&den, &reference, Some(&edges)));
+        println!(
+            "n {n}, high-gradient tenth: raw relative RMSE {:.4}, denoised {:.4}",
+            er.relative_rmse, ed.relative_rmse
+        );
+        println!(
+            "n {n}: raw relative RMSE {:.4} (block {:.4}), denoised {:.4} (block {:.4}, mean ratio {:.4?}); \
+             denoised − raw {change:.4}, raw noise (halves) {noise:.4?}",
+            cr.relative_rmse, cr.block_mean_error, cd.relative_rmse, cd.block_mean_error, cd.mean_ratio
+        );
+        figures.push((n, cr, cd, change, noise));
+    }
+    let (_, raw16, den16, _, _) = figures[0];
+    let (_, raw64, _, _, _) = figures[1];
+    // Denoising 16 iterations halves their error (measured 0.44×) and leaves it near 64
+    // raw iterations' (measured 1.05×); the block means stay within 0.5 % (measured 0.37 %).
+    assert!(den16.relative_rmse < 0.5 * raw16.relative_rmse, "denoised 16 {den16:?} vs raw {raw16:?}");
+    assert!(den16.relative_rmse < 1.1 * raw64.relative_rmse, "denoised 16 {den16:?} vs raw 64 {raw64:?}");
+    assert!(den16.block_mean_error < 0.005, "denoised 16: block-mean error {}", den16.block_mean_error);
+    for c in den16.mean_ratio {
+        assert!((c - 1.0).abs() < 0.005, "denoised 16: mean ratio {:?}", den16.mean_ratio);
+    }
+    // At 256 iterations the denoised image is no farther from the reference than the raw one
+    // (measured 0.0157 vs 0.0164).
+    let (_, raw256, den256, _, _) = figures[2];
+    assert!(den256.relative_rmse < raw256.relative_rmse, "256: denoised {den256:?} vs raw {raw256:?}");
+    // The convergence rule: at 1024 iterations denoised − raw is under the raw noise.
+    let (_, _, _, change, noise) = figures[3];
+    let noise = noise.expect("both halves hold iterations at 1024");
+    assert!(change < noise, "1024: the denoiser changes the image by {change}, the raw noise is {noise}");
+}
+
+/// Prints the CPU twin's figures for a few parameter sets on the Cornell box (tuning aid:
+/// `cargo test --release --test denoise -- --ignored --nocapture tune`).
+#[test]
+#[ignore]
+fn tune() {
+    let gpu = common::gpu();
+    let scene = cornell_box();
+    let settings = RenderSettings { seed: 5, ..common::fitted_settings(&scene, 128, 5) };
+    let probe = rastergi::image_io::read_exr(&common::data("cornell_path_128_a.exr")).unwrap();
+    let mask = emitter_mask(&probe, 3.0);
+    let (reference, _) = common::reference_pair("cornell_path_128", Some(&mask));
+    let mut r = Renderer::new(&gpu, &scene, settings).unwrap();
+    r.enable_denoiser().unwrap();
+    let angle = rastergi::denoise::pixel_angle(&r.camera(), 128);
+    let variants = [
+        DenoiseParams::default(),
+        DenoiseParams { sigma_l: 1.0, ..Default::default() },
+        DenoiseParams { sigma_l: 2.0, ..Default::default() },
+        DenoiseParams { levels: 5, ..Default::default() },
+        DenoiseParams { filter_direct: false, ..Default::default() },
+    ];
+    let mut done = 0;
+    for n in [16u32, 256, 1024] {
+        while done < n {
+            r.iterate().unwrap();
+            done += 1;
+        }
+        let film = r.film_state().unwrap();
+        let guides = r.read_guides().unwrap();
+        let input = cpu::Input {
+            width: 128,
+            height: 128,
+            samples: film.samples,
+            guide_samples: guides.samples,
+            film: &film.sums,
+            guides: &guides.sums,
+            pixel_angle: angle,
+        };
+        let raw = cpu::raw(&input);
+        let c = compare(&raw, &reference, Some(&mask));
+        let mean = rastergi::metrics::masked_mean(&raw, Some(&mask));
+        println!("n {n} raw noise (halves) {:?}", film.error_estimate());
+        if std::env::var_os("TUNE_IMAGES").is_some() {
+            use rastergi::image_io::{display_encode, write_png};
+            let den = cpu::denoise(&input, &variants[0]);
+            let raw = cpu::raw(&input);
+            let signed = |a: &LinearImage| LinearImage {
+                width: 128,
+                height: 128,
+                pixels: a
+                    .pixels
+                    .iter()
+                    .zip(&reference.pixels)
+                    .map(|(p, q)| {
+                        let d = (p[1] - q[1]) / q[1].max(1e-3) * 10.0;
+                        [d.max(0.0), (-d).max(0.0), 0.0]
+                    })
+                    .collect(),
+            };
+            for (name, img) in [("raw", &raw), ("den", &den)] {
+                write_png(std::path::Path::new(&format!("/tmp/dn/{name}{n}.png")), &display_encode(img, 0.0)).unwrap();
+                write_png(
+                    std::path::Path::new(&format!("/tmp/dn/{name}{n}_err.png")),
+                    &display_encode(&signed(img), 0.0),
+                )
+                .unwrap();
+            }
+        }
+        println!("n {n} raw: rrmse {:.4} block {:.4}", c.relative_rmse, c.block_mean_error);
+        for v in &variants {
+            let den = cpu::denoise(&input, v);
+            let c = compare(&den, &reference, Some(&mask));
+            let change = rmse(&den, &raw, Some(&mask)) / mean;
+            println!("n {n} {v:?}: rrmse {:.4} block {:.4} change {change:.4}", c.relative_rmse, c.block_mean_error);
+        }
+    }
+}
+
+/// The cost of one application at 256² and 1080p on this machine's GPU (synthetic sums; the
+/// filter's work does not depend on the content): `cargo test --release --test denoise --
+/// --ignored --nocapture cost`.
+#[test]
+#[ignore]
+fn cost_per_application() {
+    let gpu = common::gpu();
+    for (w, h) in [(256u32, 256u32), (1920, 1080)] {
+        let s = Synthetic { w, h };
+        let (film, guides) = s.render(2, 0.5, 1);
+        let usage = wgpu::BufferUsages::COPY_SRC;
+        let film_buffer = gpu.storage_buffer("film", bytemuck::cast_slice(&film), usage);
+        let guide_buffer = gpu.storage_buffer("guides", bytemuck::cast_slice(&guides), usage);
+        let params = DenoiseParams::default();
+        let denoiser = Denoiser::new(&gpu, (w, h), &film_buffer, &guide_buffer, params.levels);
+        let run = || {
+            let mut enc = gpu.device.create_command_encoder(&Default::default());
+            denoiser.encode(&gpu, &mut enc, (2, 2), PIXEL_ANGLE, &params);
+            gpu.queue.submit([enc.finish()]);
+            gpu.wait().unwrap();
+        };
+        run();
+        let reps = 3;
+        let start = std::time::Instant::now();
+        for _ in 0..reps {
+            run();
+        }
+        let ms = 1e3 * start.elapsed().as_secs_f64() / reps as f64;
+        println!("{w}x{h}: {ms:.1} ms per application ({} levels)", params.levels);
+    }
+}

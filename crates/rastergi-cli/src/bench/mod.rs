@@ -9,6 +9,7 @@
 
 mod bvh;
 mod converge;
+mod denoise;
 mod frames;
 mod gather;
 mod memory;
@@ -39,6 +40,8 @@ pub enum BenchCommand {
     Bvh(bvh::BvhArgs),
     /// GPU memory of a render (the device allocator's report), by resource.
     Memory(memory::MemoryArgs),
+    /// Milliseconds per application of the denoiser at the window's size.
+    Denoise(denoise::DenoiseArgs),
     /// Rays per second of each kind the renderer casts (camera, shadow, bounce, gather, photon)
     /// on the GPU kernel and the CPU twin, hit for hit, and the BVH's build time, SAH cost and size.
     Rays(rays::RaysArgs),
@@ -52,6 +55,7 @@ pub fn run(command: &BenchCommand) -> Result<()> {
         BenchCommand::Frames(a) => frames::run(a),
         BenchCommand::Bvh(a) => bvh::run(a),
         BenchCommand::Memory(a) => memory::run(a),
+        BenchCommand::Denoise(a) => denoise::run(a),
         BenchCommand::Rays(a) => rays::run(a),
     }
 }

@@ -24,6 +24,19 @@ struct Synthetic {
 }
 
 impl Synthetic {
+    /// The CPU twin's input for `n` iterations of this image's sums.
+    fn input<'a>(&self, n: u32, film: &'a [f32], guides: &'a [f32]) -> cpu::Input<'a> {
+        cpu::Input {
+            width: self.w,
+            height: self.h,
+            samples: n,
+            guide_samples: n,
+            film,
+            guides,
+            pixel_angle: PIXEL_ANGLE,
+        }
+    }
+
     fn albedo(&self, x: u32, y: u32) -> [f32; 3] {
         if x < self.w / 2 {
             if (x / 4 + y / 4).is_multiple_of(2) { [0.8, 0.2, 0.2] } else { [0.3, 0.7, 0.3] }
@@ -140,15 +153,7 @@ fn gpu_filter_matches_its_cpu_twin() {
     let n = 16;
     let (film, guides) = s.render(n, 0.5, 7);
     let params = DenoiseParams::default();
-    let input = cpu::Input {
-        width: s.w,
-        height: s.h,
-        samples: n,
-        guide_samples: n,
-        film: &film,
-        guides: &guides,
-        pixel_angle: PIXEL_ANGLE,
-    };
+    let input = s.input(n, &film, &guides);
     let expected = cpu::denoise(&input, &params);
     let raw = cpu::raw(&input);
     let usage = wgpu::BufferUsages::COPY_SRC;
@@ -181,15 +186,7 @@ fn denoised_image_converges_to_the_raw_one() {
     let mut ratios = Vec::new();
     for n in [16u32, 256, 4096] {
         let (film, guides) = s.render(n, 1.0, 3);
-        let input = cpu::Input {
-            width: s.w,
-            height: s.h,
-            samples: n,
-            guide_samples: n,
-            film: &film,
-            guides: &guides,
-            pixel_angle: PIXEL_ANGLE,
-        };
+        let input = s.input(n, &film, &guides);
         let (raw, denoised) = (cpu::raw(&input), cpu::denoise(&input, &params));
         let (raw_err, den_err, change) =
             (rmse(&raw, &truth, None), rmse(&denoised, &truth, None), rmse(&denoised, &raw, None));

@@ -34,8 +34,9 @@ def cli_render(cli, out, *args, iterations=8, seed=3):
             {"show": "indirect", "point": [(0, 0.5, 0, 1, 1, 1)], "fov": 50, "up": np.array([0.1, 1, 0]), **MOVED},
             ["--show", "indirect", "--point", "0,0.5,0,1,1,1", "--fov", "50", "--up", "0.1,1,0", *MOVED_ARGS],
         ),
+        ({"denoise": True}, ["--denoise"]),
     ],
-    ids=["gather", "path", "options"],
+    ids=["gather", "path", "options", "denoise"],
 )
 def test_render_equals_the_cli_exr(cli, options, args):
     image = rastergi.render("cornell", iterations=8, **SMALL, **options)

@@ -889,8 +889,11 @@ pub fn on_gpu(
     let size = (queries.len() as u64 * 64).max(64);
     let output = gpu.zeroed_buffer("bsdf answers", size, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
     let c = wgpu::ShaderStages::COMPUTE;
-    let table =
-        gpu.storage_buffer("bsdf ggx albedo", bytemuck::bytes_of(&ggx_albedo().gpu(true)), wgpu::BufferUsages::empty());
+    let table = gpu.storage_buffer(
+        "bsdf ggx albedo",
+        bytemuck::bytes_of(&*ggx_albedo().gpu(true)),
+        wgpu::BufferUsages::empty(),
+    );
     let main = "
         struct Query { v: array<f32, 25> }
         struct Answer { v: array<f32, 16> }

@@ -482,8 +482,8 @@ impl GpuScene {
             label: Some("scene ggx albedo"),
             // Read only where some material is not Lambertian (SCENE_BSDF): other scenes
             // neither compute the table nor read it.
-            contents: bytemuck::bytes_of(&if !has_bsdfs {
-                crate::bsdf::albedo::GpuGgxAlbedo::zeroed()
+            contents: bytemuck::bytes_of(&*if !has_bsdfs {
+                bytemuck::zeroed_box::<crate::bsdf::albedo::GpuGgxAlbedo>()
             } else {
                 crate::bsdf::ggx_albedo().gpu(s.materials.iter().any(|m| m.needs_glass_table()))
             }),

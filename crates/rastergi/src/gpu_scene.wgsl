@@ -445,10 +445,9 @@ fn surface_bsdf(s: Surface) -> Bsdf {
 // diffuse or glossy lobe): eye and gather rays continue through it (specular.wgsl,
 // gather_radiance).
 fn surface_purely_specular(s: Surface) -> bool {
-    let r = clamp(s.roughness, 0.0, 1.0);
-    let rc = clamp(s.clearcoat_roughness, 0.0, 1.0);
-    let opaque = (1.0 - clamp(s.metallic, 0.0, 1.0)) * (1.0 - s.transmission);
-    return r * r < SMOOTH_ALPHA && opaque <= 0.0 && (s.clearcoat <= 0.0 || rc * rc < SMOOTH_ALPHA);
+    let b = surface_bsdf(s);
+    let opaque = (1.0 - b.metallic) * (1.0 - b.transmission);
+    return bsdf_is_smooth(b) && opaque <= 0.0 && !rough_coat(b);
 }
 
 // Whether eye and gather rays go on through the surface rather than stop at it: a purely

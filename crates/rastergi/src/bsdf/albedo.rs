@@ -121,9 +121,10 @@ impl GgxAlbedo {
     }
 
     /// The GPU form, bsdf.wgsl's `GgxAlbedoTable` (bound as the scene's `ggx_table`), with the
-    /// glass's table where `glass` (computing it on first use), zeros elsewhere.
-    pub fn gpu(&self, glass: bool) -> GpuGgxAlbedo {
-        let mut g = GpuGgxAlbedo::zeroed();
+    /// glass's table where `glass` (read on first use), zeros elsewhere. Boxed: with the glass
+    /// table it is 272 KiB, too large for a worker thread's stack to copy around.
+    pub fn gpu(&self, glass: bool) -> Box<GpuGgxAlbedo> {
+        let mut g: Box<GpuGgxAlbedo> = bytemuck::zeroed_box();
         if glass {
             g.glass.copy_from_slice(&glass_albedo().e);
         }

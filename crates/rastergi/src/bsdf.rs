@@ -900,6 +900,9 @@ pub fn on_gpu(
         @group(0) @binding(0) var<storage, read> queries: array<Query>;
         @group(0) @binding(1) var<storage, read_write> answers: array<Answer>;
         @group(0) @binding(2) var<storage, read> ggx_table: GgxAlbedoTable;
+        fn ggx_cell(k: u32) -> vec4f { return ggx_table.cells[k]; }
+        fn ggx_mean(j: u32) -> vec4f { return ggx_table.means[j]; }
+        fn glass_cell(r: u32) -> f32 { return ggx_table.glass[r]; }
         @compute @workgroup_size(64)
         fn main(@builtin(global_invocation_id) gid: vec3u) {
             if gid.x >= arrayLength(&queries) {

@@ -160,8 +160,9 @@ fn layer_fresnel(b: Bsdf, c: f32) -> vec3f {
 }
 
 // The GGX lobe's directional albedo tables (bsdf/albedo.rs, GpuGgxAlbedo): cell k = √α·N + μ
-// holds (E₁, E₅) at k and k + 1; means[j] (Ē₁, Ē₅) at √α cells j and j + 1. Bound by the pass
-// as `ggx_table` (the scene's binding 13).
+// holds (E₁, E₅) at k and k + 1; means[j] (Ē₁, Ē₅) at √α cells j and j + 1. Read through
+// the includer's ggx_cell(k), ggx_mean(j) and glass_cell(r) (the scene's from scene_data,
+// gpu_scene.wgsl).
 struct GgxAlbedoTable {
     cells: array<vec4f, GGX_ALBEDO_CELLS>,
     means: array<vec4f, GGX_ALBEDO_N>,
@@ -179,8 +180,8 @@ fn ggx_albedo(mu: f32, alpha: f32) -> vec2f {
     let i = min(u32(tx), n - 2u);
     let j = min(u32(ty), n - 2u);
     let fx = tx - f32(i);
-    let a = ggx_table.cells[j * n + i];
-    let b = ggx_table.cells[(j + 1u) * n + i];
+    let a = ggx_cell(j * n + i);
+    let b = ggx_cell((j + 1u) * n + i);
     let lo = a.xy + (a.zw - a.xy) * fx;
     let hi = b.xy + (b.zw - b.xy) * fx;
     return lo + (hi - lo) * (ty - f32(j));
@@ -190,7 +191,7 @@ fn ggx_albedo(mu: f32, alpha: f32) -> vec2f {
 fn ggx_albedo_mean(alpha: f32) -> vec2f {
     let t = sqrt(clamp(alpha, 0.0, 1.0)) * f32(GGX_ALBEDO_N - 1u);
     let j = min(u32(t), GGX_ALBEDO_N - 2u);
-    let m = ggx_table.means[j];
+    let m = ggx_mean(j);
     return m.xy + (m.zw - m.xy) * (t - f32(j));
 }
 
@@ -225,8 +226,8 @@ fn glass_single_albedo(b: Bsdf, w: vec3f) -> f32 {
     for (var d = 0u; d < 2u; d++) {
         let r0 = ((side + k + d) * n + j) * n + i;
         let r1 = r0 + n;
-        let lo = ggx_table.glass[r0] + (ggx_table.glass[r0 + 1u] - ggx_table.glass[r0]) * fx;
-        let hi = ggx_table.glass[r1] + (ggx_table.glass[r1 + 1u] - ggx_table.glass[r1]) * fx;
+        let lo = glass_cell(r0) + (glass_cell(r0 + 1u) - glass_cell(r0)) * fx;
+        let hi = glass_cell(r1) + (glass_cell(r1 + 1u) - glass_cell(r1)) * fx;
         e[d] = lo + (hi - lo) * fy;
     }
     return e[0] + (e[1] - e[0]) * (tz - f32(k));

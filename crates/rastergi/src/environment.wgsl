@@ -11,7 +11,7 @@ struct Environment {
     // The light table's probability of picking it.
     pmf: f32,
     _pad0: u32,
-    // Offsets in environment_data of the row cdf (H − 1), the column cdfs ((H − 1)·W) and
+    // Offsets in the environment's data (env_data; at scene_offsets().environment in scene_data) of the row cdf (H − 1), the column cdfs ((H − 1)·W) and
     // the cells' pmfs ((H − 1)·W); the texels (RGB) come first.
     row_cdf: u32,
     column_cdf: u32,
@@ -19,8 +19,12 @@ struct Environment {
     _pad1: u32,
 }
 
-@group(0) @binding(8) var<storage, read> environment_data: array<f32>;
 @group(0) @binding(9) var<uniform> environment: Environment;
+
+// Word k of the environment's data.
+fn env_data(k: u32) -> f32 {
+    return scene_f32(scene_offsets().environment + k);
+}
 
 fn has_environment() -> bool {
     return environment.width != 0u;
@@ -28,7 +32,7 @@ fn has_environment() -> bool {
 
 fn env_texel(i: u32, j: u32) -> vec3f {
     let k = 3u * (j * environment.width + i % environment.width);
-    return vec3f(environment_data[k], environment_data[k + 1u], environment_data[k + 2u]);
+    return vec3f(env_data(k), env_data(k + 1u), env_data(k + 2u));
 }
 
 // (u, v) of unit direction d: u = atan2(x, −z)/2π wrapped to [0, 1), v = acos(y)/π.
@@ -79,7 +83,7 @@ fn env_pdf(d: vec3f) -> f32 {
     let p = env_position(d);
     let i = min(u32(p.x), environment.width - 1u);
     let j = min(u32(p.y), environment.height - 2u);
-    return environment_data[environment.cell_pmf + j * environment.width + i] / env_cell_solid_angle(j);
+    return env_data(environment.cell_pmf + j * environment.width + i) / env_cell_solid_angle(j);
 }
 
 // The first index in [lo, lo + n) whose value exceeds u (an upper bound of a cdf section).
@@ -88,7 +92,7 @@ fn env_search(lo: u32, n: u32, u: f32) -> u32 {
     var b = n - 1u;
     while a < b {
         let mid = (a + b) / 2u;
-        if environment_data[lo + mid] <= u {
+        if env_data(lo + mid) <= u {
             a = mid + 1u;
         } else {
             b = mid;
@@ -109,20 +113,20 @@ fn env_sample(u1: f32, u2: f32) -> vec4f {
     let j = env_search(environment.row_cdf, rows, u1);
     var lo = 0.0;
     if j > 0u {
-        lo = environment_data[environment.row_cdf + j - 1u];
+        lo = env_data(environment.row_cdf + j - 1u);
     }
-    let r1 = env_remap(u1, lo, environment_data[environment.row_cdf + j]);
+    let r1 = env_remap(u1, lo, env_data(environment.row_cdf + j));
     let row = environment.column_cdf + j * w;
     let i = env_search(row, w, u2);
     lo = 0.0;
     if i > 0u {
-        lo = environment_data[row + i - 1u];
+        lo = env_data(row + i - 1u);
     }
-    let r2 = env_remap(u2, lo, environment_data[row + i]);
+    let r2 = env_remap(u2, lo, env_data(row + i));
     let phi = 2.0 * PI * (f32(i) + 0.5 + r2) / f32(w);
     let c = env_row_cosines(j);
     let cos_t = c.x - r1 * (c.x - c.y);
     let sin_t = sqrt(max(1.0 - cos_t * cos_t, 0.0));
     let d = vec3f(sin(phi) * sin_t, cos_t, -cos(phi) * sin_t);
-    return vec4f(d, environment_data[environment.cell_pmf + j * w + i] / env_cell_solid_angle(j));
+    return vec4f(d, env_data(environment.cell_pmf + j * w + i) / env_cell_solid_angle(j));
 }

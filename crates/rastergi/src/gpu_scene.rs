@@ -103,6 +103,59 @@ pub struct GpuMaterialMaps {
     pub clearcoat_roughness_map: GpuTextureSlot,
 }
 
+/// `SceneOffsets` in `gpu_scene.wgsl`: where each part of the scene's data buffer
+/// (`scene_data`, [`SceneData`]) starts, in 32-bit words, and how many items some hold. It is
+/// the buffer's header, its first 16 words (field i is word i).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuSceneOffsets {
+    /// Texture coordinates: two words per corner, three corners per triangle.
+    pub uvs: u32,
+    pub uv_triangles: u32,
+    /// Shading normals: nine words per triangle.
+    pub normals: u32,
+    pub normal_triangles: u32,
+    /// Tangents (xyz, handedness): twelve words per triangle.
+    pub tangents: u32,
+    pub tangent_triangles: u32,
+    /// The light distribution's entries ([`crate::lights::LightEntry`], four words each).
+    pub lights: u32,
+    pub light_count: u32,
+    /// The point, spot and distant lights ([`crate::lights::PunctualLight`], sixteen words each).
+    pub punctual: u32,
+    /// The environment map's data ([`Environment::gpu_data`]).
+    pub environment: u32,
+    /// The GGX albedo tables' parts ([`crate::bsdf::albedo::GpuGgxAlbedo`]; 0 where the
+    /// scene has none).
+    pub ggx_cells: u32,
+    pub ggx_means: u32,
+    pub glass: u32,
+    pub _pad: [u32; 3],
+}
+
+/// The scene's data buffer as it is filled: each part appended as 32-bit words.
+#[derive(Default)]
+struct SceneData {
+    words: Vec<u32>,
+}
+
+impl SceneData {
+    /// Appends `items` and returns the word at which they start.
+    fn push<T: Pod>(&mut self, items: &[T]) -> u32 {
+        let at = self.words.len() as u32;
+        self.words.extend_from_slice(bytemuck::cast_slice(items));
+        at
+    }
+}
+
+/// `MaterialRecord` in `gpu_scene.wgsl`: a material and its textures, one binding for both.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuMaterialRecord {
+    pub material: GpuMaterial,
+    pub maps: GpuMaterialMaps,
+}
+
 impl GpuMaterial {
     pub fn new(m: &Material) -> (GpuMaterial, GpuMaterialMaps) {
         let (alpha, alpha_cutoff) = match m.alpha_mode {
@@ -421,8 +474,14 @@ impl GpuScene {
                 light,
             })
             .collect();
-        let (materials, maps): (Vec<GpuMaterial>, Vec<GpuMaterialMaps>) =
-            s.materials.iter().map(GpuMaterial::new).unzip();
+        let materials: Vec<GpuMaterialRecord> = s
+            .materials
+            .iter()
+            .map(|m| {
+                let (material, maps) = GpuMaterial::new(m);
+                GpuMaterialRecord { material, maps }
+            })
+            .collect();
         // One triangle's worth of zeros when the scene has no texture coordinates: a binding
         // cannot be empty, and `surface_uv` clamps its index into the buffer.
         let uvs: Vec<[f32; 2]> = if s.uvs.is_empty() {
@@ -460,70 +519,78 @@ impl GpuScene {
         )?;
         let (disc_centre, disc_radius) = prepared.lights.disc;
         let env_uniform = GpuEnvironment::new(env, disc_centre, disc_radius, prepared.lights.environment_pmf);
+        // Everything but the triangles, materials and BVH in one buffer of words (SceneData):
+        // WebGPU allows 10 storage buffers per shader stage, and a gather pass binds the
+        // scene, the visible points, the film and the photon map.
+        // The header (GpuSceneOffsets) comes first; it is written once the offsets are known.
+        let mut data = SceneData { words: vec![0; std::mem::size_of::<GpuSceneOffsets>() / 4] };
+        let no_light = [LightEntry::zeroed()];
+        let mut offsets = GpuSceneOffsets {
+            uvs: data.push(&uvs),
+            uv_triangles: (uvs.len() / 3) as u32,
+            normals: data.push(&normals),
+            normal_triangles: (normals.len() / 9) as u32,
+            tangents: data.push(&tangents),
+            tangent_triangles: (tangents.len() / 12) as u32,
+            // One zero entry where the scene has no lights: light_count ≥ 1, pmf 0.
+            lights: data.push(if lights.is_empty() { &no_light[..] } else { &lights[..] }),
+            light_count: lights.len().max(1) as u32,
+            punctual: data.push(&punctual),
+            environment: data.push(&env_data),
+            ..GpuSceneOffsets::default()
+        };
+        // The GGX albedo tables are read only where some material is not Lambertian
+        // (SCENE_BSDF): other scenes neither compute nor hold them.
+        if has_bsdfs {
+            let table = crate::bsdf::ggx_albedo().gpu(s.materials.iter().any(|m| m.needs_glass_table()));
+            let at = data.push(std::slice::from_ref(&*table));
+            use crate::bsdf::albedo::GpuGgxAlbedo as T;
+            offsets.ggx_cells = at + (std::mem::offset_of!(T, cells) / 4) as u32;
+            offsets.ggx_means = at + (std::mem::offset_of!(T, means) / 4) as u32;
+            offsets.glass = at + (std::mem::offset_of!(T, glass) / 4) as u32;
+        }
+        data.words[..size_of::<GpuSceneOffsets>() / 4].copy_from_slice(bytemuck::cast_slice(&[offsets]));
+        crate::limits::check_storage_buffer(
+            &limits,
+            "the scene's texture coordinates, normals, tangents, lights and environment map",
+            data.words.len() as u64,
+            4,
+            "use a smaller --env image or a scene with fewer triangles",
+        )?;
         let none = wgpu::BufferUsages::empty();
         let buffers = [
             gpu.storage_buffer("scene triangles", bytemuck::cast_slice(&triangles), none),
             gpu.storage_buffer("scene materials", bytemuck::cast_slice(&materials), none),
             gpu.storage_buffer("scene bvh nodes", bytemuck::cast_slice(&nodes), none),
-            gpu.storage_buffer("scene lights", bytemuck::cast_slice(&lights), none),
-            gpu.storage_buffer("scene texture coordinates", bytemuck::cast_slice(&uvs), none),
-            gpu.storage_buffer("scene punctual lights", bytemuck::cast_slice(&punctual), none),
-            gpu.storage_buffer("scene environment map", bytemuck::cast_slice(&env_data), none),
-            gpu.storage_buffer("scene shading normals", bytemuck::cast_slice(&normals), none),
-            gpu.storage_buffer("scene tangents", bytemuck::cast_slice(&tangents), none),
-            gpu.storage_buffer("scene material maps", bytemuck::cast_slice(&maps), none),
+            gpu.storage_buffer("scene data", bytemuck::cast_slice(&data.words), none),
         ];
         let env_uniform_buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("scene environment"),
             contents: bytemuck::bytes_of(&env_uniform),
             usage: wgpu::BufferUsages::UNIFORM,
         });
-        let ggx_buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("scene ggx albedo"),
-            // Read only where some material is not Lambertian (SCENE_BSDF): other scenes
-            // neither compute the table nor read it.
-            contents: bytemuck::bytes_of(&*if !has_bsdfs {
-                bytemuck::zeroed_box::<crate::bsdf::albedo::GpuGgxAlbedo>()
-            } else {
-                crate::bsdf::ggx_albedo().gpu(s.materials.iter().any(|m| m.needs_glass_table()))
-            }),
-            usage: wgpu::BufferUsages::STORAGE,
-        });
         let vis = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
-        // The BVH and the lights serve compute passes only: the raster stages (which pull
-        // vertices and discard holes) see five storage buffers of the scene, well under the
-        // count at which lavapipe loses fragment writes (below).
+        // The BVH serves compute passes only: the raster stages (which pull vertices and
+        // discard holes) see three storage buffers of the scene, well under the count at
+        // which lavapipe (Mesa 22.3) silently loses fragment writes (11 storage buffers in a
+        // fragment stage, though it reports 32: the fragment lists' gather lost 10 % of its
+        // estimates, tests/gather.rs).
         let compute = wgpu::ShaderStages::COMPUTE;
         let layout = bind_group_layout(
             &gpu.device,
             "scene",
             &[
                 storage_entry::<GpuTriangle>(0, vis, true),
-                storage_entry::<GpuMaterial>(1, vis, true),
+                storage_entry::<GpuMaterialRecord>(1, vis, true),
                 storage_entry::<WideNode>(2, compute, true),
-                storage_entry::<crate::lights::LightEntry>(3, compute, true),
-                storage_entry::<[f32; 2]>(4, vis, true),
                 texture_array_entry(5, vis),
                 sampler_entry(6, vis),
-                storage_entry::<crate::lights::PunctualLight>(7, compute, true),
-                // The environment, the shading normals and the tangents are read by compute
-                // passes only, and
-                // hidden from the raster stages: lavapipe (Mesa 22.3) silently loses fragment
-                // writes once a fragment stage sees 11 storage buffers (it reports 32): with
-                // them visible, the fragment lists' gather lost 10 % of its estimates
-                // (tests/gather.rs).
-                storage_entry::<f32>(8, wgpu::ShaderStages::COMPUTE, true),
+                storage_entry::<u32>(8, vis, true),
                 uniform_entry::<GpuEnvironment>(9, wgpu::ShaderStages::COMPUTE),
-                storage_entry::<[f32; 9]>(10, wgpu::ShaderStages::COMPUTE, true),
-                storage_entry::<[f32; 12]>(11, wgpu::ShaderStages::COMPUTE, true),
-                storage_entry::<GpuMaterialMaps>(12, vis, true),
-                // The GGX albedo tables of the scattering model, for compute passes: a uniform
-                // buffer here (any visibility) crashed lavapipe (Mesa 22.3) in the raster gather.
-                storage_entry::<crate::bsdf::albedo::GpuGgxAlbedo>(13, compute, true),
             ],
         );
         // The buffers' bindings, in the order of `buffers`.
-        const BUFFER_BINDINGS: [u32; 10] = [0, 1, 2, 3, 4, 7, 8, 10, 11, 12];
+        const BUFFER_BINDINGS: [u32; 4] = [0, 1, 2, 8];
         let mut entries: Vec<wgpu::BindGroupEntry> = buffers
             .iter()
             .zip(BUFFER_BINDINGS)
@@ -532,7 +599,6 @@ impl GpuScene {
         entries.push(wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&texture_view) });
         entries.push(wgpu::BindGroupEntry { binding: 6, resource: wgpu::BindingResource::Sampler(&sampler) });
         entries.push(wgpu::BindGroupEntry { binding: 9, resource: env_uniform_buffer.as_entire_binding() });
-        entries.push(wgpu::BindGroupEntry { binding: 13, resource: ggx_buffer.as_entire_binding() });
         let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("scene"),
             layout: &layout,
@@ -571,7 +637,7 @@ const FEWER_TRIANGLES: &str =
 pub fn check_scene_buffers(limits: &wgpu::Limits, triangles: usize, materials: usize, lights: usize) -> Result<()> {
     let fewer = FEWER_TRIANGLES;
     let triangle_stride = std::mem::size_of::<GpuTriangle>() as u64;
-    let material_stride = std::mem::size_of::<GpuMaterial>() as u64;
+    let material_stride = std::mem::size_of::<GpuMaterialRecord>() as u64;
     let light_stride = std::mem::size_of::<crate::lights::LightEntry>() as u64;
     let what = format!("the scene's {triangles} triangles");
     check_storage_buffer(limits, &what, triangles as u64, triangle_stride, fewer)?;

@@ -39,7 +39,7 @@ struct TextureSlot {
 }
 
 // flags: MATERIAL_TWO_SIDED, MATERIAL_ALPHA_MASK, MATERIAL_ALPHA_BLEND, MATERIAL_TEXTURED
-// (gpu_scene.rs). Its textures are in material_maps, read only where the flags say.
+// (gpu_scene.rs). Its textures are in its record's maps, read only where the flags say.
 struct Material {
     albedo: vec3f,
     flags: u32,
@@ -117,28 +117,98 @@ struct PunctualLight {
 }
 
 @group(0) @binding(0) var<storage, read> triangles: array<Triangle>;
-@group(0) @binding(1) var<storage, read> materials: array<Material>;
+// A material and its textures (gpu_scene.rs, GpuMaterialRecord): one binding for both.
+struct MaterialRecord {
+    material: Material,
+    maps: MaterialMaps,
+}
+
+@group(0) @binding(1) var<storage, read> materials: array<MaterialRecord>;
 @group(0) @binding(2) var<storage, read> bvh_nodes: array<WideNode>;
-@group(0) @binding(3) var<storage, read> lights: array<LightEntry>;
-// The point, spot and distant lights (one zero light when the scene has none).
-@group(0) @binding(7) var<storage, read> punctual: array<PunctualLight>;
-// Texture coordinates of the triangles' corners, three per triangle (one zero triangle when
-// the scene has none).
-@group(0) @binding(4) var<storage, read> uvs: array<vec2f>;
 // Every albedo texture, one layer each, with its mip chain (sRGB, read as linear RGB).
 @group(0) @binding(5) var textures: texture_2d_array<f32>;
 // Trilinear filtering, repeat addressing.
 @group(0) @binding(6) var texture_sampler: sampler;
-// Shading normals at the triangles' corners, nine floats per triangle (zero: the triangle
-// shades flat; one zero triangle when the scene has none).
-@group(0) @binding(10) var<storage, read> normals: array<f32>;
-// Tangents (xyz, handedness w) at the triangles' corners for normal maps, twelve floats per
-// triangle (zero: none; one zero triangle when the scene has none).
-@group(0) @binding(11) var<storage, read> tangents: array<f32>;
-// The materials' textures, at the materials' indices.
-@group(0) @binding(12) var<storage, read> material_maps: array<MaterialMaps>;
-// The GGX lobe's albedo tables of the scattering model (bsdf.wgsl, bsdf/albedo.rs).
-@group(0) @binding(13) var<storage, read> ggx_table: GgxAlbedoTable;
+
+// Where each part of `scene_data` starts, in words (gpu_scene.rs, GpuSceneOffsets): the
+// buffer's first 16 words (a uniform buffer beside the storage buffers crashes lavapipe,
+// Mesa 22.3, in the raster gather).
+struct SceneOffsets {
+    uvs: u32,
+    uv_triangles: u32,
+    normals: u32,
+    normal_triangles: u32,
+    tangents: u32,
+    tangent_triangles: u32,
+    lights: u32,
+    light_count: u32,
+    punctual: u32,
+    environment: u32,
+    ggx_cells: u32,
+    ggx_means: u32,
+    glass: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}
+
+// The rest of the scene in one buffer of words (one binding: WebGPU allows 10 storage buffers
+// per shader stage), after its header (SceneOffsets) at the offsets the header gives:
+// - texture coordinates of the triangles' corners, three vec2f per triangle (one zero
+//   triangle when the scene has none);
+// - shading normals at the corners, nine floats per triangle (zero: the triangle shades flat;
+//   one zero triangle when the scene has none);
+// - tangents (xyz, handedness w) at the corners for normal maps, twelve floats per triangle
+//   (zero: none; one zero triangle when the scene has none);
+// - the light distribution's entries (LightEntry; one zero entry when the scene has none);
+// - the point, spot and distant lights (PunctualLight; one zero light when the scene has none);
+// - the environment map (environment.wgsl);
+// - the GGX lobe's albedo tables of the scattering model (bsdf.wgsl, bsdf/albedo.rs).
+@group(0) @binding(8) var<storage, read> scene_data: array<u32>;
+
+fn scene_offsets() -> SceneOffsets {
+    return SceneOffsets(scene_data[0], scene_data[1], scene_data[2], scene_data[3], scene_data[4], scene_data[5],
+        scene_data[6], scene_data[7], scene_data[8], scene_data[9], scene_data[10], scene_data[11], scene_data[12],
+        0u, 0u, 0u);
+}
+
+fn scene_f32(i: u32) -> f32 {
+    return bitcast<f32>(scene_data[i]);
+}
+
+fn scene_vec3(i: u32) -> vec3f {
+    return vec3f(scene_f32(i), scene_f32(i + 1u), scene_f32(i + 2u));
+}
+
+fn scene_vec4(i: u32) -> vec4f {
+    return vec4f(scene_f32(i), scene_f32(i + 1u), scene_f32(i + 2u), scene_f32(i + 3u));
+}
+
+// Entry e of the light distribution.
+fn light_entry(e: u32) -> LightEntry {
+    let i = scene_offsets().lights + 4u * e;
+    return LightEntry(scene_data[i], scene_f32(i + 1u), scene_f32(i + 2u), scene_f32(i + 3u));
+}
+
+// Punctual light k.
+fn punctual_light(k: u32) -> PunctualLight {
+    let i = scene_offsets().punctual + 16u * k;
+    return PunctualLight(scene_vec3(i), scene_data[i + 3u], scene_vec3(i + 4u), scene_f32(i + 7u),
+        scene_vec3(i + 8u), scene_f32(i + 11u), scene_vec3(i + 12u), scene_f32(i + 15u));
+}
+
+// The GGX albedo tables' cell k, mean j and glass cell r (bsdf.wgsl's accessors).
+fn ggx_cell(k: u32) -> vec4f {
+    return scene_vec4(scene_offsets().ggx_cells + 4u * k);
+}
+
+fn ggx_mean(j: u32) -> vec4f {
+    return scene_vec4(scene_offsets().ggx_means + 4u * j);
+}
+
+fn glass_cell(r: u32) -> f32 {
+    return scene_f32(scene_offsets().glass + r);
+}
 
 // The random stream of stochastic opacity (passes_through): each entry point that finds
 // surfaces sets it from its iteration's seed, so that the holes of a semi-transparent
@@ -198,8 +268,10 @@ fn triangle_normal(t: Triangle) -> vec3f {
 
 // Texture coordinates at barycentrics (b1, b2) of triangle `tri` (PreparedScene::uv_at).
 fn surface_uv(tri: u32, b1: f32, b2: f32) -> vec2f {
-    let i = 3u * min(tri, arrayLength(&uvs) / 3u - 1u);
-    return uvs[i] * (1.0 - b1 - b2) + uvs[i + 1u] * b1 + uvs[i + 2u] * b2;
+    let i = scene_offsets().uvs + 6u * min(tri, scene_offsets().uv_triangles - 1u);
+    let uv = array<vec2f, 3>(vec2f(scene_f32(i), scene_f32(i + 1u)), vec2f(scene_f32(i + 2u), scene_f32(i + 3u)),
+        vec2f(scene_f32(i + 4u), scene_f32(i + 5u)));
+    return uv[0] * (1.0 - b1 - b2) + uv[1] * b1 + uv[2] * b2;
 }
 
 // The texture of slot s at the triangle's texture coordinates uv and level of detail lod.
@@ -216,10 +288,10 @@ fn shading_normal(tri: u32, b1: f32, b2: f32, n: vec3f, mi: u32, textured: bool,
     let w = vec3f(1.0 - b1 - b2, b1, b2);
     var ns = n;
     if SCENE_NORMALS {
-        let i = 9u * min(tri, arrayLength(&normals) / 9u - 1u);
+        let i = scene_offsets().normals + 9u * min(tri, scene_offsets().normal_triangles - 1u);
         var v = vec3f(0.0);
         for (var k = 0u; k < 3u; k++) {
-            v += w[k] * vec3f(normals[i + 3u * k], normals[i + 3u * k + 1u], normals[i + 3u * k + 2u]);
+            v += w[k] * scene_vec3(i + 3u * k);
         }
         let len = length(v);
         if len >= 1e-6 {
@@ -230,17 +302,16 @@ fn shading_normal(tri: u32, b1: f32, b2: f32, n: vec3f, mi: u32, textured: bool,
     if !textured {
         return ns;
     }
-    let map = material_maps[mi].normal_map;
+    let map = materials[mi].maps.normal_map;
     if map.layer == NO_TEXTURE {
         return ns;
     }
-    let j = 12u * min(tri, arrayLength(&tangents) / 12u - 1u);
+    let j = scene_offsets().tangents + 12u * min(tri, scene_offsets().tangent_triangles - 1u);
     var t = vec4f(0.0);
     for (var k = 0u; k < 3u; k++) {
-        t += w[k] * vec4f(tangents[j + 4u * k], tangents[j + 4u * k + 1u], tangents[j + 4u * k + 2u],
-            tangents[j + 4u * k + 3u]);
+        t += w[k] * scene_vec4(j + 4u * k);
     }
-    return perturb_normal(n, ns, t, slot_sample(map, uv, 0.0).rgb, material_maps[mi].normal_scale);
+    return perturb_normal(n, ns, t, slot_sample(map, uv, 0.0).rgb, materials[mi].maps.normal_scale);
 }
 
 // gpu_scene::perturb_normal: ns perturbed by the normal-map texel c in the frame (t', b, ns).
@@ -262,7 +333,7 @@ fn perturb_normal(n: vec3f, ns: vec3f, t: vec4f, c: vec3f, scale: f32) -> vec3f 
 // The opacity α of material mi (its factor `opacity`) at texture coordinates uv
 // (PreparedScene::opacity_at).
 fn surface_opacity(mi: u32, opacity: f32, uv: vec2f, lod: f32) -> f32 {
-    let map = material_maps[mi].opacity_map;
+    let map = materials[mi].maps.opacity_map;
     if map.layer == NO_TEXTURE {
         return opacity;
     }
@@ -277,13 +348,13 @@ fn passes_through(tri: u32, b1: f32, b2: f32, lod: f32) -> bool {
         return false;
     }
     let mi = triangles[tri].material;
-    let m = materials[mi];
+    let m = materials[mi].material;
     if (m.flags & (MATERIAL_ALPHA_MASK | MATERIAL_ALPHA_BLEND)) == 0u {
         return false;
     }
     let a = surface_opacity(mi, m.opacity, surface_uv(tri, b1, b2), lod);
     if (m.flags & MATERIAL_ALPHA_MASK) != 0u {
-        return a < material_maps[mi].alpha_cutoff;
+        return a < materials[mi].maps.alpha_cutoff;
     }
     let u = unit_f32(pcg_hash(pcg_hash(pcg_hash(tri ^ alpha_seed) ^ bitcast<u32>(b1)) ^ bitcast<u32>(b2)));
     return u >= a;
@@ -294,14 +365,14 @@ fn passes_through(tri: u32, b1: f32, b2: f32, lod: f32) -> bool {
 // emission on a stochastic surface.
 fn emitter_radiance(tri: u32, b1: f32, b2: f32) -> vec3f {
     let mi = triangles[tri].material;
-    let m = materials[mi];
+    let m = materials[mi].material;
     if !(SCENE_TEXTURES || SCENE_HOLES) || (m.flags & (MATERIAL_TEXTURED | MATERIAL_ALPHA_MASK | MATERIAL_ALPHA_BLEND)) == 0u {
         return m.emission;
     }
     let uv = surface_uv(tri, b1, b2);
     let le = surface_emission(mi, m.emission, uv);
     if (m.flags & MATERIAL_ALPHA_MASK) != 0u {
-        return select(le, vec3f(0.0), surface_opacity(mi, m.opacity, uv, 0.0) < material_maps[mi].alpha_cutoff);
+        return select(le, vec3f(0.0), surface_opacity(mi, m.opacity, uv, 0.0) < materials[mi].maps.alpha_cutoff);
     }
     if (m.flags & MATERIAL_ALPHA_BLEND) != 0u {
         return le * surface_opacity(mi, m.opacity, uv, 0.0);
@@ -312,7 +383,7 @@ fn emitter_radiance(tri: u32, b1: f32, b2: f32) -> vec3f {
 // The emitted radiance of material mi (its factor `emission`) at texture coordinates uv
 // (PreparedScene::emission_at).
 fn surface_emission(mi: u32, emission: vec3f, uv: vec2f) -> vec3f {
-    let map = material_maps[mi].emission_map;
+    let map = materials[mi].maps.emission_map;
     if map.layer == NO_TEXTURE {
         return emission;
     }
@@ -342,7 +413,7 @@ fn texture_lod(dx: vec2f, dy: vec2f) -> f32 {
 // The level of detail of material mi's albedo texture where the triangle's texture coordinates
 // change by dx and dy across a pixel: those changes placed by the texture's transform.
 fn albedo_lod(mi: u32, dx: vec2f, dy: vec2f) -> f32 {
-    let s = material_maps[mi].albedo_map;
+    let s = materials[mi].maps.albedo_map;
     let a = mat2x2f(vec2f(s.u.x, s.v.x), vec2f(s.u.y, s.v.y));
     return texture_lod(a * dx, a * dy);
 }
@@ -370,7 +441,7 @@ fn plane_barycentrics(t: Triangle, p: vec3f) -> vec2f {
 fn surface_at(tri: u32, b1: f32, b2: f32, lod: f32) -> Surface {
     let t = triangles[tri];
     let mi = t.material;
-    let m = materials[mi];
+    let m = materials[mi].material;
     let textured = SCENE_TEXTURES && (m.flags & MATERIAL_TEXTURED) != 0u;
     var uv = vec2f(0.0);
     if textured {
@@ -383,7 +454,7 @@ fn surface_at(tri: u32, b1: f32, b2: f32, lod: f32) -> Surface {
     s.albedo = m.albedo;
     s.emission = m.emission;
     if textured {
-        let maps = material_maps[mi];
+        let maps = materials[mi].maps;
         if maps.albedo_map.layer != NO_TEXTURE {
             s.albedo *= slot_sample(maps.albedo_map, uv, lod).rgb;
         }
@@ -402,29 +473,29 @@ fn surface_at(tri: u32, b1: f32, b2: f32, lod: f32) -> Surface {
     s.clearcoat = m.clearcoat;
     s.clearcoat_roughness = m.clearcoat_roughness;
     if textured {
-        let mr_map = material_maps[mi].metal_rough_map;
+        let mr_map = materials[mi].maps.metal_rough_map;
         if mr_map.layer != NO_TEXTURE {
             let mr = slot_sample(mr_map, uv, 0.0);
             s.roughness *= mr.g;
             s.metallic *= mr.b;
         }
-        let t_map = material_maps[mi].transmission_map;
+        let t_map = materials[mi].maps.transmission_map;
         if t_map.layer != NO_TEXTURE {
             s.transmission = clamp(s.transmission * slot_sample(t_map, uv, 0.0).r, 0.0, 1.0);
         }
-        let s_map = material_maps[mi].specular_map;
+        let s_map = materials[mi].maps.specular_map;
         if s_map.layer != NO_TEXTURE {
             s.specular = clamp(s.specular * slot_sample(s_map, uv, 0.0).a, 0.0, 1.0);
         }
-        let c_map = material_maps[mi].specular_color_map;
+        let c_map = materials[mi].maps.specular_color_map;
         if c_map.layer != NO_TEXTURE {
             s.specular_color *= slot_sample(c_map, uv, 0.0).rgb;
         }
-        let k_map = material_maps[mi].clearcoat_map;
+        let k_map = materials[mi].maps.clearcoat_map;
         if k_map.layer != NO_TEXTURE {
             s.clearcoat *= slot_sample(k_map, uv, 0.0).r;
         }
-        let kr_map = material_maps[mi].clearcoat_roughness_map;
+        let kr_map = materials[mi].maps.clearcoat_roughness_map;
         if kr_map.layer != NO_TEXTURE {
             s.clearcoat_roughness *= slot_sample(kr_map, uv, 0.0).g;
         }
@@ -586,16 +657,16 @@ fn scatter_from(pos: vec3f, a: Arrival, u: vec3f, eps: f32) -> Scatter {
 // Whether the scene has emitters: an empty light table is stored as one zero entry (a
 // binding cannot be empty), whose pmf is 0.
 fn has_lights() -> bool {
-    return lights[0].pmf > 0.0;
+    return light_entry(0).pmf > 0.0;
 }
 
 // The light entry whose cdf interval holds u: the first with u < cdf (LightTable::pick).
 fn light_pick(u: f32) -> u32 {
     var lo = 0u;
-    var hi = arrayLength(&lights) - 1u;
+    var hi = scene_offsets().light_count - 1u;
     while lo < hi {
         let mid = (lo + hi) / 2u;
-        if lights[mid].cdf <= u {
+        if light_entry(mid).cdf <= u {
             lo = mid + 1u;
         } else {
             hi = mid;
@@ -611,11 +682,11 @@ fn light_pick(u: f32) -> u32 {
 fn remap_in_entry(a: u32, e: u32) -> f32 {
     var lo = 0.0;
     if e > 0u {
-        lo = lights[e - 1u].cdf;
+        lo = light_entry(e - 1u).cdf;
     }
     // lo ≤ unit_f32(a) ≤ a / 2³² (the pick), so the offset does not wrap.
     let offset = a - u32(lo * 4294967296.0);
-    return min(f32(offset) / ((lights[e].cdf - lo) * 4294967296.0), 0.99999994);
+    return min(f32(offset) / ((light_entry(e).cdf - lo) * 4294967296.0), 0.99999994);
 }
 
 // A light of the table and two uniforms for the point or direction on it.
@@ -682,7 +753,7 @@ struct LightRay {
 
 fn sample_light_at(x: vec3f, c: LightChoice) -> LightRay {
     var r: LightRay;
-    let entry = lights[c.entry];
+    let entry = light_entry(c.entry);
     let u1 = c.u1;
     let u2 = c.u2;
     r.pdf = 0.0;
@@ -706,7 +777,7 @@ fn sample_light_at(x: vec3f, c: LightChoice) -> LightRay {
         r.e = select(vec3f(0.0), l.radiance * (cos_y / (dist2 * l.pdf_area)), cos_y > 0.0);
         return r;
     }
-    let p = punctual[entry.triangle & ~PUNCTUAL_LIGHT];
+    let p = punctual_light(entry.triangle & ~PUNCTUAL_LIGHT);
     r.tri = NO_TRIANGLE;
     if p.kind == LIGHT_DISTANT {
         r.dir = -cone_direction(p.direction, p.cos_outer, u1, u2);
@@ -743,7 +814,7 @@ fn disc_point(axis: vec3f, centre: vec3f, r: f32, u1: f32, u2: f32) -> vec3f {
 fn emit_photon(u0: f32, u1: f32, u2: f32, u3: f32, u4: f32, eps: f32) -> PhotonStart {
     var s: PhotonStart;
     let e = light_pick(u0);
-    let entry = lights[e];
+    let entry = light_entry(e);
     if entry.triangle == ENVIRONMENT_LIGHT {
         // Towards the sky along the sampled direction; the photon travels the other way, from
         // the disc across the bounding sphere: L(ω)·πR²/(pdf(ω)·pmf).
@@ -764,7 +835,7 @@ fn emit_photon(u0: f32, u1: f32, u2: f32, u3: f32, u4: f32, eps: f32) -> PhotonS
         s.skip = l.tri;
         return s;
     }
-    let p = punctual[entry.triangle & ~PUNCTUAL_LIGHT];
+    let p = punctual_light(entry.triangle & ~PUNCTUAL_LIGHT);
     s.skip = NO_TRIANGLE;
     if p.kind == LIGHT_POINT {
         s.origin = p.position;
@@ -800,7 +871,7 @@ fn segment_transmittance(tri: u32, d: vec3f, t: f32) -> vec3f {
         return vec3f(1.0);
     }
     let tr = triangles[tri];
-    let m = materials[tr.material];
+    let m = materials[tr.material].material;
     let sigma = vec3f(m.attenuation[0], m.attenuation[1], m.attenuation[2]);
     if all(sigma == vec3f(0.0)) || dot(d, triangle_normal(tr)) <= 0.0 {
         return vec3f(1.0);
@@ -815,12 +886,12 @@ fn emitter_pdf_area(tri: u32) -> f32 {
     if e == NO_LIGHT {
         return 0.0;
     }
-    return lights[e].pmf / lights[e].area;
+    return light_entry(e).pmf / light_entry(e).area;
 }
 
 // A point uniformly (u1, u2) on the emissive triangle of light entry `entry`.
 fn sample_light(entry: u32, u1: f32, u2: f32) -> LightSample {
-    let e = lights[entry];
+    let e = light_entry(entry);
     let t = triangles[e.triangle];
     let b = uniform_triangle_bary(u1, u2);
     var s: LightSample;

@@ -65,6 +65,26 @@ fn twins() -> Vec<Twin> {
             [disc_centre, disc_radius, width, height, pmf, row_cdf, column_cdf, cell_pmf]
         ),
         twin!(GpuTriangle, "Triangle", [v0, material, v1, flags, v2, light]),
+        twin!(crate::gpu_scene::GpuMaterialRecord, "MaterialRecord", [material, maps]),
+        twin!(
+            crate::gpu_scene::GpuSceneOffsets,
+            "SceneOffsets",
+            [
+                uvs,
+                uv_triangles,
+                normals,
+                normal_triangles,
+                tangents,
+                tangent_triangles,
+                lights,
+                light_count,
+                punctual,
+                environment,
+                ggx_cells,
+                ggx_means,
+                glass
+            ]
+        ),
         twin!(GpuTextureSlot, "TextureSlot", [u, layer, v]),
         twin!(
             GpuMaterial,
@@ -318,4 +338,52 @@ fn the_design_page_names_every_wgsl_entry_point_and_each_exists() {
     let stale: Vec<_> = page.difference(&code).collect();
     assert!(missing.is_empty(), "entry points docs/design.md does not name: {missing:?}");
     assert!(stale.is_empty(), "docs/design.md names entry points the code lacks: {stale:?}");
+}
+
+/// The storage buffers each entry point of each shader uses, by stage: `(shader, entry point,
+/// count, names)`.
+fn storage_buffers_per_entry_point() -> Vec<(String, String, usize, Vec<String>)> {
+    let mut out = Vec::new();
+    for (label, source) in shaders() {
+        let module =
+            naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| panic!("{label}: {}", e.emit_to_string(&source)));
+        let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
+            .validate(&module)
+            .unwrap_or_else(|e| panic!("{label}: {e:?}"));
+        for (i, ep) in module.entry_points.iter().enumerate() {
+            let used = info.get_entry_point(i);
+            let names: Vec<String> = module
+                .global_variables
+                .iter()
+                .filter(|(h, g)| matches!(g.space, naga::AddressSpace::Storage { .. }) && !used[*h].is_empty())
+                .map(|(_, g)| g.name.clone().unwrap_or_default())
+                .collect();
+            out.push((label.to_string(), ep.name.clone(), names.len(), names));
+        }
+    }
+    out
+}
+
+/// WebGPU's most storage buffers per shader stage that browsers grant (Chrome's adapters and
+/// SwiftShader report 10; the WebGPU default is 8): the passes a web page runs must fit it.
+const WEB_STORAGE_BUFFERS: usize = 10;
+
+/// The passes that need more than [`WEB_STORAGE_BUFFERS`]; a web page cannot use them
+/// (docs/design.md, "In the browser"). The raster gathers' projections bind the ray view's
+/// layers or lists besides everything the traced gather binds.
+const NATIVE_ONLY: &[&str] = &["gather project", "gather list project"];
+
+#[test]
+fn every_pass_a_web_page_runs_binds_at_most_the_storage_buffers_browsers_grant() {
+    let mut over = Vec::new();
+    for (shader, entry, n, names) in storage_buffers_per_entry_point() {
+        println!("{n:3} {shader} / {entry}: {}", names.join(" "));
+        if n > WEB_STORAGE_BUFFERS && !NATIVE_ONLY.contains(&shader.as_str()) {
+            over.push(format!("{shader} / {entry}: {n} ({})", names.join(", ")));
+        }
+    }
+    assert!(over.is_empty(), "more than {WEB_STORAGE_BUFFERS} storage buffers in one stage: {over:#?}");
+    // What the raster gathers check against the device's limit is what they bind.
+    let raster = storage_buffers_per_entry_point().into_iter().filter(|(s, ..)| NATIVE_ONLY.contains(&s.as_str()));
+    assert_eq!(raster.map(|(.., n, _)| n).max(), Some(crate::gather::RASTER_STORAGE_BUFFERS as usize));
 }

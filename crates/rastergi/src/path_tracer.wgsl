@@ -75,7 +75,7 @@ fn path_radiance(origin: vec3f, dir: vec3f, xy: vec2u, rng: ptr<function, u32>) 
         }
         throughput *= segment_transmittance(hit.tri, d, hit.t);
         var lod = 0.0;
-        if bounce == 0u && (materials[triangles[hit.tri].material].flags & MATERIAL_TEXTURED) != 0u {
+        if bounce == 0u && (materials[triangles[hit.tri].material].material.flags & MATERIAL_TEXTURED) != 0u {
             lod = primary_lod(hit.tri, xy);
         }
         let s = surface_at(hit.tri, hit.b1, hit.b2, lod);
@@ -86,7 +86,7 @@ fn path_radiance(origin: vec3f, dir: vec3f, xy: vec2u, rng: ptr<function, u32>) 
         if front && any(s.emission > vec3f(0.0)) {
             var w = 1.0;
             if last_pdf > 0.0 {
-                let p_light = light_pdf_area(materials[triangles[hit.tri].material].emission) * hit.t * hit.t / cos_in;
+                let p_light = light_pdf_area(materials[triangles[hit.tri].material].material.emission) * hit.t * hit.t / cos_in;
                 w = power_heuristic(last_pdf, p_light);
             }
             radiance += throughput * s.emission * w;
@@ -137,7 +137,7 @@ fn path_radiance(origin: vec3f, dir: vec3f, xy: vec2u, rng: ptr<function, u32>) 
                     let t = triangles[l.tri];
                     let cos_y = -dot(triangle_normal(t), l.dir);
                     let to_solid_angle = l.dist * l.dist / cos_y;
-                    mis = power_heuristic(light_pdf_area(materials[t.material].emission) * to_solid_angle, p_bsdf);
+                    mis = power_heuristic(light_pdf_area(materials[t.material].material.emission) * to_solid_angle, p_bsdf);
                 }
                 radiance += throughput * f * l.e * (abs(wi.z) * mis);
             }

@@ -176,11 +176,11 @@ impl GpuPhotonMap {
         let area_scaled: Vec<f32> = layout.area.iter().map(|&a| (a / h2) as f32).collect();
         let area_buffer =
             gpu.storage_buffer("photon slot areas", bytemuck::cast_slice(&area_scaled), wgpu::BufferUsages::empty());
-        let keys = gpu.storage_buffer(
-            "photon slot keys",
-            bytemuck::cast_slice(&layout.table.keys),
-            wgpu::BufferUsages::empty(),
-        );
+        // The slots' keys, then the separators' (one binding: table.wgsl).
+        let sep = &layout.separators;
+        let all_keys: Vec<[u32; 2]> = layout.table.keys.iter().chain(&sep.table.keys).copied().collect();
+        let keys =
+            gpu.storage_buffer("photon table keys", bytemuck::cast_slice(&all_keys), wgpu::BufferUsages::empty());
         // Never empty: a scene without triangles still binds one entry.
         let planes = if layout.planes.is_empty() {
             vec![TrianglePlane::new(glam::Vec3::ZERO, glam::Vec3::ZERO)]
@@ -188,12 +188,6 @@ impl GpuPhotonMap {
             layout.planes.clone()
         };
         let planes = gpu.storage_buffer("photon planes", bytemuck::cast_slice(&planes), wgpu::BufferUsages::empty());
-        let sep = &layout.separators;
-        let sep_keys = gpu.storage_buffer(
-            "photon separator keys",
-            bytemuck::cast_slice(&sep.table.keys),
-            wgpu::BufferUsages::empty(),
-        );
         let sep_planes =
             gpu.storage_buffer("photon separators", bytemuck::cast_slice(&sep.planes), wgpu::BufferUsages::empty());
         let (sep_mask, sep_max_probe) = (sep.table.capacity() as u32 - 1, sep.table.max_probe);
@@ -221,8 +215,7 @@ impl GpuPhotonMap {
                 storage_entry::<[f32; 4]>(5, c, false),
                 storage_entry::<[u32; 2]>(6, c, true),
                 storage_entry::<TrianglePlane>(7, c, true),
-                storage_entry::<[u32; 2]>(8, c, true),
-                storage_entry::<[Separator; MAX_SEPARATORS]>(9, c, true),
+                storage_entry::<[Separator; MAX_SEPARATORS]>(8, c, true),
             ],
         );
         let channel = |c: u64| {
@@ -245,7 +238,6 @@ impl GpuPhotonMap {
                 slots.as_entire_binding(),
                 keys.as_entire_binding(),
                 planes.as_entire_binding(),
-                sep_keys.as_entire_binding(),
                 sep_planes.as_entire_binding(),
             ],
         );
@@ -285,7 +277,7 @@ impl GpuPhotonMap {
             sep_max_probe,
             indirect_only: settings.indirect_only as u32,
         };
-        let buffers = [&slots, &keys, &planes, &sep_keys, &sep_planes];
+        let buffers = [&slots, &keys, &planes, &sep_planes];
         let (bind_layout, bind_group) = lookup_binding(gpu, &grid_uniforms, buffers);
         Ok(GpuPhotonMap {
             layout,
@@ -403,7 +395,7 @@ impl GpuPhotonMap {
 fn lookup_binding(
     gpu: &Gpu,
     u: &PhotonGridUniforms,
-    [slots, keys, planes, sep_keys, sep_planes]: [&wgpu::Buffer; 5],
+    [slots, keys, planes, sep_planes]: [&wgpu::Buffer; 4],
 ) -> (wgpu::BindGroupLayout, wgpu::BindGroup) {
     let uniforms = gpu.zeroed_buffer(
         "photon grid",
@@ -420,15 +412,10 @@ fn lookup_binding(
             uniform_entry::<PhotonGridUniforms>(1, vis),
             storage_entry::<[u32; 2]>(2, vis, true),
             storage_entry::<TrianglePlane>(3, vis, true),
-            storage_entry::<[u32; 2]>(4, vis, true),
-            storage_entry::<[Separator; MAX_SEPARATORS]>(5, vis, true),
+            storage_entry::<[Separator; MAX_SEPARATORS]>(4, vis, true),
         ],
     );
-    let bind_group = buffer_bind_group(
-        &gpu.device,
-        "photon map lookup",
-        &layout,
-        &[slots, &uniforms, keys, planes, sep_keys, sep_planes],
-    );
+    let bind_group =
+        buffer_bind_group(&gpu.device, "photon map lookup", &layout, &[slots, &uniforms, keys, planes, sep_planes]);
     (layout, bind_group)
 }

@@ -342,7 +342,7 @@ impl MapLayout {
                     && entries.saturating_mul(24) <= limits.max_buffer_size
             };
             let outcome = if fits(estimate) || resolution == 1 {
-                let start = std::time::Instant::now();
+                let start = web_time::Instant::now();
                 let layout = MapLayout::new(scene, &grid);
                 log::info!(
                     "photon map layout: grid {}x{}x{}, {} slots, {} with separators, {:.2} s",

@@ -17,14 +17,14 @@ struct PhotonGrid {
 
 @group(3) @binding(0) var<storage, read> photon_slots: array<vec4f>;
 @group(3) @binding(1) var<uniform> photon_grid: PhotonGrid;
+// The slots' table keys, then the separators' (table.wgsl).
 @group(3) @binding(2) var<storage, read> slot_keys: array<vec2u>;
 @group(3) @binding(3) var<storage, read> planes: array<TrianglePlane>;
-@group(3) @binding(4) var<storage, read> separator_keys: array<vec2u>;
-@group(3) @binding(5) var<storage, read> separator_planes: array<SeparatorRecord>;
+@group(3) @binding(4) var<storage, read> separator_planes: array<SeparatorRecord>;
 
 // p's region among the separators of base slot (cell, key): 0 where it has none.
 fn photon_region(cell: u32, key: u32, p: vec3f) -> u32 {
-    let sep = find_separators(cell, key, photon_grid.sep_mask, photon_grid.sep_max_probe);
+    let sep = find_separators(cell, key, photon_grid.mask + 1u, photon_grid.sep_mask, photon_grid.sep_max_probe);
     if sep == NO_SLOT {
         return 0u;
     }
@@ -56,7 +56,7 @@ fn photon_lookup(p: vec3f, tri: u32, back: bool, twin: u32) -> vec3f {
     // The separators of p's own slot: cells beyond them (across a wall) do not count.
     let home = vec3u(clamp(vec3i(floor((p - origin) / h)), vec3i(0), hi));
     let home_key = plane_key(plane, cell_centre(origin, h, home), h, back);
-    let own = find_separators(grid_cell_index(home), home_key, photon_grid.sep_mask, photon_grid.sep_max_probe);
+    let own = find_separators(grid_cell_index(home), home_key, photon_grid.mask + 1u, photon_grid.sep_mask, photon_grid.sep_max_probe);
     var own_record: SeparatorRecord;
     if own != NO_SLOT {
         own_record = separator_planes[own];

@@ -67,12 +67,13 @@ fn region_of(r: SeparatorRecord, p: vec3f) -> u32 {
     return region;
 }
 
-// The entry of base slot (cell, plane)'s separators in `separator_keys` (bound by the including
-// shader), NO_SLOT where it has none: find_slot over the separators' table.
-fn find_separators(cell: u32, plane: u32, mask: u32, max_probe: u32) -> u32 {
+// The entry of base slot (cell, plane)'s separators, NO_SLOT where it has none: find_slot over
+// the separators' table, which follows the slots' in `slot_keys` (from entry `base`, the
+// slots' capacity: one binding for both, under WebGPU's 10 storage buffers per stage).
+fn find_separators(cell: u32, plane: u32, base: u32, mask: u32, max_probe: u32) -> u32 {
     var i = slot_hash(cell, plane) & mask;
     for (var probe = 0u; probe < max_probe; probe++) {
-        let k = separator_keys[i];
+        let k = slot_keys[base + i];
         if k.x == cell && k.y == plane {
             return i;
         }

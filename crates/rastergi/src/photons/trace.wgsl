@@ -39,10 +39,10 @@ struct PhotonParams {
 @group(1) @binding(4) var<storage, read> slot_area: array<f32>;
 // Per table entry: (Φ_rgb/h², A/h²), what the lookups read (map.wgsl).
 @group(1) @binding(5) var<storage, read_write> slots_out: array<vec4f>;
+// The slots' table keys, then the separators' (table.wgsl).
 @group(1) @binding(6) var<storage, read> slot_keys: array<vec2u>;
 @group(1) @binding(7) var<storage, read> planes: array<TrianglePlane>;
-@group(1) @binding(8) var<storage, read> separator_keys: array<vec2u>;
-@group(1) @binding(9) var<storage, read> separator_planes: array<SeparatorRecord>;
+@group(1) @binding(8) var<storage, read> separator_planes: array<SeparatorRecord>;
 
 // The table entry of a deposit at p on side `back` of triangle tri (MapLayout::deposit_slot).
 // With `twin` = CAUSTIC_CELL, the slot's caustic twin (NO_SLOT where the map has none).
@@ -51,7 +51,7 @@ fn slot_of(p: vec3f, tri: u32, back: bool, twin: u32) -> u32 {
     let cell = (c.z * params.dims.y + c.y) * params.dims.x + c.x;
     let key = plane_key(planes[tri], cell_centre(params.origin, params.cell, c), params.cell, back);
     var region = 0u;
-    let sep = find_separators(cell, key, params.sep_mask, params.sep_max_probe);
+    let sep = find_separators(cell, key, params.mask + 1u, params.sep_mask, params.sep_max_probe);
     if sep != NO_SLOT {
         region = region_of(separator_planes[sep], p);
     }

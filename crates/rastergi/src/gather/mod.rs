@@ -45,7 +45,9 @@ pub mod raster;
 pub mod ray_view;
 pub mod trace;
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
+
+use web_time::Instant;
 
 use glam::{Vec2, Vec3};
 
@@ -132,6 +134,12 @@ pub const AUTO_TRIALS: u32 = 3;
 /// [`DROP_SLOWER`] times as slow as the fastest are dropped after their first run).
 pub const AUTO_ITERATIONS: u32 = CANDIDATES.len() as u32 * AUTO_TRIALS;
 
+/// Storage buffers that the raster gathers' projection passes bind in their compute stage
+/// (the scene, the visible points, the film, the photon map, and the ray view's layers or
+/// lists): more than the 10 that browsers' WebGPU grants, where only the traced gather runs.
+/// The layout test counts them.
+pub const RASTER_STORAGE_BUFFERS: u32 = 12;
+
 /// Builds the implementation `method` (not `Auto`) for a `bundle`² ray view, reading the
 /// gather's `uniforms`.
 fn build(
@@ -141,6 +149,12 @@ fn build(
     uniforms: &wgpu::Buffer,
     bundle: u32,
 ) -> Result<Box<dyn Gather>> {
+    let allowed = gpu.device.limits().max_storage_buffers_per_shader_stage;
+    if matches!(method, GatherMethod::Raster | GatherMethod::Lists) && allowed < RASTER_STORAGE_BUFFERS {
+        return Err(crate::Error::Limits(format!(
+            "the {method:?} gather binds {RASTER_STORAGE_BUFFERS} storage buffers in one shader stage and this GPU allows {allowed} (a web browser's WebGPU allows 8 or 10); use the trace gather"
+        )));
+    }
     Ok(match method {
         GatherMethod::Raster => Box::new(raster::RasterGather::new(gpu, setup, uniforms, bundle)?),
         GatherMethod::Lists => Box::new(lists::ListGather::new(gpu, setup, uniforms, bundle)?),
@@ -372,6 +386,13 @@ impl GatherPass {
         directions: GatherDirections,
         sampler: DirectionSampler,
     ) -> Result<GatherPass> {
+        // Both read back from the GPU within an iteration (the peel's layer count, the trials'
+        // timings), which a web page cannot wait for.
+        if cfg!(target_arch = "wasm32") && matches!(method, GatherMethod::Auto | GatherMethod::Raster) {
+            return Err(crate::Error::Gpu(format!(
+                "the {method:?} gather reads back from the GPU within an iteration, which a web page cannot wait for; choose the lists or trace gather"
+            )));
+        }
         let uniforms = gpu.zeroed_buffer(
             "gather uniforms",
             std::mem::size_of::<GatherUniforms>() as u64,

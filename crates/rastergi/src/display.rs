@@ -248,7 +248,15 @@ impl WindowSurface {
             .create_surface(window)
             .map_err(|e| Error::Gpu(format!("cannot create a surface for the window: {e}")))?;
         let gpu = Gpu::open(&instance, options, Some(&surface))?;
+        let window = WindowSurface::new(&gpu, surface, width, height)?;
+        Ok((gpu, window))
+    }
 
+    /// Configures `surface` (of a window, or a web page's canvas: `SurfaceTarget::Canvas`)
+    /// for `gpu`, opened for it ([`Gpu::open_async`] with the surface), at `width × height`
+    /// (at least 1×1): a plain 8-bit format where the surface offers one (the shader encodes
+    /// sRGB itself, [`needs_decode`]).
+    pub fn new(gpu: &Gpu, surface: wgpu::Surface<'static>, width: u32, height: u32) -> Result<WindowSurface> {
         let caps = surface.get_capabilities(&gpu.adapter);
         use wgpu::TextureFormat as F;
         let format = caps
@@ -270,9 +278,9 @@ impl WindowSurface {
             view_formats: vec![],
         };
         surface.configure(&gpu.device, &config);
-        let pass = DisplayPass::new(&gpu, format);
+        let pass = DisplayPass::new(gpu, format);
         log::info!("window surface format {format:?} (shader sRGB decode: {})", needs_decode(format));
-        Ok((gpu, WindowSurface { surface, config, pass }))
+        Ok(WindowSurface { surface, config, pass })
     }
 
     pub fn format(&self) -> wgpu::TextureFormat {

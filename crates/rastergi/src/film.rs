@@ -205,23 +205,28 @@ impl Film {
     /// The sums and their odd half, read back (for checkpoints, merging and the error
     /// estimate).
     pub fn read_state(&self, gpu: &Gpu) -> Result<FilmState> {
+        crate::gpu::block_on(self.read_state_async(gpu))
+    }
+
+    /// [`read_state`](Self::read_state) as a future (a web page's error estimate): of the
+    /// film as it is now (the copies are submitted at once; the future borrows nothing).
+    pub fn read_state_async(&self, gpu: &Gpu) -> impl std::future::Future<Output = Result<FilmState>> + 'static {
         let floats = |bytes: Vec<u8>| bytemuck::cast_slice::<u8, f32>(&bytes).to_vec();
         let n = (COMPONENTS * self.width as u64 * self.height as u64 * 16) as usize;
-        let sums = floats(gpu.read_buffer(&self.accumulation, self.accumulation.size())?[..n].to_vec());
-        let mut half = floats(gpu.read_buffer(&self.half, self.half.size())?[..n].to_vec());
-        if self.half_open {
-            for (h, s) in half.iter_mut().zip(&sums) {
-                *h += s;
+        let sums = gpu.read_buffer_async(&self.accumulation, self.accumulation.size());
+        let half = gpu.read_buffer_async(&self.half, self.half.size());
+        let (width, height, samples, half_samples, half_open) =
+            (self.width, self.height, self.samples, self.half_samples, self.half_open);
+        async move {
+            let sums = floats(sums.await?[..n].to_vec());
+            let mut half = floats(half.await?[..n].to_vec());
+            if half_open {
+                for (h, s) in half.iter_mut().zip(&sums) {
+                    *h += s;
+                }
             }
+            Ok(FilmState { width, height, samples, half_samples, sums, half })
         }
-        Ok(FilmState {
-            width: self.width,
-            height: self.height,
-            samples: self.samples,
-            half_samples: self.half_samples,
-            sums,
-            half,
-        })
     }
 
     /// Puts `state`'s sums back (a resumed render). The next odd block opens afresh.
@@ -291,12 +296,26 @@ impl Film {
 
     /// The display encoding of `show`: 2^exposure · mean, clamped to [0,1], sRGB, 8 bits.
     pub fn read_display(&self, gpu: &Gpu, show: Show, exposure: f32) -> Result<DisplayImage> {
+        crate::gpu::block_on(self.read_display_async(gpu, show, exposure))
+    }
+
+    /// [`read_display`](Self::read_display) as a future (a web page's "save PNG"), of the film
+    /// as it is now.
+    pub fn read_display_async(
+        &self,
+        gpu: &Gpu,
+        show: Show,
+        exposure: f32,
+    ) -> impl std::future::Future<Output = Result<DisplayImage>> + 'static {
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         self.encode_resolve(gpu, &mut enc, show, exposure);
         gpu.queue.submit([enc.finish()]);
-        let bytes = gpu.read_buffer(&self.display, self.display.size())?;
-        let n = (self.width * self.height) as usize * 4;
-        Ok(DisplayImage { width: self.width, height: self.height, rgba: bytes[..n].to_vec() })
+        let bytes = gpu.read_buffer_async(&self.display, self.display.size());
+        let (width, height) = (self.width, self.height);
+        async move {
+            let n = (width * height) as usize * 4;
+            Ok(DisplayImage { width, height, rgba: bytes.await?[..n].to_vec() })
+        }
     }
 }
 

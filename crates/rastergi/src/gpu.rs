@@ -222,23 +222,42 @@ impl Gpu {
     }
 
     /// Copies `size` bytes from the start of `buffer` (which needs COPY_SRC) back to the CPU.
+    /// Blocks until the GPU has finished: natively only; a web page awaits
+    /// [`read_buffer_async`](Self::read_buffer_async) (see [`block_on`]).
     pub fn read_buffer(&self, buffer: &wgpu::Buffer, size: u64) -> Result<Vec<u8>> {
+        block_on(self.read_buffer_async(buffer, size))
+    }
+
+    /// [`read_buffer`](Self::read_buffer) as a future. The copy is submitted at once (the
+    /// future holds no borrow: it reads the buffer as it is now). Natively the future waits for
+    /// the GPU in `device.poll`; in a browser `map_async` answers only once control has
+    /// returned to the event loop, so the future is pending until then.
+    pub fn read_buffer_async(
+        &self,
+        buffer: &wgpu::Buffer,
+        size: u64,
+    ) -> impl std::future::Future<Output = Result<Vec<u8>>> + 'static {
         let staging = self.zeroed_buffer("readback", size, wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST);
         let mut enc = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback") });
         enc.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
         self.queue.submit([enc.finish()]);
-        let (tx, rx) = std::sync::mpsc::channel();
+        let (tx, rx) = futures_channel::oneshot::channel();
         staging.map_async(wgpu::MapMode::Read, ..size, move |r| {
             let _ = tx.send(r);
         });
-        self.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| Error::Gpu(e.to_string()))?;
-        self.check()?;
-        rx.recv()
-            .map_err(|e| Error::Gpu(e.to_string()))?
-            .map_err(|e| Error::Gpu(format!("mapping a readback buffer failed: {e}")))?;
-        let data = staging.get_mapped_range(..size).map_err(|e| Error::Gpu(e.to_string()))?.to_vec();
-        staging.unmap();
-        Ok(data)
+        let gpu = self.clone();
+        async move {
+            // A no-op on WebGPU, where the browser maps the buffer on its own.
+            gpu.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| Error::Gpu(e.to_string()))?;
+            let mapped = rx.await;
+            gpu.check()?;
+            mapped
+                .map_err(|_| Error::Gpu("the GPU dropped a read-back before it finished".into()))?
+                .map_err(|e| Error::Gpu(format!("mapping a readback buffer failed: {e}")))?;
+            let data = staging.get_mapped_range(..size).map_err(|e| Error::Gpu(e.to_string()))?.to_vec();
+            staging.unmap();
+            Ok(data)
+        }
     }
 
     /// Copies every texel of mip level 0 of `texture` (which needs COPY_SRC) back to the CPU:
@@ -271,7 +290,8 @@ impl Gpu {
         Ok(bytes.chunks(row as usize).take(rows as usize).flat_map(|r| &r[..tight]).copied().collect())
     }
 
-    /// Blocks until all submitted work has finished.
+    /// Blocks until all submitted work has finished. In a browser, where nothing can block,
+    /// it returns at once (the browser orders the work; read-backs are awaited).
     pub fn wait(&self) -> Result<()> {
         self.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| Error::Gpu(e.to_string()))?;
         self.check()
@@ -289,6 +309,28 @@ impl Gpu {
         match &f.error {
             Some(message) => Err(Error::Gpu(message.clone())),
             None => Ok(()),
+        }
+    }
+}
+
+/// Runs a read-back's future to its end. Natively it blocks (the future waits for the GPU in
+/// `device.poll`). A browser cannot block: there the answer arrives only after control returns
+/// to its event loop, so a future that is not ready at once is an error that names the
+/// asynchronous twin to await instead.
+pub fn block_on<T>(future: impl std::future::Future<Output = Result<T>>) -> Result<T> {
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        pollster::block_on(future)
+    }
+    #[cfg(target_arch = "wasm32")]
+    {
+        let mut future = std::pin::pin!(future);
+        let mut cx = std::task::Context::from_waker(std::task::Waker::noop());
+        match future.as_mut().poll(&mut cx) {
+            std::task::Poll::Ready(r) => r,
+            std::task::Poll::Pending => Err(Error::Gpu(
+                "a read-back from the GPU cannot block in a web page; await its asynchronous twin (read_buffer_async, read_state_async, read_display_async)".into(),
+            )),
         }
     }
 }

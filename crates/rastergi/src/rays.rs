@@ -331,7 +331,7 @@ impl RayCaster {
         let (gx, gy) = (wg.min(65535), wg.div_ceil(65535));
         let mut times = Vec::new();
         for run in 0..=repeats {
-            let start = std::time::Instant::now();
+            let start = web_time::Instant::now();
             let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("rays") });
             {
                 let mut pass = enc

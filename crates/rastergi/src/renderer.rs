@@ -225,7 +225,7 @@ impl Renderer {
                 crate::limits::check_bundle(&limits, settings.bundle_for(detail_bundle))?;
             }
         }
-        let start = std::time::Instant::now();
+        let start = web_time::Instant::now();
         let prepared = PreparedScene::new(scene);
         log::info!(
             "BVH over {} triangles: {} nodes, depth {}, built in {:.2} s",

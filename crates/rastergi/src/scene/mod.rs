@@ -10,6 +10,7 @@
 
 mod cornell;
 pub mod export;
+pub mod files;
 pub mod generate;
 mod gltf;
 mod obj;
@@ -17,8 +18,9 @@ mod tangents;
 mod texture;
 
 pub use cornell::cornell_box;
-pub use gltf::{GltfOptions, load_gltf, load_gltf_with};
-pub use obj::load_obj;
+pub use files::{Files, MemoryFiles};
+pub use gltf::{GltfOptions, load_gltf, load_gltf_in, load_gltf_with};
+pub use obj::{load_obj, load_obj_in};
 pub use tangents::mikktspace;
 pub use texture::{MAX_DECODED_SIDE, Texture};
 

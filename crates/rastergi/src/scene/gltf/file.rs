@@ -134,7 +134,7 @@ pub(super) fn percent_decode(uri: &str) -> String {
 }
 
 /// The bytes a URI names: a base64 `data:` URI, or a file relative to the glTF file.
-pub(super) fn read_uri(dir: &Path, uri: &str) -> Res<Vec<u8>> {
+pub(super) fn read_uri(files: Files, dir: &Path, uri: &str) -> Res<Vec<u8>> {
     if let Some(data) = uri.strip_prefix("data:") {
         let (header, payload) = data.split_once(',').ok_or("a data: URI without ','")?;
         if !header.ends_with(";base64") {
@@ -152,13 +152,13 @@ pub(super) fn read_uri(dir: &Path, uri: &str) -> Res<Vec<u8>> {
     }
     let file: PathBuf = dir.join(percent_decode(uri));
     // A device or a pipe (`/dev/zero`) would be read forever.
-    if file.exists() && !file.is_file() {
+    if files.is_special(&file) {
         return Err(format!("{} is not a regular file", file.display()));
     }
-    std::fs::read(&file).map_err(|e| format!("{} cannot be read ({e})", file.display()))
+    files.read(&file).map_err(|e| format!("{} cannot be read ({e})", file.display()))
 }
 
-pub(super) fn load_buffer(dir: &Path, buffer: &::gltf::Buffer, bin: Option<&[u8]>) -> Res<Vec<u8>> {
+pub(super) fn load_buffer(files: Files, dir: &Path, buffer: &::gltf::Buffer, bin: Option<&[u8]>) -> Res<Vec<u8>> {
     let name = |b: &::gltf::Buffer| match b.name() {
         Some(n) => format!("buffer {} ('{n}')", b.index()),
         None => format!("buffer {}", b.index()),
@@ -168,7 +168,7 @@ pub(super) fn load_buffer(dir: &Path, buffer: &::gltf::Buffer, bin: Option<&[u8]
             Some(bin) if buffer.index() == 0 => bin.to_vec(),
             _ => return Err(format!("{} has no uri and there is no .glb binary chunk for it", name(buffer))),
         },
-        ::gltf::buffer::Source::Uri(uri) => read_uri(dir, uri).map_err(|e| format!("{}: {e}", name(buffer)))?,
+        ::gltf::buffer::Source::Uri(uri) => read_uri(files, dir, uri).map_err(|e| format!("{}: {e}", name(buffer)))?,
     };
     if (data.len() as u64) < buffer.length() as u64 {
         return Err(format!("{} holds {} bytes but its byteLength is {}", name(buffer), data.len(), buffer.length()));

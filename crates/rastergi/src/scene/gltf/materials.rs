@@ -171,7 +171,9 @@ impl Loader<'_> {
                 let end = range.ok_or_else(|| format!("{what}: its bufferView runs past the end of its buffer"))?;
                 buffer[view.offset()..end].to_vec()
             }
-            ::gltf::image::Source::Uri { uri, .. } => read_uri(&self.dir, uri).map_err(|e| format!("{what}: {e}"))?,
+            ::gltf::image::Source::Uri { uri, .. } => {
+                read_uri(self.files, &self.dir, uri).map_err(|e| format!("{what}: {e}"))?
+            }
         };
         let name = image.name().map_or_else(|| format!("image {}", image.index()), str::to_owned);
         let decoded = Texture::decode(&name, &bytes).map_err(|e| format!("{what} {e}"))?;

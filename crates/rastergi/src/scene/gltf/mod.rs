@@ -71,7 +71,7 @@ use ::gltf::{Document, Semantic};
 use base64::Engine as _;
 use glam::{Mat4, Quat, Vec2, Vec3, Vec4};
 
-use super::{AlphaMode, Camera, Light, Material, Scene, Texture, TextureRef, UvTransform};
+use super::{AlphaMode, Camera, Files, Light, Material, Scene, Texture, TextureRef, UvTransform};
 use crate::error::{Error, Result};
 
 use file::{check_before_validation, describe_gltf_error, load_buffer, read_uri, split_glb};
@@ -113,18 +113,22 @@ pub fn load_gltf(path: &Path) -> Result<Scene> {
 
 /// Loads a `.gltf` or `.glb` file.
 pub fn load_gltf_with(path: &Path, options: &GltfOptions) -> Result<Scene> {
-    if !path.is_file() {
-        let what = if path.exists() { "is not a file" } else { "no such file" };
+    load_gltf_in(Files::Disk, path, options)
+}
+
+/// Loads the `.gltf` or `.glb` file at `path` of `files` (its buffers and images too).
+pub fn load_gltf_in(files: Files, path: &Path, options: &GltfOptions) -> Result<Scene> {
+    if let Some(what) = files.missing(path) {
         return Err(file_error(path, format!("{what}; give the path of a .gltf or .glb file")));
     }
-    let bytes = std::fs::read(path).map_err(|e| file_error(path, format!("cannot be read: {e}")))?;
-    load(path, &bytes, options).map_err(|message| file_error(path, message))
+    let bytes = files.read(path).map_err(|e| file_error(path, format!("cannot be read: {e}")))?;
+    load(files, path, &bytes, options).map_err(|message| file_error(path, message))
 }
 
 /// Everything wrong with a file is a message; `load_gltf_with` prefixes the file's name.
 type Res<T> = std::result::Result<T, String>;
 
-fn load(path: &Path, bytes: &[u8], options: &GltfOptions) -> Res<Scene> {
+fn load(files: Files, path: &Path, bytes: &[u8], options: &GltfOptions) -> Res<Scene> {
     let (json, bin) = if bytes.starts_with(b"glTF") { split_glb(bytes)? } else { (bytes, None) };
     let root = ::gltf::json::Root::from_slice(json).map_err(|e| format!("not valid glTF JSON ({e})"))?;
     check_before_validation(&root)?;
@@ -138,8 +142,9 @@ fn load(path: &Path, bytes: &[u8], options: &GltfOptions) -> Res<Scene> {
         log::warn!("{}: uses the glTF extension {ext}, which rastergi ignores", path.display());
     }
     let dir = path.parent().unwrap_or(Path::new("")).to_path_buf();
-    let buffers = document.buffers().map(|b| load_buffer(&dir, &b, bin)).collect::<Res<Vec<Vec<u8>>>>()?;
+    let buffers = document.buffers().map(|b| load_buffer(files, &dir, &b, bin)).collect::<Res<Vec<Vec<u8>>>>()?;
     let mut loader = Loader {
+        files,
         dir,
         document: &document,
         buffers,
@@ -168,6 +173,7 @@ fn placeholder_camera() -> Camera {
 }
 
 struct Loader<'a> {
+    files: Files<'a>,
     dir: PathBuf,
     document: &'a Document,
     buffers: Vec<Vec<u8>>,

@@ -40,7 +40,7 @@ use std::path::{Path, PathBuf};
 
 use glam::{Vec2, Vec3};
 
-use super::{Material, Scene, Texture, TextureRef, UvTransform};
+use super::{Files, Material, Scene, Texture, TextureRef, UvTransform};
 use crate::error::{Error, Result};
 
 mod mtl;
@@ -54,18 +54,22 @@ fn file_error(path: &Path, message: impl Into<String>) -> Error {
 
 /// Loads an OBJ file (and the MTL libraries it names) as a scene.
 pub fn load_obj(path: &Path) -> Result<Scene> {
-    if !path.is_file() {
-        let what = if path.exists() { "is not a file" } else { "no such file" };
+    load_obj_in(Files::Disk, path)
+}
+
+/// Loads the OBJ file at `path` of `files` (its MTL libraries and textures too).
+pub fn load_obj_in(files: Files, path: &Path) -> Result<Scene> {
+    if let Some(what) = files.missing(path) {
         return Err(file_error(
             path,
             format!("{what}; give the path of a .obj file or the built-in scene name 'cornell'"),
         ));
     }
-    let mut text = std::fs::read(path).map_err(|e| file_error(path, format!("cannot be read: {e}")))?;
+    let mut text = text_of(files, path)?;
     comment_out_texcoords_and_normals(&mut text);
     let options =
         tobj::LoadOptions { triangulate: true, ignore_points: true, ignore_lines: true, ..Default::default() };
-    let (mut models, materials) = load_obj_text(path, &text, &options)?;
+    let (mut models, materials) = load_obj_text(files, path, &text, &options)?;
     if models.iter().any(|m| m.mesh.positions.iter().any(|c| !c.is_finite())) {
         let (line, word) = first_non_finite_vertex(&text).unwrap_or((0, "?".into()));
         return Err(file_error(
@@ -76,7 +80,7 @@ pub fn load_obj(path: &Path) -> Result<Scene> {
         ));
     }
     let textured = materials.iter().any(|m| TEXTURE_KEYS.iter().any(|&key| map_file(m, key).is_some()));
-    let mut text = text_of(path)?;
+    let mut text = text_of(files, path)?;
     // Normals that faces refer to out of range are not used (the faces shade flat).
     let mut smooth = has_keyword(&text, b"vn")
         && check_references(&text, "vn", 2, "normal")
@@ -102,7 +106,7 @@ pub fn load_obj(path: &Path) -> Result<Scene> {
         if textured {
             check_references(&text, "vt", 1, "texture coordinate").map_err(|message| file_error(path, message))?;
         }
-        models = load_obj_text(path, &text, &tobj::LoadOptions { single_index: true, ..options })?.0;
+        models = load_obj_text(files, path, &text, &tobj::LoadOptions { single_index: true, ..options })?.0;
     }
 
     let mut scene = Scene::new(super::Camera { eye: Vec3::Z, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 45.0 });
@@ -123,7 +127,7 @@ pub fn load_obj(path: &Path) -> Result<Scene> {
             {
                 return Ok(Some(TextureRef { texture: t, transform }));
             }
-            let mut texture = read_texture(&file).map_err(|e| {
+            let mut texture = read_texture(files, &file).map_err(|e| {
                 file_error(path, format!("the texture {} ({key} of material '{}') {e}", file.display(), m.name))
             })?;
             if opacity && !texture.has_alpha() {
@@ -244,15 +248,18 @@ pub fn load_obj(path: &Path) -> Result<Scene> {
 }
 
 /// Reads a `map_Kd` image; a device or a pipe (`map_Kd /dev/zero`) would be read forever.
-fn read_texture(file: &Path) -> std::result::Result<Texture, String> {
-    if file.exists() && !file.is_file() {
+fn read_texture(files: Files, file: &Path) -> std::result::Result<Texture, String> {
+    if files.is_special(file) {
         return Err("is not a regular file".into());
     }
-    Texture::read(file)
+    let bytes = files.read(file).map_err(|e| format!("cannot be read ({e})"))?;
+    let name = file.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    Texture::decode(&name, &bytes)
 }
 
 /// Parses OBJ text with tobj, loading its MTL libraries relative to `path`.
 fn load_obj_text(
+    files: Files,
     path: &Path,
     text: &[u8],
     options: &tobj::LoadOptions,
@@ -260,7 +267,7 @@ fn load_obj_text(
     // tobj keeps only the last MTL error, and none at all once one library loaded; the first
     // failure, with the library's path, is kept here.
     let mtl_error = RefCell::new(None);
-    let (models, materials) = tobj::load_obj_buf(&mut &text[..], options, |mtl| load_mtl(path, mtl, &mtl_error))
+    let (models, materials) = tobj::load_obj_buf(&mut &text[..], options, |mtl| load_mtl(files, path, mtl, &mtl_error))
         .map_err(|e| file_error(path, obj_error_message(e, text)))?;
     let mtl_failure = mtl_error.into_inner().or_else(|| materials.as_ref().err().map(|e| e.to_string()));
     if let Some(message) = mtl_failure {
@@ -271,8 +278,8 @@ fn load_obj_text(
 }
 
 /// The file's bytes.
-fn text_of(path: &Path) -> Result<Vec<u8>> {
-    std::fs::read(path).map_err(|e| file_error(path, format!("cannot be read: {e}")))
+fn text_of(files: Files, path: &Path) -> Result<Vec<u8>> {
+    files.read(path).map_err(|e| file_error(path, format!("cannot be read: {e}")))
 }
 
 /// The first word of a line.

@@ -183,7 +183,7 @@ pub(super) fn texture_statement(key: &str, value: &str) -> std::result::Result<(
 /// Loads the MTL library `name`, found relative to the OBJ file `obj` as tobj does. MTL lets
 /// a colour be one number (`Kd 0.5` means `Kd 0.5 0.5 0.5`) but tobj panics on fewer than
 /// three: such lines are completed here first. The first failure is recorded in `error`.
-pub(super) fn load_mtl(obj: &Path, name: &Path, error: &RefCell<Option<String>>) -> tobj::MTLLoadResult {
+pub(super) fn load_mtl(files: Files, obj: &Path, name: &Path, error: &RefCell<Option<String>>) -> tobj::MTLLoadResult {
     let mtl_path = obj.parent().unwrap_or(Path::new("")).join(name);
     let fail = |message: String, e: tobj::LoadError| {
         error.borrow_mut().get_or_insert(format!("{}: {message}", mtl_path.display()));
@@ -194,10 +194,10 @@ pub(super) fn load_mtl(obj: &Path, name: &Path, error: &RefCell<Option<String>>)
         return Err(tobj::LoadError::OpenFileFailed);
     }
     // A device or a pipe (`mtllib /dev/zero`) would be read forever.
-    if mtl_path.exists() && !mtl_path.is_file() {
+    if files.is_special(&mtl_path) {
         return fail("is not a regular file".into(), tobj::LoadError::OpenFileFailed);
     }
-    let text = match std::fs::read_to_string(&mtl_path) {
+    let text = match files.read_to_string(&mtl_path) {
         Ok(text) => text,
         Err(e) => return fail(e.to_string(), tobj::LoadError::OpenFileFailed),
     };

@@ -9,4 +9,5 @@ pub mod compare;
 pub mod export;
 pub mod merge;
 pub mod render;
+pub mod serve;
 pub mod view;

@@ -4,7 +4,7 @@
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use rastergi_cli::{args, bench, compare, export, merge, render, view};
+use rastergi_cli::{args, bench, compare, export, merge, render, serve, view};
 
 #[derive(Parser)]
 #[command(
@@ -39,6 +39,8 @@ enum Command {
     /// Open a window that shows the image converging; fly or orbit through the scene.
     #[command(after_help = view::AFTER_HELP)]
     View(view::ViewArgs),
+    /// Serve the web page (web/, built by scripts/web-build.sh) on localhost for a browser with WebGPU.
+    Serve(serve::ServeArgs),
 }
 
 /// Mesa's Vulkan drivers probe Wayland when they start and, where `XDG_RUNTIME_DIR` is unset
@@ -81,6 +83,7 @@ fn main() -> ExitCode {
         Command::Compare(args) => ok(compare::run(&args)),
         Command::Export(args) => ok(export::run(&args)),
         Command::View(args) => ok(view::run(&args)),
+        Command::Serve(args) => ok(serve::run(&args)),
     };
     match result {
         Ok(code) => code,

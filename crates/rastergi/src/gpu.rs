@@ -12,7 +12,16 @@ pub struct GpuOptions {
     pub backends: Option<wgpu::Backends>,
     /// Time every pass with GPU timestamps ([`crate::profile`]), where the adapter can.
     pub profile: bool,
+    /// Open the device with at most this many storage buffers per shader stage (the
+    /// adapter's own limit where it is lower): [`WEB_STORAGE_BUFFERS`] gives a native device a
+    /// browser's limit, so that tests check what a web page can run.
+    pub max_storage_buffers: Option<u32>,
 }
+
+/// The most storage buffers per shader stage that browsers' WebGPU grants (Chrome's adapters
+/// and SwiftShader report 10; the WebGPU default is 8). WebGPU counts every storage binding of
+/// a pipeline layout's bind groups that is visible to the stage, used by the shader or not.
+pub const WEB_STORAGE_BUFFERS: u32 = 10;
 
 /// Re-exported so front ends need no direct wgpu dependency.
 pub use wgpu::Backends;
@@ -110,7 +119,10 @@ impl Gpu {
             Error::NoAdapter(format!("{what} for backends {backends:?}"))
         })?;
         let info = adapter.get_info();
-        let limits = adapter.limits();
+        let mut limits = adapter.limits();
+        if let Some(n) = options.max_storage_buffers {
+            limits.max_storage_buffers_per_shader_stage = limits.max_storage_buffers_per_shader_stage.min(n);
+        }
         let timestamps = wgpu::Features::TIMESTAMP_QUERY;
         let required_features = if options.profile { adapter.features() & timestamps } else { wgpu::Features::empty() };
         if options.profile && required_features.is_empty() {

@@ -65,3 +65,69 @@ fn a_photon_grid_or_bundle_beyond_the_device_is_refused_with_the_option_to_chang
     println!("{e}");
     assert!(e.contains("--bundle"), "{e}");
 }
+
+/// A browser's WebGPU grants 10 storage buffers per shader stage (counted over a pipeline
+/// layout's bind groups, used by the shader or not), where lavapipe allows far more. On a
+/// device opened with that limit, everything a web page runs must build and give the image
+/// the full device gives (the same shaders: bit for bit): the photon map with the traced
+/// gather, the photon view, the caustics and the specular chains (a glass sphere), the
+/// denoiser's guides, and the path tracer. The raster gathers, which bind more, are refused in
+/// one line.
+#[test]
+fn what_a_web_page_runs_fits_a_browsers_storage_buffer_limit() {
+    use rastergi::film::Show;
+    use rastergi::gather::GatherMethod;
+    use rastergi::gpu::{Gpu, GpuOptions, WEB_STORAGE_BUFFERS};
+    let full = common::gpu();
+    let web =
+        Gpu::new(&GpuOptions { max_storage_buffers: Some(WEB_STORAGE_BUFFERS), ..GpuOptions::default() }).unwrap();
+    assert_eq!(web.device.limits().max_storage_buffers_per_shader_stage, WEB_STORAGE_BUFFERS);
+    let glass = rastergi::scene::load_obj(&common::data("obj/mat_glass.obj")).unwrap();
+    let s = RenderSettings {
+        gather: GatherMethod::Trace,
+        show_photon_map: true,
+        photon_passes: 2,
+        pass_iterations: 2,
+        ..settings()
+    };
+    for (name, scene) in [("cornell", cornell_box()), ("glass sphere", glass)] {
+        let images = [&full, &web].map(|gpu| {
+            let mut r = Renderer::new(gpu, &scene, s.clone()).unwrap();
+            r.enable_denoiser().unwrap();
+            for _ in 0..4 {
+                r.iterate().unwrap();
+            }
+            let image = r.read_linear(Show::Full).unwrap();
+            let photon_view = r.read_linear(Show::PhotonMap).unwrap();
+            let denoised = r.read_denoised(&Default::default()).unwrap();
+            let mut pt = PathTracer::new(gpu, &scene, s.clone()).unwrap();
+            for _ in 0..2 {
+                pt.iterate();
+            }
+            let path = pt.read_linear().unwrap();
+            gpu.check().unwrap();
+            [image, photon_view, denoised, path]
+        });
+        for (k, what) in ["image", "photon view", "denoised image", "path tracer"].iter().enumerate() {
+            assert_eq!(images[0][k].pixels, images[1][k].pixels, "{name}: the {what} differs on the limited device");
+        }
+        assert!(images[1][0].pixels.iter().flatten().any(|&v| v > 0.0), "{name}: a black image");
+    }
+    // The raster gathers bind RASTER_STORAGE_BUFFERS: a device with that many builds and runs
+    // them, one with fewer refuses them before a pipeline fails.
+    let n = rastergi::gather::RASTER_STORAGE_BUFFERS;
+    let enough = Gpu::new(&GpuOptions { max_storage_buffers: Some(n), ..GpuOptions::default() }).unwrap();
+    let fewer = Gpu::new(&GpuOptions { max_storage_buffers: Some(n - 1), ..GpuOptions::default() }).unwrap();
+    for method in [GatherMethod::Raster, GatherMethod::Lists] {
+        let mut r = Renderer::new(&enough, &cornell_box(), RenderSettings { gather: method, ..settings() }).unwrap();
+        r.iterate().unwrap();
+        r.wait().unwrap();
+        enough.check().unwrap();
+        let e = Renderer::new(&fewer, &cornell_box(), RenderSettings { gather: method, ..settings() })
+            .err()
+            .expect("the raster gather was built on a device that cannot bind it")
+            .to_string();
+        println!("{e}");
+        assert!(e.contains("storage buffers") && e.contains("trace gather"), "{e}");
+    }
+}

@@ -137,7 +137,7 @@ pub const AUTO_ITERATIONS: u32 = CANDIDATES.len() as u32 * AUTO_TRIALS;
 /// Storage buffers that the raster gathers' projection passes bind in their compute stage
 /// (the scene, the visible points, the film, the photon map, and the ray view's layers or
 /// lists): more than the 10 that browsers' WebGPU grants, where only the traced gather runs.
-/// The layout test counts them.
+/// `tests/limits.rs` runs them on a device that allows exactly this many.
 pub const RASTER_STORAGE_BUFFERS: u32 = 12;
 
 /// Builds the implementation `method` (not `Auto`) for a `bundle`² ray view, reading the

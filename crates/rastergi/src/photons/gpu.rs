@@ -20,7 +20,7 @@ use glam::UVec3;
 use super::map::{GridSpec, MAX_SEPARATORS, MapLayout, PhotonMap, Separator, TABLE_WGSL, TrianglePlane};
 use super::{MAX_BOUNCES, PhotonSettings};
 use crate::error::Result;
-use crate::gpu::{Gpu, bind_group, bind_group_layout, buffer_bind_group, storage_entry, uniform_entry};
+use crate::gpu::{Gpu, bind_group_layout, buffer_bind_group, storage_entry, uniform_entry};
 use crate::gpu_scene::{GpuScene, PreparedScene};
 use crate::profile::compute_pass;
 use crate::shader;
@@ -107,7 +107,9 @@ pub struct GpuPhotonMap {
 
 struct Build {
     tally: wgpu::Buffer,
+    /// The trace's and the resolve's bindings (group 1).
     trace_group: wgpu::BindGroup,
+    resolve_group: wgpu::BindGroup,
 }
 
 impl GpuPhotonMap {
@@ -202,22 +204,10 @@ impl GpuPhotonMap {
             wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         );
 
+        // Two bind groups over the shader's bindings, each with what its entry point reads:
+        // with the scene's, one group of all of them would bind 12 storage buffers, beyond a
+        // browser's 10 per stage.
         let c = wgpu::ShaderStages::COMPUTE;
-        let trace_layout = bind_group_layout(
-            device,
-            "photon trace",
-            &[
-                uniform_entry::<PhotonParams>(0, c),
-                storage_entry::<u32>(1, c, false),
-                storage_entry::<u32>(2, c, false),
-                storage_entry::<u32>(3, c, false),
-                storage_entry::<f32>(4, c, true),
-                storage_entry::<[f32; 4]>(5, c, false),
-                storage_entry::<[u32; 2]>(6, c, true),
-                storage_entry::<TrianglePlane>(7, c, true),
-                storage_entry::<[Separator; MAX_SEPARATORS]>(8, c, true),
-            ],
-        );
         let channel = |c: u64| {
             wgpu::BindingResource::Buffer(wgpu::BufferBinding {
                 buffer: &tally,
@@ -225,26 +215,48 @@ impl GpuPhotonMap {
                 size: std::num::NonZeroU64::new(channel_bytes),
             })
         };
-        let trace_group = bind_group(
-            device,
-            "photon trace",
-            &trace_layout,
-            &[
-                params_buffer.as_entire_binding(),
-                channel(0),
-                channel(1),
-                channel(2),
-                area_buffer.as_entire_binding(),
-                slots.as_entire_binding(),
-                keys.as_entire_binding(),
-                planes.as_entire_binding(),
-                sep_planes.as_entire_binding(),
-            ],
-        );
+        let counters = [
+            (uniform_entry::<PhotonParams>(0, c), params_buffer.as_entire_binding()),
+            (storage_entry::<u32>(1, c, false), channel(0)),
+            (storage_entry::<u32>(2, c, false), channel(1)),
+            (storage_entry::<u32>(3, c, false), channel(2)),
+        ];
+        let trace_only = [
+            (storage_entry::<[u32; 2]>(6, c, true), keys.as_entire_binding()),
+            (storage_entry::<TrianglePlane>(7, c, true), planes.as_entire_binding()),
+            (storage_entry::<[Separator; MAX_SEPARATORS]>(8, c, true), sep_planes.as_entire_binding()),
+        ];
+        let resolve_only = [
+            (storage_entry::<f32>(4, c, true), area_buffer.as_entire_binding()),
+            (storage_entry::<[f32; 4]>(5, c, false), slots.as_entire_binding()),
+        ];
+        let group = |label: &str, entries: Vec<(wgpu::BindGroupLayoutEntry, wgpu::BindingResource)>| {
+            let layout_entries: Vec<_> = entries.iter().map(|(l, _)| *l).collect();
+            let layout = bind_group_layout(device, label, &layout_entries);
+            let resources: Vec<_> = entries
+                .into_iter()
+                .map(|(l, resource)| wgpu::BindGroupEntry { binding: l.binding, resource })
+                .collect();
+            let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some(label),
+                layout: &layout,
+                entries: &resources,
+            });
+            (layout, group)
+        };
+        let (trace_layout, trace_group) = group("photon trace", counters.iter().cloned().chain(trace_only).collect());
+        let (resolve_layout, resolve_group) =
+            group("photon resolve", counters.into_iter().chain(resolve_only).collect());
         let module = shader::module(device, "photon trace", &trace_source());
-        let layouts = [&scene.layout, &trace_layout];
-        let trace_pipeline = scene.compute_pipeline(device, "trace photons", &module, "trace_photons", &layouts);
-        let resolve_pipeline = scene.compute_pipeline(device, "resolve photon map", &module, "resolve_map", &layouts);
+        let trace_pipeline =
+            scene.compute_pipeline(device, "trace photons", &module, "trace_photons", &[&scene.layout, &trace_layout]);
+        let resolve_pipeline = scene.compute_pipeline(
+            device,
+            "resolve photon map",
+            &module,
+            "resolve_map",
+            &[&scene.layout, &resolve_layout],
+        );
         let mask = capacity as u32 - 1;
         let max_probe = layout.table.max_probe;
         let params = PhotonParams {
@@ -285,7 +297,7 @@ impl GpuPhotonMap {
             slots,
             bind_layout,
             bind_group,
-            build: Some(Build { tally, trace_group }),
+            build: Some(Build { tally, trace_group, resolve_group }),
             quantum,
             params,
             params_buffer,
@@ -322,33 +334,40 @@ impl GpuPhotonMap {
         gpu.queue.submit([enc.finish()]);
         let inv_photon_count = 1.0 / count.max(1) as f32;
         let mut params = PhotonParams { pass_index: pass, inv_photon_count, ..self.params };
-        let dispatch =
-            |params: &mut PhotonParams, items: u32, pipeline: &wgpu::ComputePipeline, label: &'static str| {
-                let groups = items.div_ceil(WORKGROUP);
-                let (gx, gy) = (groups.min(65535), groups.div_ceil(65535));
-                params.groups_x = gx;
-                gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(params));
-                let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
-                {
-                    let mut pass = compute_pass(&mut enc, gpu.profiler.as_ref(), label);
-                    pass.set_pipeline(pipeline);
-                    pass.set_bind_group(0, &scene.bind_group, &[]);
-                    pass.set_bind_group(1, &build.trace_group, &[]);
-                    pass.dispatch_workgroups(gx, gy, 1);
-                }
-                gpu.queue.submit([enc.finish()]);
-            };
+        let dispatch = |params: &mut PhotonParams,
+                        items: u32,
+                        (pipeline, group): (&wgpu::ComputePipeline, &wgpu::BindGroup),
+                        label: &'static str| {
+            let groups = items.div_ceil(WORKGROUP);
+            let (gx, gy) = (groups.min(65535), groups.div_ceil(65535));
+            params.groups_x = gx;
+            gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(params));
+            let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+            {
+                let mut pass = compute_pass(&mut enc, gpu.profiler.as_ref(), label);
+                pass.set_pipeline(pipeline);
+                pass.set_bind_group(0, &scene.bind_group, &[]);
+                pass.set_bind_group(1, group, &[]);
+                pass.dispatch_workgroups(gx, gy, 1);
+            }
+            gpu.queue.submit([enc.finish()]);
+        };
         if self.has_lights {
             let mut first = 0u32;
             while first < count {
                 let batch = BATCH.min(count - first);
                 params.first_photon = first;
                 params.batch_size = batch;
-                dispatch(&mut params, batch, &self.trace_pipeline, "photon trace");
+                dispatch(&mut params, batch, (&self.trace_pipeline, &build.trace_group), "photon trace");
                 first += batch;
             }
         }
-        dispatch(&mut params, self.layout.table.capacity() as u32, &self.resolve_pipeline, "photon map resolve");
+        dispatch(
+            &mut params,
+            self.layout.table.capacity() as u32,
+            (&self.resolve_pipeline, &build.resolve_group),
+            "photon map resolve",
+        );
     }
 
     /// Reads the map back: from the counters (exact fixed-point sums) while they exist, else

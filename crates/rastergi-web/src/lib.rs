@@ -1,0 +1,454 @@
+//! rastergi in a web page: the progressive renderer on the browser's WebGPU, driven from
+//! JavaScript (`web/main.js`) through [`Viewer`].
+//!
+//! The page owns the loop: on each animation frame it calls [`Viewer::frame`], which submits
+//! one iteration (while fewer than [`FRAMES_IN_FLIGHT`] are still on the GPU, so the queue
+//! does not grow faster than the GPU empties it) and draws the film's resolved image onto the
+//! canvas. Nothing here waits for the GPU: the read-backs (the error estimate, "save PNG")
+//! return promises that the browser resolves once the GPU has answered
+//! (`rastergi::gpu::Gpu::read_buffer_async`).
+//!
+//! Scenes: the built-in ones by name, or files from the page (dropped or picked) held in
+//! memory ([`rastergi::scene::MemoryFiles`]): a `.glb`, a `.gltf` with its buffers and images,
+//! or an `.obj` with its `.mtl` libraries and textures. A file that is not a scene is refused
+//! with one line, and the scene shown stays.
+//!
+//! Natively this crate is empty (it builds for `wasm32-unknown-unknown` only, with
+//! `scripts/web-build.sh`).
+#![cfg(target_arch = "wasm32")]
+
+use std::path::Path;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU32, Ordering};
+
+use rastergi::camera_control::{CameraControl, DRAG_RADIANS_PER_PIXEL, MoveKeys};
+use rastergi::display::WindowSurface;
+use rastergi::film::Show;
+use rastergi::gather::GatherMethod;
+use rastergi::gpu::{Gpu, GpuOptions};
+use rastergi::path_tracer::PathTracer;
+use rastergi::progressive::Progressive;
+use rastergi::renderer::{RenderSettings, Renderer};
+use rastergi::scene::{Files, GltfOptions, Light, MemoryFiles, Scene};
+use wasm_bindgen::prelude::*;
+
+mod console;
+
+/// Iterations submitted and not yet finished on the GPU, at most.
+pub const FRAMES_IN_FLIGHT: u32 = 2;
+
+/// Which renderer draws the image.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Method {
+    /// Photon map + final gather.
+    PhotonMap,
+    /// The reference path tracer.
+    PathTracer,
+}
+
+/// What the page chose besides the scene.
+#[derive(Clone, Debug)]
+struct Options {
+    width: u32,
+    height: u32,
+    seed: u32,
+    /// Photons per pass; `None`: fitted to the scene, as `rastergi render` does.
+    photons: Option<u32>,
+    gather: GatherMethod,
+    method: Method,
+    show: Show,
+    exposure: f32,
+    /// The sun (the scene's last distant light): azimuth and elevation in degrees.
+    sun: Option<(f32, f32)>,
+}
+
+/// The renderer of a page: the device, the canvas, the scene and its progressive image.
+#[wasm_bindgen]
+pub struct Viewer {
+    /// Kept for the device's lifetime: the browser loses a device whose instance is dropped.
+    _instance: wgpu::Instance,
+    gpu: Gpu,
+    surface: WindowSurface,
+    scene_name: String,
+    scene: Scene,
+    renderer: Box<dyn Progressive>,
+    control: CameraControl,
+    options: Options,
+    in_flight: Arc<AtomicU32>,
+}
+
+/// Opens the browser's WebGPU adapter for `canvas` and shows the Cornell box at
+/// `width × height` with `seed`. Fails with one line where the browser has no WebGPU or its
+/// limits are too small.
+#[wasm_bindgen(js_name = createViewer)]
+pub async fn create_viewer(
+    canvas: web_sys::HtmlCanvasElement,
+    width: u32,
+    height: u32,
+    seed: u32,
+) -> Result<Viewer, JsError> {
+    console::init();
+    let options = GpuOptions { backends: Some(wgpu::Backends::BROWSER_WEBGPU), ..GpuOptions::default() };
+    let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+    desc.backends = wgpu::Backends::BROWSER_WEBGPU;
+    let instance = wgpu::Instance::new(desc);
+    let (canvas_width, canvas_height) = (canvas.width(), canvas.height());
+    let surface = instance
+        .create_surface(wgpu::SurfaceTarget::Canvas(canvas))
+        .map_err(|e| JsError::new(&format!("this browser cannot draw WebGPU into a canvas ({e})")))?;
+    let gpu = Gpu::open_async(&instance, &options, Some(&surface)).await.map_err(|e| {
+        JsError::new(&format!(
+            "{e}: this browser offers no WebGPU adapter (enable WebGPU, or use Chrome, Edge or Firefox 141+)"
+        ))
+    })?;
+    log::info!("{}", gpu.describe().replace('\n', "; "));
+    let surface = WindowSurface::new(&gpu, surface, canvas_width, canvas_height).map_err(error)?;
+    let options = Options {
+        width,
+        height,
+        seed,
+        photons: None,
+        // The raster gathers bind more storage buffers than browsers grant (10).
+        gather: GatherMethod::Trace,
+        method: Method::PhotonMap,
+        show: Show::Full,
+        exposure: 0.0,
+        sun: None,
+    };
+    let scene = rastergi::scene::cornell_box();
+    let renderer = build(&gpu, &scene, &options).map_err(error)?;
+    let control = CameraControl::new(&scene.camera, &scene.bounds());
+    Ok(Viewer {
+        _instance: instance,
+        gpu,
+        surface,
+        scene_name: "cornell".into(),
+        scene,
+        renderer,
+        control,
+        options,
+        in_flight: Arc::new(AtomicU32::new(0)),
+    })
+}
+
+fn error(e: impl std::fmt::Display) -> JsError {
+    JsError::new(&e.to_string())
+}
+
+/// The renderer `options` ask for, for `scene`.
+fn build(gpu: &Gpu, scene: &Scene, options: &Options) -> rastergi::Result<Box<dyn Progressive>> {
+    let mut scene = scene.clone();
+    if let (Some((azimuth, elevation)), Some(Light::Distant { direction, .. })) =
+        (options.sun, scene.lights.iter_mut().rev().find(|l| matches!(l, Light::Distant { .. })))
+    {
+        *direction = sun_direction(azimuth, elevation);
+    }
+    let grid = rastergi::fit::grid_resolution(&scene.bounds());
+    let settings = RenderSettings {
+        width: options.width,
+        height: options.height,
+        seed: options.seed,
+        photons: options.photons.unwrap_or_else(|| rastergi::fit::photon_count(&scene, grid)),
+        grid_resolution: grid,
+        gather: options.gather,
+        ..RenderSettings::default()
+    };
+    Ok(match options.method {
+        Method::PhotonMap => Box::new(Renderer::new(gpu, &scene, settings)?),
+        Method::PathTracer => Box::new(PathTracer::new(gpu, &scene, settings)?),
+    })
+}
+
+/// The direction a sun at these angles (degrees from +Z towards +X about +Y; above the XZ
+/// plane) shines along, as `rastergi render --sun` takes them.
+fn sun_direction(azimuth: f32, elevation: f32) -> glam::Vec3 {
+    let (a, e) = (azimuth.to_radians(), elevation.to_radians());
+    -glam::Vec3::new(a.sin() * e.cos(), e.sin(), a.cos() * e.cos())
+}
+
+/// The angles of a sun shining along `direction` ([`sun_direction`]'s inverse).
+fn sun_angles(direction: glam::Vec3) -> (f32, f32) {
+    let towards = -direction.normalize();
+    (towards.x.atan2(towards.z).to_degrees().rem_euclid(360.0), towards.y.clamp(-1.0, 1.0).asin().to_degrees())
+}
+
+fn last_sun(scene: &Scene) -> Option<(f32, f32)> {
+    scene.lights.iter().rev().find_map(|l| match l {
+        Light::Distant { direction, .. } => Some(sun_angles(*direction)),
+        _ => None,
+    })
+}
+
+/// The scene among `files`: the first `.glb`, `.gltf` or `.obj` by name.
+fn load_scene(files: &MemoryFiles) -> rastergi::Result<(String, Scene)> {
+    let mut names: Vec<&str> = files.names().collect();
+    names.sort();
+    let kind = |n: &str| Path::new(n).extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    let Some(name) = names.iter().find(|n| matches!(kind(n).as_deref(), Some("glb" | "gltf" | "obj"))) else {
+        return Err(rastergi::Error::InvalidScene(format!(
+            "{} is not a scene: drop a .glb, a .gltf with its files, or an .obj with its .mtl and textures",
+            names.join(", ")
+        )));
+    };
+    let path = Path::new(name);
+    let scene = match kind(name).as_deref() {
+        Some("obj") => rastergi::scene::load_obj_in(Files::Memory(files), path)?,
+        _ => rastergi::scene::load_gltf_in(Files::Memory(files), path, &GltfOptions::default())?,
+    };
+    Ok((name.to_string(), scene))
+}
+
+#[wasm_bindgen]
+impl Viewer {
+    /// Shows the built-in scene `name` (cornell, rooms, atrium, glossy-room, spheres:N).
+    #[wasm_bindgen(js_name = loadBuiltin)]
+    pub fn load_builtin(&mut self, name: &str) -> Result<(), JsError> {
+        let scene = rastergi::scene::generate::builtin(name)
+            .map_err(error)?
+            .ok_or_else(|| JsError::new(&format!("there is no built-in scene '{name}'")))?;
+        self.show_scene(name.to_string(), scene)
+    }
+
+    /// Shows the scene among the files `names` with `contents` (dropped on the page or picked):
+    /// its name, or one line saying why not (the scene shown stays).
+    #[wasm_bindgen(js_name = loadFiles)]
+    pub fn load_files(&mut self, names: Vec<String>, contents: Vec<js_sys::Uint8Array>) -> Result<String, JsError> {
+        let mut files = MemoryFiles::new();
+        for (name, bytes) in names.iter().zip(&contents) {
+            files.insert(name, bytes.to_vec());
+        }
+        let (name, scene) = load_scene(&files).map_err(error)?;
+        self.show_scene(name.clone(), scene)?;
+        Ok(name)
+    }
+
+    fn show_scene(&mut self, name: String, scene: Scene) -> Result<(), JsError> {
+        let mut options = self.options.clone();
+        options.sun = last_sun(&scene);
+        // Built before anything is replaced: a scene that fails leaves the page as it was.
+        let renderer = build(&self.gpu, &scene, &options).map_err(error)?;
+        self.control = CameraControl::new(&scene.camera, &scene.bounds());
+        (self.scene_name, self.scene, self.renderer, self.options) = (name, scene, renderer, options);
+        Ok(())
+    }
+
+    /// Changes one setting: `method` (photons | path), `gather` (lists | trace), `photons`
+    /// (a count, or auto), `show` (full | direct | indirect), `exposure` (stops), `sun`
+    /// ("azimuth,elevation" in degrees), `size` ("WIDTHxHEIGHT"), `seed`. Settings that change
+    /// what is traced rebuild the renderer; the image restarts.
+    pub fn set(&mut self, key: &str, value: &str) -> Result<(), JsError> {
+        let bad = || JsError::new(&format!("'{value}' is not a valid {key}"));
+        let mut options = self.options.clone();
+        match key {
+            "show" => {
+                self.options.show = match value {
+                    "full" => Show::Full,
+                    "direct" => Show::Direct,
+                    "indirect" => Show::Indirect,
+                    _ => return Err(bad()),
+                };
+                return Ok(());
+            }
+            "exposure" => {
+                self.options.exposure = value.parse().ok().filter(|e: &f32| e.is_finite()).ok_or_else(bad)?;
+                return Ok(());
+            }
+            "method" => {
+                options.method = match value {
+                    "photons" => Method::PhotonMap,
+                    "path" => Method::PathTracer,
+                    _ => return Err(bad()),
+                }
+            }
+            "gather" => {
+                options.gather = match value {
+                    "lists" => GatherMethod::Lists,
+                    "trace" => GatherMethod::Trace,
+                    _ => return Err(bad()),
+                }
+            }
+            "photons" => {
+                options.photons = match value {
+                    "auto" => None,
+                    n => Some(n.parse().ok().filter(|&n| n > 0).ok_or_else(bad)?),
+                }
+            }
+            "sun" => {
+                let (a, e) = value.split_once(',').ok_or_else(bad)?;
+                let (a, e): (f32, f32) = (a.trim().parse().map_err(|_| bad())?, e.trim().parse().map_err(|_| bad())?);
+                if options.sun.is_none() {
+                    return Err(JsError::new("this scene has no sun (a distant light) to turn"));
+                }
+                options.sun = Some((a.rem_euclid(360.0), e.clamp(-90.0, 90.0)));
+            }
+            "size" => {
+                let (w, h) = value.split_once('x').ok_or_else(bad)?;
+                (options.width, options.height) = (w.parse().map_err(|_| bad())?, h.parse().map_err(|_| bad())?);
+            }
+            "seed" => options.seed = value.parse().map_err(|_| bad())?,
+            _ => return Err(JsError::new(&format!("unknown setting '{key}'"))),
+        }
+        let camera = self.renderer.camera();
+        let mut renderer = build(&self.gpu, &self.scene, &options).map_err(error)?;
+        renderer.set_camera(camera).map_err(error)?;
+        (self.renderer, self.options) = (renderer, options);
+        Ok(())
+    }
+
+    /// One animation frame: an iteration (unless `limit` > 0 iterations are done, or the GPU
+    /// is [`FRAMES_IN_FLIGHT`] behind), then the image drawn onto the canvas. Returns the
+    /// iterations accumulated.
+    pub fn frame(&mut self, limit: u32) -> Result<u32, JsError> {
+        let done = limit > 0 && self.renderer.samples() >= limit;
+        if !done && self.in_flight.load(Ordering::Acquire) < FRAMES_IN_FLIGHT {
+            self.renderer.iterate().map_err(error)?;
+            self.in_flight.fetch_add(1, Ordering::AcqRel);
+            let in_flight = self.in_flight.clone();
+            self.gpu.queue.on_submitted_work_done(move || {
+                in_flight.fetch_sub(1, Ordering::AcqRel);
+            });
+        }
+        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
+        let show = if self.renderer.has(self.options.show) { self.options.show } else { Show::Full };
+        self.renderer.encode_resolve(&mut enc, show, self.options.exposure);
+        self.surface.present(&self.gpu, enc, Some(self.renderer.film()), &[]).map_err(error)?;
+        self.gpu.check().map_err(error)?;
+        Ok(self.renderer.samples())
+    }
+
+    /// Whether every submitted iteration has finished on the GPU.
+    pub fn idle(&self) -> bool {
+        self.in_flight.load(Ordering::Acquire) == 0
+    }
+
+    /// The canvas was resized to `width × height` pixels (the image keeps its size and is
+    /// scaled to fit).
+    #[wasm_bindgen(js_name = resizeCanvas)]
+    pub fn resize_canvas(&mut self, width: u32, height: u32) {
+        self.surface.resize(&self.gpu, width, height);
+    }
+
+    /// A mouse drag of (dx, dy) pixels: orbits the target, or turns the view in fly mode.
+    pub fn drag(&mut self, dx: f32, dy: f32) -> Result<(), JsError> {
+        let (yaw, pitch) = (dx * DRAG_RADIANS_PER_PIXEL, -dy * DRAG_RADIANS_PER_PIXEL);
+        let moved = match self.control.mode {
+            rastergi::camera_control::Mode::Orbit => self.control.orbit(yaw, pitch),
+            rastergi::camera_control::Mode::Fly => self.control.look(yaw, pitch),
+        };
+        self.moved(moved)
+    }
+
+    /// `steps` scroll notches: closer (positive) or farther.
+    pub fn zoom(&mut self, steps: f32) -> Result<(), JsError> {
+        let moved = self.control.zoom(steps);
+        self.moved(moved)
+    }
+
+    /// Flies for `seconds` with keys held: `keys` holds the letters of W A S D E Q (forward,
+    /// left, back, right, up, down) and `F` for fast.
+    pub fn fly(&mut self, keys: &str, seconds: f32) -> Result<(), JsError> {
+        let held = MoveKeys {
+            forward: keys.contains('W'),
+            back: keys.contains('S'),
+            left: keys.contains('A'),
+            right: keys.contains('D'),
+            up: keys.contains('E'),
+            down: keys.contains('Q'),
+            fast: keys.contains('F'),
+        };
+        let moved = self.control.fly(&held, seconds);
+        self.moved(moved)
+    }
+
+    /// Switches orbit ↔ fly; returns the new mode's name.
+    #[wasm_bindgen(js_name = toggleMode)]
+    pub fn toggle_mode(&mut self) -> String {
+        self.control.toggle_mode();
+        self.control.mode.name().to_string()
+    }
+
+    /// Back to the scene's own camera.
+    pub fn home(&mut self) -> Result<(), JsError> {
+        self.control = CameraControl::new(&self.scene.camera, &self.scene.bounds());
+        self.moved(true)
+    }
+
+    fn moved(&mut self, moved: bool) -> Result<(), JsError> {
+        if moved {
+            self.renderer.set_camera(self.control.camera()).map_err(error)?;
+        }
+        Ok(())
+    }
+
+    /// Iterations accumulated since the last restart.
+    pub fn samples(&self) -> u32 {
+        self.renderer.samples()
+    }
+
+    #[wasm_bindgen(js_name = sceneName)]
+    pub fn scene_name(&self) -> String {
+        self.scene_name.clone()
+    }
+
+    /// What is rendering, for the page's status line.
+    pub fn describe(&self) -> String {
+        let s = self.renderer.settings();
+        let what = match self.options.method {
+            Method::PhotonMap => format!("photon map ({} photons a pass) + {:?} gather", s.photons, s.gather),
+            Method::PathTracer => "path tracer".to_string(),
+        };
+        let i = &self.gpu.info;
+        let adapter = if i.name.is_empty() { format!("WebGPU ({})", i.driver) } else { i.name.clone() };
+        format!(
+            "{}: {} triangles, {}x{}, {what}, on {adapter}",
+            self.scene_name,
+            self.scene.triangles.len(),
+            s.width,
+            s.height
+        )
+    }
+
+    /// The sun's "azimuth,elevation" in degrees, or an empty string where the scene has none.
+    pub fn sun(&self) -> String {
+        self.options.sun.map_or_else(String::new, |(a, e)| format!("{a:.0},{e:.0}"))
+    }
+
+    /// The warnings logged since the last call (a loaded file's ignored parts, say).
+    #[wasm_bindgen(js_name = takeWarnings)]
+    pub fn take_warnings(&self) -> Vec<String> {
+        console::take_warnings()
+    }
+
+    /// The film's relative error estimate (from its two independent halves): a promise of a
+    /// number, or `null` before the halves hold enough iterations.
+    #[wasm_bindgen(js_name = errorEstimate)]
+    pub fn error_estimate(&self) -> js_sys::Promise {
+        let state = self.renderer.film().read_state_async(&self.gpu);
+        wasm_bindgen_futures::future_to_promise(async move {
+            let state = state.await.map_err(|e| JsValue::from(error(e)))?;
+            Ok(state.error_estimate().map_or(JsValue::NULL, JsValue::from))
+        })
+    }
+
+    /// The image as shown (the film's display encoding at its own size) as PNG bytes: a
+    /// promise of a `Uint8Array`.
+    #[wasm_bindgen(js_name = savePng)]
+    pub fn save_png(&self) -> js_sys::Promise {
+        let show = if self.renderer.has(self.options.show) { self.options.show } else { Show::Full };
+        let image = self.renderer.film().read_display_async(&self.gpu, show, self.options.exposure);
+        wasm_bindgen_futures::future_to_promise(async move {
+            let image = image.await.map_err(|e| JsValue::from(error(e)))?;
+            let mut png = Vec::new();
+            let encoder = image::codecs::png::PngEncoder::new(&mut png);
+            image::ImageEncoder::write_image(
+                encoder,
+                &image.rgba,
+                image.width,
+                image.height,
+                image::ExtendedColorType::Rgba8,
+            )
+            .map_err(|e| JsValue::from(error(e)))?;
+            Ok(js_sys::Uint8Array::from(png.as_slice()).into())
+        })
+    }
+}

@@ -133,7 +133,11 @@ function frame(now) {
 function wire() {
   const v = () => state.viewer;
   $('scene').addEventListener('change', (e) => apply(() => v().loadBuiltin(e.target.value)));
-  $('files').addEventListener('change', (e) => loadFiles(e.target.files));
+  $('files').addEventListener('change', async (e) => {
+    await loadFiles(e.target.files);
+    // Picking the same files again is a change too.
+    e.target.value = '';
+  });
   for (const key of ['method', 'gather', 'photons', 'show']) {
     $(key).addEventListener('change', (e) => apply(() => v().set(key, e.target.value)));
   }

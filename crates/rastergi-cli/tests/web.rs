@@ -1,7 +1,7 @@
 //! The web page in a real browser (issue 33): `scripts/web-test.sh` builds the page, serves it
 //! and drives headless Chromium (WebGPU on SwiftShader's Vulkan): the Cornell box at 128² for
-//! 64 iterations, a pointer drag that must restart the image, a glTF and an OBJ (with its MTL
-//! and texture) loaded through the page's file input, and a file that is not a scene, which
+//! 64 iterations, a pointer drag that must restart the image, two glTF files (one of 101 054
+//! triangles) and an OBJ (with its MTL and texture) loaded through the page's file input, and a file that is not a scene, which
 //! the page must refuse with one line while keeping its scene. The image is then compared with
 //! `rastergi render` of the same settings: their difference must be within the noise, as
 //! measured by two seeds of the native render.
@@ -28,6 +28,16 @@ fn the_web_page_renders_the_cornell_box_as_the_native_renderer_does() {
     let gltf = data.join("gltf/thick_room.gltf");
     let obj = ["alpha_card.obj", "alpha_card.mtl", "alpha_card_mask.png"].map(|f| data.join("obj").join(f));
     let obj = obj.iter().map(|p| p.to_str().unwrap()).collect::<Vec<_>>().join(",");
+    // A real-sized glTF: 101 054 triangles.
+    let big = dir.path().join("spheres.glb");
+    let made = common::run(
+        &repo(),
+        "python3",
+        &["scripts/make_big_glb.py", big.to_str().unwrap()],
+        &[],
+        Duration::from_secs(120),
+    );
+    assert!(made.status.success(), "{}", made.stderr);
     let script = repo().join("scripts/web-test.sh");
     let run = common::run(
         &repo(),
@@ -37,6 +47,8 @@ fn the_web_page_renders_the_cornell_box_as_the_native_renderer_does() {
             web.to_str().unwrap(),
             "--file",
             gltf.to_str().unwrap(),
+            "--file",
+            big.to_str().unwrap(),
             "--file",
             &obj,
             "--bad-file",
@@ -54,7 +66,9 @@ fn the_web_page_renders_the_cornell_box_as_the_native_renderer_does() {
     // What the page reported: the drag restarted the image, both files loaded, the bad file
     // was refused in one line and the scene stayed.
     assert!(run.stdout.contains("\"loaded\""), "{}", run.stdout);
-    assert!(run.stdout.contains("thick_room.gltf") && run.stdout.contains("alpha_card.obj"), "{}", run.stdout);
+    for loaded in ["thick_room.gltf: 72 triangles", "spheres.glb: 101054 triangles", "alpha_card.obj: 6 triangles"] {
+        assert!(run.stdout.contains(loaded), "{}", run.stdout);
+    }
     assert!(run.stdout.contains("\"scene_kept\": \"alpha_card.obj\""), "{}", run.stdout);
     assert!(run.stdout.contains("is not a scene"), "{}", run.stdout);
 

@@ -398,7 +398,7 @@ impl Viewer {
             Method::PathTracer => "path tracer".to_string(),
         };
         let i = &self.gpu.info;
-        let adapter = if i.name.is_empty() { format!("WebGPU ({})", i.driver) } else { i.name.clone() };
+        let adapter = if i.name.is_empty() { "the browser's WebGPU adapter".to_string() } else { i.name.clone() };
         format!(
             "{}: {} triangles, {}x{}, {what}, on {adapter}",
             self.scene_name,

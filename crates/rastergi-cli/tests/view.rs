@@ -271,6 +271,66 @@ fn the_panels_actions_switch_the_method_the_gather_and_the_scene_as_render_optio
 }
 
 #[test]
+fn the_denoiser_toggle_shows_what_render_denoise_writes() {
+    // `--denoise` from the start: the viewer's renderer accumulates the guides from its first
+    // iteration, as `render --denoise` does, so with the same seed, camera and gather the
+    // denoised screenshot is `render --denoise`'s image and, turned off, the raw one its
+    // NAME.raw.exr. The PNG is the EXR at the exposure, clamped, sRGB (computed here).
+    const SEED: u32 = 4;
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(
+        d.join("script.txt"),
+        "after 4 iterations: screenshot\nexposure 1\nscreenshot\ndenoise off\nscreenshot\nquit\n",
+    )
+    .unwrap();
+    let seed = SEED.to_string();
+    let mut args = vec!["cornell", "--seed", &seed, "--script", "script.txt", "--denoise", "--gather", "trace"];
+    args.extend_from_slice(SIZE);
+    args.extend_from_slice(PHOTONS);
+    let run = view(d, &args);
+    run.check_success("view --denoise");
+    let shots = screenshots(d, &run.stdout);
+    assert_eq!(shots.len(), 3, "{}", run.stdout);
+    let lines: Vec<&str> = run.stdout.lines().filter(|l| l.starts_with("screenshot: ")).collect();
+    for (line, denoised) in lines.iter().zip([true, true, false]) {
+        assert_eq!(line.contains("show full denoised,"), denoised, "{line}");
+    }
+    assert!(shots.iter().all(|s| s.iterations == 4), "neither the exposure nor the toggle restarts");
+    let mut options: Vec<String> = ["--gather", "trace", "--denoise"].map(String::from).to_vec();
+    options.extend(shots[0].camera.iter().cloned());
+    let denoised = render(d, "r.exr", SEED, 4, &options);
+    let raw = read_exr(&d.join("r.raw.exr")).unwrap();
+    let (a, b, c) =
+        (read_exr(&shots[0].exr).unwrap(), read_exr(&shots[1].exr).unwrap(), read_exr(&shots[2].exr).unwrap());
+    assert_eq!(a, denoised, "the viewer's denoised image is render --denoise's");
+    assert_eq!(b, denoised, "a new exposure changes the display only");
+    assert_eq!(c, raw, "turned off: the raw image, render --denoise's NAME.raw.exr");
+    let change = compare(&a, &c, None).relative_rmse;
+    println!("--denoise, 4 iterations: equal to render --denoise's image; denoised vs raw relative RMSE {change:.4}");
+    assert!(change > 0.01, "the denoiser changed the image by {change}");
+    let png = image::open(&shots[1].png).unwrap().to_rgba8();
+    for (p, l) in png.pixels().zip(&b.pixels) {
+        for ch in 0..3 {
+            assert!(p[ch].abs_diff(srgb_byte(2.0 * l[ch])) <= 1, "PNG {:?} vs denoised linear {l:?}", p.0);
+        }
+    }
+
+    // Turned on mid-render (the script's `denoise on`, as N or the checkbox): the guides
+    // start then, so the image restarts and the screenshot holds the 3 iterations since;
+    // turned off, the same iterations raw.
+    let script = "after 2 iterations: denoise on\nafter 3 iterations: screenshot\ndenoise off\nscreenshot\nquit\n";
+    let (run, shots) = scripted_view(d, script, SEED);
+    assert_eq!(shots.len(), 2, "{}", run.stdout);
+    assert!(shots.iter().all(|s| s.iterations == 3), "{}", run.stdout);
+    assert!(run.stdout.contains("show full denoised,"), "{}", run.stdout);
+    let (den, raw) = (read_exr(&shots[0].exr).unwrap(), read_exr(&shots[1].exr).unwrap());
+    let change = compare(&den, &raw, None).relative_rmse;
+    println!("turned on at 2 iterations, 3 since: denoised vs raw relative RMSE {change:.4}");
+    assert!(change > 0.01, "the denoiser changed the image by {change}");
+}
+
+#[test]
 fn view_without_a_display_fails_with_one_clear_line() {
     let dir = tempfile::tempdir().unwrap();
     let env = [("DISPLAY", None), ("WAYLAND_DISPLAY", None), ("WAYLAND_SOCKET", None)];
@@ -300,9 +360,21 @@ fn view_help_lists_the_keys_and_the_script_format() {
     let dir = tempfile::tempdir().unwrap();
     let run = rastergi(dir.path(), &["view", "--help"]);
     run.check_success("view --help");
-    for expected in
-        ["W A S D", "Tab", "Shift", "scroll", "1 2 3 4", "+ -", "P ", "Esc", "after N iterations:", "--script"]
-    {
+    for expected in [
+        "W A S D",
+        "Tab",
+        "Shift",
+        "scroll",
+        "1 2 3 4",
+        "+ -",
+        "N ",
+        "P ",
+        "Esc",
+        "after N iterations:",
+        "--script",
+        "denoise on|off",
+        "--denoise",
+    ] {
         assert!(run.stdout.contains(expected), "help lacks '{expected}':\n{}", run.stdout);
     }
     // The shared options of `render` are there too.

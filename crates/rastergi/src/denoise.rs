@@ -381,6 +381,13 @@ impl Denoiser {
         run(levels + 1, 3, 0);
     }
 
+    /// The denoised image's buffer (`width × height` vec4, linear RGB and 1), as the last
+    /// submitted [`encode`](Self::encode) left it: the source of the film's
+    /// [`ImageResolve`](crate::film::ImageResolve) for the window.
+    pub fn image(&self) -> &wgpu::Buffer {
+        &self.image
+    }
+
     /// The denoised image read back (after [`encode`](Self::encode) was submitted).
     pub fn read(&self, gpu: &Gpu) -> Result<LinearImage> {
         let bytes = gpu.read_buffer(&self.image, self.image.size())?;

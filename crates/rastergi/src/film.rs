@@ -112,6 +112,19 @@ pub struct Film {
     uniforms: wgpu::Buffer,
     pipeline: wgpu::ComputePipeline,
     bind_group: wgpu::BindGroup,
+    /// The resolve's layout and its `resolve_image` entry ([`ImageResolve`]).
+    layout: wgpu::BindGroupLayout,
+    image_pipeline: wgpu::ComputePipeline,
+}
+
+/// The resolve of a linear image of the film's size that is already a mean (one vec4 per
+/// pixel: the denoiser's output) into the film's linear and display buffers, with the film's
+/// display encoding (`resolve.wgsl`'s `resolve_image`): what the window draws then shows that
+/// image. Made by [`Film::image_resolve`], encoded by [`Film::encode_resolve_image`].
+pub struct ImageResolve {
+    /// Its own uniforms, so that it and the film's resolve can be encoded in one submission.
+    uniforms: wgpu::Buffer,
+    bind_group: wgpu::BindGroup,
 }
 
 impl Film {
@@ -142,6 +155,7 @@ impl Film {
         let bind_group = buffer_bind_group(device, "resolve", &layout, &[&uniforms, &accumulation, &linear, &display]);
         let module = shader::module(device, "resolve", &resolve_source());
         let pipeline = compute_pipeline(device, "resolve", &module, "main", &[&layout], &[]);
+        let image_pipeline = compute_pipeline(device, "resolve image", &module, "resolve_image", &[&layout], &[]);
         let half = gpu.zeroed_buffer("film odd half", COMPONENTS * pixels * 16, rw);
         let half_layout = bind_group_layout(
             device,
@@ -168,6 +182,8 @@ impl Film {
             uniforms,
             pipeline,
             bind_group,
+            layout,
+            image_pipeline,
         })
     }
 
@@ -279,6 +295,59 @@ impl Film {
         pass.dispatch_workgroups(groups(self.width, 8), groups(self.height, 8), 1);
     }
 
+    /// The resolve of `image` (a `width × height` buffer of vec4 linear values, read as
+    /// `array<vec4f>`) into this film's linear and display buffers.
+    pub fn image_resolve(&self, gpu: &Gpu, image: &wgpu::Buffer) -> ImageResolve {
+        let uniforms = gpu.zeroed_buffer(
+            "resolve image uniforms",
+            std::mem::size_of::<ResolveUniforms>() as u64,
+            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        );
+        let bind_group = buffer_bind_group(
+            &gpu.device,
+            "resolve image",
+            &self.layout,
+            &[&uniforms, image, &self.linear, &self.display],
+        );
+        ImageResolve { uniforms, bind_group }
+    }
+
+    /// Encodes the resolve of `image`'s source (as it stands when the encoder runs) at
+    /// `exposure` into the linear and display buffers, in place of the film's mean.
+    pub fn encode_resolve_image(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, image: &ImageResolve, exposure: f32) {
+        let u = ResolveUniforms {
+            resolution: [self.width, self.height],
+            samples: 1,
+            show: Show::Full.code(),
+            scale: exposure.exp2(),
+            _pad: [0; 3],
+        };
+        gpu.queue.write_buffer(&image.uniforms, 0, bytemuck::bytes_of(&u));
+        let mut pass = crate::profile::compute_pass(enc, gpu.profiler.as_ref(), "resolve image");
+        pass.set_pipeline(&self.image_pipeline);
+        pass.set_bind_group(0, &image.bind_group, &[]);
+        pass.dispatch_workgroups(groups(self.width, 8), groups(self.height, 8), 1);
+    }
+
+    /// The display buffer as the last submitted resolve left it.
+    pub fn read_display_buffer(&self, gpu: &Gpu) -> Result<DisplayImage> {
+        crate::gpu::block_on(self.read_display_buffer_async(gpu))
+    }
+
+    /// [`read_display_buffer`](Self::read_display_buffer) as a future, of the buffer as it is
+    /// now (after the work submitted so far).
+    pub fn read_display_buffer_async(
+        &self,
+        gpu: &Gpu,
+    ) -> impl std::future::Future<Output = Result<DisplayImage>> + 'static {
+        let bytes = gpu.read_buffer_async(&self.display, self.display.size());
+        let (width, height) = (self.width, self.height);
+        async move {
+            let n = (width * height) as usize * 4;
+            Ok(DisplayImage { width, height, rgba: bytes.await?[..n].to_vec() })
+        }
+    }
+
     /// The mean radiance of `show`, linear RGB.
     pub fn read_linear(&self, gpu: &Gpu, show: Show) -> Result<LinearImage> {
         let mut enc = gpu.device.create_command_encoder(&Default::default());
@@ -310,12 +379,7 @@ impl Film {
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         self.encode_resolve(gpu, &mut enc, show, exposure);
         gpu.queue.submit([enc.finish()]);
-        let bytes = gpu.read_buffer_async(&self.display, self.display.size());
-        let (width, height) = (self.width, self.height);
-        async move {
-            let n = (width * height) as usize * 4;
-            Ok(DisplayImage { width, height, rgba: bytes.await?[..n].to_vec() })
-        }
+        self.read_display_buffer_async(gpu)
     }
 }
 

@@ -6,7 +6,7 @@ use glam::{Vec2, Vec3};
 use crate::checkpoint::Progress;
 use crate::denoise::{DenoiseParams, Denoiser, GuideState, Guides};
 use crate::error::Result;
-use crate::film::{Film, FilmState, Show};
+use crate::film::{Film, FilmState, ImageResolve, Show};
 use crate::frame::{FrameBinding, FrameUniforms, pixel_jitter};
 use crate::gather::{
     DirectionSampler, FixedSample, GatherDirections, GatherFrame, GatherMethod, GatherPass, GatherSetup, HitLight,
@@ -142,7 +142,15 @@ struct ImagePasses {
     gather: Option<GatherPass>,
     film: Film,
     /// The denoiser's guides and filter, once enabled ([`Renderer::enable_denoiser`]).
-    denoise: Option<(Guides, Denoiser)>,
+    denoise: Option<DenoisePasses>,
+}
+
+/// The denoiser's passes: the guides (per iteration), the filter (on demand) and the resolve
+/// of its output into the film's display buffer (for the window).
+struct DenoisePasses {
+    guides: Guides,
+    denoiser: Denoiser,
+    resolve: ImageResolve,
 }
 
 impl ImagePasses {
@@ -189,7 +197,8 @@ impl ImagePasses {
             gpu.check_image_size(w, h, crate::denoise::LARGEST_BUFFER_PER_PIXEL)?;
             let guides = Guides::new(gpu, (scene, frame), &self.gbuffer, &self.film);
             let denoiser = Denoiser::new(gpu, (w, h), &self.film.accumulation, &guides.buffer, crate::denoise::LEVELS);
-            self.denoise = Some((guides, denoiser));
+            let resolve = self.film.image_resolve(gpu, denoiser.image());
+            self.denoise = Some(DenoisePasses { guides, denoiser, resolve });
         }
         Ok(())
     }
@@ -341,8 +350,8 @@ impl Renderer {
     /// Discards the accumulated iterations.
     pub fn reset(&mut self) {
         self.passes.film.clear(&self.gpu);
-        if let Some((guides, _)) = &mut self.passes.denoise {
-            guides.clear(&self.gpu);
+        if let Some(d) = &mut self.passes.denoise {
+            d.guides.clear(&self.gpu);
         }
         if let Some(gather) = &mut self.passes.gather {
             gather.restart();
@@ -408,8 +417,8 @@ impl Renderer {
         }
         // 5. Denoiser guides (when enabled): the visible points' albedo, normal, distance and
         //    the moments of what this iteration added to the film.
-        if let Some((guides, _)) = &mut self.passes.denoise {
-            guides.encode(&mut enc, (&self.scene, &self.frame));
+        if let Some(d) = &mut self.passes.denoise {
+            d.guides.encode(&mut enc, (&self.scene, &self.frame));
         }
         // 6. Accumulate: every pass above added its estimate to the film's sums.
         self.gpu.queue.submit([enc.finish()]);
@@ -446,8 +455,8 @@ impl Renderer {
             gather.choose_as(method, directions)?;
         }
         self.passes.film.restore(&self.gpu, film)?;
-        if let Some((guides, _)) = &mut self.passes.denoise {
-            guides.restart_from(&self.gpu, &self.passes.film);
+        if let Some(d) = &mut self.passes.denoise {
+            d.guides.restart_from(&self.gpu, &self.passes.film);
         }
         Ok(())
     }
@@ -489,7 +498,8 @@ impl Renderer {
     /// Accumulates the denoiser's guides from the next iteration on (a per-pixel pass after
     /// the others; the image itself is unchanged) so that [`read_denoised`](Self::read_denoised),
     /// [`read_guides`](Self::read_guides) can be called. Enable it before the first iteration:
-    /// the guides hold the iterations since. Fails where the image's extra buffers
+    /// the guides hold the iterations since (the viewer, turning it on mid-render, restarts the
+    /// image). Fails where the image's extra buffers
     /// ([`crate::denoise::LARGEST_BUFFER_PER_PIXEL`]) exceed the GPU's limits.
     pub fn enable_denoiser(&mut self) -> Result<()> {
         self.passes.enable_denoiser(&self.gpu, &self.scene, &self.frame)?;
@@ -497,7 +507,12 @@ impl Renderer {
         Ok(())
     }
 
-    fn denoiser(&self) -> Result<&(Guides, Denoiser)> {
+    /// Whether the denoiser's guides are accumulated ([`enable_denoiser`](Self::enable_denoiser)).
+    pub fn denoiser_enabled(&self) -> bool {
+        self.denoise
+    }
+
+    fn denoiser(&self) -> Result<&DenoisePasses> {
         self.passes.denoise.as_ref().ok_or_else(|| {
             crate::error::Error::Gpu("the denoiser was not enabled (Renderer::enable_denoiser)".to_owned())
         })
@@ -505,23 +520,47 @@ impl Renderer {
 
     /// The denoised full image ([`crate::denoise`]), linear RGB.
     pub fn read_denoised(&self, params: &DenoiseParams) -> Result<LinearImage> {
-        let (guides, denoiser) = self.denoiser()?;
+        let d = self.denoiser()?;
         let angle = crate::denoise::pixel_angle(&self.camera, self.settings.height);
-        denoiser.apply(&self.gpu, (self.passes.film.samples, guides.samples), angle, params)
+        d.denoiser.apply(&self.gpu, (self.passes.film.samples, d.guides.samples), angle, params)
     }
 
-    /// Encodes the denoiser into `enc` without reading it back (timing).
+    /// Encodes the denoiser into `enc` without reading it back: its output image holds the
+    /// filtered image once `enc` has run (timing; the window, with
+    /// [`encode_resolve_denoised`](Self::encode_resolve_denoised)).
     pub fn encode_denoise(&self, enc: &mut wgpu::CommandEncoder, params: &DenoiseParams) -> Result<()> {
-        let (guides, denoiser) = self.denoiser()?;
+        let d = self.denoiser()?;
         let angle = crate::denoise::pixel_angle(&self.camera, self.settings.height);
-        denoiser.encode(&self.gpu, enc, (self.passes.film.samples, guides.samples), angle, params);
+        d.denoiser.encode(&self.gpu, enc, (self.passes.film.samples, d.guides.samples), angle, params);
         Ok(())
+    }
+
+    /// Encodes the resolve of the denoiser's output image (as the last
+    /// [`encode_denoise`](Self::encode_denoise) before it in submission order filtered it) at
+    /// `exposure` into the film's linear and display buffers, with the display encoding of
+    /// [`encode_resolve`](Self::encode_resolve): what the window draws is then the denoised
+    /// full image. Changing the exposure needs no new filter. No read-back.
+    pub fn encode_resolve_denoised(&self, enc: &mut wgpu::CommandEncoder, exposure: f32) -> Result<()> {
+        let d = self.denoiser()?;
+        self.passes.film.encode_resolve_image(&self.gpu, enc, &d.resolve, exposure);
+        Ok(())
+    }
+
+    /// The display encoding of the denoised full image (filtered now): 2^exposure · value,
+    /// clamped to [0,1], sRGB, 8 bits, as [`read_display`](Self::read_display) of the raw one.
+    pub fn read_display_denoised(&self, params: &DenoiseParams, exposure: f32) -> Result<DisplayImage> {
+        let mut enc =
+            self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("denoise") });
+        self.encode_denoise(&mut enc, params)?;
+        self.encode_resolve_denoised(&mut enc, exposure)?;
+        self.gpu.queue.submit([enc.finish()]);
+        self.passes.film.read_display_buffer(&self.gpu)
     }
 
     /// The denoiser's guide sums read back: the albedo and normal AOVs
     /// ([`GuideState::albedo`], [`GuideState::normal`]).
     pub fn read_guides(&self) -> Result<GuideState> {
-        self.denoiser()?.0.read(&self.gpu)
+        self.denoiser()?.guides.read(&self.gpu)
     }
 
     /// Raw G-buffer texels `(triangle + 1, b1 bits, b2 bits, texture level of detail bits)`,

@@ -1,4 +1,6 @@
-// Resolve (film.rs): mean of the accumulated sums → linear RGB and display RGBA8.
+// Resolve (film.rs): mean of the accumulated sums → linear RGB and display RGBA8 (`main`);
+// or a linear image that is already a mean, such as the denoiser's, → the same two
+// (`resolve_image`, with `film` bound to that image: one vec4 per pixel).
 
 struct Resolve {
     resolution: vec2u,
@@ -28,6 +30,12 @@ fn srgb_encode(c: vec3f) -> vec3f {
     return select(hi, lo, c <= vec3f(0.0031308));
 }
 
+// The display encoding of a linear value: 2^exposure · value, clamped, sRGB, 8 bits.
+fn display_encode(mean: vec3f) -> u32 {
+    let display = srgb_encode(clamp(mean * params.scale, vec3f(0.0), vec3f(1.0)));
+    return pack4x8unorm(vec4f(display, 1.0));
+}
+
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3u) {
     if any(gid.xy >= params.resolution) {
@@ -47,6 +55,16 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     }
     let mean = sum / f32(max(params.samples, 1u));
     linear_out[pixel] = vec4f(mean, 1.0);
-    let display = srgb_encode(clamp(mean * params.scale, vec3f(0.0), vec3f(1.0)));
-    display_out[pixel] = pack4x8unorm(vec4f(display, 1.0));
+    display_out[pixel] = display_encode(mean);
+}
+
+@compute @workgroup_size(8, 8)
+fn resolve_image(@builtin(global_invocation_id) gid: vec3u) {
+    if any(gid.xy >= params.resolution) {
+        return;
+    }
+    let pixel = gid.y * params.resolution.x + gid.x;
+    let mean = film[pixel].rgb;
+    linear_out[pixel] = vec4f(mean, 1.0);
+    display_out[pixel] = display_encode(mean);
 }

@@ -274,3 +274,70 @@ fn cornell_box_denoised_against_raw_and_the_convergence_rule() {
     let noise = noise.expect("both halves hold iterations at 1024");
     assert!(change < noise, "1024: the denoiser changes the image by {change}, the raw noise is {noise}");
 }
+
+/// The display encoding computed here, independently of the GPU's: 2^exposure · value,
+/// clamped to [0, 1], the sRGB transfer function (IEC 61966-2-1), rounded to 8 bits.
+fn srgb_bytes(image: &LinearImage, exposure: f32) -> Vec<[u8; 3]> {
+    let scale = 2f64.powf(exposure as f64);
+    let byte = |v: f32| {
+        let c = (v as f64 * scale).clamp(0.0, 1.0);
+        let e = if c <= 0.0031308 { 12.92 * c } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 };
+        (e * 255.0).round() as u8
+    };
+    image.pixels.iter().map(|p| p.map(byte)).collect()
+}
+
+/// The largest difference per channel between a display image's bytes and `expected`, and
+/// how many pixels differ at all.
+fn display_difference(shown: &rastergi::image_io::DisplayImage, expected: &[[u8; 3]]) -> (u8, usize) {
+    let mut worst = 0;
+    let mut differing = 0;
+    for (px, e) in shown.rgba.chunks_exact(4).zip(expected) {
+        let d = (0..3).map(|c| px[c].abs_diff(e[c])).max().unwrap();
+        worst = worst.max(d);
+        differing += (d > 0) as usize;
+    }
+    (worst, differing)
+}
+
+/// What `rastergi view` draws with the denoiser on: the film's display buffer after
+/// `encode_denoise` + `encode_resolve_denoised` is the display encoding of `read_denoised`'s
+/// image (computed on the CPU here) within 1/255 per channel, at exposures that clamp and that
+/// do not, also when only the exposure changes (no new filter); and it is not the raw image's.
+/// Then the raw resolve draws the raw image again.
+#[test]
+fn denoised_display_is_the_display_encoding_of_the_denoised_image() {
+    let gpu = common::gpu();
+    let scene = cornell_box();
+    let mut r = Renderer::new(&gpu, &scene, common::fitted_settings(&scene, 64, 2)).unwrap();
+    r.enable_denoiser().unwrap();
+    for _ in 0..4 {
+        r.iterate().unwrap();
+    }
+    let params = DenoiseParams::default();
+    let denoised = r.read_denoised(&params).unwrap();
+    let raw = r.read_linear(Show::Full).unwrap();
+    for exposure in [0.0f32, 1.5, -2.0] {
+        let shown = r.read_display_denoised(&params, exposure).unwrap();
+        assert_eq!((shown.width, shown.height), (64, 64));
+        let (worst, differing) = display_difference(&shown, &srgb_bytes(&denoised, exposure));
+        let (_, from_raw) = display_difference(&shown, &srgb_bytes(&raw, exposure));
+        println!(
+            "exposure {exposure}: denoised display vs CPU encoding: max {worst}/255, {differing} of 4096 pixels \
+             differ; {from_raw} pixels differ from the raw image's encoding"
+        );
+        assert!(worst <= 1, "exposure {exposure}: the denoised display is {worst}/255 off its CPU encoding");
+        assert!(from_raw > 1000, "exposure {exposure}: the display shows the raw image ({from_raw} pixels differ)");
+    }
+    // A new exposure alone: the resolve of the image as last filtered, in one encoder.
+    let mut enc = gpu.device.create_command_encoder(&Default::default());
+    r.encode_resolve_denoised(&mut enc, 1.0).unwrap();
+    gpu.queue.submit([enc.finish()]);
+    let shown = r.film().read_display_buffer(&gpu).unwrap();
+    let (worst, _) = display_difference(&shown, &srgb_bytes(&denoised, 1.0));
+    assert!(worst <= 1, "re-exposed without a new filter: {worst}/255 off");
+    // The raw resolve takes the display buffer back.
+    let shown = r.read_display(Show::Full, 0.0).unwrap();
+    let (worst, _) = display_difference(&shown, &srgb_bytes(&raw, 0.0));
+    assert!(worst <= 1, "the raw display after the denoised one: {worst}/255 off");
+}

@@ -8,6 +8,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Result, anyhow};
 use rastergi::camera_control::CameraControl;
+use rastergi::denoise::DenoiseParams;
 use rastergi::display::{Presented, WindowSurface};
 use rastergi::film::Show;
 use rastergi::gather::GatherMethod;
@@ -35,6 +36,13 @@ use crate::render::Method;
 const RESIZE_SETTLE: Duration = Duration::from_millis(150);
 /// How long a script's `resize` may wait for the window to take the new size.
 const RESIZE_TIMEOUT: Duration = Duration::from_secs(10);
+/// While the denoised image is shown, the denoiser (about 90 ms at 256² on lavapipe) runs
+/// again once the image holds this factor more iterations than when it last ran...
+const DENOISE_GROWTH: u32 = 2;
+/// ...or this long after it last ran, if the image has new iterations since. Every frame
+/// resolves the last denoised image at the current exposure, so the exposure needs no new
+/// filter; a restart (camera, new renderer, resize) or the toggle turning on filters at once.
+const DENOISE_INTERVAL: Duration = Duration::from_secs(1);
 
 /// A renderer being built on a worker thread (with the scene it opened, if it opened one).
 pub enum UserEvent {
@@ -51,6 +59,26 @@ struct Measured {
     memory: Option<u64>,
     /// (iterations, estimated error) since the last restart.
     history: Vec<(u32, f64)>,
+}
+
+/// The denoiser's last run for the window: the image's iterations then, and when.
+struct Denoised {
+    samples: u32,
+    at: Instant,
+}
+
+/// Whether the denoised image on the window is due a new filter at `samples` iterations (see
+/// [`DENOISE_GROWTH`], [`DENOISE_INTERVAL`]); `last` is `None` where none is on the window.
+fn denoise_due(last: Option<&Denoised>, samples: u32, now: Instant) -> bool {
+    match last {
+        None => true,
+        // Fewer iterations: the image restarted since.
+        Some(d) if samples < d.samples => true,
+        Some(d) => {
+            samples != d.samples
+                && (samples >= d.samples.saturating_mul(DENOISE_GROWTH) || now - d.at >= DENOISE_INTERVAL)
+        }
+    }
 }
 
 /// The viewer: its window, GPU, renderer, controls, panel and script.
@@ -73,7 +101,7 @@ pub struct App {
     generation: u64,
     /// A scene to open once no build is in flight.
     pending_open: Option<String>,
-    controls: Controls,
+    pub(super) controls: Controls,
     /// The window's inner size (0 while minimised on some platforms).
     size: (u32, u32),
     /// When the size last changed, until a renderer of that size is on its way.
@@ -87,6 +115,8 @@ pub struct App {
     batch: u32,
     rate: Rate,
     measured: Measured,
+    /// The denoiser's last run for the window, while the denoised image is shown since.
+    denoised: Option<Denoised>,
     title_at: Instant,
     status: String,
     script: Option<ScriptRun>,
@@ -137,6 +167,7 @@ impl App {
             batch: 1,
             rate: Rate { since: Instant::now(), count: 0, per_second: 0.0 },
             measured: Measured::default(),
+            denoised: None,
             title_at: Instant::now(),
             status: String::new(),
             script: steps.map(|steps| ScriptRun { steps, next: 0, last: Instant::now(), resizing: None }),
@@ -210,6 +241,7 @@ impl App {
             None => format!("tracing {} photons...", wanted.settings.photons),
         };
         let loaded_scale = self.args.env_scale;
+        let denoise = self.controls.denoise;
         let proxy = self.proxy.clone();
         std::thread::spawn(move || {
             let build = std::panic::AssertUnwindSafe(|| -> Result<(Active, Build, Option<Opened>)> {
@@ -243,7 +275,13 @@ impl App {
                 let scene = prepare(scene, &wanted, loaded_scale);
                 let active = match wanted.method {
                     Method::Gather => {
-                        Active::PhotonMap(Box::new(Renderer::new(&gpu, &scene, wanted.settings.clone())?))
+                        let mut r = Renderer::new(&gpu, &scene, wanted.settings.clone())?;
+                        // The guides from the first iteration on: nothing to restart. A failure
+                        // is reported when the viewer tries again (sync_denoiser).
+                        if denoise && let Err(e) = r.enable_denoiser() {
+                            log::warn!("the denoiser: {e}");
+                        }
+                        Active::PhotonMap(Box::new(r))
                     }
                     Method::Path => {
                         Active::PathTracer(Box::new(PathTracer::new(&gpu, &scene, wanted.settings.clone())?))
@@ -305,6 +343,7 @@ impl App {
             let r = active.get_mut();
             if r.camera() != camera {
                 r.set_camera(camera)?;
+                self.denoised = None;
             }
         }
         Ok(())
@@ -318,26 +357,97 @@ impl App {
         }
     }
 
+    /// The photon-map renderer while the window shows its denoised image: the denoiser asked
+    /// for, its guides accumulating, the full image shown.
+    fn denoising(&self) -> Option<&Renderer> {
+        match &self.renderer {
+            Some((Active::PhotonMap(r), _))
+                if self.controls.denoise && r.denoiser_enabled() && self.shown() == Show::Full =>
+            {
+                Some(r)
+            }
+            _ => None,
+        }
+    }
+
+    /// Turns the denoiser's guides on where the controls ask for the denoiser and the renderer
+    /// (the photon map's) has none yet. The guides hold the iterations from then on, so an
+    /// image that has iterations restarts. Where the GPU cannot hold them the toggle goes off
+    /// with a warning.
+    fn sync_denoiser(&mut self) {
+        if !self.controls.denoise {
+            return;
+        }
+        let Some((Active::PhotonMap(r), _)) = &mut self.renderer else { return };
+        if r.denoiser_enabled() {
+            return;
+        }
+        match r.enable_denoiser() {
+            Ok(()) => {
+                if r.samples() > 0 {
+                    log::info!("denoiser on: the image restarts (its guides start now)");
+                    r.reset();
+                }
+                self.denoised = None;
+            }
+            Err(e) => {
+                eprintln!("warning: the denoiser cannot be turned on: {e}");
+                self.status = format!("no denoiser: {e}");
+                self.controls.denoise = false;
+            }
+        }
+    }
+
+    /// Encodes the resolve of what the window shows into the film's display buffer: the raw
+    /// image of `show`, or the denoised one, filtered again first when it is due
+    /// ([`denoise_due`]).
+    fn encode_resolve(&mut self, enc: &mut egui_wgpu::wgpu::CommandEncoder, show: Show) -> Result<()> {
+        let exposure = self.controls.exposure;
+        if let Some(r) = self.denoising() {
+            let (samples, now) = (r.samples(), Instant::now());
+            let due = denoise_due(self.denoised.as_ref(), samples, now);
+            if due {
+                r.encode_denoise(enc, &DenoiseParams::default())?;
+            }
+            r.encode_resolve_denoised(enc, exposure)?;
+            if due {
+                self.denoised = Some(Denoised { samples, at: now });
+            }
+        } else {
+            if let Some((active, _)) = &self.renderer {
+                active.get().encode_resolve(enc, show, exposure);
+            }
+            self.denoised = None;
+        }
+        Ok(())
+    }
+
     fn screenshot(&mut self) {
         let show = self.shown();
+        let denoised = self.denoising().is_some();
         let Some((active, _)) = &self.renderer else {
             self.status = "no image yet to save".into();
             return;
         };
         let (renderer, exposure) = (active.get(), self.controls.exposure);
-        match self.screenshots.save(renderer, show, exposure) {
+        match self.screenshots.save(renderer, show, exposure, denoised) {
             Ok((png, exr)) => {
                 println!(
-                    "screenshot: {} {} ({} iterations, {}x{}, show {}, exposure {}; camera {})",
+                    "screenshot: {} {} ({} iterations, {}x{}, show {}{}, exposure {}; camera {})",
                     png.display(),
                     exr.display(),
                     renderer.samples(),
                     renderer.settings().width,
                     renderer.settings().height,
                     show_name(show),
+                    if denoised { " denoised" } else { "" },
                     exposure,
                     camera_options(&renderer.camera())
                 );
+                // The denoiser's image now holds the current iterations' filter.
+                if denoised {
+                    self.denoised = Some(Denoised { samples: renderer.samples(), at: Instant::now() });
+                }
                 self.status = format!("saved {}", png.display());
             }
             Err(e) => {
@@ -462,7 +572,7 @@ impl App {
             return;
         }
         let Some(gpu) = self.gpu.clone() else { return };
-
+        self.sync_denoiser();
         if let Err(e) = self.iterate_batch() {
             return self.fail(event_loop, e);
         }
@@ -476,8 +586,8 @@ impl App {
         };
         let show = self.shown();
         let mut enc = gpu.device.create_command_encoder(&Default::default());
-        if let Some((active, _)) = &self.renderer {
-            active.get().encode_resolve(&mut enc, show, self.controls.exposure);
+        if let Err(e) = self.encode_resolve(&mut enc, show) {
+            return self.fail(event_loop, e);
         }
         let (Some(surface), Some(window)) = (&mut self.surface, &self.window) else { return };
         let film = self.renderer.as_ref().map(|(r, _)| r.get().film());
@@ -546,11 +656,12 @@ impl App {
     fn title(&self) -> String {
         let samples = self.renderer.as_ref().map_or(0, |(r, _)| r.get().samples());
         format!(
-            "rastergi - {} - {} iterations, {:.1}/s - {} - {}",
+            "rastergi - {} - {} iterations, {:.1}/s - {}{} - {}",
             self.scene_name,
             samples,
             self.rate.per_second,
             show_name(self.shown()),
+            if self.denoising().is_some() { " denoised" } else { "" },
             self.controls.camera.mode.name()
         )
     }
@@ -627,6 +738,7 @@ impl ApplicationHandler<UserEvent> for App {
                     self.title_at = Instant::now() - Duration::from_secs(1);
                 }
                 self.measured = Measured::default();
+                self.denoised = None;
                 self.renderer = Some((active, build));
                 if let Some(run) = &mut self.script {
                     run.last = Instant::now();
@@ -767,6 +879,7 @@ impl ApplicationHandler<UserEvent> for App {
                             if let Err(e) = r.resize(size.0, size.1) {
                                 return self.fail(event_loop, e.into());
                             }
+                            self.denoised = None;
                             *built = wanted;
                         }
                         _ => self.start_build(None),
@@ -790,5 +903,22 @@ impl ApplicationHandler<UserEvent> for App {
         }
         event_loop.set_control_flow(ControlFlow::Wait);
         self.redraw();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_denoiser_runs_again_when_the_iterations_double_or_a_second_has_passed() {
+        let t = Instant::now();
+        assert!(denoise_due(None, 0, t), "nothing denoised on the window yet");
+        let last = Denoised { samples: 8, at: t };
+        assert!(!denoise_due(Some(&last), 8, t + 10 * DENOISE_INTERVAL), "no new iterations, no new filter");
+        assert!(!denoise_due(Some(&last), 15, t + DENOISE_INTERVAL / 2));
+        assert!(denoise_due(Some(&last), 16, t + DENOISE_INTERVAL / 2), "doubled");
+        assert!(denoise_due(Some(&last), 9, t + DENOISE_INTERVAL), "a second later");
+        assert!(denoise_due(Some(&last), 3, t), "restarted: fewer iterations");
     }
 }

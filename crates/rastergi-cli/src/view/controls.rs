@@ -38,6 +38,8 @@ pub enum Key {
     SunLower,
     Screenshot,
     TogglePanel,
+    /// The denoised image on / off.
+    ToggleDenoise,
     Quit,
 }
 
@@ -108,6 +110,9 @@ pub struct Controls {
     pub env_scale: Option<f32>,
     /// The control panel is shown (H).
     pub panel: bool,
+    /// Show the denoised image (N): where the renderer has a denoiser (the photon map's) and
+    /// the full image is shown.
+    pub denoise: bool,
 }
 
 impl Controls {
@@ -130,6 +135,7 @@ impl Controls {
             sun: None,
             env_scale: None,
             panel: true,
+            denoise: false,
         }
     }
 
@@ -210,6 +216,7 @@ impl Controls {
             Key::SunLower => r.retrace = self.turn_sun(0.0, -SUN_STEP),
             Key::Screenshot => r.screenshot = true,
             Key::TogglePanel => self.panel = !self.panel,
+            Key::ToggleDenoise => self.denoise = !self.denoise,
             Key::Quit => r.quit = true,
             _ => {}
         }
@@ -287,6 +294,7 @@ impl Controls {
             }
             Action::Show(show) => self.show = show,
             Action::Exposure(ev) => self.exposure = ev,
+            Action::Denoise(on) => self.denoise = on,
             Action::Photons(n) => r.retrace = self.set_photons(n),
             Action::Grid(n) => r.retrace = self.set_grid(n),
             Action::Sun { azimuth, elevation } => r.retrace = self.set_sun(SunAngles { azimuth, elevation }),
@@ -372,11 +380,18 @@ mod tests {
             Key::ExposureDown,
             Key::ToggleMode,
             Key::TogglePanel,
+            Key::ToggleDenoise,
             Key::Fast,
         ] {
             assert_eq!(c.key(key, true, false), Response::default(), "{key:?}");
         }
         assert_eq!((c.show, c.exposure, c.camera.mode, c.panel), (Show::PhotonMap, 0.5, Mode::Orbit, false));
+        // The denoiser's toggle asks for nothing here: the application restarts the image the
+        // first time it enables the denoiser's guides.
+        assert!(c.denoise);
+        assert!(!c.key(Key::ToggleDenoise, true, true).retrace && c.denoise, "auto-repeat does not toggle again");
+        assert_eq!(c.action(&Action::Denoise(false), 64.0), Response::default());
+        assert!(!c.denoise);
         assert_eq!(c.camera.camera(), camera);
         assert_eq!(c.action(&Action::Show(Show::Direct), 64.0), Response::default());
         assert_eq!(c.action(&Action::Mode { orbit: false }, 64.0), Response::default());

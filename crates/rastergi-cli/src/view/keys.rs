@@ -31,6 +31,7 @@ pub(super) fn key_of(event: &KeyEvent) -> Option<Key> {
             KeyCode::Comma => Some(Key::CoarserGrid),
             KeyCode::Period => Some(Key::FinerGrid),
             KeyCode::KeyP => Some(Key::Screenshot),
+            KeyCode::KeyN => Some(Key::ToggleDenoise),
             KeyCode::KeyJ => Some(Key::SunWest),
             KeyCode::KeyL => Some(Key::SunEast),
             KeyCode::KeyI => Some(Key::SunHigher),

@@ -4,7 +4,8 @@
 //!
 //! The loop, per displayed frame: apply held keys and the script's due steps to the camera;
 //! if the camera moved, `Renderer::set_camera` restarts the image; run as many iterations as
-//! fit in [`frames::FRAME_BUDGET`] of GPU time (at least one); resolve the film and draw it
+//! fit in [`frames::FRAME_BUDGET`] of GPU time (at least one); resolve the film (or, with the
+//! denoiser on, its denoised image, filtered again only when due: `app.rs`) and draw it
 //! ([`rastergi::display`]) with the control panel over it; present. Building a renderer
 //! (photon tracing, or opening a scene) runs on a worker thread so the window stays live
 //! meanwhile; new settings build a new renderer at the window's size (the film is the window's size) and shows the
@@ -59,6 +60,7 @@ Keys and mouse:
   Home              back to the starting camera
   1 2 3 4           show full / direct / indirect / photon map (no restart)
   + -               exposure up / down by half a stop
+  N                 denoiser on / off (photon map, full image; the first time restarts the image)
   [ ]               halve / double the photons (re-traces the photon map)
   , .               halve / double the photon grid resolution (re-traces)
   J L / I K         turn the sun (the scene's distant light): azimuth / elevation by 5 degrees (re-traces)
@@ -82,6 +84,10 @@ pub struct ViewArgs {
     /// Directory for screenshots (default: the current directory).
     #[arg(long)]
     screenshot_dir: Option<PathBuf>,
+    /// Start with the denoiser on (N and the panel's checkbox toggle it; README "Denoiser"):
+    /// its guides accumulate from the first iteration. Photon map method, full image only.
+    #[arg(long)]
+    denoise: bool,
 }
 
 /// The `after_help` of `rastergi view`: the keys and the script format.
@@ -93,7 +99,7 @@ Script (--script FILE): one action per line, optionally after a condition; # com
   after T s: ACTION            T seconds after the previous line
   ACTION                       right after the previous line
 Actions: move R,U,F | look YAW,PITCH | orbit YAW,PITCH | pan X,Y | zoom STEPS |
-  mode fly|orbit | speed S | home | show full|direct|indirect|photon-map | exposure EV |
+  mode fly|orbit | speed S | home | show full|direct|indirect|photon-map | exposure EV | denoise on|off |
   photons N | grid N | passes N | sun AZIMUTH,ELEVATION | env-scale S | method gather|path |
   gather auto|raster|lists|trace | gather-directions per-pixel|shared | directions N |
   open SCENE | panel on|off | resize W,H | screenshot | quit
@@ -132,6 +138,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     })?;
     println!("rastergi view: {}\n{KEYS}", a.scene);
     let mut app = App::new(a, scene, base, steps, Screenshots::new(dir), event_loop.create_proxy());
+    app.controls.denoise = args.denoise;
     event_loop.run_app(&mut app).map_err(|e| anyhow!("the window's event loop failed: {e}"))?;
     app.finish()
 }

@@ -384,6 +384,21 @@ fn display(ui: &mut Ui, c: &Controls, out: &mut Vec<Action>) {
     if ui.add(Slider::new(&mut ev, -10.0..=10.0).step_by(0.1).text("exposure (EV)")).changed() {
         out.push(Action::Exposure(ev));
     }
+    let mut denoise = c.denoise;
+    let why_not = match (c.method, show) {
+        (Method::Path, _) => Some("the path tracer has no denoiser: choose the photon map + gather"),
+        (_, Show::Full) => None,
+        _ => Some("the denoiser filters the full image: show full"),
+    };
+    let r = ui
+        .add_enabled(why_not.is_none(), egui::Checkbox::new(&mut denoise, "denoise"))
+        .on_hover_text("the edge-avoiding a-trous filter of the full image (N); the first time restarts the image");
+    if let Some(why) = why_not {
+        r.on_disabled_hover_text(why);
+    }
+    if denoise != c.denoise {
+        out.push(Action::Denoise(denoise));
+    }
 }
 
 /// The name of a gather implementation as `--gather` spells it.
@@ -459,7 +474,7 @@ pub(super) struct Panel {
 mod tests {
     use super::*;
     use egui_kittest::Harness;
-    use egui_kittest::kittest::Queryable;
+    use egui_kittest::kittest::{NodeT, Queryable};
     use glam::Vec3;
     use rastergi::camera_control::CameraControl;
     use rastergi::renderer::RenderSettings;
@@ -514,20 +529,25 @@ mod tests {
         h.run();
         assert_eq!(h.state().actions, [Action::Method(Method::Path)]);
         assert!(h.query_by_label("photons").is_none(), "no photon map settings for the path tracer");
+        assert!(h.get_by_label("denoise").accesskit_node().is_disabled(), "the path tracer has no denoiser");
         h.get_by_label("photon map + gather").click();
         h.run();
         h.get_by_label("shared").click();
         h.run();
         h.get_by_label("Screenshot").click();
         h.run();
+        h.get_by_label("denoise").click();
+        h.run();
         h.get_by_label("indirect").click();
         h.run();
+        assert!(h.get_by_label("denoise").accesskit_node().is_disabled(), "the denoiser filters the full image alone");
         assert_eq!(
             h.state().actions[1..],
             [
                 Action::Method(Method::Gather),
                 Action::GatherDirections(GatherDirections::Shared),
                 Action::Screenshot,
+                Action::Denoise(true),
                 Action::Show(Show::Indirect),
             ]
         );

@@ -5,6 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
+use rastergi::denoise::DenoiseParams;
 use rastergi::film::Show;
 use rastergi::image_io::{write_exr, write_png};
 use rastergi::progressive::Progressive;
@@ -51,10 +52,23 @@ impl Screenshots {
         bail!("{}: rastergi-0000 to rastergi-9999 are all taken; choose another --screenshot-dir", self.dir.display())
     }
 
-    /// Saves the image as shown (PNG) and its linear radiance (EXR); returns the two paths.
-    pub fn save(&mut self, renderer: &dyn Progressive, show: Show, exposure: f32) -> Result<(PathBuf, PathBuf)> {
-        let display = renderer.read_display(show, exposure)?;
-        let linear = renderer.read_linear(show)?;
+    /// Saves the image as shown (PNG) and its linear radiance (EXR): `denoised` (the full
+    /// image, filtered at the iterations it holds now, where the renderer has a denoiser
+    /// enabled) or the raw image of `show`; returns the two paths.
+    pub fn save(
+        &mut self,
+        renderer: &dyn Progressive,
+        show: Show,
+        exposure: f32,
+        denoised: bool,
+    ) -> Result<(PathBuf, PathBuf)> {
+        let (display, linear) = match renderer.as_renderer().filter(|_| denoised) {
+            Some(r) => {
+                let params = DenoiseParams::default();
+                (r.read_display_denoised(&params, exposure)?, r.read_denoised(&params)?)
+            }
+            None => (renderer.read_display(show, exposure)?, renderer.read_linear(show)?),
+        };
         let (png, exr) = self.reserve()?;
         let written = write_png(&png, &display).and_then(|()| write_exr(&exr, &linear));
         if let Err(e) = written {

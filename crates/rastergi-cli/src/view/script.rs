@@ -30,6 +30,7 @@
 //! | `mode fly` / `mode orbit` | the mouse-drag mode |
 //! | `show full\|direct\|indirect\|photon-map` | what the image shows (no restart) |
 //! | `exposure EV` | sets the display exposure in stops |
+//! | `denoise on\|off` | shows the denoised full image, as the N key (photon map only; the first time restarts the image) |
 //! | `photons N` / `grid N` | re-traces the photon map with N photons / N grid cells |
 //! | `passes N` | photon passes (0: no limit; 1: one fixed map), re-traces |
 //! | `sun AZIMUTH,ELEVATION` | puts the scene's sun (its last distant light) there, re-traces |
@@ -102,6 +103,8 @@ pub enum Action {
     },
     Show(Show),
     Exposure(f32),
+    /// Shows the denoised image (on) or the raw one.
+    Denoise(bool),
     Photons(u32),
     Grid(u32),
     /// Puts the scene's sun at (azimuth, elevation) degrees.
@@ -195,7 +198,7 @@ fn parse_when(condition: &str) -> Result<When> {
     }
 }
 
-const ACTIONS: &str = "move, look, orbit, pan, zoom, mode, show, exposure, photons, grid, passes, sun, env-scale, \
+const ACTIONS: &str = "move, look, orbit, pan, zoom, mode, show, exposure, denoise, photons, grid, passes, sun, env-scale, \
                        method, gather, gather-directions, directions, speed, home, open, panel, resize, screenshot, quit";
 
 fn parse_action(action: &str) -> Result<Action> {
@@ -230,6 +233,7 @@ fn parse_action(action: &str) -> Result<Action> {
             _ => bail!("'mode' takes 'fly' or 'orbit'"),
         },
         "show" => Action::Show(choice::<ShowArg>(name, args)?.show()),
+        "denoise" => Action::Denoise(on_off(name, args)?),
         "photons" => Action::Photons(count(args, "photons", 1, u32::MAX)?),
         "grid" => Action::Grid(count(args, "grid", 1, 1024)?),
         "sun" => {
@@ -252,11 +256,7 @@ fn parse_action(action: &str) -> Result<Action> {
         "home" => none(Action::Home)?,
         "open" if args.is_empty() => bail!("'open' takes a scene: a built-in name or a file"),
         "open" => Action::Open(args.to_owned()),
-        "panel" => Action::Panel(match args {
-            "on" => true,
-            "off" => false,
-            _ => bail!("'panel' takes 'on' or 'off'"),
-        }),
+        "panel" => Action::Panel(on_off(name, args)?),
         "resize" => {
             let [width, height] = numbers::<2>(args, "W,H")?;
             let side = |v: f32| (1.0..=16384.0).contains(&v) && v.fract() == 0.0;
@@ -283,6 +283,15 @@ fn choice<T: ValueEnum>(name: &str, args: &str) -> Result<T> {
         [a, b] => bail!("'{name}' takes '{a}' or '{b}'"),
         [first @ .., last] => bail!("'{name}' takes {} or {last}", first.join(", ")),
         [] => unreachable!("a value enum has values"),
+    }
+}
+
+/// `on` or `off`.
+fn on_off(name: &str, args: &str) -> Result<bool> {
+    match args {
+        "on" => Ok(true),
+        "off" => Ok(false),
+        _ => bail!("'{name}' takes 'on' or 'off'"),
     }
 }
 
@@ -358,7 +367,7 @@ mod tests {
     fn the_panels_actions_parse() {
         let steps = parse(
             "method path\nmethod gather\ngather trace\ngather-directions shared\ndirections 2\npasses 0\n\
-             env-scale 0.5\nspeed 2\nhome\nopen scenes/my room.obj\npanel off\n",
+             env-scale 0.5\nspeed 2\nhome\nopen scenes/my room.obj\npanel off\ndenoise on\ndenoise off\n",
         )
         .unwrap();
         assert_eq!(
@@ -375,6 +384,8 @@ mod tests {
                 Action::Home,
                 Action::Open("scenes/my room.obj".into()),
                 Action::Panel(false),
+                Action::Denoise(true),
+                Action::Denoise(false),
             ]
         );
     }
@@ -399,6 +410,7 @@ mod tests {
             ("env-scale -1", "line 1", "≥ 0"),
             ("open", "line 1", "takes a scene"),
             ("panel hidden", "line 1", "'on' or 'off'"),
+            ("denoise yes", "line 1", "'denoise' takes 'on' or 'off'"),
         ];
         for (text, line, message) in cases {
             let e = format!("{:#}", parse(text).unwrap_err());

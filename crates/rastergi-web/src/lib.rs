@@ -102,6 +102,13 @@ pub async fn create_viewer(
         ))
     })?;
     log::info!("{}", gpu.describe().replace('\n', "; "));
+    let storage = gpu.device.limits().max_storage_buffers_per_shader_stage;
+    if storage < rastergi::gpu::WEB_STORAGE_BUFFERS {
+        return Err(JsError::new(&format!(
+            "this browser's WebGPU allows {storage} storage buffers per shader stage and rastergi needs {} (Chrome and Edge grant 10)",
+            rastergi::gpu::WEB_STORAGE_BUFFERS
+        )));
+    }
     let surface = WindowSurface::new(&gpu, surface, canvas_width, canvas_height).map_err(error)?;
     let options = Options {
         width,

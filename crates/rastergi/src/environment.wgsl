@@ -11,7 +11,8 @@ struct Environment {
     // The light table's probability of picking it.
     pmf: f32,
     _pad0: u32,
-    // Offsets in the environment's data (env_data; at scene_offsets().environment in scene_data) of the row cdf (H − 1), the column cdfs ((H − 1)·W) and
+    // Offsets in the environment's data (env_data, at scene_offset(DATA_ENVIRONMENT) in
+    // scene_data) of the row cdf (H − 1), the column cdfs ((H − 1)·W) and
     // the cells' pmfs ((H − 1)·W); the texels (RGB) come first.
     row_cdf: u32,
     column_cdf: u32,
@@ -23,7 +24,7 @@ struct Environment {
 
 // Word k of the environment's data.
 fn env_data(k: u32) -> f32 {
-    return scene_f32(scene_offsets().environment + k);
+    return scene_f32(scene_offset(DATA_ENVIRONMENT) + k);
 }
 
 fn has_environment() -> bool {

@@ -130,30 +130,11 @@ struct MaterialRecord {
 // Trilinear filtering, repeat addressing.
 @group(0) @binding(6) var texture_sampler: sampler;
 
-// Where each part of `scene_data` starts, in words (gpu_scene.rs, GpuSceneOffsets): the
-// buffer's first 16 words (a uniform buffer beside the storage buffers crashes lavapipe,
-// Mesa 22.3, in the raster gather).
-struct SceneOffsets {
-    uvs: u32,
-    uv_triangles: u32,
-    normals: u32,
-    normal_triangles: u32,
-    tangents: u32,
-    tangent_triangles: u32,
-    lights: u32,
-    light_count: u32,
-    punctual: u32,
-    environment: u32,
-    ggx_cells: u32,
-    ggx_means: u32,
-    glass: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
-}
-
 // The rest of the scene in one buffer of words (one binding: WebGPU allows 10 storage buffers
-// per shader stage), after its header (SceneOffsets) at the offsets the header gives:
+// per shader stage). Its first 16 words are a header (gpu_scene.rs, GpuSceneOffsets; not a
+// uniform buffer, which beside these storage buffers crashes lavapipe, Mesa 22.3, in the raster
+// gather): word DATA_UVS … DATA_GLASS (shader.rs's constants) is where each part starts or
+// how many items it holds. After it:
 // - texture coordinates of the triangles' corners, three vec2f per triangle (one zero
 //   triangle when the scene has none);
 // - shading normals at the corners, nine floats per triangle (zero: the triangle shades flat;
@@ -166,10 +147,9 @@ struct SceneOffsets {
 // - the GGX lobe's albedo tables of the scattering model (bsdf.wgsl, bsdf/albedo.rs).
 @group(0) @binding(8) var<storage, read> scene_data: array<u32>;
 
-fn scene_offsets() -> SceneOffsets {
-    return SceneOffsets(scene_data[0], scene_data[1], scene_data[2], scene_data[3], scene_data[4], scene_data[5],
-        scene_data[6], scene_data[7], scene_data[8], scene_data[9], scene_data[10], scene_data[11], scene_data[12],
-        0u, 0u, 0u);
+// Word k of the header: one load (the passes read only the fields they use).
+fn scene_offset(k: u32) -> u32 {
+    return scene_data[k];
 }
 
 fn scene_f32(i: u32) -> f32 {
@@ -186,28 +166,28 @@ fn scene_vec4(i: u32) -> vec4f {
 
 // Entry e of the light distribution.
 fn light_entry(e: u32) -> LightEntry {
-    let i = scene_offsets().lights + 4u * e;
+    let i = scene_offset(DATA_LIGHTS) + 4u * e;
     return LightEntry(scene_data[i], scene_f32(i + 1u), scene_f32(i + 2u), scene_f32(i + 3u));
 }
 
 // Punctual light k.
 fn punctual_light(k: u32) -> PunctualLight {
-    let i = scene_offsets().punctual + 16u * k;
+    let i = scene_offset(DATA_PUNCTUAL) + 16u * k;
     return PunctualLight(scene_vec3(i), scene_data[i + 3u], scene_vec3(i + 4u), scene_f32(i + 7u),
         scene_vec3(i + 8u), scene_f32(i + 11u), scene_vec3(i + 12u), scene_f32(i + 15u));
 }
 
 // The GGX albedo tables' cell k, mean j and glass cell r (bsdf.wgsl's accessors).
 fn ggx_cell(k: u32) -> vec4f {
-    return scene_vec4(scene_offsets().ggx_cells + 4u * k);
+    return scene_vec4(scene_offset(DATA_GGX_CELLS) + 4u * k);
 }
 
 fn ggx_mean(j: u32) -> vec4f {
-    return scene_vec4(scene_offsets().ggx_means + 4u * j);
+    return scene_vec4(scene_offset(DATA_GGX_MEANS) + 4u * j);
 }
 
 fn glass_cell(r: u32) -> f32 {
-    return scene_f32(scene_offsets().glass + r);
+    return scene_f32(scene_offset(DATA_GLASS) + r);
 }
 
 // The random stream of stochastic opacity (passes_through): each entry point that finds
@@ -268,7 +248,7 @@ fn triangle_normal(t: Triangle) -> vec3f {
 
 // Texture coordinates at barycentrics (b1, b2) of triangle `tri` (PreparedScene::uv_at).
 fn surface_uv(tri: u32, b1: f32, b2: f32) -> vec2f {
-    let i = scene_offsets().uvs + 6u * min(tri, scene_offsets().uv_triangles - 1u);
+    let i = scene_offset(DATA_UVS) + 6u * min(tri, scene_offset(DATA_UV_TRIANGLES) - 1u);
     let uv = array<vec2f, 3>(vec2f(scene_f32(i), scene_f32(i + 1u)), vec2f(scene_f32(i + 2u), scene_f32(i + 3u)),
         vec2f(scene_f32(i + 4u), scene_f32(i + 5u)));
     return uv[0] * (1.0 - b1 - b2) + uv[1] * b1 + uv[2] * b2;
@@ -288,7 +268,7 @@ fn shading_normal(tri: u32, b1: f32, b2: f32, n: vec3f, mi: u32, textured: bool,
     let w = vec3f(1.0 - b1 - b2, b1, b2);
     var ns = n;
     if SCENE_NORMALS {
-        let i = scene_offsets().normals + 9u * min(tri, scene_offsets().normal_triangles - 1u);
+        let i = scene_offset(DATA_NORMALS) + 9u * min(tri, scene_offset(DATA_NORMAL_TRIANGLES) - 1u);
         var v = vec3f(0.0);
         for (var k = 0u; k < 3u; k++) {
             v += w[k] * scene_vec3(i + 3u * k);
@@ -306,7 +286,7 @@ fn shading_normal(tri: u32, b1: f32, b2: f32, n: vec3f, mi: u32, textured: bool,
     if map.layer == NO_TEXTURE {
         return ns;
     }
-    let j = scene_offsets().tangents + 12u * min(tri, scene_offsets().tangent_triangles - 1u);
+    let j = scene_offset(DATA_TANGENTS) + 12u * min(tri, scene_offset(DATA_TANGENT_TRIANGLES) - 1u);
     var t = vec4f(0.0);
     for (var k = 0u; k < 3u; k++) {
         t += w[k] * scene_vec4(j + 4u * k);
@@ -663,7 +643,7 @@ fn has_lights() -> bool {
 // The light entry whose cdf interval holds u: the first with u < cdf (LightTable::pick).
 fn light_pick(u: f32) -> u32 {
     var lo = 0u;
-    var hi = scene_offsets().light_count - 1u;
+    var hi = scene_offset(DATA_LIGHT_COUNT) - 1u;
     while lo < hi {
         let mid = (lo + hi) / 2u;
         if light_entry(mid).cdf <= u {

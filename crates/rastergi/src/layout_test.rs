@@ -66,25 +66,6 @@ fn twins() -> Vec<Twin> {
         ),
         twin!(GpuTriangle, "Triangle", [v0, material, v1, flags, v2, light]),
         twin!(crate::gpu_scene::GpuMaterialRecord, "MaterialRecord", [material, maps]),
-        twin!(
-            crate::gpu_scene::GpuSceneOffsets,
-            "SceneOffsets",
-            [
-                uvs,
-                uv_triangles,
-                normals,
-                normal_triangles,
-                tangents,
-                tangent_triangles,
-                lights,
-                light_count,
-                punctual,
-                environment,
-                ggx_cells,
-                ggx_means,
-                glass
-            ]
-        ),
         twin!(GpuTextureSlot, "TextureSlot", [u, layer, v]),
         twin!(
             GpuMaterial,

@@ -65,6 +65,24 @@ pub fn constants() -> String {
         ("GLASS_ALBEDO_ETAS", crate::bsdf::albedo::GLASS_ETAS as u32),
         ("GLASS_ALBEDO_CELLS", crate::bsdf::albedo::GLASS_CELLS as u32),
     ];
+    use crate::gpu_scene::GpuSceneOffsets as O;
+    let word = |offset: usize| (offset / 4) as u32;
+    let header = [
+        ("DATA_UVS", word(std::mem::offset_of!(O, uvs))),
+        ("DATA_UV_TRIANGLES", word(std::mem::offset_of!(O, uv_triangles))),
+        ("DATA_NORMALS", word(std::mem::offset_of!(O, normals))),
+        ("DATA_NORMAL_TRIANGLES", word(std::mem::offset_of!(O, normal_triangles))),
+        ("DATA_TANGENTS", word(std::mem::offset_of!(O, tangents))),
+        ("DATA_TANGENT_TRIANGLES", word(std::mem::offset_of!(O, tangent_triangles))),
+        ("DATA_LIGHTS", word(std::mem::offset_of!(O, lights))),
+        ("DATA_LIGHT_COUNT", word(std::mem::offset_of!(O, light_count))),
+        ("DATA_PUNCTUAL", word(std::mem::offset_of!(O, punctual))),
+        ("DATA_ENVIRONMENT", word(std::mem::offset_of!(O, environment))),
+        ("DATA_GGX_CELLS", word(std::mem::offset_of!(O, ggx_cells))),
+        ("DATA_GGX_MEANS", word(std::mem::offset_of!(O, ggx_means))),
+        ("DATA_GLASS", word(std::mem::offset_of!(O, glass))),
+    ];
+    let u32s: Vec<(&str, u32)> = u32s.into_iter().chain(header).collect();
     let f32s = [
         ("OFFSET_STEP", OFFSET_STEP),
         ("MIN_LOOKUP_AREA", MIN_LOOKUP_AREA),

@@ -161,7 +161,7 @@ fn layer_fresnel(b: Bsdf, c: f32) -> vec3f {
 
 // The GGX lobe's directional albedo tables (bsdf/albedo.rs, GpuGgxAlbedo): cell k = √α·N + μ
 // holds (E₁, E₅) at k and k + 1; means[j] (Ē₁, Ē₅) at √α cells j and j + 1. Read through
-// the includer's ggx_cell(k), ggx_mean(j) and glass_cell(r) (the scene's from scene_data,
+// the includer's ggx_cell(k), ggx_mean(j) and glass_cell(r) (the scene's from two textures,
 // gpu_scene.wgsl).
 struct GgxAlbedoTable {
     cells: array<vec4f, GGX_ALBEDO_CELLS>,

@@ -125,12 +125,61 @@ pub struct GpuSceneOffsets {
     pub punctual: u32,
     /// The environment map's data ([`Environment::gpu_data`]).
     pub environment: u32,
-    /// The GGX albedo tables' parts ([`crate::bsdf::albedo::GpuGgxAlbedo`]; 0 where the
-    /// scene has none).
-    pub ggx_cells: u32,
-    pub ggx_means: u32,
-    pub glass: u32,
-    pub _pad: [u32; 3],
+    pub _pad: [u32; 6],
+}
+
+/// A float texture read texel by texel (`textureLoad`): the GGX albedo tables.
+fn table_texture_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+/// The GGX albedo tables as gpu_scene.wgsl reads them: the cells and means, N × (N + 1)
+/// RGBA32F, and the rough glass's, N × (cells / N) R32F. Computed and filled only where some
+/// material is not Lambertian (SCENE_BSDF), the glass's only where some material is rough
+/// solid glass; 1 × 1 zeros otherwise.
+fn albedo_textures(gpu: &Gpu, has_bsdfs: bool, glass: bool) -> (wgpu::TextureView, wgpu::TextureView) {
+    use crate::bsdf::albedo::N;
+    let texture = |label: &str, format: wgpu::TextureFormat, (w, h): (usize, usize), data: &[u8]| {
+        let t = gpu.device.create_texture_with_data(
+            &gpu.queue,
+            &wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d { width: w as u32, height: h as u32, depth_or_array_layers: 1 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            },
+            wgpu::util::TextureDataOrder::LayerMajor,
+            data,
+        );
+        t.create_view(&Default::default())
+    };
+    let (rgba, r) = (wgpu::TextureFormat::Rgba32Float, wgpu::TextureFormat::R32Float);
+    if !has_bsdfs {
+        let zeros = [0u8; 16];
+        return (texture("ggx albedo", rgba, (1, 1), &zeros), texture("glass albedo", r, (1, 1), &zeros[..4]));
+    }
+    let table = crate::bsdf::ggx_albedo().gpu(glass);
+    let cells: Vec<[f32; 4]> = table.cells.iter().chain(&table.means).copied().collect();
+    let ggx = texture("ggx albedo", rgba, (N, N + 1), bytemuck::cast_slice(&cells));
+    let glass = if glass {
+        texture("glass albedo", r, (N, table.glass.len() / N), bytemuck::cast_slice(&table.glass[..]))
+    } else {
+        texture("glass albedo", r, (1, 1), &[0u8; 4])
+    };
+    (ggx, glass)
 }
 
 /// The scene's data buffer as it is filled: each part appended as 32-bit words.
@@ -525,7 +574,7 @@ impl GpuScene {
         // The header (GpuSceneOffsets) comes first; it is written once the offsets are known.
         let mut data = SceneData { words: vec![0; std::mem::size_of::<GpuSceneOffsets>() / 4] };
         let no_light = [LightEntry::zeroed()];
-        let mut offsets = GpuSceneOffsets {
+        let offsets = GpuSceneOffsets {
             uvs: data.push(&uvs),
             uv_triangles: (uvs.len() / 3) as u32,
             normals: data.push(&normals),
@@ -539,16 +588,6 @@ impl GpuScene {
             environment: data.push(&env_data),
             ..GpuSceneOffsets::default()
         };
-        // The GGX albedo tables are read only where some material is not Lambertian
-        // (SCENE_BSDF): other scenes neither compute nor hold them.
-        if has_bsdfs {
-            let table = crate::bsdf::ggx_albedo().gpu(s.materials.iter().any(|m| m.needs_glass_table()));
-            let at = data.push(std::slice::from_ref(&*table));
-            use crate::bsdf::albedo::GpuGgxAlbedo as T;
-            offsets.ggx_cells = at + (std::mem::offset_of!(T, cells) / 4) as u32;
-            offsets.ggx_means = at + (std::mem::offset_of!(T, means) / 4) as u32;
-            offsets.glass = at + (std::mem::offset_of!(T, glass) / 4) as u32;
-        }
         data.words[..size_of::<GpuSceneOffsets>() / 4].copy_from_slice(bytemuck::cast_slice(&[offsets]));
         crate::limits::check_storage_buffer(
             &limits,
@@ -587,6 +626,8 @@ impl GpuScene {
                 sampler_entry(6, vis),
                 storage_entry::<u32>(8, vis, true),
                 uniform_entry::<GpuEnvironment>(9, wgpu::ShaderStages::COMPUTE),
+                table_texture_entry(13, compute),
+                table_texture_entry(14, compute),
             ],
         );
         // The buffers' bindings, in the order of `buffers`.
@@ -599,6 +640,9 @@ impl GpuScene {
         entries.push(wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&texture_view) });
         entries.push(wgpu::BindGroupEntry { binding: 6, resource: wgpu::BindingResource::Sampler(&sampler) });
         entries.push(wgpu::BindGroupEntry { binding: 9, resource: env_uniform_buffer.as_entire_binding() });
+        let (ggx_cells, glass) = albedo_textures(gpu, has_bsdfs, s.materials.iter().any(Material::needs_glass_table));
+        entries.push(wgpu::BindGroupEntry { binding: 13, resource: wgpu::BindingResource::TextureView(&ggx_cells) });
+        entries.push(wgpu::BindGroupEntry { binding: 14, resource: wgpu::BindingResource::TextureView(&glass) });
         let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("scene"),
             layout: &layout,

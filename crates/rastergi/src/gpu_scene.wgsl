@@ -133,7 +133,7 @@ struct MaterialRecord {
 // The rest of the scene in one buffer of words (one binding: WebGPU allows 10 storage buffers
 // per shader stage). Its first 16 words are a header (gpu_scene.rs, GpuSceneOffsets; not a
 // uniform buffer, which beside these storage buffers crashes lavapipe, Mesa 22.3, in the raster
-// gather): word DATA_UVS … DATA_GLASS (shader.rs's constants) is where each part starts or
+// gather): word DATA_UVS … DATA_ENVIRONMENT (shader.rs's constants) is where each part starts or
 // how many items it holds. After it:
 // - texture coordinates of the triangles' corners, three vec2f per triangle (one zero
 //   triangle when the scene has none);
@@ -143,8 +143,7 @@ struct MaterialRecord {
 //   (zero: none; one zero triangle when the scene has none);
 // - the light distribution's entries (LightEntry; one zero entry when the scene has none);
 // - the point, spot and distant lights (PunctualLight; one zero light when the scene has none);
-// - the environment map (environment.wgsl);
-// - the GGX lobe's albedo tables of the scattering model (bsdf.wgsl, bsdf/albedo.rs).
+// - the environment map (environment.wgsl).
 @group(0) @binding(8) var<storage, read> scene_data: array<u32>;
 
 // Word k of the header: one load (the passes read only the fields they use).
@@ -177,17 +176,26 @@ fn punctual_light(k: u32) -> PunctualLight {
         scene_vec3(i + 8u), scene_f32(i + 11u), scene_vec3(i + 12u), scene_f32(i + 15u));
 }
 
+// The GGX lobe's albedo tables (bsdf/albedo.rs, GpuGgxAlbedo) as textures, read texel by texel
+// (sampled textures do not count against the 10 storage buffers per stage that WebGPU grants,
+// and a typed fetch costs less than its words from scene_data: mat_mix rendered 1.36× slower
+// that way on lavapipe). cells and means: N × (N + 1) RGBA, cell k at (k mod N, k / N), mean j
+// at (j, N). Glass: N × (rows) single-channel, cell r at (r mod N, r / N). 1 × 1 where the
+// scene has no material that reads them.
+@group(0) @binding(13) var ggx_cells_texture: texture_2d<f32>;
+@group(0) @binding(14) var glass_albedo_texture: texture_2d<f32>;
+
 // The GGX albedo tables' cell k, mean j and glass cell r (bsdf.wgsl's accessors).
 fn ggx_cell(k: u32) -> vec4f {
-    return scene_vec4(scene_offset(DATA_GGX_CELLS) + 4u * k);
+    return textureLoad(ggx_cells_texture, vec2u(k % GGX_ALBEDO_N, k / GGX_ALBEDO_N), 0);
 }
 
 fn ggx_mean(j: u32) -> vec4f {
-    return scene_vec4(scene_offset(DATA_GGX_MEANS) + 4u * j);
+    return textureLoad(ggx_cells_texture, vec2u(j, GGX_ALBEDO_N), 0);
 }
 
 fn glass_cell(r: u32) -> f32 {
-    return scene_f32(scene_offset(DATA_GLASS) + r);
+    return textureLoad(glass_albedo_texture, vec2u(r % GGX_ALBEDO_N, r / GGX_ALBEDO_N), 0).x;
 }
 
 // The random stream of stochastic opacity (passes_through): each entry point that finds

@@ -78,9 +78,6 @@ pub fn constants() -> String {
         ("DATA_LIGHT_COUNT", word(std::mem::offset_of!(O, light_count))),
         ("DATA_PUNCTUAL", word(std::mem::offset_of!(O, punctual))),
         ("DATA_ENVIRONMENT", word(std::mem::offset_of!(O, environment))),
-        ("DATA_GGX_CELLS", word(std::mem::offset_of!(O, ggx_cells))),
-        ("DATA_GGX_MEANS", word(std::mem::offset_of!(O, ggx_means))),
-        ("DATA_GLASS", word(std::mem::offset_of!(O, glass))),
     ];
     let u32s: Vec<(&str, u32)> = u32s.into_iter().chain(header).collect();
     let f32s = [

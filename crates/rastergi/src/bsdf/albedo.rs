@@ -20,7 +20,7 @@
 //! bilinearly; Ē is integrated from the interpolated
 //! table itself, so that ∫(1 − E(μ_i))·cos θ_i/π dω_i / (1 − Ē) is exactly 1 and the layer's
 //! white furnace errs only by the interpolation at μ_o. The WGSL twin reads the same numbers
-//! from a storage buffer ([`GpuGgxAlbedo`], the scene's binding 13).
+//! from the scene's textures at bindings 13 and 14 (filled from [`GpuGgxAlbedo`], gpu_scene.rs).
 
 use std::sync::OnceLock;
 
@@ -141,8 +141,9 @@ impl GgxAlbedo {
     }
 }
 
-/// The tables on the GPU (a storage buffer, the scene's binding 13): cell k = √α·N + μ holds (E₁, E₅) at k and at k + 1 (the
-/// next μ, the pair a bilinear read needs from one row), mean j (Ē₁, Ē₅) at √α cells j and j + 1.
+/// The tables as the GPU reads them (the scene's two textures, gpu_scene.rs; a storage buffer
+/// in the GPU twin's test): cell k = √α·N + μ holds (E₁, E₅) at k and at k + 1 (the next μ,
+/// the pair a bilinear read needs from one row), mean j (Ē₁, Ē₅) at √α cells j and j + 1.
 /// `glass` holds the rough solid glass's albedo ([`GlassAlbedo`]), all zeros where the scene
 /// has no rough solid glass with its compensation (its kernels never read it).
 #[repr(C)]

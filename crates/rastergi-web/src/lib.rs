@@ -29,7 +29,7 @@ use rastergi::gpu::{Gpu, GpuOptions};
 use rastergi::path_tracer::PathTracer;
 use rastergi::progressive::Progressive;
 use rastergi::renderer::{RenderSettings, Renderer};
-use rastergi::scene::{Files, GltfOptions, Light, MemoryFiles, Scene};
+use rastergi::scene::{Files, GltfOptions, MemoryFiles, Scene, SunAngles};
 use wasm_bindgen::prelude::*;
 
 mod console;
@@ -58,8 +58,8 @@ struct Options {
     method: Method,
     show: Show,
     exposure: f32,
-    /// The sun (the scene's last distant light): azimuth and elevation in degrees.
-    sun: Option<(f32, f32)>,
+    /// The sun (the scene's last distant light).
+    sun: Option<SunAngles>,
 }
 
 /// The renderer of a page: the device, the canvas, the scene and its progressive image.
@@ -145,10 +145,8 @@ fn error(e: impl std::fmt::Display) -> JsError {
 /// The renderer `options` ask for, for `scene`.
 fn build(gpu: &Gpu, scene: &Scene, options: &Options) -> rastergi::Result<Box<dyn Progressive>> {
     let mut scene = scene.clone();
-    if let (Some((azimuth, elevation)), Some(Light::Distant { direction, .. })) =
-        (options.sun, scene.lights.iter_mut().rev().find(|l| matches!(l, Light::Distant { .. })))
-    {
-        *direction = sun_direction(azimuth, elevation);
+    if let Some(sun) = options.sun {
+        scene.turn_sun(sun);
     }
     let grid = rastergi::fit::grid_resolution(&scene.bounds());
     let settings = RenderSettings {
@@ -163,26 +161,6 @@ fn build(gpu: &Gpu, scene: &Scene, options: &Options) -> rastergi::Result<Box<dy
     Ok(match options.method {
         Method::PhotonMap => Box::new(Renderer::new(gpu, &scene, settings)?),
         Method::PathTracer => Box::new(PathTracer::new(gpu, &scene, settings)?),
-    })
-}
-
-/// The direction a sun at these angles (degrees from +Z towards +X about +Y; above the XZ
-/// plane) shines along, as `rastergi render --sun` takes them.
-fn sun_direction(azimuth: f32, elevation: f32) -> glam::Vec3 {
-    let (a, e) = (azimuth.to_radians(), elevation.to_radians());
-    -glam::Vec3::new(a.sin() * e.cos(), e.sin(), a.cos() * e.cos())
-}
-
-/// The angles of a sun shining along `direction` ([`sun_direction`]'s inverse).
-fn sun_angles(direction: glam::Vec3) -> (f32, f32) {
-    let towards = -direction.normalize();
-    (towards.x.atan2(towards.z).to_degrees().rem_euclid(360.0), towards.y.clamp(-1.0, 1.0).asin().to_degrees())
-}
-
-fn last_sun(scene: &Scene) -> Option<(f32, f32)> {
-    scene.lights.iter().rev().find_map(|l| match l {
-        Light::Distant { direction, .. } => Some(sun_angles(*direction)),
-        _ => None,
     })
 }
 
@@ -231,7 +209,7 @@ impl Viewer {
 
     fn show_scene(&mut self, name: String, scene: Scene) -> Result<(), JsError> {
         let mut options = self.options.clone();
-        options.sun = last_sun(&scene);
+        options.sun = scene.sun().map(SunAngles::of_direction);
         // Built before anything is replaced: a scene that fails leaves the page as it was.
         let renderer = build(&self.gpu, &scene, &options).map_err(error)?;
         self.control = CameraControl::new(&scene.camera, &scene.bounds());
@@ -286,7 +264,7 @@ impl Viewer {
                 if options.sun.is_none() {
                     return Err(JsError::new("this scene has no sun (a distant light) to turn"));
                 }
-                options.sun = Some((a.rem_euclid(360.0), e.clamp(-90.0, 90.0)));
+                options.sun = Some(SunAngles { azimuth: a.rem_euclid(360.0), elevation: e.clamp(-90.0, 90.0) });
             }
             "size" => {
                 let (w, h) = value.split_once('x').ok_or_else(bad)?;
@@ -417,7 +395,7 @@ impl Viewer {
 
     /// The sun's "azimuth,elevation" in degrees, or an empty string where the scene has none.
     pub fn sun(&self) -> String {
-        self.options.sun.map_or_else(String::new, |(a, e)| format!("{a:.0},{e:.0}"))
+        self.options.sun.map_or_else(String::new, |s| format!("{:.0},{:.0}", s.azimuth, s.elevation))
     }
 
     /// The warnings logged since the last call (a loaded file's ignored parts, say).

@@ -281,17 +281,31 @@ impl Film {
 
     /// Encodes the resolve of the current mean into the linear and display buffers.
     pub fn encode_resolve(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, show: Show, exposure: f32) {
+        let resolve = (&self.pipeline, &self.bind_group, &self.uniforms);
+        self.dispatch_resolve(gpu, enc, "resolve", resolve, (self.samples, show, exposure));
+    }
+
+    /// One resolve dispatch over the image: `pipeline` with `bind_group`, whose `uniforms` get
+    /// (samples, show, exposure).
+    fn dispatch_resolve(
+        &self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        label: &'static str,
+        (pipeline, bind_group, uniforms): (&wgpu::ComputePipeline, &wgpu::BindGroup, &wgpu::Buffer),
+        (samples, show, exposure): (u32, Show, f32),
+    ) {
         let u = ResolveUniforms {
             resolution: [self.width, self.height],
-            samples: self.samples,
+            samples,
             show: show.code(),
             scale: exposure.exp2(),
             _pad: [0; 3],
         };
-        gpu.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
-        let mut pass = crate::profile::compute_pass(enc, gpu.profiler.as_ref(), "resolve");
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &self.bind_group, &[]);
+        gpu.queue.write_buffer(uniforms, 0, bytemuck::bytes_of(&u));
+        let mut pass = crate::profile::compute_pass(enc, gpu.profiler.as_ref(), label);
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, bind_group, &[]);
         pass.dispatch_workgroups(groups(self.width, 8), groups(self.height, 8), 1);
     }
 
@@ -315,18 +329,8 @@ impl Film {
     /// Encodes the resolve of `image`'s source (as it stands when the encoder runs) at
     /// `exposure` into the linear and display buffers, in place of the film's mean.
     pub fn encode_resolve_image(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, image: &ImageResolve, exposure: f32) {
-        let u = ResolveUniforms {
-            resolution: [self.width, self.height],
-            samples: 1,
-            show: Show::Full.code(),
-            scale: exposure.exp2(),
-            _pad: [0; 3],
-        };
-        gpu.queue.write_buffer(&image.uniforms, 0, bytemuck::bytes_of(&u));
-        let mut pass = crate::profile::compute_pass(enc, gpu.profiler.as_ref(), "resolve image");
-        pass.set_pipeline(&self.image_pipeline);
-        pass.set_bind_group(0, &image.bind_group, &[]);
-        pass.dispatch_workgroups(groups(self.width, 8), groups(self.height, 8), 1);
+        let resolve = (&self.image_pipeline, &image.bind_group, &image.uniforms);
+        self.dispatch_resolve(gpu, enc, "resolve image", resolve, (1, Show::Full, exposure));
     }
 
     /// The display buffer as the last submitted resolve left it.

@@ -22,7 +22,7 @@ use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoopProxy};
 use winit::window::{Window, WindowId};
 
-use super::build::{Build, Opened, env_scale, last_sun, prepare, same_but_size};
+use super::build::{Build, Opened, env_scale, prepare, same_but_size};
 use super::controls::{Controls, Response, SunAngles, camera_options, show_name};
 use super::frames::{Active, Rate, iterate_frame};
 use super::keys::key_of;
@@ -138,7 +138,7 @@ impl App {
     ) -> App {
         let camera = CameraControl::new(&scene.camera, &scene.bounds());
         let mut controls = Controls::new(camera, a.show.show(), a.exposure.unwrap_or(0.0), &base);
-        controls.sun = last_sun(&scene).map(SunAngles::of_direction);
+        controls.sun = scene.sun().map(SunAngles::of_direction);
         controls.env_scale = env_scale(a, &scene);
         App {
             args: a.clone(),
@@ -256,7 +256,7 @@ impl App {
                             name: a.scene.clone(),
                             photons: fitted.photons,
                             grid: fitted.grid_resolution,
-                            sun: last_sun(&scene).map(SunAngles::of_direction),
+                            sun: scene.sun().map(SunAngles::of_direction),
                             env_scale: env_scale(&a, &scene).and(wanted.env_scale),
                             scene: Arc::new(scene),
                         };

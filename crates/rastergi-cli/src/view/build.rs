@@ -4,7 +4,7 @@
 use std::sync::Arc;
 
 use rastergi::renderer::RenderSettings;
-use rastergi::scene::{Light, Scene};
+use rastergi::scene::Scene;
 
 use super::controls::SunAngles;
 use crate::args::SceneArgs;
@@ -43,10 +43,8 @@ pub(super) fn same_but_size(a: &Build, b: &Build) -> bool {
 /// angles and its environment map scaled to the wanted `--env-scale` (it was loaded at
 /// `loaded_scale`).
 pub(super) fn prepare(mut scene: Scene, wanted: &Build, loaded_scale: f32) -> Scene {
-    if let (Some(sun), Some(Light::Distant { direction, .. })) =
-        (wanted.sun, scene.lights.iter_mut().rev().find(|l| matches!(l, Light::Distant { .. })))
-    {
-        *direction = sun.direction();
+    if let Some(sun) = wanted.sun {
+        scene.turn_sun(sun);
     }
     if let (Some(scale), Some(env)) = (wanted.env_scale, &scene.environment)
         && scale != loaded_scale
@@ -61,12 +59,4 @@ pub(super) fn prepare(mut scene: Scene, wanted: &Build, loaded_scale: f32) -> Sc
 /// environment map that is not black.
 pub(super) fn env_scale(a: &SceneArgs, scene: &Scene) -> Option<f32> {
     scene.environment.as_ref().filter(|e| !e.is_dark() && a.env_scale > 0.0).map(|_| a.env_scale)
-}
-
-/// The direction of the scene's last distant light (the viewer's sun), if any.
-pub(super) fn last_sun(scene: &Scene) -> Option<glam::Vec3> {
-    scene.lights.iter().rev().find_map(|l| match l {
-        Light::Distant { direction, .. } => Some(*direction),
-        _ => None,
-    })
 }

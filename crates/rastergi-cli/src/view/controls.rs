@@ -43,30 +43,7 @@ pub enum Key {
     Quit,
 }
 
-/// The sun's direction as the viewer turns it, in `--sun`'s terms: degrees from +Z towards
-/// +X about +Y, and degrees above the XZ plane.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SunAngles {
-    pub azimuth: f32,
-    pub elevation: f32,
-}
-
-impl SunAngles {
-    /// The angles of a distant light travelling along `direction`.
-    pub fn of_direction(direction: glam::Vec3) -> SunAngles {
-        let towards = -direction.normalize();
-        SunAngles {
-            azimuth: towards.x.atan2(towards.z).to_degrees().rem_euclid(360.0),
-            elevation: towards.y.clamp(-1.0, 1.0).asin().to_degrees(),
-        }
-    }
-
-    /// The direction a sun at these angles shines along (as `--sun`).
-    pub fn direction(self) -> glam::Vec3 {
-        let (a, e) = (self.azimuth.to_radians(), self.elevation.to_radians());
-        -glam::Vec3::new(a.sin() * e.cos(), e.sin(), a.cos() * e.cos())
-    }
-}
+pub use rastergi::scene::SunAngles;
 
 /// Degrees per press of the sun keys.
 pub const SUN_STEP: f32 = 5.0;

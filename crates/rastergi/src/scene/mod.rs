@@ -408,6 +408,31 @@ impl Aabb {
     }
 }
 
+/// A sun's direction as `--sun`, the viewer and the web page turn it: degrees from +Z towards
+/// +X about +Y (azimuth), and degrees above the XZ plane (elevation).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SunAngles {
+    pub azimuth: f32,
+    pub elevation: f32,
+}
+
+impl SunAngles {
+    /// The angles of a distant light travelling along `direction`.
+    pub fn of_direction(direction: Vec3) -> SunAngles {
+        let towards = -direction.normalize();
+        SunAngles {
+            azimuth: towards.x.atan2(towards.z).to_degrees().rem_euclid(360.0),
+            elevation: towards.y.clamp(-1.0, 1.0).asin().to_degrees(),
+        }
+    }
+
+    /// The direction a sun at these angles shines along (as `--sun`).
+    pub fn direction(self) -> Vec3 {
+        let (a, e) = (self.azimuth.to_radians(), self.elevation.to_radians());
+        -Vec3::new(a.sin() * e.cos(), e.sin(), a.cos() * e.cos())
+    }
+}
+
 /// A light that is not a surface: glTF `KHR_lights_punctual` lights (values read 1:1 as
 /// radiometric, as Mitsuba's `point`, `spot` and `directional` take them) and the sun.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -606,6 +631,24 @@ impl Scene {
     pub fn add_quad(&mut self, [a, b, c, d]: [Vec3; 4], material: u32) {
         self.add_triangle([a, b, c], material);
         self.add_triangle([a, c, d], material);
+    }
+
+    /// The direction of the scene's sun: its last distant light, which the viewer and the web
+    /// page turn.
+    pub fn sun(&self) -> Option<Vec3> {
+        self.lights.iter().rev().find_map(|l| match l {
+            Light::Distant { direction, .. } => Some(*direction),
+            _ => None,
+        })
+    }
+
+    /// Turns the scene's sun (its last distant light, if it has one) to `to`.
+    pub fn turn_sun(&mut self, to: SunAngles) {
+        if let Some(Light::Distant { direction, .. }) =
+            self.lights.iter_mut().rev().find(|l| matches!(l, Light::Distant { .. }))
+        {
+            *direction = to.direction();
+        }
     }
 
     pub fn bounds(&self) -> Aabb {

@@ -148,7 +148,20 @@ fn twins() -> Vec<Twin> {
         twin!(
             crate::denoise::DenoiseUniforms,
             "Denoise",
-            [resolution, samples, guide_samples, step, sigma_l, sigma_n, sigma_z, pixel_angle, filter_direct]
+            [
+                resolution,
+                samples,
+                guide_samples,
+                step,
+                sigma_l,
+                sigma_n,
+                sigma_z,
+                pixel_angle,
+                radius_direct,
+                radius_indirect,
+                sigma_g,
+                ridge
+            ]
         ),
         twin!(DisplayUniforms, "Display", [image_size, target_size, decode_srgb, text_cols, text_rows, text_scale]),
         twin!(TrianglePlane, "TrianglePlane", [normal, offset, bins]),

@@ -196,7 +196,13 @@ impl ImagePasses {
             let (w, h) = (self.film.width, self.film.height);
             gpu.check_image_size(w, h, crate::denoise::LARGEST_BUFFER_PER_PIXEL)?;
             let guides = Guides::new(gpu, (scene, frame), &self.gbuffer, &self.film);
-            let denoiser = Denoiser::new(gpu, (w, h), &self.film.accumulation, &guides.buffer, crate::denoise::LEVELS);
+            let denoiser = Denoiser::new(
+                gpu,
+                (w, h),
+                &self.film.accumulation,
+                (&guides.buffer, &guides.extra),
+                crate::denoise::LEVELS,
+            );
             let resolve = self.film.image_resolve(gpu, denoiser.image());
             self.denoise = Some(DenoisePasses { guides, denoiser, resolve });
         }

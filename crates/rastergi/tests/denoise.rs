@@ -3,10 +3,10 @@
 
 mod common;
 
-use rastergi::denoise::{DenoiseParams, Denoiser, GUIDE_SLOTS, cpu};
+use rastergi::denoise::{DenoiseParams, Denoiser, EXTRA_SLOTS, GUIDE_SLOTS, cpu};
 use rastergi::film::{COMPONENTS, Show};
 use rastergi::image_io::LinearImage;
-use rastergi::metrics::{compare, emitter_mask, rmse};
+use rastergi::metrics::{Comparison, compare, emitter_mask, rmse};
 use rastergi::renderer::{RenderSettings, Renderer};
 use rastergi::sampling::{pcg_hash, unit_f32};
 use rastergi::scene::cornell_box;
@@ -17,7 +17,8 @@ fn hash(a: u32, b: u32, c: u32) -> f32 {
 }
 
 /// A synthetic scene of `w × h` pixels: two planes meeting at a vertical edge (different
-/// normals and distances), a checker albedo on the left one, smooth light with a step.
+/// normals and distances), a checker albedo on the left one, smooth light with a step, and a
+/// small emitter on the right one (its emission 20 times the light around it).
 struct Synthetic {
     w: u32,
     h: u32,
@@ -25,7 +26,7 @@ struct Synthetic {
 
 impl Synthetic {
     /// The CPU twin's input for `n` iterations of this image's sums.
-    fn input<'a>(&self, n: u32, film: &'a [f32], guides: &'a [f32]) -> cpu::Input<'a> {
+    fn input<'a>(&self, n: u32, (film, guides, extra): (&'a [f32], &'a [f32], &'a [f32])) -> cpu::Input<'a> {
         cpu::Input {
             width: self.w,
             height: self.h,
@@ -33,8 +34,21 @@ impl Synthetic {
             guide_samples: n,
             film,
             guides,
+            extra,
             pixel_angle: PIXEL_ANGLE,
         }
+    }
+
+    /// The emission seen at (x, y): a 3 × 2-pixel emitter on the right plane.
+    fn emission(&self, x: u32, y: u32) -> [f32; 3] {
+        let (ex, ey) = (3 * self.w / 4, self.h / 2);
+        if (ex..ex + 3).contains(&x) && (ey..ey + 2).contains(&y) { [20.0, 18.0, 15.0] } else { [0.0; 3] }
+    }
+
+    /// Whether (x, y) is the emitter or one of its 8-neighbours.
+    fn near_emitter(&self, x: u32, y: u32) -> bool {
+        let (ex, ey) = (3 * self.w / 4, self.h / 2);
+        (ex - 1..ex + 4).contains(&x) && (ey - 1..ey + 3).contains(&y)
     }
 
     fn albedo(&self, x: u32, y: u32) -> [f32; 3] {
@@ -66,11 +80,13 @@ impl Synthetic {
     }
 
     /// Film and guide sums of `n` iterations: each adds the expected value times noise of
-    /// relative spread `spread` (direct a tenth of it), as the renderer's passes would.
-    fn render(&self, n: u32, spread: f32, seed: u32) -> (Vec<f32>, Vec<f32>) {
+    /// relative spread `spread` (direct a tenth of it), and the emission, as the renderer's
+    /// passes would.
+    fn render(&self, n: u32, spread: f32, seed: u32) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
         let pixels = (self.w * self.h) as usize;
         let mut film = vec![0.0f32; COMPONENTS as usize * pixels * 4];
         let mut guides = vec![0.0f32; GUIDE_SLOTS as usize * pixels * 4];
+        let mut extra = vec![0.0f32; EXTRA_SLOTS as usize * pixels * 4];
         let lum = |c: [f32; 3]| c[0] * 0.2126 + c[1] * 0.7152 + c[2] * 0.0722;
         for y in 0..self.h {
             for x in 0..self.w {
@@ -79,13 +95,15 @@ impl Synthetic {
                 let (d, i) = self.light(x, y);
                 let nrm = self.normal(x);
                 let z = self.depth(x, y);
+                let e = self.emission(x, y);
                 for k in 0..n {
                     let u = |s: u32| 2.0 * hash(seed ^ s, p as u32, k) - 1.0;
                     let (nd, ni) = (1.0 + 0.1 * spread * u(1) * 1.732, (1.0 + spread * u(2) * 1.732).max(0.0));
                     let dv = [0, 1, 2].map(|c| a[c] * d[c] * nd);
                     let iv = [0, 1, 2].map(|c| a[c] * i[c] * ni);
                     for c in 0..3 {
-                        film[4 * p + c] += dv[c];
+                        film[4 * p + c] += e[c] + dv[c];
+                        extra[4 * (2 * pixels + p) + c] += e[c];
                         film[4 * (pixels + p) + c] += iv[c];
                         guides[4 * p + c] += a[c];
                         guides[4 * (pixels + p) + c] += nrm[c];
@@ -101,7 +119,7 @@ impl Synthetic {
                 }
             }
         }
-        (film, guides)
+        (film, guides, extra)
     }
 
     /// The expected image.
@@ -111,7 +129,8 @@ impl Synthetic {
             for x in 0..self.w {
                 let a = self.albedo(x, y);
                 let (d, i) = self.light(x, y);
-                pixels.push([0, 1, 2].map(|c| a[c] * (d[c] + i[c])));
+                let e = self.emission(x, y);
+                pixels.push([0, 1, 2].map(|c| e[c] + a[c] * (d[c] + i[c])));
             }
         }
         LinearImage { width: self.w, height: self.h, pixels }
@@ -151,33 +170,40 @@ fn gpu_filter_matches_its_cpu_twin() {
     let gpu = common::gpu();
     let s = Synthetic { w: 32, h: 24 };
     let n = 16;
-    let (film, guides) = s.render(n, 0.5, 7);
+    let (film, guides, extra) = s.render(n, 0.5, 7);
     let params = DenoiseParams::default();
-    let input = s.input(n, &film, &guides);
+    let input = s.input(n, (&film, &guides, &extra));
     let expected = cpu::denoise(&input, &params);
     let raw = cpu::raw(&input);
     let usage = wgpu::BufferUsages::COPY_SRC;
     let film_buffer = gpu.storage_buffer("film", bytemuck::cast_slice(&film), usage);
     let guide_buffer = gpu.storage_buffer("guides", bytemuck::cast_slice(&guides), usage);
-    let denoiser = Denoiser::new(&gpu, (s.w, s.h), &film_buffer, &guide_buffer, params.levels);
+    let extra_buffer = gpu.storage_buffer("extra", bytemuck::cast_slice(&extra), usage);
+    let denoiser = Denoiser::new(&gpu, (s.w, s.h), &film_buffer, (&guide_buffer, &extra_buffer), 3);
     let got = denoiser.apply(&gpu, (n, n), PIXEL_ANGLE, &params).unwrap();
     let diff = max_abs_difference(&got, &expected);
     let change = max_abs_difference(&raw, &expected);
     println!("GPU vs CPU twin: max |difference| {diff:e}; the filter changed pixels by up to {change:.3}");
     assert!(change > 0.05, "the filter did nothing on the test image ({change})");
-    // f32 with exp/pow/sqrt of a few ulps' difference through five levels: 1e-4 of the
-    // light's scale (about 1).
+    // f32 with exp/pow/sqrt of a few ulps' difference through the guide's levels and the
+    // regression's solve: 1e-4 of the light's scale (about 1).
     assert!(diff < 1e-4, "GPU and CPU twin differ by {diff}");
-    // Fewer levels: also the same.
-    let two = DenoiseParams { levels: 2, ..params };
-    let got = denoiser.apply(&gpu, (n, n), PIXEL_ANGLE, &two).unwrap();
-    let diff = max_abs_difference(&got, &cpu::denoise(&input, &two));
-    assert!(diff < 1e-4, "2 levels: GPU and CPU twin differ by {diff}");
+    // Other levels and windows: also the same (3 levels, more than the default; none, the
+    // regression guided by the unfiltered light).
+    for other in [
+        DenoiseParams { levels: 3, radius_direct: 2, radius_indirect: 4, ..params },
+        DenoiseParams { levels: 0, sigma_g: 2.0, ridge: 1.0e-2, ..params },
+    ] {
+        let got = denoiser.apply(&gpu, (n, n), PIXEL_ANGLE, &other).unwrap();
+        let diff = max_abs_difference(&got, &cpu::denoise(&input, &other));
+        assert!(diff < 1e-4, "{other:?}: GPU and CPU twin differ by {diff}");
+    }
 }
 
 /// The convergence rule on the synthetic image: at 16 iterations the denoised image is
-/// closer to the expectation than the raw one; as the iterations grow, the denoised image's
-/// difference from the raw one shrinks relative to the raw image's own noise, far under it.
+/// closer to the expectation than the raw one, and next to the emitter no farther than
+/// elsewhere (its light is not spread to its neighbours); as the iterations grow, the denoised image's difference from
+/// the raw one shrinks relative to the raw image's own noise, far under it.
 #[test]
 fn denoised_image_converges_to_the_raw_one() {
     let s = Synthetic { w: 32, h: 32 };
@@ -185,8 +211,8 @@ fn denoised_image_converges_to_the_raw_one() {
     let params = DenoiseParams::default();
     let mut ratios = Vec::new();
     for n in [16u32, 256, 4096] {
-        let (film, guides) = s.render(n, 1.0, 3);
-        let input = s.input(n, &film, &guides);
+        let (film, guides, extra) = s.render(n, 1.0, 3);
+        let input = s.input(n, (&film, &guides, &extra));
         let (raw, denoised) = (cpu::raw(&input), cpu::denoise(&input, &params));
         let (raw_err, den_err, change) =
             (rmse(&raw, &truth, None), rmse(&denoised, &truth, None), rmse(&denoised, &raw, None));
@@ -196,6 +222,14 @@ fn denoised_image_converges_to_the_raw_one() {
         );
         if n == 16 {
             assert!(den_err < raw_err, "denoising did not lower the error at 16 iterations");
+            let near: Vec<bool> =
+                (0..s.h).flat_map(|y| (0..s.w).map(move |x| (x, y))).map(|(x, y)| s.near_emitter(x, y)).collect();
+            let (raw_near, den_near) = (rmse(&raw, &truth, Some(&near)), rmse(&denoised, &truth, Some(&near)));
+            println!("n {n}, the emitter and its neighbours: RMSE raw {raw_near:.5}, denoised {den_near:.5}");
+            // The emitter's neighbours are denoised as well as the image as a whole (measured
+            // 0.0120 against 0.0156; filtering the emission with the reflected light, as the
+            // denoiser did before it took the emission out, gave 0.0189 there).
+            assert!(den_near < den_err, "the emitter's light spreads: RMSE {den_near} near it, {den_err} overall");
         }
         ratios.push(change / raw_err);
     }
@@ -203,33 +237,37 @@ fn denoised_image_converges_to_the_raw_one() {
     assert!(ratios[2] < 0.5, "at 4096 iterations the denoiser still changes the image by {} of its noise", ratios[2]);
 }
 
-/// The Cornell box at 128² (the references' size) against the committed Mitsuba pair, the
-/// emitter's pixels masked as in gather.rs: 16 iterations denoised against 16, 64 and 256 raw;
-/// then the convergence rule: at 1024 iterations the denoised image differs from the raw one
-/// by less than the raw image's own noise (the film halves' estimate; at 256 iterations the
-/// render has had one photon pass, one block, and the halves say nothing). About 140 s on
-/// lavapipe.
-///
-/// Measured (lavapipe, seed 5): relative RMSE raw 16 0.0671, 64 0.0282, 256 0.0164, 1024
-/// 0.0092; denoised 16 0.0295 (block-mean error 0.0037; raw 256: 0.0028), 256 0.0157, 1024
-/// 0.0109; at 1024 denoised − raw 0.0071, the raw noise 0.0085. The issue's goal, denoised 16
-/// no worse than raw 256, is not met: 16 denoised iterations are worth about 64 raw.
-#[test]
-fn cornell_box_denoised_against_raw_and_the_convergence_rule() {
+/// The figures of one iteration count of [`against_reference`].
+#[derive(Clone, Copy, Debug)]
+struct Figures {
+    raw: Comparison,
+    denoised: Comparison,
+    /// Relative RMSE of the denoised image against the raw one.
+    change: f64,
+    /// The raw image's own relative noise from the film's halves (once both hold blocks).
+    noise: Option<f64>,
+}
+
+/// The Cornell box at `size`² (seed 5, traced gather), raw and denoised after each of
+/// `iterations`, against the committed Mitsuba pair `stem` with the emitter's pixels masked
+/// as in gather.rs; prints the figures, also for the high-gradient tenth of the pixels.
+fn against_reference(size: u32, stem: &str, iterations: &[u32]) -> Vec<Figures> {
     let gpu = common::gpu();
     let scene = cornell_box();
-    let settings = RenderSettings { seed: 5, ..common::fitted_settings(&scene, 128, 5) };
-    let probe = rastergi::image_io::read_exr(&common::data("cornell_path_128_a.exr")).unwrap();
+    let settings = RenderSettings { seed: 5, ..common::fitted_settings(&scene, size, 5) };
+    let probe = rastergi::image_io::read_exr(&common::data(&format!("{stem}_a.exr"))).unwrap();
     let mask = emitter_mask(&probe, 3.0);
-    let (reference, _) = common::reference_pair("cornell_path_128", Some(&mask));
+    let (reference, ref_noise) = common::reference_pair(stem, Some(&mask));
     let edges = high_gradient_mask(&reference, &mask);
     let mut r = Renderer::new(&gpu, &scene, settings).unwrap();
     r.enable_denoiser().unwrap();
     let params = DenoiseParams::default();
     let c = |i: &LinearImage| compare(i, &reference, Some(&mask));
+    let mean = rastergi::metrics::masked_mean(&reference, Some(&mask));
+    println!("{size}²: the reference's own relative noise {:.4}", ref_noise / mean);
     let mut done = 0;
     let mut figures = Vec::new();
-    for n in [16u32, 64, 256, 1024] {
+    for &n in iterations {
         while done < n {
             r.iterate().unwrap();
             done += 1;
@@ -239,40 +277,86 @@ fn cornell_box_denoised_against_raw_and_the_convergence_rule() {
         }
         let raw = r.read_linear(Show::Full).unwrap();
         let den = r.read_denoised(&params).unwrap();
-        let (cr, cd) = (c(&raw), c(&den));
-        let mean = rastergi::metrics::masked_mean(&raw, Some(&mask));
-        let change = rmse(&den, &raw, Some(&mask)) / mean;
-        let noise = r.film_state().unwrap().error_estimate();
+        let f = Figures {
+            raw: c(&raw),
+            denoised: c(&den),
+            change: rmse(&den, &raw, Some(&mask)) / mean,
+            noise: r.film_state().unwrap().error_estimate(),
+        };
         let (er, ed) = (compare(&raw, &reference, Some(&edges)), compare(&den, &reference, Some(&edges)));
         println!(
-            "n {n}, high-gradient tenth: raw relative RMSE {:.4}, denoised {:.4}",
+            "{size}², n {n}, high-gradient tenth: raw relative RMSE {:.4}, denoised {:.4}",
             er.relative_rmse, ed.relative_rmse
         );
         println!(
-            "n {n}: raw relative RMSE {:.4} (block {:.4}), denoised {:.4} (block {:.4}, mean ratio {:.4?}); \
-             denoised − raw {change:.4}, raw noise (halves) {noise:.4?}",
-            cr.relative_rmse, cr.block_mean_error, cd.relative_rmse, cd.block_mean_error, cd.mean_ratio
+            "{size}², n {n}: raw relative RMSE {:.4} (block {:.4}), denoised {:.4} (block {:.4}, mean ratio {:.4?}); \
+             denoised − raw {:.4}, raw noise (halves) {:.4?}",
+            f.raw.relative_rmse,
+            f.raw.block_mean_error,
+            f.denoised.relative_rmse,
+            f.denoised.block_mean_error,
+            f.denoised.mean_ratio,
+            f.change,
+            f.noise
         );
-        figures.push((n, cr, cd, change, noise));
+        figures.push(f);
     }
-    let (_, raw16, den16, _, _) = figures[0];
-    let (_, raw64, _, _, _) = figures[1];
-    // Denoising 16 iterations halves their error (measured 0.44×) and leaves it near 64
-    // raw iterations' (measured 1.05×); the block means stay within 0.5 % (measured 0.37 %).
-    assert!(den16.relative_rmse < 0.5 * raw16.relative_rmse, "denoised 16 {den16:?} vs raw {raw16:?}");
-    assert!(den16.relative_rmse < 1.1 * raw64.relative_rmse, "denoised 16 {den16:?} vs raw 64 {raw64:?}");
+    figures
+}
+
+/// The block means of 16 denoised iterations stay within 0.5 % of the reference: no
+/// darkening of corners, no light spread across edges.
+fn assert_block_means(den16: &Comparison) {
     assert!(den16.block_mean_error < 0.005, "denoised 16: block-mean error {}", den16.block_mean_error);
     for c in den16.mean_ratio {
         assert!((c - 1.0).abs() < 0.005, "denoised 16: mean ratio {:?}", den16.mean_ratio);
     }
-    // At 256 iterations the denoised image is no farther from the reference than the raw one
-    // (measured 0.0157 vs 0.0164).
-    let (_, raw256, den256, _, _) = figures[2];
+}
+
+/// The Cornell box at 128² against the committed Mitsuba pair: 16 iterations denoised against
+/// 16, 64 and 256 raw; then the convergence rule: at 1024 iterations the denoised image
+/// differs from the raw one by less than the raw image's own noise (the film halves'
+/// estimate; at 256 iterations the render has had one photon pass, one block, and the halves
+/// say nothing). About 140 s on lavapipe.
+///
+/// Measured (lavapipe, seed 5; the reference's own noise 0.0075): relative RMSE raw 16 0.0671,
+/// 64 0.0282, 256 0.0164, 1024 0.0092; denoised 16 0.0236 (block-mean error 0.0044; raw 256:
+/// 0.0028), 256 0.0134, 1024 0.0092; at 1024 denoised − raw 0.0050, the raw noise 0.0085.
+/// The issue's goal, denoised 16 no worse than raw 256, is not met: 16 denoised iterations
+/// are worth about 100 raw.
+#[test]
+fn cornell_box_denoised_against_raw_and_the_convergence_rule() {
+    let figures = against_reference(128, "cornell_path_128", &[16, 64, 256, 1024]);
+    let (raw16, den16, raw64) = (figures[0].raw, figures[0].denoised, figures[1].raw);
+    // Denoising 16 iterations cuts their error to a third (measured 0.35×) and below 64 raw
+    // iterations' (measured 0.84×).
+    assert!(den16.relative_rmse < 0.4 * raw16.relative_rmse, "denoised 16 {den16:?} vs raw {raw16:?}");
+    assert!(den16.relative_rmse < raw64.relative_rmse, "denoised 16 {den16:?} vs raw 64 {raw64:?}");
+    assert_block_means(&den16);
+    // At 256 iterations the denoised image is closer to the reference than the raw one
+    // (measured 0.0134 vs 0.0164).
+    let (raw256, den256) = (figures[2].raw, figures[2].denoised);
     assert!(den256.relative_rmse < raw256.relative_rmse, "256: denoised {den256:?} vs raw {raw256:?}");
-    // The convergence rule: at 1024 iterations denoised − raw is under the raw noise.
-    let (_, _, _, change, noise) = figures[3];
-    let noise = noise.expect("both halves hold iterations at 1024");
-    assert!(change < noise, "1024: the denoiser changes the image by {change}, the raw noise is {noise}");
+    // The convergence rule: at 1024 iterations denoised − raw is under the raw noise, and the
+    // denoised image is no farther from the reference than the raw one (measured 0.00918 vs
+    // 0.00919; 1.02× allows for the last digit).
+    let f = figures[3];
+    let noise = f.noise.expect("both halves hold iterations at 1024");
+    assert!(f.change < noise, "1024: the denoiser changes the image by {}, the raw noise is {noise}", f.change);
+    assert!(f.denoised.relative_rmse < 1.02 * f.raw.relative_rmse, "1024: {f:?}");
+}
+
+/// The issue's own comparison, the Cornell box at 256² against the committed 256² Mitsuba
+/// pair: 16 iterations denoised against 64 and 256 raw. About 100 s on lavapipe.
+///
+/// Measured (lavapipe, seed 5): see the README's Denoiser table. 16 denoised iterations are
+/// closer to the reference than 64 raw ones, not yet than 256 raw ones (the issue's goal).
+#[test]
+fn cornell_box_at_256_denoised_16_against_raw_64_and_256() {
+    let figures = against_reference(256, "cornell_path_256", &[16, 64, 256]);
+    let (den16, raw64) = (figures[0].denoised, figures[1].raw);
+    assert!(den16.relative_rmse < raw64.relative_rmse, "denoised 16 {den16:?} vs raw 64 {raw64:?}");
+    assert_block_means(&den16);
 }
 
 /// The display encoding computed here, independently of the GPU's: 2^exposure · value,

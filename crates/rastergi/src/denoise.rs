@@ -665,8 +665,9 @@ pub mod cpu {
         let rgb = |v: [f32; 4]| [v[0], v[1], v[2]];
         let yp = luminance(rgb(guide[c * n + p]));
         let s = params.sigma_g * blur3(x, y, (w, h), |k| light[c * n + k][3]).sqrt() + LUMINANCE_EPSILON;
-        let mut m = [0.0f32; REGRESSORS * (REGRESSORS + 1) / 2];
-        let mut b = [[0.0f32; 3]; REGRESSORS];
+        // The blocks of fit() in the shader: ann[c][r] is column c, row r.
+        let (mut ann, mut aan, mut aaa) = ([[0.0f32; 3]; 3], [[0.0f32; 4]; 3], [[0.0f32; 4]; 4]);
+        let (mut bn, mut ba) = ([[0.0f32; 3]; 3], [[0.0f32; 3]; 4]);
         for dy in -r..=r {
             for dx in -r..=r {
                 let (qx, qy) = (x + dx, y + dy);
@@ -682,18 +683,40 @@ pub mod cpu {
                 let wt = (-0.5 * d2 / (bandwidth * bandwidth)).exp()
                     * (-(luminance(rgb(guide[c * n + k])) - yp).abs() / s).exp();
                 let rr = r.max(1) as f32;
-                let xs =
-                    [dx as f32 / rr, dy as f32 / rr, (zq - zp) / zp, nq[0] - np[0], nq[1] - np[1], nq[2] - np[2], 1.0];
+                let xn = [nq[0] - np[0], nq[1] - np[1], nq[2] - np[2]];
+                let xa = [dx as f32 / rr, dy as f32 / rr, (zq - zp) / zp, 1.0];
                 let l = rgb(light[c * n + k]);
-                for i in 0..REGRESSORS {
-                    let wx = wt * xs[i];
-                    for ch in 0..3 {
-                        b[i][ch] += wx * l[ch];
+                for col in 0..3 {
+                    for row in 0..3 {
+                        ann[col][row] += wt * (xn[row] * xn[col]);
+                        bn[col][row] += wt * (l[row] * xn[col]);
                     }
-                    for j in 0..=i {
-                        m[tri(i, j)] += wx * xs[j];
+                    for row in 0..4 {
+                        aan[col][row] += wt * (xa[row] * xn[col]);
                     }
                 }
+                for col in 0..4 {
+                    for row in 0..4 {
+                        aaa[col][row] += wt * (xa[row] * xa[col]);
+                    }
+                    for row in 0..3 {
+                        ba[col][row] += wt * (l[row] * xa[col]);
+                    }
+                }
+            }
+        }
+        let mut m = [0.0f32; REGRESSORS * (REGRESSORS + 1) / 2];
+        let mut b = [[0.0f32; 3]; REGRESSORS];
+        for i in 0..REGRESSORS {
+            b[i] = if i < 3 { bn[i] } else { ba[i - 3] };
+            for j in 0..=i {
+                m[tri(i, j)] = if i < 3 {
+                    ann[j][i]
+                } else if j < 3 {
+                    aan[j][i - 3]
+                } else {
+                    aaa[j - 3][i - 3]
+                };
             }
         }
         let last = REGRESSORS - 1;

@@ -211,8 +211,9 @@ fn atrous(@builtin(global_invocation_id) gid: vec3u) {
     dst[n + p] = vec4f(sum_i / w_i, var_i / (w_i * w_i));
 }
 
-// Regressors of the first-order fit: the offset (dx, dy)/r, the relative change of distance,
-// the change of normal, and last the constant, whose coefficient is the fit at the pixel.
+// Regressors of the first-order fit: the change of normal (x_n), then the offset (dx, dy)/r,
+// the relative change of distance and last the constant (x_a), whose coefficient is the fit
+// at the pixel.
 const REGRESSORS: u32 = 7u;
 // The lower triangle of the REGRESSORS² normal matrix, row by row.
 const TRIANGLE: u32 = 28u;
@@ -224,6 +225,8 @@ fn tri(i: u32, j: u32) -> u32 {
 // The fit of component c at pixel xy (module notes, denoise.rs): Σ w x xᵀ β = Σ w x L over
 // the disc of radius r, w = exp(−d²/(2 (BANDWIDTH r)²)) · exp(−|Y(G_q) − Y(G_p)| / s), G the
 // guide (`src`), s = σ_g · √(g₃ ⊛ σ²)(p), solved by Cholesky with the ridge on the diagonal.
+// The sums are kept in blocks of fixed shape (x_n x_nᵀ, x_a x_nᵀ, x_a x_aᵀ, L x_nᵀ, L x_aᵀ),
+// which stay in registers, and unpacked once into the triangle.
 fn fit(xy: vec2i, c: u32) -> vec3f {
     let n = pixel_count();
     let res = vec2i(params.resolution);
@@ -234,8 +237,11 @@ fn fit(xy: vec2i, c: u32) -> vec3f {
     let bandwidth = BANDWIDTH * f32(max(radius, 1u));
     let yp = luminance(src[c * n + p].rgb);
     let s = params.sigma_g * sqrt(blurred_variance(xy, c, true)) + LUMINANCE_EPSILON;
-    var m: array<f32, TRIANGLE>;
-    var b: array<vec3f, REGRESSORS>;
+    var ann = mat3x3f();
+    var aan = mat3x4f();
+    var aaa = mat4x4f();
+    var bn = mat3x3f();
+    var ba = mat4x3f();
     for (var dy = -r; dy <= r; dy++) {
         for (var dx = -r; dx <= r; dx++) {
             let q = xy + vec2i(dx, dy);
@@ -249,24 +255,39 @@ fn fit(xy: vec2i, c: u32) -> vec3f {
             }
             let d2 = f32(dx * dx + dy * dy);
             let w = exp(-0.5 * d2 / (bandwidth * bandwidth)) * exp(-abs(luminance(src[c * n + k].rgb) - yp) / s);
-            let dn = gq.normal - gp.normal;
-            var x = array<f32, REGRESSORS>(
+            let xn = gq.normal - gp.normal;
+            let xa = vec4f(
                 f32(dx) / f32(max(r, 1)),
                 f32(dy) / f32(max(r, 1)),
                 (gq.depth - gp.depth) / gp.depth,
-                dn.x,
-                dn.y,
-                dn.z,
                 1.0,
             );
             let l = light[c * n + k].rgb;
-            for (var i = 0u; i < REGRESSORS; i++) {
-                let wx = w * x[i];
-                b[i] += wx * l;
-                for (var j = 0u; j <= i; j++) {
-                    m[tri(i, j)] += wx * x[j];
-                }
+            ann += w * mat3x3f(xn * xn.x, xn * xn.y, xn * xn.z);
+            aan += w * mat3x4f(xa * xn.x, xa * xn.y, xa * xn.z);
+            aaa += w * mat4x4f(xa * xa.x, xa * xa.y, xa * xa.z, xa * xa.w);
+            bn += w * mat3x3f(l * xn.x, l * xn.y, l * xn.z);
+            ba += w * mat4x3f(l * xa.x, l * xa.y, l * xa.z, l * xa.w);
+        }
+    }
+    var m: array<f32, TRIANGLE>;
+    var b: array<vec3f, REGRESSORS>;
+    for (var i = 0u; i < REGRESSORS; i++) {
+        if i < 3u {
+            b[i] = bn[i];
+        } else {
+            b[i] = ba[i - 3u];
+        }
+        for (var j = 0u; j <= i; j++) {
+            var v: f32;
+            if i < 3u {
+                v = ann[j][i];
+            } else if j < 3u {
+                v = aan[j][i - 3u];
+            } else {
+                v = aaa[j - 3u][i - 3u];
             }
+            m[tri(i, j)] = v;
         }
     }
     // The ridge: each regressor's weighted square grows by `ridge` of itself and a tiny part

@@ -36,7 +36,7 @@ use crate::render::Method;
 const RESIZE_SETTLE: Duration = Duration::from_millis(150);
 /// How long a script's `resize` may wait for the window to take the new size.
 const RESIZE_TIMEOUT: Duration = Duration::from_secs(10);
-/// While the denoised image is shown, the denoiser (about 90 ms at 256² on lavapipe) runs
+/// While the denoised image is shown, the denoiser (about 0.9 s at 256² on lavapipe) runs
 /// again once the image holds this factor more iterations than when it last ran...
 const DENOISE_GROWTH: u32 = 2;
 /// ...or this long after it last ran, if the image has new iterations since. Every frame

@@ -425,3 +425,42 @@ fn denoised_display_is_the_display_encoding_of_the_denoised_image() {
     let (worst, _) = display_difference(&shown, &srgb_bytes(&raw, 0.0));
     assert!(worst <= 1, "the raw display after the denoised one: {worst}/255 off");
 }
+
+/// Texture sharpness: the textured room (a checker floor, a striped back wall, a textured cube
+/// and panels: common/textured_room.rs) at 128², 16 iterations raw and denoised against 512
+/// raw iterations at another seed. In the pixels of the reference's highest tenth of
+/// gradients, the checker's and the stripes' edges among them, the denoised image is closer
+/// than the raw one, and over all pixels much closer: demodulating by the albedo keeps the
+/// textures out of the filter. About 35 s on lavapipe.
+///
+/// Measured (lavapipe): relative RMSE raw 0.0469, denoised 0.0267 (0.57×); in the high-gradient
+/// tenth raw 0.0738, denoised 0.0642 (the reference's own noise about 0.008).
+#[test]
+fn textures_stay_sharp() {
+    use common::textured_room::{self as room, Variant};
+    let gpu = common::gpu();
+    let dir = tempfile::tempdir().unwrap();
+    let path = room::room_gltf(Variant::Binary).write(dir.path(), "room.glb");
+    let scene = rastergi::scene::load_gltf(&path).unwrap();
+    let settings = |seed| RenderSettings { seed, ..common::fitted_settings(&scene, 128, seed) };
+    let reference = common::render(&gpu, &scene, settings(9), 512, Show::Full);
+    let mask = emitter_mask(&reference, 3.0);
+    let edges = high_gradient_mask(&reference, &mask);
+    let mut r = Renderer::new(&gpu, &scene, settings(5)).unwrap();
+    r.enable_denoiser().unwrap();
+    for _ in 0..16 {
+        r.iterate().unwrap();
+    }
+    let raw = r.read_linear(Show::Full).unwrap();
+    let den = r.read_denoised(&DenoiseParams::default()).unwrap();
+    let (all_raw, all_den) = (compare(&raw, &reference, Some(&mask)), compare(&den, &reference, Some(&mask)));
+    let (edge_raw, edge_den) = (compare(&raw, &reference, Some(&edges)), compare(&den, &reference, Some(&edges)));
+    println!(
+        "textured room, 16 iterations: relative RMSE raw {:.4}, denoised {:.4}; high-gradient tenth raw {:.4}, \
+         denoised {:.4}",
+        all_raw.relative_rmse, all_den.relative_rmse, edge_raw.relative_rmse, edge_den.relative_rmse
+    );
+    assert!(edge_den.relative_rmse < edge_raw.relative_rmse, "edges: denoised {edge_den:?}, raw {edge_raw:?}");
+    assert!(all_den.relative_rmse < 0.65 * all_raw.relative_rmse, "denoised {all_den:?}, raw {all_raw:?}");
+    assert_block_means(&all_den);
+}

@@ -15,6 +15,8 @@
 #                 path tracer (bench converge)
 #   Mitsuba       the same with Mitsuba 3 `cuda_ad_rgb` beside them, when python3 can import
 #                 it (otherwise the section says why it was skipped)
+#   Denoiser      milliseconds per application of the denoiser at 256² and 1920×1080
+#                 (bench denoise)
 #   Memory        GPU memory at 1920×1080 (bench memory)
 #
 # Usage: scripts/gpu-report.sh [--quick] [--out FILE.md] [--binary PATH]
@@ -28,7 +30,7 @@
 #                  the build's target/release/rastergi)
 #
 # Time: each step has a budget (below, in seconds) and is stopped if it runs past it, so the
-# full report takes at most the sum of the budgets, 455 s, plus the build. The budgets fit
+# full report takes at most the sum of the budgets, 495 s, plus the build. The budgets fit
 # a real GPU: the steps with fixed work (photons, gather, memory) need a few seconds there,
 # and the others run for a given time (--seconds, --max-seconds) chosen within them. In
 # --quick mode the budgets are only caps against a hang. A step that fails or is stopped is
@@ -88,7 +90,7 @@ started=$(date +%s)
 if [ "$quick" = 1 ]; then
     mode="quick (tiny sizes and runs of a second or two, for CI and lavapipe: its figures are no performance figures)"
     # Steps and their caps (s): every one takes a few seconds on lavapipe.
-    B_INFO=60 B_PHOTONS=60 B_RAYS=30 B_GATHER=120 B_FRAMES=60 B_REF=60 B_COMPARE=60 B_CONVERGE=60 B_MITSUBA=120 B_MEMORY=60
+    B_INFO=60 B_PHOTONS=60 B_RAYS=30 B_GATHER=120 B_FRAMES=60 B_REF=60 B_COMPARE=60 B_CONVERGE=60 B_MITSUBA=120 B_DENOISE=60 B_MEMORY=60
     PHOTONS=(--photons 65536 --grid 32 --repeats 1)
     RAYS=(--size 32 --repeats 1)
     RAYS_MESH=spheres:20000
@@ -96,9 +98,11 @@ if [ "$quick" = 1 ]; then
     FRAMES=(--width 160 --height 90 --seconds 1 --photons 65536 --grid 32)
     SIZE=64 REF_SECONDS=3 CONVERGE_SECONDS=2 MITSUBA_SECONDS=2
     MEMORY=(--width 160 --height 90 --grid 32 --bundle 256)
+    DENOISE_SIZES=(64x48)
+    DENOISE=(--repeats 1 --iterations 2)
 else
     mode="full"
-    # Budgets (s), 415 in all:
+    # Budgets (s), 495 in all (the rays', the reference's and the denoiser's twice):
     B_INFO=10      # adapter query
     B_PHOTONS=30   # 4 GPU runs of 4 M photons, then the CPU twin once (a few s on 8+ cores)
     B_RAYS=20      # each of 2 scenes: 5 kinds x 4 GPU runs of 1 M rays + the CPU twin once each
@@ -109,6 +113,7 @@ else
     B_CONVERGE=45  # 15 s each for the renderer and the path tracer, + set-up and read-backs
     B_MITSUBA=120  # 8 s each for the two, Mitsuba doubling its spp past 8 s (<= 4 x 8 s)
     #                plus its process start-up (JIT) for each of ~12 runs
+    B_DENOISE=20   # each size: a renderer, 4 iterations, 5 applications (lavapipe: 14 s each at 1080p)
     B_MEMORY=20    # one renderer at 1920x1080, grid 128, bundle 2048, auto's trial iterations
     PHOTONS=(--photons 4194304 --repeats 3)
     RAYS=(--size 1024 --repeats 3)
@@ -117,6 +122,8 @@ else
     FRAMES=(--width 1920 --height 1080 --seconds 6)
     SIZE=1024 REF_SECONDS=50 CONVERGE_SECONDS=15 MITSUBA_SECONDS=8
     MEMORY=()
+    DENOISE_SIZES=(256x256 1920x1080)
+    DENOISE=()
 fi
 
 # The report, written as it goes.
@@ -281,6 +288,13 @@ else
     step "mitsuba" "$B_MITSUBA" "$binary" bench converge --reference "$ref_a,$ref_b" --seconds "$MITSUBA_SECONDS" \
         --mitsuba --mitsuba-variant cuda_ad_rgb --csv "$stem-mitsuba.csv" --plot "$stem-mitsuba.png" || true
 fi
+
+report "## Denoiser" ""
+report "One application of the denoiser (guide and regression, tests/denoise.rs) to the accumulated image." ""
+for size in "${DENOISE_SIZES[@]}"; do
+    step "denoiser $size" "$B_DENOISE" "$binary" bench denoise cornell --width "${size%x*}" --height "${size#*x}" \
+        ${DENOISE[@]+"${DENOISE[@]}"} || true
+done
 
 report "## Memory" ""
 report "GPU memory from the device allocator's report, after set-up and while rendering." ""

@@ -11,8 +11,8 @@ use std::time::Duration;
 const TIMEOUT: Duration = Duration::from_secs(300);
 
 /// The report's sections by heading, in order.
-const SECTIONS: [&str; 9] =
-    ["Adapter", "Photons", "Rays", "Gather", "Viewer loop", "Convergence", "Mitsuba", "Memory", "Summary"];
+const SECTIONS: [&str; 10] =
+    ["Adapter", "Photons", "Rays", "Gather", "Viewer loop", "Convergence", "Mitsuba", "Denoiser", "Memory", "Summary"];
 
 /// The text of the section `## name` (up to the next heading).
 fn section<'a>(report: &'a str, name: &str) -> &'a str {
@@ -73,6 +73,7 @@ fn quick_report_has_every_section_with_its_command_and_figures() {
         ("Viewer loop", "rastergi bench frames"),
         ("Convergence", "rastergi render cornell --method path"),
         ("Convergence", "rastergi bench converge"),
+        ("Denoiser", "rastergi bench denoise cornell"),
         ("Memory", "rastergi bench memory"),
     ] {
         assert!(section(&report, name).contains(&format!("```sh\n{command}")), "{name}: no `{command}` in:\n{report}");
@@ -93,5 +94,6 @@ fn quick_report_has_every_section_with_its_command_and_figures() {
     assert!(dir.path().join("report-converge.png").is_file(), "no convergence plot beside the report");
     let mitsuba = section(&report, "Mitsuba");
     assert!(mitsuba.contains("Skipped: ") || !figures(mitsuba, "%:").is_empty(), "{mitsuba}");
+    check_figures(&report, "Denoiser", "ms per application", 1);
     check_figures(&report, "Memory", "MiB allocated", 2);
 }

@@ -544,12 +544,11 @@ pub mod cpu {
         i * (i + 1) / 2 + j
     }
 
-    /// The image's guides per pixel: unit mean normal and mean distance (0 where unseen), and
-    /// whether the distance is positive (the regression's pixels).
+    /// The image's guides per pixel: unit mean normal and mean distance (0 where unseen: the
+    /// regression fits the pixels of positive distance).
     struct Geometry {
         normal: Vec<[f32; 3]>,
         depth: Vec<f32>,
-        seen: Vec<bool>,
     }
 
     /// Component c of pixel k of a two-component buffer (direct at k, indirect at n + k).
@@ -575,26 +574,13 @@ pub mod cpu {
     fn atrous(input: &Input, params: &DenoiseParams, geometry: &Geometry, src: &Light, step: i32) -> Light {
         let (w, h) = (input.width as i32, input.height as i32);
         let n = (w * h) as usize;
-        // The level's luminance guide: the 3×3 binomial blur of each component's luminance.
+        // The level's luminance guide: the 3×3 binomial blur of each component's luminance
+        // (both in one pass in the shader, the same sums).
         let lum: Vec<[f32; 2]> = (0..n)
             .map(|p| {
                 let (x, y) = ((p as i32) % w, (p as i32) / w);
-                // Both components in one pass in the shader; the same sums here.
-                let (mut sum, mut wsum) = ([0.0f32; 2], 0.0f32);
-                for dy in -1..=1i32 {
-                    for dx in -1..=1i32 {
-                        let (qx, qy) = (x + dx, y + dy);
-                        if qx >= 0 && qy >= 0 && qx < w && qy < h {
-                            let wt = BINOMIAL3[(dx + 1) as usize] * BINOMIAL3[(dy + 1) as usize];
-                            let k = (qy * w + qx) as usize;
-                            let (d, i) = (src[k], src[n + k]);
-                            sum[0] += wt * luminance([d[0], d[1], d[2]]);
-                            sum[1] += wt * luminance([i[0], i[1], i[2]]);
-                            wsum += wt;
-                        }
-                    }
-                }
-                [sum[0] / wsum, sum[1] / wsum]
+                let y_of = |v: [f32; 4]| luminance([v[0], v[1], v[2]]);
+                [blur3(x, y, (w, h), |k| y_of(src[k])), blur3(x, y, (w, h), |k| y_of(src[n + k]))]
             })
             .collect();
         let mut dst = vec![[0.0f32; 4]; 2 * n];
@@ -675,7 +661,7 @@ pub mod cpu {
                     continue;
                 }
                 let k = (qy * w + qx) as usize;
-                if k != p && !geometry.seen[k] {
+                if k != p && geometry.depth[k] == 0.0 {
                     continue;
                 }
                 let (nq, zq) = (geometry.normal[k], geometry.depth[k]);
@@ -778,7 +764,7 @@ pub mod cpu {
             light[p] = [reflected[0] / a[0], reflected[1] / a[1], reflected[2] / a[2], variance_of_mean(m[0], m[1], g)];
             light[n + p] = [fi[0] / s / a[0], fi[1] / s / a[1], fi[2] / s / a[2], variance_of_mean(m[2], m[3], g)];
         }
-        let mut geometry = Geometry { normal: vec![[0.0; 3]; n], depth: vec![0.0; n], seen: vec![false; n] };
+        let mut geometry = Geometry { normal: vec![[0.0; 3]; n], depth: vec![0.0; n] };
         for p in 0..n {
             let (g0, g1) = (at(input.guides, p), at(input.guides, n + p));
             let len = (g1[0] * g1[0] + g1[1] * g1[1] + g1[2] * g1[2]).sqrt();
@@ -786,7 +772,6 @@ pub mod cpu {
                 geometry.normal[p] = [g1[0] / len, g1[1] / len, g1[2] / len];
                 geometry.depth[p] = g0[3] / g1[3];
             }
-            geometry.seen[p] = geometry.depth[p] > 0.0;
         }
         let mut guide = light.clone();
         for level in 0..params.levels.min(LEVELS) {
@@ -798,7 +783,7 @@ pub mod cpu {
                 let p = (y * w + x) as usize;
                 for c in 0..2 {
                     let l = light[c * n + p];
-                    fits[c * n + p] = if geometry.seen[p] {
+                    fits[c * n + p] = if geometry.depth[p] > 0.0 {
                         fit(input, params, &geometry, (&guide, &light), (x, y, c))
                     } else {
                         [l[0], l[1], l[2]]

@@ -24,15 +24,8 @@ fn accumulate_guides(@builtin(global_invocation_id) gid: vec3u) {
     var normal = vec3f(0.0);
     var depth = 0.0;
     var seen = 0.0;
-    // The emission term of direct.wgsl, as it adds it.
-    var emitted = vec3f(0.0);
-    if !v.seen {
-        emitted = env_radiance(camera_direction(xy));
-    }
-    if v.front {
-        emitted = v.x.emission;
-    }
-    emitted = v.weight * emitted;
+    // What the direct pass adds before any light is reflected.
+    let emitted = v.weight * emitted_radiance(v, xy);
     if v.seen {
         albedo = v.weight * v.x.albedo;
         normal = v.ns;

@@ -7,14 +7,7 @@
 fn main(@builtin(global_invocation_id) gid: vec3u) {
     if !begin_pixel(gid.xy) { return; }
     let p = visible_point_at(gid.xy);
-    var radiance = vec3f(0.0);
-    if !p.seen {
-        // The camera ray escapes: the environment along it (black without one).
-        radiance = env_radiance(camera_direction(gid.xy));
-    }
-    if p.front {
-        radiance = p.x.emission;
-    }
+    var radiance = emitted_radiance(p, gid.xy);
     let glass = p.seen && p.x.transmission > 0.0;
     if has_lights() && (p.ok || glass) {
         let s = p.x;

@@ -394,18 +394,31 @@ fn min_size<T>() -> Option<std::num::NonZeroU64> {
     std::num::NonZeroU64::new(std::mem::size_of::<T>() as u64)
 }
 
-/// Bind-group-layout entry for a 2D unsigned-integer texture (the G-buffer, ray-view layers).
-pub fn uint_texture_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+/// Bind-group-layout entry for a texture of `sample_type` and `dimension`, not multisampled.
+fn texture_entry(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+    sample_type: wgpu::TextureSampleType,
+    view_dimension: wgpu::TextureViewDimension,
+) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility,
-        ty: wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Uint,
-            view_dimension: wgpu::TextureViewDimension::D2,
-            multisampled: false,
-        },
+        ty: wgpu::BindingType::Texture { sample_type, view_dimension, multisampled: false },
         count: None,
     }
+}
+
+/// Bind-group-layout entry for a 2D unsigned-integer texture (the G-buffer, ray-view layers).
+pub fn uint_texture_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    texture_entry(binding, visibility, wgpu::TextureSampleType::Uint, wgpu::TextureViewDimension::D2)
+}
+
+/// Bind-group-layout entry for a 2D float texture read texel by texel (`textureLoad`; the GGX
+/// albedo tables).
+pub fn float_table_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    let sample_type = wgpu::TextureSampleType::Float { filterable: false };
+    texture_entry(binding, visibility, sample_type, wgpu::TextureViewDimension::D2)
 }
 
 /// Runs `pipeline` once per pixel of a `width × height` image (8×8 workgroups) with bind
@@ -450,16 +463,8 @@ pub fn bind_group_layout(
 
 /// Bind-group-layout entry for a filterable float 2D array texture (the scene's textures).
 pub fn texture_array_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Float { filterable: true },
-            view_dimension: wgpu::TextureViewDimension::D2Array,
-            multisampled: false,
-        },
-        count: None,
-    }
+    let sample_type = wgpu::TextureSampleType::Float { filterable: true };
+    texture_entry(binding, visibility, sample_type, wgpu::TextureViewDimension::D2Array)
 }
 
 /// Bind-group-layout entry for a filtering sampler.

@@ -11,7 +11,9 @@ use crate::error::Result;
 use wgpu::util::DeviceExt;
 
 use crate::environment::{Environment, GpuEnvironment};
-use crate::gpu::{Gpu, bind_group_layout, sampler_entry, storage_entry, texture_array_entry, uniform_entry};
+use crate::gpu::{
+    Gpu, bind_group_layout, float_table_entry, sampler_entry, storage_entry, texture_array_entry, uniform_entry,
+};
 use crate::lights::{LightEntry, LightTable};
 use crate::limits::check_storage_buffer;
 use crate::scene::{Aabb, AlphaMode, Material, Scene, TextureRef, UvTransform};
@@ -126,20 +128,6 @@ pub struct GpuSceneOffsets {
     /// The environment map's data ([`Environment::gpu_data`]).
     pub environment: u32,
     pub _pad: [u32; 6],
-}
-
-/// A float texture read texel by texel (`textureLoad`): the GGX albedo tables.
-fn table_texture_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Float { filterable: false },
-            view_dimension: wgpu::TextureViewDimension::D2,
-            multisampled: false,
-        },
-        count: None,
-    }
 }
 
 /// The GGX albedo tables as gpu_scene.wgsl reads them: the cells and means, N × (N + 1)
@@ -626,8 +614,8 @@ impl GpuScene {
                 sampler_entry(6, vis),
                 storage_entry::<u32>(8, vis, true),
                 uniform_entry::<GpuEnvironment>(9, wgpu::ShaderStages::COMPUTE),
-                table_texture_entry(13, compute),
-                table_texture_entry(14, compute),
+                float_table_entry(13, compute),
+                float_table_entry(14, compute),
             ],
         );
         // The buffers' bindings, in the order of `buffers`.

@@ -95,3 +95,18 @@ fn gather_density(p: VisiblePoint, w: vec3f) -> f32 {
     let v = visible_bsdf(p);
     return bsdf_pdf(v.b, v.wo, to_local(v.frame, w));
 }
+
+// The radiance emitted towards the eye at pixel xy's visible point, before the eye chain's
+// weight: an emitter's front face, or the environment where the camera ray escapes (black
+// without one). The direct pass adds it to the film; the denoiser's guides sum it, to keep it
+// out of the filter.
+fn emitted_radiance(p: VisiblePoint, xy: vec2u) -> vec3f {
+    var radiance = vec3f(0.0);
+    if !p.seen {
+        radiance = env_radiance(camera_direction(xy));
+    }
+    if p.front {
+        radiance = p.x.emission;
+    }
+    return radiance;
+}

@@ -68,13 +68,13 @@ pub struct RenderArgs {
     /// Print the GPU time of every pass (timestamp queries): the set-up's and the iterations'.
     #[arg(long)]
     profile: bool,
-    /// Denoise the accumulated image (edge-avoiding à-trous filter guided by albedo, normal and
-    /// depth, README "Denoiser"): --out gets the denoised image and NAME.raw.EXT beside it the
+    /// Denoise the accumulated image (a weighted regression on distance and normal guided by an
+    /// edge-avoiding à-trous filter, README "Denoiser"): --out gets the denoised image and NAME.raw.EXT beside it the
     /// raw one (what --out holds without --denoise). Gather method, full image only.
     #[arg(long)]
     denoise: bool,
     /// Also write the mean albedo of the visible points here (.exr linear, .png sRGB): a guide
-    /// for external denoisers (OIDN, OptiX). Gather method only.
+    /// for external denoisers (OIDN, OptiX; scripts/oidn.py applies OIDN). Gather method only.
     #[arg(long, value_name = "FILE")]
     albedo: Option<PathBuf>,
     /// Also write the mean world-space shading normal of the visible points here (.exr, unit

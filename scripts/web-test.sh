@@ -4,7 +4,8 @@
 # machine without a GPU; on a virtual display, xvfb-run, since headless Chromium loses the
 # WebGPU device when a canvas presents: scripts/web_test.py), renders the Cornell box at 128² for 64 iterations, writes the
 # image to OUT.png, drags the camera (the image must restart) and exits 0. Options after OUT.png
-# go to scripts/web_test.py (--iterations, --size, --seed, --gather, --file, --bad-file).
+# go to scripts/web_test.py (--iterations, --size, --seed, --gather, --denoised, --file,
+# --bad-file).
 #
 # Installs Debian's chromium and chromium-driver where they are missing (apt, as root or with
 # sudo). Exit status 3: they are missing and cannot be installed (the test suite skips then).

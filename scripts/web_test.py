@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
 """Drives rastergi's web page in Chromium through chromedriver (the W3C WebDriver
-protocol over HTTP, standard library only): renders the Cornell box, saves the image, moves
-the camera with a real pointer drag, loads files through the page's file input.
+protocol over HTTP, standard library only): renders the Cornell box, saves the image, turns
+the denoiser on with the panel's checkbox and saves the denoised image, moves the camera with
+a real pointer drag, loads files through the page's file input.
 
 Usage: web_test.py URL OUT.png [--iterations N] [--size W] [--seed S] [--gather G]
-           [--file SCENE_FILE]... [--bad-file FILE]
+           [--denoised OUT.png] [--file SCENE_FILE]... [--bad-file FILE]
 
 Prints one JSON object with what it saw; exits non-zero (with one line on stderr) when the
 page failed. scripts/web-test.sh starts the server and calls it.
@@ -128,6 +129,14 @@ def wait_for(driver, condition, what, timeout):
     fail(f"timed out after {timeout} s waiting for {what} (page error: {state['error'] or 'none'}, {state['samples']} iterations)")
 
 
+def save_png(driver, path):
+    """Writes the page's "save PNG" image to `path` (whole, or not at all)."""
+    png = base64.b64decode(driver.run("return await rastergi.png();"))
+    with open(path + ".tmp", "wb") as f:
+        f.write(png)
+    os.replace(path + ".tmp", path)
+
+
 def main():
     p = argparse.ArgumentParser()
     p.add_argument("url")
@@ -140,6 +149,7 @@ def main():
     p.add_argument("--bad-file", help="a file that is not a scene: the page must refuse it and keep its scene")
     p.add_argument("--timeout", type=int, default=600)
     p.add_argument("--screenshot", help="also save a screenshot of the whole page here, after the render")
+    p.add_argument("--denoised", help="then tick the panel's denoise box, render the same iterations again and save that image here")
     a = p.parse_args()
     chromium = shutil.which("chromium") or shutil.which("chromium-browser") or fail("chromium is not installed")
     chromedriver = shutil.which("chromedriver") or fail("chromedriver is not installed")
@@ -158,13 +168,21 @@ def main():
         start = time.time()
         wait_for(driver, f"rastergi.samples() >= {a.iterations} && rastergi.idle()", f"{a.iterations} iterations", a.timeout)
         report["seconds"] = round(time.time() - start, 1)
-        png = base64.b64decode(driver.run("return await rastergi.png();"))
-        with open(a.out + ".tmp", "wb") as f:
-            f.write(png)
-        os.replace(a.out + ".tmp", a.out)
+        save_png(driver, a.out)
         if a.screenshot:
             with open(a.screenshot, "wb") as f:
                 f.write(base64.b64decode(driver.call("GET", f"{driver.session}/screenshot")))
+
+        if a.denoised:
+            # A real click on the panel's checkbox: the denoiser's guides start, so the image
+            # restarts and runs the same iterations again.
+            driver.call("POST", f"{driver.session}/element/{driver.element('#denoise')}/click", {})
+            wait_for(driver, "rastergi.viewer.describe().includes('denoised') || rastergi.error()", "the denoiser to turn on", 60)
+            if driver.run("return rastergi.error();"):
+                fail(f"turning the denoiser on: {driver.run('return rastergi.error();')}")
+            wait_for(driver, f"rastergi.samples() >= {a.iterations} && rastergi.idle()", f"{a.iterations} denoised iterations", a.timeout)
+            save_png(driver, a.denoised)
+            report["denoised"] = driver.run("return rastergi.viewer.describe();")
 
         # A real pointer drag across the canvas orbits the camera: the image restarts.
         canvas = driver.element("#view")

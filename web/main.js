@@ -2,7 +2,8 @@
 // loop, the panel, the mouse and keys, dropped or picked files, and "save PNG".
 //
 // URL parameters (all optional): scene (a built-in name), width, height, seed, gather
-// (lists | trace), iterations (stop after this many; the test uses it). The page publishes
+// (lists | trace), denoise (1: start with the denoiser on), iterations (stop after this many;
+// the test uses it). The page publishes
 // `window.rastergi` = { ready (a promise), viewer, samples(), error(), png() } for
 // scripts/web-test.sh.
 import init, { createViewer } from './pkg/rastergi_web.js';
@@ -141,6 +142,7 @@ function wire() {
   for (const key of ['method', 'gather', 'photons', 'show']) {
     $(key).addEventListener('change', (e) => apply(() => v().set(key, e.target.value)));
   }
+  $('denoise').addEventListener('change', (e) => apply(() => v().set('denoise', e.target.checked ? 'on' : 'off')));
   $('size').addEventListener('change', (e) => apply(() => {
     v().set('size', e.target.value);
     const [w, h] = e.target.value.split('x').map(Number);
@@ -221,6 +223,10 @@ async function main() {
   if (params.get('gather')) {
     $('gather').value = params.get('gather');
     state.viewer.set('gather', params.get('gather'));
+  }
+  if (params.get('denoise') === '1') {
+    $('denoise').checked = true;
+    state.viewer.set('denoise', 'on');
   }
   if (params.get('scene') && params.get('scene') !== 'cornell') {
     $('scene').value = params.get('scene');

@@ -22,6 +22,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicU32, Ordering};
 
 use rastergi::camera_control::{CameraControl, DRAG_RADIANS_PER_PIXEL, MoveKeys};
+use rastergi::denoise::{DenoiseParams, Schedule};
 use rastergi::display::WindowSurface;
 use rastergi::film::Show;
 use rastergi::gather::GatherMethod;
@@ -60,6 +61,8 @@ struct Options {
     exposure: f32,
     /// The sun (the scene's last distant light).
     sun: Option<SunAngles>,
+    /// Show the denoised full image (the photon-map renderer's denoiser).
+    denoise: bool,
 }
 
 /// The renderer of a page: the device, the canvas, the scene and its progressive image.
@@ -75,6 +78,8 @@ pub struct Viewer {
     control: CameraControl,
     options: Options,
     in_flight: Arc<AtomicU32>,
+    /// When the denoiser last ran for the canvas (while the denoised image is shown).
+    denoised: Schedule,
 }
 
 /// Opens the browser's WebGPU adapter for `canvas` and shows the Cornell box at
@@ -121,6 +126,7 @@ pub async fn create_viewer(
         show: Show::Full,
         exposure: 0.0,
         sun: None,
+        denoise: false,
     };
     let scene = rastergi::scene::cornell_box();
     let renderer = build(&gpu, &scene, &options).map_err(error)?;
@@ -135,6 +141,7 @@ pub async fn create_viewer(
         control,
         options,
         in_flight: Arc::new(AtomicU32::new(0)),
+        denoised: Schedule::default(),
     })
 }
 
@@ -159,7 +166,13 @@ fn build(gpu: &Gpu, scene: &Scene, options: &Options) -> rastergi::Result<Box<dy
         ..RenderSettings::default()
     };
     Ok(match options.method {
-        Method::PhotonMap => Box::new(Renderer::new(gpu, &scene, settings)?),
+        Method::PhotonMap => {
+            let mut renderer = Renderer::new(gpu, &scene, settings)?;
+            if options.denoise {
+                renderer.enable_denoiser()?;
+            }
+            Box::new(renderer)
+        }
         Method::PathTracer => Box::new(PathTracer::new(gpu, &scene, settings)?),
     })
 }
@@ -214,13 +227,16 @@ impl Viewer {
         let renderer = build(&self.gpu, &scene, &options).map_err(error)?;
         self.control = CameraControl::new(&scene.camera, &scene.bounds());
         (self.scene_name, self.scene, self.renderer, self.options) = (name, scene, renderer, options);
+        self.denoised.clear();
         Ok(())
     }
 
     /// Changes one setting: `method` (photons | path), `gather` (lists | trace), `photons`
     /// (a count, or auto), `show` (full | direct | indirect), `exposure` (stops), `sun`
-    /// ("azimuth,elevation" in degrees), `size` ("WIDTHxHEIGHT"), `seed`. Settings that change
-    /// what is traced rebuild the renderer; the image restarts.
+    /// ("azimuth,elevation" in degrees), `size` ("WIDTHxHEIGHT"), `seed`, `denoise` (on | off:
+    /// show the denoised full image; the photon-map renderer's, which restarts the image the
+    /// first time, as its guides start then). Settings that change what is traced rebuild the
+    /// renderer; the image restarts.
     pub fn set(&mut self, key: &str, value: &str) -> Result<(), JsError> {
         let bad = || JsError::new(&format!("'{value}' is not a valid {key}"));
         let mut options = self.options.clone();
@@ -236,6 +252,22 @@ impl Viewer {
             }
             "exposure" => {
                 self.options.exposure = value.parse().ok().filter(|e: &f32| e.is_finite()).ok_or_else(bad)?;
+                return Ok(());
+            }
+            "denoise" => {
+                self.options.denoise = match value {
+                    "on" => true,
+                    "off" => false,
+                    _ => return Err(bad()),
+                };
+                if let Some(r) =
+                    self.renderer.as_renderer_mut().filter(|r| self.options.denoise && !r.denoiser_enabled())
+                {
+                    r.enable_denoiser().map_err(error)?;
+                    // The guides hold the iterations from now on: the image restarts with them.
+                    r.reset();
+                }
+                self.denoised.clear();
                 return Ok(());
             }
             "method" => {
@@ -277,6 +309,7 @@ impl Viewer {
         let mut renderer = build(&self.gpu, &self.scene, &options).map_err(error)?;
         renderer.set_camera(camera).map_err(error)?;
         (self.renderer, self.options) = (renderer, options);
+        self.denoised.clear();
         Ok(())
     }
 
@@ -294,8 +327,7 @@ impl Viewer {
             });
         }
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
-        let show = if self.renderer.has(self.options.show) { self.options.show } else { Show::Full };
-        self.renderer.encode_resolve(&mut enc, show, self.options.exposure);
+        self.encode_resolve(&mut enc).map_err(error)?;
         self.surface.present(&self.gpu, enc, Some(self.renderer.film()), &[]).map_err(error)?;
         self.gpu.check().map_err(error)?;
         Ok(self.renderer.samples())
@@ -361,6 +393,36 @@ impl Viewer {
     fn moved(&mut self, moved: bool) -> Result<(), JsError> {
         if moved {
             self.renderer.set_camera(self.control.camera()).map_err(error)?;
+            self.denoised.clear();
+        }
+        Ok(())
+    }
+
+    /// The photon-map renderer while the canvas shows its denoised image.
+    fn denoising(&self) -> Option<&Renderer> {
+        let shown = self.options.denoise && self.options.show == Show::Full;
+        self.renderer.as_renderer().filter(|r| shown && r.denoiser_enabled())
+    }
+
+    /// Encodes the resolve of what the canvas shows into the film's display buffer: the raw
+    /// image of the shown component, or the denoised full image, filtered again first when
+    /// the schedule says so ([`Schedule`]).
+    fn encode_resolve(&mut self, enc: &mut wgpu::CommandEncoder) -> rastergi::Result<()> {
+        let exposure = self.options.exposure;
+        if let Some(r) = self.denoising() {
+            let (samples, now) = (r.samples(), js_sys::Date::now() / 1000.0);
+            let due = self.denoised.due(samples, now);
+            if due {
+                r.encode_denoise(enc, &DenoiseParams::default())?;
+            }
+            r.encode_resolve_denoised(enc, exposure)?;
+            if due {
+                self.denoised.ran(samples, now);
+            }
+        } else {
+            let show = if self.renderer.has(self.options.show) { self.options.show } else { Show::Full };
+            self.renderer.encode_resolve(enc, show, exposure);
+            self.denoised.clear();
         }
         Ok(())
     }
@@ -379,7 +441,12 @@ impl Viewer {
     pub fn describe(&self) -> String {
         let s = self.renderer.settings();
         let what = match self.options.method {
-            Method::PhotonMap => format!("photon map ({} photons a pass) + {:?} gather", s.photons, s.gather),
+            Method::PhotonMap => format!(
+                "photon map ({} photons a pass) + {:?} gather{}",
+                s.photons,
+                s.gather,
+                if self.denoising().is_some() { ", denoised" } else { "" }
+            ),
             Method::PathTracer => "path tracer".to_string(),
         };
         let i = &self.gpu.info;
@@ -415,12 +482,18 @@ impl Viewer {
         })
     }
 
-    /// The image as shown (the film's display encoding at its own size) as PNG bytes: a
-    /// promise of a `Uint8Array`.
+    /// The image as shown (the film's display encoding at its own size; the denoised image
+    /// filtered at the current iterations where it is shown) as PNG bytes: a promise of a
+    /// `Uint8Array`.
     #[wasm_bindgen(js_name = savePng)]
-    pub fn save_png(&self) -> js_sys::Promise {
-        let show = if self.renderer.has(self.options.show) { self.options.show } else { Show::Full };
-        let image = self.renderer.film().read_display_async(&self.gpu, show, self.options.exposure);
+    pub fn save_png(&mut self) -> js_sys::Promise {
+        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
+        self.denoised.clear();
+        if let Err(e) = self.encode_resolve(&mut enc) {
+            return js_sys::Promise::reject(&JsValue::from(error(e)));
+        }
+        self.gpu.queue.submit([enc.finish()]);
+        let image = self.renderer.film().read_display_buffer_async(&self.gpu);
         wasm_bindgen_futures::future_to_promise(async move {
             let image = image.await.map_err(|e| JsValue::from(error(e)))?;
             let mut png = Vec::new();

@@ -120,6 +120,49 @@ pub const RIDGE_FLOOR: f32 = 1.0e-12;
 /// and the sums of the emission the eye sees.
 pub const EXTRA_SLOTS: u64 = 3;
 
+/// When a window that shows the denoised image filters it again ([`Schedule`]): once the image
+/// holds this factor more iterations than at the last filter...
+pub const SCHEDULE_GROWTH: u32 = 2;
+/// ...or this many seconds after it, if the image has new iterations since.
+pub const SCHEDULE_INTERVAL: f64 = 1.0;
+
+/// When an interactive window (`rastergi view`, the web page) runs the filter again while it
+/// shows the denoised image. The filter costs far more than an iteration where the GPU is slow
+/// (0.9 s at 256² on lavapipe), so not every frame: at once where nothing is denoised yet or
+/// the image restarted (fewer iterations than at the last filter), then when the iterations
+/// have grown by [`SCHEDULE_GROWTH`] (log₂ n filters in all) or [`SCHEDULE_INTERVAL`] has
+/// passed. Between filters the window resolves the last denoised image (an exposure change
+/// needs no filter). Times are seconds from any fixed origin.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Schedule {
+    /// The iterations and the time of the last filter; `None`: none is on the window.
+    last: Option<(u32, f64)>,
+}
+
+impl Schedule {
+    /// Whether the image at `samples` iterations is due a filter at time `now`.
+    pub fn due(&self, samples: u32, now: f64) -> bool {
+        match self.last {
+            None => true,
+            // Fewer iterations: the image restarted since.
+            Some((last, _)) if samples < last => true,
+            Some((last, at)) => {
+                samples != last && (samples >= last.saturating_mul(SCHEDULE_GROWTH) || now - at >= SCHEDULE_INTERVAL)
+            }
+        }
+    }
+
+    /// The filter ran on the image at `samples` iterations at time `now`.
+    pub fn ran(&mut self, samples: u32, now: f64) {
+        self.last = Some((samples, now));
+    }
+
+    /// The window no longer shows a denoised image: the next is filtered at once.
+    pub fn clear(&mut self) {
+        self.last = None;
+    }
+}
+
 /// The filter's parameters (module notes).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DenoiseParams {
@@ -815,4 +858,24 @@ pub mod cpu {
 
     /// Film sums of `COMPONENTS` components expected by [`Input::film`].
     pub const FILM_COMPONENTS: u64 = COMPONENTS;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_schedule_filters_again_when_the_iterations_double_or_a_second_has_passed() {
+        let t = 100.0;
+        assert!(Schedule::default().due(0, t), "nothing denoised on the window yet");
+        let mut s = Schedule::default();
+        s.ran(8, t);
+        assert!(!s.due(8, t + 10.0 * SCHEDULE_INTERVAL), "no new iterations, no new filter");
+        assert!(!s.due(15, t + SCHEDULE_INTERVAL / 2.0));
+        assert!(s.due(16, t + SCHEDULE_INTERVAL / 2.0), "doubled");
+        assert!(s.due(9, t + SCHEDULE_INTERVAL), "a second later");
+        assert!(s.due(3, t), "restarted: fewer iterations");
+        s.clear();
+        assert!(s.due(8, t), "cleared: filtered at once");
+    }
 }

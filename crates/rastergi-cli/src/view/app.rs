@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Result, anyhow};
 use rastergi::camera_control::CameraControl;
-use rastergi::denoise::DenoiseParams;
+use rastergi::denoise::{self, DenoiseParams};
 use rastergi::display::{Presented, WindowSurface};
 use rastergi::film::Show;
 use rastergi::gather::GatherMethod;
@@ -36,13 +36,6 @@ use crate::render::Method;
 const RESIZE_SETTLE: Duration = Duration::from_millis(150);
 /// How long a script's `resize` may wait for the window to take the new size.
 const RESIZE_TIMEOUT: Duration = Duration::from_secs(10);
-/// While the denoised image is shown, the denoiser (about 0.9 s at 256² on lavapipe) runs
-/// again once the image holds this factor more iterations than when it last ran...
-const DENOISE_GROWTH: u32 = 2;
-/// ...or this long after it last ran, if the image has new iterations since. Every frame
-/// resolves the last denoised image at the current exposure, so the exposure needs no new
-/// filter; a restart (camera, new renderer, resize) or the toggle turning on filters at once.
-const DENOISE_INTERVAL: Duration = Duration::from_secs(1);
 
 /// A renderer being built on a worker thread (with the scene it opened, if it opened one).
 pub enum UserEvent {
@@ -59,26 +52,6 @@ struct Measured {
     memory: Option<u64>,
     /// (iterations, estimated error) since the last restart.
     history: Vec<(u32, f64)>,
-}
-
-/// The denoiser's last run for the window: the image's iterations then, and when.
-struct Denoised {
-    samples: u32,
-    at: Instant,
-}
-
-/// Whether the denoised image on the window is due a new filter at `samples` iterations (see
-/// [`DENOISE_GROWTH`], [`DENOISE_INTERVAL`]); `last` is `None` where none is on the window.
-fn denoise_due(last: Option<&Denoised>, samples: u32, now: Instant) -> bool {
-    match last {
-        None => true,
-        // Fewer iterations: the image restarted since.
-        Some(d) if samples < d.samples => true,
-        Some(d) => {
-            samples != d.samples
-                && (samples >= d.samples.saturating_mul(DENOISE_GROWTH) || now - d.at >= DENOISE_INTERVAL)
-        }
-    }
 }
 
 /// The viewer: its window, GPU, renderer, controls, panel and script.
@@ -115,8 +88,10 @@ pub struct App {
     batch: u32,
     rate: Rate,
     measured: Measured,
-    /// The denoiser's last run for the window, while the denoised image is shown since.
-    denoised: Option<Denoised>,
+    /// When the denoiser last ran for the window, while the denoised image is shown since.
+    denoised: denoise::Schedule,
+    /// The origin of `denoised`'s times.
+    clock: Instant,
     title_at: Instant,
     status: String,
     script: Option<ScriptRun>,
@@ -167,7 +142,8 @@ impl App {
             batch: 1,
             rate: Rate { since: Instant::now(), count: 0, per_second: 0.0 },
             measured: Measured::default(),
-            denoised: None,
+            denoised: denoise::Schedule::default(),
+            clock: Instant::now(),
             title_at: Instant::now(),
             status: String::new(),
             script: steps.map(|steps| ScriptRun { steps, next: 0, last: Instant::now(), resizing: None }),
@@ -343,7 +319,7 @@ impl App {
             let r = active.get_mut();
             if r.camera() != camera {
                 r.set_camera(camera)?;
-                self.denoised = None;
+                self.denoised.clear();
             }
         }
         Ok(())
@@ -388,7 +364,7 @@ impl App {
                     log::info!("denoiser on: the image restarts (its guides start now)");
                     r.reset();
                 }
-                self.denoised = None;
+                self.denoised.clear();
             }
             Err(e) => {
                 eprintln!("warning: the denoiser cannot be turned on: {e}");
@@ -400,24 +376,24 @@ impl App {
 
     /// Encodes the resolve of what the window shows into the film's display buffer: the raw
     /// image of `show`, or the denoised one, filtered again first when it is due
-    /// ([`denoise_due`]).
+    /// ([`denoise::Schedule`]).
     fn encode_resolve(&mut self, enc: &mut egui_wgpu::wgpu::CommandEncoder, show: Show) -> Result<()> {
         let exposure = self.controls.exposure;
         if let Some(r) = self.denoising() {
-            let (samples, now) = (r.samples(), Instant::now());
-            let due = denoise_due(self.denoised.as_ref(), samples, now);
+            let (samples, now) = (r.samples(), self.clock.elapsed().as_secs_f64());
+            let due = self.denoised.due(samples, now);
             if due {
                 r.encode_denoise(enc, &DenoiseParams::default())?;
             }
             r.encode_resolve_denoised(enc, exposure)?;
             if due {
-                self.denoised = Some(Denoised { samples, at: now });
+                self.denoised.ran(samples, now);
             }
         } else {
             if let Some((active, _)) = &self.renderer {
                 active.get().encode_resolve(enc, show, exposure);
             }
-            self.denoised = None;
+            self.denoised.clear();
         }
         Ok(())
     }
@@ -446,7 +422,7 @@ impl App {
                 );
                 // The denoiser's image now holds the current iterations' filter.
                 if denoised {
-                    self.denoised = Some(Denoised { samples: renderer.samples(), at: Instant::now() });
+                    self.denoised.ran(renderer.samples(), self.clock.elapsed().as_secs_f64());
                 }
                 self.status = format!("saved {}", png.display());
             }
@@ -738,7 +714,7 @@ impl ApplicationHandler<UserEvent> for App {
                     self.title_at = Instant::now() - Duration::from_secs(1);
                 }
                 self.measured = Measured::default();
-                self.denoised = None;
+                self.denoised.clear();
                 self.renderer = Some((active, build));
                 if let Some(run) = &mut self.script {
                     run.last = Instant::now();
@@ -879,7 +855,7 @@ impl ApplicationHandler<UserEvent> for App {
                             if let Err(e) = r.resize(size.0, size.1) {
                                 return self.fail(event_loop, e.into());
                             }
-                            self.denoised = None;
+                            self.denoised.clear();
                             *built = wanted;
                         }
                         _ => self.start_build(None),
@@ -903,22 +879,5 @@ impl ApplicationHandler<UserEvent> for App {
         }
         event_loop.set_control_flow(ControlFlow::Wait);
         self.redraw();
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_denoiser_runs_again_when_the_iterations_double_or_a_second_has_passed() {
-        let t = Instant::now();
-        assert!(denoise_due(None, 0, t), "nothing denoised on the window yet");
-        let last = Denoised { samples: 8, at: t };
-        assert!(!denoise_due(Some(&last), 8, t + 10 * DENOISE_INTERVAL), "no new iterations, no new filter");
-        assert!(!denoise_due(Some(&last), 15, t + DENOISE_INTERVAL / 2));
-        assert!(denoise_due(Some(&last), 16, t + DENOISE_INTERVAL / 2), "doubled");
-        assert!(denoise_due(Some(&last), 9, t + DENOISE_INTERVAL), "a second later");
-        assert!(denoise_due(Some(&last), 3, t), "restarted: fewer iterations");
     }
 }

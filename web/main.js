@@ -142,7 +142,14 @@ function wire() {
   for (const key of ['method', 'gather', 'photons', 'show']) {
     $(key).addEventListener('change', (e) => apply(() => v().set(key, e.target.value)));
   }
-  $('denoise').addEventListener('change', (e) => apply(() => v().set('denoise', e.target.checked ? 'on' : 'off')));
+  $('denoise').addEventListener('change', (e) => apply(() => {
+    try {
+      v().set('denoise', e.target.checked ? 'on' : 'off');
+    } catch (err) {
+      e.target.checked = false; // the denoiser stays off
+      throw err;
+    }
+  }));
   $('size').addEventListener('change', (e) => apply(() => {
     v().set('size', e.target.value);
     const [w, h] = e.target.value.split('x').map(Number);

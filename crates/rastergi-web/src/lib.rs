@@ -255,18 +255,18 @@ impl Viewer {
                 return Ok(());
             }
             "denoise" => {
-                self.options.denoise = match value {
+                let on = match value {
                     "on" => true,
                     "off" => false,
                     _ => return Err(bad()),
                 };
-                if let Some(r) =
-                    self.renderer.as_renderer_mut().filter(|r| self.options.denoise && !r.denoiser_enabled())
-                {
+                if let Some(r) = self.renderer.as_renderer_mut().filter(|r| on && !r.denoiser_enabled()) {
+                    // A failure (its buffers beyond the device's limits) leaves the denoiser off.
                     r.enable_denoiser().map_err(error)?;
                     // The guides hold the iterations from now on: the image restarts with them.
                     r.reset();
                 }
+                self.options.denoise = on;
                 self.denoised.clear();
                 return Ok(());
             }

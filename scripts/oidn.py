@@ -15,6 +15,7 @@ an external one and how the README's comparison with OIDN was measured. Needs
 The output is OIDN's "RT" filter in HDR mode, written as RGB float32 (.exr).
 """
 import argparse
+import os
 import sys
 
 import numpy as np
@@ -23,7 +24,11 @@ import numpy as np
 def read_rgb(path):
     import OpenEXR
 
-    with OpenEXR.File(path) as f:
+    try:
+        f = OpenEXR.File(path)
+    except Exception as e:  # OpenEXR raises RuntimeError for a missing or unreadable file
+        sys.exit(f"{path}: cannot read it as an EXR image ({e})")
+    with f:
         channels = f.channels()
         if "RGB" in channels:
             return np.ascontiguousarray(channels["RGB"].pixels, dtype=np.float32)
@@ -55,8 +60,11 @@ def main():
     normal = np.where(length > 0, normal / np.where(length > 0, length, 1), 0).astype(np.float32)
     out = pyoidn.denoise(color, np.clip(albedo, 0, 1), normal, hdr=True, quality=a.quality)
     header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
+    # Written whole or not at all.
+    part = a.out + ".part.exr"
     with OpenEXR.File(header, {"RGB": out}) as f:
-        f.write(a.out)
+        f.write(part)
+    os.replace(part, a.out)
 
 
 if __name__ == "__main__":

@@ -22,7 +22,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicU32, Ordering};
 
 use rastergi::camera_control::{CameraControl, DRAG_RADIANS_PER_PIXEL, MoveKeys};
-use rastergi::denoise::{DenoiseParams, Schedule};
+use rastergi::denoise::Schedule;
 use rastergi::display::WindowSurface;
 use rastergi::film::Show;
 use rastergi::gather::GatherMethod;
@@ -409,16 +409,10 @@ impl Viewer {
     /// the schedule says so ([`Schedule`]).
     fn encode_resolve(&mut self, enc: &mut wgpu::CommandEncoder) -> rastergi::Result<()> {
         let exposure = self.options.exposure;
+        let mut schedule = self.denoised;
         if let Some(r) = self.denoising() {
-            let (samples, now) = (r.samples(), js_sys::Date::now() / 1000.0);
-            let due = self.denoised.due(samples, now);
-            if due {
-                r.encode_denoise(enc, &DenoiseParams::default())?;
-            }
-            r.encode_resolve_denoised(enc, exposure)?;
-            if due {
-                self.denoised.ran(samples, now);
-            }
+            r.encode_denoised_view(enc, &mut schedule, js_sys::Date::now() / 1000.0, exposure)?;
+            self.denoised = schedule;
         } else {
             let show = if self.renderer.has(self.options.show) { self.options.show } else { Show::Full };
             self.renderer.encode_resolve(enc, show, exposure);

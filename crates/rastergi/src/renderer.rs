@@ -4,7 +4,7 @@
 use glam::{Vec2, Vec3};
 
 use crate::checkpoint::Progress;
-use crate::denoise::{DenoiseParams, Denoiser, GuideState, Guides};
+use crate::denoise::{DenoiseParams, Denoiser, GuideState, Guides, Schedule};
 use crate::error::Result;
 use crate::film::{Film, FilmState, ImageResolve, Show};
 use crate::frame::{FrameBinding, FrameUniforms, pixel_jitter};
@@ -549,6 +549,28 @@ impl Renderer {
     pub fn encode_resolve_denoised(&self, enc: &mut wgpu::CommandEncoder, exposure: f32) -> Result<()> {
         let d = self.denoiser()?;
         self.passes.film.encode_resolve_image(&self.gpu, enc, &d.resolve, exposure);
+        Ok(())
+    }
+
+    /// What a window showing the denoised image encodes each frame (`rastergi view`, the web
+    /// page): the resolve at `exposure`, after a new filter where `schedule` says the image's
+    /// current iterations are due one at `now` (seconds, any fixed origin), which it records.
+    pub fn encode_denoised_view(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        schedule: &mut Schedule,
+        now: f64,
+        exposure: f32,
+    ) -> Result<()> {
+        let samples = self.samples();
+        let due = schedule.due(samples, now);
+        if due {
+            self.encode_denoise(enc, &DenoiseParams::default())?;
+        }
+        self.encode_resolve_denoised(enc, exposure)?;
+        if due {
+            schedule.ran(samples, now);
+        }
         Ok(())
     }
 

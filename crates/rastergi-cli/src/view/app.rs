@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Result, anyhow};
 use rastergi::camera_control::CameraControl;
-use rastergi::denoise::{self, DenoiseParams};
+use rastergi::denoise;
 use rastergi::display::{Presented, WindowSurface};
 use rastergi::film::Show;
 use rastergi::gather::GatherMethod;
@@ -379,16 +379,10 @@ impl App {
     /// ([`denoise::Schedule`]).
     fn encode_resolve(&mut self, enc: &mut egui_wgpu::wgpu::CommandEncoder, show: Show) -> Result<()> {
         let exposure = self.controls.exposure;
+        let mut schedule = self.denoised;
         if let Some(r) = self.denoising() {
-            let (samples, now) = (r.samples(), self.clock.elapsed().as_secs_f64());
-            let due = self.denoised.due(samples, now);
-            if due {
-                r.encode_denoise(enc, &DenoiseParams::default())?;
-            }
-            r.encode_resolve_denoised(enc, exposure)?;
-            if due {
-                self.denoised.ran(samples, now);
-            }
+            r.encode_denoised_view(enc, &mut schedule, self.clock.elapsed().as_secs_f64(), exposure)?;
+            self.denoised = schedule;
         } else {
             if let Some((active, _)) = &self.renderer {
                 active.get().encode_resolve(enc, show, exposure);

@@ -159,6 +159,17 @@ impl Gpu {
         Ok(Gpu { adapter, device, queue, info, profiler, fault })
     }
 
+    /// Whether the adapter offers hardware ray queries (wgpu's `EXPERIMENTAL_RAY_QUERY`:
+    /// `VK_KHR_ray_query` with acceleration structures on Vulkan, DXR 1.1 on DX12, Metal's ray
+    /// intersection), in words.
+    pub fn ray_query_support(&self) -> &'static str {
+        if self.adapter.features().contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY) {
+            "offered"
+        } else {
+            "not offered by this adapter"
+        }
+    }
+
     /// A multi-line description of the adapter and the limits that matter to rastergi.
     pub fn describe(&self) -> String {
         let i = &self.info;
@@ -168,6 +179,7 @@ impl Gpu {
         let _ = writeln!(s, "backend:  {:?}", i.backend);
         let _ = writeln!(s, "type:     {:?}", i.device_type);
         let _ = writeln!(s, "driver:   {} {}", i.driver, i.driver_info);
+        let _ = writeln!(s, "ray queries: {}", self.ray_query_support());
         let _ = writeln!(s, "vendor:   {:#06x}  device: {:#06x}", i.vendor, i.device);
         let _ = writeln!(s, "max texture 2D:            {}", l.max_texture_dimension_2d);
         let _ = writeln!(s, "max texture 3D:            {}", l.max_texture_dimension_3d);
@@ -528,7 +540,8 @@ pub fn scene_raster_pipeline(
 ) -> wgpu::RenderPipeline {
     let (module, layouts) = shader;
     let layout = pipeline_layout(device, label, layouts);
-    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+    let start = web_time::Instant::now();
+    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),
         layout: Some(&layout),
         vertex: wgpu::VertexState {
@@ -554,7 +567,9 @@ pub fn scene_raster_pipeline(
         }),
         multiview_mask: None,
         cache: None,
-    })
+    });
+    log::debug!("pipeline {label} ({fs}) created in {:.2} s", start.elapsed().as_secs_f64());
+    pipeline
 }
 
 /// A compute pipeline for `module`'s entry point `entry`, with bind groups `layouts` and values
@@ -569,14 +584,17 @@ pub fn compute_pipeline(
     constants: &[(&str, f64)],
 ) -> wgpu::ComputePipeline {
     let layout = pipeline_layout(device, label, layouts);
-    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+    let start = web_time::Instant::now();
+    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
         label: Some(label),
         layout: Some(&layout),
         module,
         entry_point: Some(entry),
         compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
         cache: None,
-    })
+    });
+    log::debug!("pipeline {label} ({entry}) created in {:.2} s", start.elapsed().as_secs_f64());
+    pipeline
 }
 
 /// Number of workgroups of `size` needed to cover `n` items.

@@ -7,6 +7,8 @@
 # go to scripts/web_test.py (--iterations, --size, --seed, --gather, --denoised, --file,
 # --bad-file).
 #
+# RASTERGI_BIN: the rastergi binary that serves the page (default: built here, release).
+#
 # Installs Debian's chromium and chromium-driver where they are missing (apt, as root or with
 # sudo). Exit status 3: they are missing and cannot be installed (the test suite skips then).
 set -euo pipefail
@@ -36,9 +38,15 @@ bash scripts/web-build.sh
 if [ -f "$HOME/.cargo/env" ]; then
     . "$HOME/.cargo/env"
 fi
-cargo build --quiet --release -p rastergi-cli
+# The server: RASTERGI_BIN where the caller has built it (the test suite passes its own build,
+# whose features differ from this package's alone: building it here would compile the CLI again).
+rastergi=${RASTERGI_BIN:-}
+if [ -z "$rastergi" ]; then
+    cargo build --quiet --release -p rastergi-cli
+    rastergi=target/release/rastergi
+fi
 log=$(mktemp)
-target/release/rastergi serve --port 0 --dir web >"$log" 2>&1 &
+"$rastergi" serve --port 0 --dir web >"$log" 2>&1 &
 server=$!
 trap 'kill $server 2>/dev/null || true; rm -f "$log"' EXIT
 url=

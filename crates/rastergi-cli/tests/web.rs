@@ -59,7 +59,7 @@ fn the_web_page_renders_the_cornell_box_as_the_native_renderer_does() {
             "--bad-file",
             data.join("README.md").to_str().unwrap(),
         ],
-        &[],
+        &[("RASTERGI_BIN", Some(env!("CARGO_BIN_EXE_rastergi")))],
         Duration::from_secs(3000),
     );
     if run.status.code() == Some(3) {

@@ -305,6 +305,7 @@ impl SceneArgs {
             bundle: self.bundle.unwrap_or(0),
             gather: self.gather.method(),
             gather_directions: self.gather_directions.directions(),
+            auto_trials_on_cpu: false,
             directions: self.directions,
             photon_passes: self.photon_passes,
             pass_iterations: self.pass_iterations,

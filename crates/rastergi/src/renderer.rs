@@ -45,6 +45,9 @@ pub struct RenderSettings {
     /// [`GatherMethod::Trace`] and the traced gather that `Auto` tries: the raster gathers
     /// always share them).
     pub gather_directions: GatherDirections,
+    /// Whether [`GatherMethod::Auto`] tries the gathers on a CPU adapter too, where it takes
+    /// the traced gather without trials otherwise ([`GatherPass::new`]).
+    pub auto_trials_on_cpu: bool,
     /// Photon passes ([`crate::photons::passes`]): the map is re-traced with fresh photons in
     /// finer cells every `pass_iterations` iterations; 1: one fixed map; 0: no limit.
     pub photon_passes: u32,
@@ -124,6 +127,7 @@ impl Default for RenderSettings {
             bundle: 0,
             gather: GatherMethod::Auto,
             gather_directions: GatherDirections::default(),
+            auto_trials_on_cpu: false,
             directions: DEFAULT_DIRECTIONS,
             photon_passes: 0,
             pass_iterations: DEFAULT_PASS_ITERATIONS,
@@ -184,7 +188,15 @@ impl ImagePasses {
         let gather = match map {
             Some(map) => {
                 let setup = GatherSetup { scene, frame, gbuffer: &gbuffer, film: &film, map };
-                Some(GatherPass::new(gpu, &setup, bundle, settings.gather, settings.gather_directions, sampler)?)
+                Some(GatherPass::new(
+                    gpu,
+                    &setup,
+                    bundle,
+                    settings.gather,
+                    settings.gather_directions,
+                    sampler,
+                    settings.auto_trials_on_cpu,
+                )?)
             }
             None => None,
         };

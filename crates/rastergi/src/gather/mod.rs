@@ -67,7 +67,8 @@ pub use crate::consts::MAX_DIRECTIONS;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum GatherMethod {
     /// Try the implementations on the first iterations and keep the one whose error falls
-    /// fastest: least variance × time per iteration.
+    /// fastest: least variance × time per iteration. On a CPU adapter (lavapipe, WARP), which
+    /// rasterizes in software, the traced gather without trials (see [`GatherPass::new`]).
     #[default]
     Auto,
     /// Depth-peeled orthographic ray view (rasterization).
@@ -378,6 +379,11 @@ impl GatherPass {
     /// The pass over `setup`'s resources with `method`, for a `bundle`² ray view, drawing
     /// directions from `sampler`; `directions` applies to [`GatherMethod::Trace`], and to
     /// the traced gather that `Auto` tries (the raster gathers share them).
+    ///
+    /// `Auto` on a CPU adapter takes the traced gather without trials unless `trials_on_cpu`:
+    /// rasterization is emulated in software there, the traced gather won every trial measured
+    /// on lavapipe (README, performance), and the raster gathers' pipelines, compiled only for
+    /// their trials, cost lavapipe minutes on a first run.
     pub fn new(
         gpu: &Gpu,
         setup: &GatherSetup,
@@ -385,6 +391,7 @@ impl GatherPass {
         method: GatherMethod,
         directions: GatherDirections,
         sampler: DirectionSampler,
+        trials_on_cpu: bool,
     ) -> Result<GatherPass> {
         // Both read back from the GPU within an iteration (the peel's layer count, the trials'
         // timings), which a web page cannot wait for.
@@ -398,8 +405,11 @@ impl GatherPass {
             std::mem::size_of::<GatherUniforms>() as u64,
             wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         );
+        let auto = method == GatherMethod::Auto;
+        let cpu = gpu.info.device_type == wgpu::DeviceType::Cpu;
+        let tried = if auto && cpu && !trials_on_cpu { GatherMethod::Trace } else { method };
         let mut candidates = Vec::new();
-        for m in CANDIDATES.into_iter().filter(|&m| method == m || method == GatherMethod::Auto) {
+        for m in CANDIDATES.into_iter().filter(|&m| tried == m || tried == GatherMethod::Auto) {
             let per_pixel = m == GatherMethod::Trace && directions == GatherDirections::PerPixel;
             match build(m, gpu, setup, &uniforms, bundle) {
                 Ok(gather) => candidates.push(Candidate {
@@ -410,11 +420,14 @@ impl GatherPass {
                     noise: PixelVariance::new(setup.film.width),
                 }),
                 // Auto does without a candidate that does not fit.
-                Err(e) if method == GatherMethod::Auto => log::info!("gather: no {m:?} gather ({e})"),
+                Err(e) if tried == GatherMethod::Auto => log::info!("gather: no {m:?} gather ({e})"),
                 Err(e) => return Err(e),
             }
         }
-        let chosen = method != GatherMethod::Auto;
+        let chosen = tried != GatherMethod::Auto;
+        if auto && chosen {
+            log::info!("gather on {} (a CPU adapter): the traced gather, without trials", gpu.info.name);
+        }
         let per_pixel = chosen && candidates[0].per_pixel;
         Ok(GatherPass {
             bundle,
@@ -423,7 +436,7 @@ impl GatherPass {
             per_pixel,
             candidates,
             chosen,
-            auto: method == GatherMethod::Auto,
+            auto,
             film: setup.film.accumulation.clone(),
             pixels: setup.film.width as usize * setup.film.height as usize,
             efficiency: Efficiency { direct: PixelVariance::new(setup.film.width), ..Default::default() },
@@ -623,17 +636,19 @@ impl GatherPass {
 
     /// Makes `Auto`'s choice without trials (a resumed render's): `method` with `directions`.
     /// An error where this pass has no such candidate (it was not `Auto`, or the GPU cannot
-    /// run it).
+    /// run it, or `Auto` chose another without trials on a CPU adapter).
     pub fn choose_as(&mut self, method: GatherMethod, directions: GatherDirections) -> Result<()> {
         let per_pixel = directions == GatherDirections::PerPixel;
         let k = self
             .candidates
             .iter()
             .position(|c| c.method == method && c.per_pixel == per_pixel)
-            .filter(|_| self.auto && !self.chosen);
+            .filter(|&k| self.auto && (!self.chosen || k == 0));
         match k {
             Some(k) => {
-                self.keep(k);
+                if !self.chosen {
+                    self.keep(k);
+                }
                 Ok(())
             }
             None => Err(crate::error::Error::Checkpoint(format!(

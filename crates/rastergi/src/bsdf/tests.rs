@@ -6,6 +6,7 @@
 use std::f64::consts::PI;
 
 use glam::Vec3;
+use rayon::prelude::*;
 
 use super::*;
 use crate::sampling::Rng;
@@ -104,15 +105,28 @@ fn erfc(x: f64) -> f64 {
 /// expecting fewer than 5 samples are pooled too. Returns the p-value.
 fn chi_square(b: &Bsdf, wo: Vec3, n: usize, seed: u32) -> f64 {
     let expected: Vec<f64> = expected_fractions(b, wo).iter().map(|f| f * n as f64).collect();
+    // CHUNKS independent streams on the cores, counted in a fixed order.
+    let counts: Vec<(Vec<f64>, f64)> = (0..CHUNKS)
+        .into_par_iter()
+        .map(|c| {
+            let mut observed = vec![0.0f64; expected.len()];
+            let mut rng = Rng::new(seed, 7, 11 + c as u32);
+            let mut outside = 0.0;
+            for _ in 0..chunk_len(n, c) {
+                let u = [rng.next_f32(), rng.next_f32(), rng.next_f32()];
+                match b.sample(wo, u, Transport::Radiance) {
+                    Some(s) if !s.delta => observed[bin_of(s.wi)] += 1.0,
+                    _ => outside += 1.0,
+                }
+            }
+            (observed, outside)
+        })
+        .collect();
     let mut observed = vec![0.0f64; expected.len()];
-    let mut rng = Rng::new(seed, 7, 11);
     let mut outside = 0.0;
-    for _ in 0..n {
-        let u = [rng.next_f32(), rng.next_f32(), rng.next_f32()];
-        match b.sample(wo, u, Transport::Radiance) {
-            Some(s) if !s.delta => observed[bin_of(s.wi)] += 1.0,
-            _ => outside += 1.0,
-        }
+    for (o, out) in counts {
+        observed.iter_mut().zip(o).for_each(|(a, b)| *a += b);
+        outside += out;
     }
     let mut cells = vec![(n as f64 - expected.iter().sum::<f64>(), outside)];
     let (mut pooled_e, mut pooled_o) = (0.0, 0.0);
@@ -167,24 +181,38 @@ fn sampled_directions_follow_the_density() {
     }
 }
 
+/// The statistical tests' samples are drawn in this many independent streams, on every core.
+const CHUNKS: usize = 16;
+
+/// Samples in chunk `c` of `n` split into [`CHUNKS`].
+fn chunk_len(n: usize, c: usize) -> usize {
+    n / CHUNKS + usize::from(c < n % CHUNKS)
+}
+
 /// ∫ f(ω_o, ω) |cos θ| dω by a midpoint rule over (cos θ, φ), 1024 × 1024 cells, plus the
 /// specular lobes' reflectance given separately (Dirac deltas have no density to integrate).
+/// Rows of cos θ on the cores, summed in order.
 fn albedo_by_quadrature(b: &Bsdf, wo: Vec3, transport: Transport) -> Vec3 {
     let n = 1024;
     let (dc, dp) = (2.0 / n as f64, 2.0 * PI / n as f64);
-    let mut sum = [0.0f64; 3];
-    for i in 0..n {
-        let c = -1.0 + (i as f64 + 0.5) * dc;
-        let s = (1.0 - c * c).sqrt();
-        for j in 0..n {
-            let phi = (j as f64 + 0.5) * dp;
-            let w = Vec3::new((s * phi.cos()) as f32, (s * phi.sin()) as f32, c as f32);
-            let f = b.eval(wo, w, transport) * c.abs() as f32;
-            for k in 0..3 {
-                sum[k] += f[k] as f64 * dc * dp;
+    let rows: Vec<[f64; 3]> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            let c = -1.0 + (i as f64 + 0.5) * dc;
+            let s = (1.0 - c * c).sqrt();
+            let mut sum = [0.0f64; 3];
+            for j in 0..n {
+                let phi = (j as f64 + 0.5) * dp;
+                let w = Vec3::new((s * phi.cos()) as f32, (s * phi.sin()) as f32, c as f32);
+                let f = b.eval(wo, w, transport) * c.abs() as f32;
+                for k in 0..3 {
+                    sum[k] += f[k] as f64 * dc * dp;
+                }
             }
-        }
-    }
+            sum
+        })
+        .collect();
+    let sum = rows.iter().fold([0.0f64; 3], |a, r| [a[0] + r[0], a[1] + r[1], a[2] + r[2]]);
     Vec3::new(sum[0] as f32, sum[1] as f32, sum[2] as f32)
 }
 
@@ -211,15 +239,28 @@ fn equilibrium_albedo(b: &Bsdf, wo: Vec3, n: usize) -> (Vec3, f32) {
 
 /// E[weight] over `n` samples and its standard error (per channel, the largest).
 fn albedo_by_sampling(b: &Bsdf, wo: Vec3, n: usize, transport: Transport) -> (Vec3, f32) {
-    let mut rng = Rng::new(3, 5, 7);
-    let (mut sum, mut sum2) = ([0.0f64; 3], [0.0f64; 3]);
-    for _ in 0..n {
-        let u = [rng.next_f32(), rng.next_f32(), rng.next_f32()];
-        if let Some(s) = b.sample(wo, u, transport) {
-            for k in 0..3 {
-                sum[k] += s.weight[k] as f64;
-                sum2[k] += (s.weight[k] as f64).powi(2);
+    let chunks: Vec<([f64; 3], [f64; 3])> = (0..CHUNKS)
+        .into_par_iter()
+        .map(|c| {
+            let mut rng = Rng::new(3, 5, 7 + c as u32);
+            let (mut sum, mut sum2) = ([0.0f64; 3], [0.0f64; 3]);
+            for _ in 0..chunk_len(n, c) {
+                let u = [rng.next_f32(), rng.next_f32(), rng.next_f32()];
+                if let Some(s) = b.sample(wo, u, transport) {
+                    for k in 0..3 {
+                        sum[k] += s.weight[k] as f64;
+                        sum2[k] += (s.weight[k] as f64).powi(2);
+                    }
+                }
             }
+            (sum, sum2)
+        })
+        .collect();
+    let (mut sum, mut sum2) = ([0.0f64; 3], [0.0f64; 3]);
+    for (s, s2) in chunks {
+        for k in 0..3 {
+            sum[k] += s[k];
+            sum2[k] += s2[k];
         }
     }
     let mean = sum.map(|s| s / n as f64);
@@ -480,17 +521,21 @@ fn ggx_albedo_table_matches_a_quadrature_of_the_lobe() {
 fn albedo_by_theta_quadrature(b: &Bsdf, wo: Vec3, transport: Transport) -> f64 {
     let (nt, np) = (2048, 512);
     let (dt, dp) = (PI / nt as f64, 2.0 * PI / np as f64);
-    let mut sum = 0.0f64;
-    for i in 0..nt {
-        let theta = (i as f64 + 0.5) * dt;
-        let (st, ct) = theta.sin_cos();
-        for j in 0..np {
-            let phi = (j as f64 + 0.5) * dp;
-            let w = Vec3::new((st * phi.cos()) as f32, (st * phi.sin()) as f32, ct as f32);
-            sum += b.eval(wo, w, transport).x as f64 * ct.abs() * st * dt * dp;
-        }
-    }
-    sum
+    let rows: Vec<f64> = (0..nt)
+        .into_par_iter()
+        .map(|i| {
+            let theta = (i as f64 + 0.5) * dt;
+            let (st, ct) = theta.sin_cos();
+            let mut sum = 0.0f64;
+            for j in 0..np {
+                let phi = (j as f64 + 0.5) * dp;
+                let w = Vec3::new((st * phi.cos()) as f32, (st * phi.sin()) as f32, ct as f32);
+                sum += b.eval(wo, w, transport).x as f64 * ct.abs() * st * dt * dp;
+            }
+            sum
+        })
+        .collect();
+    rows.iter().sum()
 }
 
 /// The rough glass's single-scattering albedo table (VNDF integration) against the quadrature

@@ -45,6 +45,31 @@ fn help_lists_the_render_and_info_commands() {
     assert!(commands.contains(&"render") && commands.contains(&"info"), "{}", run.stdout);
 }
 
+/// `info` names the driver and says whether ray queries are offered; Mesa's lavapipe implements
+/// `VK_KHR_ray_query` from Mesa 25 on (what scripts/setup.sh installs), so there it must say so.
+#[test]
+fn info_names_the_driver_and_whether_ray_queries_are_offered() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = rastergi(dir.path(), &["info"]);
+    assert!(run.status.success(), "{}", run.stderr);
+    let line = |key: &str| {
+        run.stdout
+            .lines()
+            .find_map(|l| l.strip_prefix(key))
+            .map(str::trim)
+            .unwrap_or_else(|| panic!("no {key}\n{}", run.stdout))
+    };
+    let (driver, rays) = (line("driver:"), line("ray queries:"));
+    assert!(rays == "offered" || rays == "not offered by this adapter", "{rays}");
+    // "llvmpipe Mesa 25.0.7-2~bpo12+1 (LLVM 15.0.6)": lavapipe of Mesa 25 or newer.
+    let mesa = driver.split_whitespace().skip_while(|w| *w != "Mesa").nth(1);
+    let major = mesa.and_then(|v| v.split('.').next()).and_then(|m| m.parse::<u32>().ok());
+    if driver.starts_with("llvmpipe") && major.is_some_and(|m| m >= 25) {
+        assert_eq!(rays, "offered", "{}", run.stdout);
+    }
+    println!("{driver}: ray queries {rays}");
+}
+
 #[test]
 fn unknown_option_is_a_usage_error() {
     let dir = tempfile::tempdir().unwrap();

@@ -1,0 +1,116 @@
+//! Published meshes carry degenerate triangles by the hundred (zero-area, collinear, duplicate)
+//! and albedo-1 surfaces: no pass may write NaN or infinity into the film because of them
+//! (issue 45: a classroom's sunbeam edge on two collinear triangles gave NaN pixels from the
+//! direct pass on). A sunbeam through a slot in a roof falls on a white floor (albedo 1) that
+//! carries every kind of degenerate triangle along the beam's edges; each pass and each
+//! gather renders it and the film must hold finite numbers only. Lambertian, like the Cornell
+//! box, so that its pipelines are the ones the gather tests compile (lavapipe compiles a new
+//! variant for a minute).
+
+mod common;
+
+use glam::Vec3;
+use rastergi::environment::Environment;
+use rastergi::film::Show;
+use rastergi::gather::{GatherDirections, GatherMethod, HitLight};
+use rastergi::image_io::validate_finite;
+use rastergi::renderer::RenderSettings;
+use rastergi::scene::{Camera, Light, Material, Scene};
+
+fn quad(s: &mut Scene, corners: [Vec3; 4], material: u32) {
+    s.add_triangle([corners[0], corners[1], corners[2]], material);
+    s.add_triangle([corners[0], corners[2], corners[3]], material);
+}
+
+/// The floor (y = 0, white), a roof (y = 1) with a slot along z at x ∈ [−0.1, 0.1], the sun
+/// almost straight down, a dim sky, a small emitter, and degenerate triangles where the beam's
+/// edges meet the floor.
+fn scene() -> Scene {
+    let camera =
+        Camera { eye: Vec3::new(0.0, 2.2, 2.2), target: Vec3::new(0.0, 0.0, 0.0), up: Vec3::Y, fov_y_deg: 50.0 };
+    let mut s = Scene::new(camera);
+    let white = s.add_material(Material::diffuse("white", Vec3::ONE));
+    let grey = s.add_material(Material::diffuse("grey", Vec3::splat(0.5)));
+    let lamp = s.add_material(Material { emission: Vec3::splat(5.0), ..Material::diffuse("lamp", Vec3::ZERO) });
+    let y = |x: f32, y: f32, z: f32| Vec3::new(x, y, z);
+    quad(&mut s, [y(-1.0, 0.0, -1.0), y(-1.0, 0.0, 1.0), y(1.0, 0.0, 1.0), y(1.0, 0.0, -1.0)], white);
+    // The roof in two halves, facing down, leaving the slot open.
+    quad(&mut s, [y(-1.0, 1.0, -1.0), y(-0.1, 1.0, -1.0), y(-0.1, 1.0, 1.0), y(-1.0, 1.0, 1.0)], grey);
+    quad(&mut s, [y(0.1, 1.0, -1.0), y(1.0, 1.0, -1.0), y(1.0, 1.0, 1.0), y(0.1, 1.0, 1.0)], grey);
+    // A block beside the beam.
+    quad(&mut s, [y(0.3, 0.3, -0.3), y(0.3, 0.3, 0.3), y(0.6, 0.3, 0.3), y(0.6, 0.3, -0.3)], grey);
+    let beam_edge = 0.1;
+    for (k, material) in [white, grey, lamp].into_iter().enumerate() {
+        let z = -0.5 + 0.4 * k as f32;
+        let e = beam_edge * if k % 2 == 0 { 1.0 } else { -1.0 };
+        // Zero area: a repeated corner, and all three corners equal.
+        s.add_triangle([y(e, 1e-3, z), y(e, 1e-3, z), y(e + 0.05, 1e-3, z + 0.05)], material);
+        s.add_triangle([y(e, 1e-3, z); 3], material);
+        // Collinear corners across the beam's edge, at the floor and a little above it.
+        s.add_triangle([y(e - 0.1, 0.0, z), y(e, 0.0, z), y(e + 0.1, 0.0, z)], material);
+        s.add_triangle([y(e - 0.1, 2e-3, z + 0.1), y(e + 0.1, 2e-3, z + 0.1), y(e, 2e-3, z + 0.1)], material);
+        // Nearly collinear: an area of about 1e-12.
+        s.add_triangle([y(e - 0.1, 3e-3, z), y(e + 0.1, 3e-3, z), y(e, 3e-3 + 1e-10, z + 1e-10)], material);
+    }
+    // A duplicate of a floor triangle (coplanar, the same corners) and a huge one far below.
+    let first = s.triangles[0];
+    s.add_triangle(first, white);
+    s.add_triangle([y(-1e5, -10.0, -1e5), y(1e5, -10.0, -1e5), y(0.0, -10.0, 1e5)], grey);
+    s.lights.push(Light::Distant {
+        direction: Vec3::new(0.05, -1.0, 0.02).normalize(),
+        irradiance: Vec3::splat(3.0),
+        angular_radius: 0.5f32.to_radians(),
+    });
+    s.environment = Some(std::sync::Arc::new(Environment::constant(Vec3::new(0.2, 0.3, 0.5))));
+    s
+}
+
+fn settings(gather: GatherMethod, directions: GatherDirections, hit_light: HitLight) -> RenderSettings {
+    RenderSettings {
+        width: 64,
+        height: 64,
+        seed: 7,
+        photons: 1 << 16,
+        grid_resolution: 32,
+        gather,
+        gather_directions: directions,
+        hit_light,
+        ..Default::default()
+    }
+}
+
+#[test]
+fn degenerate_triangles_in_a_sunbeam_leave_every_pass_finite() {
+    let gpu = common::gpu();
+    let scene = scene();
+    let mut failures = vec![];
+    let mut check = |what: String, image: rastergi::image_io::LinearImage| {
+        if let Err(e) = validate_finite(&image) {
+            failures.push(format!("{what}: {e}"));
+        }
+    };
+    let trace = settings(GatherMethod::Trace, GatherDirections::PerPixel, HitLight::Map);
+    for show in [Show::Direct, Show::PhotonMap, Show::Indirect, Show::Full] {
+        let s = RenderSettings { show_photon_map: show == Show::PhotonMap, ..trace.clone() };
+        check(format!("{show:?}"), common::render(&gpu, &scene, s, 16, show));
+    }
+    for (gather, directions, hit_light) in [
+        (GatherMethod::Trace, GatherDirections::Shared, HitLight::Exact),
+        (GatherMethod::Raster, GatherDirections::Shared, HitLight::Map),
+        (GatherMethod::Lists, GatherDirections::Shared, HitLight::Map),
+    ] {
+        let s = settings(gather, directions, hit_light);
+        check(
+            format!("{gather:?} gather, {directions:?}, {hit_light:?}"),
+            common::render(&gpu, &scene, s, 16, Show::Full),
+        );
+    }
+    check("path tracer".into(), common::path_trace(&gpu, &scene, trace.clone(), 32));
+    let mut denoised = rastergi::renderer::Renderer::new(&gpu, &scene, trace).unwrap();
+    denoised.enable_denoiser().unwrap();
+    for _ in 0..8 {
+        denoised.iterate().unwrap();
+    }
+    check("denoised".into(), denoised.read_denoised(&rastergi::denoise::DenoiseParams::default()).unwrap());
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}

@@ -469,8 +469,20 @@ impl Renderer {
         if let Some(photons) = &mut self.photons {
             photons.resume_at(&self.gpu, &self.scene, progress.photon_pass, progress.iterations_in_pass)?;
         }
-        if let (Some(gather), Some((method, directions))) = (&mut self.passes.gather, progress.gather) {
-            gather.choose_as(method, directions)?;
+        if let Some((method, directions)) = progress.gather {
+            let chosen = self.passes.gather.as_mut().map(|g| g.choose_as(method, directions));
+            if matches!(chosen, Some(Err(_))) && !self.settings.auto_trials_on_cpu {
+                // Auto took the traced gather without trials on this CPU adapter and the
+                // checkpoint's render chose another: build every candidate, as trials would.
+                self.settings.auto_trials_on_cpu = true;
+                let (width, height) = (self.settings.width, self.settings.height);
+                self.resize(width, height)?;
+                if let Some(g) = &mut self.passes.gather {
+                    g.choose_as(method, directions)?;
+                }
+            } else if let Some(chosen) = chosen {
+                chosen?;
+            }
         }
         self.passes.film.restore(&self.gpu, film)?;
         if let Some(d) = &mut self.passes.denoise {

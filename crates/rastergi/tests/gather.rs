@@ -466,3 +466,30 @@ fn auto_takes_the_traced_gather_on_a_cpu_adapter_and_its_trials_all_count() {
     // of them lost or counted twice by ≈ 1.4 %.
     assert!(diff < 0.012 * mean(&t3), "Auto's trials change the image's mean by {diff} of {}", mean(&t3));
 }
+
+/// A checkpoint's render chose the raster gather (on a GPU); resumed on this CPU adapter, where
+/// `Auto` takes the traced gather without trials, it gathers as the checkpoint says.
+#[test]
+fn a_checkpoints_raster_choice_resumes_on_a_cpu_adapter() {
+    let gpu = common::gpu();
+    let settings = RenderSettings {
+        width: 32,
+        height: 32,
+        photons: 1 << 14,
+        grid_resolution: 8,
+        photon_passes: 1,
+        ..Default::default()
+    };
+    let mut r = Renderer::new(&gpu, &cornell_box(), settings).unwrap();
+    assert_eq!(r.gather_method(), GatherMethod::Trace);
+    let film = r.film_state().unwrap();
+    let progress = rastergi::checkpoint::Progress {
+        photon_pass: 0,
+        iterations_in_pass: 0,
+        gather: Some((GatherMethod::Raster, GatherDirections::Shared)),
+    };
+    r.resume(&progress, &film).unwrap();
+    assert_eq!((r.gather_method(), r.gather_directions()), (GatherMethod::Raster, GatherDirections::Shared));
+    r.iterate().unwrap();
+    assert_eq!(r.progress().gather, Some((GatherMethod::Raster, GatherDirections::Shared)));
+}

@@ -20,7 +20,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use rastergi::checkpoint::Checkpoint;
 use rastergi::denoise::DenoiseParams;
 use rastergi::fit;
-use rastergi::gather::GatherDirections;
+use rastergi::gather::{GatherDirections, GatherMethod};
 use rastergi::gpu::Gpu;
 use rastergi::image_io::{ImageFormat, write_exr, write_png};
 use rastergi::path_tracer::PathTracer;
@@ -117,7 +117,7 @@ pub fn check_method_show(method: Method, show: ShowArg) -> Result<()> {
 }
 
 /// A renderer, and for the photon-map renderer its gather ray view and directions (for the log).
-pub type Built = (Box<dyn Progressive>, Option<(u32, GatherDirections)>);
+pub type Built = (Box<dyn Progressive>, Option<(u32, GatherDirections, GatherMethod)>);
 
 /// The renderer of `method` for `scene` (BVH, upload, the first photon map). `render` and the
 /// Python package build theirs here, so the same options give the same image.
@@ -125,7 +125,7 @@ pub fn new_renderer(gpu: &Gpu, scene: &Scene, settings: RenderSettings, method: 
     Ok(match method {
         Method::Gather => {
             let r = Renderer::new(gpu, scene, settings)?;
-            let info = (r.bundle(), r.gather_directions());
+            let info = (r.bundle(), r.gather_directions(), r.gather_method());
             (Box::new(r), Some(info))
         }
         Method::Path => (Box::new(PathTracer::new(gpu, scene, settings)?), None),
@@ -245,11 +245,12 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     renderer.wait()?;
     log::info!("set-up (BVH, upload, photon map) in {:.2} s", start.elapsed().as_secs_f64());
     print_profile(&gpu, args.profile, "set-up", 1, "set-up")?;
-    if let Some((bundle, directions)) = gather_info {
-        if a.gather.method() == rastergi::gather::GatherMethod::Auto {
+    if let Some((bundle, directions, method)) = gather_info {
+        // Auto without trials (a CPU adapter) has chosen already.
+        if method == GatherMethod::Auto {
             log::info!("gather ray view: {bundle}x{bundle} texels; auto chooses the gather on the first iterations");
         } else {
-            log::info!("gather ray view: {bundle}x{bundle} texels; directions {directions:?}");
+            log::info!("gather ray view: {bundle}x{bundle} texels; {method:?} gather, directions {directions:?}");
         }
     }
     let checkpoint_of = |r: &dyn Progressive, film: rastergi::film::FilmState| Checkpoint {

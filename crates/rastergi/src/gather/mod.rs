@@ -639,11 +639,8 @@ impl GatherPass {
     /// run it, or `Auto` chose another without trials on a CPU adapter).
     pub fn choose_as(&mut self, method: GatherMethod, directions: GatherDirections) -> Result<()> {
         let per_pixel = directions == GatherDirections::PerPixel;
-        let k = self
-            .candidates
-            .iter()
-            .position(|c| c.method == method && c.per_pixel == per_pixel)
-            .filter(|&k| self.auto && (!self.chosen || k == 0));
+        let k =
+            self.candidates.iter().position(|c| c.method == method && c.per_pixel == per_pixel).filter(|_| self.auto);
         match k {
             Some(k) => {
                 if !self.chosen {

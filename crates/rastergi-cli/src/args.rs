@@ -13,7 +13,7 @@ use rastergi::film::Show;
 use rastergi::fit;
 use rastergi::gather::{GatherDirections, GatherMethod, HitLight};
 use rastergi::gpu::{Backends, Gpu, GpuOptions, parse_backend};
-use rastergi::renderer::RenderSettings;
+use rastergi::renderer::{PhotonRegionChoice, RenderSettings};
 use rastergi::scene::generate::BUILTIN_NAMES;
 use rastergi::scene::{GltfOptions, Scene, load_gltf_with, load_obj};
 
@@ -76,6 +76,24 @@ pub enum HitLightArg {
     /// The direct part from one light sample with a shadow ray, the rest from a photon map
     /// of indirect light only.
     Exact,
+}
+
+/// Where the photon grid's cells are finer.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
+pub enum PhotonRegionArg {
+    /// Where the camera and its gather rays look (a room, not the ground plane around it).
+    Camera,
+    /// Nowhere: one level of cells over the whole scene.
+    Scene,
+}
+
+impl PhotonRegionArg {
+    pub fn choice(self) -> PhotonRegionChoice {
+        match self {
+            PhotonRegionArg::Camera => PhotonRegionChoice::Camera,
+            PhotonRegionArg::Scene => PhotonRegionChoice::Scene,
+        }
+    }
 }
 
 impl HitLightArg {
@@ -236,6 +254,11 @@ pub struct SceneArgs {
     /// light by a shadow ray plus a map of indirect light only (`exact`).
     #[arg(long, value_enum, default_value_t = HitLightArg::Map)]
     pub hit_light: HitLightArg,
+    /// Where the photon grid's cells are finer: around what the camera and its gather rays
+    /// reach (`camera`; a room beside a large ground plane gets cells sized to the room), or
+    /// nowhere (`scene`: one size of cell over the whole scene).
+    #[arg(long, value_enum, default_value_t = PhotonRegionArg::Camera)]
+    pub photon_region: PhotonRegionArg,
     /// What the image shows.
     #[arg(long, value_enum, default_value_t = ShowArg::Full)]
     pub show: ShowArg,
@@ -310,6 +333,7 @@ impl SceneArgs {
             photon_passes: self.photon_passes,
             pass_iterations: self.pass_iterations,
             hit_light: self.hit_light.hit_light(),
+            photon_region: self.photon_region.choice(),
         }
     }
 }

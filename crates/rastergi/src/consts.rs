@@ -52,6 +52,14 @@ pub const OFFSET_STEP: f32 = 0.125;
 /// Photon-map lookups leave out slots of less than this many cell faces h² of area
 /// ([`crate::photons::map::PhotonMap::irradiance_on_plane`]).
 pub const MIN_LOOKUP_AREA: f32 = 1e-4;
+/// How near a face of its cell (in cells) a photon's hit point is taken to lie on it: there
+/// its deposit may go to the neighbour across the face
+/// ([`crate::photons::map::MapLayout::deposit_slot`]); f32 rounding errs by about 10⁻⁷.
+pub const NEAR_FACE: f32 = 1e-4;
+/// The fraction of sun and sky photons aimed at the photon region ([`crate::lights::disc_start`]):
+/// half, so the rest of the scene (the sunlit ground outside a window, whose light the room
+/// reflects) keeps half its photons.
+pub const AIM_FRACTION: f32 = 0.5;
 /// Bit of a slot's cell index that marks the caustic twin of the slot ([`crate::photons::map`]):
 /// the flux of photons that reached it through specular surfaces alone.
 pub const CAUSTIC_CELL: u32 = 1 << 31;

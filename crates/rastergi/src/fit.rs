@@ -27,9 +27,13 @@
 //!   stops that brings it to 0.18. A guard rail for scenes whose emitters are far too
 //!   strong or weak, not a tone mapper: a reasonably lit image is left as rendered.
 
+use glam::Vec3;
+
+use crate::gpu_scene::PreparedScene;
 use crate::image_io::LinearImage;
-use crate::photons::map::GridSpec;
-use crate::scene::{Aabb, Scene, triangle_area};
+use crate::photons::map::{GridSpec, PhotonRegion};
+use crate::sampling::{Rng, cosine_hemisphere};
+use crate::scene::{Aabb, Camera, Scene, triangle_area, triangle_normal};
 
 /// The default ray-view resolution: twice the image's larger side, within [128, 2048], so a
 /// ray-view texel is about as wide as an eye pixel's footprint on a scene seen whole.
@@ -110,6 +114,86 @@ pub fn detail_bundle(scene: &Scene) -> u32 {
 pub fn bundle(detail: u32, width: u32, height: u32) -> u32 {
     default_bundle(width, height).max(detail).clamp(MIN_BUNDLE, MAX_BUNDLE)
 }
+
+/// Camera rays across the image (columns × rows, at the image's aspect) that probe where the
+/// camera reads the photon map, and gather rays from each point they hit.
+pub const REGION_PROBE: (u32, u32) = (64, 48);
+pub const REGION_GATHER_RAYS: u32 = 4;
+/// The fraction of probe points left out at each end of each axis: the region is where most
+/// reads are, not every far patch a ray through a window reaches.
+pub const REGION_TRIM: f64 = 0.01;
+/// The region's margin on each side, as a fraction of its extent.
+pub const REGION_MARGIN: f32 = 0.05;
+
+/// Where the camera reads the photon map, and how much finer its cells are there
+/// ([`PhotonRegion`]): `None` where that is the whole scene anyway.
+///
+/// The probe: [`REGION_PROBE`] camera rays through the image (aspect `aspect` = width /
+/// height), and from each surface point they reach [`REGION_GATHER_RAYS`] cosine-distributed
+/// rays, the directions the final gather samples; the points these rays hit are what the
+/// passes look up in the map. The region is the box of those points, trimmed by
+/// [`REGION_TRIM`] at each end of each axis and padded by [`REGION_MARGIN`]. Its cells get
+/// the same cell budget as a whole scene ([`grid_resolution`]), scaled as `resolution` is
+/// against the scene's fitted resolution (a user's `--grid` twice the fit refines twice as
+/// finely); `factor` is the coarse cell over the region's cell, rounded. An interior
+/// standing on a ground plane two hundred metres wide gets cells sized to the room, not to
+/// the ground.
+pub fn photon_region(prepared: &PreparedScene, camera: &Camera, aspect: f32, resolution: u32) -> Option<PhotonRegion> {
+    let scene = &prepared.scene;
+    let triangles = &scene.triangles;
+    let (right, up, forward) = camera.frame();
+    let tan = (camera.fov_y_deg.to_radians() * 0.5).tan();
+    let (cols, rows) = REGION_PROBE;
+    let mut rng = Rng::new(0x5e61, 0, 0);
+    let mut points: Vec<Vec3> = Vec::new();
+    let hit_point = |o: Vec3, d: Vec3, skip: u32| {
+        (prepared.bvh.intersect(triangles, o, d, 0.0, f32::INFINITY, skip, |_| true)).map(|h| (o + d * h.t, h.triangle))
+    };
+    let eps = prepared.ray_epsilon();
+    for j in 0..rows {
+        for i in 0..cols {
+            let x = (2.0 * (i as f32 + rng.next_f32()) / cols as f32 - 1.0) * tan * aspect;
+            let y = (1.0 - 2.0 * (j as f32 + rng.next_f32()) / rows as f32) * tan;
+            let d = (forward + right * x + up * y).normalize();
+            let Some((p, tri)) = hit_point(camera.eye, d, u32::MAX) else { continue };
+            points.push(p);
+            let n = triangle_normal(&triangles[tri as usize]);
+            let n = if n.dot(d) > 0.0 { -n } else { n };
+            for _ in 0..REGION_GATHER_RAYS {
+                let w = cosine_hemisphere(n, rng.next_f32(), rng.next_f32());
+                if let Some((q, _)) = hit_point(p + n * eps, w, tri) {
+                    points.push(q);
+                }
+            }
+        }
+    }
+    if points.len() < 16 {
+        return None;
+    }
+    let mut region = Aabb::EMPTY;
+    for axis in 0..3 {
+        let mut v: Vec<f32> = points.iter().map(|p| p[axis]).collect();
+        v.sort_unstable_by(f32::total_cmp);
+        let k = ((REGION_TRIM * v.len() as f64) as usize).min(v.len() / 2);
+        region.min[axis] = v[k];
+        region.max[axis] = v[v.len() - 1 - k];
+    }
+    let margin = REGION_MARGIN * region.extent().max_element();
+    region.min -= Vec3::splat(margin);
+    region.max += Vec3::splat(margin);
+    let bounds = scene.bounds();
+    region.min = region.min.max(bounds.min);
+    region.max = region.max.min(bounds.max);
+    let coarse = GridSpec::new(&bounds, resolution).cell;
+    let scale = resolution as f32 / grid_resolution(&bounds) as f32;
+    let fine_resolution = ((grid_resolution(&region) as f32 * scale).round() as u32).max(1);
+    let fine = GridSpec::new(&region, fine_resolution).cell;
+    let factor = (coarse / fine).round() as u32;
+    (factor >= 2).then_some(PhotonRegion { bounds: region, factor: factor.min(MAX_REGION_FACTOR) })
+}
+
+/// The finest refinement: fine cells at most this many times smaller than the coarse ones.
+pub const MAX_REGION_FACTOR: u32 = 64;
 
 /// Rec. 709 luminance of a linear RGB pixel.
 fn luminance(p: &[f32; 3]) -> f64 {

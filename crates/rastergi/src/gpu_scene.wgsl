@@ -800,18 +800,54 @@ fn disc_point(axis: vec3f, centre: vec3f, r: f32, u1: f32, u2: f32) -> vec3f {
     return centre - axis * r + (tb[0] * cos(phi) + tb[1] * sin(phi)) * rho;
 }
 
-fn emit_photon(u0: f32, u1: f32, u2: f32, u3: f32, u4: f32, eps: f32) -> PhotonStart {
+// The start of a photon crossing the sphere (centre, r) along `axis`, aimed at the sphere
+// aim = (centre, radius; radius 0: not aimed): (origin, 1/p(x)) (lights.rs: disc_start).
+struct DiscStart {
+    origin: vec3f,
+    inv_pdf: f32,
+}
+
+fn disc_start(axis: vec3f, centre: vec3f, r: f32, aim: vec4f, u1: f32, u2: f32) -> DiscStart {
+    var s: DiscStart;
+    if aim.w <= 0.0 {
+        s.origin = disc_point(axis, centre, r, u1, u2);
+        s.inv_pdf = PI * r * r;
+        return s;
+    }
+    let tb = orthonormal_basis(axis);
+    let phi = 2.0 * PI * u2;
+    let dir = tb[0] * cos(phi) + tb[1] * sin(phi);
+    let d = aim.xyz - centre;
+    let towards = d - axis * dot(d, axis);
+    let aimed = u1 < AIM_FRACTION;
+    var offset: vec3f;
+    if aimed {
+        offset = towards + dir * (aim.w * sqrt(u1 / AIM_FRACTION));
+    } else {
+        offset = dir * (r * sqrt((u1 - AIM_FRACTION) / (1.0 - AIM_FRACTION)));
+    }
+    let in_aim = aimed || length(offset - towards) <= aim.w;
+    let in_whole = !aimed || length(offset) <= r;
+    let p = select(0.0, AIM_FRACTION / (PI * aim.w * aim.w), in_aim)
+        + select(0.0, (1.0 - AIM_FRACTION) / (PI * r * r), in_whole);
+    s.origin = centre - axis * r + offset;
+    s.inv_pdf = 1.0 / p;
+    return s;
+}
+
+// `aim`: where sun and sky photons are aimed (disc_start).
+fn emit_photon(u0: f32, u1: f32, u2: f32, u3: f32, u4: f32, eps: f32, aim: vec4f) -> PhotonStart {
     var s: PhotonStart;
     let e = light_pick(u0);
     let entry = light_entry(e);
     if entry.triangle == ENVIRONMENT_LIGHT {
         // Towards the sky along the sampled direction; the photon travels the other way, from
-        // the disc across the bounding sphere: L(ω)·πR²/(pdf(ω)·pmf).
+        // the disc across the bounding sphere: L(ω)/(p(x)·pdf(ω)·pmf), 1/p(x) = πR² unaimed.
         let e = env_sample(u3, u4);
-        let r = environment.disc_radius;
         s.dir = -e.xyz;
-        s.origin = disc_point(s.dir, environment.disc_centre, r, u1, u2);
-        s.flux = select(vec3f(0.0), env_radiance(e.xyz) * (PI * r * r / (e.w * entry.pmf)), e.w > 0.0);
+        let start = disc_start(s.dir, environment.disc_centre, environment.disc_radius, aim, u1, u2);
+        s.origin = start.origin;
+        s.flux = select(vec3f(0.0), env_radiance(e.xyz) * (start.inv_pdf / (e.w * entry.pmf)), e.w > 0.0);
         s.skip = NO_TRIANGLE;
         return s;
     }
@@ -836,9 +872,10 @@ fn emit_photon(u0: f32, u1: f32, u2: f32, u3: f32, u4: f32, eps: f32) -> PhotonS
         let solid = 2.0 * PI * (1.0 - p.cos_outer);
         s.flux = p.intensity * (spot_falloff(p, dot(p.direction, s.dir)) * solid / entry.pmf);
     } else {
-        s.origin = disc_point(p.direction, p.disc_centre, p.disc_radius, u1, u2);
+        let start = disc_start(p.direction, p.disc_centre, p.disc_radius, aim, u1, u2);
+        s.origin = start.origin;
         s.dir = cone_direction(p.direction, p.cos_outer, u3, u4);
-        s.flux = p.intensity * (PI * p.disc_radius * p.disc_radius / entry.pmf);
+        s.flux = p.intensity * (start.inv_pdf / entry.pmf);
     }
     return s;
 }

@@ -17,7 +17,7 @@ use crate::gather::GatherUniforms;
 use crate::gpu_scene::{GpuMaterial, GpuMaterialMaps, GpuTextureSlot, GpuTriangle};
 use crate::lights::{LightEntry, PunctualLight};
 use crate::path_tracer::PathParams;
-use crate::photons::gpu::{PhotonGridUniforms, PhotonParams};
+use crate::photons::gpu::{GridLevels, PhotonGridUniforms, PhotonParams};
 use crate::photons::map::TrianglePlane;
 
 /// A Rust struct and the name of its WGSL twin.
@@ -120,9 +120,8 @@ fn twins() -> Vec<Twin> {
             PhotonParams,
             "PhotonParams",
             [
-                origin,
-                cell,
-                dims,
+                grid,
+                aim,
                 first_photon,
                 batch_size,
                 seed,
@@ -139,11 +138,8 @@ fn twins() -> Vec<Twin> {
                 first_deposit
             ]
         ),
-        twin!(
-            PhotonGridUniforms,
-            "PhotonGrid",
-            [origin, cell, dims, mask, max_probe, sep_mask, sep_max_probe, indirect_only]
-        ),
+        twin!(PhotonGridUniforms, "PhotonGrid", [grid, mask, max_probe, sep_mask, sep_max_probe, indirect_only]),
+        twin!(GridLevels, "GridLevels", [origin, cell, dims, factor, fine_lo, fine_cell, fine_hi, fine_base]),
         twin!(ResolveUniforms, "Resolve", [resolution, samples, show, scale]),
         twin!(
             crate::denoise::DenoiseUniforms,

@@ -200,18 +200,21 @@ impl LightTable {
 
     /// The largest flux × N, over entries and channels, that a photon starts with
     /// ([`LightTable::emit_photon`]; a spot's falloff at most 1).
-    pub fn max_photon_flux(&self, scene: &Scene) -> f64 {
+    pub fn max_photon_flux(&self, scene: &Scene, aimed: bool) -> f64 {
+        // Aimed disc photons outside the aim carry 1/(1 − α) times an unaimed one's flux.
+        let aim_gain = if aimed { 1.0 / (1.0 - AIM_FRACTION as f64) } else { 1.0 };
         (self.entries.iter())
             .map(|e| {
                 let per_pmf = if e.triangle == ENVIRONMENT_LIGHT {
                     let env = scene.environment.as_ref().expect("an environment entry has a map");
-                    std::f64::consts::PI * (self.disc.1 as f64).powi(2) * env.max_radiance_over_pdf()
+                    std::f64::consts::PI * (self.disc.1 as f64).powi(2) * env.max_radiance_over_pdf() * aim_gain
                 } else if e.triangle & PUNCTUAL_LIGHT == 0 {
                     let le = scene.material_of(e.triangle as usize).emission;
                     std::f64::consts::PI * le.max_element() as f64 * e.area as f64
                 } else {
                     let p = &self.punctual[(e.triangle & !PUNCTUAL_LIGHT) as usize];
-                    Vec3::from(p.intensity).max_element() as f64 * p.support()
+                    let gain = if p.kind == LIGHT_DISTANT { aim_gain } else { 1.0 };
+                    Vec3::from(p.intensity).max_element() as f64 * p.support() * gain
                 };
                 per_pmf / e.pmf as f64
             })
@@ -225,7 +228,8 @@ impl LightTable {
     /// uniform in its outer cone, I·s(cos θ)·2π(1 − cos θ_o)/pmf; a distant light's origin
     /// uniform on a disc of radius R across the bounding sphere (u1, u2) and direction uniform
     /// in its cone (u3, u4), E·πR²/pmf; the environment's direction from its distribution
-    /// (u3, u4) and origin on the disc, L(ω)·πR²/(pdf(ω)·pmf). `emitted(triangle, b1, b2)`
+    /// (u3, u4) and origin on the disc, L(ω)·πR²/(pdf(ω)·pmf); with `aim`, the sun's and the
+    /// sky's origins aimed ([`disc_start`]: πR² becomes 1/p(x)). `emitted(triangle, b1, b2)`
     /// is the radiance a triangle emits at barycentrics (b1, b2)
     /// ([`crate::gpu_scene::PreparedScene::emitter_radiance`]).
     pub fn emit_photon(
@@ -234,20 +238,16 @@ impl LightTable {
         emitted: impl Fn(usize, f32, f32) -> Vec3,
         u: [f32; 5],
         eps: f32,
+        aim: Option<PhotonAim>,
     ) -> (Vec3, Vec3, Vec3, Option<u32>) {
         let e = self.pick(u[0]);
-        let disc_origin = |axis: Vec3, centre: Vec3, radius: f32| {
-            let (t, b) = orthonormal_basis(axis);
-            let r = radius * u[1].sqrt();
-            let phi = 2.0 * std::f32::consts::PI * u[2];
-            centre - axis * radius + (t * phi.cos() + b * phi.sin()) * r
-        };
         if e.triangle == ENVIRONMENT_LIGHT {
             let env = scene.environment.as_ref().expect("an environment entry has a map");
             let (to_sky, pdf) = env.sample(u[3], u[4]);
             let (centre, radius) = self.disc;
-            let flux = env.eval(to_sky) * (std::f32::consts::PI * radius * radius / (pdf * e.pmf));
-            return (disc_origin(-to_sky, centre, radius), -to_sky, flux, None);
+            let (origin, area) = disc_start(-to_sky, centre, radius, aim, u[1], u[2]);
+            let flux = env.eval(to_sky) * (area / (pdf * e.pmf));
+            return (origin, -to_sky, flux, None);
         }
         if e.triangle & PUNCTUAL_LIGHT == 0 {
             let tri = &scene.triangles[e.triangle as usize];
@@ -274,12 +274,57 @@ impl LightTable {
                 (Vec3::from(p.position), d, flux, None)
             }
             _ => {
-                let origin = disc_origin(axis, Vec3::from(p.disc_centre), p.disc_radius);
-                let flux = i * (std::f32::consts::PI * p.disc_radius * p.disc_radius / e.pmf);
+                let (origin, area) = disc_start(axis, Vec3::from(p.disc_centre), p.disc_radius, aim, u[1], u[2]);
+                let flux = i * (area / e.pmf);
                 (origin, cone_direction(axis, p.cos_outer, u[3], u[4]), flux, None)
             }
         }
     }
+}
+
+/// Where sun and sky photons are aimed: a sphere about the part of the scene the camera reads
+/// (the photon region's bounding sphere), which a fraction [`AIM_FRACTION`] of them cross.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PhotonAim {
+    pub centre: Vec3,
+    pub radius: f32,
+}
+
+pub use crate::consts::AIM_FRACTION;
+
+/// The start of a photon crossing the sphere (`centre`, `radius`) along `axis`, from (u1, u2):
+/// its origin on the disc of that radius perpendicular to `axis` before the sphere, and
+/// 1/p(x), p the density per unit area of the disc's plane it was drawn with. Unaimed, x is
+/// uniform on the disc: 1/p = πR². Aimed at a sphere (c_a, r_a), x is drawn with probability
+/// α = [`AIM_FRACTION`] (u1 < α, then rescaled) uniformly on that sphere's cross-section,
+/// the disc of radius r_a about c_a's projection, else uniformly on the whole disc:
+/// p(x) = α·[x in the aim's disc]/(π r_a²) + (1 − α)·[x in the whole disc]/(π R²), the
+/// one-sample mixture's density, so Φ = E/p(x) (or L(ω)/(pdf(ω)·p(x))) keeps every photon
+/// map unbiased while about α of the photons reach the region instead of its share of the
+/// disc's area. The branch drawn always counts its own term (rounding at a disc's rim never
+/// drops it). Mirrors `disc_start` in `gpu_scene.wgsl`.
+pub fn disc_start(axis: Vec3, centre: Vec3, radius: f32, aim: Option<PhotonAim>, u1: f32, u2: f32) -> (Vec3, f32) {
+    use std::f32::consts::PI;
+    let (t, b) = orthonormal_basis(axis);
+    let phi = 2.0 * PI * u2;
+    let dir = t * phi.cos() + b * phi.sin();
+    let start = centre - axis * radius;
+    let Some(a) = aim.filter(|a| a.radius > 0.0) else {
+        return (start + dir * (radius * u1.sqrt()), PI * radius * radius);
+    };
+    let d = a.centre - centre;
+    let towards = d - axis * d.dot(axis);
+    let aimed = u1 < AIM_FRACTION;
+    let offset = if aimed {
+        towards + dir * (a.radius * (u1 / AIM_FRACTION).sqrt())
+    } else {
+        dir * (radius * ((u1 - AIM_FRACTION) / (1.0 - AIM_FRACTION)).sqrt())
+    };
+    let in_aim = aimed || (offset - towards).length() <= a.radius;
+    let in_whole = !aimed || offset.length() <= radius;
+    let p = if in_aim { AIM_FRACTION / (PI * a.radius * a.radius) } else { 0.0 }
+        + if in_whole { (1.0 - AIM_FRACTION) / (PI * radius * radius) } else { 0.0 };
+    (start + offset, 1.0 / p)
 }
 
 /// A direction uniform within the cone of half-angle cos⁻¹(cos_max) about `axis` (pdf
@@ -311,5 +356,77 @@ mod tests {
         assert_eq!(t.pick(0.2499).triangle, 0);
         assert_eq!(t.pick(0.25).triangle, 1);
         assert_eq!(t.pick(0.9999).triangle, 1);
+    }
+
+    #[test]
+    fn aimed_sun_photons_carry_the_same_flux_onto_every_patch_and_crowd_into_the_aim() {
+        // A sun at 35° over a ground 200 m across; photons aimed at a sphere of radius 5 m
+        // about (3, 1.5, 2). Through any patch of ground, inside the aim or far from it, the
+        // flux of N photons must be E·cos θ·A (the plane's irradiance times the patch's area)
+        // within 4 standard errors of the photons' own spread, aimed or not; and most aimed
+        // photons cross the aim's patch.
+        let cam = Camera { eye: Vec3::Z, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 40.0 };
+        let mut s = Scene::new(cam);
+        let m = s.add_material(Material::diffuse("ground", Vec3::splat(0.5)));
+        s.add_quad(
+            [
+                Vec3::new(-100.0, 0.0, -100.0),
+                Vec3::new(-100.0, 0.0, 100.0),
+                Vec3::new(100.0, 0.0, 100.0),
+                Vec3::new(100.0, 0.0, -100.0),
+            ],
+            m,
+        );
+        let el = 35f32.to_radians();
+        let towards = Vec3::new(0.3 * el.cos(), el.sin(), -(1.0 - 0.09f32).sqrt() * el.cos()).normalize();
+        s.lights.push(Light::Distant { direction: -towards, irradiance: Vec3::splat(3.0), angular_radius: 0.0 });
+        let table = LightTable::new(&s);
+        let aim = PhotonAim { centre: Vec3::new(3.0, 1.5, 2.0), radius: 5.0 };
+        let n = 1 << 20;
+        for (patch, half) in [(Vec3::new(3.0, 0.0, 2.0), 2.0), (Vec3::new(-60.0, 0.0, 40.0), 10.0)] {
+            let expected = 3.0 * towards.y as f64 * (2.0 * half as f64).powi(2);
+            for aimed in [None, Some(aim)] {
+                let mut rng = crate::sampling::Rng::new(17, 0, 0);
+                let (mut s1, mut s2, mut hits) = (0.0f64, 0.0f64, 0u32);
+                for _ in 0..n {
+                    let u = [(); 5].map(|_| rng.next_f32());
+                    let (o, d, flux, _) = table.emit_photon(&s, |_, _, _| Vec3::ZERO, u, 0.0, aimed);
+                    let x = o + d * (-o.y / d.y);
+                    if (x - patch).abs().max_element() < half {
+                        let f = flux.x as f64 / n as f64;
+                        s1 += f;
+                        s2 += f * f;
+                        hits += 1;
+                    }
+                }
+                // The sum's standard error: √(n·Var(X)) for X = f/n·[the photon crosses].
+                let se = (s2 - s1 * s1 / n as f64).max(0.0).sqrt();
+                println!(
+                    "patch {patch} aimed {}: {s1:.4} against {expected:.4} (se {se:.4}, {hits} photons)",
+                    aimed.is_some()
+                );
+                assert!(
+                    (s1 - expected).abs() < 4.0 * se,
+                    "patch {patch}, aimed {}: {s1} vs {expected}",
+                    aimed.is_some()
+                );
+            }
+        }
+        // The aim's own patch (a 4 m square inside it): about α·(4²/(π·5²))/cos… of the aimed
+        // photons, against 16/(π·R²)/… of the unaimed: many times more.
+        let count = |aimed| {
+            let mut rng = crate::sampling::Rng::new(3, 0, 0);
+            (0..1 << 16)
+                .filter(|_| {
+                    let u = [(); 5].map(|_| rng.next_f32());
+                    let (o, d, _, _) = table.emit_photon(&s, |_, _, _| Vec3::ZERO, u, 0.0, aimed);
+                    let x = o + d * (-o.y / d.y);
+                    (x - Vec3::new(3.0, 0.0, 2.0)).abs().max_element() < 2.0
+                })
+                .count()
+        };
+        let (plain, aimed) = (count(None), count(Some(aim)));
+        println!("photons on the aim's patch: {plain} unaimed, {aimed} aimed of 65536");
+        assert!(aimed > 100 * plain.max(1), "{aimed} vs {plain}");
     }
 }

@@ -182,7 +182,7 @@ pub fn make_rays(
                 let mut rng = Rng::new(seed, i, 0);
                 let u = [(); 5].map(|_| rng.next_f32());
                 let (o, d, _, emitter) =
-                    prepared.lights.emit_photon(scene, |t, b1, b2| prepared.emitter_radiance(t, b1, b2), u, eps);
+                    prepared.lights.emit_photon(scene, |t, b1, b2| prepared.emitter_radiance(t, b1, b2), u, eps, None);
                 ray(o, d, eps, f32::INFINITY, emitter.unwrap_or(u32::MAX), false)
             })
             .collect();

@@ -59,6 +59,19 @@ pub struct RenderSettings {
     pub directions: u32,
     /// The light at the gather's hits: all from the photon map, or the direct part exact.
     pub hit_light: HitLight,
+    /// Where the photon grid's cells are finer: where the camera reads the map, or nowhere.
+    pub photon_region: PhotonRegionChoice,
+}
+
+/// Where the photon grid is refined ([`crate::fit::photon_region`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PhotonRegionChoice {
+    /// Around what the scene's camera (when the renderer is made) and its gather rays reach:
+    /// a room beside a large ground plane gets cells sized to the room.
+    #[default]
+    Camera,
+    /// One level of cells over the whole scene.
+    Scene,
 }
 
 pub use crate::fit::default_bundle;
@@ -101,6 +114,7 @@ impl RenderSettings {
             ("pass-iterations", s.pass_iterations.to_string()),
             ("directions", s.directions.to_string()),
             ("hit-light", format!("{:?}", s.hit_light)),
+            ("photon-region", format!("{:?}", s.photon_region)),
         ]
         .into_iter()
         .map(|(k, v)| (k.to_owned(), v))
@@ -132,6 +146,7 @@ impl Default for RenderSettings {
             photon_passes: 0,
             pass_iterations: DEFAULT_PASS_ITERATIONS,
             hit_light: HitLight::Map,
+            photon_region: PhotonRegionChoice::Camera,
         }
     }
 }
@@ -265,11 +280,32 @@ impl Renderer {
         let gpu_scene = GpuScene::new(gpu, &prepared)?;
         let mut frame = FrameBinding::new(gpu);
         frame.reserve_eye_paths(gpu, settings.width as u64 * settings.height as u64);
+        let region = match settings.photon_region {
+            PhotonRegionChoice::Camera if settings.photons > 0 => {
+                let aspect = settings.width as f32 / settings.height as f32;
+                let region = crate::fit::photon_region(&prepared, &scene.camera, aspect, settings.grid_resolution);
+                if let Some(r) = &region {
+                    log::info!(
+                        "photon region: ({:.2}, {:.2}, {:.2}) to ({:.2}, {:.2}, {:.2}), cells {}x finer",
+                        r.bounds.min.x,
+                        r.bounds.min.y,
+                        r.bounds.min.z,
+                        r.bounds.max.x,
+                        r.bounds.max.y,
+                        r.bounds.max.z,
+                        r.factor
+                    );
+                }
+                region
+            }
+            _ => None,
+        };
         let photon_settings = PhotonSettings {
             count: settings.photons,
             seed: settings.seed,
             grid_resolution: settings.grid_resolution,
             indirect_only: settings.hit_light == HitLight::Exact,
+            region,
         };
         let photons = (settings.photons > 0)
             .then(|| {

@@ -83,6 +83,8 @@ pub fn constants() -> String {
     let f32s = [
         ("OFFSET_STEP", OFFSET_STEP),
         ("MIN_LOOKUP_AREA", MIN_LOOKUP_AREA),
+        ("AIM_FRACTION", crate::consts::AIM_FRACTION),
+        ("NEAR_FACE", crate::consts::NEAR_FACE),
         ("GLASS_ALBEDO_ETA_MAX", crate::bsdf::albedo::GLASS_ETA_MAX),
     ];
     let mut s = String::from("// Generated from the Rust constants (shader.rs).\n");

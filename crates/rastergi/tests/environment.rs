@@ -217,7 +217,7 @@ fn photons_carry_the_skys_flux_to_the_floor() {
         let mut scene = floor(env);
         scene.materials[0].albedo = Vec3::ZERO;
         let n = 1 << 16;
-        let settings = PhotonSettings { count: n, seed: 5, grid_resolution: 8, indirect_only: false };
+        let settings = PhotonSettings { count: n, seed: 5, grid_resolution: 8, indirect_only: false, region: None };
         let prepared = PreparedScene::new(&scene);
         let gpu = common::gpu();
         let gs = rastergi::gpu_scene::GpuScene::new(&gpu, &prepared).unwrap();
@@ -232,7 +232,7 @@ fn photons_carry_the_skys_flux_to_the_floor() {
         let samples = 1 << 18;
         for _ in 0..samples {
             let u = [(); 5].map(|_| rng.next_f32());
-            let (o, d, flux, _) = prepared.lights.emit_photon(&prepared.scene, |_, _, _| unreachable!(), u, 0.0);
+            let (o, d, flux, _) = prepared.lights.emit_photon(&prepared.scene, |_, _, _| unreachable!(), u, 0.0, None);
             let t = -o.y / d.y;
             let hit = o + d * t;
             let x = if d.y < 0.0 && hit.x.abs() < A && hit.z.abs() < A { flux.x as f64 } else { 0.0 };

@@ -73,8 +73,10 @@ fn closed_box_maps(a: f64, settings: PhotonSettings) -> (glam::DVec3, [(&'static
 fn closed_box_average_irradiance_matches_power_over_area_times_one_minus_albedo() {
     let a = 0.5f64;
     let n = 1u32 << 20;
-    let (power, maps) =
-        closed_box_maps(a, PhotonSettings { count: n, seed: 5, grid_resolution: 16, indirect_only: false });
+    let (power, maps) = closed_box_maps(
+        a,
+        PhotonSettings { count: n, seed: 5, grid_resolution: 16, indirect_only: false, region: None },
+    );
     // Every surface side that reflects: 6 walls of area 4, both sides of the 0.4×0.4 light.
     let area = 24.0 + 2.0 * 0.16;
     // Each photon deposits Φ at every hit and survives with probability a at flux Φ·a/a:
@@ -223,8 +225,10 @@ fn an_indirect_only_map_holds_the_albedo_times_the_full_maps_energy() {
     // map's. Var[K − 1] = a/(1−a)² again: relative standard deviation sqrt(1/(aN)).
     let a = 0.5f64;
     let n = 1u32 << 20;
-    let (power, maps) =
-        closed_box_maps(a, PhotonSettings { count: n, seed: 6, grid_resolution: 16, indirect_only: true });
+    let (power, maps) = closed_box_maps(
+        a,
+        PhotonSettings { count: n, seed: 6, grid_resolution: 16, indirect_only: true, region: None },
+    );
     let sigma = (1.0 / (a * n as f64)).sqrt();
     for (name, map) in maps {
         let flux = map.total_flux();

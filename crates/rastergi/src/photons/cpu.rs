@@ -85,7 +85,7 @@ fn trace_photon(
     let mut rng = Rng::new(settings.seed ^ STREAM_PHOTON, index, pass);
     let u = [(); 5].map(|_| rng.next_f32());
     let (mut origin, mut dir, flux, emitter) =
-        prepared.lights.emit_photon(scene, |t, b1, b2| prepared.emitter_radiance(t, b1, b2), u, eps);
+        prepared.lights.emit_photon(scene, |t, b1, b2| prepared.emitter_radiance(t, b1, b2), u, eps, settings.aim());
     let mut flux = flux / settings.count as f32;
     let mut skip = emitter.unwrap_or(u32::MAX);
     let first_deposit = settings.indirect_only as u32;

@@ -31,13 +31,46 @@ const QUANTUM_BITS: u32 = 24;
 const BATCH: u32 = 1 << 20;
 const WORKGROUP: u32 = 64;
 
+/// `GridLevels` in `table.wgsl`: a [`GridSpec`]'s two levels.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GridLevels {
+    pub origin: [f32; 3],
+    pub cell: f32,
+    pub dims: [u32; 3],
+    /// Fine cells per coarse cell and axis; 1: no fine level.
+    pub factor: u32,
+    /// The refined coarse cells, fine_lo ..< fine_hi, and the fine cells' side.
+    pub fine_lo: [u32; 3],
+    pub fine_cell: f32,
+    pub fine_hi: [u32; 3],
+    /// The index of the first fine cell (after every coarse one).
+    pub fine_base: u32,
+}
+
+impl From<&GridSpec> for GridLevels {
+    fn from(g: &GridSpec) -> GridLevels {
+        let fine = g.fine();
+        GridLevels {
+            origin: g.origin.into(),
+            cell: g.cell,
+            dims: g.dims.into(),
+            factor: g.refine.factor.max(1),
+            fine_lo: g.refine.lo.into(),
+            fine_cell: fine.map_or(g.cell, |f| f.cell),
+            fine_hi: g.refine.hi.into(),
+            fine_base: fine.map_or(0, |f| f.base),
+        }
+    }
+}
+
 /// `PhotonParams` in `trace.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub(crate) struct PhotonParams {
-    pub(crate) origin: [f32; 3],
-    pub(crate) cell: f32,
-    pub(crate) dims: [u32; 3],
+    pub(crate) grid: GridLevels,
+    /// Where sun and sky photons are aimed: (centre, radius), radius 0 for nowhere.
+    pub(crate) aim: [f32; 4],
     pub(crate) first_photon: u32,
     pub(crate) batch_size: u32,
     pub(crate) seed: u32,
@@ -57,16 +90,14 @@ pub(crate) struct PhotonParams {
     pub(crate) sep_max_probe: u32,
     /// The first bounce that deposits: 0, or 1 for a map of indirect light only.
     pub(crate) first_deposit: u32,
-    pub(crate) _pad: [u32; 3],
+    pub(crate) _pad: [u32; 2],
 }
 
 /// `PhotonGrid` in `map.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct PhotonGridUniforms {
-    pub origin: [f32; 3],
-    pub cell: f32,
-    pub dims: [u32; 3],
+    pub grid: GridLevels,
     /// Table capacity − 1, the longest probe, and the same for the separators' table.
     pub mask: u32,
     pub max_probe: u32,
@@ -74,6 +105,7 @@ pub struct PhotonGridUniforms {
     pub sep_max_probe: u32,
     /// 1 where the map holds indirect irradiance only (deposits from the second surface on).
     pub indirect_only: u32,
+    pub _pad: [u32; 3],
 }
 
 /// The photon tracer's composed shader (`trace.wgsl`: the trace and resolve kernels).
@@ -147,8 +179,13 @@ impl GpuPhotonMap {
         prepared: &PreparedScene,
         settings: &PhotonSettings,
     ) -> Result<GpuPhotonMap> {
-        let layout =
-            MapLayout::within(&prepared.scene, &prepared.bounds, settings.grid_resolution, &gpu.device.limits())?;
+        let layout = MapLayout::within(
+            &prepared.scene,
+            &prepared.bounds,
+            settings.grid_resolution,
+            settings.region.as_ref(),
+            &gpu.device.limits(),
+        )?;
         Self::with_layout(gpu, scene, prepared, settings, layout)
     }
 
@@ -260,9 +297,8 @@ impl GpuPhotonMap {
         let mask = capacity as u32 - 1;
         let max_probe = layout.table.max_probe;
         let params = PhotonParams {
-            origin: grid.origin.into(),
-            cell: grid.cell,
-            dims: grid.dims.into(),
+            grid: GridLevels::from(&grid),
+            aim: settings.aim().map_or([0.0; 4], |a| [a.centre.x, a.centre.y, a.centre.z, a.radius]),
             first_photon: 0,
             batch_size: 0,
             seed: settings.seed,
@@ -277,17 +313,16 @@ impl GpuPhotonMap {
             sep_mask,
             sep_max_probe,
             first_deposit: settings.indirect_only as u32,
-            _pad: [0; 3],
+            _pad: [0; 2],
         };
         let grid_uniforms = PhotonGridUniforms {
-            origin: grid.origin.into(),
-            cell: grid.cell,
-            dims: grid.dims.into(),
+            grid: GridLevels::from(&grid),
             mask,
             max_probe,
             sep_mask,
             sep_max_probe,
             indirect_only: settings.indirect_only as u32,
+            _pad: [0; 3],
         };
         let buffers = [&slots, &keys, &planes, &sep_planes];
         let (bind_layout, bind_group) = lookup_binding(gpu, &grid_uniforms, buffers);

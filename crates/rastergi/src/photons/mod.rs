@@ -57,11 +57,14 @@ pub struct PhotonSettings {
     /// Deposit from a photon's second surface on: the map then holds indirect irradiance only,
     /// and its readers add the direct part exactly ([`crate::gather::HitLight::Exact`]).
     pub indirect_only: bool,
+    /// Where the camera reads the map, in cells `factor` times finer than the rest's
+    /// ([`crate::fit::photon_region`]); `None`: one level of cells over the whole scene.
+    pub region: Option<map::PhotonRegion>,
 }
 
 impl Default for PhotonSettings {
     fn default() -> Self {
-        Self { count: 1 << 20, seed: 0, grid_resolution: 64, indirect_only: false }
+        Self { count: 1 << 20, seed: 0, grid_resolution: 64, indirect_only: false, region: None }
     }
 }
 
@@ -69,6 +72,12 @@ impl PhotonSettings {
     /// The largest flux, over lights and channels, that a photon starts with
     /// ([`crate::lights::LightTable::max_photon_flux`] / N).
     pub fn max_photon_flux(&self, prepared: &PreparedScene) -> f64 {
-        prepared.lights.max_photon_flux(&prepared.scene) / self.count.max(1) as f64
+        prepared.lights.max_photon_flux(&prepared.scene, self.region.is_some()) / self.count.max(1) as f64
+    }
+
+    /// Where sun and sky photons are aimed: the photon region's bounding sphere.
+    pub fn aim(&self) -> Option<crate::lights::PhotonAim> {
+        self.region
+            .map(|r| crate::lights::PhotonAim { centre: r.bounds.center(), radius: 0.5 * r.bounds.extent().length() })
     }
 }

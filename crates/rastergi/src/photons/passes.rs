@@ -126,7 +126,13 @@ impl PhotonPasses {
         if pass > 0 {
             let wanted = pass_resolution(self.settings.grid_resolution, pass);
             let limits = gpu.device.limits();
-            let layout = MapLayout::within(&self.prepared.scene, &self.prepared.bounds, wanted, &limits)?;
+            let layout = MapLayout::within(
+                &self.prepared.scene,
+                &self.prepared.bounds,
+                wanted,
+                self.settings.region.as_ref(),
+                &limits,
+            )?;
             let got = layout.grid.dims.max_element();
             self.finest = (got < wanted).then_some(got);
             let current = self.map.grid().dims.max_element();
@@ -157,7 +163,13 @@ impl PhotonPasses {
         let current = self.map.grid().dims.max_element();
         if wanted > current {
             let limits = gpu.device.limits();
-            let layout = MapLayout::within(&self.prepared.scene, &self.prepared.bounds, wanted, &limits)?;
+            let layout = MapLayout::within(
+                &self.prepared.scene,
+                &self.prepared.bounds,
+                wanted,
+                self.settings.region.as_ref(),
+                &limits,
+            )?;
             let got = layout.grid.dims.max_element();
             if got < wanted {
                 self.finest = Some(got);

@@ -31,6 +31,61 @@ fn cell_centre(origin: vec3f, cell: f32, c: vec3u) -> vec3f {
     return origin + (vec3f(c) + 0.5) * cell;
 }
 
+// The photon grid's two levels (photons::map::GridSpec): coarse cells of side `cell` from
+// `origin`, `dims` per axis; the coarse cells fine_lo ..< fine_hi split into factor³ cells of
+// side fine_cell, indexed from fine_base (factor 1: none).
+struct GridLevels {
+    origin: vec3f,
+    cell: f32,
+    dims: vec3u,
+    factor: u32,
+    fine_lo: vec3u,
+    fine_cell: f32,
+    fine_hi: vec3u,
+    fine_base: u32,
+}
+
+// One level's cells (photons::map::Lattice): coordinates lo ..= hi, indices from base.
+struct Lattice {
+    origin: vec3f,
+    cell: f32,
+    lo: vec3i,
+    base: u32,
+    hi: vec3i,
+    dims: vec3u,
+}
+
+// The level whose cells hold p (GridSpec::lattice_at).
+fn lattice_at(g: GridLevels, p: vec3f) -> Lattice {
+    var l: Lattice;
+    l.origin = g.origin;
+    let c = vec3u(clamp(vec3i(floor((p - g.origin) / g.cell)), vec3i(0), vec3i(g.dims) - 1));
+    if g.factor > 1u && all(c >= g.fine_lo) && all(c < g.fine_hi) {
+        l.cell = g.fine_cell;
+        l.lo = vec3i(g.fine_lo * g.factor);
+        l.dims = (g.fine_hi - g.fine_lo) * g.factor;
+        l.base = g.fine_base;
+    } else {
+        l.cell = g.cell;
+        l.lo = vec3i(0);
+        l.dims = g.dims;
+        l.base = 0u;
+    }
+    l.hi = l.lo + vec3i(l.dims) - 1;
+    return l;
+}
+
+// The cell of `l` holding p, clamped (Lattice::cell_of).
+fn lattice_cell(l: Lattice, p: vec3f) -> vec3u {
+    return vec3u(clamp(vec3i(floor((p - l.origin) / l.cell)), l.lo, l.hi));
+}
+
+// The linear index of cell c of `l` (Lattice::index).
+fn lattice_index(l: Lattice, c: vec3u) -> u32 {
+    let r = c - vec3u(l.lo);
+    return l.base + (r.z * l.dims.y + r.y) * l.dims.x + r.x;
+}
+
 fn slot_hash(cell: u32, plane: u32) -> u32 {
     return pcg_hash(cell ^ pcg_hash(plane));
 }

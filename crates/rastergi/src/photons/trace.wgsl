@@ -3,9 +3,9 @@
 // values. Draw for draw the twin of photons/cpu.rs.
 
 struct PhotonParams {
-    origin: vec3f,
-    cell: f32,
-    dims: vec3u,
+    grid: GridLevels,
+    // Where sun and sky photons are aimed: (centre, radius), radius 0 for nowhere.
+    aim: vec4f,
     first_photon: u32,
     batch_size: u32,
     seed: u32,
@@ -26,7 +26,6 @@ struct PhotonParams {
     first_deposit: u32,
     _pad1: u32,
     _pad2: u32,
-    _pad3: u32,
 }
 
 @group(1) @binding(0) var<uniform> params: PhotonParams;
@@ -35,7 +34,7 @@ struct PhotonParams {
 @group(1) @binding(1) var<storage, read_write> tally_r: array<atomic<u32>>;
 @group(1) @binding(2) var<storage, read_write> tally_g: array<atomic<u32>>;
 @group(1) @binding(3) var<storage, read_write> tally_b: array<atomic<u32>>;
-// Surface area per table entry, in units of cell side².
+// Surface area per table entry, in units of the coarse cell's side².
 @group(1) @binding(4) var<storage, read> slot_area: array<f32>;
 // Per table entry: (Φ_rgb/h², A/h²), what the lookups read (map.wgsl).
 @group(1) @binding(5) var<storage, read_write> slots_out: array<vec4f>;
@@ -46,10 +45,40 @@ struct PhotonParams {
 
 // The table entry of a deposit at p on side `back` of triangle tri (MapLayout::deposit_slot).
 // With `twin` = CAUSTIC_CELL, the slot's caustic twin (NO_SLOT where the map has none).
+// A point on a face of its cell whose cell holds no area of its plane deposits in the
+// neighbour across that face (MapLayout::deposit_slot: the area of a surface on a cell
+// boundary is in the cell above it, where f32 rounding may not put its points).
 fn slot_of(p: vec3f, tri: u32, back: bool, twin: u32) -> u32 {
-    let c = vec3u(clamp(vec3i(floor((p - params.origin) / params.cell)), vec3i(0), vec3i(params.dims) - 1));
-    let cell = (c.z * params.dims.y + c.y) * params.dims.x + c.x;
-    let key = plane_key(planes[tri], cell_centre(params.origin, params.cell, c), params.cell, back);
+    let l = lattice_at(params.grid, p);
+    let c = lattice_cell(l, p);
+    let s = slot_in(l, c, p, tri, back, twin);
+    if s != NO_SLOT {
+        return s;
+    }
+    let f = (p - l.origin) / l.cell - vec3f(c);
+    for (var axis = 0u; axis < 3u; axis++) {
+        var step = 0;
+        if f[axis] < NEAR_FACE {
+            step = -1;
+        } else if f[axis] > 1.0 - NEAR_FACE {
+            step = 1;
+        }
+        var n = vec3i(c);
+        n[axis] += step;
+        if step != 0 && all(n >= l.lo) && all(n <= l.hi) {
+            let t = slot_in(l, vec3u(n), p, tri, back, twin);
+            if t != NO_SLOT {
+                return t;
+            }
+        }
+    }
+    return NO_SLOT;
+}
+
+// The slot of p's plane and region in cell c of lattice l.
+fn slot_in(l: Lattice, c: vec3u, p: vec3f, tri: u32, back: bool, twin: u32) -> u32 {
+    let cell = lattice_index(l, c);
+    let key = plane_key(planes[tri], cell_centre(l.origin, l.cell, c), l.cell, back);
     var region = 0u;
     let sep = find_separators(cell, key, params.mask + 1u, params.sep_mask, params.sep_max_probe);
     if sep != NO_SLOT {
@@ -122,7 +151,7 @@ fn trace_photons(@builtin(global_invocation_id) gid: vec3u) {
     let u2 = rng_f32(&rng);
     let u3 = rng_f32(&rng);
     let u4 = rng_f32(&rng);
-    let start = emit_photon(u0, u1, u2, u3, u4, params.ray_epsilon);
+    let start = emit_photon(u0, u1, u2, u3, u4, params.ray_epsilon, params.aim);
     // Φ/N.
     var flux = start.flux * params.inv_photon_count;
     var dir = start.dir;
@@ -223,6 +252,6 @@ fn resolve_map(@builtin(global_invocation_id) gid: vec3u) {
     for (var c = 0u; c < 3u; c++) {
         flux[c] = tally64(c, s) / params.quantum;
     }
-    let h2 = params.cell * params.cell;
+    let h2 = params.grid.cell * params.grid.cell;
     slots_out[s] = vec4f(flux / h2, slot_area[s]);
 }

@@ -6,7 +6,9 @@
 //! - `spheres:N`: about N triangles of tessellated spheres on a floor under an area light
 //!   ([`spheres`]), for measuring scale (`spheres:1000000` is a million triangles);
 //! - `rooms`, `rooms:closed`: two rooms split by a wall 2 cm thick, lit in one, seen from the
-//!   other, through a doorway or with none ([`rooms`]): the thin-wall case of the photon map.
+//!   other, through a doorway or with none ([`rooms`]): the thin-wall case of the photon map;
+//! - `sunroom`: a room lit by the sun through two windows, standing on a ground plane 200 m
+//!   across ([`sunroom`]): the exported-interior case (add a sky with `--env`).
 //!
 //! Every surface here is built from quads oriented by an explicit outward normal, so the
 //! front faces (and the emitters' emitting sides) never depend on the order corners are
@@ -18,7 +20,8 @@ use super::{Camera, Material, Scene, cornell_box};
 use crate::error::{Error, Result};
 
 /// The built-in scene names, as shown in help texts and error messages.
-pub const BUILTIN_NAMES: &str = "cornell, atrium, spheres:N (about N triangles), rooms, rooms:closed, glossy-room";
+pub const BUILTIN_NAMES: &str =
+    "cornell, atrium, spheres:N (about N triangles), rooms, rooms:closed, glossy-room, sunroom";
 
 /// Largest triangle count `spheres:N` accepts: 2²⁸ triangles are 16 GiB of corners, far
 /// past what any GPU binds as one buffer, so larger requests are typos.
@@ -33,6 +36,7 @@ pub fn builtin(name: &str) -> Result<Option<Scene>> {
         None if name == "atrium" => Ok(Some(atrium())),
         None if name == "rooms" => Ok(Some(rooms(true))),
         None if name == "glossy-room" => Ok(Some(glossy_room())),
+        None if name == "sunroom" => Ok(Some(sunroom())),
         Some(("rooms", "closed")) => Ok(Some(rooms(false))),
         Some(("spheres", count)) => {
             let n: usize = count
@@ -113,6 +117,61 @@ pub fn rooms(doorway: bool) -> Scene {
         -Vec3::Y,
         light,
     );
+    s
+}
+
+/// The sun of [`sunroom`]: azimuth 200°, elevation 35° (`--sun 200,35,…`), 3 W/m², a delta
+/// direction (`--sun-size 0`).
+pub const SUNROOM_SUN: (f32, f32, f32) = (200.0, 35.0, 3.0);
+
+/// A room 6 × 3 × 5 m inside (x ∈ [0, 6], z ∈ [0, 5], its floor at y = 0.05) with walls and a
+/// roof 20 cm thick, standing on a ground plane 200 m across (y = 0) as exported interiors
+/// stand on their terrain. Two windows 1.5 × 1.3 m in the south wall (z = 0) let in the sun
+/// ([`SUNROOM_SUN`], one of the scene's lights: a patch of sunlight on the floor) and, with
+/// `--env`, the sky; the walls are light grey (0.7), the floor wood-coloured, an albedo-1
+/// white sofa and a grey-blue table stand in the room. The camera stands in the north-west
+/// corner looking at the windows and the sunlit floor. 84 triangles.
+pub fn sunroom() -> Scene {
+    let camera =
+        Camera { eye: Vec3::new(0.6, 1.7, 4.6), target: Vec3::new(3.8, 0.7, 0.8), up: Vec3::Y, fov_y_deg: 70.0 };
+    let mut s = Scene::new(camera);
+    let ground = s.add_material(Material::diffuse("ground", Vec3::new(0.20, 0.24, 0.16)));
+    let wall = s.add_material(Material::diffuse("wall", Vec3::splat(0.7)));
+    let floor = s.add_material(Material::diffuse("floor", Vec3::new(0.45, 0.32, 0.2)));
+    let sofa = s.add_material(Material::diffuse("sofa", Vec3::ONE));
+    let table = s.add_material(Material::diffuse("table", Vec3::new(0.3, 0.4, 0.5)));
+    let r = 100.0;
+    add_quad_facing(
+        &mut s,
+        [Vec3::new(-r, 0.0, -r), Vec3::new(r, 0.0, -r), Vec3::new(r, 0.0, r), Vec3::new(-r, 0.0, r)],
+        Vec3::Y,
+        ground,
+    );
+    let (t, h, f) = (0.2, 3.0, 0.05);
+    add_box(&mut s, Vec3::new(-t, 0.0, -t), Vec3::new(6.0 + t, f, 5.0 + t), floor);
+    add_box(&mut s, Vec3::new(-t, h, -t), Vec3::new(6.0 + t, h + t, 5.0 + t), wall); // roof
+    add_box(&mut s, Vec3::new(-t, f, 5.0), Vec3::new(6.0 + t, h, 5.0 + t), wall); // north
+    add_box(&mut s, Vec3::new(-t, f, 0.0), Vec3::new(0.0, h, 5.0), wall); // west
+    add_box(&mut s, Vec3::new(6.0, f, 0.0), Vec3::new(6.0 + t, h, 5.0), wall); // east
+    // The south wall around windows x ∈ [1, 2.5] and [3.5, 5], y ∈ [0.9, 2.2].
+    let (sill, head) = (0.9, 2.2);
+    add_box(&mut s, Vec3::new(-t, f, -t), Vec3::new(6.0 + t, sill, 0.0), wall);
+    add_box(&mut s, Vec3::new(-t, head, -t), Vec3::new(6.0 + t, h, 0.0), wall);
+    for (x0, x1) in [(-t, 1.0), (2.5, 3.5), (5.0, 6.0 + t)] {
+        add_box(&mut s, Vec3::new(x0, sill, -t), Vec3::new(x1, head, 0.0), wall);
+    }
+    // Furniture: a sofa (seat and back) against the east wall, a table in the sunbeam.
+    add_box(&mut s, Vec3::new(5.0, f, 1.5), Vec3::new(5.9, 0.5, 3.5), sofa);
+    add_box(&mut s, Vec3::new(5.6, 0.5, 1.5), Vec3::new(5.9, 0.95, 3.5), sofa);
+    add_box(&mut s, Vec3::new(2.0, 0.7, 2.6), Vec3::new(3.2, 0.76, 3.4), table);
+    let sun = Vec3::new(SUNROOM_SUN.0.to_radians().sin(), 0.0, SUNROOM_SUN.0.to_radians().cos())
+        * SUNROOM_SUN.1.to_radians().cos()
+        + Vec3::Y * SUNROOM_SUN.1.to_radians().sin();
+    s.lights.push(super::Light::Distant {
+        direction: -sun.normalize(),
+        irradiance: Vec3::splat(SUNROOM_SUN.2),
+        angular_radius: 0.0,
+    });
     s
 }
 

@@ -157,7 +157,7 @@ impl GatherDirectionsArg {
 /// what is shown and the GPU.
 #[derive(Args, Clone, Debug)]
 pub struct SceneArgs {
-    /// The scene: built in (`cornell`, `atrium`, `spheres:N` for about N triangles, `rooms`, `rooms:closed`, `glossy-room`), a Wavefront .obj file or a glTF 2.0 .gltf/.glb file.
+    /// The scene: built in (`cornell`, `atrium`, `spheres:N` for about N triangles, `rooms`, `rooms:closed`, `glossy-room`, `sunroom`), a Wavefront .obj file or a glTF 2.0 .gltf/.glb file.
     pub scene: String,
     /// Image width in pixels (`view`: the window's initial width).
     #[arg(long, default_value_t = 256)]

@@ -11,7 +11,7 @@ use crate::args::load_scene;
 
 #[derive(Args, Debug)]
 pub struct ExportArgs {
-    /// The scene: built in (`cornell`, `atrium`, `spheres:N`, `rooms`, `glossy-room`) or a file rastergi reads.
+    /// The scene: built in (`cornell`, `atrium`, `spheres:N`, `rooms`, `glossy-room`, `sunroom`) or a file rastergi reads.
     scene: String,
     /// The .obj file to write; its materials go to the .mtl file of the same name beside it.
     #[arg(long)]

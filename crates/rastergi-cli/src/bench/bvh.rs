@@ -10,7 +10,7 @@ use crate::args::load_scene;
 
 #[derive(Args, Debug)]
 pub struct BvhArgs {
-    /// The scene: built in (`cornell`, `atrium`, `spheres:N`, `rooms`, `glossy-room`) or a file.
+    /// The scene: built in (`cornell`, `atrium`, `spheres:N`, `rooms`, `glossy-room`, `sunroom`) or a file.
     #[arg(default_value = "spheres:1000000")]
     scene: String,
     /// Timed builds (the median is reported).

@@ -64,7 +64,7 @@ pub fn run(command: &BenchCommand) -> Result<()> {
 /// `memory`).
 #[derive(clap::Args, Debug)]
 pub struct WindowArgs {
-    /// The scene: built in (`cornell`, `atrium`, `spheres:N`, `rooms`, `glossy-room`) or a file.
+    /// The scene: built in (`cornell`, `atrium`, `spheres:N`, `rooms`, `glossy-room`, `sunroom`) or a file.
     #[arg(default_value = "cornell")]
     pub scene: String,
     /// The window's width in pixels.

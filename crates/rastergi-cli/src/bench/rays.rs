@@ -15,7 +15,7 @@ use crate::args::{GpuArgs, gpu};
 
 #[derive(Args, Debug)]
 pub struct RaysArgs {
-    /// The scene: built in (`cornell`, `atrium`, `spheres:N`, `rooms`, `glossy-room`) or a file.
+    /// The scene: built in (`cornell`, `atrium`, `spheres:N`, `rooms`, `glossy-room`, `sunroom`) or a file.
     #[arg(default_value = "cornell")]
     scene: String,
     /// The camera's image is SIZE × SIZE pixels: one ray of each kind per pixel.

@@ -45,6 +45,8 @@ use std::collections::HashMap;
 
 use glam::{DVec3, IVec3, UVec3, Vec3};
 
+use crate::par::prelude::*;
+
 use super::clip::{clip_to_box, clip_to_half_space, polygon_area};
 use super::separators::{Fragment, separators_of};
 pub use super::separators::{MAX_SEPARATORS, MIN_REGION, Separator, Separators, region_of};
@@ -212,6 +214,23 @@ impl Lattice {
     }
 }
 
+/// The cells' boxes of one level of a grid ([`GridSpec::cell_boxes`]): per axis, the faces
+/// between its cells, its first cell's lower face first.
+pub struct CellBoxes {
+    lo: UVec3,
+    faces: [Vec<f64>; 3],
+}
+
+impl CellBoxes {
+    /// The half-open box [min, max) of cell c.
+    pub fn cell_box(&self, c: UVec3) -> (DVec3, DVec3) {
+        let i = (c - self.lo).as_usizevec3();
+        let min = DVec3::new(self.faces[0][i.x], self.faces[1][i.y], self.faces[2][i.z]);
+        let max = DVec3::new(self.faces[0][i.x + 1], self.faces[1][i.y + 1], self.faces[2][i.z + 1]);
+        (min, max)
+    }
+}
+
 impl GridSpec {
     /// A grid over `bounds` with `resolution` cells along its longest axis, unrefined. The
     /// bounds are padded by a thousandth so that surfaces on the bounding box lie strictly
@@ -281,33 +300,30 @@ impl GridSpec {
         self.coarse().cell_count() + self.fine().map_or(0, |f| f.cell_count())
     }
 
-    /// The half-open box of cell c of `lattice` (one of this grid's levels), with faces where
-    /// `cell_of`'s f32 arithmetic divides points ([`Lattice::face`]), so that a surface lying
-    /// on a cell boundary has its area in the cell its photons land in (in exact arithmetic
-    /// f32 rounding put them in the other one where the surface met a boundary, as axis-aligned
-    /// walls through the origin of a grid centred there do: 7–18 % of a sunlit room's deposits
-    /// were lost at some resolutions). A level's outermost cells reach to its edge: the
-    /// fine level's to the refined coarse cells' faces, the coarse level's without end (points
-    /// beyond are clamped into them).
-    pub fn cell_box(&self, lattice: &Lattice, c: UVec3) -> (DVec3, DVec3) {
+    /// The half-open boxes of the cells of `lattice` (one of this grid's levels), with faces
+    /// where `cell_of`'s f32 arithmetic divides points ([`Lattice::face`]), so that a surface
+    /// lying on a cell boundary has its area in the cell its photons land in (in exact
+    /// arithmetic f32 rounding put them in the other one where the surface met a boundary, as
+    /// axis-aligned walls through the origin of a grid centred there do: 7–18 % of a sunlit
+    /// room's deposits were lost at some resolutions). A level's outermost cells reach to its
+    /// edge: the fine level's to the refined coarse cells' faces, the coarse level's without
+    /// end (points beyond are clamped into them).
+    pub fn cell_boxes(&self, lattice: &Lattice) -> CellBoxes {
         let coarse = self.coarse();
         let fine = lattice.base > 0;
-        let (mut min, mut max) = (DVec3::ZERO, DVec3::ZERO);
-        for axis in 0..3 {
-            let (first, last) = (lattice.lo[axis], lattice.lo[axis] + lattice.dims[axis] - 1);
-            let i = c[axis];
-            min[axis] = match (i == first, fine) {
-                (false, _) => lattice.face(axis, i as i64),
-                (true, true) => coarse.face(axis, self.refine.lo[axis] as i64),
-                (true, false) => f64::NEG_INFINITY,
-            };
-            max[axis] = match (i == last, fine) {
-                (false, _) => lattice.face(axis, i as i64 + 1),
-                (true, true) => coarse.face(axis, self.refine.hi[axis] as i64),
-                (true, false) => f64::INFINITY,
-            };
-        }
-        (min, max)
+        let faces = std::array::from_fn(|axis| {
+            let n = lattice.dims[axis] as usize;
+            (0..=n)
+                .map(|k| match (k, fine) {
+                    (0, true) => coarse.face(axis, self.refine.lo[axis] as i64),
+                    (0, false) => f64::NEG_INFINITY,
+                    (k, true) if k == n => coarse.face(axis, self.refine.hi[axis] as i64),
+                    (k, false) if k == n => f64::INFINITY,
+                    (k, _) => lattice.face(axis, (lattice.lo[axis] as usize + k) as i64),
+                })
+                .collect()
+        });
+        CellBoxes { lo: lattice.lo, faces }
     }
 
     /// The finest cell side.
@@ -375,11 +391,15 @@ impl MapLayout {
     pub fn new(scene: &Scene, grid: &GridSpec) -> MapLayout {
         let planes: Vec<TrianglePlane> =
             scene.triangles.iter().map(|t| TrianglePlane::new(triangle_normal(t), t[0])).collect();
-        // Every side's fragment in every cell, grouped by cell.
-        let mut cells: HashMap<u32, Vec<Fragment>> = HashMap::new();
-        for (i, t) in scene.triangles.iter().enumerate() {
+        // Every side's fragment in every cell, per triangle (on all cores), then grouped by
+        // cell in the triangles' order.
+        let levels: Vec<(Lattice, CellBoxes)> =
+            std::iter::once(grid.coarse()).chain(grid.fine()).map(|l| (l, grid.cell_boxes(&l))).collect();
+        let fragments_of = |i: usize| -> Vec<(u32, Fragment)> {
+            let mut out = Vec::new();
+            let t = &scene.triangles[i];
             if planes[i].bins[0] == EMPTY {
-                continue;
+                return out;
             }
             let sides: &[bool] = if scene.material_of(i).two_sided { &[false, true] } else { &[false] };
             let holed = scene.material_of(i).has_holes();
@@ -388,7 +408,7 @@ impl MapLayout {
             let (tmin, tmax) = (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2]));
             // The coarse cells outside the refinement, then the fine cells, that the
             // triangle's box overlaps.
-            for lattice in std::iter::once(grid.coarse()).chain(grid.fine()) {
+            for (lattice, boxes) in &levels {
                 let refined_level = lattice.base > 0;
                 let (lo, hi) = (lattice.cell_of(tmin), lattice.cell_of(tmax));
                 if refined_level
@@ -404,31 +424,42 @@ impl MapLayout {
                             if !refined_level && grid.is_refined(c) {
                                 continue;
                             }
-                            let (min, max) = grid.cell_box(&lattice, c);
+                            let (min, max) = boxes.cell_box(c);
                             let piece = clip_to_box(&poly, min, max);
                             let coverage = if holed { mean_coverage(scene, i, &piece) } else { 1.0 };
                             let area = polygon_area(&piece) * coverage;
                             if area > 0.0 {
                                 for &back in sides {
                                     let side = if back { -n } else { n };
-                                    cells.entry(lattice.index(c)).or_default().push(Fragment {
-                                        key: planes[i].key(&lattice, c, back),
-                                        plane: (side, side.dot(poly[0])),
-                                        poly: piece.clone(),
-                                        area,
-                                        coverage,
-                                    });
+                                    out.push((
+                                        lattice.index(c),
+                                        Fragment {
+                                            key: planes[i].key(lattice, c, back),
+                                            plane: (side, side.dot(poly[0])),
+                                            poly: piece.clone(),
+                                            area,
+                                            coverage,
+                                        },
+                                    ));
                                 }
                             }
                         }
                     }
                 }
             }
+            out
+        };
+        let per_triangle: Vec<Vec<(u32, Fragment)>> =
+            (0..scene.triangles.len()).into_par_iter().with_min_len(64).map(fragments_of).collect();
+        let mut cells: HashMap<u32, Vec<Fragment>> = HashMap::new();
+        for (cell, f) in per_triangle.into_iter().flatten() {
+            cells.entry(cell).or_default().push(f);
         }
-        let mut areas: HashMap<[u32; 2], f64> = HashMap::new();
-        let mut separated: Vec<([u32; 2], [Separator; MAX_SEPARATORS])> = Vec::new();
+        // Per cell (on all cores): its slots' areas and its separators.
         let eps = 1e-4 * grid.finest_cell() as f64;
-        for (&cell, fragments) in &cells {
+        type CellSlots = (Vec<([u32; 2], f64)>, Vec<([u32; 2], [Separator; MAX_SEPARATORS])>);
+        let slots_of = |(&cell, fragments): (&u32, &Vec<Fragment>)| -> CellSlots {
+            let (mut areas, mut separated) = (Vec::new(), Vec::new());
             let mut keys: Vec<u32> = fragments.iter().map(|f| f.key).collect();
             keys.sort_unstable();
             keys.dedup();
@@ -436,7 +467,7 @@ impl MapLayout {
                 let own: Vec<&Fragment> = fragments.iter().filter(|f| f.key == key).collect();
                 let separators = separators_of(&own, fragments, key, eps);
                 if separators.is_empty() {
-                    *areas.entry([cell, key]).or_default() += own.iter().map(|f| f.area).sum::<f64>();
+                    areas.push(([cell, key], own.iter().map(|f| f.area).sum::<f64>()));
                     continue;
                 }
                 let mut record = [[0.0f32; 4]; MAX_SEPARATORS];
@@ -455,10 +486,21 @@ impl MapLayout {
                     }
                     // Regions that only rounding creates (where two cuts nearly meet) get no slot.
                     if area > 1e-9 * own.iter().map(|f| f.area).sum::<f64>() {
-                        *areas.entry([cell, key | region << REGION_SHIFT]).or_default() += area;
+                        areas.push(([cell, key | region << REGION_SHIFT], area));
                     }
                 }
             }
+            (areas, separated)
+        };
+        let cell_list: Vec<(&u32, &Vec<Fragment>)> = cells.iter().collect();
+        let per_cell: Vec<CellSlots> = cell_list.into_par_iter().with_min_len(64).map(slots_of).collect();
+        let mut areas: HashMap<[u32; 2], f64> = HashMap::new();
+        let mut separated: Vec<([u32; 2], [Separator; MAX_SEPARATORS])> = Vec::new();
+        for (cell_areas, cell_separated) in per_cell {
+            for (k, a) in cell_areas {
+                *areas.entry(k).or_default() += a;
+            }
+            separated.extend(cell_separated);
         }
         // A scene with perfect mirrors or smooth glass gets a caustic twin of every slot (its
         // cell index with CAUSTIC_CELL set, the same area): the flux of photons that reached

@@ -285,16 +285,7 @@ impl Renderer {
                 let aspect = settings.width as f32 / settings.height as f32;
                 let region = crate::fit::photon_region(&prepared, &scene.camera, aspect, settings.grid_resolution);
                 if let Some(r) = &region {
-                    log::info!(
-                        "photon region: ({:.2}, {:.2}, {:.2}) to ({:.2}, {:.2}, {:.2}), cells {}x finer",
-                        r.bounds.min.x,
-                        r.bounds.min.y,
-                        r.bounds.min.z,
-                        r.bounds.max.x,
-                        r.bounds.max.y,
-                        r.bounds.max.z,
-                        r.factor
-                    );
+                    log::info!("photon region: {r}");
                 }
                 region
             }

@@ -91,14 +91,7 @@ pub fn run(a: &PhotonArgs) -> Result<()> {
             inside as f64 / all.max(1) as f64
         };
         println!(
-            "  region ({:.2}, {:.2}, {:.2}) to ({:.2}, {:.2}, {:.2}), cells {}x finer: {:.2} % of photon hits land there unaimed, {:.2} % aimed",
-            r.bounds.min.x,
-            r.bounds.min.y,
-            r.bounds.min.z,
-            r.bounds.max.x,
-            r.bounds.max.y,
-            r.bounds.max.z,
-            r.factor,
+            "  region {r}: {:.2} % of photon hits land there unaimed, {:.2} % aimed",
             100.0 * share(&unaimed),
             100.0 * share(&tally)
         );

@@ -154,6 +154,18 @@ pub struct PhotonRegion {
     pub factor: u32,
 }
 
+impl std::fmt::Display for PhotonRegion {
+    /// "(x, y, z) to (x, y, z), cells kx finer", for logs and benchmarks.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let (a, b) = (self.bounds.min, self.bounds.max);
+        write!(
+            f,
+            "({:.2}, {:.2}, {:.2}) to ({:.2}, {:.2}, {:.2}), cells {}x finer",
+            a.x, a.y, a.z, b.x, b.y, b.z, self.factor
+        )
+    }
+}
+
 /// One level of a [`GridSpec`]: cubic cells of side `cell` from `origin`, integer coordinates
 /// `lo ..< lo + dims` per axis (the fine level's count from the grid's origin in fine cells),
 /// linear indices from `base`. Every point is in exactly one level's cells; a slot's cell index

@@ -39,6 +39,12 @@ CHROMIUM_ARGS = [
     "--enable-features=Vulkan",
     "--use-vulkan=swiftshader",
     "--disable-gpu-sandbox",
+    # SwiftShader compiles and runs every shader on the GPU process's own threads: on a 2-core
+    # machine a pipeline compile or a heavy submit can outlast Chromium's GPU watchdog, which
+    # then kills the GPU process and the page loses its device ("A valid external Instance
+    # reference no longer exists"; the browser's log says "GPU process exited unexpectedly").
+    # Seen in CI when the denoiser was on while a scene loaded; the page itself is not at fault.
+    "--disable-gpu-watchdog",
     "--window-size=1280,1000",
 ]
 

@@ -4,8 +4,8 @@
     rastergi render SCENE --out IMAGE.exr --albedo ALBEDO.exr --normal NORMAL.exr [...]
     scripts/oidn.py IMAGE.exr ALBEDO.exr NORMAL.exr OUT.exr [--quality high|balanced|fast]
 
-rastergi's own denoiser is `rastergi render --denoise` (README "Denoiser"); this is the recipe for
-an external one and how the README's comparison with OIDN was measured. Needs
+rastergi's own denoiser is `rastergi render --denoise` (docs/denoiser.md); this is the recipe for
+an external one and how docs/denoiser.md's comparison with OIDN was measured. Needs
 `pip install pyoidn OpenEXR` (OIDN 2.x's CPU device, bundled by pyoidn).
 
 - IMAGE: the raw render, linear radiance (HDR), RGB.

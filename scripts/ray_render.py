@@ -21,7 +21,7 @@ Frames along keyframed cameras (FILE.json: {"frames": 120, "keys": [{"t": 0, "ey
         --out 'frames/frame_{:04d}.png' --work-dir /shared/run2
 
 On a cluster: `ray start --head` on one node, `ray start --address HEAD:6379` on the others,
-then this script with `--address auto` on the head (README, "Long renders"). Without
+then this script with `--address auto` on the head (docs/user-guide.md, "Long renders"). Without
 --address, Ray starts a local cluster of this machine's CPUs and GPUs.
 """
 

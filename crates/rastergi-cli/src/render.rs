@@ -69,7 +69,7 @@ pub struct RenderArgs {
     #[arg(long)]
     profile: bool,
     /// Denoise the accumulated image (a weighted regression on distance and normal guided by an
-    /// edge-avoiding à-trous filter, README "Denoiser"): --out gets the denoised image and NAME.raw.EXT beside it the
+    /// edge-avoiding à-trous filter, docs/denoiser.md): --out gets the denoised image and NAME.raw.EXT beside it the
     /// raw one (what --out holds without --denoise). Gather method, full image only.
     #[arg(long)]
     denoise: bool,

@@ -297,7 +297,7 @@ fn settings_differences(a: &[(String, String)], b: &[(String, String)]) -> Vec<S
 /// Merges checkpoints of one image rendered with different seeds: the sums add, so the mean
 /// weighs each render by its iteration count — in expectation the image of one render as
 /// long as all of them (for the photon map, of renders whose passes each had their own
-/// photons; see the README). Refuses checkpoints of different scenes or settings and two of
+/// photons; see docs/user-guide.md, "Merging"). Refuses checkpoints of different scenes or settings and two of
 /// the same seed (the same random numbers: not independent).
 pub fn merge(paths: &[PathBuf]) -> Result<Checkpoint> {
     let (first, rest) = paths.split_first().ok_or_else(|| Error::Checkpoint("nothing to merge".into()))?;

@@ -79,7 +79,7 @@ pub use crate::fit::default_bundle;
 /// Gather directions per iteration by default. On the Cornell box at 256² (lavapipe), the
 /// indirect light carries 97 % of an iteration's variance while the G-buffer and the direct
 /// pass take 60 % of its time: sharing them among 4 directions reaches a given error in about
-/// half the time (README, performance).
+/// half the time (docs/performance.md).
 pub const DEFAULT_DIRECTIONS: u32 = 4;
 
 /// Fixed values for one iteration's random choices, so tests can compare the passes with

@@ -349,7 +349,7 @@ fn cornell_box_denoised_against_raw_and_the_convergence_rule() {
 /// The issue's own comparison, the Cornell box at 256² against the committed 256² Mitsuba
 /// pair: 16 iterations denoised against 64 and 256 raw. About 100 s on lavapipe.
 ///
-/// Measured (lavapipe, seed 5): see the README's Denoiser table. 16 denoised iterations are
+/// Measured (lavapipe, seed 5): see the tables in docs/denoiser.md. 16 denoised iterations are
 /// closer to the reference than 64 raw ones, not yet than 256 raw ones (the goal).
 #[test]
 fn cornell_box_at_256_denoised_16_against_raw_64_and_256() {

@@ -84,7 +84,7 @@ pub struct ViewArgs {
     /// Directory for screenshots (default: the current directory).
     #[arg(long)]
     screenshot_dir: Option<PathBuf>,
-    /// Start with the denoiser on (N and the panel's checkbox toggle it; README "Denoiser"):
+    /// Start with the denoiser on (N and the panel's checkbox toggle it; docs/denoiser.md):
     /// its guides accumulate from the first iteration. Photon map method, full image only.
     #[arg(long)]
     denoise: bool,

@@ -17,7 +17,7 @@
 //! lane by lane (the words read were what a traversal step cost), and measured again on Mesa 25,
 //! whose loads are vector gathers, against the same boxes decoded into 128-byte nodes: the
 //! compressed nodes still trace 1.07–1.23× more rays per second (`bench rays`, Cornell at 1024²,
-//! atrium and spheres:1000000 at 512², every kind; README, Performance).
+//! atrium and spheres:1000000 at 512², every kind; docs/performance.md).
 
 use bytemuck::{Pod, Zeroable};
 use glam::{UVec4, Vec3, Vec4};

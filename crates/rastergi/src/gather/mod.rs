@@ -85,7 +85,7 @@ pub enum GatherMethod {
 pub enum GatherDirections {
     /// Each pixel its own K cosine-distributed directions from an Owen-scrambled Sobol'
     /// sequence. The default: no streaks, and less error per iteration than shared
-    /// directions (README, performance).
+    /// directions (docs/performance.md).
     #[default]
     PerPixel,
     /// The iteration's K directions, uniform on the sphere, shared by every pixel: each
@@ -382,7 +382,7 @@ impl GatherPass {
     ///
     /// `Auto` on a CPU adapter takes the traced gather without trials unless `trials_on_cpu`:
     /// rasterization is emulated in software there, the traced gather won every trial measured
-    /// on lavapipe (README, performance), and the raster gathers' pipelines, compiled only for
+    /// on lavapipe (docs/performance.md), and the raster gathers' pipelines, compiled only for
     /// their trials, cost lavapipe minutes on a first run.
     pub fn new(
         gpu: &Gpu,

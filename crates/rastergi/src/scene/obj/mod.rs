@@ -59,6 +59,18 @@ pub fn load_obj(path: &Path) -> Result<Scene> {
 
 /// Loads the OBJ file at `path` of `files` (its MTL libraries and textures too).
 pub fn load_obj_in(files: Files, path: &Path) -> Result<Scene> {
+    load(files, path, false)
+}
+
+/// The OBJ file's geometry alone, for scene formats that name OBJ meshes (Mitsuba's `obj`
+/// shape): its triangles with their texture coordinates (v flipped as above) and normals
+/// (`vn`, or its smoothing groups'), its MTL libraries not read (every face gets the grey
+/// default material), no camera chosen and the scene not validated.
+pub(crate) fn load_obj_geometry(files: Files, path: &Path) -> Result<Scene> {
+    load(files, path, true)
+}
+
+fn load(files: Files, path: &Path, geometry_only: bool) -> Result<Scene> {
     if let Some(what) = files.missing(path) {
         return Err(file_error(
             path,
@@ -66,6 +78,9 @@ pub fn load_obj_in(files: Files, path: &Path) -> Result<Scene> {
         ));
     }
     let mut text = text_of(files, path)?;
+    if geometry_only {
+        comment_out(&mut text, b"mtllib");
+    }
     comment_out_texcoords_and_normals(&mut text);
     let options =
         tobj::LoadOptions { triangulate: true, ignore_points: true, ignore_lines: true, ..Default::default() };
@@ -79,8 +94,15 @@ pub fn load_obj_in(files: Files, path: &Path) -> Result<Scene> {
             ),
         ));
     }
-    let textured = materials.iter().any(|m| TEXTURE_KEYS.iter().any(|&key| map_file(m, key).is_some()));
     let mut text = text_of(files, path)?;
+    if geometry_only {
+        comment_out(&mut text, b"mtllib");
+    }
+    let textured = if geometry_only {
+        has_keyword(&text, b"vt")
+    } else {
+        materials.iter().any(|m| TEXTURE_KEYS.iter().any(|&key| map_file(m, key).is_some()))
+    };
     // Normals that faces refer to out of range are not used (the faces shade flat).
     let mut smooth = has_keyword(&text, b"vn")
         && check_references(&text, "vn", 2, "normal")
@@ -241,6 +263,9 @@ pub fn load_obj_in(files: Files, path: &Path) -> Result<Scene> {
     }
     if scene.triangles.is_empty() {
         return Err(file_error(path, "contains no faces; an OBJ scene needs at least one triangle ('f' lines)"));
+    }
+    if geometry_only {
+        return Ok(scene);
     }
     scene.camera = Scene::framing_camera(&scene.bounds());
     scene.validate().map_err(|e| file_error(path, e.to_string()))?;

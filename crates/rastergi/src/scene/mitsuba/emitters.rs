@@ -1,0 +1,131 @@
+//! Emitters outside shapes: point, spot and directional lights, the environment (`envmap`,
+//! `constant`), and those not implemented yet (`sun`, `sky`, `sunsky`).
+
+use std::sync::Arc;
+
+use glam::{Mat4, Vec2, Vec3};
+
+use super::materials::Value;
+use super::values;
+use super::xml::{self, Elem, Plugin};
+use super::{Loader, Res};
+use crate::scene::{Files, Light};
+
+impl<'a> Loader<'a> {
+    /// A top-level emitter: a light or the environment.
+    pub(super) fn emitter(&mut self, e: &'a Elem) -> Res<()> {
+        let p = Plugin::new(e);
+        let ty = p.ty();
+        let light = match ty {
+            "point" => {
+                let m = self.transform(&p, "to_world")?;
+                let position = self.point(&p, "position")?.unwrap_or_else(|| m.transform_point3(Vec3::ZERO));
+                Some(Light::Point { position, intensity: self.colour(&p, "intensity")? })
+            }
+            "spot" => {
+                let m = self.transform(&p, "to_world")?;
+                let cutoff = self.float(&p, "cutoff_angle", 20.0)?;
+                let beam = self.float(&p, "beam_width", cutoff * 0.75)?;
+                let outer = cutoff.to_radians().clamp(1e-4, std::f32::consts::FRAC_PI_2);
+                self.warn(
+                    "spot lights fall off smoothly between beam_width and cutoff_angle (glTF's curve); Mitsuba's falloff is linear in angle"
+                        .into(),
+                );
+                Some(Light::Spot {
+                    position: m.transform_point3(Vec3::ZERO),
+                    direction: m.transform_vector3(Vec3::Z).normalize_or_zero(),
+                    intensity: self.colour(&p, "intensity")?,
+                    inner: beam.to_radians().clamp(0.0, outer),
+                    outer,
+                })
+            }
+            "directional" => {
+                let m = self.transform(&p, "to_world")?;
+                let direction = match p.get("direction") {
+                    Some(d) => self.v(values::vec3(d))?,
+                    None => m.transform_vector3(Vec3::Z),
+                };
+                let irradiance = self.colour(&p, "irradiance")?;
+                Some(Light::Distant { direction: direction.normalize_or_zero(), irradiance, angular_radius: 0.0 })
+            }
+            "envmap" | "constant" => {
+                let env = if ty == "constant" {
+                    crate::environment::Environment::constant(self.colour(&p, "radiance")?)
+                } else {
+                    let filename =
+                        self.string(&p, "filename")?.ok_or_else(|| self.err(e, "an envmap needs a filename"))?;
+                    let path = xml::resolve(self.dir_of(e), filename);
+                    let scale = self.float(&p, "scale", 1.0)?;
+                    if !matches!(self.files, Files::Disk) {
+                        self.warn(format!("the envmap {} is read from disk only; it is skipped", path.display()));
+                        p.read_all();
+                        return Ok(());
+                    }
+                    let env = crate::environment::Environment::load(&path, scale.max(0.0))
+                        .map_err(|err| self.err(e, format!("the envmap: {err}")))?;
+                    let m = self.transform(&p, "to_world")?;
+                    rotated(&env, m).unwrap_or_else(|| (*env).clone())
+                };
+                if self.scene.environment.is_some() {
+                    self.warn(format!("only the first environment is used; the {ty} at line {} is not", e.pos.line));
+                } else {
+                    self.scene.environment = Some(Arc::new(env));
+                }
+                None
+            }
+            "sun" | "sky" | "sunsky" => {
+                p.read_all();
+                self.warn(format!("the {ty} emitter is not implemented yet; the scene is rendered without it"));
+                None
+            }
+            "area" => {
+                p.read_all();
+                self.warn(format!("an area emitter at line {} is not inside a shape; it is skipped", e.pos.line));
+                None
+            }
+            other => {
+                p.read_all();
+                self.warn(format!("the emitter '{other}' is not supported; it is skipped"));
+                None
+            }
+        };
+        if let Some(light) = light {
+            light.validate().map_err(|m| self.err(e, m))?;
+            self.scene.lights.push(light);
+        }
+        self.warn_unread(&p, &format!("emitter '{ty}'"));
+        Ok(())
+    }
+
+    /// A constant colour property of an emitter (default 1).
+    fn colour(&mut self, p: &Plugin<'a>, key: &str) -> Res<Vec3> {
+        match self.value(p, key, Vec3::ONE)? {
+            Value::Constant(c) => Ok(c),
+            Value::Texture { factor, .. } => {
+                self.warn(format!("emitter '{}': a texture as {key} is not supported; its factor is used", p.ty()));
+                Ok(factor)
+            }
+        }
+    }
+}
+
+/// The environment turned by `m` (an envmap's to_world): the radiance arriving from world
+/// direction d is the image's at M⁻¹d, resampled bilinearly at every pixel's direction.
+/// `None` where `m` leaves directions unchanged.
+fn rotated(env: &crate::environment::Environment, m: Mat4) -> Option<crate::environment::Environment> {
+    let linear = glam::Mat3::from_mat4(m);
+    if (linear - glam::Mat3::IDENTITY).abs_diff_eq(glam::Mat3::ZERO, 1e-6) || linear.determinant() == 0.0 {
+        return None;
+    }
+    let inverse = linear.inverse();
+    let (w, h) = (env.width, env.height);
+    let texels = (0..h)
+        .flat_map(|j| (0..w).map(move |i| (i, j)))
+        .map(|(i, j)| {
+            let uv = Vec2::new((i as f32 + 0.5) / w as f32, j as f32 / (h - 1).max(1) as f32);
+            let d = crate::environment::uv_to_direction(uv);
+            env.eval((inverse * d).normalize_or_zero())
+        })
+        .collect();
+    crate::environment::Environment::new(w, h, texels).ok()
+}

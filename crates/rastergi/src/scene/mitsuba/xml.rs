@@ -1,0 +1,390 @@
+//! The XML layer: the file and its `<include>`s parsed by `roxmltree` into one owned tree of
+//! elements that remember where they start (file, line, column), with `<default>` parameters
+//! and `$name` references substituted in every attribute value, and property names in Mitsuba
+//! 3's snake_case (`toWorld` → `to_world`, `intIOR` → `int_ior`: an underscore before each
+//! capital that follows a lower-case letter or a digit, then lower case), so that the rest of
+//! the loader reads format versions 0.5/0.6 and 2/3 alike.
+//!
+//! Parameters: a caller's definitions (the CLI's `-D name=value`) come first; a `<default
+//! name value>` defines its name only where nothing did before (Mitsuba's rule). A `$name` is
+//! the longest run of letters, digits and underscores after the `$`; one that nothing defines
+//! is an error at the element that uses it. `<include filename>` splices the children of the
+//! named file's `<scene>` in its place (its path relative to the including file), at most
+//! [`MAX_INCLUDE_DEPTH`] deep.
+
+use std::cell::RefCell;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use crate::error::{Error, Result};
+use crate::scene::Files;
+
+/// Includes nested deeper than this are refused (an include cycle ends here).
+pub const MAX_INCLUDE_DEPTH: usize = 16;
+/// Most files a scene and its includes may read.
+const MAX_FILES: usize = 256;
+/// Most elements a scene and its includes may hold (a guard against hostile files).
+const MAX_NODES: u32 = 8_000_000;
+
+/// Where an element starts: the index of its file in [`Document::files`], line and column
+/// (from 1).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Pos {
+    pub file: usize,
+    pub line: u32,
+    pub column: u32,
+}
+
+/// An element with its attributes (values substituted; `name` in snake_case) and children.
+#[derive(Clone, Debug)]
+pub struct Elem {
+    pub tag: String,
+    pub attrs: Vec<(String, String)>,
+    pub children: Vec<Elem>,
+    pub pos: Pos,
+}
+
+impl Elem {
+    pub fn attr(&self, name: &str) -> Option<&str> {
+        self.attrs.iter().find(|(k, _)| k == name).map(|(_, v)| v.as_str())
+    }
+
+    /// The element's `name` attribute (a property's name), or "".
+    pub fn name(&self) -> &str {
+        self.attr("name").unwrap_or("")
+    }
+
+    /// The plugin type (`type` attribute), or "".
+    pub fn ty(&self) -> &str {
+        self.attr("type").unwrap_or("")
+    }
+
+    /// Every element of the tree, depth first, this one first.
+    pub fn walk<'s>(&'s self, f: &mut impl FnMut(&'s Elem)) {
+        f(self);
+        self.children.iter().for_each(|c| c.walk(f));
+    }
+}
+
+/// A parsed scene: its `<scene>` element and the files it came from.
+pub struct Document {
+    pub root: Elem,
+    /// The scene file first, then its includes in the order they were read.
+    pub files: Vec<PathBuf>,
+    /// The root's `version` attribute: (major, minor).
+    pub version: (u32, u32),
+}
+
+impl Document {
+    /// An error at `pos`: "FILE: line L, column C: message".
+    pub fn error_at(files: &[PathBuf], pos: Pos, message: impl std::fmt::Display) -> Error {
+        Error::SceneFile {
+            path: files.get(pos.file).cloned().unwrap_or_default(),
+            message: format!("line {}, column {}: {message}", pos.line, pos.column),
+        }
+    }
+
+    /// Whether the file is in Mitsuba 0.x's format (camelCase names, 0.6's defaults).
+    pub fn legacy(&self) -> bool {
+        self.version.0 < 2
+    }
+}
+
+/// `toWorld` → `to_world`, `intIOR` → `int_ior`; snake_case names are kept.
+pub fn snake_case(name: &str) -> String {
+    let mut out = String::with_capacity(name.len() + 4);
+    let mut previous: Option<char> = None;
+    for c in name.chars() {
+        if c.is_ascii_uppercase() && previous.is_some_and(|p| p.is_ascii_lowercase() || p.is_ascii_digit()) {
+            out.push('_');
+        }
+        out.push(c.to_ascii_lowercase());
+        previous = Some(c);
+    }
+    out
+}
+
+/// Parses the scene at `path` with the caller's parameter definitions.
+pub fn parse(files: Files, path: &Path, defines: &[(String, String)]) -> Result<Document> {
+    let mut parser = Parser { files, paths: Vec::new(), params: defines.iter().cloned().collect(), nodes: 0 };
+    let (root, version) = parser.file(path, 0, None)?;
+    Ok(Document { root, files: parser.paths, version })
+}
+
+struct Parser<'a> {
+    files: Files<'a>,
+    paths: Vec<PathBuf>,
+    params: HashMap<String, String>,
+    nodes: u32,
+}
+
+impl Parser<'_> {
+    fn error(&self, pos: Pos, message: impl std::fmt::Display) -> Error {
+        Document::error_at(&self.paths, pos, message)
+    }
+
+    /// Reads and converts one file; `from` is the `<include>` that names it.
+    fn file(&mut self, path: &Path, depth: usize, from: Option<Pos>) -> Result<(Elem, (u32, u32))> {
+        let refuse = |parser: &Parser, message: String| match from {
+            Some(pos) => parser.error(pos, format!("the included file {}: {message}", path.display())),
+            None => Error::SceneFile { path: path.to_path_buf(), message },
+        };
+        if let Some(what) = self.files.missing(path) {
+            let hint = if from.is_some() { "" } else { "; give the path of a Mitsuba scene (.xml) file" };
+            return Err(refuse(self, format!("{what}{hint}")));
+        }
+        if self.files.is_special(path) {
+            return Err(refuse(self, "is not a regular file".into()));
+        }
+        let bytes = self.files.read(path).map_err(|e| refuse(self, format!("cannot be read: {e}")))?;
+        let text = String::from_utf8(bytes).map_err(|e| {
+            refuse(self, format!("is not UTF-8 text (byte {}); save it as UTF-8", e.utf8_error().valid_up_to()))
+        })?;
+        let file = self.paths.len();
+        self.paths.push(path.to_path_buf());
+        let options = roxmltree::ParsingOptions { allow_dtd: true, nodes_limit: MAX_NODES, ..Default::default() };
+        let doc = roxmltree::Document::parse_with_options(&text, options).map_err(|e| {
+            let at = e.pos();
+            let message = e.to_string();
+            // roxmltree's messages say " at L:C"; the position is said once, first.
+            let message = message.replace(&format!(" at {}:{}", at.row, at.col), "");
+            // One line: control characters (a newline roxmltree quotes) written as escapes.
+            let message: String = message
+                .chars()
+                .map(|c| if c.is_control() { c.escape_default().to_string() } else { c.to_string() })
+                .collect();
+            self.error(Pos { file, line: at.row, column: at.col }, format!("not well-formed XML: {message}"))
+        })?;
+        let root = doc.root_element();
+        let pos = position(&doc, root, file);
+        if root.tag_name().name() != "scene" {
+            return Err(self.error(
+                pos,
+                format!("the root element is <{}>; a Mitsuba scene file has <scene>", root.tag_name().name()),
+            ));
+        }
+        let version = match root.attribute("version") {
+            Some(v) => parse_version(v).ok_or_else(|| {
+                self.error(pos, format!("version \"{v}\" is not a version number such as 0.6.0 or 3.0.0"))
+            })?,
+            None => {
+                log::warn!(
+                    "{}: <scene> has no version attribute; read as Mitsuba 0.6 (give version=\"3.0.0\" for Mitsuba 3's defaults)",
+                    path.display()
+                );
+                (0, 6)
+            }
+        };
+        let mut children = Vec::new();
+        self.children(&doc, root, file, depth, &mut children)?;
+        let attrs = root.attributes().map(|a| (a.name().to_owned(), a.value().to_owned())).collect();
+        Ok((Elem { tag: "scene".into(), attrs, children, pos }, version))
+    }
+
+    /// Converts the element children of `node` into `out`, handling `<default>` and
+    /// `<include>`.
+    fn children(
+        &mut self,
+        doc: &roxmltree::Document,
+        node: roxmltree::Node,
+        file: usize,
+        depth: usize,
+        out: &mut Vec<Elem>,
+    ) -> Result<()> {
+        for child in node.children().filter(|c| c.is_element()) {
+            self.nodes += 1;
+            if self.nodes > MAX_NODES {
+                return Err(self.error(position(doc, child, file), format!("more than {MAX_NODES} elements")));
+            }
+            let pos = position(doc, child, file);
+            let tag = child.tag_name().name();
+            match tag {
+                "default" => {
+                    let (Some(name), Some(value)) = (child.attribute("name"), child.attribute("value")) else {
+                        return Err(self.error(pos, "<default> needs a name and a value"));
+                    };
+                    if !self.params.contains_key(name) {
+                        let value = self.substitute(value, pos)?;
+                        self.params.insert(name.to_owned(), value);
+                    }
+                }
+                "include" => {
+                    let Some(filename) = child.attribute("filename") else {
+                        return Err(self.error(pos, "<include> needs a filename"));
+                    };
+                    if depth + 1 > MAX_INCLUDE_DEPTH || self.paths.len() >= MAX_FILES {
+                        return Err(self.error(
+                            pos,
+                            format!(
+                                "includes nest deeper than {MAX_INCLUDE_DEPTH} files or read more than {MAX_FILES} (an include cycle?)"
+                            ),
+                        ));
+                    }
+                    let filename = self.substitute(filename, pos)?;
+                    let base = self.paths[file].parent().unwrap_or(Path::new("")).to_path_buf();
+                    let path = resolve(&base, &filename);
+                    let (included, _) = self.file(&path, depth + 1, Some(pos))?;
+                    out.extend(included.children);
+                }
+                _ => {
+                    let mut attrs = Vec::with_capacity(child.attributes().len());
+                    for a in child.attributes() {
+                        let mut value = self.substitute(a.value(), pos)?;
+                        if a.name() == "name" {
+                            value = snake_case(&value);
+                        }
+                        attrs.push((a.name().to_owned(), value));
+                    }
+                    let mut elem = Elem { tag: tag.to_owned(), attrs, children: Vec::new(), pos };
+                    self.children(doc, child, file, depth, &mut elem.children)?;
+                    out.push(elem);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// `value` with every `$name` replaced by its parameter's value.
+    fn substitute(&self, value: &str, pos: Pos) -> Result<String> {
+        if !value.contains('$') {
+            return Ok(value.to_owned());
+        }
+        let mut out = String::with_capacity(value.len());
+        let mut rest = value;
+        while let Some(i) = rest.find('$') {
+            out.push_str(&rest[..i]);
+            let after = &rest[i + 1..];
+            let n = after.find(|c: char| !(c.is_ascii_alphanumeric() || c == '_')).unwrap_or(after.len());
+            if n == 0 {
+                out.push('$');
+                rest = after;
+                continue;
+            }
+            let name = &after[..n];
+            match self.params.get(name) {
+                Some(v) => out.push_str(v),
+                None => {
+                    return Err(self.error(
+                        pos,
+                        format!("${name} is not defined; add <default name=\"{name}\" value=\"...\"/> or pass -D {name}=VALUE"),
+                    ));
+                }
+            }
+            rest = &after[n..];
+        }
+        out.push_str(rest);
+        Ok(out)
+    }
+}
+
+fn position(doc: &roxmltree::Document, node: roxmltree::Node, file: usize) -> Pos {
+    let at = doc.text_pos_at(node.range().start);
+    Pos { file, line: at.row, column: at.col }
+}
+
+/// "0.6.0" → (0, 6); "3" → (3, 0).
+fn parse_version(v: &str) -> Option<(u32, u32)> {
+    let mut parts = v.trim().split('.');
+    let major = parts.next()?.parse().ok()?;
+    let minor = parts.next().map_or(Some(0), |m| m.parse().ok())?;
+    Some((major, minor))
+}
+
+/// A path named in a scene file: absolute as is, else relative to `base`; `\` separators
+/// (Windows exporters) read as `/`.
+pub fn resolve(base: &Path, name: &str) -> PathBuf {
+    let name = name.replace('\\', "/");
+    let path = Path::new(&name);
+    if path.is_absolute() { path.to_path_buf() } else { base.join(path) }
+}
+
+/// A plugin element (`<bsdf type=…>`, `<shape …>`) with the record of which of its children
+/// have been read, so that the rest can be named in one warning.
+pub struct Plugin<'a> {
+    pub elem: &'a Elem,
+    read: RefCell<Vec<bool>>,
+}
+
+impl<'a> Plugin<'a> {
+    pub fn new(elem: &'a Elem) -> Plugin<'a> {
+        Plugin { elem, read: RefCell::new(vec![false; elem.children.len()]) }
+    }
+
+    pub fn ty(&self) -> &'a str {
+        self.elem.ty()
+    }
+
+    /// The property named `name` (the last one, where a file repeats it), marked as read.
+    pub fn get(&self, name: &str) -> Option<&'a Elem> {
+        let (i, e) = self.elem.children.iter().enumerate().rev().find(|(_, c)| c.name() == name)?;
+        self.read.borrow_mut()[i] = true;
+        Some(e)
+    }
+
+    /// Whether the property `name` is given (without marking it read).
+    pub fn has(&self, name: &str) -> bool {
+        self.elem.children.iter().any(|c| c.name() == name)
+    }
+
+    /// The nested children with one of these tags (named or not), marked as read.
+    pub fn nested(&self, tags: &[&str]) -> Vec<&'a Elem> {
+        let mut read = self.read.borrow_mut();
+        self.elem
+            .children
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| tags.contains(&c.tag.as_str()))
+            .map(|(i, c)| {
+                read[i] = true;
+                c
+            })
+            .collect()
+    }
+
+    /// Marks every child read (a plugin ignored as a whole is named once, not its parts).
+    pub fn read_all(&self) {
+        self.read.borrow_mut().iter_mut().for_each(|r| *r = true);
+    }
+
+    /// The children never read: their names, or their tags where they have none.
+    pub fn unread(&self) -> Vec<String> {
+        let read = self.read.borrow();
+        self.elem
+            .children
+            .iter()
+            .zip(read.iter())
+            .filter(|(_, r)| !**r)
+            .map(|(c, _)| if c.name().is_empty() { format!("<{}>", c.tag) } else { c.name().to_owned() })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn camel_case_names_become_snake_case() {
+        for (a, b) in [
+            ("toWorld", "to_world"),
+            ("intIOR", "int_ior"),
+            ("fovAxis", "fov_axis"),
+            ("sampleCount", "sample_count"),
+            ("shapeIndex", "shape_index"),
+            ("diffuseReflectance", "diffuse_reflectance"),
+            ("to_world", "to_world"),
+            ("alpha", "alpha"),
+            ("uvscale", "uvscale"),
+        ] {
+            assert_eq!(snake_case(a), b);
+        }
+    }
+
+    #[test]
+    fn versions_parse() {
+        assert_eq!(parse_version("0.6.0"), Some((0, 6)));
+        assert_eq!(parse_version("3.0.0"), Some((3, 0)));
+        assert_eq!(parse_version("2"), Some((2, 0)));
+        assert_eq!(parse_version("x"), None);
+    }
+}

@@ -15,7 +15,7 @@ use rastergi::gather::{GatherDirections, GatherMethod, HitLight};
 use rastergi::gpu::{Backends, Gpu, GpuOptions, parse_backend};
 use rastergi::renderer::{PhotonRegionChoice, RenderSettings};
 use rastergi::scene::generate::BUILTIN_NAMES;
-use rastergi::scene::{GltfOptions, Scene, load_gltf_with, load_obj};
+use rastergi::scene::{GltfOptions, MitsubaOptions, Scene, load_gltf_with, load_mitsuba, load_obj};
 
 #[derive(Args, Clone, Debug)]
 pub struct GpuArgs {
@@ -157,7 +157,7 @@ impl GatherDirectionsArg {
 /// what is shown and the GPU.
 #[derive(Args, Clone, Debug)]
 pub struct SceneArgs {
-    /// The scene: built in (`cornell`, `atrium`, `spheres:N` for about N triangles, `rooms`, `rooms:closed`, `glossy-room`, `sunroom`), a Wavefront .obj file or a glTF 2.0 .gltf/.glb file.
+    /// The scene: built in (`cornell`, `atrium`, `spheres:N` for about N triangles, `rooms`, `rooms:closed`, `glossy-room`, `sunroom`), a Wavefront .obj file, a glTF 2.0 .gltf/.glb file or a Mitsuba .xml scene file.
     pub scene: String,
     /// Image width in pixels (`view`: the window's initial width).
     #[arg(long, default_value_t = 256)]
@@ -180,6 +180,10 @@ pub struct SceneArgs {
     /// glTF scenes: the camera to use, by its index in the file's cameras (default: the first).
     #[arg(long)]
     pub camera: Option<usize>,
+    /// Mitsuba scene files: sets the parameter NAME (what `$NAME` stands for, over the file's
+    /// `<default name="NAME">`) to VALUE (repeatable).
+    #[arg(short = 'D', value_name = "NAME=VALUE", value_parser = parse_define)]
+    pub define: Vec<(String, String)>,
     /// Seed of every random decision; the same seed gives the same image.
     #[arg(long, default_value_t = 0)]
     pub seed: u32,
@@ -274,7 +278,7 @@ pub struct SceneArgs {
 impl SceneArgs {
     /// The scene with the camera options applied, its camera validated.
     pub fn load_scene(&self) -> Result<Scene> {
-        let mut scene = load_scene_with_camera(&self.scene, self.camera)?;
+        let mut scene = load_scene_with(&self.scene, self.camera, &self.define)?;
         let c = &mut scene.camera;
         c.eye = self.eye.unwrap_or(c.eye);
         c.target = self.target.unwrap_or(c.target);
@@ -359,6 +363,13 @@ fn parse_sun(s: &str) -> Result<Vec3, String> {
         return Err(format!("the sun's irradiance {} W/m² is negative", v.z));
     }
     Ok(v)
+}
+
+fn parse_define(s: &str) -> Result<(String, String), String> {
+    match s.split_once('=') {
+        Some((name, value)) if !name.trim().is_empty() => Ok((name.trim().to_owned(), value.to_owned())),
+        _ => Err(format!("'{s}' is not NAME=VALUE")),
+    }
 }
 
 fn parse_env_scale(s: &str) -> Result<f32, String> {
@@ -460,6 +471,11 @@ pub fn load_scene(name: &str) -> Result<Scene> {
 
 /// [`load_scene`] with the camera of a glTF file chosen by its index.
 pub fn load_scene_with_camera(name: &str, camera: Option<usize>) -> Result<Scene> {
+    load_scene_with(name, camera, &[])
+}
+
+/// [`load_scene_with_camera`] with the parameter values of a Mitsuba file (`-D name=value`).
+pub fn load_scene_with(name: &str, camera: Option<usize>, defines: &[(String, String)]) -> Result<Scene> {
     let path = Path::new(name);
     let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     if camera.is_some() && !matches!(extension.as_deref(), Some("gltf" | "glb")) {
@@ -471,8 +487,15 @@ pub fn load_scene_with_camera(name: &str, camera: Option<usize>) -> Result<Scene
     match extension.as_deref() {
         Some("obj") => Ok(load_obj(path)?),
         Some("gltf" | "glb") => Ok(load_gltf_with(path, &GltfOptions { camera })?),
+        Some("xml") => {
+            let m = load_mitsuba(path, &MitsubaOptions { defines: defines.to_vec() })?;
+            if let (Some((w, h)), Some(n)) = (m.film, m.sample_count) {
+                log::info!("{name}: its film is {w}x{h} pixels with {n} samples per pixel (--width {w} --height {h} --iterations {n})");
+            }
+            Ok(m.scene)
+        }
         _ => anyhow::bail!(
-            "unknown scene '{name}': use a built-in scene ({BUILTIN_NAMES}) or a path to a .obj, .gltf or .glb file"
+            "unknown scene '{name}': use a built-in scene ({BUILTIN_NAMES}) or a path to a .obj, .gltf, .glb or Mitsuba .xml file"
         ),
     }
 }

@@ -302,7 +302,7 @@ impl<'a> Loader<'a> {
             "sphere" => {
                 let center = self.point(&p, "center")?.unwrap_or(Vec3::ZERO);
                 let radius = self.float(&p, "radius", 1.0)?;
-                if !(radius > 0.0) {
+                if radius.is_nan() || radius <= 0.0 {
                     return Err(self.err(e, format!("a sphere's radius {radius} must be positive")));
                 }
                 let soup = shapes::sphere();

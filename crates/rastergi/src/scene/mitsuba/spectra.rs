@@ -146,8 +146,10 @@ pub fn named_conductor(name: &str) -> Option<(Vec3, Vec3)> {
     CONDUCTORS.iter().find(|c| c.0 == name).map(|c| (Vec3::from(c.1), Vec3::from(c.2)))
 }
 
-/// (name, η, k); `X_palik` reads `X` where the two are the same data.
+/// (name, η, k); `X_palik` reads `X` where the two are the same data. The digits are the
+/// source's; its few slightly negative values (AlSb's η, some k of transparent materials) are 0.
 #[rustfmt::skip]
+#[allow(clippy::excessive_precision)]
 const CONDUCTORS: &[(&str, [f32; 3], [f32; 3])] = &[
     ("a-C", [2.9440999183, 2.2271502925, 1.9681668794], [0.8874329109, 0.7993216383, 0.8152862927]),
     ("Ag", [0.1552646489, 0.1167232965, 0.1383806959], [4.8283433224, 3.1222459278, 2.1469504455]),

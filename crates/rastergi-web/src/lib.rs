@@ -10,8 +10,8 @@
 //!
 //! Scenes: the built-in ones by name, or files from the page (dropped or picked) held in
 //! memory ([`rastergi::scene::MemoryFiles`]): a `.glb`, a `.gltf` with its buffers and images,
-//! or an `.obj` with its `.mtl` libraries and textures. A file that is not a scene is refused
-//! with one line, and the scene shown stays.
+//! an `.obj` with its `.mtl` libraries and textures, or a Mitsuba `.xml` with its folder. A
+//! file that is not a scene is refused with one line, and the scene shown stays.
 //!
 //! Natively this crate is empty (it builds for `wasm32-unknown-unknown` only, with
 //! `scripts/web-build.sh`).
@@ -177,19 +177,27 @@ fn build(gpu: &Gpu, scene: &Scene, options: &Options) -> rastergi::Result<Box<dy
     })
 }
 
-/// The scene among `files`: the first `.glb`, `.gltf` or `.obj` by name.
+/// The scene among `files`: a Mitsuba `.xml` (whose meshes are often `.obj` files beside it),
+/// else the first `.glb`, `.gltf` or `.obj` by name.
 fn load_scene(files: &MemoryFiles) -> rastergi::Result<(String, Scene)> {
     let mut names: Vec<&str> = files.names().collect();
     names.sort();
     let kind = |n: &str| Path::new(n).extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
-    let Some(name) = names.iter().find(|n| matches!(kind(n).as_deref(), Some("glb" | "gltf" | "obj"))) else {
+    let mitsuba = names.iter().find(|n| kind(n).as_deref() == Some("xml"));
+    let Some(name) =
+        mitsuba.or_else(|| names.iter().find(|n| matches!(kind(n).as_deref(), Some("glb" | "gltf" | "obj"))))
+    else {
         return Err(rastergi::Error::InvalidScene(format!(
-            "{} is not a scene: drop a .glb, a .gltf with its files, or an .obj with its .mtl and textures",
+            "{} is not a scene: drop a .glb, a .gltf with its files, an .obj with its .mtl and textures, or a Mitsuba .xml with its folder",
             names.join(", ")
         )));
     };
     let path = Path::new(name);
     let scene = match kind(name).as_deref() {
+        Some("xml") => {
+            let options = rastergi::scene::MitsubaOptions::default();
+            rastergi::scene::load_mitsuba_in(Files::Memory(files), path, &options)?.scene
+        }
         Some("obj") => rastergi::scene::load_obj_in(Files::Memory(files), path)?,
         _ => rastergi::scene::load_gltf_in(Files::Memory(files), path, &GltfOptions::default())?,
     };

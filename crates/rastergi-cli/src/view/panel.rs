@@ -24,7 +24,7 @@ use crate::render::Method;
 /// The built-in scenes the panel offers (`spheres:N` takes a count, so it is typed).
 const BUILTINS: [&str; 4] = ["cornell", "atrium", "rooms", "rooms:closed"];
 /// Scene files the browser lists.
-const SCENE_EXTENSIONS: [&str; 3] = ["obj", "gltf", "glb"];
+const SCENE_EXTENSIONS: [&str; 4] = ["obj", "gltf", "glb", "xml"];
 /// Photon counts offered: powers of two.
 const PHOTON_EXPONENTS: std::ops::RangeInclusive<u32> = 12..=26;
 /// Grid resolutions offered.

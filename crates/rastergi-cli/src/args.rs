@@ -182,7 +182,7 @@ pub struct SceneArgs {
     pub camera: Option<usize>,
     /// Mitsuba scene files: sets the parameter NAME (what `$NAME` stands for, over the file's
     /// `<default name="NAME">`) to VALUE (repeatable).
-    #[arg(short = 'D', value_name = "NAME=VALUE", value_parser = parse_define)]
+    #[arg(short = 'D', long = "define", value_name = "NAME=VALUE", value_parser = parse_define)]
     pub define: Vec<(String, String)>,
     /// Seed of every random decision; the same seed gives the same image.
     #[arg(long, default_value_t = 0)]

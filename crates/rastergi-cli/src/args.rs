@@ -490,7 +490,9 @@ pub fn load_scene_with(name: &str, camera: Option<usize>, defines: &[(String, St
         Some("xml") => {
             let m = load_mitsuba(path, &MitsubaOptions { defines: defines.to_vec() })?;
             if let (Some((w, h)), Some(n)) = (m.film, m.sample_count) {
-                log::info!("{name}: its film is {w}x{h} pixels with {n} samples per pixel (--width {w} --height {h} --iterations {n})");
+                log::info!(
+                    "{name}: its film is {w}x{h} pixels with {n} samples per pixel (--width {w} --height {h} --iterations {n})"
+                );
             }
             Ok(m.scene)
         }

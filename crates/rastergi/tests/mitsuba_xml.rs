@@ -382,6 +382,53 @@ fn emitters_and_spectra() {
     assert_eq!(red.emission, Vec3::new(1.0, 2.0, 3.0));
 }
 
+/// A Radiance .hdr image of `w` × `h` flat (not run-length encoded) RGBE pixels.
+fn radiance_hdr(w: usize, h: usize, pixel: impl Fn(usize, usize) -> [u8; 4]) -> Vec<u8> {
+    let mut out = format!("#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y {h} +X {w}\n").into_bytes();
+    for j in 0..h {
+        for i in 0..w {
+            out.extend(pixel(i, j));
+        }
+    }
+    out
+}
+
+#[test]
+fn an_envmap_is_scaled_and_turned_by_its_to_world() {
+    let hdr = radiance_hdr(4, 5, |i, j| [(40 * i + 10) as u8, (60 * j + 5) as u8, (17 * (i + j) + 3) as u8, 129]);
+    let xml = br#"<scene version="3.0.0">
+        <emitter type="envmap">
+            <string name="filename" value="sky.hdr"/>
+            <float name="scale" value="2"/>
+            <transform name="to_world"><rotate y="1" angle="90"/></transform>
+        </emitter>
+        <shape type="cube"/>
+    </scene>"#;
+    let dir = scratch(&[("sky.hdr", &hdr), ("env.xml", xml)]);
+    let scene = load(&dir.path().join("env.xml")).scene;
+    let env = scene.environment.expect("an environment");
+    let original = rastergi::environment::Environment::load(&dir.path().join("sky.hdr"), 1.0).unwrap();
+    assert_eq!((env.width, env.height), (4, 5));
+    // The radiance from world direction d is the image's at R⁻¹d (R: 90° about +y), twice,
+    // at the pixels' directions off the poles (where every column is the same direction).
+    let inverse = glam::Mat3::from_rotation_y(-PI / 2.0);
+    for j in 1..4 {
+        for i in 0..4 {
+            let uv = Vec2::new((i as f32 + 0.5) / 4.0, j as f32 / 4.0);
+            let d = rastergi::environment::uv_to_direction(uv);
+            let expected = 2.0 * original.eval(inverse * d);
+            assert!(
+                close(env.eval(d), expected, 1e-4 * expected.max_element().max(1.0)),
+                "{d}: {} vs {expected}",
+                env.eval(d)
+            );
+        }
+    }
+    // Not the unturned map: its columns moved a quarter turn.
+    let d = rastergi::environment::uv_to_direction(Vec2::new(0.125, 0.5));
+    assert!(!close(env.eval(d), 2.0 * original.eval(d), 1e-3));
+}
+
 #[test]
 fn meshes_from_obj_and_ply_with_an_include() {
     let path = data("meshes.xml");

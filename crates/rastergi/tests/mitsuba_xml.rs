@@ -382,6 +382,48 @@ fn emitters_and_spectra() {
     assert_eq!(red.emission, Vec3::new(1.0, 2.0, 3.0));
 }
 
+#[test]
+fn instances_of_a_shapegroup_and_a_normal_map() {
+    let xml = br#"<scene version="3.0.0">
+        <shape type="shapegroup" id="tile">
+            <shape type="rectangle">
+                <bsdf type="normalmap">
+                    <texture type="bitmap" name="normalmap">
+                        <string name="filename" value="checker.png"/>
+                        <boolean name="raw" value="true"/>
+                    </texture>
+                    <bsdf type="diffuse"/>
+                </bsdf>
+            </shape>
+        </shape>
+        <shape type="instance">
+            <ref id="tile"/>
+            <transform name="to_world"><translate x="10"/></transform>
+        </shape>
+        <shape type="instance">
+            <ref id="tile"/>
+            <transform name="to_world"><scale value="2"/><translate z="-3"/></transform>
+        </shape>
+        <sensor type="thinlens"><float name="aperture_radius" value="0.1"/><float name="fov" value="40"/></sensor>
+    </scene>"#;
+    let checker = std::fs::read(data("checker.png")).unwrap();
+    let dir = scratch(&[("checker.png", &checker), ("i.xml", xml)]);
+    let scene = load(&dir.path().join("i.xml")).scene;
+    // The group itself adds nothing; each instance places its rectangle.
+    assert_eq!(scene.triangles.len(), 4);
+    let corners: Vec<Vec3> = scene.triangles.iter().flatten().copied().collect();
+    assert!(corners[..6].iter().all(|p| p.z == 0.0 && (p.x - 10.0).abs() == 1.0 && p.y.abs() == 1.0));
+    assert!(corners[6..].iter().all(|p| p.z == -3.0 && p.x.abs() == 2.0 && p.y.abs() == 2.0));
+    // The normal map: the raw bitmap as linear data, and tangents along +u (+x here).
+    let m = scene.material_of(0);
+    let t = m.normal_texture.expect("a normal map");
+    assert!(scene.textures[t.texture].linear);
+    assert!(scene.tangents.iter().flatten().all(|t| close(t.truncate(), Vec3::X, 1e-5)));
+    // The thin lens is a pinhole of the same field of view (fov along x of 768 × 576).
+    let expected = 2.0 * (20f32.to_radians().tan() * 576.0 / 768.0).atan().to_degrees();
+    assert!((scene.camera.fov_y_deg - expected).abs() < 1e-3);
+}
+
 /// A Radiance .hdr image of `w` × `h` flat (not run-length encoded) RGBE pixels.
 fn radiance_hdr(w: usize, h: usize, pixel: impl Fn(usize, usize) -> [u8; 4]) -> Vec<u8> {
     let mut out = format!("#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y {h} +X {w}\n").into_bytes();

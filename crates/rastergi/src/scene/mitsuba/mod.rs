@@ -24,7 +24,7 @@
 //! | `dielectric`, `roughdielectric`, `thindielectric` | glass: transmission 1, ior int_ior/ext_ior, tint specular_transmittance, `thin` for thindielectric; roughness √α |
 //! | `twosided` | its BSDF, reflecting on both faces |
 //! | `mask` | its BSDF with stochastic opacity (constant, or a bitmap's luminance) |
-//! | `normalmap` | its BSDF with the (raw) bitmap as tangent-space normal map |
+//! | `normalmap` | its BSDF with the (raw) bitmap as tangent-space normal map, in glTF's frame (MikkTSpace, bitangent up the image); Mitsuba's frame (∂p/∂u, n × ∂p/∂u, n) is the same where the uv mapping is not mirrored (OBJ meshes), its green axis the opposite on its own `rectangle` |
 //! | `bumpmap` | its BSDF; the bumps are ignored (warned) |
 //! | `blendbsdf` | the BSDF of the larger weight (warned) |
 //! | `coating`, `roughcoating` | its BSDF under the clear coat (η 1.5) of roughness √α |

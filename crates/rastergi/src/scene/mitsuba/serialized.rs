@@ -30,8 +30,9 @@ const HAS_UVS: u32 = 0x0002;
 const HAS_COLOURS: u32 = 0x0008;
 const FACE_NORMALS: u32 = 0x0010;
 const DOUBLE: u32 = 0x2000;
-/// Most bytes one mesh may decompress to (a guard against zip bombs): 4 GiB.
-const MAX_MESH_BYTES: u64 = 4 << 30;
+/// Most bytes one mesh may decompress to (a guard against zip bombs): 4 GiB, 1 GiB where
+/// addresses are 32 bits (the web).
+const MAX_MESH_BYTES: u64 = if usize::BITS < 64 { 1 << 30 } else { 4 << 30 };
 
 fn u16_at(b: &[u8], at: usize) -> Option<u16> {
     Some(u16::from_le_bytes(b.get(at..at + 2)?.try_into().ok()?))
@@ -45,22 +46,26 @@ fn u64_at(b: &[u8], at: usize) -> Option<u64> {
     Some(u64::from_le_bytes(b.get(at..at + 8)?.try_into().ok()?))
 }
 
-/// The number of meshes in the file (its dictionary's count; 1 for a file of one mesh
-/// without a dictionary) and the offset of mesh `index`.
+/// The byte offset of mesh `index`: 0 for the first, the others' from the dictionary at the
+/// file's end.
 fn mesh_offset(bytes: &[u8], version: u16, index: u32) -> Result<usize, String> {
     if index == 0 {
         return Ok(0);
     }
     let n = bytes.len();
     let count = n.checked_sub(4).and_then(|at| u32_at(bytes, at)).ok_or("is too short for its dictionary")?;
+    // Where the dictionary entry of mesh `index` starts, counted back from the end (u64 arithmetic:
+    // no overflow on 32-bit targets).
+    let back =
+        |entry: u64, extra: u64| (n as u64).checked_sub(entry * (count - index) as u64 + extra).map(|a| a as usize);
     if index >= count {
         return Err(format!("holds {count} meshes; shape_index {index} is out of range (0 to {})", count.max(1) - 1));
     }
     let offset = if version >= 4 {
-        let at = n.checked_sub(4 + 8 * (count - index) as usize).ok_or("has a dictionary longer than the file")?;
+        let at = back(8, 4).ok_or("has a dictionary longer than the file")?;
         u64_at(bytes, at).ok_or("has a truncated dictionary")?
     } else {
-        let at = n.checked_sub(4 * (count - index + 1) as usize).ok_or("has a dictionary longer than the file")?;
+        let at = back(4, 4).ok_or("has a dictionary longer than the file")?;
         u32_at(bytes, at).ok_or("has a truncated dictionary")? as u64
     };
     if offset >= n as u64 {

@@ -347,13 +347,14 @@ fn cornell_box_denoised_against_raw_and_the_convergence_rule() {
 }
 
 /// The issue's own comparison, the Cornell box at 256² against the committed 256² Mitsuba
-/// pair: 16 iterations denoised against 64 and 256 raw. About 100 s on lavapipe.
+/// pair: 16 iterations denoised against 64 raw. About 25 s on lavapipe.
 ///
 /// Measured (lavapipe, seed 5): see the tables in docs/denoiser.md. 16 denoised iterations are
-/// closer to the reference than 64 raw ones, not yet than 256 raw ones (the goal).
+/// closer to the reference than 64 raw ones, not yet than 256 raw ones (the goal; the
+/// tables hold that figure, which nothing here asserts, so the render stops at 64).
 #[test]
-fn cornell_box_at_256_denoised_16_against_raw_64_and_256() {
-    let figures = against_reference(256, "cornell_path_256", &[16, 64, 256]);
+fn cornell_box_at_256_denoised_16_against_raw_64() {
+    let figures = against_reference(256, "cornell_path_256", &[16, 64]);
     let (den16, raw64) = (figures[0].denoised, figures[1].raw);
     assert!(den16.relative_rmse < raw64.relative_rmse, "denoised 16 {den16:?} vs raw 64 {raw64:?}");
     assert_block_means(&den16);

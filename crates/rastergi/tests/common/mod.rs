@@ -132,6 +132,21 @@ pub fn assert_within_combined_noise(
     (c, noise)
 }
 
+/// `image` at half its width and height, each pixel the mean of its 2 × 2: with a box pixel
+/// filter (rastergi's and the Mitsuba references') exactly the image rendered at that size.
+pub fn box_half(image: &LinearImage) -> LinearImage {
+    let (w, h) = (image.width / 2, image.height / 2);
+    let at = |x: u32, y: u32| image.pixels[(y * image.width + x) as usize];
+    let pixels = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .map(|(x, y)| {
+            let q = [at(2 * x, 2 * y), at(2 * x + 1, 2 * y), at(2 * x, 2 * y + 1), at(2 * x + 1, 2 * y + 1)];
+            [0, 1, 2].map(|c| 0.25 * q.iter().map(|p| p[c]).sum::<f32>())
+        })
+        .collect();
+    LinearImage { width: w, height: h, pixels }
+}
+
 pub fn average(a: &LinearImage, b: &LinearImage) -> LinearImage {
     LinearImage {
         width: a.width,

@@ -13,7 +13,7 @@ use rastergi::film::Show;
 use rastergi::fit;
 use rastergi::gather::{GatherDirections, GatherMethod, HitLight};
 use rastergi::gpu::{Backends, Gpu, GpuOptions, parse_backend};
-use rastergi::renderer::{PhotonRegionChoice, RenderSettings};
+use rastergi::renderer::{PhotonRegionChoice, RenderSettings, TextureFilter};
 use rastergi::scene::generate::BUILTIN_NAMES;
 use rastergi::scene::{GltfOptions, MitsubaOptions, Scene, load_gltf_with, load_mitsuba, load_obj};
 
@@ -85,6 +85,25 @@ pub enum PhotonRegionArg {
     Camera,
     /// Nowhere: one level of cells over the whole scene.
     Scene,
+}
+
+/// How the eye's visible points read textures.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
+pub enum TextureFilterArg {
+    /// Filtered over the pixel's footprint (trilinear mip maps): no texture noise.
+    Footprint,
+    /// Level 0, bilinearly, at each sample's point, as Mitsuba and pbrt read a `bilinear`
+    /// bitmap: for comparisons with them.
+    Bilinear,
+}
+
+impl TextureFilterArg {
+    pub fn filter(self) -> TextureFilter {
+        match self {
+            TextureFilterArg::Footprint => TextureFilter::Footprint,
+            TextureFilterArg::Bilinear => TextureFilter::Bilinear,
+        }
+    }
 }
 
 impl PhotonRegionArg {
@@ -263,6 +282,11 @@ pub struct SceneArgs {
     /// nowhere (`scene`: one size of cell over the whole scene).
     #[arg(long, value_enum, default_value_t = PhotonRegionArg::Camera)]
     pub photon_region: PhotonRegionArg,
+    /// How the eye's visible points read textures: filtered over the pixel's footprint
+    /// (`footprint`), or level 0 bilinearly at each sample (`bilinear`, as Mitsuba and pbrt
+    /// do: for comparisons with them).
+    #[arg(long, value_enum, default_value_t = TextureFilterArg::Footprint)]
+    pub texture_filter: TextureFilterArg,
     /// What the image shows.
     #[arg(long, value_enum, default_value_t = ShowArg::Full)]
     pub show: ShowArg,
@@ -338,6 +362,7 @@ impl SceneArgs {
             pass_iterations: self.pass_iterations,
             hit_light: self.hit_light.hit_light(),
             photon_region: self.photon_region.choice(),
+            texture_filter: self.texture_filter.filter(),
         }
     }
 }

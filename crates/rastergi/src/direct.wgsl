@@ -57,5 +57,5 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         }
         radiance += sum / f32(frame.light_samples);
     }
-    film_add(FILM_DIRECT, gid.xy, p.weight * (radiance));
+    film_add_seen(FILM_DIRECT, gid.xy, p.weight * (radiance), select(0.0, 1.0, sees_light(p)));
 }

@@ -30,6 +30,13 @@
 //! square root of its mean over the pixels and channels divided by the image's mean: the
 //! relative RMSE that `rastergi compare` would report against the expectation (the noise; a
 //! bias shared by both halves, such as a photon map's blur within a pass, is not in it).
+//!
+//! Pixels that see light itself — the sky or an emitter, directly or through smooth glass and
+//! mirrors, in any iteration (the direct pass and the path tracer count them in the fourth
+//! channel of [`FILM_DIRECT`]) — are left out of both the mean and the variance, as the
+//! comparisons against references leave emitters out: the sky through a room's windows is
+//! bright and almost noise-free, and with it in the mean the estimate of a sky-lit interior
+//! was about a fifth of its true error (issue 45).
 
 use bytemuck::{Pod, Zeroable};
 
@@ -431,8 +438,18 @@ impl FilmState {
         LinearImage { width: self.width, height: self.height, pixels }
     }
 
+    /// Whether any iteration's sample of pixel `p` saw light itself — the sky or an emitter's
+    /// front face, directly or through smooth glass and mirrors (the fourth channel of
+    /// [`FILM_DIRECT`], `film_add_seen` in film.wgsl; zero in checkpoints written before it).
+    pub fn sees_light(&self, p: usize) -> bool {
+        self.sums[4 * (FILM_DIRECT as usize * self.pixels() + p) + 3] > 0.0
+    }
+
     /// The estimated relative RMSE of the full image's noise (see the module's notes), from
-    /// the two halves; `None` until both hold iterations or where the image is black.
+    /// the two halves, over the pixels that never saw light itself ([`FilmState::sees_light`]:
+    /// as `rastergi compare` leaves emitters out, so that the sky through a window, bright and
+    /// noise-free, neither fills the mean nor hides the room's noise; all pixels where every
+    /// one did); `None` until both halves hold iterations or where the image is black.
     pub fn error_estimate(&self) -> Option<f64> {
         let n = self.samples as f64;
         let nb = self.half_samples as f64;
@@ -440,8 +457,13 @@ impl FilmState {
         if na < 1.0 || nb < 1.0 {
             return None;
         }
-        let (mut var, mut mean) = (0.0f64, 0.0f64);
+        let all_light = (0..self.pixels()).all(|p| self.sees_light(p));
+        let (mut var, mut mean, mut count) = (0.0f64, 0.0f64, 0.0f64);
         for p in 0..self.pixels() {
+            if self.sees_light(p) && !all_light {
+                continue;
+            }
+            count += 3.0;
             let s = self.show_sum(&self.sums, Show::Full, p);
             let b = self.show_sum(&self.half, Show::Full, p);
             for c in 0..3 {
@@ -450,7 +472,6 @@ impl FilmState {
                 mean += s[c] as f64 / n;
             }
         }
-        let count = 3.0 * self.pixels() as f64;
         (mean > 0.0).then(|| (var / count).sqrt() / (mean / count))
     }
 

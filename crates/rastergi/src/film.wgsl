@@ -7,6 +7,14 @@ fn film_slot(component: u32, pixel: u32, n_pixels: u32) -> u32 {
 
 // Adds v to component `component` of the pixel at `texel` of this frame's image.
 fn film_add(component: u32, texel: vec2u, v: vec3f) {
+    film_add_seen(component, texel, v, 0.0);
+}
+
+// film_add, and `seen` to the component's fourth channel: the direct pass and the path tracer
+// add 1 to FILM_DIRECT's where this iteration's sample of the pixel sees an emitter or the
+// sky, directly or through smooth glass and mirrors (FilmState::error_estimate leaves such
+// pixels out); nothing else writes the fourth channels.
+fn film_add_seen(component: u32, texel: vec2u, v: vec3f, seen: f32) {
     let pixel = texel.y * frame.resolution.x + texel.x;
-    film[film_slot(component, pixel, frame.resolution.x * frame.resolution.y)] += vec4f(v, 0.0);
+    film[film_slot(component, pixel, frame.resolution.x * frame.resolution.y)] += vec4f(v, seen);
 }

@@ -34,6 +34,10 @@ pub struct FrameUniforms {
     /// 1 where the eye's specular chains ran this iteration ([`crate::specular`]): the visible
     /// points are read through `eye_paths`.
     pub eye_chains: u32,
+    /// 1 where the eye's visible points read textures at their footprint's level of detail,
+    /// 0 where at level 0 ([`crate::renderer::TextureFilter`]).
+    pub texture_footprint: u32,
+    pub _pad: [u32; 3],
 }
 
 impl FrameUniforms {
@@ -67,6 +71,8 @@ impl FrameUniforms {
             gather_count: 0,
             gather_importance: 0,
             eye_chains: 0,
+            texture_footprint: 1,
+            _pad: [0; 3],
         }
     }
 }

@@ -16,6 +16,9 @@ struct Frame {
     gather_importance: u32,
     // 1: the eye's specular chains ran (specular.wgsl); read visible points via eye_paths.
     eye_chains: u32,
+    // 1: the eye's visible points read textures at their footprint's level of detail; 0: at
+    // level 0 (RenderSettings::texture_filter).
+    texture_footprint: u32,
 }
 
 @group(1) @binding(0) var<uniform> frame: Frame;

@@ -32,7 +32,7 @@ fn fs_main(in: VertexOut) -> @location(0) vec4u {
     let dy = dpdy(in.uv);
     let t = triangles[in.tri];
     var lod = 0.0;
-    if (materials[t.material].material.flags & MATERIAL_TEXTURED) != 0u {
+    if frame.texture_footprint != 0u && (materials[t.material].material.flags & MATERIAL_TEXTURED) != 0u {
         lod = albedo_lod(t.material, dx, dy);
     }
     start_alpha_stream();

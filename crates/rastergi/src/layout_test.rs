@@ -56,7 +56,8 @@ fn twins() -> Vec<Twin> {
                 ray_epsilon,
                 gather_count,
                 gather_importance,
-                eye_chains
+                eye_chains,
+                texture_footprint
             ]
         ),
         twin!(

@@ -179,7 +179,8 @@ impl PathTracer {
         let (w, h) = (self.settings.width, self.settings.height);
         let jitter = pixel_jitter(iteration, self.settings.seed);
         // The path tracer takes one light sample per vertex.
-        let frame = FrameUniforms::new(&self.camera, (w, h), &self.scene, iteration, jitter, self.settings.seed, 1);
+        let mut frame = FrameUniforms::new(&self.camera, (w, h), &self.scene, iteration, jitter, self.settings.seed, 1);
+        frame.texture_footprint = (self.settings.texture_filter == crate::renderer::TextureFilter::Footprint) as u32;
         let params = PathParams {
             light_weight: self.light_weight,
             light_count: self.scene.light_count,

@@ -51,8 +51,13 @@ fn light_pdf_area(le: vec3f) -> f32 {
 // for the estimator), for the camera ray through pixel `xy`. Textures are read filtered over
 // the pixel's footprint at the first hit and unfiltered (level 0) at every later one. Random
 // numbers per scattering event: 3 (light), 3 (BSDF), 1 (roulette).
-fn path_radiance(origin: vec3f, dir: vec3f, xy: vec2u, rng: ptr<function, u32>) -> vec3f {
+//
+// The fourth channel is 1 where the path meets the sky or an emitter's front face after smooth
+// (delta) bounces only, the camera's light-seen flag (film_add_seen), else 0.
+fn path_radiance(origin: vec3f, dir: vec3f, xy: vec2u, rng: ptr<function, u32>) -> vec4f {
     var radiance = vec3f(0.0);
+    var seen = 0.0;
+    var delta_chain = true;
     var throughput = vec3f(1.0);
     var o = origin;
     var d = dir;
@@ -71,11 +76,13 @@ fn path_radiance(origin: vec3f, dir: vec3f, xy: vec2u, rng: ptr<function, u32>) 
                 }
                 radiance += throughput * env_radiance(d) * w;
             }
+            seen = select(seen, 1.0, delta_chain);
             break;
         }
         throughput *= segment_transmittance(hit.tri, d, hit.t);
         var lod = 0.0;
-        if bounce == 0u && (materials[triangles[hit.tri].material].material.flags & MATERIAL_TEXTURED) != 0u {
+        if bounce == 0u && frame.texture_footprint != 0u
+            && (materials[triangles[hit.tri].material].material.flags & MATERIAL_TEXTURED) != 0u {
             lod = primary_lod(hit.tri, xy);
         }
         let s = surface_at(hit.tri, hit.b1, hit.b2, lod);
@@ -90,6 +97,7 @@ fn path_radiance(origin: vec3f, dir: vec3f, xy: vec2u, rng: ptr<function, u32>) 
                 w = power_heuristic(last_pdf, p_light);
             }
             radiance += throughput * s.emission * w;
+            seen = select(seen, 1.0, delta_chain);
         }
         // The back of a one-sided surface absorbs; glass is entered and left by either face.
         let glass = s.transmission > 0.0;
@@ -165,12 +173,13 @@ fn path_radiance(origin: vec3f, dir: vec3f, xy: vec2u, rng: ptr<function, u32>) 
         throughput *= bs.weight / q;
         // A specular bounce gives emitters it finds weight 1 (no light sample finds them).
         last_pdf = select(bs.pdf, 0.0, bs.delta);
+        delta_chain = delta_chain && bs.delta;
         d = normalize(dir_world);
         o = s.pos + select(n, -n, below) * frame.ray_epsilon;
         t_min = frame.ray_epsilon;
         skip = s.tri;
     }
-    return radiance;
+    return vec4f(radiance, seen);
 }
 
 // One path per pixel through this iteration's jittered pixel position, added to the film.
@@ -179,9 +188,9 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if !begin_pixel(gid.xy) { return; }
     let pixel = pixel_index(gid.xy);
     var rng = rng_new(frame.seed ^ STREAM_PATH, pixel, frame.iteration);
-    let radiance = path_radiance(frame.eye, camera_direction(gid.xy), gid.xy, &rng);
+    let r = path_radiance(frame.eye, camera_direction(gid.xy), gid.xy, &rng);
     // The path tracer has one component: the full image (resolved by Show::Full).
-    film_add(FILM_DIRECT, gid.xy, radiance);
+    film_add_seen(FILM_DIRECT, gid.xy, r.rgb, r.a);
 }
 
 // The first surface hit by each camera ray, in the G-buffer's format (gbuffer.wgsl).

@@ -61,6 +61,22 @@ pub struct RenderSettings {
     pub hit_light: HitLight,
     /// Where the photon grid's cells are finer: where the camera reads the map, or nowhere.
     pub photon_region: PhotonRegionChoice,
+    /// How the eye's visible points read textures: filtered over the pixel's footprint, or
+    /// level 0 bilinearly as reference renderers do.
+    pub texture_filter: TextureFilter,
+}
+
+/// How the eye's visible points (the G-buffer's, and the path tracer's first hits) read
+/// textures. Every other point reads level 0 either way (crate::textures).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum TextureFilter {
+    /// Trilinear over the mip maps at the level of the pixel's footprint,
+    /// λ = log2 max(|∂uv/∂x|, |∂uv/∂y|): the pixel's average texture, without noise.
+    #[default]
+    Footprint,
+    /// Level 0, bilinearly, at the sample's own point: the pixel's samples average it, as
+    /// Mitsuba's and pbrt's `bilinear` bitmap lookups do — what to compare with them.
+    Bilinear,
 }
 
 /// Where the photon grid is refined ([`crate::fit::photon_region`]).
@@ -115,6 +131,7 @@ impl RenderSettings {
             ("directions", s.directions.to_string()),
             ("hit-light", format!("{:?}", s.hit_light)),
             ("photon-region", format!("{:?}", s.photon_region)),
+            ("texture-filter", format!("{:?}", s.texture_filter)),
         ]
         .into_iter()
         .map(|(k, v)| (k.to_owned(), v))
@@ -147,6 +164,7 @@ impl Default for RenderSettings {
             pass_iterations: DEFAULT_PASS_ITERATIONS,
             hit_light: HitLight::Map,
             photon_region: PhotonRegionChoice::Camera,
+            texture_filter: TextureFilter::Footprint,
         }
     }
 }
@@ -429,6 +447,7 @@ impl Renderer {
         let mut uniforms =
             FrameUniforms::new(&self.camera, size, &self.scene, iteration, jitter, seed, self.settings.light_samples);
         uniforms.eye_chains = self.scene.eye_chains as u32;
+        uniforms.texture_footprint = (self.settings.texture_filter == TextureFilter::Footprint) as u32;
         let fixed = FixedSample { direction: o.direction, texel_jitter: o.texel_jitter };
         let map = self.photons.as_ref().map(PhotonPasses::map);
         if let (Some(gather), Some(_)) = (&self.passes.gather, map) {

@@ -110,3 +110,9 @@ fn emitted_radiance(p: VisiblePoint, xy: vec2u) -> vec3f {
     }
     return radiance;
 }
+
+// Whether the visible point is light itself, as emitted_radiance sees it: the sky where the
+// camera ray (or the eye's specular chain) escapes, or an emitter's front face.
+fn sees_light(p: VisiblePoint) -> bool {
+    return !p.seen || (p.front && any(p.x.emission > vec3f(0.0)));
+}

@@ -158,7 +158,7 @@ fn cameras_are_chosen_by_index_and_a_scene_without_one_is_framed() {
     });
     g.json.as_object_mut().unwrap().remove("cameras");
     let scene = load_gltf(&g.write(dir.path(), "no_camera.gltf")).unwrap();
-    assert_eq!(scene.camera, Scene::framing_camera(&scene.bounds()));
+    assert_eq!(scene.camera, scene.default_camera());
 }
 
 #[test]

@@ -226,3 +226,95 @@ fn colour_without_numbers_is_refused() {
     let message = refused(fixture("empty_ke.obj"));
     assert!(message.contains("empty_ke.mtl") && message.contains("Ke"), "{message}");
 }
+
+/// The faces of the box `min`–`max` as one-sided quads facing `inward` or outward, but the
+/// face whose outward normal is `open` (if any).
+fn box_faces(s: &mut Scene, min: Vec3, max: Vec3, inward: bool, open: Option<Vec3>, material: u32) {
+    let c = (min + max) / 2.0;
+    let h = (max - min) / 2.0;
+    for axis in 0..3 {
+        for sign in [-1.0f32, 1.0] {
+            let mut n = Vec3::ZERO;
+            n[axis] = sign;
+            if open == Some(n) {
+                continue;
+            }
+            let (u, w) = (Vec3::AXES[(axis + 1) % 3], Vec3::AXES[(axis + 2) % 3]);
+            let (u, w) = (u * h[(axis + 1) % 3], w * h[(axis + 2) % 3]);
+            let centre = c + n * h[axis];
+            let mut q = [centre - u - w, centre + u - w, centre + u + w, centre - u + w];
+            // Facing n (outward) or −n.
+            let facing = (q[1] - q[0]).cross(q[2] - q[0]).normalize();
+            if (facing.dot(n) > 0.0) == inward {
+                q.reverse();
+            }
+            s.add_quad(q, material);
+        }
+    }
+}
+
+fn placeholder_camera() -> rastergi::scene::Camera {
+    rastergi::scene::Camera { eye: v(0.0, 0.0, 10.0), target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 45.0 }
+}
+
+/// Of a 16 × 16 grid of the camera's view rays, the share that meet a front face (cast here on
+/// the CPU, independently of the camera's choice).
+fn front_face_share(scene: &Scene, camera: &rastergi::scene::Camera) -> f32 {
+    let bvh = rastergi::bvh::Bvh::build(&scene.triangles);
+    let triangles = bvh.permute(&scene.triangles);
+    let (right, up, forward) = camera.frame();
+    let tan = (0.5 * camera.fov_y_deg.to_radians()).tan();
+    let mut front = 0;
+    for j in 0..16 {
+        for i in 0..16 {
+            let x = (2.0 * (i as f32 + 0.5) / 16.0 - 1.0) * tan;
+            let y = (1.0 - 2.0 * (j as f32 + 0.5) / 16.0) * tan;
+            let d = (forward + right * x + up * y).normalize();
+            if let Some(h) = bvh.intersect(&triangles, camera.eye, d, 0.0, f32::INFINITY, u32::MAX, |_| true) {
+                front += (rastergi::scene::triangle_normal(&triangles[h.triangle as usize]).dot(d) < 0.0) as usize;
+            }
+        }
+    }
+    front as f32 / 256.0
+}
+
+/// Issue 45: an interior exported without a camera (a hall of one-sided walls facing in, a
+/// pillar, a light under the ceiling) is seen from inside: framed from outside, the camera
+/// would see the walls' backs, which render black.
+#[test]
+fn an_interior_without_a_camera_is_seen_from_inside() {
+    let mut s = Scene::new(placeholder_camera());
+    let wall = s.add_material(Material::diffuse("wall", Vec3::splat(0.7)));
+    let lamp = s.add_material(Material { emission: Vec3::splat(5.0), ..Material::diffuse("lamp", Vec3::ZERO) });
+    box_faces(&mut s, v(0.0, 0.0, 0.0), v(8.0, 3.0, 5.0), true, None, wall);
+    box_faces(&mut s, v(2.0, 0.0, 2.0), v(2.4, 3.0, 2.4), false, None, wall);
+    s.add_quad([v(3.0, 2.9, 2.0), v(3.0, 2.9, 3.0), v(4.0, 2.9, 3.0), v(4.0, 2.9, 2.0)], lamp);
+    let framing = Scene::framing_camera(&s.bounds());
+    let camera = s.default_camera();
+    camera.validate().unwrap();
+    let (outside, inside) = (front_face_share(&s, &framing), front_face_share(&s, &camera));
+    println!("front faces seen: framed from outside {outside:.2}, default camera {inside:.2} ({camera:?})");
+    let b = s.bounds();
+    assert!(b.min.cmplt(camera.eye).all() && camera.eye.cmplt(b.max).all(), "{camera:?}");
+    assert!(outside < 0.1, "the framing camera sees the walls' front faces ({outside})");
+    assert!(inside > 0.95, "the default camera sees back faces ({inside})");
+}
+
+/// Objects, and a box open towards +z like the Cornell box, keep the framing camera: it sees
+/// them whole.
+#[test]
+fn objects_and_open_boxes_without_a_camera_are_framed_from_outside() {
+    let mut open = Scene::new(placeholder_camera());
+    let m = open.add_material(Material::diffuse("white", Vec3::splat(0.7)));
+    box_faces(&mut open, v(-1.0, -1.0, -1.0), v(1.0, 1.0, 1.0), true, Some(Vec3::Z), m);
+    let mut object = Scene::new(open.camera);
+    let m = object.add_material(Material::diffuse("white", Vec3::splat(0.7)));
+    box_faces(&mut object, v(-1.0, 0.0, -1.0), v(1.0, 0.5, 1.0), false, None, m);
+    box_faces(&mut object, v(-0.2, 0.5, -0.2), v(0.2, 2.0, 0.2), false, None, m);
+    for (name, s) in [("open box", &open), ("object", &object)] {
+        assert_eq!(s.default_camera(), Scene::framing_camera(&s.bounds()), "{name}");
+    }
+    // And the loader uses the default camera.
+    let scene = load_obj(&fixture("scene.obj")).unwrap();
+    assert_eq!(scene.camera, scene.default_camera());
+}

@@ -136,6 +136,31 @@ fn gbuffer_level_of_detail_is_a_pixels_footprint_in_texels() {
     }
 }
 
+/// `--texture-filter bilinear` (issue 45: textures as a reference renderer reads them): the
+/// G-buffer's visible points read level 0 (λ = 0) however small the texels are on screen: a
+/// square whose texture repeats 64 times, which the footprint reads at λ ≈ 6.1
+/// (`gbuffer_level_of_detail_is_a_pixels_footprint_in_texels`); the pixel's jittered samples
+/// then average the texels themselves.
+#[test]
+fn bilinear_texture_filter_reads_level_zero_at_every_visible_point() {
+    use rastergi::renderer::TextureFilter;
+    let gpu = common::gpu();
+    let size = 64;
+    let scene = frontal_square(64.0, 3.0);
+    let settings = RenderSettings {
+        width: size,
+        height: size,
+        photons: 0,
+        texture_filter: TextureFilter::Bilinear,
+        ..Default::default()
+    };
+    let mut r = Renderer::new(&gpu, &scene, settings).unwrap();
+    r.iterate().unwrap();
+    let lods: Vec<f32> = r.read_gbuffer().unwrap().iter().filter(|g| g[0] != 0).map(|g| f32::from_bits(g[3])).collect();
+    assert!(lods.len() > 1000, "the square covers too few pixels");
+    assert!(lods.iter().all(|&l| l == 0.0), "λ {:?}", lods.iter().fold(0.0f32, |a, &b| a.max(b)));
+}
+
 fn gpu_map(gpu: &Gpu, scene: &Scene, settings: &PhotonSettings) -> PhotonMap {
     let prepared = PreparedScene::new(scene);
     let gs = GpuScene::new(gpu, &prepared).expect("scene upload");

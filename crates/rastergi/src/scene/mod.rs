@@ -9,6 +9,7 @@
 //! at the triangle's interpolated texture coordinates.
 
 mod cornell;
+pub mod default_camera;
 pub mod export;
 pub mod files;
 pub mod generate;
@@ -788,7 +789,8 @@ impl Scene {
     }
 
     /// A camera that frames the whole scene from its +z side, looking at the centre of its
-    /// bounds with a 45° vertical field of view (used when a file gives no camera).
+    /// bounds with a 45° vertical field of view ([`Scene::default_camera`] keeps it where its
+    /// view shows the scene).
     pub fn framing_camera(bounds: &Aabb) -> Camera {
         let fov_y_deg = 45.0f32;
         let radius = 0.5 * bounds.extent().length().max(1e-6);

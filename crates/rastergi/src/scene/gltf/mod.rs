@@ -43,8 +43,8 @@
 //! - **Camera**: a perspective camera placed by the first node of the scene that uses it,
 //!   looking down its −z with +y up (yfov is the vertical field of view; the aspect ratio is the
 //!   image's). [`GltfOptions::camera`] picks one by its index in the file's `cameras`; by
-//!   default the first perspective camera the scene uses. Without one, the scene is framed
-//!   ([`Scene::framing_camera`]).
+//!   default the first perspective camera the scene uses. Without one, the scene's default
+//!   camera ([`Scene::default_camera`]: framed from outside, or inside its most open room).
 //!
 //! Robustness: every size and index is checked before it is used and before anything is
 //! allocated from it (accessor ranges against their buffer views and the bytes actually
@@ -162,7 +162,7 @@ fn load(files: Files, path: &Path, bytes: &[u8], options: &GltfOptions) -> Res<S
         return Err("contains no triangles in the displayed scene".into());
     }
     if loader.camera.is_none() {
-        scene.camera = Scene::framing_camera(&scene.bounds());
+        scene.camera = scene.default_camera();
     }
     scene.validate().map_err(|e| e.to_string())?;
     Ok(scene)

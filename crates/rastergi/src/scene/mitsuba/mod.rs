@@ -137,7 +137,7 @@ pub fn load_mitsuba_in(files: Files, path: &Path, options: &MitsubaOptions) -> R
     if scene.triangles.is_empty() {
         return Err(Error::SceneFile { path: path.to_path_buf(), message: "has no shapes with triangles".into() });
     }
-    scene.camera = camera.unwrap_or_else(|| Scene::framing_camera(&scene.bounds()));
+    scene.camera = camera.unwrap_or_else(|| scene.default_camera());
     scene.validate().map_err(|e| Error::SceneFile { path: path.to_path_buf(), message: e.to_string() })?;
     Ok(MitsubaScene { scene, film, sample_count })
 }

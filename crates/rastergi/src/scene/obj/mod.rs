@@ -267,7 +267,7 @@ fn load(files: Files, path: &Path, geometry_only: bool) -> Result<Scene> {
     if geometry_only {
         return Ok(scene);
     }
-    scene.camera = Scene::framing_camera(&scene.bounds());
+    scene.camera = scene.default_camera();
     scene.validate().map_err(|e| file_error(path, e.to_string()))?;
     Ok(scene)
 }

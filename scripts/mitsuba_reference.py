@@ -1085,6 +1085,72 @@ def check_env(args):
         raise SceneError(f"--env-scale must be a finite number >= 0, got {args.env_scale}")
 
 
+def xml_for_mitsuba3(text, width, height, spp, max_depth):
+    """A Mitsuba scene file as Mitsuba 3 renders it beside rastergi (issue 47): the file's
+    integrator replaced by `path` (max_depth as --max-depth), its film's size and pixel filter
+    by width x height and a box filter (rastergi's), its sampler's count by spp, `trilinear`
+    texture filtering written `bilinear` (Mitsuba 3 has no trilinear; compare with rastergi's
+    --texture-filter bilinear), `extEta` and `maxSmoothAngle` dropped (Mitsuba 3 knows neither; rastergi warns
+    that it does not use them) and `phong`
+    (which Mitsuba 3 lacks; Sponza's vault) read as `diffuse` of its diffuseReflectance, as
+    rastergi reads it: the ../shared/scenes README's list of what Mitsuba 3 needs changed in
+    these 0.6 files, and phong.
+    Everything else is the file as published."""
+    import xml.etree.ElementTree as ET
+    root = ET.fromstring(text)
+    for parent in root.iter():
+        for child in list(parent):
+            if child.tag == "integrator":
+                parent.remove(child)
+            elif child.get("name") in ("extEta", "maxSmoothAngle"):
+                parent.remove(child)
+            elif child.get("name") == "filterType" and child.get("value") == "trilinear":
+                child.set("value", "bilinear")
+        if parent.tag == "bsdf" and parent.get("type") == "phong":
+            # Mitsuba 3 has no phong: its diffuse part, as rastergi reads it (with a warning).
+            parent.set("type", "diffuse")
+            for child in list(parent):
+                if child.get("name") == "diffuseReflectance":
+                    child.set("name", "reflectance")
+                else:
+                    parent.remove(child)
+    integrator = ET.Element("integrator", {"type": "path"})
+    ET.SubElement(integrator, "integer", {"name": "maxDepth" if root.get("version", "3").startswith("0") else "max_depth",
+                                          "value": str(max_depth)})
+    root.insert(0, integrator)
+    old = root.get("version", "3").startswith("0")
+    for sensor in root.iter("sensor"):
+        for film in sensor.findall("film"):
+            for child in list(film):
+                if child.get("name") in ("width", "height") or child.tag == "rfilter":
+                    film.remove(child)
+            ET.SubElement(film, "integer", {"name": "width", "value": str(width)})
+            ET.SubElement(film, "integer", {"name": "height", "value": str(height)})
+            ET.SubElement(film, "rfilter", {"type": "box"})
+        for sampler in sensor.findall("sampler"):
+            for child in list(sampler):
+                if child.get("name") in ("sampleCount", "sample_count"):
+                    sampler.remove(child)
+            ET.SubElement(sampler, "integer", {"name": "sampleCount" if old else "sample_count", "value": str(spp)})
+    return ET.tostring(root, encoding="unicode")
+
+
+def load_xml_scene(mi, args, spp):
+    """A Mitsuba scene file (`--scene X.xml`) as Mitsuba 3 loads it, after xml_for_mitsuba3,
+    from a string with the file's folder first on the file resolver's path (meshes and
+    textures are found relative to it; the folder may be read-only). The camera options do
+    not apply: the file's own sensor is used, as rastergi uses it."""
+    if not os.path.isfile(args.scene):
+        raise SceneError(f"{args.scene}: no such file")
+    if args.eye or args.target or args.up or args.fov or args.point or args.spot or args.sun or args.env:
+        raise SceneError("--eye/--target/--up/--fov and extra lights do not apply to a .xml scene")
+    with open(args.scene, encoding="utf-8") as f:
+        text = xml_for_mitsuba3(f.read(), args.width, args.height, spp, args.max_depth)
+    folder = os.path.dirname(os.path.abspath(args.scene))
+    mi.file_resolver().prepend(folder)
+    return mi.load_string(text)
+
+
 def load_scene(mi, args, spp):
     """The Mitsuba scene of --scene with the camera options and extra lights applied."""
     check_env(args)
@@ -1095,9 +1161,11 @@ def load_scene(mi, args, spp):
         camera = scene_camera(args, CORNELL_CAMERA)
         return mi.load_dict(add_lights(mi, cornell_scene_dict(mi, args.width, args.height,
                                                               args.max_depth, spp, camera), args))
+    if args.scene.lower().endswith(".xml"):
+        return load_xml_scene(mi, args, spp)
     if not args.scene.lower().endswith((".obj", ".gltf", ".glb")):
         raise SceneError(f"unknown scene '{args.scene}': use the built-in 'cornell' "
-                         "or a path to a .obj, .gltf or .glb file")
+                         "or a path to a .obj, .gltf, .glb or Mitsuba .xml file")
     if not os.path.isfile(args.scene):
         raise SceneError(f"{args.scene}: no such file")
     file_lights = []
@@ -1248,8 +1316,9 @@ def main():
     p = argparse.ArgumentParser(description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--scene", default="cornell",
-                   help="the built-in 'cornell' (default), a Wavefront .obj file (+ .mtl) or a glTF "
-                        ".gltf/.glb file (scripts/mitsuba_gltf.py)")
+                   help="the built-in 'cornell' (default), a Wavefront .obj file (+ .mtl), a glTF "
+                        ".gltf/.glb file (scripts/mitsuba_gltf.py) or a Mitsuba .xml scene file "
+                        "(rendered as published: xml_for_mitsuba3)")
     p.add_argument("--eye", type=parse_vec3, help="camera position x,y,z (as rastergi's --eye)")
     p.add_argument("--target", type=parse_vec3, help="point looked at, x,y,z")
     p.add_argument("--up", type=parse_vec3, help="camera up vector x,y,z")

@@ -190,12 +190,20 @@ fn the_lookat_camera_and_the_field_of_view_per_axis() {
     }
 }
 
+/// Linear sRGB of a flat emission spectrum of value 1 in Mitsuba 3's RGB variants, printed by
+/// mitsuba 3.9.1 for `<spectrum name="radiance" value="1"/>` on an area emitter
+/// (`SRGBReflectanceSpectrum[value = [1.20479, 0.948291, 0.908916]]`): `<spectrum>` values
+/// on emitters are emission spectra there, `<rgb>` and `<float>` stay as given.
+const EQUAL_ENERGY_SRGB: Vec3 = Vec3::new(1.20479, 0.948291, 0.908916);
+
 #[test]
 fn an_area_light_on_a_sphere_keeps_its_power() {
     let scene = load(&data("basic.xml")).scene;
-    // Radiance 10 from a sphere of radius 0.5: Φ = π L · 4π r² = 10 π².
+    // Radiance 10 (a flat emission spectrum: EQUAL_ENERGY_SRGB × 10 in Mitsuba 3's RGB mode)
+    // from a sphere of radius 0.5: Φ = π L · 4π r² = 10 π² × EQUAL_ENERGY_SRGB.
     let power = scene.emitted_power();
-    assert!((power - Vec3::splat(10.0 * PI * PI)).abs().max_element() < 1e-3 * 10.0 * PI * PI, "{power}");
+    let expected = EQUAL_ENERGY_SRGB * 10.0 * PI * PI;
+    assert!((power - expected).abs().max_element() < 1e-3 * 10.0 * PI * PI, "{power}");
     // Mitsuba's default BSDF on an emitter is black; the triangles face out, around (0, 5, 0).
     let lit: Vec<usize> = (0..scene.triangles.len()).filter(|&i| scene.material_of(i).is_emitter()).collect();
     assert!(lit.len() > 1000);
@@ -324,7 +332,7 @@ fn each_bsdf_maps_onto_the_material_model() {
     }));
     assert!(scene.lights.contains(&rastergi::scene::Light::Distant {
         direction: -Vec3::Y,
-        irradiance: Vec3::splat(3.0),
+        irradiance: EQUAL_ENERGY_SRGB * 3.0,
         angular_radius: 0.0
     }));
 
@@ -875,9 +883,10 @@ fn the_shared_staircase_and_sponza_load_as_their_files_say() {
         assert!(close(c.eye, eye, 1e-5) && close(forward, dir, 1e-5) && close(cam_up, up, 1e-4));
         let expected = 2.0 * ((0.5 * 96.6708f32).to_radians().tan() * 720.0 / 1280.0).atan().to_degrees();
         assert!((c.fov_y_deg - expected).abs() < 1e-3);
-        // The light: radiance 16000 from a sphere of radius 0.1: Φ = π L 4π r².
+        // The light: radiance 16000 (a flat spectrum: red EQUAL_ENERGY_SRGB.x × 16000) from a
+        // sphere of radius 0.1: Φ = π L 4π r².
         let power = m.scene.emitted_power();
-        let expected = PI * 16000.0 * 4.0 * PI * 0.01;
+        let expected = PI * 16000.0 * EQUAL_ENERGY_SRGB.x * 4.0 * PI * 0.01;
         assert!((power.x - expected).abs() < 1e-3 * expected, "{power} vs {expected}");
     }
 }

@@ -97,9 +97,16 @@ impl<'a> Loader<'a> {
         Ok(())
     }
 
-    /// A constant colour property of an emitter (default 1).
+    /// A constant colour property of an emitter (default 1). Given as a `<spectrum>` it is an
+    /// emission spectrum, which Mitsuba 3's RGB mode projects to sRGB: a flat one (one value,
+    /// or flat wavelength:value pairs) is equal-energy light, [`EQUAL_ENERGY_SRGB`] times the
+    /// value, not grey (`<rgb>` and `<float>` stay as given, as there). Measured on Sponza
+    /// (its light is `<spectrum value="16000"/>`): read as grey, the image's channel means were
+    /// 0.83, 1.05, 1.10 of Mitsuba 3's on the same file.
     fn colour(&mut self, p: &Plugin<'a>, key: &str) -> Res<Vec3> {
+        let spectrum = p.get(key).is_some_and(|e| e.tag == "spectrum");
         match self.value(p, key, Vec3::ONE)? {
+            Value::Constant(c) if spectrum => Ok(c * EQUAL_ENERGY_SRGB),
             Value::Constant(c) => Ok(c),
             Value::Texture { factor, .. } => {
                 self.warn(format!("emitter '{}': a texture as {key} is not supported; its factor is used", p.ty()));
@@ -129,3 +136,8 @@ fn rotated(env: &crate::environment::Environment, m: Mat4) -> Option<crate::envi
         .collect();
     crate::environment::Environment::new(w, h, texels).ok()
 }
+
+/// Linear sRGB of an equal-energy emission spectrum of value 1, as Mitsuba 3's RGB variants
+/// compute it (`<spectrum name="radiance" value="1"/>` on an area emitter prints
+/// `SRGBReflectanceSpectrum[value = [1.20479, 0.948291, 0.908916]]`, mitsuba 3.9.1).
+pub const EQUAL_ENERGY_SRGB: Vec3 = Vec3::new(1.20479, 0.948291, 0.908916);

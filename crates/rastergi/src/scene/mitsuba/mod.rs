@@ -355,7 +355,12 @@ impl<'a> Loader<'a> {
             self.warn(format!("a shape's emitter must be 'area', not '{}'; it is skipped", p.ty()));
             return Ok(Value::Constant(Vec3::ZERO));
         }
-        let radiance = self.value(&p, "radiance", Vec3::ONE)?;
+        let spectrum = p.get("radiance").is_some_and(|e| e.tag == "spectrum");
+        let radiance = match self.value(&p, "radiance", Vec3::ONE)? {
+            // An emission spectrum, as Mitsuba 3's RGB mode reads it (emitters.rs).
+            Value::Constant(c) if spectrum => Value::Constant(c * emitters::EQUAL_ENERGY_SRGB),
+            v => v,
+        };
         self.warn_unread(&p, "emitter 'area'");
         Ok(radiance)
     }

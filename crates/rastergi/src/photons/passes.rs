@@ -125,14 +125,7 @@ impl PhotonPasses {
         }
         if pass > 0 {
             let wanted = pass_resolution(self.settings.grid_resolution, pass);
-            let limits = gpu.device.limits();
-            let layout = MapLayout::within(
-                &self.prepared.scene,
-                &self.prepared.bounds,
-                wanted,
-                self.settings.region.as_ref(),
-                &limits,
-            )?;
+            let layout = self.layout(gpu, wanted)?;
             let got = layout.grid.dims.max_element();
             self.finest = (got < wanted).then_some(got);
             let current = self.map.grid().dims.max_element();
@@ -145,6 +138,18 @@ impl PhotonPasses {
         self.pass = pass;
         self.iterations_in_pass = iterations_in_pass;
         Ok(())
+    }
+
+    /// The map's layout at `resolution` cells along the longest axis (fewer where the GPU's
+    /// limits ask), over the scene with its photon region.
+    fn layout(&self, gpu: &Gpu, resolution: u32) -> Result<MapLayout> {
+        MapLayout::within(
+            &self.prepared.scene,
+            &self.prepared.bounds,
+            resolution,
+            self.settings.region.as_ref(),
+            &gpu.device.limits(),
+        )
     }
 
     /// Called before each iteration: once the current pass has had its iterations, traces the
@@ -162,14 +167,7 @@ impl PhotonPasses {
         let wanted = self.finest.map_or(wanted, |f| wanted.min(f));
         let current = self.map.grid().dims.max_element();
         if wanted > current {
-            let limits = gpu.device.limits();
-            let layout = MapLayout::within(
-                &self.prepared.scene,
-                &self.prepared.bounds,
-                wanted,
-                self.settings.region.as_ref(),
-                &limits,
-            )?;
+            let layout = self.layout(gpu, wanted)?;
             let got = layout.grid.dims.max_element();
             if got < wanted {
                 self.finest = Some(got);

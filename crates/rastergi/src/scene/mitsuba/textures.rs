@@ -182,33 +182,20 @@ impl<'a> Loader<'a> {
         match v {
             Value::Constant(c) => Value::Constant(f(c)),
             Value::Texture { texture, factor } => {
-                let cache = (texture.texture, format!("{key} {factor}"));
-                let t = match self.derived.get(&cache) {
-                    Some(&t) => t,
-                    None => {
-                        let source = &self.scene.textures[texture.texture];
-                        let linear = source.linear;
-                        let decode = |c: u8| if linear { c as f32 / 255.0 } else { srgb_to_linear(c as f32 / 255.0) };
-                        let encode =
-                            |x: f32| (if linear { x.clamp(0.0, 1.0) } else { linear_to_srgb(x) } * 255.0).round() as u8;
-                        let texels = source
-                            .texels
-                            .iter()
-                            .map(|t| {
-                                let c = f(factor * Vec3::new(decode(t[0]), decode(t[1]), decode(t[2])));
-                                [encode(c.x), encode(c.y), encode(c.z), t[3]]
-                            })
-                            .collect();
-                        let derived = Texture { name: format!("{} ({key})", source.name), texels, ..source.clone() };
-                        if self.scene.textures.len() >= crate::scene::MAX_TEXTURES {
-                            return Value::Constant(f(factor * 0.5));
-                        }
-                        let t = self.scene.add_texture(derived);
-                        self.derived.insert(cache, t);
-                        t
-                    }
-                };
-                Value::Texture { texture: TextureRef { texture: t, transform: texture.transform }, factor: Vec3::ONE }
+                let linear = self.scene.textures[texture.texture].linear;
+                let encode =
+                    |x: f32| (if linear { x.clamp(0.0, 1.0) } else { linear_to_srgb(x) } * 255.0).round() as u8;
+                let derived = self.derived_texture(texture.texture, format!("{key} {factor}"), key, |t, rgb| {
+                    let c = f(factor * rgb);
+                    [encode(c.x), encode(c.y), encode(c.z), t[3]]
+                });
+                match derived {
+                    Some(t) => Value::Texture {
+                        texture: TextureRef { texture: t, transform: texture.transform },
+                        factor: Vec3::ONE,
+                    },
+                    None => Value::Constant(f(factor * 0.5)),
+                }
             }
         }
     }
@@ -216,30 +203,40 @@ impl<'a> Loader<'a> {
     /// A texture as an opacity: its luminance (linear) in the alpha channel of a copy.
     fn as_opacity(&mut self, v: Value) -> Value {
         let Value::Texture { texture, factor } = v else { return v };
-        let cache = (texture.texture, "opacity".to_owned());
-        let t = match self.derived.get(&cache) {
-            Some(&t) => t,
-            None => {
-                let source = &self.scene.textures[texture.texture];
-                let linear = source.linear;
-                let decode = |c: u8| if linear { c as f32 / 255.0 } else { srgb_to_linear(c as f32 / 255.0) };
-                let texels = source
-                    .texels
-                    .iter()
-                    .map(|t| {
-                        let y = crate::environment::luminance(Vec3::new(decode(t[0]), decode(t[1]), decode(t[2])));
-                        [t[0], t[1], t[2], (y.clamp(0.0, 1.0) * 255.0).round() as u8]
-                    })
-                    .collect();
-                let derived = Texture { name: format!("{} (opacity)", source.name), texels, ..source.clone() };
-                if self.scene.textures.len() >= crate::scene::MAX_TEXTURES {
-                    return Value::Constant(factor * 0.5);
-                }
-                let t = self.scene.add_texture(derived);
-                self.derived.insert(cache, t);
-                t
-            }
-        };
-        Value::Texture { texture: TextureRef { texture: t, transform: texture.transform }, factor }
+        let derived = self.derived_texture(texture.texture, "opacity".to_owned(), "opacity", |t, rgb| {
+            [t[0], t[1], t[2], (crate::environment::luminance(rgb).clamp(0.0, 1.0) * 255.0).round() as u8]
+        });
+        match derived {
+            Some(t) => Value::Texture { texture: TextureRef { texture: t, transform: texture.transform }, factor },
+            None => Value::Constant(factor * 0.5),
+        }
+    }
+
+    /// A copy of texture `source` whose every texel is `texel(bytes, linear RGB)`, named
+    /// "`source` (`label`)" and cached under `cache`; `None` where the scene holds the most
+    /// textures it may.
+    fn derived_texture(
+        &mut self,
+        source: usize,
+        cache: String,
+        label: &str,
+        texel: impl Fn([u8; 4], Vec3) -> [u8; 4],
+    ) -> Option<usize> {
+        let key = (source, cache);
+        if let Some(&t) = self.derived.get(&key) {
+            return Some(t);
+        }
+        if self.scene.textures.len() >= crate::scene::MAX_TEXTURES {
+            return None;
+        }
+        let src = &self.scene.textures[source];
+        let linear = src.linear;
+        let decode = |c: u8| if linear { c as f32 / 255.0 } else { srgb_to_linear(c as f32 / 255.0) };
+        let texels =
+            src.texels.iter().map(|&t| texel(t, Vec3::new(decode(t[0]), decode(t[1]), decode(t[2])))).collect();
+        let derived = Texture { name: format!("{} ({label})", src.name), texels, ..src.clone() };
+        let t = self.scene.add_texture(derived);
+        self.derived.insert(key, t);
+        Some(t)
     }
 }

@@ -72,20 +72,38 @@ fn integrate(mu: f32, alpha: f32) -> [f32; 2] {
     [(e1 / n) as f32, (e5 / n) as f32]
 }
 
+/// Cell k = √α·N + μ of the GGX table, integrated: (E₁, E₅).
+pub fn ggx_cell(k: usize) -> [f32; 2] {
+    let (i, j) = (k % N, k / N);
+    if j == 0 {
+        // The mirror limit: every ray reflects, F at μ itself.
+        [1.0, (1.0 - grid(i)).powi(5)]
+    } else {
+        integrate(grid(i), grid(j) * grid(j))
+    }
+}
+
+/// The GGX table as committed (`ggx_albedo.bin`, little-endian f32 pairs (E₁, E₅) in
+/// [`GgxAlbedo::e`]'s order), written by `cargo run --release -p rastergi --example
+/// albedo_tables` from [`ggx_cell`]: 4 M microfacet samples, which took every process 0.3–0.4 s
+/// of start-up on two cores when integrated there (`the_committed_ggx_table_is_what_the_integral_gives`
+/// integrates every cell again).
+const GGX_TABLE: &[u8] = include_bytes!("ggx_albedo.bin");
+
 impl GgxAlbedo {
-    fn compute() -> Self {
-        let e: Vec<[f32; 2]> = (0..N * N)
-            .into_par_iter()
-            .map(|k| {
-                let (i, j) = (k % N, k / N);
-                if j == 0 {
-                    // The mirror limit: every ray reflects, F at μ itself.
-                    [1.0, (1.0 - grid(i)).powi(5)]
-                } else {
-                    integrate(grid(i), grid(j) * grid(j))
-                }
-            })
-            .collect();
+    /// Every cell integrated (in parallel): what the committed table holds.
+    pub fn compute() -> Self {
+        GgxAlbedo::with_cells((0..N * N).into_par_iter().map(ggx_cell).collect())
+    }
+
+    fn committed() -> Self {
+        assert_eq!(GGX_TABLE.len(), N * N * 8, "ggx_albedo.bin holds {} cells", N * N);
+        let f = |b: &[u8]| f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
+        GgxAlbedo::with_cells(GGX_TABLE.chunks_exact(8).map(|b| [f(&b[..4]), f(&b[4..])]).collect())
+    }
+
+    /// The table of cells `e` with its cosine-weighted means.
+    fn with_cells(e: Vec<[f32; 2]>) -> Self {
         let mut table = GgxAlbedo { e, mean: vec![[0.0; 2]; N] };
         // 2∫ E(μ) μ dμ of the interpolated table, by the midpoint rule on a fine grid.
         const STEPS: usize = 4096;
@@ -161,10 +179,10 @@ fn cell(x: f32) -> (usize, f32) {
     (i, t - i as f32)
 }
 
-/// The tables, computed on first use.
+/// The GGX tables (the committed cells, read on first use).
 pub fn ggx_albedo() -> &'static GgxAlbedo {
     static TABLE: OnceLock<GgxAlbedo> = OnceLock::new();
-    TABLE.get_or_init(GgxAlbedo::compute)
+    TABLE.get_or_init(GgxAlbedo::committed)
 }
 
 /// Cells of the glass table along η.
@@ -232,8 +250,8 @@ pub fn glass_cell(k: usize) -> f32 {
 }
 
 /// The glass table as committed (`glass_albedo.bin`, little-endian f32 in [`GlassAlbedo::e`]'s
-/// order), written by `cargo run --release -p rastergi --example glass_albedo_table` from
-/// [`glass_cell`]: 134 M microfacet samples, too slow to integrate at every start
+/// order), written by `cargo run --release -p rastergi --example albedo_tables` from
+/// [`glass_cell`] (`cargo run --release -p rastergi --example albedo_tables`): 134 M microfacet samples, too slow to integrate at every start
 /// (`the_committed_glass_table_is_what_the_integral_gives` recomputes cells of it).
 const GLASS_TABLE: &[u8] = include_bytes!("glass_albedo.bin");
 

@@ -578,6 +578,20 @@ fn the_committed_glass_table_is_what_the_integral_gives() {
 }
 
 #[test]
+fn the_committed_ggx_table_is_what_the_integral_gives() {
+    let table = albedo::ggx_albedo();
+    let integrated = albedo::GgxAlbedo::compute();
+    for (k, (c, e)) in table.e.iter().zip(&integrated.e).enumerate() {
+        for i in 0..2 {
+            assert!((c[i] - e[i]).abs() <= 1e-6, "cell {k}: committed {c:?}, integrated {e:?}");
+        }
+    }
+    for (j, (c, e)) in table.mean.iter().zip(&integrated.mean).enumerate() {
+        assert_eq!(c, e, "the cosine-weighted mean at √α cell {j}");
+    }
+}
+
+#[test]
 fn fresnel_terms_match_their_closed_forms() {
     // Normal incidence: ((η − 1)/(η + 1))² = 0.04 for η = 1.5, from either side.
     assert!((fresnel_dielectric(1.0, 1.5) - 0.04).abs() < 1e-6);

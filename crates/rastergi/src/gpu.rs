@@ -51,6 +51,8 @@ pub struct Gpu {
     /// The first error the device reported outside a call that returns one (a lost device, a
     /// GPU timeout, an allocation that failed): [`Gpu::wait`] and every readback return it.
     fault: std::sync::Arc<std::sync::Mutex<Fault>>,
+    /// Releases the device's compiled objects ([`crate::compiled`]) with the last clone.
+    _compiled: std::sync::Arc<crate::compiled::Release>,
 }
 
 /// What the device reported outside the calls that return errors.
@@ -156,7 +158,8 @@ impl Gpu {
                 fault.lock().unwrap_or_else(|e| e.into_inner()).lost.get_or_insert(why);
             });
         }
-        Ok(Gpu { adapter, device, queue, info, profiler, fault })
+        let _compiled = std::sync::Arc::new(crate::compiled::register(&device));
+        Ok(Gpu { adapter, device, queue, info, profiler, fault, _compiled })
     }
 
     /// Whether the adapter offers hardware ray queries (wgpu's `EXPERIMENTAL_RAY_QUERY`:
@@ -464,13 +467,14 @@ pub fn uniform_entry<T>(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::B
     }
 }
 
-/// A bind group layout of `entries` (each names its binding).
+/// A bind group layout of `entries` (each names its binding): the device's one of them
+/// ([`crate::compiled`]).
 pub fn bind_group_layout(
     device: &wgpu::Device,
     label: &str,
     entries: &[wgpu::BindGroupLayoutEntry],
 ) -> wgpu::BindGroupLayout {
-    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries })
+    crate::compiled::bind_group_layout(device, label, entries)
 }
 
 /// Bind-group-layout entry for a filterable float 2D array texture (the scene's textures).
@@ -539,42 +543,45 @@ pub fn scene_raster_pipeline(
     depth: Option<wgpu::TextureFormat>,
 ) -> wgpu::RenderPipeline {
     let (module, layouts) = shader;
-    let layout = pipeline_layout(device, label, layouts);
-    let start = web_time::Instant::now();
-    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some(label),
-        layout: Some(&layout),
-        vertex: wgpu::VertexState {
-            module,
-            entry_point: Some("vs_main"),
-            compilation_options: Default::default(),
-            buffers: &[],
-        },
-        primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-        depth_stencil: depth.map(|format| wgpu::DepthStencilState {
-            format,
-            depth_write_enabled: Some(true),
-            depth_compare: Some(wgpu::CompareFunction::Greater),
-            stencil: Default::default(),
-            bias: Default::default(),
-        }),
-        multisample: Default::default(),
-        fragment: Some(wgpu::FragmentState {
-            module,
-            entry_point: Some(fs),
-            compilation_options: Default::default(),
-            targets: &[Some(target)],
-        }),
-        multiview_mask: None,
-        cache: None,
-    });
-    log::debug!("pipeline {label} ({fs}) created in {:.2} s", start.elapsed().as_secs_f64());
-    pipeline
+    crate::compiled::raster_pipeline(device, shader, fs, &target, depth, || {
+        let layout = pipeline_layout(device, label, layouts);
+        let start = web_time::Instant::now();
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(label),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+            depth_stencil: depth.map(|format| wgpu::DepthStencilState {
+                format,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Greater),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module,
+                entry_point: Some(fs),
+                compilation_options: Default::default(),
+                targets: &[Some(target.clone())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        log::debug!("pipeline {label} ({fs}) created in {:.2} s", start.elapsed().as_secs_f64());
+        pipeline
+    })
 }
 
 /// A compute pipeline for `module`'s entry point `entry`, with bind groups `layouts` and values
 /// for the shader's pipeline-overridable constants (`override` declarations; none: `&[]`), e.g.
-/// [`crate::gpu_scene::GpuScene::pipeline_constants`].
+/// [`crate::gpu_scene::GpuScene::pipeline_constants`]: the device's one of them, compiled on
+/// first use ([`crate::compiled`]).
 pub fn compute_pipeline(
     device: &wgpu::Device,
     label: &str,
@@ -583,18 +590,20 @@ pub fn compute_pipeline(
     layouts: &[&wgpu::BindGroupLayout],
     constants: &[(&str, f64)],
 ) -> wgpu::ComputePipeline {
-    let layout = pipeline_layout(device, label, layouts);
-    let start = web_time::Instant::now();
-    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some(label),
-        layout: Some(&layout),
-        module,
-        entry_point: Some(entry),
-        compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
-        cache: None,
-    });
-    log::debug!("pipeline {label} ({entry}) created in {:.2} s", start.elapsed().as_secs_f64());
-    pipeline
+    crate::compiled::compute_pipeline(device, module, entry, layouts, constants, || {
+        let layout = pipeline_layout(device, label, layouts);
+        let start = web_time::Instant::now();
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(label),
+            layout: Some(&layout),
+            module,
+            entry_point: Some(entry),
+            compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
+            cache: None,
+        });
+        log::debug!("pipeline {label} ({entry}) created in {:.2} s", start.elapsed().as_secs_f64());
+        pipeline
+    })
 }
 
 /// Number of workgroups of `size` needed to cover `n` items.

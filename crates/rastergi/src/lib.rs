@@ -14,6 +14,7 @@ pub mod bsdf;
 pub mod bvh;
 pub mod camera_control;
 pub mod checkpoint;
+pub mod compiled;
 pub mod consts;
 pub mod denoise;
 pub mod direct;

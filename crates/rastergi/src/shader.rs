@@ -115,9 +115,7 @@ pub fn per_pixel(pieces: &[&str]) -> String {
     compose(&all)
 }
 
+/// The shader module of `source`: the device's one of it ([`crate::compiled`]).
 pub fn module(device: &wgpu::Device, label: &str, source: &str) -> wgpu::ShaderModule {
-    device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some(label),
-        source: wgpu::ShaderSource::Wgsl(source.into()),
-    })
+    crate::compiled::module(device, label, source)
 }

@@ -69,15 +69,20 @@ fn gradient_sky() -> Environment {
 
 /// The mean of the floor's pixels per iteration over `iterations` (the film's sums read after
 /// each), for a render with `settings`: (mean, its standard error from the iterations' spread).
-fn floor_mean(scene: &Scene, settings: RenderSettings, iterations: u32, path: bool) -> (Vec3, Vec3) {
-    let gpu = common::gpu();
+fn floor_mean(
+    gpu: &rastergi::gpu::Gpu,
+    scene: &Scene,
+    settings: RenderSettings,
+    iterations: u32,
+    path: bool,
+) -> (Vec3, Vec3) {
     let mut means = Vec::new();
     let mut previous = Vec3::ZERO;
     let image_mean = |img: &rastergi::image_io::LinearImage| {
         img.pixels.iter().map(|p| Vec3::from(*p)).sum::<Vec3>() / img.pixels.len() as f32
     };
     if path {
-        let mut pt = PathTracer::new(&gpu, scene, settings).unwrap();
+        let mut pt = PathTracer::new(gpu, scene, settings).unwrap();
         for i in 1..=iterations {
             pt.iterate();
             let sum = image_mean(&pt.read_linear().unwrap()) * i as f32;
@@ -85,7 +90,7 @@ fn floor_mean(scene: &Scene, settings: RenderSettings, iterations: u32, path: bo
             previous = sum;
         }
     } else {
-        let mut r = Renderer::new(&gpu, scene, settings).unwrap();
+        let mut r = Renderer::new(gpu, scene, settings).unwrap();
         for i in 1..=iterations {
             r.iterate().unwrap();
             let sum = image_mean(&r.read_linear(Show::Full).unwrap()) * i as f32;
@@ -129,6 +134,7 @@ fn settings(gather: GatherMethod, directions: GatherDirections) -> RenderSetting
 
 #[test]
 fn a_constant_sky_over_an_open_floor_gives_rho_l_in_every_gather_and_the_path_tracer() {
+    let gpu = common::gpu();
     let l = Vec3::new(1.0, 0.6, 0.3);
     let scene = floor(Environment::constant(l));
     let expected = l * ALBEDO;
@@ -140,7 +146,7 @@ fn a_constant_sky_over_an_open_floor_gives_rho_l_in_every_gather_and_the_path_tr
         ("path tracer", settings(GatherMethod::Trace, GatherDirections::PerPixel), true),
     ];
     for (label, s, path) in cases {
-        let (mean, sigma) = floor_mean(&scene, s, 24, path);
+        let (mean, sigma) = floor_mean(&gpu, &scene, s, 24, path);
         let err = (mean - expected).abs();
         println!("{label}: floor mean {mean} (σ {sigma}), ρL {expected}");
         // Within 5 standard errors (and float rounding): the MIS weights of the direct pass's
@@ -151,6 +157,7 @@ fn a_constant_sky_over_an_open_floor_gives_rho_l_in_every_gather_and_the_path_tr
 
 #[test]
 fn a_structured_sky_over_an_open_floor_gives_rho_e_over_pi() {
+    let gpu = common::gpu();
     // A bright patch and a gradient: the sky's importance sampling, its pdf and the MIS
     // weights against cosine-distributed gather rays (per-pixel) and uniform ones (lists), and
     // the path tracer's own MIS, against ρ/π·E with E = ∫₊ L cos θ dω by quadrature.
@@ -163,7 +170,7 @@ fn a_structured_sky_over_an_open_floor_gives_rho_e_over_pi() {
         ("trace, per-pixel directions", settings(GatherMethod::Trace, GatherDirections::PerPixel), false),
         ("lists", settings(GatherMethod::Lists, GatherDirections::Shared), false),
     ] {
-        let (mean, sigma) = floor_mean(&scene, s, 32, path);
+        let (mean, sigma) = floor_mean(&gpu, &scene, s, 32, path);
         println!("{label}, structured sky: floor mean {mean} (σ {sigma}), ρE/π {expected}");
         assert!(
             (mean - expected).abs().cmple(5.0 * sigma + expected * 2e-3).all(),
@@ -330,6 +337,7 @@ fn floor_pixel_cosines() -> Vec<f32> {
 
 #[test]
 fn a_glossy_floor_under_a_constant_sky_reflects_l_times_its_directional_albedo() {
+    let gpu = common::gpu();
     // The direct pass's sky samples and the gather's escaping rays share the sky by MIS; on a
     // glossy surface the traced gather's per-pixel directions come from the BSDF's sampling,
     // and its density must be the one the weights use, or the two do not sum to L·a(ω_o).
@@ -385,7 +393,7 @@ fn a_glossy_floor_under_a_constant_sky_reflects_l_times_its_directional_albedo()
             ("lists", settings(GatherMethod::Lists, GatherDirections::Shared), false),
             ("path tracer", settings(GatherMethod::Trace, GatherDirections::PerPixel), true),
         ] {
-            let (mean, sigma) = floor_mean(&scene, s, 24, path);
+            let (mean, sigma) = floor_mean(&gpu, &scene, s, 24, path);
             println!("{} floor, {label}: mean {mean} (σ {sigma}), L·a(ω_o) {expected}", material.name);
             assert!(
                 (mean - expected).abs().cmple(5.0 * sigma + expected * 2e-3).all(),
@@ -404,6 +412,7 @@ fn a_glossy_floor_under_a_constant_sky_reflects_l_times_its_directional_albedo()
 /// iterations at 32², the camera inside the sphere's silhouette (every pixel sees it).
 #[test]
 fn rough_glass_spheres_vanish_in_a_white_furnace() {
+    let gpu = common::gpu();
     let sphere = |roughness: f32, multiple_scattering: bool| {
         let camera = Camera { eye: Vec3::new(0.0, 0.0, 4.0), target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 15.0 };
         let mut s = Scene::new(camera);
@@ -421,8 +430,8 @@ fn rough_glass_spheres_vanish_in_a_white_furnace() {
     };
     for roughness in [0.3f32, 0.6, 1.0] {
         let s = settings(GatherMethod::Trace, GatherDirections::PerPixel);
-        let (mean, sigma) = floor_mean(&sphere(roughness, true), s.clone(), 64, true);
-        let (single, single_sigma) = floor_mean(&sphere(roughness, false), s, 64, true);
+        let (mean, sigma) = floor_mean(&gpu, &sphere(roughness, true), s.clone(), 64, true);
+        let (single, single_sigma) = floor_mean(&gpu, &sphere(roughness, false), s, 64, true);
         println!(
             "rough glass sphere, roughness {roughness}: {:.4} ± {:.4} (single scattering {:.4} ± {:.4})",
             mean.x, sigma.x, single.x, single_sigma.x

@@ -11,8 +11,15 @@ use rastergi::image_io::{LinearImage, read_exr};
 use rastergi::renderer::{RenderSettings, Renderer};
 use rastergi::scene::Scene;
 
+/// The test's device: one per test (each test runs on a thread of its own), so that a test's
+/// renderers reuse each other's compiled pipelines (`rastergi::compiled`) while a device
+/// error stays within the test that caused it.
 pub fn gpu() -> Gpu {
-    Gpu::new(&GpuOptions::default()).unwrap_or_else(|e| panic!("tests need a GPU adapter (lavapipe on CI): {e}"))
+    thread_local! {
+        static GPU: Gpu = Gpu::new(&GpuOptions::default())
+            .unwrap_or_else(|e| panic!("tests need a GPU adapter (lavapipe on CI): {e}"));
+    }
+    GPU.with(Gpu::clone)
 }
 
 /// Renders `iterations` iterations and returns the mean image of `show`.

@@ -583,11 +583,17 @@ fn photon_map_and_gather_on_spheres_of_each_material_match_mitsuba() {
     use rastergi::film::Show;
     use rastergi::metrics::emitter_mask;
     let gpu = common::gpu();
-    for kind in ["metal_rough", "mix", "mirror", "glass", "rough_glass"] {
+    // The rough metal and the mix at 128 iterations: their relative RMSE was 1.4 % at 256
+    // (noise 1.3 %), so about 2 % at 128 against the 5 % bound, and their block-mean errors
+    // 0.14–0.18 % against 1.5 %; the mirror (2.8 % at 256) and the glasses (channel means
+    // 0.5–0.75 % off against 1 %) keep 256.
+    for (kind, iterations) in
+        [("metal_rough", 128), ("mix", 128), ("mirror", 256), ("glass", 256), ("rough_glass", 256)]
+    {
         let scene = material_scene(&format!("mat_{kind}"), stage_camera());
         let grid = rastergi::fit::grid_resolution(&scene.bounds());
-        let a = common::render(&gpu, &scene, common::fitted_settings(&scene, 64, 1), 256, Show::Full);
-        let b = common::render(&gpu, &scene, common::fitted_settings(&scene, 64, 2), 256, Show::Full);
+        let a = common::render(&gpu, &scene, common::fitted_settings(&scene, 64, 1), iterations, Show::Full);
+        let b = common::render(&gpu, &scene, common::fitted_settings(&scene, 64, 2), iterations, Show::Full);
         let stem = format!("mat_{kind}_path_64");
         let probe = rastergi::image_io::read_exr(&common::data(&format!("{stem}_a.exr"))).unwrap();
         let mask = emitter_mask(&probe, 3.0);
@@ -667,7 +673,8 @@ fn cornell_box_with_glass_and_mirror_spheres_matches_mitsuba_caustic_included() 
 /// is another one): the eye's chains follow its mirror lobe stochastically (specular.wgsl), so
 /// the sphere shows the stage it reflects, with the criteria of the other spheres. Without
 /// them (measured) the reflection is missing: relative RMSE 16.6 % (noise 2.4 %), block-mean
-/// error 2.3 %, the image's mean 2.2 % low; with them 4.0 % (noise 4.8 %), 0.6 %, 0.2 %.
+/// error 2.3 %, the image's mean 2.2 % low; with them 4.0 % (noise 4.8 %), 0.6 %, 0.2 %
+/// (against 2 × 1024 path-traced iterations; see below for 2 × 512).
 #[test]
 fn a_polished_sphere_reflects_the_stage_as_the_path_tracer_shows_it() {
     use rastergi::film::Show;
@@ -678,8 +685,11 @@ fn a_polished_sphere_reflects_the_stage_as_the_path_tracer_shows_it() {
     assert!(m.has_delta_lobe() && !m.passes_rays());
     let gpu = common::gpu();
     let settings = |seed| rastergi::renderer::RenderSettings { width: 64, height: 64, seed, ..Default::default() };
+    // The path tracer at 2 × 512 iterations (2 × 1024 until issue 44: block-mean error 0.29 %
+    // and channel means 0.25 % off against the 1.5 % and 1 % bounds, with the reference's
+    // noise the larger part of the comparison's; √2 more of it leaves both far inside).
     let (ra, rb) =
-        (common::path_trace(&gpu, &scene, settings(1), 1024), common::path_trace(&gpu, &scene, settings(2), 1024));
+        (common::path_trace(&gpu, &scene, settings(1), 512), common::path_trace(&gpu, &scene, settings(2), 512));
     let mask = emitter_mask(&ra, 3.0);
     let reference = common::average(&ra, &rb);
     let ref_noise = rmse(&ra, &rb, Some(&mask)) / 2.0;
@@ -694,10 +704,12 @@ fn a_polished_sphere_reflects_the_stage_as_the_path_tracer_shows_it() {
 /// wood; metal legs) rendered as users do (fitted photon map, traced gather) against rastergi's
 /// own path tracer at 2 × 16384 iterations (tests/data/glossy_room_path_64_{a,b}.exr): the map
 /// answers for the Lambertian part of each hit's BSDF exactly and the gather follows the rest,
-/// so the image converges to the path tracer's: the 16 × 16 block means within 0.5 % at 64,
-/// 256 and 1024 iterations (the mean of two seeds), the channel means within 0.5 %. Measured:
-/// block-mean error 0.16 %, 0.17 %, 0.16 % (the photon map's cells, which its progressive
-/// passes shrink slowly, and the references' noise); with the Lambertian stand-in the gather had before (the hit's directional
+/// so the image converges to the path tracer's: the 16 × 16 block means within 0.5 % at 64
+/// and 256 iterations (the mean of two seeds), the channel means within 0.5 %. Measured:
+/// block-mean error 0.16 %, 0.17 % (0.16 % at 1024, where this test stopped until issue 44:
+/// the error is the photon map's cells, which its progressive passes shrink slowly, and the
+/// references' noise, flat from 64 iterations on, so 1024 told no more than 256 at 4× the
+/// time); with the Lambertian stand-in the gather had before (the hit's directional
 /// albedo, bsdf_diffuse_equivalent) it stayed at 2.2 % with the image 1.6–2.7 % bright,
 /// however long it ran (`rastergi compare` of 1024-iteration renders, issue 31's note).
 #[test]
@@ -709,17 +721,18 @@ fn a_room_with_a_rough_metal_floor_and_a_polished_table_converges_to_the_path_tr
     let probe = rastergi::image_io::read_exr(&common::data("glossy_room_path_64_a.exr")).unwrap();
     let mask = emitter_mask(&probe, 3.0);
     let (reference, ref_noise) = common::reference_pair("glossy_room_path_64", Some(&mask));
-    // Each seed's image after 64, 256 and 1024 iterations.
+    // Each seed's image after 64 and 256 iterations.
+    const COUNTS: [u32; 2] = [64, 256];
     let render = |seed| {
         let mut r = rastergi::renderer::Renderer::new(&gpu, &scene, common::fitted_settings(&scene, 64, seed))
             .expect("renderer");
         let mut images = vec![];
-        for i in 1..=1024u32 {
+        for i in 1..=COUNTS[1] {
             r.iterate().expect("iteration");
             if i % 16 == 0 {
                 r.wait().unwrap();
             }
-            if i == 64 || i == 256 || i == 1024 {
+            if COUNTS.contains(&i) {
                 images.push(r.read_linear(Show::Full).expect("readback"));
             }
         }
@@ -727,13 +740,13 @@ fn a_room_with_a_rough_metal_floor_and_a_polished_table_converges_to_the_path_tr
     };
     let (a, b) = (render(1), render(2));
     let mut errors = vec![];
-    for (k, iterations) in [64, 256, 1024].into_iter().enumerate() {
+    for (k, iterations) in COUNTS.into_iter().enumerate() {
         let (c, noise, bias) = common::against_reference(&a[k], &b[k], &reference, ref_noise, Some(&mask));
         common::print_agreement(&format!("glossy room, {iterations} iterations"), &c, noise, bias);
         errors.push(c.block_mean_error);
     }
-    let (c, _, _) = common::against_reference(&a[2], &b[2], &reference, ref_noise, Some(&mask));
-    for (e, iterations) in errors.iter().zip([64, 256, 1024]) {
+    let (c, _, _) = common::against_reference(&a[1], &b[1], &reference, ref_noise, Some(&mask));
+    for (e, iterations) in errors.iter().zip(COUNTS) {
         assert!(*e < 0.005, "block-mean error {e} at {iterations} iterations");
     }
     for r in c.mean_ratio {

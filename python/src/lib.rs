@@ -91,6 +91,23 @@ fn parse(argv: Vec<String>) -> PyResult<RenderOptions> {
     })
 }
 
+/// The process's device for `args`' backends: one for every renderer made in Python, so that
+/// a renderer made after another of the same shader variants reuses its compiled pipelines
+/// (`rastergi::compiled`: set-up about 1 s shorter per renderer on lavapipe). A device that
+/// reported an error (lost, out of memory) is replaced by a fresh one.
+fn shared_gpu(args: &rastergi_cli::args::GpuArgs) -> Result<rastergi::gpu::Gpu> {
+    static GPUS: Mutex<Vec<(String, rastergi::gpu::Gpu)>> = Mutex::new(Vec::new());
+    let backends = format!("{:?}", args.options().backends);
+    let mut gpus = GPUS.lock().unwrap_or_else(|e| e.into_inner());
+    gpus.retain(|(b, gpu)| *b != backends || gpu.check().is_ok());
+    if let Some((_, gpu)) = gpus.iter().find(|(b, _)| *b == backends) {
+        return Ok(gpu.clone());
+    }
+    let gpu = rastergi_cli::args::gpu(args)?;
+    gpus.push((backends, gpu.clone()));
+    Ok(gpu)
+}
+
 /// Loads the scene and builds the renderer as `rastergi render` does (the photon map traced).
 fn build(o: &RenderOptions) -> Result<Box<dyn Progressive>, PyErr> {
     cli_render::check_method_show(o.method, o.scene.show).map_err(value_err)?;
@@ -100,7 +117,7 @@ fn build(o: &RenderOptions) -> Result<Box<dyn Progressive>, PyErr> {
     let a = &o.scene;
     let scene = a.load_scene().map_err(py_err)?;
     let settings = a.settings(&scene, a.width, a.height, matches!(a.show, ShowArg::PhotonMap));
-    let gpu = rastergi_cli::args::gpu(&a.gpu).map_err(py_err)?;
+    let gpu = shared_gpu(&a.gpu).map_err(py_err)?;
     let (mut renderer, _) = cli_render::new_renderer(&gpu, &scene, settings, o.method).map_err(py_err)?;
     if o.denoise
         && let Some(r) = renderer.as_renderer_mut()

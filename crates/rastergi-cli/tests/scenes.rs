@@ -86,3 +86,74 @@ fn a_bad_built_in_parameter_is_one_error_line() {
     assert_eq!(errors.len(), 1, "{log}");
     assert!(errors[0].contains("spheres:many") && errors[0].contains("spheres:1000000"), "{log}");
 }
+
+/// `scripts/fetch-scenes.sh --from ../shared/scenes` copies the shared public scenes into a
+/// cache, each file checked against its folder's FILES.txt; run again it leaves them as they
+/// are; a truncated file is refused with one line naming it, and an unknown scene or option
+/// with one line too.
+#[test]
+fn fetch_scenes_copies_the_shared_scenes_and_refuses_a_truncated_file() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let shared = root.join("../shared/scenes");
+    if !shared.exists() {
+        println!("skipped: {} is not here (the shared public scenes are not on this machine)", shared.display());
+        return;
+    }
+    let (cache, other) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    let fetch_to = |dest: &Path, args: &[&std::ffi::OsStr]| {
+        Command::new("bash")
+            .arg(root.join("scripts/fetch-scenes.sh"))
+            .args(args)
+            .arg("--dest")
+            .arg(dest)
+            .output()
+            .expect("bash runs")
+    };
+    let fetch = |args: &[&std::ffi::OsStr]| fetch_to(cache.path(), args);
+    let out = |o: &Output| String::from_utf8_lossy(&o.stdout).into_owned();
+    let run = fetch(&["--from".as_ref(), shared.as_os_str()]);
+    assert!(run.status.success(), "{}{}", out(&run), stderr(&run));
+    let lines = out(&run);
+    assert_eq!(lines.lines().last(), Some(cache.path().to_str().unwrap()), "{lines}");
+    // Every file that FILES.txt lists and the shared folder has, in the cache with its size.
+    let mut files = 0;
+    for scene in ["staircase", "sponza", "cornell-box-original", "gltf/ToyCar", "gltf/SheenChair", "env"] {
+        assert!(lines.contains(&format!("{scene}: copied")), "{lines}");
+        let manifest = std::fs::read_to_string(shared.join(scene).join("FILES.txt")).unwrap();
+        for line in manifest.lines() {
+            let (size, path) = line.split_once(char::is_whitespace).unwrap();
+            if let Ok(m) = std::fs::metadata(shared.join(scene).join(path)) {
+                let copied = std::fs::metadata(cache.path().join(scene).join(path)).map(|c| c.len());
+                assert_eq!(copied.ok(), Some(m.len()), "{scene}/{path}");
+                assert_eq!(m.len().to_string(), size.trim(), "{scene}/{path}: the shared copy against FILES.txt");
+                files += 1;
+            }
+        }
+    }
+    assert!(files > 800, "{files} files");
+    let again = fetch(&["--from".as_ref(), shared.as_os_str()]);
+    assert!(again.status.success() && out(&again).contains("staircase: already in"), "{}", out(&again));
+    // A truncated copy of the skies, into an empty cache.
+    let bad = tempfile::tempdir().unwrap();
+    std::fs::create_dir(bad.path().join("env")).unwrap();
+    std::fs::copy(shared.join("env/FILES.txt"), bad.path().join("env/FILES.txt")).unwrap();
+    for sky in ["aerodynamics_workshop_1k.hdr", "brown_photostudio_02_1k.hdr"] {
+        let bytes = std::fs::read(shared.join("env").join(sky)).unwrap();
+        std::fs::write(bad.path().join("env").join(sky), &bytes[..bytes.len() / 2]).unwrap();
+    }
+    let refused = fetch_to(other.path(), &["--from".as_ref(), bad.path().as_os_str(), "env".as_ref()]);
+    let message = stderr(&refused);
+    assert!(!refused.status.success(), "a truncated sky was taken: {}", out(&refused));
+    assert_eq!(message.lines().count(), 1, "{message}");
+    assert!(
+        message.contains("aerodynamics_workshop_1k.hdr") && message.contains("FILES.txt says 1488808"),
+        "{message}"
+    );
+    for (args, what) in [(&["nowhere"][..], "unknown scene 'nowhere'"), (&["--bogus"][..], "unknown option '--bogus'")]
+    {
+        let args: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_ref()).collect();
+        let run = fetch(&args);
+        assert_eq!(run.status.code(), Some(2), "{}", stderr(&run));
+        assert!(stderr(&run).contains(what) && stderr(&run).lines().count() == 1, "{}", stderr(&run));
+    }
+}

@@ -131,6 +131,25 @@ impl Environment {
         Environment::new(2, 3, vec![l; 6]).expect("a valid constant environment")
     }
 
+    /// The neutral light that models without lights are shown in, as glTF viewers show them
+    /// (their default image-based light is a grey studio): a grey dome, radiance 1 from the
+    /// zenith down to 30° above the horizon, falling smoothly to 0.3 at 10° below it and below
+    /// — light from everywhere, with enough above-versus-below to show a model's shape. No
+    /// colour, so the model's own colours are what the image shows. 64 × 33 texels.
+    pub fn neutral() -> Environment {
+        let (w, h) = (64u32, 33u32);
+        let texels = (0..h)
+            .flat_map(|j| {
+                // Row j's elevation: +90° at row 0, −90° at the last.
+                let elevation = 90.0 - 180.0 * j as f32 / (h - 1) as f32;
+                let t = ((elevation + 10.0) / 40.0).clamp(0.0, 1.0);
+                let l = 0.3 + 0.7 * t * t * (3.0 - 2.0 * t);
+                std::iter::repeat_n(Vec3::splat(l), w as usize)
+            })
+            .collect();
+        Environment::new(w, h, texels).expect("a valid neutral environment")
+    }
+
     /// Reads an equirectangular image (`.exr` linear RGB, or Radiance `.hdr`) and scales its
     /// radiance by `scale`.
     pub fn load(path: &Path, scale: f32) -> Result<Arc<Environment>> {
@@ -452,6 +471,23 @@ mod tests {
             }
         }
         assert!((p - 1.0).abs() < 1e-5, "∫ pdf = {p}");
+    }
+
+    /// The neutral light: grey, 1 at the zenith, 0.3 below the horizon, in between at it.
+    #[test]
+    fn the_neutral_light_is_a_grey_dome() {
+        let e = Environment::neutral();
+        let at = |d: Vec3| e.eval(d.normalize());
+        assert!((at(Vec3::Y) - Vec3::ONE).abs().max_element() < 1e-5, "{}", at(Vec3::Y));
+        assert!((at(-Vec3::Y) - Vec3::splat(0.3)).abs().max_element() < 1e-5, "{}", at(-Vec3::Y));
+        let horizon = at(Vec3::X);
+        assert!(horizon.x > 0.35 && horizon.x < 0.95 && horizon.x == horizon.y && horizon.y == horizon.z, "{horizon}");
+        // 2π sr above at ≥ 0.3 and ≤ 1, and the same below.
+        assert!(
+            e.integral.x > 0.3 * 4.0 * std::f32::consts::PI && e.integral.x < 1.3 * 2.0 * std::f32::consts::PI,
+            "{}",
+            e.integral
+        );
     }
 
     #[test]

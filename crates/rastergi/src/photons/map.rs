@@ -48,7 +48,7 @@ use glam::{DVec3, IVec3, UVec3, Vec3};
 use crate::par::prelude::*;
 
 use super::clip::{clip_to_box, clip_to_half_space, polygon_area};
-use super::separators::{Fragment, separators_of};
+use super::separators::{CellPlanes, Fragment, separators_of};
 pub use super::separators::{MAX_SEPARATORS, MIN_REGION, Separator, Separators, region_of};
 pub use super::table::{EMPTY, SlotTable};
 use crate::consts::CAUSTIC_CELL;
@@ -472,12 +472,14 @@ impl MapLayout {
         type CellSlots = (Vec<([u32; 2], f64)>, Vec<([u32; 2], [Separator; MAX_SEPARATORS])>);
         let slots_of = |(&cell, fragments): (&u32, &Vec<Fragment>)| -> CellSlots {
             let (mut areas, mut separated) = (Vec::new(), Vec::new());
-            let mut keys: Vec<u32> = fragments.iter().map(|f| f.key).collect();
-            keys.sort_unstable();
-            keys.dedup();
-            for &key in &keys {
-                let own: Vec<&Fragment> = fragments.iter().filter(|f| f.key == key).collect();
-                let separators = separators_of(&own, fragments, key, eps);
+            // The cell's fragments grouped by key (in the cell's order within each key) and its
+            // candidate planes, once.
+            let mut by_key: Vec<&Fragment> = fragments.iter().collect();
+            by_key.sort_by_key(|f| f.key);
+            let cell_planes = CellPlanes::new(fragments);
+            for own in by_key.chunk_by(|a, b| a.key == b.key) {
+                let key = own[0].key;
+                let separators = separators_of(own, &cell_planes, key, eps);
                 if separators.is_empty() {
                     areas.push(([cell, key], own.iter().map(|f| f.area).sum::<f64>()));
                     continue;
@@ -489,7 +491,7 @@ impl MapLayout {
                 separated.push(([cell, key], record));
                 for region in 0..1u32 << separators.len() {
                     let mut area = 0.0;
-                    for f in &own {
+                    for f in own {
                         let mut piece = f.poly.clone();
                         for (k, &(n, d)) in separators.iter().enumerate() {
                             piece = clip_to_half_space(&piece, n, d, region >> k & 1 == 1);

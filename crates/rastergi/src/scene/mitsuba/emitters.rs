@@ -106,8 +106,8 @@ impl<'a> Loader<'a> {
     }
 
     /// A `sunsky` (Mitsuba 3 and 0.6), or 0.6's `sun` (the sun alone) or `sky` (the sky alone),
-    /// as a [`SunSky`](crate::sky::SunSky). Mitsuba 3's frame is Z up (its `to_world` turns it),
-    /// 0.6's Y up; `sun_direction` is in world space in both. Without it, the sun stands where
+    /// as a [`SunSky`](crate::sky::SunSky). Mitsuba 3's frame is Z up, 0.6's Y up, each turned
+    /// by the emitter's `to_world`; `sun_direction` is in world space in both. Without it, the sun stands where
     /// the place and time put it (Mitsuba 3's defaults: Tokyo, 2010-07-10 15:00). 0.6's
     /// differences: its albedo defaults to 0.15 (3: 0.3); `scale` sets both `sun_scale` and
     /// `sky_scale`; `sun_radius_scale` × 0.5358° is the aperture (0: a delta direction); its
@@ -117,7 +117,7 @@ impl<'a> Loader<'a> {
         let ty = p.ty();
         let legacy = self.doc.legacy() || ty != "sunsky";
         let m = self.transform(p, "to_world")?;
-        let up = if legacy { Vec3::Y } else { m.transform_vector3(Vec3::Z).normalize_or_zero() };
+        let up = m.transform_vector3(if legacy { Vec3::Y } else { Vec3::Z }).normalize_or_zero();
         let time_keys = ["latitude", "longitude", "timezone", "year", "month", "day", "hour", "minute", "second"];
         let sun = match p.get("sun_direction") {
             Some(d) => {
@@ -139,12 +139,9 @@ impl<'a> Loader<'a> {
                     f(self, "minute", 0.0)?,
                     f(self, "second", 0.0)?,
                 );
-                if legacy {
-                    // 0.6's spherical coordinates put the zenith on +Y: (x, z, y) of 3's.
-                    Vec3::new(local.x, local.z, local.y)
-                } else {
-                    m.transform_vector3(local).normalize_or_zero()
-                }
+                // 0.6's spherical coordinates put the zenith on +Y: (x, z, y) of 3's.
+                let local = if legacy { Vec3::new(local.x, local.z, local.y) } else { local };
+                m.transform_vector3(local).normalize_or_zero()
             }
         };
         let scale = if legacy { self.float(p, "scale", 1.0)? } else { 1.0 };

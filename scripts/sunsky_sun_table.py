@@ -48,6 +48,7 @@ print()
 print("/// The sun's irradiance (W/m², linear sRGB, Mitsuba 3's RGB `sunsky` units) on a surface")
 print("/// facing it, per turbidity 1, 2, …, 10 and solar elevation 2°, 5°, …, 89°.")
 print("#[rustfmt::skip]")
+print("#[allow(clippy::excessive_precision)] // nine digits, as printed; f32 keeps what it can")
 print("pub(crate) const SUN_IRRADIANCE: [[[f32; 3]; 30]; 10] = [")
 for row in rows:
     print("    [")

@@ -5,6 +5,7 @@
 /// The sun's irradiance (W/m², linear sRGB, Mitsuba 3's RGB `sunsky` units) on a surface
 /// facing it, per turbidity 1, 2, …, 10 and solar elevation 2°, 5°, …, 89°.
 #[rustfmt::skip]
+#[allow(clippy::excessive_precision)] // nine digits, as printed; f32 keeps what it can
 pub(crate) const SUN_IRRADIANCE: [[[f32; 3]; 30]; 10] = [
     [
         [4.8476669e-01, 1.3815485e-01, -7.5810244e-03],

@@ -607,3 +607,46 @@ pub fn load_scene_with(name: &str, camera: Option<usize>, defines: &[(String, St
         ),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use clap::Parser;
+
+    use super::*;
+
+    #[derive(Parser)]
+    struct Command {
+        #[command(flatten)]
+        scene: SceneArgs,
+    }
+
+    /// `sunroom --sky 3`: the scene's sun (35° up, azimuth 200°, a delta direction) becomes
+    /// the model's, of the irradiance Mitsuba 3.9.1's sunsky gives at 35° and turbidity 3 (its
+    /// radiance at the disc's centre, (20755.25, 16636.76, 11582.435), × the disc's solid
+    /// angle), same direction and disc; the sky is the environment, bright above the horizon
+    /// and black below it.
+    #[test]
+    fn sky_replaces_the_scenes_sun_with_the_models() {
+        let before = load_scene("sunroom").unwrap();
+        let scene = Command::parse_from(["x", "sunroom", "--sky", "3"]).scene.load_scene().unwrap();
+        let sun = |s: &Scene| {
+            let distant: Vec<_> =
+                s.lights.iter().filter(|l| matches!(l, rastergi::scene::Light::Distant { .. })).collect();
+            assert_eq!(distant.len(), 1, "{:?}", s.lights);
+            *distant[0]
+        };
+        let (
+            rastergi::scene::Light::Distant { direction: d0, angular_radius: r0, .. },
+            rastergi::scene::Light::Distant { direction, irradiance, angular_radius },
+        ) = (sun(&before), sun(&scene))
+        else {
+            unreachable!()
+        };
+        assert_eq!((direction, angular_radius), (d0, r0));
+        let omega = (std::f64::consts::TAU * (1.0 - (0.5 * 0.5358f64).to_radians().cos())) as f32;
+        let mitsuba = Vec3::new(20755.25, 16636.76, 11582.435) * omega;
+        assert!(((irradiance - mitsuba) / mitsuba).abs().max_element() < 2e-3, "{irradiance} vs {mitsuba}");
+        let env = scene.environment.as_ref().expect("the sky");
+        assert!(env.eval(Vec3::Y).min_element() > 0.0 && env.eval(-Vec3::Y) == Vec3::ZERO);
+    }
+}

@@ -136,7 +136,7 @@ def render(scene: Union[str, "os.PathLike[str]"], width: int = 256, height: int 
     (``"auto"``, ``"raster"``, ``"lists"``, ``"trace"``; ``auto`` chooses by timing, so give
     another for images that repeat bit for bit), ``gather_directions``, ``directions``,
     ``hit_light``, ``show`` (``"full"``, ``"direct"``, ``"indirect"``, ``"photon-map"``),
-    ``eye``, ``target``, ``up``, ``fov``, ``camera``, ``sun``, ``sun_size``, ``point``, ``spot``,
+    ``eye``, ``target``, ``up``, ``fov``, ``camera``, ``sun``, ``sun_size``, ``sky``, ``point``, ``spot``,
     ``env``, ``env_scale``, ``light_samples``, ``photon_passes``, ``pass_iterations``,
     ``bundle``, ``backend``, ``method`` (``"gather"`` or ``"path"``, the reference path
     tracer) and ``denoise`` (``True``: the image denoised as ``rastergi render --denoise``

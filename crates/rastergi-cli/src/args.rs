@@ -207,9 +207,16 @@ pub struct SceneArgs {
     #[arg(long, default_value_t = 0)]
     pub seed: u32,
     /// Adds the sun: AZIMUTH,ELEVATION,IRRADIANCE — degrees from +Z towards +X about the +Y
-    /// axis, degrees above the XZ plane, W/m² on a surface facing it (e.g. 30,45,1000).
-    #[arg(long, value_parser = parse_sun, allow_hyphen_values = true)]
-    pub sun: Option<Vec3>,
+    /// axis, degrees above the XZ plane, W/m² on a surface facing it (e.g. 30,45,1000). With
+    /// --sky, AZIMUTH,ELEVATION alone: the sky model gives the irradiance.
+    #[arg(long, value_parser = parse_sun, allow_hyphen_values = true, value_name = "AZIMUTH,ELEVATION[,IRRADIANCE]")]
+    pub sun: Option<Sun>,
+    /// Adds a physical sky of this turbidity (1–10: 2 clear and blue, 8 hazy): Mitsuba 3's
+    /// `sunsky` (Hosek–Wilkie sky and sun, ground albedo 0.3, in its units) for the sun of
+    /// --sun AZIMUTH,ELEVATION, or for the scene's own sun, which it replaces (same direction
+    /// and disc, the model's irradiance and colour). The sky is the scene's environment.
+    #[arg(long, value_parser = parse_turbidity, value_name = "TURBIDITY")]
+    pub sky: Option<f32>,
     /// The sun's angular diameter in degrees (its soft shadows; 0 for a sharp one).
     #[arg(long, default_value_t = 0.53, requires = "sun", value_parser = parse_sun_size)]
     pub sun_size: f32,
@@ -310,8 +317,38 @@ impl SceneArgs {
         c.fov_y_deg = self.fov.unwrap_or(c.fov_y_deg);
         scene.camera.validate()?;
         scene.lights.extend(self.point.iter().chain(&self.spot).cloned());
-        if let Some(sun) = self.sun {
-            scene.lights.push(sun_light(sun, self.sun_size));
+        match (self.sun, self.sky) {
+            (Some(Sun { irradiance: Some(_), .. }), Some(_)) => anyhow::bail!(
+                "with --sky the sky model gives the sun's irradiance: give --sun AZIMUTH,ELEVATION without IRRADIANCE"
+            ),
+            (Some(Sun { irradiance: None, .. }), None) => {
+                anyhow::bail!(
+                    "--sun AZIMUTH,ELEVATION needs --sky (or add IRRADIANCE: --sun AZIMUTH,ELEVATION,IRRADIANCE)"
+                )
+            }
+            (Some(sun), None) => scene.lights.push(sun_light(sun, self.sun_size)),
+            (sun, Some(turbidity)) => {
+                if self.env.is_some() {
+                    anyhow::bail!("--sky and --env each give the scene's environment; give one of them");
+                }
+                let light = match sun {
+                    Some(sun) => sun_light(sun, self.sun_size),
+                    None => {
+                        let i = scene.lights.iter().rposition(|l| matches!(l, rastergi::scene::Light::Distant { .. }));
+                        let Some(i) = i else {
+                            anyhow::bail!(
+                                "--sky needs the sun's position: give --sun AZIMUTH,ELEVATION (the scene {} has no sun)",
+                                self.scene
+                            );
+                        };
+                        scene.lights.remove(i)
+                    }
+                };
+                let (environment, sun) = physical_sky(turbidity, light)?;
+                scene.environment = Some(std::sync::Arc::new(environment));
+                scene.lights.extend(sun);
+            }
+            (None, None) => {}
         }
         if let Some(path) = &self.env {
             let env = rastergi::environment::Environment::load(path, self.env_scale)?;
@@ -327,8 +364,8 @@ impl SceneArgs {
         if scene.lights.is_empty() && scene.emissive_triangles().is_empty() && !lit_by_env {
             log::warn!(
                 "{}: the scene has no light, so it renders black: give it emission (OBJ Ke, glTF \
-                 emissiveFactor), glTF KHR_lights_punctual lights, --sun AZIMUTH,ELEVATION,IRRADIANCE \
-                 or --env SKY.exr",
+                 emissiveFactor), glTF KHR_lights_punctual lights, --sun AZIMUTH,ELEVATION,IRRADIANCE, \
+                 --env SKY.exr or --sky TURBIDITY",
                 self.scene
             );
         }
@@ -367,27 +404,71 @@ impl SceneArgs {
     }
 }
 
-/// The sun of `--sun` (azimuth, elevation in degrees, irradiance) with angular diameter
-/// `size` degrees: light travelling along −(sin a cos e, sin e, cos a cos e).
-pub fn sun_light(sun: Vec3, size: f32) -> rastergi::scene::Light {
-    let (a, e) = (sun.x.to_radians(), sun.y.to_radians());
+/// The sun of `--sun`: azimuth and elevation in degrees, and its irradiance in W/m² (none
+/// with `--sky`, whose model gives it).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sun {
+    pub azimuth: f32,
+    pub elevation: f32,
+    pub irradiance: Option<f32>,
+}
+
+/// The sun of `--sun` with angular diameter `size` degrees: light travelling along
+/// −(sin a cos e, sin e, cos a cos e), of the given irradiance (0 where none is given: `--sky`
+/// replaces it).
+pub fn sun_light(sun: Sun, size: f32) -> rastergi::scene::Light {
+    let (a, e) = (sun.azimuth.to_radians(), sun.elevation.to_radians());
     let towards = Vec3::new(a.sin() * e.cos(), e.sin(), a.cos() * e.cos());
     rastergi::scene::Light::Distant {
         direction: -towards.normalize(),
-        irradiance: Vec3::splat(sun.z),
+        irradiance: Vec3::splat(sun.irradiance.unwrap_or(0.0)),
         angular_radius: 0.5 * size.to_radians(),
     }
 }
 
-fn parse_sun(s: &str) -> Result<Vec3, String> {
-    let v = parse_vec3(s).map_err(|e| format!("{e} (azimuth°,elevation°,irradiance W/m²)"))?;
-    if !(-90.0..=90.0).contains(&v.y) {
-        return Err(format!("the sun's elevation {}° is not within -90..90", v.y));
+/// `--sky TURBIDITY` for the sun `light` (a distant light: its direction and disc): Mitsuba
+/// 3's `sunsky` with the zenith on +Y, as the environment (sky::SKY_WIDTH × SKY_HEIGHT) and
+/// the sun with the model's irradiance (none below the horizon, where the sky is black too).
+pub fn physical_sky(
+    turbidity: f32,
+    light: rastergi::scene::Light,
+) -> Result<(rastergi::environment::Environment, Option<rastergi::scene::Light>)> {
+    let rastergi::scene::Light::Distant { direction, angular_radius, .. } = light else {
+        anyhow::bail!("--sky needs a distant light as the sun");
+    };
+    let sky = rastergi::sky::SunSky { turbidity, ..rastergi::sky::SunSky::new(-direction, Vec3::Y) };
+    if sky.sun_elevation() < 0.0 {
+        log::warn!("--sky: the sun is below the horizon, so the sky and the sun are black");
     }
-    if v.z < 0.0 {
-        return Err(format!("the sun's irradiance {} W/m² is negative", v.z));
+    let environment = sky.environment(rastergi::sky::SKY_WIDTH, rastergi::sky::SKY_HEIGHT)?;
+    let sun = sky.sun_light().map(|l| match l {
+        rastergi::scene::Light::Distant { direction, irradiance, .. } => {
+            log::info!("--sky {turbidity}: the sun's irradiance is {irradiance} W/m² (RGB)");
+            rastergi::scene::Light::Distant { direction, irradiance, angular_radius }
+        }
+        other => other,
+    });
+    Ok((environment, sun))
+}
+
+fn parse_sun(s: &str) -> Result<Sun, String> {
+    let v = parse_floats(s, &[2, 3], "AZIMUTH,ELEVATION[,IRRADIANCE] like 30,45,1000")
+        .map_err(|e| format!("{e} (azimuth°,elevation°,irradiance W/m²)"))?;
+    if !(-90.0..=90.0).contains(&v[1]) {
+        return Err(format!("the sun's elevation {}° is not within -90..90", v[1]));
     }
-    Ok(v)
+    if v.get(2).is_some_and(|&i| i < 0.0) {
+        return Err(format!("the sun's irradiance {} W/m² is negative", v[2]));
+    }
+    Ok(Sun { azimuth: v[0], elevation: v[1], irradiance: v.get(2).copied() })
+}
+
+fn parse_turbidity(s: &str) -> Result<f32, String> {
+    let t: f32 = s.parse().map_err(|_| format!("'{s}' is not a number"))?;
+    if !(1.0..=10.0).contains(&t) {
+        return Err(format!("the sky's turbidity {t} is not within the model's range 1..10"));
+    }
+    Ok(t)
 }
 
 fn parse_define(s: &str) -> Result<(String, String), String> {
@@ -524,5 +605,48 @@ pub fn load_scene_with(name: &str, camera: Option<usize>, defines: &[(String, St
         _ => anyhow::bail!(
             "unknown scene '{name}': use a built-in scene ({BUILTIN_NAMES}) or a path to a .obj, .gltf, .glb or Mitsuba .xml file"
         ),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::Parser;
+
+    use super::*;
+
+    #[derive(Parser)]
+    struct Command {
+        #[command(flatten)]
+        scene: SceneArgs,
+    }
+
+    /// `sunroom --sky 3`: the scene's sun (35° up, azimuth 200°, a delta direction) becomes
+    /// the model's, of the irradiance Mitsuba 3.9.1's sunsky gives at 35° and turbidity 3 (its
+    /// radiance at the disc's centre, (20755.25, 16636.76, 11582.435), × the disc's solid
+    /// angle), same direction and disc; the sky is the environment, bright above the horizon
+    /// and black below it.
+    #[test]
+    fn sky_replaces_the_scenes_sun_with_the_models() {
+        let before = load_scene("sunroom").unwrap();
+        let scene = Command::parse_from(["x", "sunroom", "--sky", "3"]).scene.load_scene().unwrap();
+        let sun = |s: &Scene| {
+            let distant: Vec<_> =
+                s.lights.iter().filter(|l| matches!(l, rastergi::scene::Light::Distant { .. })).collect();
+            assert_eq!(distant.len(), 1, "{:?}", s.lights);
+            *distant[0]
+        };
+        let (
+            rastergi::scene::Light::Distant { direction: d0, angular_radius: r0, .. },
+            rastergi::scene::Light::Distant { direction, irradiance, angular_radius },
+        ) = (sun(&before), sun(&scene))
+        else {
+            unreachable!()
+        };
+        assert_eq!((direction, angular_radius), (d0, r0));
+        let omega = (std::f64::consts::TAU * (1.0 - (0.5 * 0.5358f64).to_radians().cos())) as f32;
+        let mitsuba = Vec3::new(20755.25, 16636.76, 11582.435) * omega;
+        assert!(((irradiance - mitsuba) / mitsuba).abs().max_element() < 2e-3, "{irradiance} vs {mitsuba}");
+        let env = scene.environment.as_ref().expect("the sky");
+        assert!(env.eval(Vec3::Y).min_element() > 0.0 && env.eval(-Vec3::Y) == Vec3::ZERO);
     }
 }

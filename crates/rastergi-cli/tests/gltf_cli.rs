@@ -96,6 +96,34 @@ fn gltf_scenes_render_from_the_camera_chosen_with_camera() {
 }
 
 #[test]
+fn a_physical_sky_lights_a_gltf_scene() {
+    // From above (camera 1: straight down, 3 m up), the 2 × 2 floor under the emitter, without
+    // and with `--sky 3 --sun 90,30`: the sky and its sun light the floor, and the pixels
+    // around it, which look below the horizon, stay black (Mitsuba 3's sunsky is black there).
+    let dir = tempfile::tempdir().unwrap();
+    write_scene(dir.path());
+    let base = ["render", "scene.gltf", "--camera", "1", "--width", "16", "--height", "16", "--iterations", "8"];
+    let sky = ["--sky", "3", "--sun", "90,30", "--gather", "trace", "--out", "sky.exr"];
+    let run = rastergi(dir.path(), &[&base[..], &sky[..]].concat());
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let run = rastergi(dir.path(), &[&base[..], &["--gather", "trace", "--out", "plain.exr"]].concat());
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let read = |name: &str| rastergi::image_io::read_exr(&dir.path().join(name)).unwrap();
+    let (sky, plain) = (read("sky.exr"), read("plain.exr"));
+    let (mut background, mut floor_gain) = (0, 0.0f32);
+    for (s, p) in sky.pixels.iter().zip(&plain.pixels) {
+        if p.iter().all(|&v| v == 0.0) {
+            background += 1;
+            assert_eq!(*s, [0.0; 3], "a pixel below the horizon shows the sky");
+        } else {
+            floor_gain += s[1] - p[1];
+        }
+    }
+    assert!(background > 0 && background < 16 * 16, "{background} background pixels");
+    assert!(floor_gain > 0.0, "the sky adds no light to the floor");
+}
+
+#[test]
 fn a_camera_the_file_lacks_or_a_camera_for_another_scene_is_one_error_line() {
     let dir = tempfile::tempdir().unwrap();
     write_scene(dir.path());

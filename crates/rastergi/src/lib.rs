@@ -45,6 +45,8 @@ pub mod renderer;
 pub mod sampling;
 pub mod scene;
 mod shader;
+pub mod sky;
+mod sky_sun_table;
 pub mod specular;
 pub mod textures;
 

@@ -335,17 +335,15 @@ fn each_bsdf_maps_onto_the_material_model() {
         irradiance: EQUAL_ENERGY_SRGB * 3.0,
         angular_radius: 0.0
     }));
+    // The default sunsky: its sky (the environment) and its sun (a third light; values against
+    // Mitsuba 3's in `sunsky_reads_as_mitsuba_3s_and_0_6s`).
+    assert!(scene.environment.is_some() && scene.lights.len() == 3, "{:?}", scene.lights);
 
     // What is not used is named, once each.
     let warnings = warnings_about(&path);
-    for needle in [
-        "fancy-unknown",
-        "mystery-shape",
-        "sunsky",
-        "beckmann microfacet",
-        "bump maps are not supported",
-        "blendbsdf 'blend'",
-    ] {
+    for needle in
+        ["fancy-unknown", "mystery-shape", "beckmann microfacet", "bump maps are not supported", "blendbsdf 'blend'"]
+    {
         let n = warnings.iter().filter(|w| w.contains(needle)).count();
         assert!(n >= 1, "no warning about {needle}: {warnings:#?}");
     }
@@ -681,7 +679,9 @@ fn unknown_plugins_are_warned_about_once_and_the_scene_loads() {
     assert_eq!(count("<medium>"), 1, "{warnings:#?}");
     assert_eq!(count("BSDF type 'hk'"), 1, "{warnings:#?}");
     assert_eq!(count("wobble is not used"), 1, "{warnings:#?}");
-    assert_eq!(count("sky emitter is not implemented"), 1, "{warnings:#?}");
+    // 0.6's `sky` is read (the physical sky's tests): the sky alone, no warning.
+    assert!(scene.environment.is_some() && scene.lights.is_empty());
+    assert_eq!(count("sky emitter") + count("emitter 'sky'"), 0, "{warnings:#?}");
 }
 
 #[test]
@@ -889,4 +889,89 @@ fn the_shared_staircase_and_sponza_load_as_their_files_say() {
         let expected = PI * 16000.0 * EQUAL_ENERGY_SRGB.x * 4.0 * PI * 0.01;
         assert!((power.x - expected).abs() < 1e-3 * expected, "{power} vs {expected}");
     }
+}
+
+/// The environment's radiance at `d` against Mitsuba 3's `emitter.eval` there: within 1 %
+/// (the map is bilinear between pixels 0.35° apart; the model varies slowly away from the sun).
+fn sky_is(env: &rastergi::environment::Environment, d: Vec3, mitsuba: Vec3) {
+    let got = env.eval(d.normalize());
+    assert!(((got - mitsuba) / mitsuba).abs().max_element() < 0.01, "{d}: {got} vs Mitsuba 3's {mitsuba}");
+}
+
+/// The one light, a distant one: its direction (where light travels) and irradiance.
+fn the_sun(scene: &Scene) -> (Vec3, Vec3, f32) {
+    let [rastergi::scene::Light::Distant { direction, irradiance, angular_radius }] = scene.lights[..] else {
+        panic!("one distant light: {:?}", scene.lights);
+    };
+    (direction, irradiance, angular_radius)
+}
+
+#[test]
+fn sunsky_reads_as_mitsuba_3s_and_0_6s() {
+    // Values Mitsuba 3.9.1 prints (llvm_ad_rgb, `emitter.eval`; the sun's radiance times its
+    // disc's solid angle): a default `sunsky` (Tokyo, 2010-07-10 15:00, turbidity 3, albedo
+    // 0.3, Z up), and the same as 0.6 reads it (Y up, albedo 0.15, scale 2) with a given sun.
+    let v3 = br#"<scene version="3.0.0"><emitter type="sunsky"/><shape type="cube"/></scene>"#;
+    let v06 = br#"<scene version="0.6.0">
+        <emitter type="sunsky">
+            <vector name="sunDirection" x="0.3" y="0.8" z="-0.5"/>
+            <float name="scale" value="2"/>
+            <float name="sunRadiusScale" value="0"/>
+            <integer name="resolution" value="256"/>
+        </emitter>
+        <shape type="cube"/>
+    </scene>"#;
+    let sun_only = br#"<scene version="0.6.0"><emitter type="sun"><vector name="sunDirection" x="0.3" y="0.8" z="-0.5"/><float name="scale" value="2"/></emitter><shape type="cube"/></scene>"#;
+    let sky_only = br#"<scene version="0.6.0"><emitter type="sky"><vector name="sunDirection" x="0.3" y="0.8" z="-0.5"/><float name="scale" value="2"/></emitter><shape type="cube"/></scene>"#;
+    let both = br#"<scene version="3.0.0"><emitter type="sunsky"><vector name="sun_direction" x="0" y="0" z="1"/><float name="hour" value="9"/></emitter></scene>"#;
+    let murky =
+        br#"<scene version="3.0.0"><emitter type="sunsky"><float name="turbidity" value="12"/></emitter></scene>"#;
+    let dir = scratch(&[
+        ("v3.xml", v3),
+        ("v06.xml", v06),
+        ("sun.xml", sun_only),
+        ("sky.xml", sky_only),
+        ("both.xml", both),
+        ("murky.xml", murky),
+    ]);
+    start_capture();
+
+    let scene = load(&dir.path().join("v3.xml")).scene;
+    let env = scene.environment.as_ref().expect("the sky");
+    sky_is(env, Vec3::Z, Vec3::new(0.02435108, 0.04230876, 0.08559478));
+    sky_is(env, Vec3::new(1.0, 0.0, 0.2), Vec3::new(0.08044496, 0.13044094, 0.20640446));
+    sky_is(env, Vec3::new(0.0, -1.0, 0.5), Vec3::new(0.04145552, 0.0761675, 0.14089988));
+    assert_eq!(env.eval(Vec3::new(0.3, 0.2, -0.9).normalize()), Vec3::ZERO, "black below the horizon");
+    let (direction, irradiance, radius) = the_sun(&scene);
+    assert!(close(-direction, Vec3::new(0.05138512, 0.691748, 0.7203085), 1e-3), "{direction}");
+    let mitsuba = Vec3::new(1.4710907, 1.2106092, 0.8957329);
+    assert!(((irradiance - mitsuba) / mitsuba).abs().max_element() < 2e-3, "{irradiance} vs {mitsuba}");
+    assert!((radius - (0.5 * 0.5358f32).to_radians()).abs() < 1e-7);
+
+    let file = dir.path().join("v06.xml");
+    let scene = load(&file).scene;
+    let env = scene.environment.as_ref().expect("the sky");
+    sky_is(env, Vec3::Y, Vec3::new(0.0553268, 0.08946305, 0.17662245));
+    sky_is(env, Vec3::new(1.0, 0.2, 0.0), Vec3::new(0.16776873, 0.26477593, 0.42151704));
+    sky_is(env, Vec3::new(0.0, 0.5, 1.0), Vec3::new(0.07120366, 0.13429418, 0.25932977));
+    let (direction, irradiance, radius) = the_sun(&scene);
+    assert!(close(-direction, Vec3::new(0.3, 0.8, -0.5).normalize(), 1e-6));
+    let mitsuba = Vec3::new(2.9825687, 2.482181, 1.8844848);
+    assert!(((irradiance - mitsuba) / mitsuba).abs().max_element() < 2e-3, "{irradiance} vs {mitsuba}");
+    assert!(radius < 1e-6, "sunRadiusScale 0: a delta direction, not {radius}");
+    assert!(warnings_about(&file).iter().any(|w| w.contains("resolution")), "{:?}", warnings_about(&file));
+
+    // 0.6's sun alone and sky alone: the same parts.
+    let sun = load(&dir.path().join("sun.xml")).scene;
+    assert!(sun.environment.is_none());
+    assert_eq!(the_sun(&sun).1, irradiance);
+    let sky = load(&dir.path().join("sky.xml")).scene;
+    assert!(sky.lights.is_empty());
+    sky_is(sky.environment.as_ref().unwrap(), Vec3::Y, Vec3::new(0.0553268, 0.08946305, 0.17662245));
+
+    // Mitsuba 3 refuses both a sun direction and a time, and a turbidity outside 1..10.
+    let err = load_err(&dir.path().join("both.xml"));
+    assert!(err.contains("not both") && err.contains("line 1"), "{err}");
+    let err = load_err(&dir.path().join("murky.xml"));
+    assert!(err.contains("turbidity 12"), "{err}");
 }

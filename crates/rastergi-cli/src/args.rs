@@ -232,7 +232,9 @@ pub struct SceneArgs {
     pub spot: Vec<rastergi::scene::Light>,
     /// Lights the scene with an environment map: an equirectangular .exr or .hdr image of
     /// the radiance from every direction (Mitsuba 3's `envmap` convention: row 0 is +Y, the
-    /// image's left edge looks along −Z, its first quarter turns towards +X).
+    /// image's left edge looks along −Z, its first quarter turns towards +X). A scene without
+    /// lights (and a glTF model whose only light is emission) is lit by a neutral grey
+    /// environment unless this is given; `none` turns that off.
     #[arg(long, value_name = "FILE")]
     pub env: Option<std::path::PathBuf>,
     /// Scales the environment map's radiance.
@@ -350,7 +352,8 @@ impl SceneArgs {
             }
             (None, None) => {}
         }
-        if let Some(path) = &self.env {
+        let no_default_light = self.env.as_deref() == Some(Path::new("none"));
+        if let Some(path) = self.env.as_ref().filter(|_| !no_default_light) {
             let env = rastergi::environment::Environment::load(path, self.env_scale)?;
             if env.is_dark() {
                 log::warn!("{}: the environment map is black everywhere; it adds no light", path.display());
@@ -360,12 +363,18 @@ impl SceneArgs {
         if self.single_scattering {
             scene.single_scattering();
         }
-        let lit_by_env = scene.environment.as_ref().is_some_and(|e| !e.is_dark());
-        if scene.lights.is_empty() && scene.emissive_triangles().is_empty() && !lit_by_env {
+        let model = matches!(extension_of(&self.scene).as_deref(), Some("gltf" | "glb"));
+        if no_default_light {
+            let lit_by_env = scene.environment.as_ref().is_some_and(|e| !e.is_dark());
+            if scene.lights.is_empty() && !lit_by_env && scene.emissive_triangles().is_empty() {
+                log::warn!("{}: the scene has no light and --env none, so it renders black", self.scene);
+            }
+        } else if let Some(what) = scene.light_if_unlit(model) {
+            // glTF models rarely carry lights, and glTF viewers show them in a neutral
+            // image-based light by default: so does rastergi, a scene without any light too.
             log::warn!(
-                "{}: the scene has no light, so it renders black: give it emission (OBJ Ke, glTF \
-                 emissiveFactor), glTF KHR_lights_punctual lights, --sun AZIMUTH,ELEVATION,IRRADIANCE, \
-                 --env SKY.exr or --sky TURBIDITY",
+                "{}: {what}: lit by a neutral grey environment, as glTF viewers light models (--env none: \
+                 no light; --env SKY.hdr, --sky TURBIDITY or --sun: other light)",
                 self.scene
             );
         }
@@ -580,10 +589,15 @@ pub fn load_scene_with_camera(name: &str, camera: Option<usize>) -> Result<Scene
     load_scene_with(name, camera, &[])
 }
 
+/// The file extension of a scene name, lower case.
+fn extension_of(name: &str) -> Option<String> {
+    Path::new(name).extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase)
+}
+
 /// [`load_scene_with_camera`] with the parameter values of a Mitsuba file (`-D name=value`).
 pub fn load_scene_with(name: &str, camera: Option<usize>, defines: &[(String, String)]) -> Result<Scene> {
     let path = Path::new(name);
-    let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    let extension = extension_of(name);
     if camera.is_some() && !matches!(extension.as_deref(), Some("gltf" | "glb")) {
         anyhow::bail!("--camera chooses among a glTF file's cameras; '{name}' is not a .gltf or .glb file");
     }

@@ -309,16 +309,25 @@ fn floor_obj(dir: &Path) -> &'static str {
 }
 
 #[test]
-fn a_scene_without_light_warns_and_the_sun_lights_it() {
+fn a_scene_without_light_is_lit_by_a_neutral_environment_or_the_sun() {
     let dir = tempfile::tempdir().unwrap();
     let floor = floor_obj(dir.path());
     let camera = ["--eye", "0,3,0.01", "--target", "0,0,0", "--fov", "40", "--width", "16", "--height", "16"];
-    let dark =
-        rastergi(dir.path(), &[&["render", floor, "--iterations", "1", "--out", "dark.exr"], &camera[..]].concat());
+    // Without light it is lit by the neutral environment, with one line saying so; with
+    // `--env none` too, it renders black, with one line saying that.
+    let grey =
+        rastergi(dir.path(), &[&["render", floor, "--iterations", "1", "--out", "grey.exr"], &camera[..]].concat());
+    assert!(grey.status.success(), "{}", grey.stderr);
+    let warnings: Vec<&str> = grey.our_stderr().into_iter().filter(|l| l.contains("neutral grey")).collect();
+    assert_eq!(warnings.len(), 1, "one warning line:\n{}", grey.stderr);
+    assert!(warnings[0].contains("floor.obj: no lights") && warnings[0].contains("--env none"), "{}", warnings[0]);
+    let none = ["render", floor, "--iterations", "1", "--env", "none", "--out", "dark.exr"];
+    let dark = rastergi(dir.path(), &[&none[..], &camera[..]].concat());
     assert!(dark.status.success(), "{}", dark.stderr);
     let warnings: Vec<&str> = dark.our_stderr().into_iter().filter(|l| l.contains("has no light")).collect();
     assert_eq!(warnings.len(), 1, "one warning line:\n{}", dark.stderr);
-    assert!(warnings[0].contains("--sun") && warnings[0].contains("Ke"), "{}", warnings[0]);
+    let img = rastergi::image_io::read_exr(&dir.path().join("dark.exr")).unwrap();
+    assert!(img.pixels.iter().all(|p| *p == [0.0; 3]), "--env none lit the floor");
     // Sun at 30° elevation (azimuth 90°: towards +X), 2 W/m², a point (size 0): the floor gets
     // E sin 30° = 1, radiance ρ/π · 1 everywhere (nothing shadows it, nothing comes back).
     let sun = ["--sun", "90,30,2", "--sun-size", "0"];
@@ -327,7 +336,7 @@ fn a_scene_without_light_warns_and_the_sun_lights_it() {
         &[&["render", floor, "--iterations", "4", "--out", "lit.exr"], &camera[..], &sun[..]].concat(),
     );
     assert!(lit.status.success(), "{}", lit.stderr);
-    assert!(!lit.stderr.contains("has no light"), "{}", lit.stderr);
+    assert!(!lit.stderr.contains("has no light") && !lit.stderr.contains("neutral grey"), "{}", lit.stderr);
     let img = rastergi::image_io::read_exr(&dir.path().join("lit.exr")).unwrap();
     let expected = 0.5 / std::f32::consts::PI;
     for p in &img.pixels {
@@ -363,7 +372,7 @@ fn a_physical_sky_lights_an_open_floor_as_mitsubas_sunsky_does() {
         &[&["render", floor, "--iterations", "16", "--out", "sky.exr"], &camera[..], &sky[..]].concat(),
     );
     assert!(run.status.success(), "{}", run.stderr);
-    assert!(!run.stderr.contains("has no light"), "{}", run.stderr);
+    assert!(!run.stderr.contains("has no light") && !run.stderr.contains("neutral grey"), "{}", run.stderr);
     // Mitsuba 3.9.1's sunsky (turbidity 3, albedo 0.3, the sun 30° up, its Z-up frame turned
     // to Y up) on an open floor of albedo ½: its sky's irradiance there (a 2000 × 4000
     // midpoint quadrature of `emitter.eval` over the hemisphere) is (0.144370, 0.221091,
@@ -435,7 +444,7 @@ fn an_environment_map_lights_an_open_floor_from_exr_and_hdr_alike() {
         ];
         let run = rastergi(d, &[&args[..], &camera[..]].concat());
         assert!(run.status.success(), "{}", run.stderr);
-        assert!(!run.stderr.contains("has no light"), "{}", run.stderr);
+        assert!(!run.stderr.contains("has no light") && !run.stderr.contains("neutral grey"), "{}", run.stderr);
         images.push(rastergi::image_io::read_exr(&d.join(out)).unwrap());
     }
     assert_eq!(images[0], images[1], "the same sky from .exr and .hdr renders the same image");
@@ -482,7 +491,7 @@ fn point_and_spot_options_light_the_floor_below_them() {
         let args = [&["render", floor, "--iterations", "8", "--out", out][..], &light[..], &camera[..]].concat();
         let run = rastergi(dir.path(), &args);
         assert!(run.status.success(), "{}", run.stderr);
-        assert!(!run.stderr.contains("has no light"), "{}", run.stderr);
+        assert!(!run.stderr.contains("has no light") && !run.stderr.contains("neutral grey"), "{}", run.stderr);
         let img = rastergi::image_io::read_exr(&dir.path().join(out)).unwrap();
         let c = centre(&img);
         assert!(c.iter().all(|&v| (0.98 * rho_over_pi..=1.0001 * rho_over_pi).contains(&v)), "{out}: centre {c:?}");

@@ -106,7 +106,8 @@ fn a_physical_sky_lights_a_gltf_scene() {
     let sky = ["--sky", "3", "--sun", "90,30", "--gather", "trace", "--out", "sky.exr"];
     let run = rastergi(dir.path(), &[&base[..], &sky[..]].concat());
     assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
-    let run = rastergi(dir.path(), &[&base[..], &["--gather", "trace", "--out", "plain.exr"]].concat());
+    let plain = ["--gather", "trace", "--env", "none", "--out", "plain.exr"];
+    let run = rastergi(dir.path(), &[&base[..], &plain[..]].concat());
     assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
     let read = |name: &str| rastergi::image_io::read_exr(&dir.path().join(name)).unwrap();
     let (sky, plain) = (read("sky.exr"), read("plain.exr"));
@@ -121,6 +122,42 @@ fn a_physical_sky_lights_a_gltf_scene() {
     }
     assert!(background > 0 && background < 16 * 16, "{background} background pixels");
     assert!(floor_gain > 0.0, "the sky adds no light to the floor");
+}
+
+/// A glTF model whose only light is an emissive surface is lit, as glTF viewers light models,
+/// by the neutral grey environment, and says so in one line: seen from above, the pixels
+/// around the floor look below the horizon, where that environment's radiance is 0.3 exactly
+/// (with `--env none` they are black); the floor gets its light beside the emitter's.
+#[test]
+fn a_gltf_model_without_lights_is_lit_by_a_neutral_environment() {
+    let dir = tempfile::tempdir().unwrap();
+    write_scene(dir.path());
+    let base = ["render", "scene.gltf", "--camera", "1", "--width", "16", "--height", "16", "--iterations", "8"];
+    let run = rastergi(dir.path(), &[&base[..], &["--gather", "trace", "--out", "lit.exr"]].concat());
+    let log = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{log}");
+    let said: Vec<&str> = log.lines().filter(|l| l.contains("neutral grey environment")).collect();
+    assert_eq!(said.len(), 1, "{log}");
+    assert!(said[0].contains("scene.gltf: no lights but its emissive surfaces"), "{log}");
+    let run = rastergi(dir.path(), &[&base[..], &["--gather", "trace", "--env", "none", "--out", "dark.exr"]].concat());
+    let log = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success() && !log.contains("neutral"), "{log}");
+    let read = |name: &str| rastergi::image_io::read_exr(&dir.path().join(name)).unwrap();
+    let (lit, dark) = (read("lit.exr"), read("dark.exr"));
+    // Black without the environment: the background, or the emitter's unlit black back.
+    let (mut background, mut floor_gain) = (0, 0.0f32);
+    for (l, d) in lit.pixels.iter().zip(&dark.pixels) {
+        if d.iter().all(|&v| v == 0.0) {
+            let sky = l.iter().all(|&v| (v - 0.3).abs() < 1e-5);
+            assert!(sky || *l == [0.0; 3], "a pixel black without the environment shows {l:?}");
+            background += sky as usize;
+        } else {
+            floor_gain += l[1] - d[1];
+        }
+    }
+    assert!((lit.pixels[0][0] - 0.3).abs() < 1e-5, "the corner shows {:?}", lit.pixels[0]);
+    assert!(background > 0 && background < 16 * 16, "{background} background pixels");
+    assert!(floor_gain > 0.0, "the neutral environment adds no light to the floor");
 }
 
 #[test]

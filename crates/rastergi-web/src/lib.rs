@@ -201,6 +201,10 @@ fn load_scene(files: &MemoryFiles) -> rastergi::Result<(String, Scene)> {
         Some("obj") => rastergi::scene::load_obj_in(Files::Memory(files), path)?,
         _ => rastergi::scene::load_gltf_in(Files::Memory(files), path, &GltfOptions::default())?,
     };
+    let mut scene = scene;
+    if let Some(what) = scene.light_if_unlit(matches!(kind(name).as_deref(), Some("glb" | "gltf"))) {
+        log::warn!("{name}: {what}: lit by a neutral grey environment, as glTF viewers light models");
+    }
     Ok((name.to_string(), scene))
 }
 

@@ -573,6 +573,21 @@ impl Scene {
         h.digest()
     }
 
+    /// Lights a scene that has no light of its own as glTF viewers light models: with
+    /// [`crate::environment::Environment::neutral`], where it has no lights, no environment
+    /// that gives light, and either no emissive surface or (`model`: a glTF file, whose
+    /// emission is rarely meant to light it) only emissive surfaces. Returns what it found
+    /// ("no lights", "no lights but its emissive surfaces") where it lit the scene.
+    pub fn light_if_unlit(&mut self, model: bool) -> Option<&'static str> {
+        let lit_by_env = self.environment.as_ref().is_some_and(|e| !e.is_dark());
+        let emissive = !self.emissive_triangles().is_empty();
+        if !self.lights.is_empty() || lit_by_env || (emissive && !model) {
+            return None;
+        }
+        self.environment = Some(std::sync::Arc::new(crate::environment::Environment::neutral()));
+        Some(if emissive { "no lights but its emissive surfaces" } else { "no lights" })
+    }
+
     /// Every material without the rough metal's multiple-scattering compensation: the
     /// single-scattering model of Mitsuba 3's `roughconductor`, for comparisons with it.
     pub fn single_scattering(&mut self) {

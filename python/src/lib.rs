@@ -108,15 +108,20 @@ fn shared_gpu(args: &rastergi_cli::args::GpuArgs) -> Result<rastergi::gpu::Gpu> 
     Ok(gpu)
 }
 
-/// Loads the scene and builds the renderer as `rastergi render` does (the photon map traced).
-fn build(o: &RenderOptions) -> Result<Box<dyn Progressive>, PyErr> {
+/// Width and height in pixels.
+type ImageSize = (u32, u32);
+
+/// Loads the scene and builds the renderer as `rastergi render` does (the photon map traced);
+/// with its image size.
+fn build(o: &RenderOptions) -> Result<(Box<dyn Progressive>, ImageSize), PyErr> {
     cli_render::check_method_show(o.method, o.scene.show).map_err(value_err)?;
     if o.denoise && (o.method != Method::Gather || !matches!(o.scene.show, ShowArg::Full)) {
         return Err(PyValueError::new_err("denoise needs method='gather' and the full image (no show)"));
     }
     let a = &o.scene;
     let scene = a.load_scene().map_err(py_err)?;
-    let settings = a.settings(&scene, a.width, a.height, matches!(a.show, ShowArg::PhotonMap));
+    let (width, height) = a.image_size(&scene);
+    let settings = a.settings(&scene, width, height, matches!(a.show, ShowArg::PhotonMap));
     let gpu = shared_gpu(&a.gpu).map_err(py_err)?;
     let (mut renderer, _) = cli_render::new_renderer(&gpu, &scene, settings, o.method).map_err(py_err)?;
     if o.denoise
@@ -125,7 +130,7 @@ fn build(o: &RenderOptions) -> Result<Box<dyn Progressive>, PyErr> {
         r.enable_denoiser().map_err(|e| py_err(e.into()))?;
     }
     renderer.wait().map_err(|e| py_err(e.into()))?;
-    Ok(renderer)
+    Ok((renderer, (width, height)))
 }
 
 /// Iterations submitted between waits (as `rastergi render`'s queue) and between checks for
@@ -194,7 +199,7 @@ fn render<'py>(py: Python<'py>, argv: Vec<String>) -> PyResult<Bound<'py, PyArra
     if o.iterations == 0 {
         return Err(PyValueError::new_err("--iterations must be at least 1"));
     }
-    let mut renderer = py.detach(|| build(&o))?;
+    let (mut renderer, _) = py.detach(|| build(&o))?;
     in_chunks(py, o.iterations, |k| iterations(renderer.as_mut(), k))?;
     let show = o.scene.show.show();
     let denoise = o.denoise;
@@ -249,14 +254,8 @@ impl PyRenderer {
     #[new]
     fn new(py: Python<'_>, argv: Vec<String>) -> PyResult<Self> {
         let o = parse(argv)?;
-        let renderer = py.detach(|| build(&o))?;
-        Ok(PyRenderer {
-            renderer: Mutex::new(renderer),
-            show: o.scene.show,
-            method: o.method,
-            width: o.scene.width,
-            height: o.scene.height,
-        })
+        let (renderer, (width, height)) = py.detach(|| build(&o))?;
+        Ok(PyRenderer { renderer: Mutex::new(renderer), show: o.scene.show, method: o.method, width, height })
     }
 
     /// Runs `n` more iterations (one sample per pixel each).

@@ -178,12 +178,14 @@ impl GatherDirectionsArg {
 pub struct SceneArgs {
     /// The scene: built in (`cornell`, `atrium`, `spheres:N` for about N triangles, `rooms`, `rooms:closed`, `glossy-room`, `sunroom`), a Wavefront .obj file, a glTF 2.0 .gltf/.glb file or a Mitsuba .xml scene file.
     pub scene: String,
-    /// Image width in pixels (`view`: the window's initial width).
-    #[arg(long, default_value_t = 256)]
-    pub width: u32,
-    /// Image height in pixels (`view`: the window's initial height).
-    #[arg(long, default_value_t = 256)]
-    pub height: u32,
+    /// Image width in pixels (`view`: the window's initial width) [default: the scene file's
+    /// film (Mitsuba), else 256].
+    #[arg(long)]
+    pub width: Option<u32>,
+    /// Image height in pixels (`view`: the window's initial height) [default: the scene
+    /// file's film (Mitsuba), else 256].
+    #[arg(long)]
+    pub height: Option<u32>,
     /// Camera position, overriding the scene's (x,y,z).
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
     pub eye: Option<Vec3>,
@@ -379,6 +381,19 @@ impl SceneArgs {
             );
         }
         Ok(scene)
+    }
+
+    /// The image size: `--width` and `--height` as given, else the scene file's film (where one
+    /// of them is given, the other from the film's aspect), else 256 × 256.
+    pub fn image_size(&self, scene: &Scene) -> (u32, u32) {
+        let other = |given: u32, a: u32, b: u32| ((given as u64 * b as u64 + a as u64 / 2) / a as u64).max(1) as u32;
+        match (self.width, self.height, scene.framing.filter(|f| f.width > 0 && f.height > 0)) {
+            (Some(w), Some(h), _) => (w, h),
+            (None, None, Some(f)) => (f.width, f.height),
+            (Some(w), None, Some(f)) => (w, other(w, f.width, f.height)),
+            (None, Some(h), Some(f)) => (other(h, f.height, f.width), h),
+            (w, h, None) => (w.unwrap_or(256), h.unwrap_or(256)),
+        }
     }
 
     /// The renderer's settings for `scene` at the given image size: the photon grid and count
@@ -611,7 +626,7 @@ pub fn load_scene_with(name: &str, camera: Option<usize>, defines: &[(String, St
             let m = load_mitsuba(path, &MitsubaOptions { defines: defines.to_vec() })?;
             if let (Some((w, h)), Some(n)) = (m.film, m.sample_count) {
                 log::info!(
-                    "{name}: its film is {w}x{h} pixels with {n} samples per pixel (--width {w} --height {h} --iterations {n})"
+                    "{name}: its film is {w}x{h} pixels with {n} samples per pixel (the default size and iterations)"
                 );
             }
             Ok(m.scene)

@@ -35,9 +35,9 @@ pub struct RenderArgs {
     #[command(flatten)]
     scene: SceneArgs,
     /// Progressive iterations (one sample per pixel each) in all, a resumed checkpoint's
-    /// included.
-    #[arg(long, default_value_t = 256)]
-    iterations: u32,
+    /// included [default: the scene file's sample count (Mitsuba's sampler), else 256].
+    #[arg(long)]
+    iterations: Option<u32>,
     /// Stop after this many seconds of rendering (set-up not counted) if the iterations are
     /// not done by then; the image holds the iterations done, and a note says how many.
     #[arg(long, value_name = "SECONDS", alias = "max-seconds")]
@@ -205,7 +205,8 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     let start = Instant::now();
     let scene = a.load_scene()?;
     log::info!("{}: {} triangles loaded in {:.2} s", a.scene, scene.triangles.len(), start.elapsed().as_secs_f64());
-    if args.iterations == 0 {
+    let iterations = args.iterations.or(scene.framing.and_then(|f| f.samples)).unwrap_or(256);
+    if iterations == 0 {
         anyhow::bail!("--iterations must be at least 1");
     }
     if let Some(s) = args.time_limit.filter(|s| !(s.is_finite() && *s > 0.0)) {
@@ -217,7 +218,8 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     if !(args.checkpoint_every.is_finite() && args.checkpoint_every >= 0.0) {
         anyhow::bail!("--checkpoint-every must be a number of seconds ≥ 0, got {}", args.checkpoint_every);
     }
-    let settings = a.settings(&scene, a.width, a.height, matches!(a.show, ShowArg::PhotonMap));
+    let (width, height) = a.image_size(&scene);
+    let settings = a.settings(&scene, width, height, matches!(a.show, ShowArg::PhotonMap));
     let mut fingerprint = settings.fingerprint();
     fingerprint.insert(0, ("method".to_owned(), args.method.name().to_owned()));
     let scene_hash = scene.content_hash();
@@ -263,7 +265,7 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     let start = Instant::now();
     let first = renderer.samples();
     let progress = if std::io::stderr().is_terminal() {
-        let bar = ProgressBar::new(args.iterations as u64);
+        let bar = ProgressBar::new(iterations as u64);
         bar.set_style(
             ProgressStyle::with_template("{bar:40} {pos}/{len} iterations  {per_sec}  eta {eta}  {msg}")
                 .expect("valid progress template"),
@@ -287,7 +289,7 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
         if sig != 0 {
             break Stop::Signal(sig as i32);
         }
-        if done >= args.iterations {
+        if done >= iterations {
             break Stop::Done;
         }
         renderer.iterate()?;
@@ -401,8 +403,8 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     let saved = args.checkpoint.as_ref().map_or(String::new(), |p| format!("; checkpoint {}", p.display()));
     match stop {
         Stop::Done => {
-            if first >= args.iterations && resume.is_some() {
-                eprintln!("note: the checkpoint already holds {first} iterations (--iterations {})", args.iterations);
+            if first >= iterations && resume.is_some() {
+                eprintln!("note: the checkpoint already holds {first} iterations (--iterations {iterations})");
             }
             Ok(ExitCode::SUCCESS)
         }
@@ -410,7 +412,7 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
             eprintln!(
                 "note: --time-limit {} reached: {done} of {} iterations in {seconds:.2} s{error_text}{saved}",
                 args.time_limit.unwrap_or_default(),
-                args.iterations
+                iterations
             );
             Ok(ExitCode::SUCCESS)
         }
@@ -427,7 +429,7 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
             eprintln!(
                 "interrupted ({name}): {} holds {done} of {} iterations{error_text}{saved}",
                 args.out.display(),
-                args.iterations
+                iterations
             );
             Ok(ExitCode::from(128 + sig as u8))
         }

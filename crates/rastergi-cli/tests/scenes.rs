@@ -157,3 +157,30 @@ fn fetch_scenes_copies_the_shared_scenes_and_refuses_a_truncated_file() {
         assert!(stderr(&run).contains(what) && stderr(&run).lines().count() == 1, "{}", stderr(&run));
     }
 }
+
+/// A Mitsuba file's film and sample count are what `render` makes when not told otherwise: its
+/// size (one of `--width` and `--height` given: the other from its aspect) and its iterations.
+#[test]
+fn a_mitsuba_files_film_and_sample_count_are_the_default_size_and_iterations() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../rastergi/tests/data/mitsuba/basic.xml");
+    let xml = std::fs::read_to_string(data).unwrap();
+    let xml = xml.replace("\"400\"", "\"24\"").replace("\"200\"", "\"12\"").replace("\"64\"", "\"3\"");
+    assert!(xml.contains("value=\"24\"") && xml.contains("value=\"3\""), "basic.xml changed: {xml}");
+    std::fs::write(dir.path().join("scene.xml"), xml).unwrap();
+    let render = |extra: &[&str], out: &str| {
+        let run = rastergi(dir.path(), &[&["render", "scene.xml", "--photons", "4096", "--out", out], extra].concat());
+        let log = stderr(&run);
+        assert!(run.status.success(), "{log}");
+        let image = rastergi::image_io::read_exr(&dir.path().join(out)).unwrap();
+        let iterations = log
+            .lines()
+            .find_map(|l| l.split("rastergi_cli::render] ").nth(1)?.strip_suffix(" s")?.split_once(" iterations in "))
+            .map(|(n, _)| n.parse::<u32>().unwrap());
+        ((image.width, image.height), iterations)
+    };
+    assert_eq!(render(&[], "film.exr"), ((24, 12), Some(3)));
+    assert_eq!(render(&["--width", "48"], "wide.exr"), ((48, 24), Some(3)));
+    assert_eq!(render(&["--height", "8", "--iterations", "2"], "small.exr"), ((16, 8), Some(2)));
+    assert_eq!(render(&["--width", "10", "--height", "10"], "square.exr"), ((10, 10), Some(3)));
+}

@@ -132,7 +132,7 @@ impl App {
             building: None,
             generation: 0,
             pending_open: None,
-            size: (a.width, a.height),
+            size: (a.width.unwrap_or(256), a.height.unwrap_or(256)),
             resized_at: None,
             occluded: false,
             retry_at: None,

@@ -74,7 +74,7 @@ Any camera move restarts the accumulation; the photon map is kept.\n"
 /// The keys, for the start-up message.
 pub const KEYS: &str = keys_text!();
 
-#[derive(Args, Debug)]
+#[derive(Args, Clone, Debug)]
 pub struct ViewArgs {
     #[command(flatten)]
     scene: SceneArgs,
@@ -108,6 +108,7 @@ Each screenshot prints its files and the camera as render options to stdout."
 );
 
 pub fn run(args: &ViewArgs) -> Result<()> {
+    let mut args = args.clone();
     // Everything that can be checked without a window is checked first.
     let steps = args.script.as_deref().map(script::load).transpose()?;
     // No directory: names relative to the current directory, printed as such.
@@ -118,12 +119,16 @@ pub fn run(args: &ViewArgs) -> Result<()> {
             dir.display()
         );
     }
+    let scene = args.scene.load_scene()?;
+    // The window's first size: the scene file's film unless given.
+    let (width, height) = args.scene.image_size(&scene);
+    args.scene.width = Some(width);
+    args.scene.height = Some(height);
     let a = &args.scene;
-    let scene = a.load_scene()?;
-    let base = a.settings(&scene, a.width, a.height, true);
+    let base = a.settings(&scene, width, height, true);
     // Building the first renderer validates the rest; check the size here for a clear error.
-    if a.width == 0 || a.height == 0 {
-        bail!("the window size {}x{} is empty; give a --width and --height of at least 1", a.width, a.height);
+    if width == 0 || height == 0 {
+        bail!("the window size {width}x{height} is empty; give a --width and --height of at least 1");
     }
 
     check_display()?;

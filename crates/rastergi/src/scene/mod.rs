@@ -524,6 +524,17 @@ pub struct Scene {
     /// Textures, referred to by the materials.
     pub textures: Vec<Texture>,
     pub camera: Camera,
+    /// The image its file frames (a Mitsuba film and sampler), if it says: what `render`
+    /// makes when not told otherwise.
+    pub framing: Option<Framing>,
+}
+
+/// The image a scene file frames: its film's size and its sample count per pixel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Framing {
+    pub width: u32,
+    pub height: u32,
+    pub samples: Option<u32>,
 }
 
 impl Scene {
@@ -539,6 +550,7 @@ impl Scene {
             tangents: Vec::new(),
             textures: Vec::new(),
             camera,
+            framing: None,
         }
     }
 

@@ -138,6 +138,7 @@ pub fn load_mitsuba_in(files: Files, path: &Path, options: &MitsubaOptions) -> R
         return Err(Error::SceneFile { path: path.to_path_buf(), message: "has no shapes with triangles".into() });
     }
     scene.camera = camera.unwrap_or_else(|| scene.default_camera());
+    scene.framing = film.map(|(width, height)| super::Framing { width, height, samples: sample_count });
     scene.validate().map_err(|e| Error::SceneFile { path: path.to_path_buf(), message: e.to_string() })?;
     Ok(MitsubaScene { scene, film, sample_count })
 }

@@ -16,6 +16,10 @@ pub struct GpuOptions {
     /// adapter's own limit where it is lower): [`WEB_STORAGE_BUFFERS`] gives a native device a
     /// browser's limit, so that tests check what a web page can run.
     pub max_storage_buffers: Option<u32>,
+    /// Which traversal the passes' rays take ([`crate::accel`]); `None` means `RASTERGI_RAYS`
+    /// if set, else the compute BVH (so that a library caller or a test gets the hardware path
+    /// only where it asks: `--rays` of the front ends defaults to `auto`).
+    pub rays: Option<crate::accel::Rays>,
 }
 
 /// The most storage buffers per shader stage that browsers' WebGPU grants (Chrome's adapters
@@ -48,6 +52,9 @@ pub struct Gpu {
     pub info: wgpu::AdapterInfo,
     /// Pass timings, when profiling was asked for and the adapter supports timestamps.
     pub profiler: Option<Profiler>,
+    /// The ray path asked for ([`GpuOptions::rays`] resolved); the device has
+    /// `EXPERIMENTAL_RAY_QUERY` where this is not `Compute` and the adapter offers it.
+    pub rays: crate::accel::Rays,
     /// The first error the device reported outside a call that returns one (a lost device, a
     /// GPU timeout, an allocation that failed): [`Gpu::wait`] and every readback return it.
     fault: std::sync::Arc<std::sync::Mutex<Fault>>,
@@ -76,6 +83,11 @@ impl GpuOptions {
     /// The backends to consider: as asked, else `WGPU_BACKEND`, else Vulkan/Metal/DX12.
     pub fn backends(&self) -> wgpu::Backends {
         self.backends.or_else(wgpu::Backends::from_env).unwrap_or(wgpu::Backends::PRIMARY)
+    }
+
+    /// The ray path asked for: as set, else `RASTERGI_RAYS`, else the compute BVH.
+    pub fn rays(&self) -> crate::accel::Rays {
+        self.rays.or_else(crate::accel::Rays::from_env).unwrap_or(crate::accel::Rays::Compute)
     }
 }
 
@@ -124,8 +136,17 @@ impl Gpu {
             limits.max_storage_buffers_per_shader_stage = limits.max_storage_buffers_per_shader_stage.min(n);
         }
         let timestamps = wgpu::Features::TIMESTAMP_QUERY;
-        let required_features = if options.profile { adapter.features() & timestamps } else { wgpu::Features::empty() };
-        if options.profile && required_features.is_empty() {
+        let mut required_features =
+            if options.profile { adapter.features() & timestamps } else { wgpu::Features::empty() };
+        let rays = options.rays();
+        let ray_queries = rays != crate::accel::Rays::Compute && adapter.features().contains(crate::accel::FEATURE);
+        if rays == crate::accel::Rays::Hardware && !ray_queries {
+            return Err(crate::accel::not_offered(&info.name));
+        }
+        if ray_queries {
+            required_features |= crate::accel::FEATURE;
+        }
+        if options.profile && !required_features.contains(timestamps) {
             log::warn!("{} has no timestamp queries: --profile reports wall-clock time only", info.name);
         }
         let (device, queue) = adapter
@@ -133,7 +154,14 @@ impl Gpu {
                 label: Some("rastergi device"),
                 required_features,
                 required_limits: limits,
-                experimental_features: wgpu::ExperimentalFeatures::disabled(),
+                // SAFETY: the one experimental feature asked for is EXPERIMENTAL_RAY_QUERY, used
+                // as wgpu documents it (acceleration structures built before the passes that
+                // bind them, `accel::build`).
+                experimental_features: if ray_queries {
+                    unsafe { wgpu::ExperimentalFeatures::enabled() }
+                } else {
+                    wgpu::ExperimentalFeatures::disabled()
+                },
                 memory_hints: wgpu::MemoryHints::Performance,
                 trace: wgpu::Trace::Off,
             })
@@ -156,7 +184,7 @@ impl Gpu {
                 fault.lock().unwrap_or_else(|e| e.into_inner()).lost.get_or_insert(why);
             });
         }
-        Ok(Gpu { adapter, device, queue, info, profiler, fault })
+        Ok(Gpu { adapter, device, queue, info, profiler, rays, fault })
     }
 
     /// Whether the adapter offers hardware ray queries (wgpu's `EXPERIMENTAL_RAY_QUERY`:

@@ -198,6 +198,21 @@ impl Gpu {
         }
     }
 
+    /// Which ray path scenes get on this device and why, in words (`rastergi info`); the
+    /// choice for one scene is `GpuScene::rays` (auto's probe runs per scene).
+    pub fn ray_path_description(&self) -> String {
+        use crate::accel::Rays;
+        let has = crate::accel::device_has_ray_queries(&self.device);
+        match self.rays {
+            Rays::Compute => "compute (asked for: --rays compute)".to_owned(),
+            Rays::Hardware => "hardware (asked for: --rays hardware)".to_owned(),
+            Rays::Auto if has => {
+                "auto: hardware, unless a start-up probe on the scene measures it slower than compute".to_owned()
+            }
+            Rays::Auto => "auto: compute (the adapter offers no ray queries)".to_owned(),
+        }
+    }
+
     /// A multi-line description of the adapter and the limits that matter to rastergi.
     pub fn describe(&self) -> String {
         let i = &self.info;
@@ -208,6 +223,7 @@ impl Gpu {
         let _ = writeln!(s, "type:     {:?}", i.device_type);
         let _ = writeln!(s, "driver:   {} {}", i.driver, i.driver_info);
         let _ = writeln!(s, "ray queries: {}", self.ray_query_support());
+        let _ = writeln!(s, "rays:     {}", self.ray_path_description());
         let _ = writeln!(s, "vendor:   {:#06x}  device: {:#06x}", i.vendor, i.device);
         let _ = writeln!(s, "max texture 2D:            {}", l.max_texture_dimension_2d);
         let _ = writeln!(s, "max texture 3D:            {}", l.max_texture_dimension_3d);

@@ -720,6 +720,7 @@ impl GpuScene {
                 rate(compute)
             );
         }
+        log::info!("rays: {} ({})", scene.rays.name(), scene.rays_why);
         Ok(scene)
     }
 }

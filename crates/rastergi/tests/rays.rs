@@ -130,9 +130,10 @@ fn cornell_with_glass() -> Scene {
 /// camera rays; a 32² image meets none at these seeds (the number of differing pixels is
 /// printed, and must be 0). Not with stochastic opacity: there a hash of the hit's
 /// barycentrics decides each crossing, and the last-bit differences of b1, b2 between two
-/// compilations of the same Möller–Trumbore code (the compute and the hardware kernel, as
-/// between the GPU and the CPU twin) flip some decisions — 7 of 4096 camera rays of this box
-/// with its small box at opacity 0.5, on either path against the CPU.
+/// compilations of the same Möller–Trumbore code (the compute and the hardware kernel, the
+/// GPU and the CPU twin) flip some decisions: with the small box at opacity 0.5, 7 of 4096
+/// camera rays differed between the compute path and the CPU twin, and between the two GPU
+/// paths, none between the hardware path and the twin.
 #[test]
 fn every_tracing_pass_renders_the_same_image_on_both_paths() {
     use rastergi::film::Show;

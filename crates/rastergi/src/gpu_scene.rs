@@ -714,11 +714,16 @@ impl GpuScene {
             let (compute, hardware) = crate::rays::probe(gpu, prepared, &scene)?;
             let rate = |s: f64| format!("{:.1} Mrays/s", crate::rays::PROBE_RAYS as f64 / s / 1e6);
             scene.rays = if hardware <= compute { RayPath::Hardware } else { RayPath::Compute };
-            scene.rays_why = format!(
-                "auto: the start-up probe measured hardware {} against compute {} on this scene",
-                rate(hardware),
-                rate(compute)
-            );
+            scene.rays_why = if compute > 0.0 {
+                format!(
+                    "auto: the start-up probe measured hardware {} against compute {} on this scene",
+                    rate(hardware),
+                    rate(compute)
+                )
+            } else {
+                "auto: offered, and the scene gave the probe no rays (its camera sees nothing, it has no lights)"
+                    .to_owned()
+            };
         }
         log::info!("rays: {} ({})", scene.rays.name(), scene.rays_why);
         Ok(scene)

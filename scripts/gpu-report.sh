@@ -6,7 +6,9 @@
 #   Adapter       rastergi info
 #   Photons       photons/s, GPU against the CPU twin (bench photons)
 #   Rays          rays/s of each kind the passes cast, GPU kernel against the CPU twin, on
-#                 the Cornell box and a 1 M-triangle mesh (bench rays)
+#                 the Cornell box and a 1 M-triangle mesh, on both ray paths (the compute
+#                 BVH and, where the GPU has them, hardware ray queries with their build
+#                 time and memory) side by side (bench rays)
 #   Gather        directions/s of each gather (raster, lists, trace) at 512² and 1024²
 #   Viewer loop   frames/s and iterations/s of the viewer's frame loop at 1920×1080, no
 #                 window (bench frames)

@@ -138,7 +138,8 @@ def render(scene: Union[str, "os.PathLike[str]"], width: int = 256, height: int 
     ``hit_light``, ``show`` (``"full"``, ``"direct"``, ``"indirect"``, ``"photon-map"``),
     ``eye``, ``target``, ``up``, ``fov``, ``camera``, ``sun``, ``sun_size``, ``sky``, ``point``, ``spot``,
     ``env``, ``env_scale``, ``light_samples``, ``photon_passes``, ``pass_iterations``,
-    ``bundle``, ``backend``, ``method`` (``"gather"`` or ``"path"``, the reference path
+    ``bundle``, ``backend``, ``rays`` (``"auto"``, ``"hardware"``, ``"compute"``: hardware ray
+    queries or the compute-shader BVH), ``method`` (``"gather"`` or ``"path"``, the reference path
     tracer) and ``denoise`` (``True``: the image denoised as ``rastergi render --denoise``
     writes it; gather method, full image).
 

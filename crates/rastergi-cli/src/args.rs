@@ -9,6 +9,7 @@ use std::path::Path;
 use anyhow::Result;
 use clap::{Args, ValueEnum};
 use glam::Vec3;
+use rastergi::accel::{Rays, parse_rays};
 use rastergi::film::Show;
 use rastergi::fit;
 use rastergi::gather::{GatherDirections, GatherMethod, HitLight};
@@ -22,12 +23,19 @@ pub struct GpuArgs {
     /// Graphics backend: vulkan, metal, dx12, gl (default: WGPU_BACKEND, else the platform's primary).
     #[arg(long, value_parser = parse_backend)]
     backend: Option<Backends>,
+    /// Ray traversal: auto (hardware ray queries where the adapter offers them, unless a
+    /// start-up probe on the scene measures them slower), hardware, or compute (the
+    /// compute-shader BVH) [default: RASTERGI_RAYS, else auto].
+    #[arg(long, value_parser = parse_rays)]
+    rays: Option<Rays>,
 }
 
 impl GpuArgs {
-    /// The options of a GPU on the backends asked for (`None`: the default choice), unprofiled.
+    /// The options of a GPU on the backends and ray path asked for (`None`: the default
+    /// choice), unprofiled.
     pub fn options(&self) -> GpuOptions {
-        GpuOptions { backends: self.backend, ..Default::default() }
+        let rays = self.rays.or_else(Rays::from_env).unwrap_or(Rays::Auto);
+        GpuOptions { backends: self.backend, rays: Some(rays), ..Default::default() }
     }
 }
 

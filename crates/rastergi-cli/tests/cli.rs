@@ -67,7 +67,22 @@ fn info_names_the_driver_and_whether_ray_queries_are_offered() {
     if driver.starts_with("llvmpipe") && major.is_some_and(|m| m >= 25) {
         assert_eq!(rays, "offered", "{}", run.stdout);
     }
-    println!("{driver}: ray queries {rays}");
+    // What --rays (default auto) does with them.
+    let path = line("rays:");
+    let expected = if rays == "offered" { "auto: hardware, unless" } else { "auto: compute (the adapter" };
+    assert!(path.starts_with(expected), "{path}");
+    println!("{driver}: ray queries {rays}; rays {path}");
+}
+
+/// `--rays` takes auto, hardware or compute; anything else is a usage error naming them.
+#[test]
+fn an_unknown_ray_path_is_a_usage_error_naming_the_choices() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = rastergi(dir.path(), &["info", "--rays", "magic"]);
+    assert_eq!(run.status.code(), Some(2), "{}", run.stderr);
+    assert!(run.stderr.contains("expected auto, hardware or compute"), "{}", run.stderr);
+    let run = rastergi(dir.path(), &["info", "--rays", "compute"]);
+    assert!(run.status.success() && run.stdout.contains("rays:     compute (asked for"), "{}", run.stdout);
 }
 
 #[test]

@@ -136,7 +136,7 @@ impl PixelPass {
     ) -> PixelPass {
         let device = &gpu.device;
         let label = shader.label;
-        let module = shader::module(device, label, shader.source);
+        let module = scene.module(device, label, shader.source);
         let layout = bind_group_layout(
             device,
             label,

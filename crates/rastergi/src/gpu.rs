@@ -16,6 +16,10 @@ pub struct GpuOptions {
     /// adapter's own limit where it is lower): [`WEB_STORAGE_BUFFERS`] gives a native device a
     /// browser's limit, so that tests check what a web page can run.
     pub max_storage_buffers: Option<u32>,
+    /// Which traversal the passes' rays take ([`crate::accel`]); `None` means `RASTERGI_RAYS`
+    /// if set, else the compute BVH (so that a library caller or a test gets the hardware path
+    /// only where it asks: `--rays` of the front ends defaults to `auto`).
+    pub rays: Option<crate::accel::Rays>,
 }
 
 /// The most storage buffers per shader stage that browsers' WebGPU grants (Chrome's adapters
@@ -48,6 +52,9 @@ pub struct Gpu {
     pub info: wgpu::AdapterInfo,
     /// Pass timings, when profiling was asked for and the adapter supports timestamps.
     pub profiler: Option<Profiler>,
+    /// The ray path asked for ([`GpuOptions::rays`] resolved); the device has
+    /// `EXPERIMENTAL_RAY_QUERY` where this is not `Compute` and the adapter offers it.
+    pub rays: crate::accel::Rays,
     /// The first error the device reported outside a call that returns one (a lost device, a
     /// GPU timeout, an allocation that failed): [`Gpu::wait`] and every readback return it.
     fault: std::sync::Arc<std::sync::Mutex<Fault>>,
@@ -78,6 +85,11 @@ impl GpuOptions {
     /// The backends to consider: as asked, else `WGPU_BACKEND`, else Vulkan/Metal/DX12.
     pub fn backends(&self) -> wgpu::Backends {
         self.backends.or_else(wgpu::Backends::from_env).unwrap_or(wgpu::Backends::PRIMARY)
+    }
+
+    /// The ray path asked for: as set, else `RASTERGI_RAYS`, else the compute BVH.
+    pub fn rays(&self) -> crate::accel::Rays {
+        self.rays.or_else(crate::accel::Rays::from_env).unwrap_or(crate::accel::Rays::Compute)
     }
 }
 
@@ -126,8 +138,17 @@ impl Gpu {
             limits.max_storage_buffers_per_shader_stage = limits.max_storage_buffers_per_shader_stage.min(n);
         }
         let timestamps = wgpu::Features::TIMESTAMP_QUERY;
-        let required_features = if options.profile { adapter.features() & timestamps } else { wgpu::Features::empty() };
-        if options.profile && required_features.is_empty() {
+        let mut required_features =
+            if options.profile { adapter.features() & timestamps } else { wgpu::Features::empty() };
+        let rays = options.rays();
+        let ray_queries = rays != crate::accel::Rays::Compute && adapter.features().contains(crate::accel::FEATURE);
+        if rays == crate::accel::Rays::Hardware && !ray_queries {
+            return Err(crate::accel::not_offered(&info.name));
+        }
+        if ray_queries {
+            required_features |= crate::accel::FEATURE;
+        }
+        if options.profile && !required_features.contains(timestamps) {
             log::warn!("{} has no timestamp queries: --profile reports wall-clock time only", info.name);
         }
         let (device, queue) = adapter
@@ -135,7 +156,14 @@ impl Gpu {
                 label: Some("rastergi device"),
                 required_features,
                 required_limits: limits,
-                experimental_features: wgpu::ExperimentalFeatures::disabled(),
+                // SAFETY: the one experimental feature asked for is EXPERIMENTAL_RAY_QUERY, used
+                // as wgpu documents it (acceleration structures built before the passes that
+                // bind them, `accel::build`).
+                experimental_features: if ray_queries {
+                    unsafe { wgpu::ExperimentalFeatures::enabled() }
+                } else {
+                    wgpu::ExperimentalFeatures::disabled()
+                },
                 memory_hints: wgpu::MemoryHints::Performance,
                 trace: wgpu::Trace::Off,
             })
@@ -159,7 +187,7 @@ impl Gpu {
             });
         }
         let _compiled = std::sync::Arc::new(crate::compiled::register(&device));
-        Ok(Gpu { adapter, device, queue, info, profiler, fault, _compiled })
+        Ok(Gpu { adapter, device, queue, info, profiler, rays, fault, _compiled })
     }
 
     /// Whether the adapter offers hardware ray queries (wgpu's `EXPERIMENTAL_RAY_QUERY`:
@@ -173,6 +201,21 @@ impl Gpu {
         }
     }
 
+    /// Which ray path scenes get on this device and why, in words (`rastergi info`); the
+    /// choice for one scene is `GpuScene::rays` (auto's probe runs per scene).
+    pub fn ray_path_description(&self) -> String {
+        use crate::accel::Rays;
+        let has = crate::accel::device_has_ray_queries(&self.device);
+        match self.rays {
+            Rays::Compute => "compute (asked for: --rays compute)".to_owned(),
+            Rays::Hardware => "hardware (asked for: --rays hardware)".to_owned(),
+            Rays::Auto if has => {
+                "auto: hardware, unless a start-up probe on the scene measures it slower than compute".to_owned()
+            }
+            Rays::Auto => "auto: compute (the adapter offers no ray queries)".to_owned(),
+        }
+    }
+
     /// A multi-line description of the adapter and the limits that matter to rastergi.
     pub fn describe(&self) -> String {
         let i = &self.info;
@@ -183,6 +226,7 @@ impl Gpu {
         let _ = writeln!(s, "type:     {:?}", i.device_type);
         let _ = writeln!(s, "driver:   {} {}", i.driver, i.driver_info);
         let _ = writeln!(s, "ray queries: {}", self.ray_query_support());
+        let _ = writeln!(s, "rays:     {}", self.ray_path_description());
         let _ = writeln!(s, "vendor:   {:#06x}  device: {:#06x}", i.vendor, i.device);
         let _ = writeln!(s, "max texture 2D:            {}", l.max_texture_dimension_2d);
         let _ = writeln!(s, "max texture 3D:            {}", l.max_texture_dimension_3d);

@@ -5,6 +5,7 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3, Vec4};
 
+use crate::accel::{RayPath, Rays, SceneAccel};
 use crate::bvh::Bvh;
 use crate::bvh::wide::WideNode;
 use crate::error::Result;
@@ -451,6 +452,13 @@ pub struct GpuScene {
     pub has_holes: bool,
     /// Some solid glass attenuates the light inside it (`SCENE_MEDIA`, [`Material::medium`]).
     pub has_media: bool,
+    /// The traversal this scene's passes are built with ([`GpuScene::module`], `accel.rs`).
+    pub rays: RayPath,
+    /// Why [`Self::rays`] was chosen, in words (`rastergi info`, the render's log).
+    pub rays_why: String,
+    /// The acceleration structures, bound at `accel::TLAS_BINDING`, where the device has ray
+    /// queries and the compute path was not asked for.
+    pub accel: Option<SceneAccel>,
 }
 
 impl GpuScene {
@@ -481,6 +489,17 @@ impl GpuScene {
         layouts: &[&wgpu::BindGroupLayout],
     ) -> wgpu::ComputePipeline {
         crate::gpu::compute_pipeline(device, label, module, entry, layouts, &self.pipeline_constants())
+    }
+
+    /// A shader module of `source` (a composed shader that reads this scene) on this scene's
+    /// ray path ([`crate::shader::for_rays`]).
+    pub fn module(&self, device: &wgpu::Device, label: &str, source: &str) -> wgpu::ShaderModule {
+        self.module_for(device, label, source, self.rays)
+    }
+
+    /// [`Self::module`] on ray path `path` (the hardware one needs [`Self::accel`]).
+    pub fn module_for(&self, device: &wgpu::Device, label: &str, source: &str, path: RayPath) -> wgpu::ShaderModule {
+        crate::shader::module(device, label, &crate::shader::for_rays(source, path))
     }
 
     /// Uploads `prepared`, after checking that its buffers fit the device (see [`crate::limits`]).
@@ -585,8 +604,15 @@ impl GpuScene {
             "use a smaller --env image or a scene with fewer triangles",
         )?;
         let none = wgpu::BufferUsages::empty();
+        // Ray queries where the device has them and the compute path was not asked for: the
+        // triangles are then also the BLAS's vertices (accel::build).
+        let ray_queries = gpu.rays != Rays::Compute && crate::accel::device_has_ray_queries(&gpu.device);
+        if gpu.rays == Rays::Hardware && !ray_queries {
+            return Err(crate::accel::not_offered(&gpu.info.name));
+        }
+        let blas_input = if ray_queries { wgpu::BufferUsages::BLAS_INPUT } else { none };
         let buffers = [
-            gpu.storage_buffer("scene triangles", bytemuck::cast_slice(&triangles), none),
+            gpu.storage_buffer("scene triangles", bytemuck::cast_slice(&triangles), blas_input),
             gpu.storage_buffer("scene materials", bytemuck::cast_slice(&materials), none),
             gpu.storage_buffer("scene bvh nodes", bytemuck::cast_slice(&nodes), none),
             gpu.storage_buffer("scene data", bytemuck::cast_slice(&data.words), none),
@@ -603,6 +629,12 @@ impl GpuScene {
         // fragment stage, though it reports 32: the fragment lists' gather lost 10 % of its
         // estimates, tests/gather.rs).
         let compute = wgpu::ShaderStages::COMPUTE;
+        let accel = if ray_queries && !triangles.is_empty() {
+            Some(crate::accel::build(gpu, &buffers[0], triangles.len() as u32)?)
+        } else {
+            None
+        };
+        let tlas_entry = accel.as_ref().map(|_| crate::accel::tlas_entry());
         let layout = bind_group_layout(
             &gpu.device,
             "scene",
@@ -616,7 +648,10 @@ impl GpuScene {
                 uniform_entry::<GpuEnvironment>(9, wgpu::ShaderStages::COMPUTE),
                 float_table_entry(13, compute),
                 float_table_entry(14, compute),
-            ],
+            ]
+            .into_iter()
+            .chain(tlas_entry)
+            .collect::<Vec<_>>(),
         );
         // The buffers' bindings, in the order of `buffers`.
         const BUFFER_BINDINGS: [u32; 4] = [0, 1, 2, 8];
@@ -631,12 +666,26 @@ impl GpuScene {
         let (ggx_cells, glass) = albedo_textures(gpu, has_bsdfs, s.materials.iter().any(Material::needs_glass_table));
         entries.push(wgpu::BindGroupEntry { binding: 13, resource: wgpu::BindingResource::TextureView(&ggx_cells) });
         entries.push(wgpu::BindGroupEntry { binding: 14, resource: wgpu::BindingResource::TextureView(&glass) });
+        if let Some(a) = &accel {
+            entries.push(wgpu::BindGroupEntry {
+                binding: crate::accel::TLAS_BINDING,
+                resource: wgpu::BindingResource::AccelerationStructure(&a.tlas),
+            });
+        }
         let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("scene"),
             layout: &layout,
             entries: &entries,
         });
-        Ok(GpuScene {
+        let (rays, rays_why) = match (gpu.rays, &accel) {
+            (Rays::Compute, _) => (RayPath::Compute, "asked for (--rays compute)".to_owned()),
+            (_, Some(_)) if gpu.rays == Rays::Hardware => (RayPath::Hardware, "asked for (--rays hardware)".to_owned()),
+            // Auto: hardware until the probe below says otherwise.
+            (_, Some(_)) => (RayPath::Hardware, String::new()),
+            (_, None) if ray_queries => (RayPath::Compute, "the scene has no triangles".to_owned()),
+            (_, None) => (RayPath::Compute, format!("{} offers no hardware ray queries", gpu.info.name)),
+        };
+        let mut scene = GpuScene {
             layout,
             bind_group,
             triangle_count: triangles.len() as u32,
@@ -657,7 +706,27 @@ impl GpuScene {
             has_normals: !s.normals.is_empty(),
             has_holes: s.materials.iter().any(Material::has_holes),
             has_media: s.materials.iter().any(|m| m.medium() != Vec3::ZERO),
-        })
+            rays,
+            rays_why,
+            accel,
+        };
+        if gpu.rays == Rays::Auto && scene.accel.is_some() {
+            let (compute, hardware) = crate::rays::probe(gpu, prepared, &scene)?;
+            let rate = |s: f64| format!("{:.1} Mrays/s", crate::rays::PROBE_RAYS as f64 / s / 1e6);
+            scene.rays = if hardware <= compute { RayPath::Hardware } else { RayPath::Compute };
+            scene.rays_why = if compute > 0.0 {
+                format!(
+                    "auto: the start-up probe measured hardware {} against compute {} on this scene",
+                    rate(hardware),
+                    rate(compute)
+                )
+            } else {
+                "auto: offered, and the scene gave the probe no rays (its camera sees nothing, it has no lights)"
+                    .to_owned()
+            };
+        }
+        log::info!("rays: {} ({})", scene.rays.name(), scene.rays_why);
+        Ok(scene)
     }
 }
 

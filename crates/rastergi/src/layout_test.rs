@@ -272,6 +272,34 @@ fn every_shader_holds_the_rust_constants() {
     }
 }
 
+/// Every shader that traces, composed for the hardware ray path (`shader::for_rays`), parses
+/// and validates with naga: the ray query's `traverse` in place of the BVH walk, the TLAS at
+/// its binding, the compute BVH's nodes no longer read by `traverse`.
+#[test]
+fn every_tracing_shader_composes_and_validates_for_hardware_ray_queries() {
+    use crate::accel::{RayPath, TLAS_BINDING};
+    let mut traced = Vec::new();
+    for (label, source) in shaders() {
+        let hardware = crate::shader::for_rays(&source, RayPath::Hardware);
+        if hardware == source {
+            continue;
+        }
+        traced.push(label);
+        assert!(!hardware.contains("fn node_corners"), "{label}: the compute traversal is still there");
+        let module = naga::front::wgsl::parse_str(&hardware)
+            .unwrap_or_else(|e| panic!("{label} (hardware): {}", e.emit_to_string(&hardware)));
+        let tlas = naga::ResourceBinding { group: 0, binding: TLAS_BINDING };
+        assert!(module.global_variables.iter().any(|(_, g)| g.binding == Some(tlas)), "{label}: no TLAS binding");
+        naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
+            .validate(&module)
+            .unwrap_or_else(|e| panic!("{label} (hardware): {}", e.emit_to_string(&hardware)));
+    }
+    // Every pass that casts rays (the G-buffer's raster shader holds the prelude too).
+    let expected = ["gbuffer", "direct", "photon view", "gather project", "gather list project", "gather trace"];
+    let expected = expected.into_iter().chain(["photon trace", "denoiser guides", "path tracer", "rays"]);
+    assert_eq!(traced, expected.collect::<Vec<_>>());
+}
+
 /// The WGSL entry points (`@compute`, `@vertex`, `@fragment`) of every file under `src/`, as
 /// (file relative to `src/`, function name).
 fn entry_points_in_the_code() -> BTreeSet<(String, String)> {

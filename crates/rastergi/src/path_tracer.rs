@@ -127,7 +127,7 @@ impl PathTracer {
         let placeholder = gpu.zeroed_buffer("path tracer visibility placeholder", 16, wgpu::BufferUsages::STORAGE);
         let bind_group =
             buffer_bind_group(device, "path tracer", &layout, &[&film.accumulation, &params, &placeholder]);
-        let module = shader::module(device, "path tracer", &source());
+        let module = gpu_scene.module(device, "path tracer", &source());
         let layouts = [&gpu_scene.layout, &frame.layout, &layout];
         let trace = gpu_scene.compute_pipeline(device, "path tracer", &module, "main", &layouts);
         let primary = gpu_scene.compute_pipeline(device, "path tracer primary hits", &module, "primary_hits", &layouts);

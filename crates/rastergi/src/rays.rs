@@ -22,6 +22,7 @@
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
+use crate::accel::RayPath;
 use crate::bvh::Hit;
 use crate::consts::{LIGHT_POINT, LIGHT_SPOT, PUNCTUAL_LIGHT};
 use crate::error::Result;
@@ -290,7 +291,13 @@ pub struct RayCaster {
 }
 
 impl RayCaster {
+    /// The kernel on `scene`'s own ray path.
     pub fn new(gpu: &Gpu, scene: &GpuScene) -> RayCaster {
+        RayCaster::on(gpu, scene, scene.rays)
+    }
+
+    /// The kernel on ray path `path` (the hardware one needs `scene.accel`).
+    pub fn on(gpu: &Gpu, scene: &GpuScene, path: RayPath) -> RayCaster {
         let device = &gpu.device;
         let c = wgpu::ShaderStages::COMPUTE;
         let layout = bind_group_layout(
@@ -298,7 +305,7 @@ impl RayCaster {
             "rays",
             &[storage_entry::<GpuRay>(0, c, true), storage_entry::<GpuRayHit>(1, c, false)],
         );
-        let module = crate::shader::module(device, "rays", &source());
+        let module = scene.module_for(device, "rays", &source(), path);
         let pipeline =
             compute_pipeline(device, "rays", &module, "main", &[&scene.layout, &layout], &scene.pipeline_constants());
         RayCaster { pipeline, layout }
@@ -350,6 +357,32 @@ impl RayCaster {
         let bytes = gpu.read_buffer(&output, out_size)?;
         Ok((bytemuck::cast_slice(&bytes)[..rays.len()].to_vec(), times))
     }
+}
+
+/// How many rays the start-up probe of `--rays auto` traces on each path.
+pub const PROBE_RAYS: u32 = 128 * 128;
+
+/// The start-up probe of `--rays auto` (`GpuScene::new`): the seconds the ray kernel takes
+/// on each path, (compute, hardware), to trace the scene's bounce rays from its camera's view at
+/// 128² (incoherent closest hits, the passes' commonest), the faster of two timed runs after
+/// a warm-up each; a scene whose camera sees nothing probes with its photon rays.
+pub fn probe(gpu: &Gpu, prepared: &PreparedScene, scene: &GpuScene) -> Result<(f64, f64)> {
+    let side = (PROBE_RAYS as f64).sqrt() as u32;
+    let mut rays = make_rays(prepared, &prepared.scene.camera, (side, side), RayKind::Bounce, 1);
+    if rays.is_empty() {
+        rays = make_rays(prepared, &prepared.scene.camera, (side, side), RayKind::Photon, 1);
+    }
+    if rays.is_empty() {
+        return Ok((0.0, 0.0));
+    }
+    let mut seconds = [0.0; 2];
+    for (path, s) in [RayPath::Compute, RayPath::Hardware].into_iter().zip(&mut seconds) {
+        let (_, times) = RayCaster::on(gpu, scene, path).trace(gpu, scene, &rays, 2)?;
+        *s = times.iter().map(|t| t.as_secs_f64()).fold(f64::INFINITY, f64::min);
+    }
+    // Per PROBE_RAYS rays, whatever the batch held.
+    let scale = PROBE_RAYS as f64 / rays.len() as f64;
+    Ok((seconds[0] * scale, seconds[1] * scale))
 }
 
 /// The kernel's composed shader.

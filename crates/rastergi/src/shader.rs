@@ -19,7 +19,13 @@ pub const SCENE: &str =
     concat!(include_str!("gpu_scene.wgsl"), "\n", include_str!("environment.wgsl"), "\n", include_str!("bsdf.wgsl"));
 /// The scattering model alone (it needs [`SAMPLING`]).
 pub const BSDF: &str = include_str!("bsdf.wgsl");
-pub const BVH: &str = include_str!("bvh.wgsl");
+/// Tracing's interface (`trace`, `occluded`, `bvh.wgsl`) with the compute path's `traverse`
+/// (`bvh_compute.wgsl`); [`for_rays`] swaps the latter for the hardware one.
+pub const BVH: &str = concat!(include_str!("bvh.wgsl"), "\n", include_str!("bvh_compute.wgsl"));
+/// The compute path's `traverse`, as [`BVH`] holds it.
+pub const TRAVERSE_COMPUTE: &str = include_str!("bvh_compute.wgsl");
+/// The hardware path's `traverse`: a ray query over the scene's TLAS (`accel.rs`).
+pub const TRAVERSE_HARDWARE: &str = include_str!("bvh_hardware.wgsl");
 pub const FRAME: &str = include_str!("frame.wgsl");
 /// The G-buffer texel → visible point decode (`visible_point`), for per-pixel passes.
 pub const VISIBLE_POINT: &str = include_str!("visible_point.wgsl");
@@ -113,6 +119,19 @@ pub fn per_pixel(pieces: &[&str]) -> String {
     let mut all = vec![SAMPLING, SCENE, BVH, FRAME, VISIBLE_POINT, FILM];
     all.extend_from_slice(pieces);
     compose(&all)
+}
+
+/// `source` (a composed shader) for ray path `path`: unchanged for the compute path; for the
+/// hardware path its compute `traverse` replaced by the ray query's and `enable wgpu_ray_query;`
+/// put first. A shader without [`BVH`] casts no rays and is returned as it is.
+pub fn for_rays(source: &str, path: crate::accel::RayPath) -> std::borrow::Cow<'_, str> {
+    match path {
+        crate::accel::RayPath::Hardware if source.contains(TRAVERSE_COMPUTE) => std::borrow::Cow::Owned(format!(
+            "enable wgpu_ray_query;\n{}",
+            source.replacen(TRAVERSE_COMPUTE, TRAVERSE_HARDWARE, 1)
+        )),
+        _ => std::borrow::Cow::Borrowed(source),
+    }
 }
 
 /// The shader module of `source`: the device's one of it ([`crate::compiled`]).

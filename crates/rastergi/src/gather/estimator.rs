@@ -127,7 +127,7 @@ impl GatherSetup<'_> {
         own: &wgpu::BindGroupLayout,
         entries: [&str; N],
     ) -> [wgpu::ComputePipeline; N] {
-        let module = shader::module(device, label, &estimate_source(pieces));
+        let module = self.scene.module(device, label, &estimate_source(pieces));
         let layouts = [&self.scene.layout, &self.frame.layout, own, &self.map.bind_layout];
         entries.map(|entry| self.scene.compute_pipeline(device, label, &module, entry, &layouts))
     }

@@ -284,7 +284,7 @@ impl GpuPhotonMap {
         let (trace_layout, trace_group) = group("photon trace", counters.iter().cloned().chain(trace_only).collect());
         let (resolve_layout, resolve_group) =
             group("photon resolve", counters.into_iter().chain(resolve_only).collect());
-        let module = shader::module(device, "photon trace", &trace_source());
+        let module = scene.module(device, "photon trace", &trace_source());
         let trace_pipeline =
             scene.compute_pipeline(device, "trace photons", &module, "trace_photons", &[&scene.layout, &trace_layout]);
         let resolve_pipeline = scene.compute_pipeline(

@@ -1094,7 +1094,8 @@ def xml_for_mitsuba3(text, width, height, spp, max_depth):
     that it does not use them) and `phong`
     (which Mitsuba 3 lacks; Sponza's vault) read as `diffuse` of its diffuseReflectance, as
     rastergi reads it: the ../shared/scenes README's list of what Mitsuba 3 needs changed in
-    these 0.6 files, and phong.
+    these 0.6 files, and phong; a bitmap's 0.6 `gamma` 1 written as Mitsuba 3's `raw` (other
+    gammas dropped: sRGB), and the film's 0.6 display settings (`gamma`, `banner`) dropped.
     Everything else is the file as published."""
     import xml.etree.ElementTree as ET
     root = ET.fromstring(text)
@@ -1106,6 +1107,12 @@ def xml_for_mitsuba3(text, width, height, spp, max_depth):
                 parent.remove(child)
             elif child.get("name") == "filterType" and child.get("value") == "trilinear":
                 child.set("value", "bilinear")
+            elif parent.tag == "texture" and parent.get("type") == "bitmap" and child.get("name") == "gamma":
+                # 0.6's gamma 1 is a linear texture: Mitsuba 3's raw (rastergi reads it so);
+                # Mitsuba 3 has no gamma, and sRGB is its default.
+                parent.remove(child)
+                if abs(float(child.get("value", "-1")) - 1.0) < 1e-3:
+                    ET.SubElement(parent, "boolean", {"name": "raw", "value": "true"})
         if parent.tag == "bsdf" and parent.get("type") == "phong":
             # Mitsuba 3 has no phong: its diffuse part, as rastergi reads it (with a warning).
             parent.set("type", "diffuse")
@@ -1121,8 +1128,14 @@ def xml_for_mitsuba3(text, width, height, spp, max_depth):
     old = root.get("version", "3").startswith("0")
     for sensor in root.iter("sensor"):
         for film in sensor.findall("film"):
+            # What Mitsuba 3's hdrfilm takes besides the size and filter set here; 0.6's
+            # display settings (`gamma`, `banner`, tone mapping) are for its LDR films and the
+            # reference is linear: Mitsuba 3 refuses them as unreferenced.
+            keep = {"file_format", "fileFormat", "pixel_format", "pixelFormat", "component_format",
+                    "componentFormat", "crop_offset_x", "crop_offset_y", "crop_width", "crop_height",
+                    "cropOffsetX", "cropOffsetY", "cropWidth", "cropHeight", "sample_border", "compensate"}
             for child in list(film):
-                if child.get("name") in ("width", "height") or child.tag == "rfilter":
+                if child.get("name") not in keep or child.tag == "rfilter":
                     film.remove(child)
             ET.SubElement(film, "integer", {"name": "width", "value": str(width)})
             ET.SubElement(film, "integer", {"name": "height", "value": str(height)})

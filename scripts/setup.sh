@@ -13,7 +13,10 @@ MIN_RUST=1.95
 PACKAGES=(build-essential pkg-config libvulkan1 curl ca-certificates
     # The viewer's window (`rastergi view`): the X11 libraries winit loads at run time, and
     # Xvfb + xauth (for xvfb-run) so its tests run without a display.
-    libx11-6 libx11-xcb1 libxcursor1 libxrandr2 libxi6 libxkbcommon-x11-0 xvfb xauth)
+    libx11-6 libx11-xcb1 libxcursor1 libxrandr2 libxi6 libxkbcommon-x11-0 xvfb xauth
+    # Mesa's OpenGL through EGL: wgpu's GL backend, an adapter without ray queries, on which
+    # the tests check what `--rays hardware` and `auto` do there.
+    libegl1 libegl-mesa0)
 
 say() { echo "setup: $*"; }
 die() {

@@ -47,6 +47,30 @@ fn help_lists_the_render_and_info_commands() {
 
 /// `info` names the driver and says whether ray queries are offered; Mesa's lavapipe implements
 /// `VK_KHR_ray_query` from Mesa 25 on (what scripts/setup.sh installs), so there it must say so.
+/// An adapter without ray queries — Mesa's OpenGL through wgpu's GL backend —: `--rays
+/// hardware` is one error line naming the option and the way out, with no file; `auto` renders
+/// on the compute BVH, and `info` says so.
+#[test]
+fn rays_hardware_on_an_adapter_without_ray_queries_is_one_error_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let info = rastergi(dir.path(), &["info", "--backend", "gl"]);
+    assert!(info.status.success(), "{}", info.stderr);
+    assert!(info.stdout.contains("ray queries: not offered by this adapter"), "{}", info.stdout);
+    assert!(info.stdout.contains("rays:     auto: compute (the adapter offers no ray queries)"), "{}", info.stdout);
+    let small = ["--width", "16", "--height", "16", "--iterations", "2", "--photons", "4096", "--backend", "gl"];
+    let run =
+        rastergi(dir.path(), &[&["render", "cornell", "--rays", "hardware", "--out", "x.png"], &small[..]].concat());
+    assert_eq!(run.status.code(), Some(1), "{}", run.stderr);
+    let errors: Vec<&str> = run.stderr.lines().filter(|l| l.starts_with("error:")).collect();
+    assert_eq!(errors.len(), 1, "{}", run.stderr);
+    assert!(errors[0].contains("--rays hardware") && errors[0].contains("use --rays compute or auto"), "{}", errors[0]);
+    assert!(!run.stderr.contains("panicked") && files_in(dir.path()).is_empty(), "{}", run.stderr);
+    let run =
+        rastergi(dir.path(), &[&["render", "cornell", "--rays", "auto", "--out", "auto.png"], &small[..]].concat());
+    assert!(run.status.success(), "{}", run.stderr);
+    assert_eq!(files_in(dir.path()), ["auto.png"]);
+}
+
 #[test]
 fn info_names_the_driver_and_whether_ray_queries_are_offered() {
     let dir = tempfile::tempdir().unwrap();

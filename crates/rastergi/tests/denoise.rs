@@ -428,7 +428,7 @@ fn denoised_display_is_the_display_encoding_of_the_denoised_image() {
 }
 
 /// Texture sharpness: the textured room (a checker floor, a striped back wall, a textured cube
-/// and panels: common/textured_room.rs) at 128², 16 iterations raw and denoised against 512
+/// and panels: common/textured_room.rs) at 128², 16 iterations raw and denoised against 256
 /// raw iterations at another seed. In the pixels of the reference's highest tenth of
 /// gradients, the checker's and the stripes' edges among them, the denoised image is closer
 /// than the raw one, and over all pixels much closer: demodulating by the albedo keeps the
@@ -444,7 +444,9 @@ fn textures_stay_sharp() {
     let path = room::room_gltf(Variant::Binary).write(dir.path(), "room.glb");
     let scene = rastergi::scene::load_gltf(&path).unwrap();
     let settings = |seed| RenderSettings { seed, ..common::fitted_settings(&scene, 128, seed) };
-    let reference = common::render(&gpu, &scene, settings(9), 512, Show::Full);
+    // 256 iterations (512 until issue 44): its own noise about 0.011 instead of 0.008, which adds
+    // to both comparisons alike (measured denoised/raw 0.57 with 512, against the 0.65 bound).
+    let reference = common::render(&gpu, &scene, settings(9), 256, Show::Full);
     let mask = emitter_mask(&reference, 3.0);
     let edges = high_gradient_mask(&reference, &mask);
     let mut r = Renderer::new(&gpu, &scene, settings(5)).unwrap();

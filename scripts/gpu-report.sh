@@ -98,7 +98,7 @@ if [ "$quick" = 1 ]; then
     RAYS_MESH=spheres:20000
     GATHER=(--sizes 64,128 --iterations 4 --bundle 256 --photons 65536 --grid 32)
     FRAMES=(--width 160 --height 90 --seconds 1 --photons 65536 --grid 32)
-    SIZE=64 REF_SECONDS=3 CONVERGE_SECONDS=2 MITSUBA_SECONDS=2
+    SIZE=64 REF_SECONDS=1 CONVERGE_SECONDS=1 MITSUBA_SECONDS=1
     MEMORY=(--width 160 --height 90 --grid 32 --bundle 256)
     DENOISE_SIZES=(64x48)
     DENOISE=(--repeats 1 --iterations 2)

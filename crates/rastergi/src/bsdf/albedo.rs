@@ -85,9 +85,9 @@ pub fn ggx_cell(k: usize) -> [f32; 2] {
 
 /// The GGX table as committed (`ggx_albedo.bin`, little-endian f32 pairs (E₁, E₅) in
 /// [`GgxAlbedo::e`]'s order), written by `cargo run --release -p rastergi --example
-/// albedo_tables` from [`ggx_cell`]: 4 M microfacet samples, which took every process 0.3–0.4 s
-/// of start-up on two cores when integrated there (`the_committed_ggx_table_is_what_the_integral_gives`
-/// integrates every cell again).
+/// albedo_tables` from [`ggx_cell`]: 4 M microfacet samples, which took every process 0.08 s
+/// of start-up on two cores (0.3–0.4 s on a loaded machine) when integrated there
+/// (`the_committed_ggx_table_is_what_the_integral_gives` integrates every cell again).
 const GGX_TABLE: &[u8] = include_bytes!("ggx_albedo.bin");
 
 impl GgxAlbedo {

@@ -95,6 +95,20 @@ fn gltf_scenes_render_from_the_camera_chosen_with_camera() {
     assert_ne!(read("front.png"), read("top.png"), "the two cameras see the same image");
 }
 
+/// Over one view rendered without (`dark`) and with (`lit`) some light: what `lit` shows
+/// where `dark` is black, and the green `lit` gains everywhere else.
+fn where_black(lit: &rastergi::image_io::LinearImage, dark: &rastergi::image_io::LinearImage) -> (Vec<[f32; 3]>, f32) {
+    let (mut black, mut gain) = (Vec::new(), 0.0f32);
+    for (l, d) in lit.pixels.iter().zip(&dark.pixels) {
+        if d.iter().all(|&v| v == 0.0) {
+            black.push(*l);
+        } else {
+            gain += l[1] - d[1];
+        }
+    }
+    (black, gain)
+}
+
 #[test]
 fn a_physical_sky_lights_a_gltf_scene() {
     // From above (camera 1: straight down, 3 m up), the 2 × 2 floor under the emitter, without
@@ -110,16 +124,11 @@ fn a_physical_sky_lights_a_gltf_scene() {
     let run = rastergi(dir.path(), &[&base[..], &plain[..]].concat());
     assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
     let read = |name: &str| rastergi::image_io::read_exr(&dir.path().join(name)).unwrap();
-    let (sky, plain) = (read("sky.exr"), read("plain.exr"));
-    let (mut background, mut floor_gain) = (0, 0.0f32);
-    for (s, p) in sky.pixels.iter().zip(&plain.pixels) {
-        if p.iter().all(|&v| v == 0.0) {
-            background += 1;
-            assert_eq!(*s, [0.0; 3], "a pixel below the horizon shows the sky");
-        } else {
-            floor_gain += s[1] - p[1];
-        }
+    let (background, floor_gain) = where_black(&read("sky.exr"), &read("plain.exr"));
+    for s in &background {
+        assert_eq!(*s, [0.0; 3], "a pixel below the horizon shows the sky");
     }
+    let background = background.len();
     assert!(background > 0 && background < 16 * 16, "{background} background pixels");
     assert!(floor_gain > 0.0, "the sky adds no light to the floor");
 }
@@ -143,17 +152,14 @@ fn a_gltf_model_without_lights_is_lit_by_a_neutral_environment() {
     let log = String::from_utf8_lossy(&run.stderr);
     assert!(run.status.success() && !log.contains("neutral"), "{log}");
     let read = |name: &str| rastergi::image_io::read_exr(&dir.path().join(name)).unwrap();
-    let (lit, dark) = (read("lit.exr"), read("dark.exr"));
+    let lit = read("lit.exr");
     // Black without the environment: the background, or the emitter's unlit black back.
-    let (mut background, mut floor_gain) = (0, 0.0f32);
-    for (l, d) in lit.pixels.iter().zip(&dark.pixels) {
-        if d.iter().all(|&v| v == 0.0) {
-            let sky = l.iter().all(|&v| (v - 0.3).abs() < 1e-5);
-            assert!(sky || *l == [0.0; 3], "a pixel black without the environment shows {l:?}");
-            background += sky as usize;
-        } else {
-            floor_gain += l[1] - d[1];
-        }
+    let (black, floor_gain) = where_black(&lit, &read("dark.exr"));
+    let mut background = 0;
+    for l in &black {
+        let sky = l.iter().all(|&v| (v - 0.3).abs() < 1e-5);
+        assert!(sky || *l == [0.0; 3], "a pixel black without the environment shows {l:?}");
+        background += sky as usize;
     }
     assert!((lit.pixels[0][0] - 0.3).abs() < 1e-5, "the corner shows {:?}", lit.pixels[0]);
     assert!(background > 0 && background < 16 * 16, "{background} background pixels");

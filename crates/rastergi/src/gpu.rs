@@ -521,20 +521,11 @@ pub fn bind_group_layout(
     crate::compiled::bind_group_layout(device, label, entries)
 }
 
-/// Bind-group-layout entry for a filterable float 2D array texture (the scene's textures).
-pub fn texture_array_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
-    let sample_type = wgpu::TextureSampleType::Float { filterable: true };
-    texture_entry(binding, visibility, sample_type, wgpu::TextureViewDimension::D2Array)
-}
-
-/// Bind-group-layout entry for a filtering sampler.
-pub fn sampler_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-        count: None,
-    }
+/// Bind-group-layout entry for an unfiltered float 2D texture read with `textureLoad` (the
+/// scene's texture atlas, `textures.rs`).
+pub fn atlas_texture_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    let sample_type = wgpu::TextureSampleType::Float { filterable: false };
+    texture_entry(binding, visibility, sample_type, wgpu::TextureViewDimension::D2)
 }
 
 /// Bind group whose entries are `resources`, at bindings 0, 1, 2, … (the order of the

@@ -12,13 +12,11 @@ use crate::error::Result;
 use wgpu::util::DeviceExt;
 
 use crate::environment::{Environment, GpuEnvironment};
-use crate::gpu::{
-    Gpu, bind_group_layout, float_table_entry, sampler_entry, storage_entry, texture_array_entry, uniform_entry,
-};
+use crate::gpu::{Gpu, atlas_texture_entry, bind_group_layout, float_table_entry, storage_entry, uniform_entry};
 use crate::lights::{LightEntry, LightTable};
 use crate::limits::check_storage_buffer;
 use crate::scene::{Aabb, AlphaMode, Material, Scene, TextureRef, UvTransform};
-use crate::textures::TextureArray;
+use crate::textures::TextureAtlas;
 
 /// `Triangle` in `gpu_scene.wgsl`.
 #[repr(C)]
@@ -38,21 +36,21 @@ pub struct GpuTriangle {
 /// [`GpuTriangle::light`] of a triangle that is not in the light table.
 pub const NO_LIGHT: u32 = u32::MAX;
 
-/// `TextureSlot` in `gpu_scene.wgsl`: a texture a material reads, the layer of the texture
-/// array ([`NO_TEXTURE`] for none) and the rows (`u`, `v`) of its [`UvTransform`].
+/// `TextureSlot` in `gpu_scene.wgsl`: a texture a material reads, its index in the texture
+/// atlas ([`NO_TEXTURE`] for none) and the rows (`u`, `v`) of its [`UvTransform`].
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuTextureSlot {
     pub u: [f32; 3],
-    pub layer: u32,
+    pub texture: u32,
     pub v: [f32; 3],
     pub _pad: u32,
 }
 
 impl GpuTextureSlot {
     pub fn new(slot: Option<TextureRef>) -> GpuTextureSlot {
-        let (layer, t) = slot.map_or((NO_TEXTURE, UvTransform::IDENTITY), |t| (t.texture as u32, t.transform));
-        GpuTextureSlot { u: t.0[0], layer, v: t.0[1], _pad: 0 }
+        let (texture, t) = slot.map_or((NO_TEXTURE, UvTransform::IDENTITY), |t| (t.texture as u32, t.transform));
+        GpuTextureSlot { u: t.0[0], texture, v: t.0[1], _pad: 0 }
     }
 }
 
@@ -128,7 +126,9 @@ pub struct GpuSceneOffsets {
     pub punctual: u32,
     /// The environment map's data ([`Environment::gpu_data`]).
     pub environment: u32,
-    pub _pad: [u32; 6],
+    /// The texture atlas's entries ([`crate::textures::AtlasEntry`], four words each).
+    pub textures: u32,
+    pub _pad: [u32; 5],
 }
 
 /// The GGX albedo tables as gpu_scene.wgsl reads them: the cells and means, N × (N + 1)
@@ -257,7 +257,7 @@ pub struct PreparedScene {
     pub bvh: Bvh,
     pub lights: LightTable,
     pub bounds: Aabb,
-    pub textures: TextureArray,
+    pub textures: TextureAtlas,
 }
 
 impl PreparedScene {
@@ -278,7 +278,7 @@ impl PreparedScene {
         let bvh = Bvh { order: (0..scene.triangles.len() as u32).collect(), ..bvh };
         let lights = LightTable::new(&scene);
         let bounds = scene.bounds();
-        let textures = TextureArray::new(&scene.textures);
+        let textures = TextureAtlas::new(&scene.textures);
         PreparedScene { scene, bvh, lights, bounds, textures }
     }
 
@@ -557,7 +557,8 @@ impl GpuScene {
         } else {
             s.tangents.iter().flat_map(|t| t.iter().flat_map(|v| v.to_array())).collect()
         };
-        let (texture_view, sampler) = prepared.textures.upload(gpu);
+        let texture_view = prepared.textures.upload(gpu);
+        let atlas_entries = prepared.textures.gpu_entries();
         let lights: Vec<LightEntry> = prepared.lights.entries.clone();
         // A binding cannot be empty: one zero light where the scene has none.
         let mut punctual = prepared.lights.punctual.clone();
@@ -593,6 +594,7 @@ impl GpuScene {
             light_count: lights.len().max(1) as u32,
             punctual: data.push(&punctual),
             environment: data.push(&env_data),
+            textures: data.push(&atlas_entries),
             ..GpuSceneOffsets::default()
         };
         data.words[..size_of::<GpuSceneOffsets>() / 4].copy_from_slice(bytemuck::cast_slice(&[offsets]));
@@ -642,8 +644,7 @@ impl GpuScene {
                 storage_entry::<GpuTriangle>(0, vis, true),
                 storage_entry::<GpuMaterialRecord>(1, vis, true),
                 storage_entry::<WideNode>(2, compute, true),
-                texture_array_entry(5, vis),
-                sampler_entry(6, vis),
+                atlas_texture_entry(5, vis),
                 storage_entry::<u32>(8, vis, true),
                 uniform_entry::<GpuEnvironment>(9, wgpu::ShaderStages::COMPUTE),
                 float_table_entry(13, compute),
@@ -661,7 +662,6 @@ impl GpuScene {
             .map(|(b, binding)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() })
             .collect();
         entries.push(wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&texture_view) });
-        entries.push(wgpu::BindGroupEntry { binding: 6, resource: wgpu::BindingResource::Sampler(&sampler) });
         entries.push(wgpu::BindGroupEntry { binding: 9, resource: env_uniform_buffer.as_entire_binding() });
         let (ggx_cells, glass) = albedo_textures(gpu, has_bsdfs, s.materials.iter().any(Material::needs_glass_table));
         entries.push(wgpu::BindGroupEntry { binding: 13, resource: wgpu::BindingResource::TextureView(&ggx_cells) });

@@ -29,11 +29,11 @@ struct Triangle {
 
 const NO_LIGHT: u32 = 0xffffffffu;
 
-// A texture a material reads: its layer in `textures` (NO_TEXTURE for none) and the affine
+// A texture a material reads: its index in the atlas (NO_TEXTURE for none) and the affine
 // map of the triangle's texture coordinates onto it, (dot(u, (uv, 1)), dot(v, (uv, 1))).
 struct TextureSlot {
     u: vec3f,
-    layer: u32,
+    texture: u32,
     v: vec3f,
     _pad: u32,
 }
@@ -125,10 +125,8 @@ struct MaterialRecord {
 
 @group(0) @binding(1) var<storage, read> materials: array<MaterialRecord>;
 @group(0) @binding(2) var<storage, read> bvh_nodes: array<WideNode>;
-// Every albedo texture, one layer each, with its mip chain (sRGB, read as linear RGB).
-@group(0) @binding(5) var textures: texture_2d_array<f32>;
-// Trilinear filtering, repeat addressing.
-@group(0) @binding(6) var texture_sampler: sampler;
+// Every texture's mip chain at its own size, the rows of one texture (textures.wgsl).
+@group(0) @binding(5) var textures: texture_2d<f32>;
 
 // The rest of the scene in one buffer of words (one binding: WebGPU allows 10 storage buffers
 // per shader stage). Its first 16 words are a header (gpu_scene.rs, GpuSceneOffsets; not a
@@ -154,6 +152,11 @@ fn scene_offset(k: u32) -> u32 {
 
 fn scene_f32(i: u32) -> f32 {
     return bitcast<f32>(scene_data[i]);
+}
+
+// Word i of the texture atlas's entries (textures.wgsl).
+fn atlas_entry_word(i: u32) -> u32 {
+    return scene_data[scene_offset(DATA_TEXTURES) + i];
 }
 
 fn scene_vec3(i: u32) -> vec3f {
@@ -266,7 +269,7 @@ fn surface_uv(tri: u32, b1: f32, b2: f32) -> vec2f {
 // The texture of slot s at the triangle's texture coordinates uv and level of detail lod.
 fn slot_sample(s: TextureSlot, uv: vec2f, lod: f32) -> vec4f {
     let st = vec2f(dot(s.u, vec3f(uv, 1.0)), dot(s.v, vec3f(uv, 1.0)));
-    return textureSampleLevel(textures, texture_sampler, st, s.layer, lod);
+    return atlas_sample(s.texture, st, lod);
 }
 
 // The shading normal at barycentrics (b1, b2) of triangle `tri` of geometric normal n and
@@ -292,7 +295,7 @@ fn shading_normal(tri: u32, b1: f32, b2: f32, n: vec3f, mi: u32, textured: bool,
         return ns;
     }
     let map = materials[mi].maps.normal_map;
-    if map.layer == NO_TEXTURE {
+    if map.texture == NO_TEXTURE {
         return ns;
     }
     let j = scene_offset(DATA_TANGENTS) + 12u * min(tri, scene_offset(DATA_TANGENT_TRIANGLES) - 1u);
@@ -323,7 +326,7 @@ fn perturb_normal(n: vec3f, ns: vec3f, t: vec4f, c: vec3f, scale: f32) -> vec3f 
 // (PreparedScene::opacity_at).
 fn surface_opacity(mi: u32, opacity: f32, uv: vec2f, lod: f32) -> f32 {
     let map = materials[mi].maps.opacity_map;
-    if map.layer == NO_TEXTURE {
+    if map.texture == NO_TEXTURE {
         return opacity;
     }
     return opacity * slot_sample(map, uv, lod).a;
@@ -373,7 +376,7 @@ fn emitter_radiance(tri: u32, b1: f32, b2: f32) -> vec3f {
 // (PreparedScene::emission_at).
 fn surface_emission(mi: u32, emission: vec3f, uv: vec2f) -> vec3f {
     let map = materials[mi].maps.emission_map;
-    if map.layer == NO_TEXTURE {
+    if map.texture == NO_TEXTURE {
         return emission;
     }
     return emission * slot_sample(map, uv, 0.0).rgb;
@@ -390,21 +393,12 @@ fn bend_towards(ns: vec3f, v: vec3f) -> vec3f {
     return normalize(ns + (1e-3 - c) * v);
 }
 
-// Level of detail of a footprint whose texture coordinates change by dx and dy across one
-// pixel: log2 of the longer change in texels of level 0, 0 under magnification
-// (TextureArray::lod).
-fn texture_lod(dx: vec2f, dy: vec2f) -> f32 {
-    let size = vec2f(textureDimensions(textures));
-    let rho = max(length(dx * size), length(dy * size));
-    return min(log2(max(rho, 1.0)), 32.0);
-}
-
 // The level of detail of material mi's albedo texture where the triangle's texture coordinates
 // change by dx and dy across a pixel: those changes placed by the texture's transform.
 fn albedo_lod(mi: u32, dx: vec2f, dy: vec2f) -> f32 {
     let s = materials[mi].maps.albedo_map;
     let a = mat2x2f(vec2f(s.u.x, s.v.x), vec2f(s.u.y, s.v.y));
-    return texture_lod(a * dx, a * dy);
+    return texture_lod(s.texture, a * dx, a * dy);
 }
 
 // Barycentrics (b1, b2) of the point p of triangle t's plane.
@@ -444,10 +438,10 @@ fn surface_at(tri: u32, b1: f32, b2: f32, lod: f32) -> Surface {
     s.emission = m.emission;
     if textured {
         let maps = materials[mi].maps;
-        if maps.albedo_map.layer != NO_TEXTURE {
+        if maps.albedo_map.texture != NO_TEXTURE {
             s.albedo *= slot_sample(maps.albedo_map, uv, lod).rgb;
         }
-        if maps.emission_map.layer != NO_TEXTURE {
+        if maps.emission_map.texture != NO_TEXTURE {
             s.emission *= slot_sample(maps.emission_map, uv, 0.0).rgb;
         }
     }
@@ -463,29 +457,29 @@ fn surface_at(tri: u32, b1: f32, b2: f32, lod: f32) -> Surface {
     s.clearcoat_roughness = m.clearcoat_roughness;
     if textured {
         let mr_map = materials[mi].maps.metal_rough_map;
-        if mr_map.layer != NO_TEXTURE {
+        if mr_map.texture != NO_TEXTURE {
             let mr = slot_sample(mr_map, uv, 0.0);
             s.roughness *= mr.g;
             s.metallic *= mr.b;
         }
         let t_map = materials[mi].maps.transmission_map;
-        if t_map.layer != NO_TEXTURE {
+        if t_map.texture != NO_TEXTURE {
             s.transmission = clamp(s.transmission * slot_sample(t_map, uv, 0.0).r, 0.0, 1.0);
         }
         let s_map = materials[mi].maps.specular_map;
-        if s_map.layer != NO_TEXTURE {
+        if s_map.texture != NO_TEXTURE {
             s.specular = clamp(s.specular * slot_sample(s_map, uv, 0.0).a, 0.0, 1.0);
         }
         let c_map = materials[mi].maps.specular_color_map;
-        if c_map.layer != NO_TEXTURE {
+        if c_map.texture != NO_TEXTURE {
             s.specular_color *= slot_sample(c_map, uv, 0.0).rgb;
         }
         let k_map = materials[mi].maps.clearcoat_map;
-        if k_map.layer != NO_TEXTURE {
+        if k_map.texture != NO_TEXTURE {
             s.clearcoat *= slot_sample(k_map, uv, 0.0).r;
         }
         let kr_map = materials[mi].maps.clearcoat_roughness_map;
-        if kr_map.layer != NO_TEXTURE {
+        if kr_map.texture != NO_TEXTURE {
             s.clearcoat_roughness *= slot_sample(kr_map, uv, 0.0).g;
         }
     }

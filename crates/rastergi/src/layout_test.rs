@@ -67,7 +67,8 @@ fn twins() -> Vec<Twin> {
         ),
         twin!(GpuTriangle, "Triangle", [v0, material, v1, flags, v2, light]),
         twin!(crate::gpu_scene::GpuMaterialRecord, "MaterialRecord", [material, maps]),
-        twin!(GpuTextureSlot, "TextureSlot", [u, layer, v]),
+        twin!(GpuTextureSlot, "TextureSlot", [u, texture, v]),
+        twin!(crate::textures::AtlasEntry, "AtlasEntry", [width, height, levels, first]),
         twin!(
             GpuMaterial,
             "Material",

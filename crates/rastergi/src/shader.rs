@@ -15,8 +15,18 @@ use crate::consts::{
 
 pub const SAMPLING: &str = include_str!("sampling.wgsl");
 /// The scene's bind group: geometry, materials, lights and the environment.
-pub const SCENE: &str =
-    concat!(include_str!("gpu_scene.wgsl"), "\n", include_str!("environment.wgsl"), "\n", include_str!("bsdf.wgsl"));
+pub const SCENE: &str = concat!(
+    include_str!("gpu_scene.wgsl"),
+    "\n",
+    include_str!("textures.wgsl"),
+    "\n",
+    include_str!("environment.wgsl"),
+    "\n",
+    include_str!("bsdf.wgsl")
+);
+/// The texture atlas's sampling (`atlas_sample`); the includer binds `textures` and defines
+/// `atlas_entry_word` (needs [`constants`]).
+pub const TEXTURES: &str = include_str!("textures.wgsl");
 /// The scattering model alone (it needs [`SAMPLING`]).
 pub const BSDF: &str = include_str!("bsdf.wgsl");
 /// Tracing's interface (`trace`, `occluded`, `bvh.wgsl`) with the compute path's `traverse`
@@ -46,6 +56,7 @@ pub fn constants() -> String {
         ("MAX_HOLE_CROSSINGS", MAX_HOLE_CROSSINGS),
         ("TRIANGLE_HAS_HOLES", TRIANGLE_HAS_HOLES),
         ("NO_TEXTURE", NO_TEXTURE),
+        ("ATLAS_ROW", crate::textures::ROW),
         ("FILM_DIRECT", FILM_DIRECT),
         ("FILM_INDIRECT", FILM_INDIRECT),
         ("FILM_PHOTON_VIEW", FILM_PHOTON_VIEW),
@@ -84,6 +95,7 @@ pub fn constants() -> String {
         ("DATA_LIGHT_COUNT", word(std::mem::offset_of!(O, light_count))),
         ("DATA_PUNCTUAL", word(std::mem::offset_of!(O, punctual))),
         ("DATA_ENVIRONMENT", word(std::mem::offset_of!(O, environment))),
+        ("DATA_TEXTURES", word(std::mem::offset_of!(O, textures))),
     ];
     let u32s: Vec<(&str, u32)> = u32s.into_iter().chain(header).collect();
     let f32s = [

@@ -1,60 +1,75 @@
-//! The scene's albedo textures as the passes sample them, and the CPU twin of that sampling.
+//! The scene's textures as the passes sample them, and the CPU twin of that sampling.
 //!
-//! **One texture array.** Every texture is resampled to one common size W × H and becomes a
-//! layer of a single `texture_2d_array`, so one binding and one sampler serve every material
-//! and every pass, and the sampler's repeat addressing and trilinear filtering work unchanged
-//! (an atlas would need hand-made wrapping and padded mip levels). The texels are linear RGB in
-//! half floats (`rgba16float`, filterable everywhere): the sRGB decoding happens here, exactly,
-//! so the GPU filters the very values the CPU twin reads (hardware sRGB decoding is only
-//! approximately specified: lavapipe's is off by up to 0.7 %), and 11 significant bits keep
-//! more precision than 8-bit sRGB at every level. The alpha channel (opacity) is linear, c/255,
-//! and so are the RGB of textures holding data rather than colour (normal maps,
-//! [`Texture::linear`]).
-//! W and H are the largest texture's sides rounded up to powers of two, at most
-//! [`MAX_SIDE`], halved (the longer one first) until the whole chain fits [`BUDGET_BYTES`].
-//! Resampling happens in linear RGB with a tent filter as wide as the larger of one source
-//! texel and one destination texel: bilinear interpolation when enlarging (what the GPU's
-//! magnification filter would have shown of the original), an area-weighted average when
-//! shrinking.
+//! **One atlas, each texture at its own size.** Every texture keeps its own resolution and its
+//! own mip chain; the chains lie one after another in one run of texels ([`TextureAtlas`]),
+//! which the GPU holds as the rows of a single `rgba16float` 2D texture read with
+//! `textureLoad` (texel i at column i mod [`ROW`], row i / [`ROW`]): one binding serves every
+//! texture of every size, nothing is resized to a common size, and the capacity is that of a
+//! texture (WebGPU guarantees 8192 rows, [`CAPACITY`] texels, 256 MiB), not the far smaller
+//! storage-binding limit (128 MiB on lavapipe). Filtering is therefore done by the shader
+//! (`textures.wgsl`), the same arithmetic as [`TextureAtlas::sample`] here. Only when the
+//! chains together exceed the capacity is the largest texture halved, and again, until they
+//! fit ([`fitted_sizes`]): a scene with one 8 k texture keeps its other textures as they are.
 //!
-//! **Mip maps.** The full chain down to 1 × 1 is computed here: each level is the 2 × 2 box
-//! average of the previous one in linear RGB (W and H are powers of two, so the boxes tile
-//! exactly; a side that reached 1 averages 2 × 1), computed in f32 and stored rounded to f16.
+//! **Texels.** Linear RGB in half floats: the sRGB decoding happens here, exactly, so the GPU
+//! filters the very values the CPU twin reads, and 11 significant bits keep more precision
+//! than 8-bit sRGB at every level. The alpha channel (opacity) is linear, c/255, and so are
+//! the RGB of textures holding data rather than colour (normal maps, [`Texture::linear`]). A
+//! texture halved to fit is resampled in linear RGB with a tent filter as wide as one
+//! destination texel (an area-weighted average).
 //!
-//! **Sampling.** Trilinear: repeat addressing, bilinear within a level, linear between the
-//! two levels around the level of detail λ, clamped to [0, levels − 1]. The
-//! passes give λ explicitly (`textureSampleLevel`): at the eye's visible points
-//! λ = log2 max(|∂uv/∂x|, |∂uv/∂y|) in texels of level 0, from the G-buffer's screen-space
-//! derivatives (or the path tracer's ray differentials); at every secondary point (photon
-//! hits, gather hits, path bounces) λ = 0, the unfiltered texture: those points are averaged
-//! over many samples, and a footprint filter there would only add a bias. [`TextureArray`]
-//! holds the very texels the GPU samples, and [`TextureArray::sample`] is its twin.
+//! **Mip maps.** Level k + 1 of a w × h level is max(⌊w/2⌋, 1) × max(⌊h/2⌋, 1), down to 1 × 1.
+//! Along an axis that halves exactly each texel is the mean of its two parents (the 2 × 2 box
+//! where both do); along an odd one, the tent filter above (repeat addressing). Computed in
+//! f32, stored rounded to f16.
+//!
+//! **Sampling** (`atlas_sample` in WGSL, [`TextureAtlas::sample`]). Trilinear with repeat
+//! addressing: the coordinates wrapped to [0, 1), bilinear within a level between the four
+//! texels around u·w − ½, v·h − ½ (texel centres at (i + ½)/w, as Vulkan, WebGPU and Mitsuba's
+//! bitmap place them), linear between the two levels around the level of detail λ, clamped to
+//! [0, levels − 1]. The passes give λ explicitly: at the eye's visible points
+//! λ = log2 max(|∂st/∂x|·(w, h), |∂st/∂y|·(w, h)) in texels of the texture's own level 0, from
+//! the G-buffer's screen-space derivatives (or the path tracer's ray differentials); at every
+//! secondary point (photon hits, gather hits, path bounces) λ = 0, the unfiltered texture:
+//! those points are averaged over many samples, and a footprint filter there would only add a
+//! bias. `--texture-filter bilinear` reads level 0 at the visible points too, as a reference
+//! renderer's bilinear lookups averaged over the pixel do.
 
 use glam::{Vec2, Vec3, Vec4};
 
 use crate::error::{Error, Result};
-use crate::gpu::{Gpu, sampler_entry, storage_entry, texture_array_entry};
+use crate::gpu::{Gpu, atlas_texture_entry, storage_entry};
+use crate::par::prelude::*;
 use crate::scene::Texture;
 use crate::shader;
 
-/// Largest side of the common layer size (WebGPU guarantees 8192).
-pub const MAX_SIDE: u32 = 4096;
-/// Largest size of the texture array with all its mip levels.
-pub const BUDGET_BYTES: u64 = 256 << 20;
+/// Texels per row of the atlas texture.
+pub const ROW: u32 = 4096;
+/// Rows of the atlas texture at most (WebGPU guarantees 8192 texels per side).
+pub const MAX_ROWS: u32 = 8192;
+/// Texels the atlas holds at most: 256 MiB of `rgba16float`.
+pub const CAPACITY: u64 = ROW as u64 * MAX_ROWS as u64;
 pub const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// Bytes per texel of [`FORMAT`].
 const TEXEL_BYTES: u64 = 8;
 
-/// The layers of the texture array with their mip chains, exactly as uploaded.
-#[derive(Clone, Debug, PartialEq)]
-pub struct TextureArray {
-    /// Size of level 0.
+/// Where texture k lies in the atlas: its level 0's size, its level count and its first
+/// texel. `AtlasEntry` in `textures.wgsl`, four words each in the scene's data buffer.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct AtlasEntry {
     pub width: u32,
     pub height: u32,
-    pub layers: u32,
-    /// `levels[k]`: level k of every layer, layer after layer, rows from the top; linear RGBA
-    /// as f16 bits.
-    pub levels: Vec<Vec<[u16; 4]>>,
+    pub levels: u32,
+    pub first: u32,
+}
+
+/// Every texture's mip chain, exactly as uploaded.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TextureAtlas {
+    pub entries: Vec<AtlasEntry>,
+    /// Texture after texture, level after level, rows from the top: linear RGBA as f16 bits.
+    pub texels: Vec<[u16; 4]>,
 }
 
 /// The sRGB transfer function's inverse, for each 8-bit code.
@@ -73,36 +88,47 @@ pub fn srgb_to_linear(code: u8) -> f32 {
     srgb_decode_table()[code as usize]
 }
 
-/// Size in bytes of a chain of levels starting at `w × h`, with `layers` layers.
-fn chain_bytes(w: u32, h: u32, layers: u32) -> u64 {
-    let (mut w, mut h, mut total) = (w as u64, h as u64, 0u64);
+/// Size of the level after a `w × h` one.
+fn next_level(w: u32, h: u32) -> (u32, u32) {
+    ((w / 2).max(1), (h / 2).max(1))
+}
+
+/// Number of levels of a chain starting at `w × h` (down to 1 × 1).
+pub fn level_count(w: u32, h: u32) -> u32 {
+    w.max(h).max(1).ilog2() + 1
+}
+
+/// Texels of a chain of levels starting at `w × h`.
+pub fn chain_texels(w: u32, h: u32) -> u64 {
+    let (mut w, mut h, mut total) = (w.max(1), h.max(1), 0u64);
     loop {
-        total += w * h * TEXEL_BYTES * layers as u64;
+        total += w as u64 * h as u64;
         if w == 1 && h == 1 {
             return total;
         }
-        w = (w / 2).max(1);
-        h = (h / 2).max(1);
+        (w, h) = next_level(w, h);
     }
 }
 
-/// The common layer size for textures of these sizes (see the module documentation).
-pub fn common_size(sizes: &[(u32, u32)]) -> (u32, u32) {
-    let fit = |s: u32| s.max(1).next_power_of_two().min(MAX_SIDE);
-    let mut w = fit(sizes.iter().map(|s| s.0).max().unwrap_or(1));
-    let mut h = fit(sizes.iter().map(|s| s.1).max().unwrap_or(1));
-    let layers = sizes.len().max(1) as u32;
-    while chain_bytes(w, h, layers) > BUDGET_BYTES && (w > 1 || h > 1) {
-        if w >= h {
-            w = (w / 2).max(1);
-        } else {
-            h = (h / 2).max(1);
+/// The size each texture keeps in the atlas: its own, unless the chains together exceed
+/// [`CAPACITY`]; then the texture with the largest chain is halved (both sides, rounded up),
+/// and again, until they fit. Textures that were not the largest keep their size.
+pub fn fitted_sizes(sizes: &[(u32, u32)]) -> Vec<(u32, u32)> {
+    let mut out: Vec<(u32, u32)> = sizes.iter().map(|&(w, h)| (w.max(1), h.max(1))).collect();
+    let mut total: u64 = out.iter().map(|&(w, h)| chain_texels(w, h)).sum();
+    while total > CAPACITY {
+        let (k, &(w, h)) = out.iter().enumerate().max_by_key(|(_, s)| chain_texels(s.0, s.1)).expect("not empty");
+        if (w, h) == (1, 1) {
+            break; // More textures than texels: reported by TextureAtlas::check.
         }
+        let halved = (w.div_ceil(2), h.div_ceil(2));
+        total = total - chain_texels(w, h) + chain_texels(halved.0, halved.1);
+        out[k] = halved;
     }
-    (w, h)
+    out
 }
 
-/// Resamples one axis of a `n`-long periodic signal to `m` samples: a tent filter of radius
+/// Resamples one axis of an `n`-long periodic signal to `m` samples: a tent filter of radius
 /// max(1, n/m) source texels around each destination texel's centre, weights normalised.
 fn resample_axis(n: usize, m: usize) -> Vec<Vec<(usize, f32)>> {
     let scale = n as f64 / m as f64;
@@ -127,10 +153,48 @@ fn resample_axis(n: usize, m: usize) -> Vec<Vec<(usize, f32)>> {
         .collect()
 }
 
+/// The taps of one axis of the next mip level: the mean of two parents where the side halves
+/// exactly, the identity where it stays (1), the tent filter where it is odd.
+fn mip_axis(n: usize, m: usize) -> Vec<Vec<(usize, f32)>> {
+    if n == m {
+        (0..m).map(|j| vec![(j, 1.0)]).collect()
+    } else if n == 2 * m {
+        (0..m).map(|j| vec![(2 * j, 0.5), (2 * j + 1, 0.5)]).collect()
+    } else {
+        resample_axis(n, m)
+    }
+}
+
+/// Applies separable taps to a `sw × sh` image: `xs` along rows (to `xs.len()` columns), then
+/// `ys` along columns.
+fn separable(
+    src: impl Fn(usize) -> Vec4,
+    sw: usize,
+    sh: usize,
+    xs: &[Vec<(usize, f32)>],
+    ys: &[Vec<(usize, f32)>],
+) -> Vec<Vec4> {
+    let dw = xs.len();
+    let mut rows = vec![Vec4::ZERO; dw * sh];
+    for y in 0..sh {
+        for (x, taps) in xs.iter().enumerate() {
+            rows[y * dw + x] = taps.iter().map(|&(i, w)| src(y * sw + i) * w).sum();
+        }
+    }
+    let mut out = vec![Vec4::ZERO; dw * ys.len()];
+    for (y, taps) in ys.iter().enumerate() {
+        for x in 0..dw {
+            out[y * dw + x] = taps.iter().map(|&(i, w)| rows[i * dw + x] * w).sum();
+        }
+    }
+    out
+}
+
 /// A texture's texels as linear RGBA (sRGB colour decoded, linear data and alpha as c/255),
-/// resampled to `dw × dh` with repeat addressing. The texels are decoded as they are read: no
-/// linear copy of a large source is made.
-fn resample(t: &Texture, dw: u32, dh: u32) -> Vec<Vec4> {
+/// at `dw × dh`: as they are where that is the texture's size, else resampled with repeat
+/// addressing. The texels are decoded as they are read: no linear copy of a large source is
+/// made.
+fn decode(t: &Texture, dw: u32, dh: u32) -> Vec<Vec4> {
     let (sw, sh, dw, dh) = (t.width as usize, t.height as usize, dw as usize, dh as usize);
     let rgb = |c: u8| if t.linear { c as f32 / 255.0 } else { srgb_to_linear(c) };
     let src = |i: usize| {
@@ -140,40 +204,15 @@ fn resample(t: &Texture, dw: u32, dh: u32) -> Vec<Vec4> {
     if (sw, sh) == (dw, dh) {
         return (0..sw * sh).map(src).collect();
     }
-    let xs = resample_axis(sw, dw);
-    let ys = resample_axis(sh, dh);
-    let mut rows = vec![Vec4::ZERO; dw * sh];
-    for y in 0..sh {
-        for (x, taps) in xs.iter().enumerate() {
-            rows[y * dw + x] = taps.iter().map(|&(i, w)| src(y * sw + i) * w).sum();
-        }
-    }
-    let mut out = vec![Vec4::ZERO; dw * dh];
-    for (y, taps) in ys.iter().enumerate() {
-        for x in 0..dw {
-            out[y * dw + x] = taps.iter().map(|&(i, w)| rows[i * dw + x] * w).sum();
-        }
-    }
-    out
+    separable(src, sw, sh, &resample_axis(sw, dw), &resample_axis(sh, dh))
 }
 
-/// The 2 × 2 box average of a `w × h` level (a side of 1 stays 1).
+/// The next mip level of a `w × h` level.
 fn downsample(src: &[Vec4], w: u32, h: u32) -> (Vec<Vec4>, u32, u32) {
-    let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
-    let (fx, fy) = ((w / nw) as usize, (h / nh) as usize);
-    let mut out = Vec::with_capacity((nw * nh) as usize);
-    for y in 0..nh as usize {
-        for x in 0..nw as usize {
-            let mut sum = Vec4::ZERO;
-            for dy in 0..fy {
-                for dx in 0..fx {
-                    sum += src[(y * fy + dy) * w as usize + x * fx + dx];
-                }
-            }
-            out.push(sum / (fx * fy) as f32);
-        }
-    }
-    (out, nw, nh)
+    let (nw, nh) = next_level(w, h);
+    let xs = mip_axis(w as usize, nw as usize);
+    let ys = mip_axis(h as usize, nh as usize);
+    (separable(|i| src[i], w as usize, h as usize, &xs, &ys), nw, nh)
 }
 
 fn encode(level: &[Vec4]) -> impl Iterator<Item = [u16; 4]> + '_ {
@@ -181,193 +220,242 @@ fn encode(level: &[Vec4]) -> impl Iterator<Item = [u16; 4]> + '_ {
     level.iter().map(move |c| c.to_array().map(h))
 }
 
-impl TextureArray {
-    /// The array of `textures` (a single white texel when there are none, so that the
-    /// binding always exists).
-    pub fn new(textures: &[Texture]) -> TextureArray {
-        if textures.is_empty() {
-            let one = half::f16::ONE.to_bits();
-            return TextureArray { width: 1, height: 1, layers: 1, levels: vec![vec![[one; 4]]] };
-        }
+impl TextureAtlas {
+    /// The atlas of `textures`, each at its [`fitted_sizes`] size (a single white texel and no
+    /// entries when there are none, so that the binding always exists).
+    pub fn new(textures: &[Texture]) -> TextureAtlas {
         let sizes: Vec<(u32, u32)> = textures.iter().map(|t| (t.width, t.height)).collect();
-        let (width, height) = common_size(&sizes);
-        let level_count = width.max(height).ilog2() as usize + 1;
-        let mut levels: Vec<Vec<[u16; 4]>> = vec![Vec::new(); level_count];
-        for t in textures {
-            let (mut level, mut w, mut h) = (resample(t, width, height), width, height);
-            for (k, out) in levels.iter_mut().enumerate() {
-                if k > 0 {
-                    (level, w, h) = downsample(&level, w, h);
+        let fitted = fitted_sizes(&sizes);
+        // Each texture's chain on a core of its own (the decoding and the mip levels of a
+        // staircase's ten photographs dominate its start-up), then laid one after another.
+        let chains: Vec<Vec<[u16; 4]>> = (0..textures.len())
+            .into_par_iter()
+            .map(|i| {
+                let (t, (width, height)) = (&textures[i], fitted[i]);
+                let (mut level, mut w, mut h) = (decode(t, width, height), width, height);
+                let mut chain = Vec::with_capacity(chain_texels(width, height) as usize);
+                for k in 0..level_count(width, height) {
+                    if k > 0 {
+                        (level, w, h) = downsample(&level, w, h);
+                    }
+                    chain.extend(encode(&level));
                 }
-                out.extend(encode(&level));
-            }
+                chain
+            })
+            .collect();
+        let mut texels = Vec::with_capacity(chains.iter().map(Vec::len).sum());
+        let mut entries = Vec::with_capacity(textures.len());
+        for (chain, &(width, height)) in chains.iter().zip(&fitted) {
+            let levels = level_count(width, height);
+            entries.push(AtlasEntry { width, height, levels, first: texels.len() as u32 });
+            texels.extend_from_slice(chain);
         }
-        TextureArray { width, height, layers: textures.len() as u32, levels }
+        if texels.is_empty() {
+            texels.push([half::f16::ONE.to_bits(); 4]);
+        }
+        TextureAtlas { entries, texels }
     }
 
-    pub fn level_count(&self) -> u32 {
-        self.levels.len() as u32
+    /// Size of level `k` of texture `t`.
+    pub fn level_size(&self, t: u32, k: u32) -> (u32, u32) {
+        let e = self.entries[t as usize];
+        ((e.width >> k).max(1), (e.height >> k).max(1))
     }
 
-    /// Size of mip level `k`.
-    pub fn level_size(&self, k: usize) -> (u32, u32) {
-        ((self.width >> k).max(1), (self.height >> k).max(1))
+    /// The atlas index of texel (0, 0) of level `k` of texture `t`.
+    fn level_first(&self, t: u32, k: u32) -> u32 {
+        let e = self.entries[t as usize];
+        let (mut first, mut w, mut h) = (e.first, e.width, e.height);
+        for _ in 0..k {
+            first += w * h;
+            (w, h) = next_level(w, h);
+        }
+        first
     }
 
-    /// The linear RGB of texel (x, y) of `layer` at level `k`.
-    pub fn texel(&self, k: usize, layer: u32, x: u32, y: u32) -> Vec3 {
-        self.texel_rgba(k, layer, x, y).truncate()
+    /// The linear RGB of texel (x, y) of level `k` of texture `t`.
+    pub fn texel(&self, t: u32, k: u32, x: u32, y: u32) -> Vec3 {
+        self.texel_rgba(t, k, x, y).truncate()
     }
 
-    /// The linear RGB and alpha of texel (x, y) of `layer` at level `k`.
-    pub fn texel_rgba(&self, k: usize, layer: u32, x: u32, y: u32) -> Vec4 {
-        let (w, h) = self.level_size(k);
-        let p = self.levels[k][((layer * h + y) * w + x) as usize].map(|b| half::f16::from_bits(b).to_f32());
+    /// The linear RGB and alpha of texel (x, y) of level `k` of texture `t`.
+    pub fn texel_rgba(&self, t: u32, k: u32, x: u32, y: u32) -> Vec4 {
+        let (w, _) = self.level_size(t, k);
+        let p = self.texels[(self.level_first(t, k) + y * w + x) as usize].map(|b| half::f16::from_bits(b).to_f32());
         Vec4::from_array(p)
     }
 
-    /// Bilinear filtering of level `k` at `uv`, repeat addressing (`textureSampleLevel` within
-    /// one level).
-    fn bilinear(&self, k: usize, layer: u32, uv: Vec2) -> Vec4 {
-        let (w, h) = self.level_size(k);
-        let x = uv.x * w as f32 - 0.5;
-        let y = uv.y * h as f32 - 0.5;
-        let (x0, y0) = (x.floor(), y.floor());
-        let (a, b) = (x - x0, y - y0);
-        let wrap = |i: f32, n: u32| (i as i64).rem_euclid(n as i64) as u32;
-        let (x0, x1) = (wrap(x0, w), wrap(x0 + 1.0, w));
-        let (y0, y1) = (wrap(y0, h), wrap(y0 + 1.0, h));
-        let t = |x, y| self.texel_rgba(k, layer, x, y);
-        (t(x0, y0) * (1.0 - a) + t(x1, y0) * a) * (1.0 - b) + (t(x0, y1) * (1.0 - a) + t(x1, y1) * a) * b
+    /// Bilinear filtering of the `w × h` level starting at texel `first`, at `st`, repeat
+    /// addressing (`atlas_bilinear` in WGSL, step for step).
+    fn bilinear(&self, first: u32, w: u32, h: u32, st: Vec2) -> Vec4 {
+        let f = st - st.floor();
+        let p = f * Vec2::new(w as f32, h as f32) - 0.5;
+        let p0 = p.floor();
+        let a = p - p0;
+        // p0 ∈ [−1, side − 1]: −1 wraps to the last texel, side to the first.
+        let wrap = |i: f32, n: u32| if i < 0.0 { n - 1 } else { (i as u32).min(n - 1) };
+        let (x0, y0) = (wrap(p0.x, w), wrap(p0.y, h));
+        let (x1, y1) = (if x0 + 1 >= w { 0 } else { x0 + 1 }, if y0 + 1 >= h { 0 } else { y0 + 1 });
+        let texel = |x: u32, y: u32| {
+            Vec4::from_array(self.texels[(first + y * w + x) as usize].map(|b| half::f16::from_bits(b).to_f32()))
+        };
+        let top = texel(x0, y0) * (1.0 - a.x) + texel(x1, y0) * a.x;
+        let bottom = texel(x0, y1) * (1.0 - a.x) + texel(x1, y1) * a.x;
+        top * (1.0 - a.y) + bottom * a.y
     }
 
-    /// Trilinear sample of `layer` at `uv` and level of detail `lod`: the CPU twin of
-    /// `textureSampleLevel` with the array's sampler (linear filters, repeat addressing).
-    pub fn sample(&self, layer: u32, uv: Vec2, lod: f32) -> Vec3 {
-        self.sample_rgba(layer, uv, lod).truncate()
+    /// Trilinear sample of texture `t` at `st` and level of detail `lod` (linear RGB): the
+    /// CPU twin of `atlas_sample` in WGSL.
+    pub fn sample(&self, t: u32, st: Vec2, lod: f32) -> Vec3 {
+        self.sample_rgba(t, st, lod).truncate()
     }
 
-    /// [`TextureArray::sample`] with the alpha channel.
-    pub fn sample_rgba(&self, layer: u32, uv: Vec2, lod: f32) -> Vec4 {
-        let last = self.levels.len() - 1;
+    /// [`TextureAtlas::sample`] with the alpha channel.
+    pub fn sample_rgba(&self, t: u32, st: Vec2, lod: f32) -> Vec4 {
+        let e = self.entries[t as usize];
+        let last = e.levels - 1;
         let lod = if lod.is_nan() { 0.0 } else { lod.clamp(0.0, last as f32) };
-        let k = (lod.floor() as usize).min(last);
+        let k = (lod.floor() as u32).min(last);
         let f = lod - k as f32;
-        let lo = self.bilinear(k, layer, uv);
-        if f > 0.0 && k < last { lo * (1.0 - f) + self.bilinear(k + 1, layer, uv) * f } else { lo }
+        let (w, h) = self.level_size(t, k);
+        let first = self.level_first(t, k);
+        let lo = self.bilinear(first, w, h, st);
+        if f > 0.0 && k < last {
+            let (nw, nh) = next_level(w, h);
+            lo * (1.0 - f) + self.bilinear(first + w * h, nw, nh, st) * f
+        } else {
+            lo
+        }
     }
 
-    /// Level of detail of a footprint whose texture coordinates change by `dx` and `dy` across
-    /// one pixel: log2 of the longer change in texels of level 0 (the isotropic formula of the
-    /// Vulkan and WebGPU specifications), 0 under magnification. `texture_lod` in WGSL.
-    pub fn lod(&self, dx: Vec2, dy: Vec2) -> f32 {
-        let size = Vec2::new(self.width as f32, self.height as f32);
+    /// Level of detail of a footprint on texture `t` whose coordinates change by `dx` and
+    /// `dy` across one pixel: log2 of the longer change in texels of the texture's level 0
+    /// (the isotropic formula of the Vulkan and WebGPU specifications), 0 under magnification.
+    /// `texture_lod` in WGSL.
+    pub fn lod(&self, t: u32, dx: Vec2, dy: Vec2) -> f32 {
+        let e = self.entries[t as usize];
+        let size = Vec2::new(e.width as f32, e.height as f32);
         let rho = (dx * size).length().max((dy * size).length());
         if rho.is_nan() { 0.0 } else { rho.max(1.0).log2().min(32.0) }
     }
 
-    /// Checks the array against the device's limits.
+    /// Rows of the atlas texture.
+    pub fn rows(&self) -> u32 {
+        (self.texels.len() as u64).div_ceil(ROW as u64) as u32
+    }
+
+    /// Bytes the atlas takes on the GPU.
+    pub fn bytes(&self) -> u64 {
+        self.rows() as u64 * ROW as u64 * TEXEL_BYTES
+    }
+
+    /// The entries as the scene's data buffer holds them (one zero entry where there are none:
+    /// no texture slot then points into them).
+    pub fn gpu_entries(&self) -> Vec<AtlasEntry> {
+        if self.entries.is_empty() { vec![bytemuck::Zeroable::zeroed()] } else { self.entries.clone() }
+    }
+
+    /// Checks the atlas against the device's limits (the 2D texture it becomes).
     pub fn check_limits(&self, gpu: &Gpu) -> Result<()> {
-        let l = gpu.device.limits();
-        if self.width.max(self.height) > l.max_texture_dimension_2d || self.layers > l.max_texture_array_layers {
+        let max = gpu.device.limits().max_texture_dimension_2d;
+        if self.rows() > max || ROW > max {
             return Err(Error::Limits(format!(
-                "the scene's {} textures need a {}x{} texture array with {} layers, but this GPU allows {} texels per side and {} layers",
-                self.layers,
-                self.width,
-                self.height,
-                self.layers,
-                l.max_texture_dimension_2d,
-                l.max_texture_array_layers
+                "the scene's {} textures need {} MiB ({} rows of {ROW} texels), but this GPU allows {max} texels per side; use smaller textures",
+                self.entries.len(),
+                self.bytes() >> 20,
+                self.rows()
             )));
         }
         Ok(())
     }
 
-    /// Uploads the array with all its levels and creates the sampler every pass uses.
-    pub fn upload(&self, gpu: &Gpu) -> (wgpu::TextureView, wgpu::Sampler) {
+    /// Uploads the atlas as the rows of one `rgba16float` texture (the last row padded).
+    pub fn upload(&self, gpu: &Gpu) -> wgpu::TextureView {
+        let rows = self.rows();
+        let width = if rows == 1 { self.texels.len() as u32 } else { ROW };
         let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("scene textures"),
-            size: wgpu::Extent3d { width: self.width, height: self.height, depth_or_array_layers: self.layers },
-            mip_level_count: self.level_count(),
+            size: wgpu::Extent3d { width, height: rows, depth_or_array_layers: 1 },
+            mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format: FORMAT,
             usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
             view_formats: &[],
         });
-        for (k, level) in self.levels.iter().enumerate() {
-            let (w, h) = self.level_size(k);
-            gpu.queue.write_texture(
-                wgpu::TexelCopyTextureInfo {
-                    texture: &texture,
-                    mip_level: k as u32,
-                    origin: wgpu::Origin3d::ZERO,
-                    aspect: wgpu::TextureAspect::All,
-                },
-                bytemuck::cast_slice(level),
-                wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(TEXEL_BYTES as u32 * w),
-                    rows_per_image: Some(h),
-                },
-                wgpu::Extent3d { width: w, height: h, depth_or_array_layers: self.layers },
-            );
-        }
-        let view = texture.create_view(&wgpu::TextureViewDescriptor {
-            label: Some("scene textures"),
-            dimension: Some(wgpu::TextureViewDimension::D2Array),
-            ..Default::default()
-        });
-        let sampler = gpu.device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("scene textures"),
-            address_mode_u: wgpu::AddressMode::Repeat,
-            address_mode_v: wgpu::AddressMode::Repeat,
-            address_mode_w: wgpu::AddressMode::Repeat,
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            mipmap_filter: wgpu::MipmapFilterMode::Linear,
-            ..Default::default()
-        });
-        (view, sampler)
+        let mut data: Vec<[u16; 4]> = Vec::new();
+        let texels: &[[u16; 4]] = if self.texels.len() == (width * rows) as usize {
+            &self.texels
+        } else {
+            data.extend_from_slice(&self.texels);
+            data.resize((width * rows) as usize, [0; 4]);
+            &data
+        };
+        gpu.queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture: &texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            bytemuck::cast_slice(texels),
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(TEXEL_BYTES as u32 * width),
+                rows_per_image: Some(rows),
+            },
+            wgpu::Extent3d { width, height: rows, depth_or_array_layers: 1 },
+        );
+        texture.create_view(&wgpu::TextureViewDescriptor { label: Some("scene textures"), ..Default::default() })
     }
 }
 
-/// Samples `array` on the GPU with the passes' sampler: `textureSampleLevel` at each
-/// (layer, uv, lod) of `queries`, linear RGB. The GPU side of the CPU twin's tests.
-pub fn sample_on_gpu(gpu: &Gpu, array: &TextureArray, queries: &[(u32, Vec2, f32)]) -> Result<Vec<Vec3>> {
+/// Samples `atlas` on the GPU with `textures.wgsl`'s `atlas_sample` at each (texture, st, lod)
+/// of `queries`, linear RGBA. The GPU side of the CPU twin's tests.
+pub fn sample_on_gpu(gpu: &Gpu, atlas: &TextureAtlas, queries: &[(u32, Vec2, f32)]) -> Result<Vec<Vec4>> {
     let device = &gpu.device;
-    let (view, sampler) = array.upload(gpu);
-    let input: Vec<[f32; 4]> = queries.iter().map(|&(layer, uv, lod)| [uv.x, uv.y, lod, layer as f32]).collect();
+    atlas.check_limits(gpu)?;
+    let view = atlas.upload(gpu);
+    let entries =
+        gpu.storage_buffer("texture entries", bytemuck::cast_slice(&atlas.gpu_entries()), wgpu::BufferUsages::empty());
+    let input: Vec<[f32; 4]> = queries.iter().map(|&(t, st, lod)| [st.x, st.y, lod, f32::from_bits(t)]).collect();
     let input = gpu.storage_buffer("texture queries", bytemuck::cast_slice(&input), wgpu::BufferUsages::empty());
     let size = (queries.len() as u64 * 16).max(16);
     let output = gpu.zeroed_buffer("texture samples", size, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
     let c = wgpu::ShaderStages::COMPUTE;
-    let source = "
-        @group(0) @binding(0) var textures: texture_2d_array<f32>;
-        @group(0) @binding(1) var texture_sampler: sampler;
+    let source = format!(
+        "{}{}
+        @group(0) @binding(0) var textures: texture_2d<f32>;
+        @group(0) @binding(1) var<storage, read> entries: array<u32>;
         @group(0) @binding(2) var<storage, read> queries: array<vec4f>;
         @group(0) @binding(3) var<storage, read_write> samples: array<vec4f>;
+        fn atlas_entry_word(i: u32) -> u32 {{
+            return entries[i];
+        }}
         @compute @workgroup_size(64)
-        fn main(@builtin(global_invocation_id) gid: vec3u) {
-            if gid.x >= arrayLength(&queries) {
+        fn main(@builtin(global_invocation_id) gid: vec3u) {{
+            if gid.x >= arrayLength(&queries) {{
                 return;
-            }
+            }}
             let q = queries[gid.x];
-            samples[gid.x] = textureSampleLevel(textures, texture_sampler, q.xy, u32(q.w), q.z);
-        }";
-    let module = shader::module(device, "texture samples", source);
+            samples[gid.x] = atlas_sample(bitcast<u32>(q.w), q.xy, q.z);
+        }}",
+        shader::constants(),
+        shader::TEXTURES
+    );
+    let module = shader::module(device, "texture samples", &source);
     gpu.run_once(
         "texture samples",
         &module,
         &[
-            texture_array_entry(0, c),
-            sampler_entry(1, c),
+            atlas_texture_entry(0, c),
+            storage_entry::<u32>(1, c, true),
             storage_entry::<[f32; 4]>(2, c, true),
             storage_entry::<[f32; 4]>(3, c, false),
         ],
         &[
             wgpu::BindingResource::TextureView(&view),
-            wgpu::BindingResource::Sampler(&sampler),
+            entries.as_entire_binding(),
             input.as_entire_binding(),
             output.as_entire_binding(),
         ],
@@ -375,7 +463,7 @@ pub fn sample_on_gpu(gpu: &Gpu, array: &TextureArray, queries: &[(u32, Vec2, f32
     );
     let bytes = gpu.read_buffer(&output, size)?;
     let samples: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
-    Ok(samples[..queries.len()].iter().map(|s| Vec3::new(s[0], s[1], s[2])).collect())
+    Ok(samples[..queries.len()].iter().map(|&s| Vec4::from_array(s)).collect())
 }
 
 #[cfg(test)]
@@ -385,6 +473,10 @@ mod tests {
     fn texture(w: u32, h: u32, f: impl Fn(u32, u32) -> [u8; 4]) -> Texture {
         let texels = (0..h).flat_map(|y| (0..w).map(move |x| (x, y))).map(|(x, y)| f(x, y)).collect();
         Texture { name: "t".into(), width: w, height: h, texels, linear: false }
+    }
+
+    fn f16(v: f32) -> f32 {
+        half::f16::from_f32(v).to_f32()
     }
 
     #[test]
@@ -398,14 +490,51 @@ mod tests {
     }
 
     #[test]
-    fn common_size_is_the_largest_side_in_powers_of_two_within_the_budget() {
-        assert_eq!(common_size(&[(100, 30), (64, 64)]), (128, 64));
-        assert_eq!(common_size(&[(1, 1)]), (1, 1));
-        assert_eq!(common_size(&[(100_000, 3)]), (MAX_SIDE, 4));
-        // 256 layers of 4096²: halved until the chain (4/3 of level 0) fits 256 MiB.
-        let (w, h) = common_size(&vec![(4096, 4096); 256]);
-        assert!(chain_bytes(w, h, 256) <= BUDGET_BYTES && chain_bytes(2 * w, h, 256) > BUDGET_BYTES);
-        assert_eq!((w, h), (256, 256));
+    fn every_texture_keeps_its_own_size_unless_the_atlas_overflows() {
+        assert_eq!(fitted_sizes(&[(100, 30), (64, 64), (1, 1)]), vec![(100, 30), (64, 64), (1, 1)]);
+        assert_eq!(level_count(100, 30), 7);
+        assert_eq!(chain_texels(4, 2), 8 + 2 + 1);
+        assert_eq!(chain_texels(5, 3), 15 + 2 + 1);
+        // One 16 k texture beside ten of 512²: only the large one shrinks, by halving, to the
+        // largest size whose chain fits beside the others.
+        let mut sizes = vec![(16384, 16384)];
+        sizes.extend([(512, 512); 10]);
+        let fitted = fitted_sizes(&sizes);
+        assert_eq!(&fitted[1..], &sizes[1..]);
+        assert_eq!(fitted[0], (4096, 4096));
+        let total = |s: &[(u32, u32)]| s.iter().map(|&(w, h)| chain_texels(w, h)).sum::<u64>();
+        assert!(total(&fitted) <= CAPACITY);
+        let mut larger = fitted.clone();
+        larger[0] = (8192, 8192);
+        assert!(total(&larger) > CAPACITY);
+        // Many equal textures: halved in turn, never below what fits.
+        let fitted = fitted_sizes(&[(4096, 4096); 4]);
+        assert!(total(&fitted) <= CAPACITY);
+        assert!(fitted.iter().all(|&s| s == (4096, 4096) || s == (2048, 2048)), "{fitted:?}");
+    }
+
+    #[test]
+    fn level_zero_holds_each_texture_as_it_was_decoded() {
+        // Three sizes, none a power of two, in one atlas: texel (x, y) of level 0 is the
+        // source's sRGB code decoded (to f16), and a sample at its centre returns it.
+        let code = |t: u32, x: u32, y: u32| ((t * 71 + x * 13 + y * 29) % 256) as u8;
+        let sizes = [(37, 23), (5, 300), (129, 1)];
+        let textures: Vec<Texture> = sizes
+            .iter()
+            .enumerate()
+            .map(|(t, &(w, h))| texture(w, h, |x, y| [code(t as u32, x, y), 0, 255, 128]))
+            .collect();
+        let a = TextureAtlas::new(&textures);
+        for (t, &(w, h)) in sizes.iter().enumerate() {
+            let t = t as u32;
+            assert_eq!(a.level_size(t, 0), (w, h));
+            for (x, y) in [(0, 0), (w - 1, h - 1), (w / 2, h / 3)] {
+                let want = Vec4::new(f16(srgb_to_linear(code(t, x, y))), 0.0, 1.0, f16(128.0 / 255.0));
+                assert_eq!(a.texel_rgba(t, 0, x, y), want);
+                let centre = Vec2::new((x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32);
+                assert!((a.sample_rgba(t, centre, 0.0) - want).abs().max_element() < 1e-6, "texture {t} ({x}, {y})");
+            }
+        }
     }
 
     #[test]
@@ -413,51 +542,54 @@ mod tests {
         // A 4×2 texture of black and white columns: level 1 (2×1) is the linear mean 0.5 (sRGB
         // code 188), not the sRGB code 128 (linear 0.216) an average of the codes would give.
         let t = texture(4, 2, |x, _| if x % 2 == 0 { [0, 0, 0, 255] } else { [255; 4] });
-        let a = TextureArray::new(&[t]);
-        assert_eq!((a.width, a.height, a.level_count()), (4, 2, 3));
+        let a = TextureAtlas::new(&[t]);
+        assert_eq!((a.level_size(0, 0), a.entries[0].levels), ((4, 2), 3));
         assert_eq!(a.texel(0, 0, 1, 1), Vec3::ONE);
         for (k, x) in [(1, 0), (1, 1), (2, 0)] {
-            assert_eq!(a.texel(k, 0, x, 0), Vec3::splat(0.5), "level {k} texel {x}");
+            assert_eq!(a.texel(0, k, x, 0), Vec3::splat(0.5), "level {k} texel {x}");
         }
+        // An odd side (3 → 1): the level keeps the mean of a constant row and of any row.
+        let t = texture(3, 1, |x, _| [[0, 255, 255][x as usize], 0, 0, 255]);
+        let a = TextureAtlas::new(&[t]);
+        assert_eq!(a.level_size(0, 1), (1, 1));
+        assert!((a.texel(0, 1, 0, 0).x - 2.0 / 3.0).abs() < 1e-3, "{}", a.texel(0, 1, 0, 0));
     }
 
     #[test]
-    fn smaller_textures_are_enlarged_bilinearly_with_wrapping() {
-        // A 2×1 texture (black, white) enlarged to 4×1 next to a 4×1 one: destination texel
-        // centres fall at source coordinates −0.25, 0.25, 0.75, 1.25 (texel units, wrapped).
-        let small = texture(2, 1, |x, _| if x == 0 { [0, 0, 0, 255] } else { [255; 4] });
-        let a = TextureArray::new(&[small, texture(4, 1, |_, _| [0; 4])]);
-        assert_eq!((a.width, a.height), (4, 1));
-        let row: Vec<f32> = (0..4).map(|x| a.texel(0, 0, x, 0).x).collect();
-        let expected = [0.25, 0.25, 0.75, 0.75];
-        for (got, want) in row.iter().zip(expected) {
-            assert!((got - want).abs() < 5e-4, "{row:?} vs {expected:?}");
-        }
+    fn a_texture_halved_to_fit_is_its_area_average() {
+        // 2×1 (black, white) to 1×1 by the tent filter of one destination texel: the mean.
+        let t = texture(2, 1, |x, _| if x == 0 { [0, 0, 0, 255] } else { [255; 4] });
+        let level = decode(&t, 1, 1);
+        assert!((level[0].x - 0.5).abs() < 1e-6);
     }
 
     #[test]
     fn sampling_interpolates_within_and_between_levels_and_repeats() {
         let t = texture(4, 4, |x, y| [(x * 60) as u8, (y * 60) as u8, 100, 255]);
-        let a = TextureArray::new(&[t]);
+        let a = TextureAtlas::new(&[texture(3, 5, |_, _| [7; 4]), t]);
         // At a texel centre of level 0 the sample is that texel; one period away too.
         let centre = Vec2::new(1.5 / 4.0, 2.5 / 4.0);
-        assert_eq!(a.sample(0, centre, 0.0), a.texel(0, 0, 1, 2));
-        assert!((a.sample(0, centre + Vec2::new(3.0, -2.0), 0.0) - a.texel(0, 0, 1, 2)).abs().max_element() < 1e-5);
-        // Halfway between two texels of a row: their mean.
-        let mid = a.sample(0, Vec2::new(2.0 / 4.0, 0.5 / 4.0), 0.0);
-        assert!((mid - 0.5 * (a.texel(0, 0, 1, 0) + a.texel(0, 0, 2, 0))).abs().max_element() < 1e-6);
+        assert_eq!(a.sample(1, centre, 0.0), a.texel(1, 0, 1, 2));
+        assert!((a.sample(1, centre + Vec2::new(3.0, -2.0), 0.0) - a.texel(1, 0, 1, 2)).abs().max_element() < 1e-5);
+        // Halfway between two texels of a row: their mean; at the left edge: the mean of the
+        // first and the last texel (repeat).
+        let mid = a.sample(1, Vec2::new(2.0 / 4.0, 0.5 / 4.0), 0.0);
+        assert!((mid - 0.5 * (a.texel(1, 0, 1, 0) + a.texel(1, 0, 2, 0))).abs().max_element() < 1e-6);
+        let edge = a.sample(1, Vec2::new(0.0, 0.5 / 4.0), 0.0);
+        assert!((edge - 0.5 * (a.texel(1, 0, 0, 0) + a.texel(1, 0, 3, 0))).abs().max_element() < 1e-6);
         // Between levels: the linear blend of the two levels' samples; beyond the last: clamped.
         let uv = Vec2::new(0.3, 0.7);
-        let blend = a.sample(0, uv, 1.25);
-        let expected = a.sample(0, uv, 1.0) * 0.75 + a.sample(0, uv, 2.0) * 0.25;
+        let blend = a.sample(1, uv, 1.25);
+        let expected = a.sample(1, uv, 1.0) * 0.75 + a.sample(1, uv, 2.0) * 0.25;
         assert!((blend - expected).abs().max_element() < 1e-6);
-        assert!((a.sample(0, uv, 7.0) - a.texel(2, 0, 0, 0)).abs().max_element() < 1e-6);
+        assert!((a.sample(1, uv, 7.0) - a.texel(1, 2, 0, 0)).abs().max_element() < 1e-6);
     }
 
     #[test]
-    fn level_of_detail_is_log2_of_the_footprint_in_texels() {
-        let a = TextureArray::new(&[texture(64, 16, |_, _| [0; 4])]);
-        assert_eq!(a.lod(Vec2::new(4.0 / 64.0, 0.0), Vec2::new(0.0, 1.0 / 16.0)), 2.0);
-        assert_eq!(a.lod(Vec2::new(0.1 / 64.0, 0.0), Vec2::ZERO), 0.0, "magnification reads level 0");
+    fn level_of_detail_is_log2_of_the_footprint_in_the_textures_own_texels() {
+        let a = TextureAtlas::new(&[texture(64, 16, |_, _| [0; 4]), texture(16, 16, |_, _| [0; 4])]);
+        assert_eq!(a.lod(0, Vec2::new(4.0 / 64.0, 0.0), Vec2::new(0.0, 1.0 / 16.0)), 2.0);
+        assert_eq!(a.lod(1, Vec2::new(4.0 / 64.0, 0.0), Vec2::new(0.0, 1.0 / 16.0)), 0.0);
+        assert_eq!(a.lod(0, Vec2::new(0.1 / 64.0, 0.0), Vec2::ZERO), 0.0, "magnification reads level 0");
     }
 }

@@ -7,8 +7,7 @@ use std::io::Cursor;
 use std::path::Path;
 
 /// Largest image side accepted when decoding (a guard against hostile headers; the largest
-/// texture WebGPU guarantees, and the renderer resamples to at most
-/// [`crate::textures::MAX_SIDE`] anyway).
+/// texture WebGPU guarantees).
 pub const MAX_DECODED_SIDE: u32 = 8192;
 /// Largest allocation the image decoder may make for one image (8192² texels of 16-bit RGBA).
 const MAX_DECODE_BYTES: u64 = 512 << 20;

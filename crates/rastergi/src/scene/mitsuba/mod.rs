@@ -19,7 +19,7 @@
 //! | Mitsuba | rastergi |
 //! |---|---|
 //! | `diffuse` (reflectance) | Lambertian albedo (RGB or bitmap) |
-//! | `plastic`, `roughplastic` | a dielectric layer of η = int_ior/ext_ior (weight: mean specular_reflectance) over a diffuse base of albedo [`materials::plastic_albedo`]`(ρ)`, which matches Mitsuba's diffuse lobe (linear or `nonlinear`) up to Schlick's Fresnel against the exact one; roughness √α |
+//! | `plastic`, `roughplastic` | a dielectric layer of η = int_ior/ext_ior (weight: mean specular_reflectance) over a diffuse base of albedo [`materials::plastic_albedo`]`(ρ)`, which reflects what Mitsuba's diffuse lobe does under uniform light (Mitsuba's own rough-interface terms; linear or `nonlinear`), up to Schlick's Fresnel against the exact one; roughness √α |
 //! | `conductor`, `roughconductor` | metal of base colour F₀(η, k) × specular_reflectance (η, k given or from `material`, [`spectra`]); roughness √α |
 //! | `dielectric`, `roughdielectric`, `thindielectric` | glass: transmission 1, ior int_ior/ext_ior, tint specular_transmittance, `thin` for thindielectric; roughness √α |
 //! | `twosided` | its BSDF, reflecting on both faces |

@@ -73,7 +73,7 @@ pub struct Sun {
 
 /// What a front end asks for: the scene and its overrides, the image size, the renderer and
 /// its settings, and the GPU. `None` fields are fitted to the scene or taken from it. The
-/// defaults are the command line's.
+/// defaults are the command line's (and the scene, which it always names, `cornell`).
 #[derive(Clone, Debug)]
 pub struct Options {
     /// A built-in scene's name (`cornell`, `spheres:N` …) or a scene file's path (.obj, .gltf,

@@ -1,11 +1,13 @@
 //! `rastergi._rastergi`: the native module of the Python package `rastergi` (see
 //! `rastergi/__init__.py`, which wraps it). The render options arrive as the command line of
 //! `rastergi render` (the Python wrapper turns keyword arguments into `--name value`) and are
-//! parsed by the CLI's own parser ([`SceneArgs`]), and the renderer is built by the CLI's own
-//! function ([`cli_render::new_renderer`]): the options, defaults, checks, messages and images are
-//! the CLI's. The interpreter's lock is released while scenes load, photons are traced,
-//! iterations run and images are read back.
+//! parsed by the CLI's own parser ([`SceneArgs`], the library's `rastergi::session::args`), the
+//! scene is loaded and the renderer built by the library's session ([`Session`]) and the
+//! iterations run by its render loop ([`rastergi::session::run`]), as in `rastergi render`: the
+//! options, defaults, checks, messages and images are the CLI's. The interpreter's lock is
+//! released while scenes load, photons are traced, iterations run and images are read back.
 
+use std::ops::ControlFlow;
 use std::path::PathBuf;
 use std::sync::{Mutex, MutexGuard};
 
@@ -17,11 +19,14 @@ use pyo3::exceptions::{PyFileNotFoundError, PyRuntimeError, PyTypeError, PyValue
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rastergi::error::Error;
+use rastergi::film::Show;
+use rastergi::gpu::GpuOptions;
 use rastergi::image_io::{ImageFormat, LinearImage, display_encode, write_exr, write_png};
 use rastergi::progressive::Progressive;
 use rastergi::scene::Camera;
-use rastergi_cli::args::{SceneArgs, ShowArg};
-use rastergi_cli::render::{self as cli_render, Method};
+use rastergi::session::args::{SceneArgs, ShowArg};
+use rastergi::session::run::{Limits, Observer, run};
+use rastergi::session::{Method, Session};
 
 create_exception!(
     _rastergi,
@@ -91,19 +96,19 @@ fn parse(argv: Vec<String>) -> PyResult<RenderOptions> {
     })
 }
 
-/// The process's device for `args`' backends: one for every renderer made in Python, so that
-/// a renderer made after another of the same shader variants reuses its compiled pipelines
-/// (`rastergi::compiled`: set-up about 1 s shorter per renderer on lavapipe). A device that
-/// reported an error (lost, out of memory) is replaced by a fresh one.
-fn shared_gpu(args: &rastergi_cli::args::GpuArgs) -> Result<rastergi::gpu::Gpu> {
+/// The process's device for `options`' backends: one for every renderer made in Python, so
+/// that a renderer made after another of the same shader variants reuses its compiled
+/// pipelines (`rastergi::compiled`: set-up about 1 s shorter per renderer on lavapipe). A
+/// device that reported an error (lost, out of memory) is replaced by a fresh one.
+fn shared_gpu(options: &GpuOptions) -> Result<rastergi::gpu::Gpu> {
     static GPUS: Mutex<Vec<(String, rastergi::gpu::Gpu)>> = Mutex::new(Vec::new());
-    let backends = format!("{:?}", args.options().backends);
+    let backends = format!("{:?}", options.backends);
     let mut gpus = GPUS.lock().unwrap_or_else(|e| e.into_inner());
     gpus.retain(|(b, gpu)| *b != backends || gpu.check().is_ok());
     if let Some((_, gpu)) = gpus.iter().find(|(b, _)| *b == backends) {
         return Ok(gpu.clone());
     }
-    let gpu = rastergi_cli::args::gpu(args)?;
+    let gpu = rastergi::gpu::Gpu::new(options)?;
     gpus.push((backends, gpu.clone()));
     Ok(gpu)
 }
@@ -114,48 +119,52 @@ type ImageSize = (u32, u32);
 /// Loads the scene and builds the renderer as `rastergi render` does (the photon map traced);
 /// with its image size.
 fn build(o: &RenderOptions) -> Result<(Box<dyn Progressive>, ImageSize), PyErr> {
-    cli_render::check_method_show(o.method, o.scene.show).map_err(value_err)?;
-    if o.denoise && (o.method != Method::Gather || !matches!(o.scene.show, ShowArg::Full)) {
+    let options = o.scene.options(o.method, o.denoise);
+    o.method.check_show(options.show).map_err(|e| value_err(e.into()))?;
+    if o.denoise && (o.method != Method::Gather || options.show != Show::Full) {
         return Err(PyValueError::new_err("denoise needs method='gather' and the full image (no show)"));
     }
-    let a = &o.scene;
-    let scene = a.load_scene().map_err(py_err)?;
-    let (width, height) = a.image_size(&scene);
-    let settings = a.settings(&scene, width, height, matches!(a.show, ShowArg::PhotonMap));
-    let gpu = shared_gpu(&a.gpu).map_err(py_err)?;
-    let (mut renderer, _) = cli_render::new_renderer(&gpu, &scene, settings, o.method).map_err(py_err)?;
-    if o.denoise
-        && let Some(r) = renderer.as_renderer_mut()
-    {
-        r.enable_denoiser().map_err(|e| py_err(e.into()))?;
-    }
+    let session = Session::load(&options).map_err(|e| py_err(e.into()))?;
+    let (width, height) = (session.settings.width, session.settings.height);
+    let gpu = shared_gpu(&options.gpu).map_err(py_err)?;
+    let (renderer, _) = session.renderer(&gpu, &options).map_err(|e| py_err(e.into()))?;
     renderer.wait().map_err(|e| py_err(e.into()))?;
     Ok((renderer, (width, height)))
 }
 
-/// Iterations submitted between waits (as `rastergi render`'s queue) and between checks for
-/// Ctrl-C.
-const CHUNK: u32 = 8;
+/// Watches the render loop for Ctrl-C: at each of its syncs (every 8 iterations, as
+/// `rastergi render`'s queue, or every one where they are slow) it takes the interpreter's
+/// lock to check for signals, and stops the loop with the KeyboardInterrupt it finds.
+#[derive(Default)]
+struct Interrupts(Option<PyErr>);
 
-/// Runs `n` iterations by calls of `run(k)` for chunks of k, with the interpreter's lock
-/// released, checking for signals (Ctrl-C raises KeyboardInterrupt) between chunks.
-fn in_chunks(py: Python<'_>, n: u32, mut run: impl FnMut(u32) -> rastergi::error::Result<()> + Send) -> PyResult<()> {
-    let mut left = n;
-    while left > 0 {
-        let k = left.min(CHUNK);
-        py.detach(|| run(k)).map_err(|e| py_err(e.into()))?;
-        left -= k;
-        py.check_signals()?;
+impl Observer for Interrupts {
+    fn synced(&mut self, _done: u32) -> ControlFlow<()> {
+        match Python::attach(|py| py.check_signals()) {
+            Ok(()) => ControlFlow::Continue(()),
+            Err(e) => {
+                self.0 = Some(e);
+                ControlFlow::Break(())
+            }
+        }
     }
-    Ok(())
 }
 
-/// Submits `k` iterations and waits for them.
-fn iterations(renderer: &mut dyn Progressive, k: u32) -> rastergi::error::Result<()> {
-    for _ in 0..k {
-        renderer.iterate()?;
-    }
-    renderer.wait()
+/// Runs `n` more iterations of the renderer that `renderer` gives (a [`PyRenderer`]'s lock,
+/// taken with the interpreter's lock released, as everywhere) by the library's render loop;
+/// Ctrl-C raises KeyboardInterrupt.
+fn iterate<R>(py: Python<'_>, renderer: impl FnOnce() -> R + Send, n: u32) -> PyResult<()>
+where
+    R: std::ops::DerefMut<Target = Box<dyn Progressive>>,
+{
+    let mut interrupts = Interrupts::default();
+    py.detach(|| {
+        let mut renderer = renderer();
+        let limits = Limits::iterations(renderer.samples().saturating_add(n));
+        run(renderer.as_mut(), &limits, None, &mut interrupts)
+    })
+    .map_err(|e| py_err(e.into()))?;
+    interrupts.0.map_or(Ok(()), Err)
 }
 
 /// A numpy float32 array (height, width, 3).
@@ -200,7 +209,8 @@ fn render<'py>(py: Python<'py>, argv: Vec<String>) -> PyResult<Bound<'py, PyArra
         return Err(PyValueError::new_err("--iterations must be at least 1"));
     }
     let (mut renderer, _) = py.detach(|| build(&o))?;
-    in_chunks(py, o.iterations, |k| iterations(renderer.as_mut(), k))?;
+    let r = &mut renderer;
+    iterate(py, move || r, o.iterations)?;
     let show = o.scene.show.show();
     let denoise = o.denoise;
     let image = py
@@ -260,7 +270,7 @@ impl PyRenderer {
 
     /// Runs `n` more iterations (one sample per pixel each).
     fn iterate(&self, py: Python<'_>, n: u32) -> PyResult<()> {
-        in_chunks(py, n, |k| iterations(self.lock().as_mut(), k))
+        iterate(py, || self.lock(), n)
     }
 
     /// The mean radiance so far of `show` (default: the renderer's).
@@ -386,12 +396,12 @@ fn compare<'py>(
     let (image, reference) = (from_numpy(&image)?, from_numpy(&reference)?);
     let m = py
         .detach(|| {
-            use rastergi_cli::compare::{check_finite, metrics};
+            use rastergi::metrics::{check_finite, metrics};
             check_finite(image_name, &image)?;
             check_finite(reference_name, &reference)?;
             metrics(&image, image_name, &reference, reference_name, mask_emitters)
         })
-        .map_err(value_err)?;
+        .map_err(|e| value_err(e.into()))?;
     let c = &m.comparison;
     let d = PyDict::new(py);
     d.set_item("relative_rmse", c.relative_rmse)?;

@@ -5,8 +5,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
 use clap::Args;
-use rastergi::image_io::{LinearImage, read_image, validate_finite, write_png};
-use rastergi::metrics::{BLOCK, Comparison, compare, difference_image, emitter_mask, masked_mean, rmse};
+use rastergi::image_io::{LinearImage, read_image, write_png};
+use rastergi::metrics::{BLOCK, difference_image};
+pub use rastergi::metrics::{Metrics, check_finite, check_mask_threshold, metrics};
 
 /// Reference values above which `--mask-emitters` without a value treats a pixel as an emitter.
 const DEFAULT_EMITTER_THRESHOLD: &str = "3";
@@ -63,82 +64,6 @@ pub fn read(path: &Path) -> Result<LinearImage> {
     let image = read_image(path)?;
     check_finite(path.display(), &image)?;
     Ok(image)
-}
-
-/// Refuses an image with a NaN or infinite pixel; `name` says which (its path).
-pub fn check_finite(name: impl std::fmt::Display, image: &LinearImage) -> Result<()> {
-    validate_finite(image).map_err(|e| anyhow::anyhow!("{name}: {e}; compare needs finite pixel values"))
-}
-
-/// Refuses a `--mask-emitters` threshold that is not a finite number.
-pub fn check_mask_threshold(mask_emitters: Option<f32>) -> Result<()> {
-    if let Some(t) = mask_emitters.filter(|t| !t.is_finite()) {
-        bail!("--mask-emitters needs a finite threshold, got {t}");
-    }
-    Ok(())
-}
-
-/// What `rastergi compare` prints: the metrics over the compared pixels.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Metrics {
-    pub comparison: Comparison,
-    /// The emitter mask of `--mask-emitters` (`None`: every pixel compared).
-    pub mask: Option<Vec<bool>>,
-    /// Absolute RMSE, linear units.
-    pub rmse: f64,
-    /// The reference's mean over the compared pixels.
-    pub reference_mean: f64,
-    /// The reference's maximum over the compared pixels and channels (the PSNR's peak).
-    pub peak: f32,
-    pub compared_pixels: usize,
-    pub total_pixels: usize,
-}
-
-/// Compares `image` with `reference` as `rastergi compare` does, refusing images of different
-/// sizes, a mask that leaves nothing and a black reference; the names (their paths) are for
-/// the messages.
-pub fn metrics(
-    image: &LinearImage,
-    image_name: impl std::fmt::Display,
-    reference: &LinearImage,
-    reference_name: impl std::fmt::Display,
-    mask_emitters: Option<f32>,
-) -> Result<Metrics> {
-    check_mask_threshold(mask_emitters)?;
-    if (image.width, image.height) != (reference.width, reference.height) {
-        bail!(
-            "the images differ in size: {image_name} is {} x {} but {reference_name} is {} x {}; compare needs images of the same size",
-            image.width,
-            image.height,
-            reference.width,
-            reference.height
-        );
-    }
-    let mask = mask_emitters.map(|t| emitter_mask(reference, t));
-    let m = mask.as_deref();
-    let total = image.pixels.len();
-    let kept = m.map_or(total, |m| m.iter().filter(|&&k| k).count());
-    if kept == 0 {
-        bail!("--mask-emitters leaves no pixel to compare; raise its threshold");
-    }
-    let mean_ref = masked_mean(reference, m);
-    if mean_ref <= 0.0 {
-        bail!(
-            "{reference_name}: the reference is black over the compared pixels (mean {mean_ref}), so relative errors are undefined"
-        );
-    }
-    let comparison = compare(image, reference, m);
-    let peak = reference.pixels.iter().enumerate().filter(|(i, _)| m.is_none_or(|m| m[*i]));
-    let peak = peak.flat_map(|(_, p)| *p).fold(0.0f32, f32::max);
-    Ok(Metrics {
-        comparison,
-        rmse: rmse(image, reference, m),
-        reference_mean: mean_ref,
-        peak,
-        compared_pixels: kept,
-        total_pixels: total,
-        mask,
-    })
 }
 
 fn describe(path: &Path, image: &LinearImage) -> String {

@@ -1,7 +1,8 @@
 //! The subcommands of the `rastergi` program, as a library: the binary (`main.rs`) parses the
-//! command line into them, and the Python package (`python/`) builds its renders from the same
-//! options ([`args::SceneArgs`]), so both take the same options, give the same images and say
-//! the same things about bad input.
+//! command line into them. Their scene, renderer and GPU options ([`args::SceneArgs`]), the
+//! scene loading, the building of the renderer and the render loop are the `rastergi`
+//! library's (`rastergi::session`), which the Python package uses too, so both take the same
+//! options, give the same images and say the same things about bad input.
 
 pub mod args;
 pub mod bench;

@@ -8,25 +8,27 @@
 //! written every `--checkpoint-every` seconds). `--resume` continues a checkpoint.
 
 use std::io::IsTerminal;
+use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize};
 use std::time::{Duration, Instant};
 
 use anyhow::Result;
-use clap::{Args, ValueEnum};
+use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use rastergi::checkpoint::Checkpoint;
 use rastergi::denoise::DenoiseParams;
+use rastergi::film::FilmState;
 use rastergi::fit;
-use rastergi::gather::{GatherDirections, GatherMethod};
+use rastergi::gather::GatherMethod;
 use rastergi::gpu::Gpu;
 use rastergi::image_io::{ImageFormat, write_exr, write_png};
-use rastergi::path_tracer::PathTracer;
 use rastergi::progressive::Progressive;
-use rastergi::renderer::{RenderSettings, Renderer};
-use rastergi::scene::Scene;
+pub use rastergi::session::Method;
+use rastergi::session::new_renderer;
+use rastergi::session::run::{Limits, Observer, Stop};
 
 use crate::args::{SceneArgs, ShowArg, gpu_profiled, print_profile};
 
@@ -89,49 +91,6 @@ pub fn raw_path(out: &Path) -> PathBuf {
     out.with_extension(format!("raw.{ext}"))
 }
 
-/// Which renderer makes the image.
-#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
-pub enum Method {
-    /// The photon map + rasterized final gather ([`Renderer`]).
-    Gather,
-    /// The reference path tracer ([`PathTracer`]).
-    Path,
-}
-
-impl Method {
-    /// The name on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            Method::Gather => "gather",
-            Method::Path => "path",
-        }
-    }
-}
-
-/// Refuses a view the method does not render (the path tracer renders the full image only).
-pub fn check_method_show(method: Method, show: ShowArg) -> Result<()> {
-    if method == Method::Path && !matches!(show, ShowArg::Full) {
-        anyhow::bail!("--method path renders the full image only; drop --show or use --method gather");
-    }
-    Ok(())
-}
-
-/// A renderer, and for the photon-map renderer its gather ray view and directions (for the log).
-pub type Built = (Box<dyn Progressive>, Option<(u32, GatherDirections, GatherMethod)>);
-
-/// The renderer of `method` for `scene` (BVH, upload, the first photon map). `render` and the
-/// Python package build theirs here, so the same options give the same image.
-pub fn new_renderer(gpu: &Gpu, scene: &Scene, settings: RenderSettings, method: Method) -> Result<Built> {
-    Ok(match method {
-        Method::Gather => {
-            let r = Renderer::new(gpu, scene, settings)?;
-            let info = (r.bundle(), r.gather_directions(), r.gather_method());
-            (Box::new(r), Some(info))
-        }
-        Method::Path => (Box::new(PathTracer::new(gpu, scene, settings)?), None),
-    })
-}
-
 /// Refuses, before any rendering, an output path the image could never be written to.
 /// `option` names it in the message (`--out`, `--checkpoint`).
 pub fn check_output_path(out: &Path, option: &str) -> Result<()> {
@@ -153,16 +112,6 @@ pub fn check_output_path(out: &Path, option: &str) -> Result<()> {
     Ok(())
 }
 
-/// Why a render stopped.
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Stop {
-    Done,
-    TimeLimit,
-    TargetError(f64),
-    /// The signal's number.
-    Signal(i32),
-}
-
 /// SIGINT and SIGTERM set the returned number (the signal's) that the render loop reads
 /// between iterations; a second one of either ends the process at once (exit 130).
 fn catch_signals() -> Result<Arc<AtomicUsize>> {
@@ -176,6 +125,44 @@ fn catch_signals() -> Result<Arc<AtomicUsize>> {
         signal_hook::flag::register_usize(sig, caught.clone(), sig as usize)?;
     }
     Ok(caught)
+}
+
+/// What `render` shows and writes while the library's loop runs: the progress bar and its
+/// error estimate, the periodic checkpoint, and the test hook that loses the device.
+struct Watch<'a> {
+    progress: &'a ProgressBar,
+    gpu: &'a Gpu,
+    /// The iterations held before the loop (a resumed checkpoint's).
+    first: u32,
+    lose_device_after: Option<u32>,
+    /// Where `--checkpoint` goes.
+    checkpoint: Option<&'a Path>,
+    /// A checkpoint of the renderer and its film.
+    checkpoint_of: &'a dyn Fn(&dyn Progressive, FilmState) -> Checkpoint,
+}
+
+impl Observer for Watch<'_> {
+    fn iterated(&mut self, done: u32) {
+        if self.lose_device_after == Some(done - self.first) {
+            self.gpu.device.destroy();
+        }
+    }
+    fn synced(&mut self, done: u32) -> ControlFlow<()> {
+        self.progress.set_position(done as u64);
+        ControlFlow::Continue(())
+    }
+    fn wants_estimate(&self) -> bool {
+        !self.progress.is_hidden()
+    }
+    fn estimated(&mut self, error: f64) {
+        self.progress.set_message(format!("error ≈ {:.2} %", 100.0 * error));
+    }
+    fn checkpoint(&mut self, renderer: &dyn Progressive, film: FilmState) -> rastergi::Result<()> {
+        match self.checkpoint {
+            Some(path) => (self.checkpoint_of)(renderer, film).write(path),
+            None => Ok(()),
+        }
+    }
 }
 
 pub fn run(args: &RenderArgs) -> Result<ExitCode> {
@@ -202,8 +189,9 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
         check_output_path(path, "--checkpoint")?;
     }
     let a = &args.scene;
+    let options = a.options(args.method, guides_wanted);
     let start = Instant::now();
-    let scene = a.load_scene()?;
+    let scene = options.load_scene()?;
     log::info!("{}: {} triangles loaded in {:.2} s", a.scene, scene.triangles.len(), start.elapsed().as_secs_f64());
     let iterations = args.iterations.or(scene.framing.and_then(|f| f.samples)).unwrap_or(256);
     if iterations == 0 {
@@ -218,8 +206,8 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     if !(args.checkpoint_every.is_finite() && args.checkpoint_every >= 0.0) {
         anyhow::bail!("--checkpoint-every must be a number of seconds ≥ 0, got {}", args.checkpoint_every);
     }
-    let (width, height) = a.image_size(&scene);
-    let settings = a.settings(&scene, width, height, matches!(a.show, ShowArg::PhotonMap));
+    let (width, height) = options.image_size(&scene);
+    let settings = options.settings(&scene, width, height, matches!(a.show, ShowArg::PhotonMap));
     let mut fingerprint = settings.fingerprint();
     fingerprint.insert(0, ("method".to_owned(), args.method.name().to_owned()));
     let scene_hash = scene.content_hash();
@@ -233,13 +221,10 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     };
     let caught = catch_signals()?;
     let gpu = gpu_profiled(&a.gpu, args.profile)?;
-    check_method_show(args.method, a.show)?;
+    args.method.check_show(options.show)?;
     let seed = settings.seed;
     let start = Instant::now();
-    let (mut renderer, gather_info) = new_renderer(&gpu, &scene, settings, args.method)?;
-    if guides_wanted && let Some(r) = renderer.as_renderer_mut() {
-        r.enable_denoiser()?;
-    }
+    let (mut renderer, gather_info) = new_renderer(&gpu, &scene, settings, args.method, guides_wanted)?;
     if let Some(c) = &resume {
         renderer.resume(&c.progress, &c.film)?;
         log::info!("resumed {} iterations", c.film.samples);
@@ -255,14 +240,13 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
             log::info!("gather ray view: {bundle}x{bundle} texels; {method:?} gather, directions {directions:?}");
         }
     }
-    let checkpoint_of = |r: &dyn Progressive, film: rastergi::film::FilmState| Checkpoint {
+    let checkpoint_of = |r: &dyn Progressive, film: FilmState| Checkpoint {
         scene_hash,
         seed,
         settings: fingerprint.clone(),
         progress: r.progress(),
         film,
     };
-    let start = Instant::now();
     let first = renderer.samples();
     let progress = if std::io::stderr().is_terminal() {
         let bar = ProgressBar::new(iterations as u64);
@@ -276,70 +260,24 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     } else {
         ProgressBar::hidden()
     };
-    // Test hook: destroy the device after this many iterations, as a lost GPU would be.
-    let lose_device_after: Option<u32> =
-        std::env::var("RASTERGI_TEST_LOSE_DEVICE_AFTER").ok().and_then(|v| v.parse().ok());
-    let mut done = first;
-    let mut last_checkpoint = Instant::now();
-    let mut last_estimate: Option<Instant> = None;
-    let mut error = None;
-    let (mut queued, mut sync_every, mut last_sync) = (0u32, 8u32, Instant::now());
-    let stop = loop {
-        let sig = caught.load(Ordering::Relaxed);
-        if sig != 0 {
-            break Stop::Signal(sig as i32);
-        }
-        if done >= iterations {
-            break Stop::Done;
-        }
-        renderer.iterate()?;
-        done += 1;
-        if lose_device_after == Some(done - first) {
-            gpu.device.destroy();
-        }
-        // Keep the GPU queue short so the progress bar, the limits and a signal act soon: at
-        // most 8 iterations in flight, or one where iterations take over 50 ms.
-        queued += 1;
-        if queued < sync_every {
-            continue;
-        }
-        renderer.wait()?;
-        let per_iteration = last_sync.elapsed().as_secs_f64() / queued as f64;
-        sync_every = if per_iteration > 0.05 { 1 } else { 8 };
-        (queued, last_sync) = (0, Instant::now());
-        progress.set_position(done as u64);
-        if args.time_limit.is_some_and(|s| start.elapsed().as_secs_f64() >= s) {
-            break Stop::TimeLimit;
-        }
-        // The error estimate reads the film back: at most once a second.
-        let estimate_due = last_estimate.is_none_or(|t| t.elapsed() >= Duration::from_secs(1));
-        let checkpoint_due =
-            args.checkpoint.is_some() && last_checkpoint.elapsed().as_secs_f64() >= args.checkpoint_every;
-        if !(checkpoint_due || estimate_due && (args.target_error.is_some() || !progress.is_hidden())) {
-            continue;
-        }
-        let film = renderer.film_state()?;
-        last_estimate = Some(Instant::now());
-        error = film.error_estimate();
-        if let Some(e) = error {
-            progress.set_message(format!("error ≈ {:.2} %", 100.0 * e));
-        }
-        // The halves need a few blocks each before their difference means much.
-        let blocks = renderer.film().blocks();
-        if let (Some(target), Some(e)) = (args.target_error, error)
-            && blocks >= 4
-            && e <= target
-        {
-            break Stop::TargetError(e);
-        }
-        if let Some(path) = args.checkpoint.as_ref().filter(|_| checkpoint_due) {
-            checkpoint_of(renderer.as_ref(), film).write(path)?;
-            last_checkpoint = Instant::now();
-        }
+    let limits = Limits {
+        iterations,
+        time_limit: args.time_limit,
+        target_error: args.target_error,
+        checkpoint_every: args.checkpoint.as_ref().map(|_| args.checkpoint_every),
     };
-    renderer.wait()?;
+    let mut watch = Watch {
+        progress: &progress,
+        gpu: &gpu,
+        first,
+        // Test hook: destroy the device after this many iterations, as a lost GPU would be.
+        lose_device_after: std::env::var("RASTERGI_TEST_LOSE_DEVICE_AFTER").ok().and_then(|v| v.parse().ok()),
+        checkpoint: args.checkpoint.as_deref(),
+        checkpoint_of: &checkpoint_of,
+    };
+    let outcome = rastergi::session::run::run(renderer.as_mut(), &limits, Some(&*caught), &mut watch)?;
     progress.finish_and_clear();
-    let seconds = start.elapsed().as_secs_f64();
+    let (stop, done, seconds, mut error) = (outcome.stop, outcome.done, outcome.seconds, outcome.error);
     let rendered = done - first;
     log::info!("{rendered} iterations in {seconds:.2} s");
     let film = renderer.film_state()?;
@@ -402,7 +340,7 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     let error_text = error.map_or(String::new(), |e| format!(", estimated error {:.2} %", 100.0 * e));
     let saved = args.checkpoint.as_ref().map_or(String::new(), |p| format!("; checkpoint {}", p.display()));
     match stop {
-        Stop::Done => {
+        Stop::Done | Stop::Requested => {
             if first >= iterations && resume.is_some() {
                 eprintln!("note: the checkpoint already holds {first} iterations (--iterations {iterations})");
             }

@@ -27,25 +27,16 @@ use rastergi::display::WindowSurface;
 use rastergi::film::Show;
 use rastergi::gather::GatherMethod;
 use rastergi::gpu::{Gpu, GpuOptions};
-use rastergi::path_tracer::PathTracer;
 use rastergi::progressive::Progressive;
-use rastergi::renderer::{RenderSettings, Renderer};
+use rastergi::renderer::Renderer;
 use rastergi::scene::{Files, GltfOptions, MemoryFiles, Scene, SunAngles};
+use rastergi::session::{Method, Session};
 use wasm_bindgen::prelude::*;
 
 mod console;
 
 /// Iterations submitted and not yet finished on the GPU, at most.
 pub const FRAMES_IN_FLIGHT: u32 = 2;
-
-/// Which renderer draws the image.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Method {
-    /// Photon map + final gather.
-    PhotonMap,
-    /// The reference path tracer.
-    PathTracer,
-}
 
 /// What the page chose besides the scene.
 #[derive(Clone, Debug)]
@@ -122,7 +113,7 @@ pub async fn create_viewer(
         photons: None,
         // The raster gathers bind more storage buffers than browsers grant (10).
         gather: GatherMethod::Trace,
-        method: Method::PhotonMap,
+        method: Method::Gather,
         show: Show::Full,
         exposure: 0.0,
         sun: None,
@@ -149,32 +140,33 @@ fn error(e: impl std::fmt::Display) -> JsError {
     JsError::new(&e.to_string())
 }
 
-/// The renderer `options` ask for, for `scene`.
+impl Options {
+    /// The library's options of the page's (the rest as `rastergi render` has them by default:
+    /// the photon grid and count fitted to the scene).
+    fn session(&self) -> rastergi::session::Options {
+        rastergi::session::Options {
+            width: Some(self.width),
+            height: Some(self.height),
+            seed: self.seed,
+            photons: self.photons,
+            gather: self.gather,
+            method: self.method,
+            denoiser: self.denoise,
+            ..rastergi::session::Options::default()
+        }
+    }
+}
+
+/// The renderer `options` ask for, for `scene` (its sun turned as they say), built by the
+/// library's session as every front end's is.
 fn build(gpu: &Gpu, scene: &Scene, options: &Options) -> rastergi::Result<Box<dyn Progressive>> {
     let mut scene = scene.clone();
     if let Some(sun) = options.sun {
         scene.turn_sun(sun);
     }
-    let grid = rastergi::fit::grid_resolution(&scene.bounds());
-    let settings = RenderSettings {
-        width: options.width,
-        height: options.height,
-        seed: options.seed,
-        photons: options.photons.unwrap_or_else(|| rastergi::fit::photon_count(&scene, grid)),
-        grid_resolution: grid,
-        gather: options.gather,
-        ..RenderSettings::default()
-    };
-    Ok(match options.method {
-        Method::PhotonMap => {
-            let mut renderer = Renderer::new(gpu, &scene, settings)?;
-            if options.denoise {
-                renderer.enable_denoiser()?;
-            }
-            Box::new(renderer)
-        }
-        Method::PathTracer => Box::new(PathTracer::new(gpu, &scene, settings)?),
-    })
+    let session_options = options.session();
+    let (renderer, _) = Session::of_scene(scene, &session_options).renderer(gpu, &session_options)?;
+    Ok(renderer)
 }
 
 /// The scene among `files`: a Mitsuba `.xml` (whose meshes are often `.obj` files beside it),
@@ -284,8 +276,8 @@ impl Viewer {
             }
             "method" => {
                 options.method = match value {
-                    "photons" => Method::PhotonMap,
-                    "path" => Method::PathTracer,
+                    "photons" => Method::Gather,
+                    "path" => Method::Path,
                     _ => return Err(bad()),
                 }
             }
@@ -447,13 +439,13 @@ impl Viewer {
     pub fn describe(&self) -> String {
         let s = self.renderer.settings();
         let what = match self.options.method {
-            Method::PhotonMap => format!(
+            Method::Gather => format!(
                 "photon map ({} photons a pass) + {:?} gather{}",
                 s.photons,
                 s.gather,
                 if self.denoising().is_some() { ", denoised" } else { "" }
             ),
-            Method::PathTracer => "path tracer".to_string(),
+            Method::Path => "path tracer".to_string(),
         };
         let i = &self.gpu.info;
         let adapter = if i.name.is_empty() { "the browser's WebGPU adapter".to_string() } else { i.name.clone() };

@@ -29,4 +29,8 @@ pub enum Error {
     Checkpoint(String),
     #[error("checkpoint {}: {message}", path.display())]
     CheckpointFile { path: PathBuf, message: String },
+    /// Options, or inputs, that do not fit together (a front end's flags named in the message:
+    /// `--sky` without a sun, two images of different sizes to compare).
+    #[error("{0}")]
+    Invalid(String),
 }

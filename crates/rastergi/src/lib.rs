@@ -6,7 +6,7 @@
 //! iteration ([`gbuffer`] → [`specular`] chains → [`direct`] → [`gather`] ([`gather::raster`], [`gather::lists`] or
 //! [`gather::trace`])) → [`film`] (accumulate, resolve) → [`image_io`]. [`path_tracer`] is the
 //! reference; both it and the [`renderer`] are [`progressive`] renderers. [`profile`] times the
-//! passes.
+//! passes. [`session`] turns a front end's options into a scene and a renderer, and runs it.
 //!
 //! [`renderer::Renderer::iterate`] is the one place that shows the order of the passes.
 
@@ -45,6 +45,7 @@ pub mod rays;
 pub mod renderer;
 pub mod sampling;
 pub mod scene;
+pub mod session;
 mod shader;
 pub mod sky;
 mod sky_sun_table;

@@ -275,7 +275,12 @@ impl Options {
     /// where `show_photon_map` is set (the viewer keeps it to switch to it).
     pub fn settings(&self, scene: &Scene, width: u32, height: u32, show_photon_map: bool) -> RenderSettings {
         let grid = self.grid.unwrap_or_else(|| fit::grid_resolution(&scene.bounds()));
-        let photons = self.photons.unwrap_or_else(|| fit::photon_count(scene, grid));
+        // Progressive passes at the fitted cadence: no pass longer than about 64 iterations.
+        let progressive = self.photon_passes != 1 && self.pass_iterations == 0;
+        let photons = self.photons.unwrap_or_else(|| {
+            let fitted = fit::photon_count(scene, grid);
+            if progressive { fit::photons_for_image(fitted, width as u64 * height as u64) } else { fitted }
+        });
         log::info!(
             "photons {photons}{}, grid {grid}{}",
             if self.photons.is_some() { "" } else { " (fitted)" },

@@ -57,9 +57,14 @@ pub const MIN_LOOKUP_AREA: f32 = 1e-4;
 /// ([`crate::photons::map::MapLayout::deposit_slot`]); f32 rounding errs by about 10⁻⁷.
 pub const NEAR_FACE: f32 = 1e-4;
 /// The fraction of sun and sky photons aimed at the photon region ([`crate::lights::disc_start`]):
-/// half, so the rest of the scene (the sunlit ground outside a window, whose light the room
-/// reflects) keeps half its photons.
+/// half.
 pub const AIM_FRACTION: f32 = 0.5;
+/// The fraction aimed at the region's surroundings, a disc [`NEAR_SCALE`] times as wide
+/// (the sunlit ground outside a window, whose light the room reflects): a quarter. The last
+/// quarter covers the whole scene.
+pub const NEAR_FRACTION: f32 = 0.25;
+/// The surroundings' disc radius over the aim's.
+pub const NEAR_SCALE: f32 = 4.0;
 /// Bit of a slot's cell index that marks the caustic twin of the slot ([`crate::photons::map`]):
 /// the flux of photons that reached it through specular surfaces alone.
 pub const CAUSTIC_CELL: u32 = 1 << 31;

@@ -813,17 +813,29 @@ fn disc_start(axis: vec3f, centre: vec3f, r: f32, aim: vec4f, u1: f32, u2: f32) 
     let dir = tb[0] * cos(phi) + tb[1] * sin(phi);
     let d = aim.xyz - centre;
     let towards = d - axis * dot(d, axis);
-    let aimed = u1 < AIM_FRACTION;
-    var offset: vec3f;
-    if aimed {
-        offset = towards + dir * (aim.w * sqrt(u1 / AIM_FRACTION));
-    } else {
-        offset = dir * (r * sqrt((u1 - AIM_FRACTION) / (1.0 - AIM_FRACTION)));
+    let near = aim.w * NEAR_SCALE;
+    let whole = 1.0 - AIM_FRACTION - NEAR_FRACTION;
+    var branch = 2u;
+    if u1 < AIM_FRACTION {
+        branch = 0u;
+    } else if u1 < AIM_FRACTION + NEAR_FRACTION {
+        branch = 1u;
     }
-    let in_aim = aimed || length(offset - towards) <= aim.w;
-    let in_whole = !aimed || length(offset) <= r;
+    var offset: vec3f;
+    if branch == 0u {
+        offset = towards + dir * (aim.w * sqrt(u1 / AIM_FRACTION));
+    } else if branch == 1u {
+        offset = towards + dir * (near * sqrt((u1 - AIM_FRACTION) / NEAR_FRACTION));
+    } else {
+        offset = dir * (r * sqrt((u1 - AIM_FRACTION - NEAR_FRACTION) / whole));
+    }
+    let from_aim = length(offset - towards);
+    let in_aim = branch == 0u || from_aim <= aim.w;
+    let in_near = branch <= 1u || from_aim <= near;
+    let in_whole = branch == 2u || length(offset) <= r;
     let p = select(0.0, AIM_FRACTION / (PI * aim.w * aim.w), in_aim)
-        + select(0.0, (1.0 - AIM_FRACTION) / (PI * r * r), in_whole);
+        + select(0.0, NEAR_FRACTION / (PI * near * near), in_near)
+        + select(0.0, whole / (PI * r * r), in_whole);
     s.origin = centre - axis * r + offset;
     s.inv_pdf = 1.0 / p;
     return s;

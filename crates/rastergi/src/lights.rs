@@ -201,8 +201,9 @@ impl LightTable {
     /// The largest flux × N, over entries and channels, that a photon starts with
     /// ([`LightTable::emit_photon`]; a spot's falloff at most 1).
     pub fn max_photon_flux(&self, scene: &Scene, aimed: bool) -> f64 {
-        // Aimed disc photons outside the aim carry 1/(1 − α) times an unaimed one's flux.
-        let aim_gain = if aimed { 1.0 / (1.0 - AIM_FRACTION as f64) } else { 1.0 };
+        // Aimed disc photons outside the aim and its surroundings carry 1/(1 − α − β) times
+        // an unaimed one's flux.
+        let aim_gain = if aimed { 1.0 / (1.0 - AIM_FRACTION as f64 - NEAR_FRACTION as f64) } else { 1.0 };
         (self.entries.iter())
             .map(|e| {
                 let per_pmf = if e.triangle == ENVIRONMENT_LIGHT {
@@ -290,19 +291,29 @@ pub struct PhotonAim {
     pub radius: f32,
 }
 
-pub use crate::consts::AIM_FRACTION;
+pub use crate::consts::{AIM_FRACTION, NEAR_FRACTION, NEAR_SCALE};
 
 /// The start of a photon crossing the sphere (`centre`, `radius`) along `axis`, from (u1, u2):
 /// its origin on the disc of that radius perpendicular to `axis` before the sphere, and
 /// 1/p(x), p the density per unit area of the disc's plane it was drawn with. Unaimed, x is
-/// uniform on the disc: 1/p = πR². Aimed at a sphere (c_a, r_a), x is drawn with probability
-/// α = [`AIM_FRACTION`] (u1 < α, then rescaled) uniformly on that sphere's cross-section,
-/// the disc of radius r_a about c_a's projection, else uniformly on the whole disc:
-/// p(x) = α·[x in the aim's disc]/(π r_a²) + (1 − α)·[x in the whole disc]/(π R²), the
-/// one-sample mixture's density, so Φ = E/p(x) (or L(ω)/(pdf(ω)·p(x))) keeps every photon
-/// map unbiased while about α of the photons reach the region instead of its share of the
-/// disc's area. The branch drawn always counts its own term (rounding at a disc's rim never
-/// drops it). Mirrors `disc_start` in `gpu_scene.wgsl`.
+/// uniform on the disc: 1/p = πR². Aimed at a sphere (c_a, r_a), x is drawn from a mixture of
+/// three uniform discs: with probability α = [`AIM_FRACTION`] the sphere's cross-section (radius
+/// r_a about c_a's projection), with β = [`NEAR_FRACTION`] its surroundings (radius
+/// s·r_a, s = [`NEAR_SCALE`], the same centre), else the whole disc (u1 picks, then is
+/// rescaled):
+///
+/// ```text
+/// p(x) = α·[x in aim]/(π r_a²) + β·[x in surroundings]/(π s² r_a²) + (1 − α − β)·[x in disc]/(π R²)
+/// ```
+///
+/// the one-sample mixture's density, so Φ = E/p(x) (or L(ω)/(pdf(ω)·p(x))) keeps every photon
+/// map unbiased while about α of the photons reach the region. The surroundings' share keeps
+/// the photons that reach the region after a bounce nearby (the sunlit ground outside a window)
+/// from carrying (R/r_a)² times an aimed one's flux: with two discs alone, the few such
+/// photons from the 200 m ground of the sunroom carried 1600 times the flux of the room's own
+/// and spotted a sky-lit render with fireflies in one pass of 2¹⁷ photons. The branch drawn
+/// always counts its own term (rounding at a disc's rim never drops it). Mirrors `disc_start`
+/// in `gpu_scene.wgsl`.
 pub fn disc_start(axis: Vec3, centre: Vec3, radius: f32, aim: Option<PhotonAim>, u1: f32, u2: f32) -> (Vec3, f32) {
     use std::f32::consts::PI;
     let (t, b) = orthonormal_basis(axis);
@@ -314,16 +325,27 @@ pub fn disc_start(axis: Vec3, centre: Vec3, radius: f32, aim: Option<PhotonAim>,
     };
     let d = a.centre - centre;
     let towards = d - axis * d.dot(axis);
-    let aimed = u1 < AIM_FRACTION;
-    let offset = if aimed {
-        towards + dir * (a.radius * (u1 / AIM_FRACTION).sqrt())
+    let near = a.radius * NEAR_SCALE;
+    let whole = 1.0 - AIM_FRACTION - NEAR_FRACTION;
+    let branch = if u1 < AIM_FRACTION {
+        0
+    } else if u1 < AIM_FRACTION + NEAR_FRACTION {
+        1
     } else {
-        dir * (radius * ((u1 - AIM_FRACTION) / (1.0 - AIM_FRACTION)).sqrt())
+        2
     };
-    let in_aim = aimed || (offset - towards).length() <= a.radius;
-    let in_whole = !aimed || offset.length() <= radius;
+    let offset = match branch {
+        0 => towards + dir * (a.radius * (u1 / AIM_FRACTION).sqrt()),
+        1 => towards + dir * (near * ((u1 - AIM_FRACTION) / NEAR_FRACTION).sqrt()),
+        _ => dir * (radius * ((u1 - AIM_FRACTION - NEAR_FRACTION) / whole).sqrt()),
+    };
+    let from_aim = (offset - towards).length();
+    let in_aim = branch == 0 || from_aim <= a.radius;
+    let in_near = branch <= 1 || from_aim <= near;
+    let in_whole = branch == 2 || offset.length() <= radius;
     let p = if in_aim { AIM_FRACTION / (PI * a.radius * a.radius) } else { 0.0 }
-        + if in_whole { (1.0 - AIM_FRACTION) / (PI * radius * radius) } else { 0.0 };
+        + if in_near { NEAR_FRACTION / (PI * near * near) } else { 0.0 }
+        + if in_whole { whole / (PI * radius * radius) } else { 0.0 };
     (start + offset, 1.0 / p)
 }
 
@@ -361,7 +383,7 @@ mod tests {
     #[test]
     fn aimed_sun_photons_carry_the_same_flux_onto_every_patch_and_crowd_into_the_aim() {
         // A sun at 35° over a ground 200 m across; photons aimed at a sphere of radius 5 m
-        // about (3, 1.5, 2). Through any patch of ground, inside the aim or far from it, the
+        // about (3, 1.5, 2). Through any patch of ground, inside the aim, near it or far, the
         // flux of N photons must be E·cos θ·A (the plane's irradiance times the patch's area)
         // within 4 standard errors of the photons' own spread, aimed or not; and most aimed
         // photons cross the aim's patch.
@@ -383,7 +405,10 @@ mod tests {
         let table = LightTable::new(&s);
         let aim = PhotonAim { centre: Vec3::new(3.0, 1.5, 2.0), radius: 5.0 };
         let n = 1 << 20;
-        for (patch, half) in [(Vec3::new(3.0, 0.0, 2.0), 2.0), (Vec3::new(-60.0, 0.0, 40.0), 10.0)] {
+        // Patches in the aim, in its surroundings (the disc 4 × as wide) and far from both.
+        let patches =
+            [(Vec3::new(3.0, 0.0, 2.0), 2.0), (Vec3::new(14.0, 0.0, 2.0), 2.0), (Vec3::new(-60.0, 0.0, 40.0), 10.0)];
+        for (patch, half) in patches {
             let expected = 3.0 * towards.y as f64 * (2.0 * half as f64).powi(2);
             for aimed in [None, Some(aim)] {
                 let mut rng = crate::sampling::Rng::new(17, 0, 0);

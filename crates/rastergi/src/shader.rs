@@ -102,6 +102,8 @@ pub fn constants() -> String {
         ("OFFSET_STEP", OFFSET_STEP),
         ("MIN_LOOKUP_AREA", MIN_LOOKUP_AREA),
         ("AIM_FRACTION", crate::consts::AIM_FRACTION),
+        ("NEAR_FRACTION", crate::consts::NEAR_FRACTION),
+        ("NEAR_SCALE", crate::consts::NEAR_SCALE),
         ("NEAR_FACE", crate::consts::NEAR_FACE),
         ("GLASS_ALBEDO_ETA_MAX", crate::bsdf::albedo::GLASS_ETA_MAX),
     ];

@@ -22,46 +22,10 @@
 //! round differently (counted as the CPU twin's comparison counts them, `rays::disagreements`).
 //! Alpha holes stay with `trace`, shared by both paths: a hit on a hole re-traverses past it.
 
-use crate::error::{Error, Result};
-
-/// What the user asked for (`--rays`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Rays {
-    /// Hardware ray queries where the adapter offers them, unless a start-up probe on the
-    /// scene measures them slower than the compute BVH on this device.
-    #[default]
-    Auto,
-    /// Hardware ray queries; an error where the adapter lacks them.
-    Hardware,
-    /// The compute-shader BVH (every device).
-    Compute,
-}
-
-impl Rays {
-    pub fn name(self) -> &'static str {
-        match self {
-            Rays::Auto => "auto",
-            Rays::Hardware => "hardware",
-            Rays::Compute => "compute",
-        }
-    }
-
-    /// `RASTERGI_RAYS`, if set to one of the names: the default of [`crate::gpu::GpuOptions`]
-    /// where no front end chose (so the test suite can run on either path).
-    pub fn from_env() -> Option<Rays> {
-        std::env::var("RASTERGI_RAYS").ok().and_then(|v| parse_rays(&v).ok())
-    }
-}
-
-/// Parses `auto`, `hardware` or `compute` (`--rays`).
-pub fn parse_rays(name: &str) -> std::result::Result<Rays, String> {
-    match name.to_ascii_lowercase().as_str() {
-        "auto" => Ok(Rays::Auto),
-        "hardware" | "hw" => Ok(Rays::Hardware),
-        "compute" => Ok(Rays::Compute),
-        other => Err(format!("unknown ray path '{other}' (expected auto, hardware or compute)")),
-    }
-}
+use crate::error::Result;
+/// The choice of traversal and the device's ray-query support live with the device
+/// ([`crate::gpu`]); re-exported here, where the traversals are.
+pub use crate::gpu::{FEATURE, Rays, device_has_ray_queries, not_offered, parse_rays};
 
 /// The traversal a scene's pipelines are built with.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -77,22 +41,6 @@ impl RayPath {
             RayPath::Hardware => "hardware",
         }
     }
-}
-
-/// The device feature hardware ray queries need.
-pub const FEATURE: wgpu::Features = wgpu::Features::EXPERIMENTAL_RAY_QUERY;
-
-/// Whether `device` was opened with ray queries.
-pub fn device_has_ray_queries(device: &wgpu::Device) -> bool {
-    device.features().contains(FEATURE)
-}
-
-/// What `--rays hardware` says where the device lacks ray queries: one line.
-pub fn not_offered(adapter: &str) -> Error {
-    Error::Device(format!(
-        "--rays hardware: {adapter} offers no hardware ray queries (wgpu's EXPERIMENTAL_RAY_QUERY: VK_KHR_ray_query and \
-         VK_KHR_acceleration_structure on Vulkan, DXR 1.1 on DX12; never in a browser); use --rays compute or auto"
-    ))
 }
 
 /// The scene's acceleration structures: one BLAS of every triangle, one TLAS with one

@@ -106,3 +106,46 @@ pub mod stream {
     /// stream).
     pub const PIXEL_JITTER: u32 = 0x6a09e667;
 }
+
+/// Marks an unused child slot of a wide BVH node ([`crate::bvh::wide`]).
+pub const NO_CHILD: u32 = u32::MAX;
+
+/// Cells of the GGX albedo table along μ and along α ([`crate::bsdf::albedo`]).
+pub const GGX_ALBEDO_N: usize = 32;
+/// η values of the rough glass's albedo table ([`crate::bsdf::albedo`]).
+pub const GLASS_ETAS: usize = 32;
+/// The glass table's cells: two sides × [`GLASS_ETAS`] × N (√α) × N (μ).
+pub const GLASS_CELLS: usize = 2 * GLASS_ETAS * GGX_ALBEDO_N * GGX_ALBEDO_N;
+
+/// The largest η the glass table holds (η is clamped to [1, GLASS_ETA_MAX] there).
+pub const GLASS_ETA_MAX: f32 = 3.0;
+
+/// Texels per row of the texture atlas's texture ([`crate::textures`]).
+pub const ATLAS_ROW: u32 = 4096;
+
+/// `SceneOffsets` in `gpu_scene.wgsl`: where each part of the scene's data buffer
+/// (`scene_data`, `gpu_scene::SceneData`) starts, in 32-bit words, and how many items some hold. It is
+/// the buffer's header, its first 16 words (field i is word i).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct GpuSceneOffsets {
+    /// Texture coordinates: two words per corner, three corners per triangle.
+    pub uvs: u32,
+    pub uv_triangles: u32,
+    /// Shading normals: nine words per triangle.
+    pub normals: u32,
+    pub normal_triangles: u32,
+    /// Tangents (xyz, handedness): twelve words per triangle.
+    pub tangents: u32,
+    pub tangent_triangles: u32,
+    /// The light distribution's entries ([`crate::lights::LightEntry`], four words each).
+    pub lights: u32,
+    pub light_count: u32,
+    /// The point, spot and distant lights ([`crate::lights::PunctualLight`], sixteen words each).
+    pub punctual: u32,
+    /// The environment map's data ([`crate::environment::Environment::gpu_data`]).
+    pub environment: u32,
+    /// The texture atlas's entries ([`crate::textures::AtlasEntry`], four words each).
+    pub textures: u32,
+    pub _pad: [u32; 5],
+}

@@ -19,7 +19,7 @@ pub struct GpuOptions {
     /// Which traversal the passes' rays take ([`crate::accel`]); `None` means `RASTERGI_RAYS`
     /// if set, else the compute BVH (so that a library caller or a test gets the hardware path
     /// only where it asks: `--rays` of the front ends defaults to `auto`).
-    pub rays: Option<crate::accel::Rays>,
+    pub rays: Option<Rays>,
 }
 
 /// The most storage buffers per shader stage that browsers' WebGPU grants (Chrome's adapters
@@ -54,7 +54,7 @@ pub struct Gpu {
     pub profiler: Option<Profiler>,
     /// The ray path asked for ([`GpuOptions::rays`] resolved); the device has
     /// `EXPERIMENTAL_RAY_QUERY` where this is not `Compute` and the adapter offers it.
-    pub rays: crate::accel::Rays,
+    pub rays: Rays,
     /// The first error the device reported outside a call that returns one (a lost device, a
     /// GPU timeout, an allocation that failed): [`Gpu::wait`] and every readback return it.
     fault: std::sync::Arc<std::sync::Mutex<Fault>>,
@@ -88,8 +88,8 @@ impl GpuOptions {
     }
 
     /// The ray path asked for: as set, else `RASTERGI_RAYS`, else the compute BVH.
-    pub fn rays(&self) -> crate::accel::Rays {
-        self.rays.or_else(crate::accel::Rays::from_env).unwrap_or(crate::accel::Rays::Compute)
+    pub fn rays(&self) -> Rays {
+        self.rays.or_else(Rays::from_env).unwrap_or(Rays::Compute)
     }
 }
 
@@ -141,12 +141,12 @@ impl Gpu {
         let mut required_features =
             if options.profile { adapter.features() & timestamps } else { wgpu::Features::empty() };
         let rays = options.rays();
-        let ray_queries = rays != crate::accel::Rays::Compute && adapter.features().contains(crate::accel::FEATURE);
-        if rays == crate::accel::Rays::Hardware && !ray_queries {
-            return Err(crate::accel::not_offered(&info.name));
+        let ray_queries = rays != Rays::Compute && adapter.features().contains(FEATURE);
+        if rays == Rays::Hardware && !ray_queries {
+            return Err(not_offered(&info.name));
         }
         if ray_queries {
-            required_features |= crate::accel::FEATURE;
+            required_features |= FEATURE;
         }
         if options.profile && !required_features.contains(timestamps) {
             log::warn!("{} has no timestamp queries: --profile reports wall-clock time only", info.name);
@@ -204,8 +204,8 @@ impl Gpu {
     /// Which ray path scenes get on this device and why, in words (`rastergi info`); the
     /// choice for one scene is `GpuScene::rays` (auto's probe runs per scene).
     pub fn ray_path_description(&self) -> String {
-        use crate::accel::Rays;
-        let has = crate::accel::device_has_ray_queries(&self.device);
+        use Rays;
+        let has = device_has_ray_queries(&self.device);
         match self.rays {
             Rays::Compute => "compute (asked for: --rays compute)".to_owned(),
             Rays::Hardware => "hardware (asked for: --rays hardware)".to_owned(),
@@ -644,4 +644,59 @@ pub fn compute_pipeline(
 /// Number of workgroups of `size` needed to cover `n` items.
 pub fn groups(n: u32, size: u32) -> u32 {
     n.div_ceil(size)
+}
+
+/// What the user asked for (`--rays`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Rays {
+    /// Hardware ray queries where the adapter offers them, unless a start-up probe on the
+    /// scene measures them slower than the compute BVH on this device.
+    #[default]
+    Auto,
+    /// Hardware ray queries; an error where the adapter lacks them.
+    Hardware,
+    /// The compute-shader BVH (every device).
+    Compute,
+}
+
+impl Rays {
+    pub fn name(self) -> &'static str {
+        match self {
+            Rays::Auto => "auto",
+            Rays::Hardware => "hardware",
+            Rays::Compute => "compute",
+        }
+    }
+
+    /// `RASTERGI_RAYS`, if set to one of the names: the default of [`crate::gpu::GpuOptions`]
+    /// where no front end chose (so the test suite can run on either path).
+    pub fn from_env() -> Option<Rays> {
+        std::env::var("RASTERGI_RAYS").ok().and_then(|v| parse_rays(&v).ok())
+    }
+}
+
+/// Parses `auto`, `hardware` or `compute` (`--rays`).
+pub fn parse_rays(name: &str) -> std::result::Result<Rays, String> {
+    match name.to_ascii_lowercase().as_str() {
+        "auto" => Ok(Rays::Auto),
+        "hardware" | "hw" => Ok(Rays::Hardware),
+        "compute" => Ok(Rays::Compute),
+        other => Err(format!("unknown ray path '{other}' (expected auto, hardware or compute)")),
+    }
+}
+
+/// The device feature hardware ray queries need.
+pub const FEATURE: wgpu::Features = wgpu::Features::EXPERIMENTAL_RAY_QUERY;
+
+/// Whether `device` was opened with ray queries.
+pub fn device_has_ray_queries(device: &wgpu::Device) -> bool {
+    device.features().contains(FEATURE)
+}
+
+/// What `--rays hardware` says where the device lacks ray queries: one line.
+pub fn not_offered(adapter: &str) -> Error {
+    Error::Device(format!(
+        "--rays hardware: {adapter} offers no hardware ray queries (wgpu's EXPERIMENTAL_RAY_QUERY: VK_KHR_ray_query and \
+         VK_KHR_acceleration_structure on Vulkan, DXR 1.1 on DX12; never in a browser); use --rays compute or auto"
+    ))
 }

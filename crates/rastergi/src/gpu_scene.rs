@@ -104,32 +104,7 @@ pub struct GpuMaterialMaps {
     pub clearcoat_roughness_map: GpuTextureSlot,
 }
 
-/// `SceneOffsets` in `gpu_scene.wgsl`: where each part of the scene's data buffer
-/// (`scene_data`, [`SceneData`]) starts, in 32-bit words, and how many items some hold. It is
-/// the buffer's header, its first 16 words (field i is word i).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
-pub struct GpuSceneOffsets {
-    /// Texture coordinates: two words per corner, three corners per triangle.
-    pub uvs: u32,
-    pub uv_triangles: u32,
-    /// Shading normals: nine words per triangle.
-    pub normals: u32,
-    pub normal_triangles: u32,
-    /// Tangents (xyz, handedness): twelve words per triangle.
-    pub tangents: u32,
-    pub tangent_triangles: u32,
-    /// The light distribution's entries ([`crate::lights::LightEntry`], four words each).
-    pub lights: u32,
-    pub light_count: u32,
-    /// The point, spot and distant lights ([`crate::lights::PunctualLight`], sixteen words each).
-    pub punctual: u32,
-    /// The environment map's data ([`Environment::gpu_data`]).
-    pub environment: u32,
-    /// The texture atlas's entries ([`crate::textures::AtlasEntry`], four words each).
-    pub textures: u32,
-    pub _pad: [u32; 5],
-}
+pub use crate::consts::GpuSceneOffsets;
 
 /// The GGX albedo tables as gpu_scene.wgsl reads them: the cells and means, N × (N + 1)
 /// RGBA32F, and the rough glass's, N × (cells / N) R32F. Computed and filled only where some

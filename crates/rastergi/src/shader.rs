@@ -56,7 +56,7 @@ pub fn constants() -> String {
         ("MAX_HOLE_CROSSINGS", MAX_HOLE_CROSSINGS),
         ("TRIANGLE_HAS_HOLES", TRIANGLE_HAS_HOLES),
         ("NO_TEXTURE", NO_TEXTURE),
-        ("ATLAS_ROW", crate::textures::ROW),
+        ("ATLAS_ROW", crate::consts::ATLAS_ROW),
         ("FILM_DIRECT", FILM_DIRECT),
         ("FILM_INDIRECT", FILM_INDIRECT),
         ("FILM_PHOTON_VIEW", FILM_PHOTON_VIEW),
@@ -76,13 +76,13 @@ pub fn constants() -> String {
         ("LIGHT_POINT", LIGHT_POINT),
         ("LIGHT_SPOT", LIGHT_SPOT),
         ("LIGHT_DISTANT", LIGHT_DISTANT),
-        ("NO_CHILD", crate::bvh::wide::NO_CHILD),
-        ("GGX_ALBEDO_N", crate::bsdf::albedo::N as u32),
-        ("GGX_ALBEDO_CELLS", (crate::bsdf::albedo::N * crate::bsdf::albedo::N) as u32),
-        ("GLASS_ALBEDO_ETAS", crate::bsdf::albedo::GLASS_ETAS as u32),
-        ("GLASS_ALBEDO_CELLS", crate::bsdf::albedo::GLASS_CELLS as u32),
+        ("NO_CHILD", crate::consts::NO_CHILD),
+        ("GGX_ALBEDO_N", crate::consts::GGX_ALBEDO_N as u32),
+        ("GGX_ALBEDO_CELLS", (crate::consts::GGX_ALBEDO_N * crate::consts::GGX_ALBEDO_N) as u32),
+        ("GLASS_ALBEDO_ETAS", crate::consts::GLASS_ETAS as u32),
+        ("GLASS_ALBEDO_CELLS", crate::consts::GLASS_CELLS as u32),
     ];
-    use crate::gpu_scene::GpuSceneOffsets as O;
+    use crate::consts::GpuSceneOffsets as O;
     let word = |offset: usize| (offset / 4) as u32;
     let header = [
         ("DATA_UVS", word(std::mem::offset_of!(O, uvs))),
@@ -105,7 +105,7 @@ pub fn constants() -> String {
         ("NEAR_FRACTION", crate::consts::NEAR_FRACTION),
         ("NEAR_SCALE", crate::consts::NEAR_SCALE),
         ("NEAR_FACE", crate::consts::NEAR_FACE),
-        ("GLASS_ALBEDO_ETA_MAX", crate::bsdf::albedo::GLASS_ETA_MAX),
+        ("GLASS_ALBEDO_ETA_MAX", crate::consts::GLASS_ETA_MAX),
     ];
     let mut s = String::from("// Generated from the Rust constants (shader.rs).\n");
     for (name, value) in u32s {

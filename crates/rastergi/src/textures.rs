@@ -44,7 +44,7 @@ use crate::scene::Texture;
 use crate::shader;
 
 /// Texels per row of the atlas texture.
-pub const ROW: u32 = 4096;
+pub use crate::consts::ATLAS_ROW as ROW;
 /// Rows of the atlas texture at most (WebGPU guarantees 8192 texels per side).
 pub const MAX_ROWS: u32 = 8192;
 /// Texels the atlas holds at most: 256 MiB of `rgba16float`.

@@ -31,7 +31,7 @@ use super::{fresnel_dielectric, ggx_g1, reflect, refract, vndf_sample};
 use crate::par::prelude::*;
 
 /// Cells along μ and along α.
-pub const N: usize = 32;
+pub use crate::consts::GGX_ALBEDO_N as N;
 /// Strata per axis of the (u₁, u₂) grid of each cell's integral.
 const STRATA: usize = 64;
 
@@ -185,12 +185,8 @@ pub fn ggx_albedo() -> &'static GgxAlbedo {
     TABLE.get_or_init(GgxAlbedo::committed)
 }
 
-/// Cells of the glass table along η.
-pub const GLASS_ETAS: usize = 32;
-/// The glass table's cells: two sides × [`GLASS_ETAS`] × N (√α) × N (μ).
-pub const GLASS_CELLS: usize = 2 * GLASS_ETAS * N * N;
-/// The largest η the glass table holds (η is clamped to [1, GLASS_ETA_MAX] there).
-pub const GLASS_ETA_MAX: f32 = 3.0;
+pub use crate::consts::GLASS_ETA_MAX;
+pub use crate::consts::{GLASS_CELLS, GLASS_ETAS};
 /// Strata per axis of each glass cell's integral: the integrand jumps where total internal
 /// reflection begins, and 24 × 24 midpoints left the albedo from inside 1.5 % off at roughness
 /// 1 (64 × 64: within 0.1 % of a quadrature of `eval` and of sampling).

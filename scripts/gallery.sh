@@ -67,10 +67,10 @@ for entry in "${GALLERY[@]}"; do
     /usr/bin/time -f 'gallery-time %e %M' env RUST_LOG=info "$bin" render "$scenes/$file" \
         --width "$w" --height "$h" --iterations 100000 --time-limit "$seconds" --denoise \
         --out "$out/$name.png" $extra > "$log" 2>&1 || { cat "$log" >&2; echo "gallery: $name failed" >&2; exit 1; }
-    triangles="$(grep -o '[0-9]* triangles loaded' "$log" | head -1 | cut -d' ' -f1)"
-    photons="$(grep -o 'photons [0-9]*' "$log" | head -1 | cut -d' ' -f2)"
-    iterations="$(grep -o 'render\] [0-9]* iterations in' "$log" | tail -1 | cut -d' ' -f2)"
-    error="$(grep -o 'estimated error [0-9.]* %' "$log" | tail -1 | cut -d' ' -f3)"
+    triangles="$(grep -o '[0-9]* triangles loaded' "$log" | head -1 | cut -d' ' -f1 || true)"
+    photons="$(grep -o 'photons [0-9]*' "$log" | head -1 | cut -d' ' -f2 || true)"
+    iterations="$(grep -o 'render\] [0-9]* iterations in' "$log" | tail -1 | cut -d' ' -f2 || true)"
+    error="$(grep -o 'estimated error [0-9.]* %' "$log" | tail -1 | cut -d' ' -f3 || true)"
     read -r _ wall rss <<< "$(grep '^gallery-time' "$log")"
     warnings="$(grep -c 'WARN' "$log" || true)"
     rm -f "$out/$name.raw.png"
@@ -80,7 +80,7 @@ for entry in "${GALLERY[@]}"; do
         echo "![$name](images/gallery/$name.png)"
         echo
         echo "$credit. \`$file\`: ${triangles:-?} triangles, ${w}×${h}, ${iterations:-?} iterations in ${wall} s"
-        echo "(whole process), $((rss / 1024)) MiB, ${photons:-?} photons per pass, estimated error ${error:-?} %, $warnings warnings."
+        echo "(whole process), $((rss / 1024)) MiB, ${photons:-?} photons per pass, ${error:+estimated error $error %}${error:-no error estimate (too few iterations for its two halves)}, $warnings warnings."
         echo
     } >> "$md"
     echo "$name: ${iterations:-?} iterations, ${wall} s, $((rss / 1024)) MiB, error ${error:-?} %"

@@ -105,12 +105,15 @@ pub const MAX_FITTED_PASS_ITERATIONS: u64 = 64;
 /// iterations, stayed on its first map: the sunlit room came out 4 % bright in its means and
 /// 3.9 % in its blocks against Mitsuba; with 2¹⁷ photons a pass (76 iterations) it is within
 /// 0.8 % in both, in less time. Images of 256 × 256 and larger keep the scene's count up to 2²⁰
-/// (the Cornell box's unchanged there).
+/// (the Cornell box's unchanged there); none gets fewer than [`MIN_PASS_PHOTONS`].
 pub fn photons_for_image(photons: u32, pixels: u64) -> u32 {
     let wanted = (pixels.max(1) * MAX_FITTED_PASS_ITERATIONS / 4) as f64;
-    let cap = 1u64 << (wanted.log2().round() as u32).min(31);
+    let cap = (1u64 << (wanted.log2().round() as u32).min(31)).max(MIN_PASS_PHOTONS as u64);
     photons.min(cap.min(u32::MAX as u64) as u32)
 }
+
+/// The fewest photons [`photons_for_image`] leaves a pass (a thumbnail keeps a usable map).
+pub const MIN_PASS_PHOTONS: u32 = 1 << 16;
 
 /// The ray-view resolution the scene's detail asks for: [`TEXELS_PER_EDGE`] texels across
 /// the median (over triangles of non-zero size) of the triangles' shortest edges, over the
@@ -305,6 +308,7 @@ mod tests {
         assert_eq!(photons_for_image(1 << 21, 96 * 72), 1 << 17);
         assert_eq!(crate::photons::passes::fitted_pass_iterations(1 << 17, 96 * 72), 76);
         assert_eq!(photons_for_image(1 << 18, 1920 * 1080), 1 << 18);
+        assert_eq!(photons_for_image(1 << 20, 16 * 16), MIN_PASS_PHOTONS);
         assert_eq!(photon_count(&s, 4), MIN_PHOTONS);
         assert_eq!(photon_count(&s, 1024), MAX_PHOTONS);
     }

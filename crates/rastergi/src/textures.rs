@@ -383,29 +383,36 @@ impl TextureAtlas {
             usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
             view_formats: &[],
         });
-        let mut data: Vec<[u16; 4]> = Vec::new();
-        let texels: &[[u16; 4]] = if self.texels.len() == (width * rows) as usize {
-            &self.texels
+        // The full rows straight from the texels, the last row padded: no copy of the whole.
+        let full = if rows == 1 { 1 } else { (self.texels.len() / ROW as usize) as u32 };
+        let tail: Vec<[u16; 4]> = if full < rows {
+            let mut t = self.texels[(full * ROW) as usize..].to_vec();
+            t.resize(ROW as usize, [0; 4]);
+            t
         } else {
-            data.extend_from_slice(&self.texels);
-            data.resize((width * rows) as usize, [0; 4]);
-            &data
+            Vec::new()
         };
-        gpu.queue.write_texture(
-            wgpu::TexelCopyTextureInfo {
-                texture: &texture,
-                mip_level: 0,
-                origin: wgpu::Origin3d::ZERO,
-                aspect: wgpu::TextureAspect::All,
-            },
-            bytemuck::cast_slice(texels),
-            wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(TEXEL_BYTES as u32 * width),
-                rows_per_image: Some(rows),
-            },
-            wgpu::Extent3d { width, height: rows, depth_or_array_layers: 1 },
-        );
+        let full_texels = &self.texels[..(full * width) as usize];
+        for (y, texels, height) in [(0, full_texels, full), (full, &tail[..], rows - full)] {
+            if height == 0 {
+                continue;
+            }
+            gpu.queue.write_texture(
+                wgpu::TexelCopyTextureInfo {
+                    texture: &texture,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d { x: 0, y, z: 0 },
+                    aspect: wgpu::TextureAspect::All,
+                },
+                bytemuck::cast_slice(texels),
+                wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(TEXEL_BYTES as u32 * width),
+                    rows_per_image: Some(height),
+                },
+                wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+            );
+        }
         texture.create_view(&wgpu::TextureViewDescriptor { label: Some("scene textures"), ..Default::default() })
     }
 }

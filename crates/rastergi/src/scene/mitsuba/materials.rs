@@ -79,6 +79,20 @@ fn rough_interface(mu: f32, alpha: f32, eta: f32, reflect: bool) -> f64 {
 /// tabulated on the same nodes and interpolated linearly — single scattering, so a white
 /// rough plastic reflects less than 1 (0.907 at α 0.1, η 1.5, normal incidence).
 pub fn mitsuba_plastic_terms(eta: f32, alpha: f32) -> (f32, f32) {
+    // A file's plastics share a few (η, α): each pair's quadrature (2 M microfacet samples)
+    // is done once per process.
+    static TERMS: std::sync::Mutex<Vec<((u32, u32), (f32, f32))>> = std::sync::Mutex::new(Vec::new());
+    let key = (eta.to_bits(), alpha.to_bits());
+    if let Some(&(_, terms)) = TERMS.lock().unwrap_or_else(|e| e.into_inner()).iter().find(|(k, _)| *k == key) {
+        return terms;
+    }
+    let terms = compute_plastic_terms(eta, alpha);
+    TERMS.lock().unwrap_or_else(|e| e.into_inner()).push((key, terms));
+    terms
+}
+
+/// [`mitsuba_plastic_terms`], computed.
+fn compute_plastic_terms(eta: f32, alpha: f32) -> (f32, f32) {
     if alpha <= 0.0 {
         let f_int = diffuse_fresnel(1.0 / eta as f64) as f32;
         return (f_int, 1.0 - diffuse_fresnel(eta as f64) as f32);

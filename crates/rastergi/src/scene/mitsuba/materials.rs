@@ -81,7 +81,8 @@ fn rough_interface(mu: f32, alpha: f32, eta: f32, reflect: bool) -> f64 {
 pub fn mitsuba_plastic_terms(eta: f32, alpha: f32) -> (f32, f32) {
     // A file's plastics share a few (η, α): each pair's quadrature (2 M microfacet samples)
     // is done once per process.
-    static TERMS: std::sync::Mutex<Vec<((u32, u32), (f32, f32))>> = std::sync::Mutex::new(Vec::new());
+    type Memo = Vec<((u32, u32), (f32, f32))>;
+    static TERMS: std::sync::Mutex<Memo> = std::sync::Mutex::new(Vec::new());
     let key = (eta.to_bits(), alpha.to_bits());
     if let Some(&(_, terms)) = TERMS.lock().unwrap_or_else(|e| e.into_inner()).iter().find(|(k, _)| *k == key) {
         return terms;

@@ -59,17 +59,8 @@ pub struct SceneAccel {
 const BLAS_LABEL: &str = "scene blas";
 const TLAS_LABEL: &str = "scene tlas";
 
-/// The layout entry of the TLAS binding (binding 15 of the scene group, compute stages).
+/// The TLAS's binding in the scene's group (`gpu_scene::group`).
 pub const TLAS_BINDING: u32 = 15;
-
-pub fn tlas_entry() -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding: TLAS_BINDING,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::AccelerationStructure { vertex_return: false },
-        count: None,
-    }
-}
 
 /// Builds the acceleration structures over `triangles`, the scene's triangle buffer
 /// (`GpuTriangle`: v0, v1, v2 each a vec3 in its own 16 bytes, 48 bytes a triangle, made with

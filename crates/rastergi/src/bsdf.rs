@@ -851,7 +851,7 @@ pub fn on_gpu(
     gpu: &crate::gpu::Gpu,
     queries: &[(Bsdf, Vec3, Vec3, [f32; 3], Transport)],
 ) -> crate::Result<Vec<GpuAnswer>> {
-    use crate::gpu::storage_entry;
+    use crate::binding::{Group, Slot};
     let device = &gpu.device;
     let input: Vec<[f32; 25]> = queries
         .iter()
@@ -888,7 +888,6 @@ pub fn on_gpu(
     let input = gpu.storage_buffer("bsdf queries", bytemuck::cast_slice(&input), wgpu::BufferUsages::empty());
     let size = (queries.len() as u64 * 64).max(64);
     let output = gpu.zeroed_buffer("bsdf answers", size, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
-    let c = wgpu::ShaderStages::COMPUTE;
     let table = gpu.storage_buffer(
         "bsdf ggx albedo",
         bytemuck::bytes_of(&*ggx_albedo().gpu(true)),
@@ -930,12 +929,19 @@ pub fn on_gpu(
     gpu.run_once(
         "bsdf",
         &module,
+        &Group::compute(
+            "bsdf",
+            &[
+                Slot::read::<[f32; 25]>(0, "queries"),
+                Slot::write::<[f32; 16]>(1, "answers"),
+                Slot::read::<albedo::GpuGgxAlbedo>(2, "ggx_table"),
+            ],
+        ),
         &[
-            storage_entry::<[f32; 25]>(0, c, true),
-            storage_entry::<[f32; 16]>(1, c, false),
-            storage_entry::<albedo::GpuGgxAlbedo>(2, c, true),
+            ("queries", input.as_entire_binding()),
+            ("answers", output.as_entire_binding()),
+            ("ggx_table", table.as_entire_binding()),
         ],
-        &[input.as_entire_binding(), output.as_entire_binding(), table.as_entire_binding()],
         queries.len() as u32,
     );
     let bytes = gpu.read_buffer(&output, size)?;

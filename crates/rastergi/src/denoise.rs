@@ -81,11 +81,12 @@
 
 use bytemuck::{Pod, Zeroable};
 
+use crate::binding::{Group, Slot};
 use crate::error::Result;
 use crate::film::{COMPONENTS, FILM_DIRECT, FILM_INDIRECT, Film};
 use crate::frame::FrameBinding;
 use crate::gbuffer::{GBUFFER_FILM_WGSL, GBufferPass, PixelPass, PixelShader};
-use crate::gpu::{Gpu, bind_group_layout, buffer_bind_group, compute_pipeline, groups, storage_entry, uniform_entry};
+use crate::gpu::{Gpu, compute_pipeline, groups};
 use crate::gpu_scene::GpuScene;
 use crate::image_io::LinearImage;
 use crate::scene::Camera;
@@ -259,6 +260,30 @@ pub struct Guides {
     height: u32,
 }
 
+/// The guides pass's bind group 3: the guides and the previous sums, both accumulated.
+pub fn guides_group() -> Group {
+    Group::compute("denoiser guides", &[Slot::write::<[f32; 4]>(0, "guides"), Slot::write::<[f32; 4]>(1, "previous")])
+}
+
+/// The filter's bind group: the film, the guides and the previous sums read; each dispatch
+/// reads `src` and writes `dst` (ping-pong), the image, luminance and unfiltered light.
+pub fn filter_group() -> Group {
+    Group::compute(
+        "denoiser",
+        &[
+            Slot::uniform::<DenoiseUniforms>(0, "params"),
+            Slot::read::<[f32; 4]>(1, "film"),
+            Slot::read::<[f32; 4]>(2, "guides"),
+            Slot::read::<[f32; 4]>(3, "extra"),
+            Slot::read::<[f32; 4]>(4, "src"),
+            Slot::write::<[f32; 4]>(5, "dst"),
+            Slot::write::<[f32; 4]>(6, "image"),
+            Slot::write::<[f32; 2]>(7, "lum"),
+            Slot::write::<[f32; 4]>(8, "light"),
+        ],
+    )
+}
+
 impl Guides {
     pub fn new(gpu: &Gpu, (scene, frame): (&GpuScene, &FrameBinding), gbuffer: &GBufferPass, film: &Film) -> Guides {
         let (width, height) = (film.width, film.height);
@@ -266,13 +291,10 @@ impl Guides {
         let rw = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
         let buffer = gpu.zeroed_buffer("denoiser guides", GUIDE_SLOTS * pixels * 16, rw);
         let extra = gpu.zeroed_buffer("denoiser previous sums and emission", EXTRA_SLOTS * pixels * 16, rw);
-        let c = wgpu::ShaderStages::COMPUTE;
-        let layout = bind_group_layout(
+        let (layout, bind_group) = guides_group().layout_and_bind(
             &gpu.device,
-            "denoiser guides",
-            &[storage_entry::<[f32; 4]>(0, c, false), storage_entry::<[f32; 4]>(1, c, false)],
+            &[("guides", buffer.as_entire_binding()), ("previous", extra.as_entire_binding())],
         );
-        let bind_group = buffer_bind_group(&gpu.device, "denoiser guides", &layout, &[&buffer, &extra]);
         let source = guides_source();
         let shader = PixelShader { label: "denoiser guides", source: &source, entry: "accumulate_guides" };
         let pass = PixelPass::new(gpu, (scene, frame), (gbuffer, film), shader, &[&layout]);
@@ -402,22 +424,8 @@ impl Denoiser {
         let light = gpu.zeroed_buffer("denoiser unfiltered light", 2 * pixels * 16, rw);
         let image = gpu.zeroed_buffer("denoised image", pixels * 16, rw);
         let lum = gpu.zeroed_buffer("denoiser luminance", pixels * 8, rw);
-        let c = wgpu::ShaderStages::COMPUTE;
-        let layout = bind_group_layout(
-            device,
-            "denoiser",
-            &[
-                uniform_entry::<DenoiseUniforms>(0, c),
-                storage_entry::<[f32; 4]>(1, c, true),
-                storage_entry::<[f32; 4]>(2, c, true),
-                storage_entry::<[f32; 4]>(3, c, true),
-                storage_entry::<[f32; 4]>(4, c, true),
-                storage_entry::<[f32; 4]>(5, c, false),
-                storage_entry::<[f32; 4]>(6, c, false),
-                storage_entry::<[f32; 2]>(7, c, false),
-                storage_entry::<[f32; 4]>(8, c, false),
-            ],
-        );
+        let group = filter_group();
+        let layout = group.layout(device);
         let dispatches = levels as usize + 3;
         let uniforms: Vec<wgpu::Buffer> = (0..dispatches)
             .map(|_| {
@@ -434,8 +442,10 @@ impl Denoiser {
         let groups = (0..dispatches)
             .map(|d| {
                 let (src, dst) = (&ping[(d + 1) % 2], &ping[d % 2]);
+                let names = ["params", "film", "guides", "extra", "src", "dst", "image", "lum", "light"];
                 let buffers = [&uniforms[d], film, guides, extra, src, dst, &image, &lum, &light];
-                buffer_bind_group(device, "denoiser", &layout, &buffers)
+                let resources: Vec<_> = names.into_iter().zip(buffers.map(|b| b.as_entire_binding())).collect();
+                group.bind(device, &layout, &resources)
             })
             .collect();
         let module = shader::module(device, "denoiser", &filter_source());

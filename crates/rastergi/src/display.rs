@@ -14,9 +14,10 @@
 
 use bytemuck::{Pod, Zeroable};
 
+use crate::binding::{Group, Slot};
 use crate::error::{Error, Result};
 use crate::film::Film;
-use crate::gpu::{Gpu, bind_group, bind_group_layout, storage_entry, uniform_entry};
+use crate::gpu::Gpu;
 use crate::shader;
 
 /// Re-exported so front ends can hand over a window without a direct wgpu dependency.
@@ -91,20 +92,25 @@ pub struct DisplayPass {
     bound: Option<(wgpu::Buffer, wgpu::BindGroup)>,
 }
 
+/// The display's bind group: the uniforms, the film's display image, the font and the
+/// overlay's text, all read by the fragment shader.
+pub fn group() -> Group {
+    Group::new(
+        "display",
+        wgpu::ShaderStages::FRAGMENT,
+        &[
+            Slot::uniform::<DisplayUniforms>(0, "params"),
+            Slot::read::<u32>(1, "image"),
+            Slot::read::<u32>(2, "font"),
+            Slot::read::<u32>(3, "text"),
+        ],
+    )
+}
+
 impl DisplayPass {
     pub fn new(gpu: &Gpu, format: wgpu::TextureFormat) -> DisplayPass {
         let device = &gpu.device;
-        let f = wgpu::ShaderStages::FRAGMENT;
-        let layout = bind_group_layout(
-            device,
-            "display",
-            &[
-                uniform_entry::<DisplayUniforms>(0, f),
-                storage_entry::<u32>(1, f, true),
-                storage_entry::<u32>(2, f, true),
-                storage_entry::<u32>(3, f, true),
-            ],
-        );
+        let layout = group().layout(device);
         let module = shader::module(device, "display", SOURCE);
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("display"),
@@ -177,15 +183,14 @@ impl DisplayPass {
         gpu.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
         let image = film.map_or(&self.no_image, |f| f.display_buffer()).clone();
         if self.bound.as_ref().is_none_or(|(b, _)| *b != image) {
-            let bind_group = bind_group(
+            let bind_group = group().bind(
                 &gpu.device,
-                "display",
                 &self.layout,
                 &[
-                    self.uniforms.as_entire_binding(),
-                    image.as_entire_binding(),
-                    self.font.as_entire_binding(),
-                    self.text.as_entire_binding(),
+                    ("params", self.uniforms.as_entire_binding()),
+                    ("image", image.as_entire_binding()),
+                    ("font", self.font.as_entire_binding()),
+                    ("text", self.text.as_entire_binding()),
                 ],
             );
             self.bound = Some((image, bind_group));

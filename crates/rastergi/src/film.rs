@@ -40,8 +40,9 @@
 
 use bytemuck::{Pod, Zeroable};
 
+use crate::binding::{Group, Slot};
 use crate::error::Result;
-use crate::gpu::{Gpu, bind_group_layout, buffer_bind_group, compute_pipeline, groups, storage_entry, uniform_entry};
+use crate::gpu::{Gpu, compute_pipeline, groups};
 use crate::image_io::{DisplayImage, LinearImage};
 use crate::shader;
 
@@ -134,6 +135,44 @@ pub struct ImageResolve {
     bind_group: wgpu::BindGroup,
 }
 
+/// The resolve's bind group: the film's sums (or an image) and the uniforms read, the linear
+/// and display images written.
+pub fn resolve_group() -> Group {
+    Group::compute(
+        "resolve",
+        &[
+            Slot::uniform::<ResolveUniforms>(0, "params"),
+            Slot::read::<[f32; 4]>(1, "film"),
+            Slot::write::<[f32; 4]>(2, "linear_out"),
+            Slot::write::<u32>(3, "display_out"),
+        ],
+    )
+}
+
+/// The resolve's bind group of `uniforms` over `source` into `linear` and `display`.
+fn bind_resolve(
+    gpu: &Gpu,
+    layout: &wgpu::BindGroupLayout,
+    (uniforms, source): (&wgpu::Buffer, &wgpu::Buffer),
+    (linear, display): (&wgpu::Buffer, &wgpu::Buffer),
+) -> wgpu::BindGroup {
+    resolve_group().bind(
+        &gpu.device,
+        layout,
+        &[
+            ("params", uniforms.as_entire_binding()),
+            ("film", source.as_entire_binding()),
+            ("linear_out", linear.as_entire_binding()),
+            ("display_out", display.as_entire_binding()),
+        ],
+    )
+}
+
+/// The odd-iteration half's bind group: the film read, the half's sums written.
+pub fn half_group() -> Group {
+    Group::compute("film half", &[Slot::read::<[f32; 4]>(0, "film"), Slot::write::<[f32; 4]>(1, "half_sums")])
+}
+
 impl Film {
     pub fn new(gpu: &Gpu, width: u32, height: u32) -> Result<Film> {
         gpu.check_image_size(width, height, COMPONENTS * 16)?;
@@ -148,28 +187,16 @@ impl Film {
             wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         );
         let device = &gpu.device;
-        let c = wgpu::ShaderStages::COMPUTE;
-        let layout = bind_group_layout(
-            device,
-            "resolve",
-            &[
-                uniform_entry::<ResolveUniforms>(0, c),
-                storage_entry::<[f32; 4]>(1, c, true),
-                storage_entry::<[f32; 4]>(2, c, false),
-                storage_entry::<u32>(3, c, false),
-            ],
-        );
-        let bind_group = buffer_bind_group(device, "resolve", &layout, &[&uniforms, &accumulation, &linear, &display]);
+        let layout = resolve_group().layout(device);
+        let bind_group = bind_resolve(gpu, &layout, (&uniforms, &accumulation), (&linear, &display));
         let module = shader::module(device, "resolve", &resolve_source());
         let pipeline = compute_pipeline(device, "resolve", &module, "main", &[&layout], &[]);
         let image_pipeline = compute_pipeline(device, "resolve image", &module, "resolve_image", &[&layout], &[]);
         let half = gpu.zeroed_buffer("film odd half", COMPONENTS * pixels * 16, rw);
-        let half_layout = bind_group_layout(
+        let (half_layout, half_bind_group) = half_group().layout_and_bind(
             device,
-            "film half",
-            &[storage_entry::<[f32; 4]>(0, c, true), storage_entry::<[f32; 4]>(1, c, false)],
+            &[("film", accumulation.as_entire_binding()), ("half_sums", half.as_entire_binding())],
         );
-        let half_bind_group = buffer_bind_group(device, "film half", &half_layout, &[&accumulation, &half]);
         let half_module = shader::module(device, "film half", include_str!("film_half.wgsl"));
         let half_pipelines = ["open_block", "close_block"]
             .map(|entry| compute_pipeline(device, "film half", &half_module, entry, &[&half_layout], &[]));
@@ -324,12 +351,7 @@ impl Film {
             std::mem::size_of::<ResolveUniforms>() as u64,
             wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         );
-        let bind_group = buffer_bind_group(
-            &gpu.device,
-            "resolve image",
-            &self.layout,
-            &[&uniforms, image, &self.linear, &self.display],
-        );
+        let bind_group = bind_resolve(gpu, &self.layout, (&uniforms, image), (&self.linear, &self.display));
         ImageResolve { uniforms, bind_group }
     }
 

@@ -4,7 +4,8 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec2, Vec3};
 
-use crate::gpu::{Gpu, bind_group_layout, buffer_bind_group, storage_entry, uniform_entry};
+use crate::binding::{Group, Slot};
+use crate::gpu::Gpu;
 use crate::gpu_scene::GpuScene;
 use crate::sampling::{pcg_hash, sobol_owen_2d, stream, unit_f32};
 use crate::scene::{Aabb, Camera};
@@ -118,6 +119,32 @@ pub struct FrameBinding {
     pub bind_group: wgpu::BindGroup,
 }
 
+/// Bind group 1 of every per-iteration pass: the frame's uniforms (read) and the eye paths
+/// that the specular chains leave for later passes (written).
+pub fn group() -> Group {
+    Group::new(
+        "frame",
+        wgpu::ShaderStages::VERTEX_FRAGMENT | wgpu::ShaderStages::COMPUTE,
+        &[
+            Slot::uniform::<FrameUniforms>(0, "frame"),
+            Slot::write::<[f32; 4]>(1, "eye_paths").only(wgpu::ShaderStages::COMPUTE),
+        ],
+    )
+}
+
+fn bind(
+    gpu: &Gpu,
+    layout: &wgpu::BindGroupLayout,
+    uniforms: &wgpu::Buffer,
+    eye_paths: &wgpu::Buffer,
+) -> wgpu::BindGroup {
+    group().bind(
+        &gpu.device,
+        layout,
+        &[("frame", uniforms.as_entire_binding()), ("eye_paths", eye_paths.as_entire_binding())],
+    )
+}
+
 /// Bytes of a pixel's eye path: three vec4f (`eye_paths` in `frame.wgsl`).
 pub const EYE_PATH_BYTES: u64 = 48;
 
@@ -128,14 +155,10 @@ impl FrameBinding {
             std::mem::size_of::<FrameUniforms>() as u64,
             wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         );
-        let vis = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
-        let layout = bind_group_layout(
-            &gpu.device,
-            "frame",
-            &[uniform_entry::<FrameUniforms>(0, vis), storage_entry::<[f32; 4]>(1, wgpu::ShaderStages::COMPUTE, false)],
-        );
         let eye_paths = gpu.zeroed_buffer("eye paths", EYE_PATH_BYTES, wgpu::BufferUsages::STORAGE);
-        let bind_group = buffer_bind_group(&gpu.device, "frame", &layout, &[&buffer, &eye_paths]);
+        let group = group();
+        let layout = group.layout(&gpu.device);
+        let bind_group = bind(gpu, &layout, &buffer, &eye_paths);
         Self { buffer, eye_paths, layout, bind_group }
     }
 
@@ -146,7 +169,7 @@ impl FrameBinding {
             return;
         }
         self.eye_paths = gpu.zeroed_buffer("eye paths", size, wgpu::BufferUsages::STORAGE);
-        self.bind_group = buffer_bind_group(&gpu.device, "frame", &self.layout, &[&self.buffer, &self.eye_paths]);
+        self.bind_group = bind(gpu, &self.layout, &self.buffer, &self.eye_paths);
     }
 
     pub fn write(&self, gpu: &Gpu, u: &FrameUniforms) {

@@ -6,12 +6,11 @@
 //! in texels (`texture_lod`), so that the passes read the texture filtered like a fragment
 //! shader would.
 
+use crate::binding::{Group, Slot};
 use crate::error::Result;
 use crate::film::Film;
 use crate::frame::FrameBinding;
-use crate::gpu::{
-    Gpu, bind_group, bind_group_layout, dispatch_pixels, scene_raster_pipeline, storage_entry, uint_texture_entry,
-};
+use crate::gpu::{Gpu, dispatch_pixels, scene_raster_pipeline};
 use crate::gpu_scene::GpuScene;
 use crate::profile::{Profiler, compute_pass};
 use crate::shader;
@@ -106,6 +105,11 @@ impl GBufferPass {
 /// The WGSL of a [`PixelPass`]'s bind group 2 (`gbuffer`, `film`).
 pub const GBUFFER_FILM_WGSL: &str = include_str!("gbuffer_film.wgsl");
 
+/// A [`PixelPass`]'s bind group 2: the G-buffer read, the film written.
+pub fn pixel_group() -> Group {
+    Group::compute("gbuffer film", &[Slot::uint_texture(0, "gbuffer"), Slot::write::<[f32; 4]>(1, "film")])
+}
+
 /// A compute pass run once per eye pixel, in 8×8 workgroups (`begin_pixel` in `frame.wgsl`):
 /// bind group 0 is the scene, 1 the frame, 2 the G-buffer and the film (`gbuffer_film.wgsl`),
 /// 3, … whatever else its shader declares. The direct light, the specular chains, the photon
@@ -137,16 +141,11 @@ impl PixelPass {
         let device = &gpu.device;
         let label = shader.label;
         let module = scene.module(device, label, shader.source);
-        let layout = bind_group_layout(
-            device,
-            label,
-            &[
-                uint_texture_entry(0, wgpu::ShaderStages::COMPUTE),
-                storage_entry::<[f32; 4]>(1, wgpu::ShaderStages::COMPUTE, false),
-            ],
-        );
-        let resources = [wgpu::BindingResource::TextureView(&gbuffer.view), film.accumulation.as_entire_binding()];
-        let bind_group = bind_group(device, label, &layout, &resources);
+        let resources = [
+            ("gbuffer", wgpu::BindingResource::TextureView(&gbuffer.view)),
+            ("film", film.accumulation.as_entire_binding()),
+        ];
+        let (layout, bind_group) = pixel_group().layout_and_bind(device, &resources);
         let layouts: Vec<&wgpu::BindGroupLayout> =
             [&scene.layout, &frame.layout, &layout].into_iter().chain(more_layouts.iter().copied()).collect();
         let pipeline = scene.compute_pipeline(device, label, &module, shader.entry, &layouts);

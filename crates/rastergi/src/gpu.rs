@@ -407,19 +407,18 @@ pub fn block_on<T>(future: impl std::future::Future<Output = Result<T>>) -> Resu
 }
 
 impl Gpu {
-    /// Runs `module`'s entry point `main` (`@workgroup_size(64)`, bind group 0 = `resources` on
-    /// a layout of `entries`) over `n` invocations, submits and waits for nothing: the GPU side
+    /// Runs `module`'s entry point `main` (`@workgroup_size(64)`, bind group 0 = `group` of
+    /// the named `resources`) over `n` invocations, submits and waits for nothing: the GPU side
     /// of a CPU twin's test, read back with [`Gpu::read_buffer`].
     pub fn run_once(
         &self,
         label: &str,
         module: &wgpu::ShaderModule,
-        entries: &[wgpu::BindGroupLayoutEntry],
-        resources: &[wgpu::BindingResource],
+        group: &crate::binding::Group,
+        resources: &[(&str, wgpu::BindingResource)],
         n: u32,
     ) {
-        let layout = bind_group_layout(&self.device, label, entries);
-        let group = bind_group(&self.device, label, &layout, resources);
+        let (layout, group) = group.layout_and_bind(&self.device, resources);
         let pipeline = compute_pipeline(&self.device, label, module, "main", &[&layout], &[]);
         let mut enc = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
         {
@@ -431,53 +430,6 @@ impl Gpu {
         }
         self.queue.submit([enc.finish()]);
     }
-}
-
-/// Bind-group-layout entry for a storage buffer holding `T`s (an array of them or one): wgpu
-/// refuses a bound buffer smaller than one `T`, and a shader whose type there is larger.
-pub fn storage_entry<T>(binding: u32, visibility: wgpu::ShaderStages, read_only: bool) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: min_size::<T>(),
-        },
-        count: None,
-    }
-}
-
-/// The size of `T` as a binding's minimum size.
-fn min_size<T>() -> Option<std::num::NonZeroU64> {
-    std::num::NonZeroU64::new(std::mem::size_of::<T>() as u64)
-}
-
-/// Bind-group-layout entry for a texture of `sample_type` and `dimension`, not multisampled.
-fn texture_entry(
-    binding: u32,
-    visibility: wgpu::ShaderStages,
-    sample_type: wgpu::TextureSampleType,
-    view_dimension: wgpu::TextureViewDimension,
-) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Texture { sample_type, view_dimension, multisampled: false },
-        count: None,
-    }
-}
-
-/// Bind-group-layout entry for a 2D unsigned-integer texture (the G-buffer, ray-view layers).
-pub fn uint_texture_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
-    texture_entry(binding, visibility, wgpu::TextureSampleType::Uint, wgpu::TextureViewDimension::D2)
-}
-
-/// Bind-group-layout entry for a 2D float texture read texel by texel (`textureLoad`; the GGX
-/// albedo tables).
-pub fn float_table_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
-    let sample_type = wgpu::TextureSampleType::Float { filterable: false };
-    texture_entry(binding, visibility, sample_type, wgpu::TextureViewDimension::D2)
 }
 
 /// Runs `pipeline` once per pixel of a `width × height` image (8×8 workgroups) with bind
@@ -494,65 +446,6 @@ pub fn dispatch_pixels(
         pass.set_bind_group(i as u32, *g, &[]);
     }
     pass.dispatch_workgroups(groups(width, 8), groups(height, 8), 1);
-}
-
-/// Bind-group-layout entry for a uniform buffer holding a `T`: wgpu refuses a bound buffer
-/// smaller than `T` and a shader whose struct there is larger.
-pub fn uniform_entry<T>(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: false,
-            min_binding_size: min_size::<T>(),
-        },
-        count: None,
-    }
-}
-
-/// A bind group layout of `entries` (each names its binding): the device's one of them
-/// ([`crate::compiled`]).
-pub fn bind_group_layout(
-    device: &wgpu::Device,
-    label: &str,
-    entries: &[wgpu::BindGroupLayoutEntry],
-) -> wgpu::BindGroupLayout {
-    crate::compiled::bind_group_layout(device, label, entries)
-}
-
-/// Bind-group-layout entry for an unfiltered float 2D texture read with `textureLoad` (the
-/// scene's texture atlas, `textures.rs`).
-pub fn atlas_texture_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
-    let sample_type = wgpu::TextureSampleType::Float { filterable: false };
-    texture_entry(binding, visibility, sample_type, wgpu::TextureViewDimension::D2)
-}
-
-/// Bind group whose entries are `resources`, at bindings 0, 1, 2, … (the order of the
-/// layout's entries and of the shader's `@binding`s).
-pub fn bind_group(
-    device: &wgpu::Device,
-    label: &str,
-    layout: &wgpu::BindGroupLayout,
-    resources: &[wgpu::BindingResource],
-) -> wgpu::BindGroup {
-    let entries: Vec<wgpu::BindGroupEntry> = resources
-        .iter()
-        .enumerate()
-        .map(|(i, r)| wgpu::BindGroupEntry { binding: i as u32, resource: r.clone() })
-        .collect();
-    device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout, entries: &entries })
-}
-
-/// Bind group whose entries are `buffers` bound whole, at bindings 0, 1, 2, …
-pub fn buffer_bind_group(
-    device: &wgpu::Device,
-    label: &str,
-    layout: &wgpu::BindGroupLayout,
-    buffers: &[&wgpu::Buffer],
-) -> wgpu::BindGroup {
-    let resources: Vec<wgpu::BindingResource> = buffers.iter().map(|b| b.as_entire_binding()).collect();
-    bind_group(device, label, layout, &resources)
 }
 
 /// A pipeline layout of bind groups 0, 1, … = `layouts`.

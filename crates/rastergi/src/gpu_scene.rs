@@ -11,8 +11,9 @@ use crate::bvh::wide::WideNode;
 use crate::error::Result;
 use wgpu::util::DeviceExt;
 
+use crate::binding::{Group, Slot};
 use crate::environment::{Environment, GpuEnvironment};
-use crate::gpu::{Gpu, atlas_texture_entry, bind_group_layout, float_table_entry, storage_entry, uniform_entry};
+use crate::gpu::Gpu;
 use crate::lights::{LightEntry, LightTable};
 use crate::limits::check_storage_buffer;
 use crate::scene::{Aabb, AlphaMode, Material, Scene, TextureRef, UvTransform};
@@ -105,6 +106,36 @@ pub struct GpuMaterialMaps {
 }
 
 pub use crate::consts::GpuSceneOffsets;
+
+/// The scene's bind group 0, read by every pass: triangles, materials, the texture atlas, the
+/// scene data (coordinates, normals, tangents, lights, environment), the environment's
+/// uniforms, the albedo tables; the BVH (or, with `tlas`, the hardware's acceleration
+/// structure) for the compute passes. The BVH serves compute passes only: the raster stages
+/// (which pull vertices and discard holes) see three storage buffers of the scene, well under
+/// the count at which lavapipe (Mesa 22.3) silently loses fragment writes (11 storage buffers
+/// in a fragment stage, though it reports 32: the fragment lists' gather lost 10 % of its
+/// estimates, tests/gather.rs).
+pub fn group(tlas: bool) -> Group {
+    let compute = wgpu::ShaderStages::COMPUTE;
+    let mut g = Group::new(
+        "scene",
+        wgpu::ShaderStages::VERTEX_FRAGMENT | compute,
+        &[
+            Slot::read::<GpuTriangle>(0, "triangles"),
+            Slot::read::<GpuMaterialRecord>(1, "materials"),
+            Slot::read::<WideNode>(2, "bvh_nodes").only(compute),
+            Slot::float_texture(5, "textures"),
+            Slot::read::<u32>(8, "scene_data"),
+            Slot::uniform::<GpuEnvironment>(9, "environment").only(compute),
+            Slot::float_texture(13, "ggx_cells_texture").only(compute),
+            Slot::float_texture(14, "glass_albedo_texture").only(compute),
+        ],
+    );
+    if tlas {
+        g.slots.push(Slot::tlas(crate::accel::TLAS_BINDING, "scene_tlas").only(compute));
+    }
+    g
+}
 
 /// The GGX albedo tables as gpu_scene.wgsl reads them: the cells and means, N × (N + 1)
 /// RGBA32F, and the rough glass's, N × (cells / N) R32F. Computed and filled only where some
@@ -599,59 +630,28 @@ impl GpuScene {
             contents: bytemuck::bytes_of(&env_uniform),
             usage: wgpu::BufferUsages::UNIFORM,
         });
-        let vis = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
-        // The BVH serves compute passes only: the raster stages (which pull vertices and
-        // discard holes) see three storage buffers of the scene, well under the count at
-        // which lavapipe (Mesa 22.3) silently loses fragment writes (11 storage buffers in a
-        // fragment stage, though it reports 32: the fragment lists' gather lost 10 % of its
-        // estimates, tests/gather.rs).
-        let compute = wgpu::ShaderStages::COMPUTE;
         let accel = if ray_queries && !triangles.is_empty() {
             Some(crate::accel::build(gpu, &buffers[0], triangles.len() as u32)?)
         } else {
             None
         };
-        let tlas_entry = accel.as_ref().map(|_| crate::accel::tlas_entry());
-        let layout = bind_group_layout(
-            &gpu.device,
-            "scene",
-            &[
-                storage_entry::<GpuTriangle>(0, vis, true),
-                storage_entry::<GpuMaterialRecord>(1, vis, true),
-                storage_entry::<WideNode>(2, compute, true),
-                atlas_texture_entry(5, vis),
-                storage_entry::<u32>(8, vis, true),
-                uniform_entry::<GpuEnvironment>(9, wgpu::ShaderStages::COMPUTE),
-                float_table_entry(13, compute),
-                float_table_entry(14, compute),
-            ]
-            .into_iter()
-            .chain(tlas_entry)
-            .collect::<Vec<_>>(),
-        );
-        // The buffers' bindings, in the order of `buffers`.
-        const BUFFER_BINDINGS: [u32; 4] = [0, 1, 2, 8];
-        let mut entries: Vec<wgpu::BindGroupEntry> = buffers
-            .iter()
-            .zip(BUFFER_BINDINGS)
-            .map(|(b, binding)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() })
-            .collect();
-        entries.push(wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&texture_view) });
-        entries.push(wgpu::BindGroupEntry { binding: 9, resource: env_uniform_buffer.as_entire_binding() });
+        let group = group(accel.is_some());
+        let layout = group.layout(&gpu.device);
         let (ggx_cells, glass) = albedo_textures(gpu, has_bsdfs, s.materials.iter().any(Material::needs_glass_table));
-        entries.push(wgpu::BindGroupEntry { binding: 13, resource: wgpu::BindingResource::TextureView(&ggx_cells) });
-        entries.push(wgpu::BindGroupEntry { binding: 14, resource: wgpu::BindingResource::TextureView(&glass) });
+        let mut resources = vec![
+            ("triangles", buffers[0].as_entire_binding()),
+            ("materials", buffers[1].as_entire_binding()),
+            ("bvh_nodes", buffers[2].as_entire_binding()),
+            ("textures", wgpu::BindingResource::TextureView(&texture_view)),
+            ("scene_data", buffers[3].as_entire_binding()),
+            ("environment", env_uniform_buffer.as_entire_binding()),
+            ("ggx_cells_texture", wgpu::BindingResource::TextureView(&ggx_cells)),
+            ("glass_albedo_texture", wgpu::BindingResource::TextureView(&glass)),
+        ];
         if let Some(a) = &accel {
-            entries.push(wgpu::BindGroupEntry {
-                binding: crate::accel::TLAS_BINDING,
-                resource: wgpu::BindingResource::AccelerationStructure(&a.tlas),
-            });
+            resources.push(("scene_tlas", wgpu::BindingResource::AccelerationStructure(&a.tlas)));
         }
-        let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("scene"),
-            layout: &layout,
-            entries: &entries,
-        });
+        let bind_group = group.bind(&gpu.device, &layout, &resources);
         let (rays, rays_why) = match (gpu.rays, &accel) {
             (Rays::Compute, _) => (RayPath::Compute, "asked for (--rays compute)".to_owned()),
             (_, Some(_)) if gpu.rays == Rays::Hardware => (RayPath::Hardware, "asked for (--rays hardware)".to_owned()),

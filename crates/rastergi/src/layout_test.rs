@@ -8,6 +8,8 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::mem::{offset_of, size_of};
 use std::path::Path;
 
+use crate::binding::{Group, Kind};
+
 use crate::bvh::wide::WideNode;
 use crate::display::DisplayUniforms;
 use crate::environment::GpuEnvironment;
@@ -176,6 +178,7 @@ fn shaders() -> Vec<(&'static str, String)> {
     vec![
         ("gbuffer", crate::gbuffer::source()),
         ("direct", crate::direct::source()),
+        ("specular chains", crate::specular::source()),
         ("photon view", crate::photon_view::source()),
         ("gather ray view", crate::gather::ray_view::ray_view_source()),
         ("gather project", estimate_source(&[RAY_VIEW_LOOKUP, include_str!("gather/raster.wgsl")])),
@@ -183,6 +186,7 @@ fn shaders() -> Vec<(&'static str, String)> {
         ("gather trace", estimate_source(&[include_str!("gather/trace.wgsl")])),
         ("photon trace", crate::photons::gpu::trace_source()),
         ("resolve", crate::film::resolve_source()),
+        ("film half", include_str!("film_half.wgsl").to_string()),
         ("denoiser guides", crate::denoise::guides_source()),
         ("denoiser", crate::denoise::filter_source()),
         ("display", crate::display::SOURCE.to_string()),
@@ -261,8 +265,8 @@ fn every_shader_holds_the_rust_constants() {
     assert_eq!(expected["NO_TEXTURE"], crate::gpu_scene::NO_TEXTURE);
     assert_eq!(expected["STREAM_PHOTON"], crate::sampling::stream::PHOTON);
     for (label, source) in shaders() {
-        if label == "display" {
-            continue; // draws an image; no shared constant
+        if label == "display" || label == "film half" {
+            continue; // draws an image, sums the film: no shared constant
         }
         let module =
             naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| panic!("{label}: {}", e.emit_to_string(&source)));
@@ -296,7 +300,15 @@ fn every_tracing_shader_composes_and_validates_for_hardware_ray_queries() {
             .unwrap_or_else(|e| panic!("{label} (hardware): {}", e.emit_to_string(&hardware)));
     }
     // Every pass that casts rays (the G-buffer's raster shader holds the prelude too).
-    let expected = ["gbuffer", "direct", "photon view", "gather project", "gather list project", "gather trace"];
+    let expected = [
+        "gbuffer",
+        "direct",
+        "specular chains",
+        "photon view",
+        "gather project",
+        "gather list project",
+        "gather trace",
+    ];
     let expected = expected.into_iter().chain(["photon trace", "denoiser guides", "path tracer", "rays"]);
     assert_eq!(traced, expected.collect::<Vec<_>>());
 }
@@ -358,4 +370,116 @@ fn the_design_page_names_every_wgsl_entry_point_and_each_exists() {
     let stale: Vec<_> = page.difference(&code).collect();
     assert!(missing.is_empty(), "entry points docs/design.md does not name: {missing:?}");
     assert!(stale.is_empty(), "docs/design.md names entry points the code lacks: {stale:?}");
+}
+
+/// The bind groups each shader of [`shaders`] is built with, by group index; where one module
+/// serves several pipelines, each group index lists the alternatives (the ray view's count,
+/// peel and fill; the photon shader's trace and resolve).
+fn declared_groups(label: &str) -> Vec<Vec<Group>> {
+    use crate::{denoise, film, frame, gather, gbuffer, gpu_scene, photons};
+    let scene = || vec![gpu_scene::group(false)];
+    let per_pixel = || vec![scene(), vec![frame::group()], vec![gbuffer::pixel_group()]];
+    let lookup = || vec![photons::gpu::lookup_group()];
+    let estimate = |own: Group| vec![scene(), vec![frame::group()], vec![own], lookup()];
+    match label {
+        "gbuffer" => vec![scene(), vec![frame::group()]],
+        "direct" | "specular chains" => per_pixel(),
+        "photon view" => [per_pixel(), vec![lookup()]].concat(),
+        "gather ray view" => vec![
+            scene(),
+            vec![gather::raster::count_group(), gather::raster::peel_group(), gather::lists::fill_group()],
+        ],
+        "gather project" => estimate(gather::raster::project_group()),
+        "gather list project" => estimate(gather::lists::project_group()),
+        "gather trace" => estimate(gather::trace::group()),
+        "photon trace" => vec![scene(), vec![photons::gpu::trace_group(), photons::gpu::resolve_group()]],
+        "resolve" => vec![vec![film::resolve_group()]],
+        "film half" => vec![vec![film::half_group()]],
+        "denoiser guides" => [per_pixel(), vec![vec![denoise::guides_group()]]].concat(),
+        "denoiser" => vec![vec![denoise::filter_group()]],
+        "display" => vec![vec![crate::display::group()]],
+        "path tracer" => vec![scene(), vec![frame::group()], vec![crate::path_tracer::group()]],
+        "rays" => vec![scene(), vec![crate::rays::group()]],
+        _ => panic!("shader {label}: its bind groups are not declared here"),
+    }
+}
+
+/// What a WGSL global variable is, in the terms of a [`Slot`]'s [`Kind`] (`None`: something a
+/// declaration cannot name).
+fn wgsl_kind(module: &naga::Module, layouter: &naga::proc::Layouter, var: &naga::GlobalVariable) -> Option<Kind> {
+    use naga::{AddressSpace, ImageClass, ImageDimension, ScalarKind, TypeInner};
+    let size = |ty: naga::Handle<naga::Type>| match module.types[ty].inner {
+        TypeInner::Array { base, .. } => layouter[base].size as u64,
+        _ => layouter[ty].size as u64,
+    };
+    match (var.space, &module.types[var.ty].inner) {
+        (AddressSpace::Uniform, _) => Some(Kind::Uniform { size: layouter[var.ty].size as u64 }),
+        (AddressSpace::Storage { access }, _) => {
+            Some(Kind::Storage { write: access.contains(naga::StorageAccess::STORE), size: size(var.ty) })
+        }
+        (
+            AddressSpace::Handle,
+            TypeInner::Image {
+                dim: ImageDimension::D2,
+                arrayed: false,
+                class: ImageClass::Sampled { kind, multi: false },
+            },
+        ) => match kind {
+            ScalarKind::Uint => Some(Kind::UintTexture),
+            ScalarKind::Float => Some(Kind::FloatTexture),
+            _ => None,
+        },
+        (AddressSpace::Handle, TypeInner::AccelerationStructure { .. }) => Some(Kind::Tlas),
+        _ => None,
+    }
+}
+
+/// Every pass's declared bind groups ([`crate::binding`]) say what its shaders bind: each
+/// WGSL binding is a declared slot of the same number, name, kind, access and element size,
+/// and each declared slot is bound in the WGSL. A pass that reads or writes something it does
+/// not declare, or declares what its shader lacks, fails here.
+#[test]
+fn every_declared_bind_group_matches_the_bindings_of_its_shaders() {
+    let mut failures = Vec::new();
+    // Each shader as composed for the compute ray path, and where it traces, for the hardware
+    // one, whose scene group also binds the TLAS.
+    let hardware = shaders().into_iter().filter_map(|(label, source)| {
+        let hw = crate::shader::for_rays(&source, crate::accel::RayPath::Hardware);
+        (hw != source).then(|| (label, hw.into_owned(), true))
+    });
+    for (label, source, tlas) in shaders().into_iter().map(|(l, s)| (l, s, false)).chain(hardware) {
+        let module = naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| panic!("{label}: {e}"));
+        let mut layouter = naga::proc::Layouter::default();
+        layouter.update(module.to_ctx()).expect("layouts of a parsed module");
+        let mut groups = declared_groups(label);
+        if tlas {
+            groups[0] = vec![crate::gpu_scene::group(true)];
+        }
+        let mut bound = BTreeSet::new();
+        for (_, var) in module.global_variables.iter() {
+            let (Some(b), Some(name)) = (&var.binding, &var.name) else { continue };
+            bound.insert((b.group, b.binding, name.clone()));
+            let kind = wgsl_kind(&module, &layouter, var);
+            let declared = groups.get(b.group as usize).into_iter().flatten().flat_map(|g| &g.slots);
+            let same = declared.filter(|s| s.binding == b.binding && s.name == name).collect::<Vec<_>>();
+            if same.is_empty() {
+                failures.push(format!("{label}: @group({}) @binding({}) {name} is not declared", b.group, b.binding));
+            } else if same.iter().any(|s| Some(s.kind) != kind) {
+                failures.push(format!("{label}: {name} is {kind:?} in WGSL, declared {:?}", same[0].kind));
+            }
+        }
+        for (g, alternatives) in groups.iter().enumerate() {
+            for group in alternatives {
+                for s in &group.slots {
+                    if !bound.contains(&(g as u32, s.binding, s.name.to_string())) {
+                        failures.push(format!(
+                            "{label}: {}'s slot {} (binding {}) is not @group({g}) @binding({}) in WGSL",
+                            group.label, s.name, s.binding, s.binding
+                        ));
+                    }
+                }
+            }
+        }
+    }
+    assert!(failures.is_empty(), "declared bind groups and WGSL differ:\n{}", failures.join("\n"));
 }

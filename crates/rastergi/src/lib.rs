@@ -11,6 +11,7 @@
 //! [`renderer::Renderer::iterate`] is the one place that shows the order of the passes.
 
 pub mod accel;
+pub mod binding;
 pub mod bsdf;
 pub mod bvh;
 pub mod camera_control;

@@ -39,10 +39,11 @@
 
 use bytemuck::{Pod, Zeroable};
 
+use crate::binding::{Group, Slot};
 use crate::error::Result;
 use crate::film::{Film, Show};
 use crate::frame::{FrameBinding, FrameUniforms, pixel_jitter};
-use crate::gpu::{Gpu, bind_group_layout, buffer_bind_group, groups, storage_entry, uniform_entry};
+use crate::gpu::{Gpu, groups};
 use crate::gpu_scene::{GpuScene, PreparedScene};
 use crate::image_io::{DisplayImage, LinearImage};
 use crate::renderer::RenderSettings;
@@ -93,6 +94,34 @@ pub struct PathTracer {
     primary: wgpu::ComputePipeline,
 }
 
+/// The path tracer's bind group 2: the film written, the parameters read, the primary hits
+/// written (by `primary_hits` only).
+pub fn group() -> Group {
+    Group::compute(
+        "path tracer",
+        &[
+            Slot::write::<[f32; 4]>(0, "film"),
+            Slot::uniform::<PathParams>(1, "params"),
+            Slot::write::<[u32; 4]>(2, "visibility"),
+        ],
+    )
+}
+
+fn bind(
+    gpu: &Gpu,
+    layout: &wgpu::BindGroupLayout,
+    film: &wgpu::Buffer,
+    params: &wgpu::Buffer,
+    visibility: &wgpu::Buffer,
+) -> wgpu::BindGroup {
+    let resources = [
+        ("film", film.as_entire_binding()),
+        ("params", params.as_entire_binding()),
+        ("visibility", visibility.as_entire_binding()),
+    ];
+    group().bind(&gpu.device, layout, &resources)
+}
+
 impl PathTracer {
     /// Uploads `scene` and builds the pipeline. Of `settings`, the size and seed are used:
     /// every vertex takes one light sample, and no photon map is involved.
@@ -108,16 +137,7 @@ impl PathTracer {
         let frame = FrameBinding::new(gpu);
 
         let device = &gpu.device;
-        let c = wgpu::ShaderStages::COMPUTE;
-        let layout = bind_group_layout(
-            device,
-            "path tracer",
-            &[
-                storage_entry::<[f32; 4]>(0, c, false),
-                uniform_entry::<PathParams>(1, c),
-                storage_entry::<[u32; 4]>(2, c, false),
-            ],
-        );
+        let layout = group().layout(device);
         let params = gpu.zeroed_buffer(
             "path tracer params",
             std::mem::size_of::<PathParams>() as u64,
@@ -125,8 +145,7 @@ impl PathTracer {
         );
         // `main` does not write the visibility buffer; a placeholder fills its binding.
         let placeholder = gpu.zeroed_buffer("path tracer visibility placeholder", 16, wgpu::BufferUsages::STORAGE);
-        let bind_group =
-            buffer_bind_group(device, "path tracer", &layout, &[&film.accumulation, &params, &placeholder]);
+        let bind_group = bind(gpu, &layout, &film.accumulation, &params, &placeholder);
         let module = gpu_scene.module(device, "path tracer", &source());
         let layouts = [&gpu_scene.layout, &frame.layout, &layout];
         let trace = gpu_scene.compute_pipeline(device, "path tracer", &module, "main", &layouts);
@@ -263,12 +282,7 @@ impl PathTracer {
             size,
             wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
         );
-        let bind_group = buffer_bind_group(
-            &self.gpu.device,
-            "path tracer primary hits",
-            &self.layout,
-            &[&self.film.accumulation, &self.params, &visibility],
-        );
+        let bind_group = bind(&self.gpu, &self.layout, &self.film.accumulation, &self.params, &visibility);
         self.write_uniforms(iteration);
         let mut enc = self
             .gpu

@@ -23,10 +23,11 @@ use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
 use crate::accel::RayPath;
+use crate::binding::{Group, Slot};
 use crate::bvh::Hit;
 use crate::consts::{LIGHT_POINT, LIGHT_SPOT, PUNCTUAL_LIGHT};
 use crate::error::Result;
-use crate::gpu::{Gpu, bind_group, bind_group_layout, compute_pipeline, groups, storage_entry};
+use crate::gpu::{Gpu, compute_pipeline, groups};
 use crate::gpu_scene::{GpuScene, PreparedScene, alpha_uniform};
 use crate::par::prelude::*;
 use crate::sampling::{Rng, cosine_hemisphere, uniform_triangle};
@@ -290,6 +291,11 @@ pub struct RayCaster {
     layout: wgpu::BindGroupLayout,
 }
 
+/// The ray kernel's bind group 1: the rays read, their hits written.
+pub fn group() -> Group {
+    Group::compute("rays", &[Slot::read::<GpuRay>(0, "rays"), Slot::write::<GpuRayHit>(1, "hits")])
+}
+
 impl RayCaster {
     /// The kernel on `scene`'s own ray path.
     pub fn new(gpu: &Gpu, scene: &GpuScene) -> RayCaster {
@@ -299,12 +305,7 @@ impl RayCaster {
     /// The kernel on ray path `path` (the hardware one needs `scene.accel`).
     pub fn on(gpu: &Gpu, scene: &GpuScene, path: RayPath) -> RayCaster {
         let device = &gpu.device;
-        let c = wgpu::ShaderStages::COMPUTE;
-        let layout = bind_group_layout(
-            device,
-            "rays",
-            &[storage_entry::<GpuRay>(0, c, true), storage_entry::<GpuRayHit>(1, c, false)],
-        );
+        let layout = group().layout(device);
         let module = scene.module_for(device, "rays", &source(), path);
         let pipeline =
             compute_pipeline(device, "rays", &module, "main", &[&scene.layout, &layout], &scene.pipeline_constants());
@@ -330,8 +331,11 @@ impl RayCaster {
         let out_size = (rays.len() * std::mem::size_of::<GpuRayHit>()) as u64;
         let output =
             gpu.zeroed_buffer("ray hits", out_size, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
-        let group =
-            bind_group(&gpu.device, "rays", &self.layout, &[input.as_entire_binding(), output.as_entire_binding()]);
+        let group = group().bind(
+            &gpu.device,
+            &self.layout,
+            &[("rays", input.as_entire_binding()), ("hits", output.as_entire_binding())],
+        );
         let n = rays.len() as u32;
         // The dispatch's workgroups in x and y (one dimension holds at most 65535).
         let wg = groups(n, 64);

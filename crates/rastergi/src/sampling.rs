@@ -6,9 +6,10 @@
 
 use glam::Vec3;
 
+use crate::binding::{Group, Slot};
 pub use crate::consts::stream;
 use crate::error::Result;
-use crate::gpu::{Gpu, storage_entry};
+use crate::gpu::Gpu;
 
 /// One round of the PCG permutation, also used as an integer hash.
 #[inline]
@@ -179,7 +180,6 @@ pub fn sobol_owen_on_gpu(gpu: &Gpu, queries: &[(u32, u32)]) -> Result<Vec<[u32; 
     let input = gpu.storage_buffer("sobol queries", bytemuck::cast_slice(&input), wgpu::BufferUsages::empty());
     let size = (queries.len() as u64 * 8).max(8);
     let output = gpu.zeroed_buffer("sobol points", size, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
-    let c = wgpu::ShaderStages::COMPUTE;
     let main = "
         @group(0) @binding(0) var<storage, read> queries: array<vec2u>;
         @group(0) @binding(1) var<storage, read_write> points: array<vec2u>;
@@ -195,8 +195,8 @@ pub fn sobol_owen_on_gpu(gpu: &Gpu, queries: &[(u32, u32)]) -> Result<Vec<[u32; 
     gpu.run_once(
         "sobol points",
         &module,
-        &[storage_entry::<[u32; 2]>(0, c, true), storage_entry::<[u32; 2]>(1, c, false)],
-        &[input.as_entire_binding(), output.as_entire_binding()],
+        &Group::compute("sobol points", &[Slot::read::<[u32; 2]>(0, "queries"), Slot::write::<[u32; 2]>(1, "points")]),
+        &[("queries", input.as_entire_binding()), ("points", output.as_entire_binding())],
         queries.len() as u32,
     );
     let bytes = gpu.read_buffer(&output, size)?;

@@ -37,8 +37,9 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
+use crate::binding::{Group, Slot};
 use crate::error::{Error, Result};
-use crate::gpu::{Gpu, atlas_texture_entry, storage_entry};
+use crate::gpu::Gpu;
 use crate::par::prelude::*;
 use crate::scene::Texture;
 use crate::shader;
@@ -429,7 +430,6 @@ pub fn sample_on_gpu(gpu: &Gpu, atlas: &TextureAtlas, queries: &[(u32, Vec2, f32
     let input = gpu.storage_buffer("texture queries", bytemuck::cast_slice(&input), wgpu::BufferUsages::empty());
     let size = (queries.len() as u64 * 16).max(16);
     let output = gpu.zeroed_buffer("texture samples", size, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
-    let c = wgpu::ShaderStages::COMPUTE;
     let source = format!(
         "{}{}
         @group(0) @binding(0) var textures: texture_2d<f32>;
@@ -454,17 +454,20 @@ pub fn sample_on_gpu(gpu: &Gpu, atlas: &TextureAtlas, queries: &[(u32, Vec2, f32
     gpu.run_once(
         "texture samples",
         &module,
+        &Group::compute(
+            "texture samples",
+            &[
+                Slot::float_texture(0, "textures"),
+                Slot::read::<u32>(1, "entries"),
+                Slot::read::<[f32; 4]>(2, "queries"),
+                Slot::write::<[f32; 4]>(3, "samples"),
+            ],
+        ),
         &[
-            atlas_texture_entry(0, c),
-            storage_entry::<u32>(1, c, true),
-            storage_entry::<[f32; 4]>(2, c, true),
-            storage_entry::<[f32; 4]>(3, c, false),
-        ],
-        &[
-            wgpu::BindingResource::TextureView(&view),
-            entries.as_entire_binding(),
-            input.as_entire_binding(),
-            output.as_entire_binding(),
+            ("textures", wgpu::BindingResource::TextureView(&view)),
+            ("entries", entries.as_entire_binding()),
+            ("queries", input.as_entire_binding()),
+            ("samples", output.as_entire_binding()),
         ],
         queries.len() as u32,
     );

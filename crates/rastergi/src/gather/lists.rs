@@ -16,10 +16,9 @@
 use super::Gather;
 use super::estimator::{GatherInputs, GatherSetup, GatherUniforms, RAY_VIEW_LOOKUP};
 use super::ray_view::{ray_view_module, ray_view_pipeline, texel_size};
+use crate::binding::{Group, Slot};
 use crate::error::{Error, Result};
-use crate::gpu::{
-    Gpu, bind_group, bind_group_layout, dispatch_pixels, storage_entry, uint_texture_entry, uniform_entry,
-};
+use crate::gpu::{Gpu, dispatch_pixels};
 use crate::gpu_scene::GpuScene;
 use crate::profile::{Profiler, compute_pass};
 
@@ -42,6 +41,36 @@ pub struct ListGather {
     fill_group: wgpu::BindGroup,
     project_group: wgpu::BindGroup,
     profiler: Option<Profiler>,
+}
+
+/// The fill's bind group 1: each fragment of the ray view pushes its visible point onto its
+/// texel's list (heads, nodes and the node count written).
+pub fn fill_group() -> Group {
+    let f = wgpu::ShaderStages::FRAGMENT;
+    Group::new(
+        "gather list fill",
+        wgpu::ShaderStages::VERTEX_FRAGMENT,
+        &[
+            Slot::uniform::<GatherUniforms>(0, "gather"),
+            Slot::write::<u32>(1, "heads").only(f),
+            Slot::write::<[u32; 2]>(2, "nodes").only(f),
+            Slot::write::<u32>(3, "node_count").only(f),
+        ],
+    )
+}
+
+/// The projection's bind group 2: the G-buffer and the lists read, the film written.
+pub fn project_group() -> Group {
+    Group::compute(
+        "gather list project",
+        &[
+            Slot::uniform::<GatherUniforms>(0, "gather"),
+            Slot::uint_texture(1, "gbuffer"),
+            Slot::read::<u32>(2, "heads"),
+            Slot::read::<[u32; 2]>(3, "nodes"),
+            Slot::write::<[f32; 4]>(4, "film"),
+        ],
+    )
 }
 
 impl ListGather {
@@ -76,51 +105,23 @@ impl ListGather {
             })
             .create_view(&Default::default());
 
-        let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
-        let f = wgpu::ShaderStages::FRAGMENT;
-        let c = wgpu::ShaderStages::COMPUTE;
-        let fill_layout = bind_group_layout(
+        let (fill_layout, fill_group) = fill_group().layout_and_bind(
             device,
-            "gather list fill",
             &[
-                uniform_entry::<GatherUniforms>(0, vf),
-                storage_entry::<u32>(1, f, false),
-                storage_entry::<[u32; 2]>(2, f, false),
-                storage_entry::<u32>(3, f, false),
+                ("gather", uniforms.as_entire_binding()),
+                ("heads", heads.as_entire_binding()),
+                ("nodes", nodes.as_entire_binding()),
+                ("node_count", node_count.as_entire_binding()),
             ],
         );
-        let fill_group = bind_group(
+        let (project_layout, project_group) = project_group().layout_and_bind(
             device,
-            "gather list fill",
-            &fill_layout,
             &[
-                uniforms.as_entire_binding(),
-                heads.as_entire_binding(),
-                nodes.as_entire_binding(),
-                node_count.as_entire_binding(),
-            ],
-        );
-        let project_layout = bind_group_layout(
-            device,
-            "gather list project",
-            &[
-                uniform_entry::<GatherUniforms>(0, c),
-                uint_texture_entry(1, c),
-                storage_entry::<u32>(2, c, true),
-                storage_entry::<[u32; 2]>(3, c, true),
-                storage_entry::<[f32; 4]>(4, c, false),
-            ],
-        );
-        let project_group = bind_group(
-            device,
-            "gather list project",
-            &project_layout,
-            &[
-                uniforms.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&setup.gbuffer.view),
-                heads.as_entire_binding(),
-                nodes.as_entire_binding(),
-                setup.film.accumulation.as_entire_binding(),
+                ("gather", uniforms.as_entire_binding()),
+                ("gbuffer", wgpu::BindingResource::TextureView(&setup.gbuffer.view)),
+                ("heads", heads.as_entire_binding()),
+                ("nodes", nodes.as_entire_binding()),
+                ("film", setup.film.accumulation.as_entire_binding()),
             ],
         );
 

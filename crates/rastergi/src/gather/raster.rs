@@ -22,10 +22,9 @@
 use super::Gather;
 use super::estimator::{GatherInputs, GatherSetup, GatherUniforms, RAY_VIEW_LOOKUP, submit_and_renew};
 use super::ray_view::{DEPTH_FORMAT, ray_view_module, ray_view_pipeline};
+use crate::binding::{Group, Slot};
 use crate::error::Result;
-use crate::gpu::{
-    Gpu, bind_group, bind_group_layout, dispatch_pixels, storage_entry, uint_texture_entry, uniform_entry,
-};
+use crate::gpu::{Gpu, dispatch_pixels};
 use crate::gpu_scene::GpuScene;
 use crate::profile::{Profiler, compute_pass};
 
@@ -49,6 +48,49 @@ pub struct RasterGather {
     /// project_groups[k]: reads layer texture k (the layer just peeled).
     project_groups: [wgpu::BindGroup; 2],
     profiler: Option<Profiler>,
+}
+
+/// The count's bind group 1: how many visible points each ray-view texel holds, and their
+/// maximum (written by the fragments).
+pub fn count_group() -> Group {
+    let f = wgpu::ShaderStages::FRAGMENT;
+    Group::new(
+        "gather count",
+        wgpu::ShaderStages::VERTEX_FRAGMENT,
+        &[
+            Slot::uniform::<GatherUniforms>(0, "gather"),
+            Slot::write::<u32>(1, "counts").only(f),
+            Slot::write::<u32>(2, "max_count").only(f),
+        ],
+    )
+}
+
+/// A depth peel's bind group 1: the layer peeled before, read.
+pub fn peel_group() -> Group {
+    Group::new(
+        "gather peel",
+        wgpu::ShaderStages::VERTEX_FRAGMENT,
+        &[
+            Slot::uniform::<GatherUniforms>(0, "gather"),
+            Slot::uint_texture(1, "previous_layer").only(wgpu::ShaderStages::FRAGMENT),
+        ],
+    )
+}
+
+/// The projection's bind group 2: the G-buffer and a peeled layer read; which visible points
+/// found their texel, the film, and the points behind written.
+pub fn project_group() -> Group {
+    Group::compute(
+        "gather project",
+        &[
+            Slot::uniform::<GatherUniforms>(0, "gather"),
+            Slot::uint_texture(1, "gbuffer"),
+            Slot::uint_texture(2, "layer"),
+            Slot::write::<u32>(3, "found"),
+            Slot::write::<[f32; 4]>(4, "film"),
+            Slot::write::<[u32; 2]>(5, "behind"),
+        ],
+    )
 }
 
 impl RasterGather {
@@ -93,63 +135,33 @@ impl RasterGather {
         let behind =
             gpu.zeroed_buffer("gather behind", pixels * 8, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST);
 
-        let vf = wgpu::ShaderStages::VERTEX_FRAGMENT;
-        let c = wgpu::ShaderStages::COMPUTE;
-        let tex_entry = uint_texture_entry;
-        let count_layout = bind_group_layout(
+        let (count_layout, count_group) = count_group().layout_and_bind(
             device,
-            "gather count",
             &[
-                uniform_entry::<GatherUniforms>(0, vf),
-                storage_entry::<u32>(1, wgpu::ShaderStages::FRAGMENT, false),
-                storage_entry::<u32>(2, wgpu::ShaderStages::FRAGMENT, false),
+                ("gather", uniforms.as_entire_binding()),
+                ("counts", counts.as_entire_binding()),
+                ("max_count", max_count.as_entire_binding()),
             ],
         );
-        let peel_layout = bind_group_layout(
-            device,
-            "gather peel",
-            &[uniform_entry::<GatherUniforms>(0, vf), tex_entry(1, wgpu::ShaderStages::FRAGMENT)],
-        );
-        let project_layout = bind_group_layout(
-            device,
-            "gather project",
-            &[
-                uniform_entry::<GatherUniforms>(0, c),
-                tex_entry(1, c),
-                tex_entry(2, c),
-                storage_entry::<u32>(3, c, false),
-                storage_entry::<[f32; 4]>(4, c, false),
-                storage_entry::<[u32; 2]>(5, c, false),
-            ],
-        );
-        let count_group = bind_group(
-            device,
-            "gather count",
-            &count_layout,
-            &[uniforms.as_entire_binding(), counts.as_entire_binding(), max_count.as_entire_binding()],
-        );
+        let (peel, project) = (peel_group(), project_group());
+        let (peel_layout, project_layout) = (peel.layout(device), project.layout(device));
         let peel_group = |prev: &wgpu::TextureView| {
-            bind_group(
-                device,
-                "gather peel",
-                &peel_layout,
-                &[uniforms.as_entire_binding(), wgpu::BindingResource::TextureView(prev)],
-            )
+            let resources = [
+                ("gather", uniforms.as_entire_binding()),
+                ("previous_layer", wgpu::BindingResource::TextureView(prev)),
+            ];
+            peel.bind(device, &peel_layout, &resources)
         };
         let project_group = |layer: &wgpu::TextureView| {
-            bind_group(
-                device,
-                "gather project",
-                &project_layout,
-                &[
-                    uniforms.as_entire_binding(),
-                    wgpu::BindingResource::TextureView(&gbuffer.view),
-                    wgpu::BindingResource::TextureView(layer),
-                    found.as_entire_binding(),
-                    film.accumulation.as_entire_binding(),
-                    behind.as_entire_binding(),
-                ],
-            )
+            let resources = [
+                ("gather", uniforms.as_entire_binding()),
+                ("gbuffer", wgpu::BindingResource::TextureView(&gbuffer.view)),
+                ("layer", wgpu::BindingResource::TextureView(layer)),
+                ("found", found.as_entire_binding()),
+                ("film", film.accumulation.as_entire_binding()),
+                ("behind", behind.as_entire_binding()),
+            ];
+            project.bind(device, &project_layout, &resources)
         };
         let peel_groups = [peel_group(&layers[1]), peel_group(&layers[0])];
         let project_groups = [project_group(&layers[0]), project_group(&layers[1])];

@@ -15,10 +15,9 @@
 
 use super::Gather;
 use super::estimator::{GatherInputs, GatherSetup, GatherUniforms};
+use crate::binding::{Group, Slot};
 use crate::error::Result;
-use crate::gpu::{
-    Gpu, bind_group, bind_group_layout, dispatch_pixels, storage_entry, uint_texture_entry, uniform_entry,
-};
+use crate::gpu::{Gpu, dispatch_pixels};
 use crate::profile::{Profiler, compute_pass};
 
 pub struct TraceGather {
@@ -27,23 +26,27 @@ pub struct TraceGather {
     profiler: Option<Profiler>,
 }
 
+/// The traced gather's bind group 2: the G-buffer read, the film written.
+pub fn group() -> Group {
+    Group::compute(
+        "gather trace",
+        &[
+            Slot::uniform::<GatherUniforms>(0, "gather"),
+            Slot::uint_texture(1, "gbuffer"),
+            Slot::write::<[f32; 4]>(2, "film"),
+        ],
+    )
+}
+
 impl TraceGather {
     pub fn new(gpu: &Gpu, setup: &GatherSetup, uniforms: &wgpu::Buffer) -> TraceGather {
         let device = &gpu.device;
-        let c = wgpu::ShaderStages::COMPUTE;
-        let layout = bind_group_layout(
+        let (layout, bind_group) = group().layout_and_bind(
             device,
-            "gather trace",
-            &[uniform_entry::<GatherUniforms>(0, c), uint_texture_entry(1, c), storage_entry::<[f32; 4]>(2, c, false)],
-        );
-        let bind_group = bind_group(
-            device,
-            "gather trace",
-            &layout,
             &[
-                uniforms.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&setup.gbuffer.view),
-                setup.film.accumulation.as_entire_binding(),
+                ("gather", uniforms.as_entire_binding()),
+                ("gbuffer", wgpu::BindingResource::TextureView(&setup.gbuffer.view)),
+                ("film", setup.film.accumulation.as_entire_binding()),
             ],
         );
         let pipeline = setup.estimate_pipeline(device, "gather trace", &[include_str!("trace.wgsl")], &layout);

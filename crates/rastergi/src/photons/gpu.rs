@@ -19,8 +19,9 @@ use glam::UVec3;
 
 use super::map::{GridSpec, MAX_SEPARATORS, MapLayout, PhotonMap, Separator, TABLE_WGSL, TrianglePlane};
 use super::{MAX_BOUNCES, PhotonSettings};
+use crate::binding::{Group, Slot};
 use crate::error::Result;
-use crate::gpu::{Gpu, bind_group_layout, buffer_bind_group, storage_entry, uniform_entry};
+use crate::gpu::Gpu;
 use crate::gpu_scene::{GpuScene, PreparedScene};
 use crate::profile::compute_pass;
 use crate::shader;
@@ -241,10 +242,6 @@ impl GpuPhotonMap {
             wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         );
 
-        // Two bind groups over the shader's bindings, each with what its entry point reads:
-        // with the scene's, one group of all of them would bind 12 storage buffers, beyond a
-        // browser's 10 per stage.
-        let c = wgpu::ShaderStages::COMPUTE;
         let channel = |c: u64| {
             wgpu::BindingResource::Buffer(wgpu::BufferBinding {
                 buffer: &tally,
@@ -253,37 +250,21 @@ impl GpuPhotonMap {
             })
         };
         let counters = [
-            (uniform_entry::<PhotonParams>(0, c), params_buffer.as_entire_binding()),
-            (storage_entry::<u32>(1, c, false), channel(0)),
-            (storage_entry::<u32>(2, c, false), channel(1)),
-            (storage_entry::<u32>(3, c, false), channel(2)),
+            ("params", params_buffer.as_entire_binding()),
+            ("tally_r", channel(0)),
+            ("tally_g", channel(1)),
+            ("tally_b", channel(2)),
         ];
         let trace_only = [
-            (storage_entry::<[u32; 2]>(6, c, true), keys.as_entire_binding()),
-            (storage_entry::<TrianglePlane>(7, c, true), planes.as_entire_binding()),
-            (storage_entry::<[Separator; MAX_SEPARATORS]>(8, c, true), sep_planes.as_entire_binding()),
+            ("slot_keys", keys.as_entire_binding()),
+            ("planes", planes.as_entire_binding()),
+            ("separator_planes", sep_planes.as_entire_binding()),
         ];
-        let resolve_only = [
-            (storage_entry::<f32>(4, c, true), area_buffer.as_entire_binding()),
-            (storage_entry::<[f32; 4]>(5, c, false), slots.as_entire_binding()),
-        ];
-        let group = |label: &str, entries: Vec<(wgpu::BindGroupLayoutEntry, wgpu::BindingResource)>| {
-            let layout_entries: Vec<_> = entries.iter().map(|(l, _)| *l).collect();
-            let layout = bind_group_layout(device, label, &layout_entries);
-            let resources: Vec<_> = entries
-                .into_iter()
-                .map(|(l, resource)| wgpu::BindGroupEntry { binding: l.binding, resource })
-                .collect();
-            let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some(label),
-                layout: &layout,
-                entries: &resources,
-            });
-            (layout, group)
-        };
-        let (trace_layout, trace_group) = group("photon trace", counters.iter().cloned().chain(trace_only).collect());
-        let (resolve_layout, resolve_group) =
-            group("photon resolve", counters.into_iter().chain(resolve_only).collect());
+        let resolve_only = [("slot_area", area_buffer.as_entire_binding()), ("slots_out", slots.as_entire_binding())];
+        let trace_resources: Vec<_> = counters.iter().cloned().chain(trace_only).collect();
+        let (trace_layout, trace_group) = trace_group().layout_and_bind(device, &trace_resources);
+        let resolve_resources: Vec<_> = counters.into_iter().chain(resolve_only).collect();
+        let (resolve_layout, resolve_group) = resolve_group().layout_and_bind(device, &resolve_resources);
         let module = scene.module(device, "photon trace", &trace_source());
         let trace_pipeline =
             scene.compute_pipeline(device, "trace photons", &module, "trace_photons", &[&scene.layout, &trace_layout]);
@@ -457,19 +438,58 @@ fn lookup_binding(
         wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
     );
     gpu.queue.write_buffer(&uniforms, 0, bytemuck::bytes_of(u));
-    let vis = wgpu::ShaderStages::COMPUTE | wgpu::ShaderStages::FRAGMENT;
-    let layout = bind_group_layout(
-        &gpu.device,
+    let resources = [
+        ("photon_slots", slots.as_entire_binding()),
+        ("photon_grid", uniforms.as_entire_binding()),
+        ("slot_keys", keys.as_entire_binding()),
+        ("planes", planes.as_entire_binding()),
+        ("separator_planes", sep_planes.as_entire_binding()),
+    ];
+    lookup_group().layout_and_bind(&gpu.device, &resources)
+}
+
+/// The photon map's counters (its tally, one channel a binding) and parameters, bound to both
+/// entry points of the photon shader.
+const COUNTERS: [Slot; 4] = [
+    Slot::uniform::<PhotonParams>(0, "params"),
+    Slot::write::<u32>(1, "tally_r"),
+    Slot::write::<u32>(2, "tally_g"),
+    Slot::write::<u32>(3, "tally_b"),
+];
+
+/// The tracing's bind group 1: the counters written, the table's keys and the planes read.
+/// Two groups over the shader's bindings, each with what its entry point reads: with the
+/// scene's, one group of all of them would bind 12 storage buffers, beyond a browser's 10 per
+/// stage.
+pub fn trace_group() -> Group {
+    let mut g = Group::compute("photon trace", &COUNTERS);
+    g.slots.extend([
+        Slot::read::<[u32; 2]>(6, "slot_keys"),
+        Slot::read::<TrianglePlane>(7, "planes"),
+        Slot::read::<[Separator; MAX_SEPARATORS]>(8, "separator_planes"),
+    ]);
+    g
+}
+
+/// The resolve's bind group 1: the counters and the slots' areas read, the slots written.
+pub fn resolve_group() -> Group {
+    let mut g = Group::compute("photon resolve", &COUNTERS);
+    g.slots.extend([Slot::read::<f32>(4, "slot_area"), Slot::write::<[f32; 4]>(5, "slots_out")]);
+    g
+}
+
+/// The lookup's bind group (3 in the per-pixel passes, where the gather binds it): the
+/// slots' values, the grid, the table's keys and the planes, all read.
+pub fn lookup_group() -> Group {
+    Group::new(
         "photon map lookup",
+        wgpu::ShaderStages::COMPUTE | wgpu::ShaderStages::FRAGMENT,
         &[
-            storage_entry::<[f32; 4]>(0, vis, true),
-            uniform_entry::<PhotonGridUniforms>(1, vis),
-            storage_entry::<[u32; 2]>(2, vis, true),
-            storage_entry::<TrianglePlane>(3, vis, true),
-            storage_entry::<[Separator; MAX_SEPARATORS]>(4, vis, true),
+            Slot::read::<[f32; 4]>(0, "photon_slots"),
+            Slot::uniform::<PhotonGridUniforms>(1, "photon_grid"),
+            Slot::read::<[u32; 2]>(2, "slot_keys"),
+            Slot::read::<TrianglePlane>(3, "planes"),
+            Slot::read::<[Separator; MAX_SEPARATORS]>(4, "separator_planes"),
         ],
-    );
-    let bind_group =
-        buffer_bind_group(&gpu.device, "photon map lookup", &layout, &[slots, &uniforms, keys, planes, sep_planes]);
-    (layout, bind_group)
+    )
 }

@@ -85,10 +85,11 @@ use crate::binding::{Group, Slot};
 use crate::error::Result;
 use crate::film::{COMPONENTS, FILM_DIRECT, FILM_INDIRECT, Film};
 use crate::frame::FrameBinding;
-use crate::gbuffer::{GBUFFER_FILM_WGSL, GBufferPass, PixelPass, PixelShader};
+use crate::gbuffer::{GBUFFER_FILM_WGSL, GBufferPass, GroupThree, PixelPass, PixelShader};
 use crate::gpu::{Gpu, compute_pipeline, groups};
 use crate::gpu_scene::GpuScene;
 use crate::image_io::LinearImage;
+use crate::pass::{FrameContext, IterationPass};
 use crate::scene::Camera;
 use crate::shader;
 
@@ -253,11 +254,19 @@ pub struct Guides {
     /// sums of the emission the eye sees.
     pub extra: wgpu::Buffer,
     pass: PixelPass,
-    bind_group: wgpu::BindGroup,
     /// Iterations in the sums (fewer than the film's after a resume).
     pub samples: u32,
     width: u32,
     height: u32,
+}
+
+impl IterationPass for Guides {
+    /// Reads: the visible points, the film. Writes: the guides. After the iteration's passes.
+    fn encode(&mut self, enc: &mut wgpu::CommandEncoder, ctx: &FrameContext) -> Result<()> {
+        self.pass.encode(enc, ctx)?;
+        self.samples += 1;
+        Ok(())
+    }
 }
 
 /// The guides pass's bind group 3: the guides and the previous sums, both accumulated.
@@ -286,8 +295,7 @@ pub fn filter_group() -> Group {
 
 impl Guides {
     pub fn new(gpu: &Gpu, (scene, frame): (&GpuScene, &FrameBinding), gbuffer: &GBufferPass, film: &Film) -> Guides {
-        let (width, height) = (film.width, film.height);
-        let pixels = width as u64 * height as u64;
+        let pixels = film.width as u64 * film.height as u64;
         let rw = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
         let buffer = gpu.zeroed_buffer("denoiser guides", GUIDE_SLOTS * pixels * 16, rw);
         let extra = gpu.zeroed_buffer("denoiser previous sums and emission", EXTRA_SLOTS * pixels * 16, rw);
@@ -297,14 +305,8 @@ impl Guides {
         );
         let source = guides_source();
         let shader = PixelShader { label: "denoiser guides", source: &source, entry: "accumulate_guides" };
-        let pass = PixelPass::new(gpu, (scene, frame), (gbuffer, film), shader, &[&layout]);
-        Guides { buffer, extra, pass, bind_group, samples: 0, width, height }
-    }
-
-    /// Reads: the visible points, the film. Writes: the guides. After the iteration's passes.
-    pub fn encode(&mut self, enc: &mut wgpu::CommandEncoder, (scene, frame): (&GpuScene, &FrameBinding)) {
-        self.pass.encode(enc, (scene, frame), &[&self.bind_group], self.width, self.height);
-        self.samples += 1;
+        let pass = PixelPass::new(gpu, (scene, frame), (gbuffer, film), shader, GroupThree::Own(&layout, bind_group));
+        Guides { buffer, extra, pass, samples: 0, width: film.width, height: film.height }
     }
 
     /// Clears the sums (with the film's).

@@ -31,7 +31,7 @@
 
 use crate::film::Film;
 use crate::frame::FrameBinding;
-use crate::gbuffer::{GBUFFER_FILM_WGSL, GBufferPass, PixelPass, PixelShader};
+use crate::gbuffer::{GBUFFER_FILM_WGSL, GBufferPass, GroupThree, PixelPass, PixelShader};
 use crate::gpu::Gpu;
 use crate::gpu_scene::GpuScene;
 use crate::lights::LightTable;
@@ -77,7 +77,7 @@ pub fn source() -> String {
 /// The direct pass. Reads: scene, frame, G-buffer. Adds to: the film's direct component.
 pub fn pass(gpu: &Gpu, scene: &GpuScene, frame: &FrameBinding, gbuffer: &GBufferPass, film: &Film) -> PixelPass {
     let shader = PixelShader { label: "direct", source: &source(), entry: "main" };
-    PixelPass::new(gpu, (scene, frame), (gbuffer, film), shader, &[])
+    PixelPass::new(gpu, (scene, frame), (gbuffer, film), shader, GroupThree::None)
 }
 
 #[cfg(test)]

@@ -12,6 +12,8 @@ use crate::film::Film;
 use crate::frame::FrameBinding;
 use crate::gpu::{Gpu, dispatch_pixels, scene_raster_pipeline};
 use crate::gpu_scene::GpuScene;
+use crate::pass::{FrameContext, IterationPass};
+use crate::photons::gpu::GpuPhotonMap;
 use crate::profile::{Profiler, compute_pass};
 use crate::shader;
 
@@ -67,8 +69,17 @@ impl GBufferPass {
         Self { pipeline, texture, view, depth_view, profiler: gpu.profiler.clone() }
     }
 
+    /// Raw texels `(triangle + 1, b1 bits, b2 bits, texture level of detail bits)`, row by row
+    /// (for tests and tools).
+    pub fn read(&self, gpu: &Gpu) -> Result<Vec<[u32; 4]>> {
+        Ok(bytemuck::pod_collect_to_vec(&gpu.read_texture(&self.texture, 16)?))
+    }
+}
+
+impl IterationPass for GBufferPass {
     /// Reads: scene, frame. Writes: the G-buffer.
-    pub fn encode(&self, enc: &mut wgpu::CommandEncoder, scene: &GpuScene, frame: &FrameBinding) {
+    fn encode(&mut self, enc: &mut wgpu::CommandEncoder, ctx: &FrameContext) -> Result<()> {
+        let (scene, frame) = (ctx.scene, ctx.frame);
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("gbuffer"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -93,12 +104,7 @@ impl GBufferPass {
         pass.set_bind_group(0, &scene.bind_group, &[]);
         pass.set_bind_group(1, &frame.bind_group, &[]);
         pass.draw(0..3 * scene.triangle_count, 0..1);
-    }
-
-    /// Raw texels `(triangle + 1, b1 bits, b2 bits, texture level of detail bits)`, row by row
-    /// (for tests and tools).
-    pub fn read(&self, gpu: &Gpu) -> Result<Vec<[u32; 4]>> {
-        Ok(bytemuck::pod_collect_to_vec(&gpu.read_texture(&self.texture, 16)?))
+        Ok(())
     }
 }
 
@@ -112,13 +118,30 @@ pub fn pixel_group() -> Group {
 
 /// A compute pass run once per eye pixel, in 8×8 workgroups (`begin_pixel` in `frame.wgsl`):
 /// bind group 0 is the scene, 1 the frame, 2 the G-buffer and the film (`gbuffer_film.wgsl`),
-/// 3, … whatever else its shader declares. The direct light, the specular chains, the photon
-/// view and the caustic term are such passes.
+/// 3 whatever else its shader declares ([`GroupThree`]). The direct light, the specular
+/// chains, the photon view, the caustic term and the denoiser's guides are such passes.
 pub struct PixelPass {
     pipeline: wgpu::ComputePipeline,
     bind_group: wgpu::BindGroup,
+    third: Third,
     profiler: Option<Profiler>,
     label: &'static str,
+}
+
+/// What a [`PixelPass`] binds as group 3.
+pub enum GroupThree<'a> {
+    None,
+    /// The current photon map's lookup group, from the frame context at each iteration.
+    PhotonMap(&'a GpuPhotonMap),
+    /// A group of the pass's own, on its layout.
+    Own(&'a wgpu::BindGroupLayout, wgpu::BindGroup),
+}
+
+/// [`GroupThree`] as the pass keeps it.
+enum Third {
+    None,
+    PhotonMap,
+    Own(wgpu::BindGroup),
 }
 
 /// A [`PixelPass`]'s shader: the composed `source`, its entry point `entry`, and the label of
@@ -130,13 +153,13 @@ pub struct PixelShader<'a> {
 }
 
 impl PixelPass {
-    /// `more_layouts`: the layouts of bind groups 3, … of `shader`.
+    /// `third`: what `shader` binds as group 3.
     pub fn new(
         gpu: &Gpu,
         (scene, frame): (&GpuScene, &FrameBinding),
         (gbuffer, film): (&GBufferPass, &Film),
         shader: PixelShader,
-        more_layouts: &[&wgpu::BindGroupLayout],
+        third: GroupThree,
     ) -> PixelPass {
         let device = &gpu.device;
         let label = shader.label;
@@ -146,26 +169,32 @@ impl PixelPass {
             ("film", film.accumulation.as_entire_binding()),
         ];
         let (layout, bind_group) = pixel_group().layout_and_bind(device, &resources);
+        let (third_layout, third) = match third {
+            GroupThree::None => (None, Third::None),
+            GroupThree::PhotonMap(map) => (Some(&map.bind_layout), Third::PhotonMap),
+            GroupThree::Own(layout, group) => (Some(layout), Third::Own(group)),
+        };
         let layouts: Vec<&wgpu::BindGroupLayout> =
-            [&scene.layout, &frame.layout, &layout].into_iter().chain(more_layouts.iter().copied()).collect();
+            [&scene.layout, &frame.layout, &layout].into_iter().chain(third_layout).collect();
         let pipeline = scene.compute_pipeline(device, label, &module, shader.entry, &layouts);
-        PixelPass { pipeline, bind_group, profiler: gpu.profiler.clone(), label }
+        PixelPass { pipeline, bind_group, third, profiler: gpu.profiler.clone(), label }
     }
+}
 
-    /// Runs the pass over a `width × height` image; `more_groups`: bind groups 3, ….
-    pub fn encode(
-        &self,
-        enc: &mut wgpu::CommandEncoder,
-        (scene, frame): (&GpuScene, &FrameBinding),
-        more_groups: &[&wgpu::BindGroup],
-        width: u32,
-        height: u32,
-    ) {
+impl IterationPass for PixelPass {
+    /// Runs the pass over the frame's image (nothing where it reads a photon map and the
+    /// render has none).
+    fn encode(&mut self, enc: &mut wgpu::CommandEncoder, ctx: &FrameContext) -> Result<()> {
+        let third = match (&self.third, ctx.map) {
+            (Third::None, _) => None,
+            (Third::PhotonMap, Some(map)) => Some(&map.bind_group),
+            (Third::PhotonMap, None) => return Ok(()),
+            (Third::Own(group), _) => Some(group),
+        };
         let mut pass = compute_pass(enc, self.profiler.as_ref(), self.label);
-        let groups: Vec<&wgpu::BindGroup> = [&scene.bind_group, &frame.bind_group, &self.bind_group]
-            .into_iter()
-            .chain(more_groups.iter().copied())
-            .collect();
-        dispatch_pixels(&mut pass, &self.pipeline, &groups, width, height);
+        let groups: Vec<&wgpu::BindGroup> =
+            [&ctx.scene.bind_group, &ctx.frame.bind_group, &self.bind_group].into_iter().chain(third).collect();
+        dispatch_pixels(&mut pass, &self.pipeline, &groups, ctx.width, ctx.height);
+        Ok(())
     }
 }

@@ -37,6 +37,7 @@ pub mod lights;
 pub mod limits;
 pub mod metrics;
 mod par;
+pub mod pass;
 pub mod path_tracer;
 pub mod photon_view;
 pub mod photons;

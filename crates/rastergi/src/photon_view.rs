@@ -4,7 +4,7 @@
 
 use crate::film::Film;
 use crate::frame::FrameBinding;
-use crate::gbuffer::{GBUFFER_FILM_WGSL, GBufferPass, PixelPass, PixelShader};
+use crate::gbuffer::{GBUFFER_FILM_WGSL, GBufferPass, GroupThree, PixelPass, PixelShader};
 use crate::gpu::Gpu;
 use crate::gpu_scene::GpuScene;
 use crate::photons::gpu::GpuPhotonMap;
@@ -43,5 +43,5 @@ pub fn pass(
         PhotonView::Caustics => ("caustics", "caustics"),
     };
     let shader = PixelShader { label, source: &source(), entry };
-    PixelPass::new(gpu, (scene, frame), (gbuffer, film), shader, &[&map.bind_layout])
+    PixelPass::new(gpu, (scene, frame), (gbuffer, film), shader, GroupThree::PhotonMap(map))
 }

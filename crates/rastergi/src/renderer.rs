@@ -8,13 +8,12 @@ use crate::denoise::{DenoiseParams, Denoiser, GuideState, Guides, Schedule};
 use crate::error::Result;
 use crate::film::{Film, FilmState, ImageResolve, Show};
 use crate::frame::{FrameBinding, FrameUniforms, pixel_jitter};
-use crate::gather::{
-    DirectionSampler, FixedSample, GatherDirections, GatherFrame, GatherMethod, GatherPass, GatherSetup, HitLight,
-};
+use crate::gather::{DirectionSampler, FixedSample, GatherDirections, GatherMethod, GatherPass, GatherSetup, HitLight};
 use crate::gbuffer::{GBufferPass, PixelPass};
 use crate::gpu::Gpu;
 use crate::gpu_scene::{GpuScene, PreparedScene};
 use crate::image_io::{DisplayImage, LinearImage};
+use crate::pass::{FrameContext, IterationPass};
 use crate::photon_view::PhotonView;
 use crate::photons::PhotonSettings;
 use crate::photons::gpu::GpuPhotonMap;
@@ -456,33 +455,45 @@ impl Renderer {
             uniforms.gather_importance = per_pixel as u32;
         }
         self.frame.write(&self.gpu, &uniforms);
+        let ctx = FrameContext {
+            gpu: &self.gpu,
+            scene: &self.scene,
+            frame: &self.frame,
+            map,
+            width: w,
+            height: h,
+            iteration,
+            directions: self.settings.directions,
+            fixed,
+        };
         let mut enc =
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("iteration") });
-        // 1. Eye pass: the visible point of each pixel, at this iteration's jitter; through
-        //    mirrors and glass to the first surface that is not purely specular.
-        self.passes.gbuffer.encode(&mut enc, &self.scene, &self.frame);
-        if let Some(specular) = &self.passes.specular {
-            specular.encode(&mut enc, (&self.scene, &self.frame), &[], w, h);
+        let p = &mut self.passes;
+        // 1. Eye pass: the visible point of each pixel, at this iteration's jitter (G-buffer);
+        //    through mirrors and glass to the first surface that is not purely specular (eye paths).
+        p.gbuffer.encode(&mut enc, &ctx)?;
+        if let Some(specular) = &mut p.specular {
+            specular.encode(&mut enc, &ctx)?;
         }
-        // 2. Emission + direct light with soft shadows → film (direct component).
-        self.passes.direct.encode(&mut enc, (&self.scene, &self.frame), &[], w, h);
+        // 2. Emission + direct light with soft shadows at the visible points → film (direct).
+        p.direct.encode(&mut enc, &ctx)?;
         // Debug view: the photon map's radiance at the visible points → film (photon view).
-        if let (Some(view), Some(map)) = (&self.passes.photon_view, map) {
-            view.encode(&mut enc, (&self.scene, &self.frame), &[&map.bind_group], w, h);
+        if let Some(view) = &mut p.photon_view {
+            view.encode(&mut enc, &ctx)?;
         }
         // 3. Caustics: the light that came through mirrors and glass, from the caustic map.
-        if let (Some(caustics), Some(map)) = (&self.passes.caustics, map) {
-            caustics.encode(&mut enc, (&self.scene, &self.frame), &[&map.bind_group], w, h);
+        if let Some(caustics) = &mut p.caustics {
+            caustics.encode(&mut enc, &ctx)?;
         }
-        // 4. Final gather along the iteration's directions for every visible point → film (indirect).
-        if let (Some(gather), Some(map)) = (&mut self.passes.gather, map) {
-            let f = GatherFrame { scene: &self.scene, frame: &self.frame, map, width: w, height: h };
-            gather.encode(&self.gpu, &mut enc, &f, iteration, self.settings.directions, &fixed)?;
+        // 4. Final gather along the iteration's directions for every visible point, reading
+        //    the photon map where the directions land → film (indirect).
+        if let Some(gather) = &mut p.gather {
+            gather.encode(&mut enc, &ctx)?;
         }
         // 5. Denoiser guides (when enabled): the visible points' albedo, normal, distance and
         //    the moments of what this iteration added to the film.
-        if let Some(d) = &mut self.passes.denoise {
-            d.guides.encode(&mut enc, (&self.scene, &self.frame));
+        if let Some(d) = &mut p.denoise {
+            d.guides.encode(&mut enc, &ctx)?;
         }
         // 6. Accumulate: every pass above added its estimate to the film's sums.
         self.gpu.queue.submit([enc.finish()]);

@@ -14,7 +14,7 @@
 
 use crate::film::Film;
 use crate::frame::FrameBinding;
-use crate::gbuffer::{GBUFFER_FILM_WGSL, GBufferPass, PixelPass, PixelShader};
+use crate::gbuffer::{GBUFFER_FILM_WGSL, GBufferPass, GroupThree, PixelPass, PixelShader};
 use crate::gpu::Gpu;
 use crate::gpu_scene::GpuScene;
 use crate::shader;
@@ -28,5 +28,5 @@ pub fn source() -> String {
 /// film's direct component (the environment seen through the chains).
 pub fn pass(gpu: &Gpu, scene: &GpuScene, frame: &FrameBinding, gbuffer: &GBufferPass, film: &Film) -> PixelPass {
     let shader = PixelShader { label: "specular chains", source: &source(), entry: "main" };
-    PixelPass::new(gpu, (scene, frame), (gbuffer, film), shader, &[])
+    PixelPass::new(gpu, (scene, frame), (gbuffer, film), shader, GroupThree::None)
 }

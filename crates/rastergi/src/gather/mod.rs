@@ -55,10 +55,8 @@ pub use estimator::{GatherInputs, GatherSample, GatherSetup, GatherUniforms, Pix
 
 use crate::consts::{FILM_DIRECT, FILM_INDIRECT};
 use crate::error::Result;
-use crate::frame::FrameBinding;
 use crate::gpu::Gpu;
-use crate::gpu_scene::GpuScene;
-use crate::photons::gpu::GpuPhotonMap;
+use crate::pass::{FrameContext, IterationPass};
 use crate::sampling::{Rng, pcg_hash, sobol_owen_2d, stream, uniform_sphere, unit_f32};
 
 pub use crate::consts::MAX_DIRECTIONS;
@@ -365,16 +363,6 @@ pub struct GatherPass {
     efficiency: Efficiency,
 }
 
-/// What the gather pass reads, besides the G-buffer and film it was built with.
-#[derive(Clone, Copy)]
-pub struct GatherFrame<'a> {
-    pub scene: &'a GpuScene,
-    pub frame: &'a FrameBinding,
-    pub map: &'a GpuPhotonMap,
-    pub width: u32,
-    pub height: u32,
-}
-
 impl GatherPass {
     /// The pass over `setup`'s resources with `method`, for a `bundle`² ray view, drawing
     /// directions from `sampler`; `directions` applies to [`GatherMethod::Trace`], and to
@@ -465,48 +453,7 @@ impl GatherPass {
         self.efficiency.last_direct = None;
     }
 
-    /// Encodes the gather of `iteration` along `directions` directions (1 to
-    /// [`MAX_DIRECTIONS`]; one where `fixed` gives it, and then shared by every pixel even in
-    /// per-pixel mode) after the work already in `enc`; the encoder to go on with is left in
-    /// `enc`.
-    pub fn encode(
-        &mut self,
-        gpu: &Gpu,
-        enc: &mut wgpu::CommandEncoder,
-        f: &GatherFrame,
-        iteration: u32,
-        directions: u32,
-        fixed: &FixedSample,
-    ) -> Result<()> {
-        let samples = self.sampler.samples(iteration, directions, fixed);
-        // While Auto tries them: the directions of the candidate whose turn it is.
-        let trial = (!self.chosen).then(|| self.next_candidate());
-        let per_pixel = trial.map_or(self.per_pixel, |k| self.candidates[k].per_pixel);
-        let pixel_samples = (per_pixel && fixed.direction.is_none()).then(|| PixelSamples {
-            key: self.sampler.pixel_key(),
-            first_index: iteration.wrapping_mul(samples.len() as u32),
-        });
-        // A handle (reference counted): the trials below change `self`.
-        let uniforms = self.uniforms.clone();
-        let inputs = GatherInputs {
-            scene: f.scene,
-            frame: f.frame,
-            map: f.map,
-            width: f.width,
-            height: f.height,
-            samples: &samples,
-            pixel_samples,
-            first_index: iteration.wrapping_mul(samples.len() as u32),
-            uniforms: &uniforms,
-            bundle: self.bundle,
-        };
-        match trial {
-            None => self.candidates[0].gather.encode(gpu, enc, &inputs),
-            Some(k) => self.encode_trial(gpu, enc, &inputs, k),
-        }
-    }
-
-    /// The directions per pixel that [`encode`](Self::encode) will gather along with the same
+    /// The directions per pixel that [`IterationPass::encode`] will gather along with the same
     /// arguments, and whether each point draws its own from its scattering (per-pixel; else
     /// uniform on the hemisphere): the direct pass weighs its environment samples against them
     /// ([`crate::frame::FrameUniforms::gather_count`]).
@@ -651,6 +598,43 @@ impl GatherPass {
             None => Err(crate::error::Error::Checkpoint(format!(
                 "the checkpoint's gather ({method:?}, {directions:?}) is not available here"
             ))),
+        }
+    }
+}
+
+impl IterationPass for GatherPass {
+    /// Encodes the gather of the context's iteration along its directions (one where `fixed`
+    /// gives it, and then shared by every pixel even in per-pixel mode) after the work already
+    /// in `enc`; the encoder to go on with is left in `enc`. Nothing where the render has no
+    /// photon map.
+    fn encode(&mut self, enc: &mut wgpu::CommandEncoder, ctx: &FrameContext) -> Result<()> {
+        let Some(map) = ctx.map else { return Ok(()) };
+        let (iteration, fixed, gpu) = (ctx.iteration, &ctx.fixed, ctx.gpu);
+        let samples = self.sampler.samples(iteration, ctx.directions, fixed);
+        // While Auto tries them: the directions of the candidate whose turn it is.
+        let trial = (!self.chosen).then(|| self.next_candidate());
+        let per_pixel = trial.map_or(self.per_pixel, |k| self.candidates[k].per_pixel);
+        let pixel_samples = (per_pixel && fixed.direction.is_none()).then(|| PixelSamples {
+            key: self.sampler.pixel_key(),
+            first_index: iteration.wrapping_mul(samples.len() as u32),
+        });
+        // A handle (reference counted): the trials below change `self`.
+        let uniforms = self.uniforms.clone();
+        let inputs = GatherInputs {
+            scene: ctx.scene,
+            frame: ctx.frame,
+            map,
+            width: ctx.width,
+            height: ctx.height,
+            samples: &samples,
+            pixel_samples,
+            first_index: iteration.wrapping_mul(samples.len() as u32),
+            uniforms: &uniforms,
+            bundle: self.bundle,
+        };
+        match trial {
+            None => self.candidates[0].gather.encode(gpu, enc, &inputs),
+            Some(k) => self.encode_trial(gpu, enc, &inputs, k),
         }
     }
 }

@@ -1,0 +1,38 @@
+//! What the passes of an iteration share: one [`FrameContext`] that each reads, and one
+//! [`IterationPass::encode`] signature. A pass's own resources (its bind groups,
+//! [`crate::binding`]) are bound to the G-buffer and film it was made with; what changes from
+//! iteration to iteration — the frame's uniforms, the photon map of the current photon pass,
+//! the gather's directions — comes through the context. [`crate::renderer::Renderer::iterate`]
+//! runs them in the order of the data flow.
+
+use crate::error::Result;
+use crate::frame::FrameBinding;
+use crate::gather::FixedSample;
+use crate::gpu::Gpu;
+use crate::gpu_scene::GpuScene;
+use crate::photons::gpu::GpuPhotonMap;
+
+/// What every pass of one iteration reads besides its own resources.
+pub struct FrameContext<'a> {
+    pub gpu: &'a Gpu,
+    /// Bind group 0 of every pass.
+    pub scene: &'a GpuScene,
+    /// Bind group 1: this iteration's uniforms (camera jitter, seed, gather strategy).
+    pub frame: &'a FrameBinding,
+    /// The current photon pass's map; `None` where the render has none (direct light only).
+    pub map: Option<&'a GpuPhotonMap>,
+    pub width: u32,
+    pub height: u32,
+    /// The iteration's index since the film was last cleared.
+    pub iteration: u32,
+    /// The gather's directions per pixel and iteration (1 to [`crate::gather::MAX_DIRECTIONS`]).
+    pub directions: u32,
+    /// Random choices fixed for a test ([`crate::renderer::Overrides`]).
+    pub fixed: FixedSample,
+}
+
+/// One pass of an iteration: it adds its commands to `enc` (an implementation that must read
+/// a result back may submit `enc` and leave a new encoder in it).
+pub trait IterationPass {
+    fn encode(&mut self, enc: &mut wgpu::CommandEncoder, ctx: &FrameContext) -> Result<()>;
+}

@@ -214,7 +214,7 @@ fn render<'py>(py: Python<'py>, argv: Vec<String>) -> PyResult<Bound<'py, PyArra
     let show = o.scene.show.show();
     let denoise = o.denoise;
     let image = py
-        .detach(move || match renderer.as_renderer().filter(|_| denoise) {
+        .detach(move || match renderer.denoising().filter(|_| denoise) {
             Some(r) => r.read_denoised(&rastergi::denoise::DenoiseParams::default()),
             None => renderer.read_linear(show),
         })

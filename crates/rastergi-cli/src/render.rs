@@ -297,13 +297,13 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
 
     let show = a.show.show();
     let linear = renderer.read_linear(show)?;
-    let denoised = match renderer.as_renderer().filter(|_| args.denoise) {
+    let denoised = match renderer.denoising().filter(|_| args.denoise) {
         Some(r) => Some(r.read_denoised(&DenoiseParams::default())?),
         None => None,
     };
     // With --denoise the raw image goes beside --out, the denoised one to --out.
     let raw_out = if args.denoise { raw_path(&args.out) } else { args.out.clone() };
-    if let Some(r) = renderer.as_renderer().filter(|_| args.albedo.is_some() || args.normal.is_some()) {
+    if let Some(r) = renderer.denoising().filter(|_| args.albedo.is_some() || args.normal.is_some()) {
         let guides = r.read_guides()?;
         if let Some(path) = &args.albedo {
             let albedo = guides.albedo();

@@ -27,8 +27,8 @@ use rastergi::display::WindowSurface;
 use rastergi::film::Show;
 use rastergi::gather::GatherMethod;
 use rastergi::gpu::{Gpu, GpuOptions};
-use rastergi::progressive::Progressive;
-use rastergi::renderer::Renderer;
+use rastergi::progressive::{Denoising, Progressive};
+
 use rastergi::scene::{Files, GltfOptions, MemoryFiles, Scene, SunAngles};
 use rastergi::session::{Method, Session};
 use wasm_bindgen::prelude::*;
@@ -264,11 +264,11 @@ impl Viewer {
                     "off" => false,
                     _ => return Err(bad()),
                 };
-                if let Some(r) = self.renderer.as_renderer_mut().filter(|r| on && !r.denoiser_enabled()) {
+                if let Some(r) = self.renderer.denoising_mut().filter(|r| on && !r.denoiser_enabled()) {
                     // A failure (its buffers beyond the device's limits) leaves the denoiser off.
                     r.enable_denoiser().map_err(error)?;
                     // The guides hold the iterations from now on: the image restarts with them.
-                    r.reset();
+                    self.renderer.reset();
                 }
                 self.options.denoise = on;
                 self.denoised.clear();
@@ -403,9 +403,9 @@ impl Viewer {
     }
 
     /// The photon-map renderer while the canvas shows its denoised image.
-    fn denoising(&self) -> Option<&Renderer> {
+    fn denoising(&self) -> Option<&dyn Denoising> {
         let shown = self.options.denoise && self.options.show == Show::Full;
-        self.renderer.as_renderer().filter(|r| shown && r.denoiser_enabled())
+        self.renderer.denoising().filter(|r| shown && r.denoiser_enabled())
     }
 
     /// Encodes the resolve of what the canvas shows into the film's display buffer: the raw

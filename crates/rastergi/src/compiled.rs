@@ -207,7 +207,8 @@ mod tests {
     use crate::film::Show;
     use crate::gpu::{Gpu, GpuOptions};
     use crate::image_io::LinearImage;
-    use crate::renderer::{RenderSettings, Renderer};
+    use crate::renderer::Renderer;
+    use crate::settings::RenderSettings;
 
     /// The Cornell box at 32², 4 iterations of the traced gather, seed 3.
     fn render(gpu: &Gpu) -> LinearImage {

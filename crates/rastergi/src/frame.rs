@@ -36,7 +36,7 @@ pub struct FrameUniforms {
     /// points are read through `eye_paths`.
     pub eye_chains: u32,
     /// 1 where the eye's visible points read textures at their footprint's level of detail,
-    /// 0 where at level 0 ([`crate::renderer::TextureFilter`]).
+    /// 0 where at level 0 ([`crate::settings::TextureFilter`]).
     pub texture_footprint: u32,
     pub _pad: [u32; 3],
 }

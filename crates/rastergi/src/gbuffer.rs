@@ -14,7 +14,7 @@ use crate::gpu::{Gpu, dispatch_pixels, scene_raster_pipeline};
 use crate::gpu_scene::GpuScene;
 use crate::pass::{FrameContext, IterationPass};
 use crate::photons::gpu::GpuPhotonMap;
-use crate::profile::{Profiler, compute_pass};
+use crate::profile::{Profiler, compute_pass, render_pass};
 use crate::shader;
 
 /// The pass's composed shader.
@@ -80,26 +80,9 @@ impl IterationPass for GBufferPass {
     /// Reads: scene, frame. Writes: the G-buffer.
     fn encode(&mut self, enc: &mut wgpu::CommandEncoder, ctx: &FrameContext) -> Result<()> {
         let (scene, frame) = (ctx.scene, ctx.frame);
-        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("gbuffer"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &self.view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &self.depth_view,
-                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(0.0), store: wgpu::StoreOp::Discard }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: self.profiler.as_ref().and_then(|p| p.render("gbuffer")),
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let clear =
+            wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store };
+        let mut pass = render_pass(enc, self.profiler.as_ref(), "gbuffer", (&self.view, clear), Some(&self.depth_view));
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &scene.bind_group, &[]);
         pass.set_bind_group(1, &frame.bind_group, &[]);

@@ -48,6 +48,7 @@ pub mod renderer;
 pub mod sampling;
 pub mod scene;
 pub mod session;
+pub mod settings;
 mod shader;
 pub mod sky;
 mod sky_sun_table;

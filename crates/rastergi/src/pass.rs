@@ -5,9 +5,10 @@
 //! the gather's directions — comes through the context. [`crate::renderer::Renderer::iterate`]
 //! runs them in the order of the data flow.
 
+use glam::{Vec2, Vec3};
+
 use crate::error::Result;
 use crate::frame::FrameBinding;
-use crate::gather::FixedSample;
 use crate::gpu::Gpu;
 use crate::gpu_scene::GpuScene;
 use crate::photons::gpu::GpuPhotonMap;
@@ -25,10 +26,20 @@ pub struct FrameContext<'a> {
     pub height: u32,
     /// The iteration's index since the film was last cleared.
     pub iteration: u32,
-    /// The gather's directions per pixel and iteration (1 to [`crate::gather::MAX_DIRECTIONS`]).
+    /// The gather's directions per pixel and iteration (1 to [`crate::consts::MAX_DIRECTIONS`]).
     pub directions: u32,
     /// Random choices fixed for a test ([`crate::renderer::Overrides`]).
     pub fixed: FixedSample,
+}
+
+/// Values that replace the sampler's for one iteration (tests compare the gather with other
+/// estimators for the same samples).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FixedSample {
+    /// One direction ω instead of the iteration's.
+    pub direction: Option<Vec3>,
+    /// The ray view's sub-texel offset instead of a random one.
+    pub texel_jitter: Option<Vec2>,
 }
 
 /// One pass of an iteration: it adds its commands to `enc` (an implementation that must read

@@ -40,14 +40,16 @@
 use bytemuck::{Pod, Zeroable};
 
 use crate::binding::{Group, Slot};
+use crate::checkpoint::Progress;
 use crate::error::Result;
-use crate::film::{Film, Show};
+use crate::film::{Film, FilmState, Show};
 use crate::frame::{FrameBinding, FrameUniforms, pixel_jitter};
 use crate::gpu::{Gpu, groups};
 use crate::gpu_scene::{GpuScene, PreparedScene};
 use crate::image_io::{DisplayImage, LinearImage};
-use crate::renderer::RenderSettings;
+use crate::progressive::Progressive;
 use crate::scene::{Camera, Scene};
+use crate::settings::RenderSettings;
 use crate::shader;
 
 /// Scattering events after which every path ends (a safety cap; roulette ends them first).
@@ -199,7 +201,7 @@ impl PathTracer {
         let jitter = pixel_jitter(iteration, self.settings.seed);
         // The path tracer takes one light sample per vertex.
         let mut frame = FrameUniforms::new(&self.camera, (w, h), &self.scene, iteration, jitter, self.settings.seed, 1);
-        frame.texture_footprint = (self.settings.texture_filter == crate::renderer::TextureFilter::Footprint) as u32;
+        frame.texture_footprint = (self.settings.texture_filter == crate::settings::TextureFilter::Footprint) as u32;
         let params = PathParams {
             light_weight: self.light_weight,
             light_count: self.scene.light_count,
@@ -302,5 +304,57 @@ impl PathTracer {
         self.gpu.queue.submit([enc.finish()]);
         let bytes = self.gpu.read_buffer(&visibility, size)?;
         Ok(bytemuck::cast_slice(&bytes).to_vec())
+    }
+}
+
+impl Progressive for PathTracer {
+    fn name(&self) -> &'static str {
+        "rastergi path tracer"
+    }
+    fn settings(&self) -> &RenderSettings {
+        PathTracer::settings(self)
+    }
+    fn iterate(&mut self) -> Result<()> {
+        PathTracer::iterate(self);
+        Ok(())
+    }
+    fn wait(&self) -> Result<()> {
+        PathTracer::wait(self)
+    }
+    fn samples(&self) -> u32 {
+        PathTracer::samples(self)
+    }
+    fn camera(&self) -> Camera {
+        PathTracer::camera(self)
+    }
+    fn set_camera(&mut self, camera: Camera) -> Result<()> {
+        PathTracer::set_camera(self, camera)
+    }
+    fn reset(&mut self) {
+        PathTracer::reset(self)
+    }
+    fn film(&self) -> &Film {
+        PathTracer::film(self)
+    }
+    fn has(&self, show: Show) -> bool {
+        show == Show::Full
+    }
+    fn encode_resolve(&self, enc: &mut wgpu::CommandEncoder, _show: Show, exposure: f32) {
+        PathTracer::encode_resolve(self, enc, exposure)
+    }
+    fn read_linear(&self, _show: Show) -> Result<LinearImage> {
+        PathTracer::read_linear(self)
+    }
+    fn read_display(&self, _show: Show, exposure: f32) -> Result<DisplayImage> {
+        PathTracer::read_display(self, exposure)
+    }
+    fn progress(&self) -> Progress {
+        Progress::default()
+    }
+    fn film_state(&self) -> Result<FilmState> {
+        PathTracer::film_state(self)
+    }
+    fn resume(&mut self, _progress: &Progress, film: &FilmState) -> Result<()> {
+        PathTracer::resume(self, film)
     }
 }

@@ -217,3 +217,32 @@ pub fn compute_pass<'e>(
     let timestamp_writes = profiler.and_then(|p| p.compute(label));
     enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes })
 }
+
+/// A render pass into `color` with its operations and, where given, a depth target cleared to
+/// 0 (reversed Z: the nearest surface has the largest depth) and discarded after the pass;
+/// timed under `label` where `profiler` is given.
+pub fn render_pass<'e>(
+    enc: &'e mut wgpu::CommandEncoder,
+    profiler: Option<&Profiler>,
+    label: &'static str,
+    (color, ops): (&wgpu::TextureView, wgpu::Operations<wgpu::Color>),
+    depth: Option<&wgpu::TextureView>,
+) -> wgpu::RenderPass<'e> {
+    enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: color,
+            depth_slice: None,
+            resolve_target: None,
+            ops,
+        })],
+        depth_stencil_attachment: depth.map(|view| wgpu::RenderPassDepthStencilAttachment {
+            view,
+            depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(0.0), store: wgpu::StoreOp::Discard }),
+            stencil_ops: None,
+        }),
+        timestamp_writes: profiler.and_then(|p| p.render(label)),
+        occlusion_query_set: None,
+        multiview_mask: None,
+    })
+}

@@ -1,15 +1,16 @@
-//! The progressive-renderer interface shared by the photon-map renderer ([`Renderer`]) and the
-//! reference path tracer ([`PathTracer`]): front ends (render, view, bench) drive either through
+//! The progressive-renderer interface shared by the photon-map renderer
+//! ([`crate::renderer::Renderer`]) and the reference path tracer
+//! ([`crate::path_tracer::PathTracer`]), each of which implements it beside itself: front ends (render, view, bench) drive either through
 //! it. Each iteration adds one estimate per pixel to a [`Film`]; the image is the mean of the
 //! estimates since the last restart (a camera move or [`Progressive::reset`]).
 
 use crate::checkpoint::Progress;
+use crate::denoise::{DenoiseParams, GuideState, Schedule};
 use crate::error::Result;
 use crate::film::{Film, FilmState, Show};
 use crate::image_io::{DisplayImage, LinearImage};
-use crate::path_tracer::PathTracer;
-use crate::renderer::{RenderSettings, Renderer};
 use crate::scene::Camera;
+use crate::settings::RenderSettings;
 
 /// `Send`: a renderer may be built on one thread and used on another (the viewer's builds, the
 /// Python package's renders with the interpreter's lock released). On wasm32, where wgpu's
@@ -47,121 +48,39 @@ pub trait Progressive: wgpu::WasmNotSend {
     /// Continues from a checkpoint's state: the next iteration is the one the checkpointed
     /// render would have run next.
     fn resume(&mut self, progress: &Progress, film: &FilmState) -> Result<()>;
-    /// The photon-map renderer behind this one (its denoiser, [`Renderer::enable_denoiser`]);
-    /// `None` for the path tracer.
-    fn as_renderer(&self) -> Option<&Renderer> {
+    /// The renderer's denoiser, where it has one (the photon-map renderer; not the path
+    /// tracer).
+    fn denoising(&self) -> Option<&dyn Denoising> {
         None
     }
-    fn as_renderer_mut(&mut self) -> Option<&mut Renderer> {
+    fn denoising_mut(&mut self) -> Option<&mut dyn Denoising> {
         None
     }
 }
 
-impl Progressive for Renderer {
-    fn name(&self) -> &'static str {
-        "rastergi photon map + final gather"
-    }
-    fn settings(&self) -> &RenderSettings {
-        Renderer::settings(self)
-    }
-    fn iterate(&mut self) -> Result<()> {
-        Renderer::iterate(self)
-    }
-    fn wait(&self) -> Result<()> {
-        Renderer::wait(self)
-    }
-    fn samples(&self) -> u32 {
-        Renderer::samples(self)
-    }
-    fn camera(&self) -> Camera {
-        Renderer::camera(self)
-    }
-    fn set_camera(&mut self, camera: Camera) -> Result<()> {
-        Renderer::set_camera(self, camera)
-    }
-    fn reset(&mut self) {
-        Renderer::reset(self)
-    }
-    fn film(&self) -> &Film {
-        Renderer::film(self)
-    }
-    fn has(&self, show: Show) -> bool {
-        show != Show::PhotonMap || self.settings().show_photon_map
-    }
-    fn encode_resolve(&self, enc: &mut wgpu::CommandEncoder, show: Show, exposure: f32) {
-        Renderer::encode_resolve(self, enc, show, exposure)
-    }
-    fn read_linear(&self, show: Show) -> Result<LinearImage> {
-        Renderer::read_linear(self, show)
-    }
-    fn read_display(&self, show: Show, exposure: f32) -> Result<DisplayImage> {
-        Renderer::read_display(self, show, exposure)
-    }
-    fn progress(&self) -> Progress {
-        Renderer::progress(self)
-    }
-    fn film_state(&self) -> Result<FilmState> {
-        Renderer::film_state(self)
-    }
-    fn resume(&mut self, progress: &Progress, film: &FilmState) -> Result<()> {
-        Renderer::resume(self, progress, film)
-    }
-    fn as_renderer(&self) -> Option<&Renderer> {
-        Some(self)
-    }
-    fn as_renderer_mut(&mut self) -> Option<&mut Renderer> {
-        Some(self)
-    }
-}
-
-impl Progressive for PathTracer {
-    fn name(&self) -> &'static str {
-        "rastergi path tracer"
-    }
-    fn settings(&self) -> &RenderSettings {
-        PathTracer::settings(self)
-    }
-    fn iterate(&mut self) -> Result<()> {
-        PathTracer::iterate(self);
-        Ok(())
-    }
-    fn wait(&self) -> Result<()> {
-        PathTracer::wait(self)
-    }
-    fn samples(&self) -> u32 {
-        PathTracer::samples(self)
-    }
-    fn camera(&self) -> Camera {
-        PathTracer::camera(self)
-    }
-    fn set_camera(&mut self, camera: Camera) -> Result<()> {
-        PathTracer::set_camera(self, camera)
-    }
-    fn reset(&mut self) {
-        PathTracer::reset(self)
-    }
-    fn film(&self) -> &Film {
-        PathTracer::film(self)
-    }
-    fn has(&self, show: Show) -> bool {
-        show == Show::Full
-    }
-    fn encode_resolve(&self, enc: &mut wgpu::CommandEncoder, _show: Show, exposure: f32) {
-        PathTracer::encode_resolve(self, enc, exposure)
-    }
-    fn read_linear(&self, _show: Show) -> Result<LinearImage> {
-        PathTracer::read_linear(self)
-    }
-    fn read_display(&self, _show: Show, exposure: f32) -> Result<DisplayImage> {
-        PathTracer::read_display(self, exposure)
-    }
-    fn progress(&self) -> Progress {
-        Progress::default()
-    }
-    fn film_state(&self) -> Result<FilmState> {
-        PathTracer::film_state(self)
-    }
-    fn resume(&mut self, _progress: &Progress, film: &FilmState) -> Result<()> {
-        PathTracer::resume(self, film)
-    }
+/// A renderer's denoiser ([`crate::denoise`]): its guides, accumulated from when it is
+/// enabled, and the filtered image.
+pub trait Denoising {
+    /// Starts accumulating the guides (fails where their buffers exceed the device's limits);
+    /// the iterations before have none, so an image with iterations should restart.
+    fn enable_denoiser(&mut self) -> Result<()>;
+    /// Whether the guides are accumulated.
+    fn denoiser_enabled(&self) -> bool;
+    /// The denoised full image, linear.
+    fn read_denoised(&self, params: &DenoiseParams) -> Result<LinearImage>;
+    /// The denoised full image, display-encoded at `exposure`.
+    fn read_display_denoised(&self, params: &DenoiseParams, exposure: f32) -> Result<DisplayImage>;
+    /// The guides: albedo, normal, distance per pixel.
+    fn read_guides(&self) -> Result<GuideState>;
+    /// Encodes the filter without reading it back (timing).
+    fn encode_denoise(&self, enc: &mut wgpu::CommandEncoder, params: &DenoiseParams) -> Result<()>;
+    /// Encodes the resolve of the denoised image for display at `exposure`, filtering again
+    /// first where `schedule` says it is due at `now` (seconds).
+    fn encode_denoised_view(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        schedule: &mut Schedule,
+        now: f64,
+        exposure: f32,
+    ) -> Result<()>;
 }

@@ -8,94 +8,20 @@ use crate::denoise::{DenoiseParams, Denoiser, GuideState, Guides, Schedule};
 use crate::error::Result;
 use crate::film::{Film, FilmState, ImageResolve, Show};
 use crate::frame::{FrameBinding, FrameUniforms, pixel_jitter};
-use crate::gather::{DirectionSampler, FixedSample, GatherDirections, GatherMethod, GatherPass, GatherSetup, HitLight};
+use crate::gather::{DirectionSampler, GatherDirections, GatherMethod, GatherPass, GatherSetup, HitLight};
 use crate::gbuffer::{GBufferPass, PixelPass};
 use crate::gpu::Gpu;
 use crate::gpu_scene::{GpuScene, PreparedScene};
 use crate::image_io::{DisplayImage, LinearImage};
-use crate::pass::{FrameContext, IterationPass};
+use crate::pass::{FixedSample, FrameContext, IterationPass};
 use crate::photon_view::PhotonView;
 use crate::photons::PhotonSettings;
 use crate::photons::gpu::GpuPhotonMap;
 use crate::photons::map::GridSpec;
-use crate::photons::passes::{DEFAULT_PASS_ITERATIONS, PhotonPasses, fitted_pass_iterations};
+use crate::photons::passes::{PhotonPasses, fitted_pass_iterations};
+use crate::progressive::{Denoising, Progressive};
 use crate::scene::{Camera, Scene};
-
-/// Settings of a render.
-#[derive(Clone, Debug, PartialEq)]
-pub struct RenderSettings {
-    pub width: u32,
-    pub height: u32,
-    pub seed: u32,
-    /// Light samples per pixel per iteration in the direct pass.
-    pub light_samples: u32,
-    /// Photons traced into the photon map (0: no photon map, no indirect light).
-    pub photons: u32,
-    /// Photon grid cells along the scene's longest axis.
-    pub grid_resolution: u32,
-    /// Also accumulate the photon-map view (`Show::PhotonMap`).
-    pub show_photon_map: bool,
-    /// Ray-view resolution of the final gather (texels per side); 0 fits it to the scene and
-    /// the image size ([`crate::fit::bundle`]: at least [`default_bundle`]).
-    pub bundle: u32,
-    /// How the final gather finds the nearest surface along its direction.
-    pub gather: GatherMethod,
-    /// The traced gather's directions: per pixel or shared by every pixel (applies to
-    /// [`GatherMethod::Trace`] and the traced gather that `Auto` tries: the raster gathers
-    /// always share them).
-    pub gather_directions: GatherDirections,
-    /// Whether [`GatherMethod::Auto`] tries the gathers on a CPU adapter too, where it takes
-    /// the traced gather without trials otherwise ([`GatherPass::new`]).
-    pub auto_trials_on_cpu: bool,
-    /// Photon passes ([`crate::photons::passes`]): the map is re-traced with fresh photons in
-    /// finer cells every `pass_iterations` iterations; 1: one fixed map; 0: no limit.
-    pub photon_passes: u32,
-    /// Iterations per photon pass; 0: fitted to the photon count and the image size
-    /// ([`crate::photons::passes::fitted_pass_iterations`]).
-    pub pass_iterations: u32,
-    /// Gather directions per iteration, 1 to [`crate::gather::MAX_DIRECTIONS`]: they share the iteration's
-    /// G-buffer and direct light.
-    pub directions: u32,
-    /// The light at the gather's hits: all from the photon map, or the direct part exact.
-    pub hit_light: HitLight,
-    /// Where the photon grid's cells are finer: where the camera reads the map, or nowhere.
-    pub photon_region: PhotonRegionChoice,
-    /// How the eye's visible points read textures: filtered over the pixel's footprint, or
-    /// level 0 bilinearly as reference renderers do.
-    pub texture_filter: TextureFilter,
-}
-
-/// How the eye's visible points (the G-buffer's, and the path tracer's first hits) read
-/// textures. Every other point reads level 0 either way (crate::textures).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum TextureFilter {
-    /// Trilinear over the mip maps at the level of the pixel's footprint,
-    /// λ = log2 max(|∂uv/∂x|, |∂uv/∂y|): the pixel's average texture, without noise.
-    #[default]
-    Footprint,
-    /// Level 0, bilinearly, at the sample's own point: the pixel's samples average it, as
-    /// Mitsuba's and pbrt's `bilinear` bitmap lookups do — what to compare with them.
-    Bilinear,
-}
-
-/// Where the photon grid is refined ([`crate::fit::photon_region`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum PhotonRegionChoice {
-    /// Around what the scene's camera (when the renderer is made) and its gather rays reach:
-    /// a room beside a large ground plane gets cells sized to the room.
-    #[default]
-    Camera,
-    /// One level of cells over the whole scene.
-    Scene,
-}
-
-pub use crate::fit::default_bundle;
-
-/// Gather directions per iteration by default. On the Cornell box at 256² (lavapipe), the
-/// indirect light carries 97 % of an iteration's variance while the G-buffer and the direct
-/// pass take 60 % of its time: sharing them among 4 directions reaches a given error in about
-/// half the time (docs/performance.md).
-pub const DEFAULT_DIRECTIONS: u32 = 4;
+use crate::settings::{PhotonRegionChoice, RenderSettings, TextureFilter};
 
 /// Fixed values for one iteration's random choices, so tests can compare the passes with
 /// other estimators for the same samples.
@@ -110,63 +36,7 @@ pub struct Overrides {
     pub texel_jitter: Option<Vec2>,
 }
 
-impl RenderSettings {
-    /// The settings other than the seed, as `(key, value)` text in a fixed order: what a
-    /// checkpoint records of them, so a render resumed or merged with other settings is
-    /// refused with what differs.
-    pub fn fingerprint(&self) -> Vec<(String, String)> {
-        let s = self;
-        [
-            ("size", format!("{}x{}", s.width, s.height)),
-            ("light-samples", s.light_samples.to_string()),
-            ("photons", s.photons.to_string()),
-            ("grid", s.grid_resolution.to_string()),
-            ("photon-view", s.show_photon_map.to_string()),
-            ("bundle", s.bundle.to_string()),
-            ("gather", format!("{:?}", s.gather)),
-            ("gather-directions", format!("{:?}", s.gather_directions)),
-            ("photon-passes", s.photon_passes.to_string()),
-            ("pass-iterations", s.pass_iterations.to_string()),
-            ("directions", s.directions.to_string()),
-            ("hit-light", format!("{:?}", s.hit_light)),
-            ("photon-region", format!("{:?}", s.photon_region)),
-            ("texture-filter", format!("{:?}", s.texture_filter)),
-        ]
-        .into_iter()
-        .map(|(k, v)| (k.to_owned(), v))
-        .collect()
-    }
-
-    /// The gather's bundle: as set, or (0) fitted to a scene of this [`crate::fit::detail_bundle`].
-    pub fn bundle_for(&self, detail_bundle: u32) -> u32 {
-        if self.bundle == 0 { crate::fit::bundle(detail_bundle, self.width, self.height) } else { self.bundle }
-    }
-}
-
-impl Default for RenderSettings {
-    fn default() -> Self {
-        let p = PhotonSettings::default();
-        Self {
-            width: 256,
-            height: 256,
-            seed: 0,
-            light_samples: 1,
-            photons: p.count,
-            grid_resolution: p.grid_resolution,
-            show_photon_map: false,
-            bundle: 0,
-            gather: GatherMethod::Auto,
-            gather_directions: GatherDirections::default(),
-            auto_trials_on_cpu: false,
-            directions: DEFAULT_DIRECTIONS,
-            photon_passes: 0,
-            pass_iterations: DEFAULT_PASS_ITERATIONS,
-            hit_light: HitLight::Map,
-            photon_region: PhotonRegionChoice::Camera,
-            texture_filter: TextureFilter::Footprint,
-        }
-    }
-}
+pub use crate::fit::default_bundle;
 
 /// The passes whose resources depend on the image size.
 struct ImagePasses {
@@ -676,5 +546,92 @@ impl Renderer {
     /// row by row (for tests and tools).
     pub fn read_gbuffer(&self) -> Result<Vec<[u32; 4]>> {
         self.passes.gbuffer.read(&self.gpu)
+    }
+}
+
+impl Progressive for Renderer {
+    fn name(&self) -> &'static str {
+        "rastergi photon map + final gather"
+    }
+    fn settings(&self) -> &RenderSettings {
+        Renderer::settings(self)
+    }
+    fn iterate(&mut self) -> Result<()> {
+        Renderer::iterate(self)
+    }
+    fn wait(&self) -> Result<()> {
+        Renderer::wait(self)
+    }
+    fn samples(&self) -> u32 {
+        Renderer::samples(self)
+    }
+    fn camera(&self) -> Camera {
+        Renderer::camera(self)
+    }
+    fn set_camera(&mut self, camera: Camera) -> Result<()> {
+        Renderer::set_camera(self, camera)
+    }
+    fn reset(&mut self) {
+        Renderer::reset(self)
+    }
+    fn film(&self) -> &Film {
+        Renderer::film(self)
+    }
+    fn has(&self, show: Show) -> bool {
+        show != Show::PhotonMap || self.settings().show_photon_map
+    }
+    fn encode_resolve(&self, enc: &mut wgpu::CommandEncoder, show: Show, exposure: f32) {
+        Renderer::encode_resolve(self, enc, show, exposure)
+    }
+    fn read_linear(&self, show: Show) -> Result<LinearImage> {
+        Renderer::read_linear(self, show)
+    }
+    fn read_display(&self, show: Show, exposure: f32) -> Result<DisplayImage> {
+        Renderer::read_display(self, show, exposure)
+    }
+    fn progress(&self) -> Progress {
+        Renderer::progress(self)
+    }
+    fn film_state(&self) -> Result<FilmState> {
+        Renderer::film_state(self)
+    }
+    fn resume(&mut self, progress: &Progress, film: &FilmState) -> Result<()> {
+        Renderer::resume(self, progress, film)
+    }
+    fn denoising(&self) -> Option<&dyn Denoising> {
+        Some(self)
+    }
+    fn denoising_mut(&mut self) -> Option<&mut dyn Denoising> {
+        Some(self)
+    }
+}
+
+impl Denoising for Renderer {
+    fn enable_denoiser(&mut self) -> Result<()> {
+        Renderer::enable_denoiser(self)
+    }
+    fn denoiser_enabled(&self) -> bool {
+        Renderer::denoiser_enabled(self)
+    }
+    fn read_denoised(&self, params: &DenoiseParams) -> Result<LinearImage> {
+        Renderer::read_denoised(self, params)
+    }
+    fn read_display_denoised(&self, params: &DenoiseParams, exposure: f32) -> Result<DisplayImage> {
+        Renderer::read_display_denoised(self, params, exposure)
+    }
+    fn read_guides(&self) -> Result<GuideState> {
+        Renderer::read_guides(self)
+    }
+    fn encode_denoise(&self, enc: &mut wgpu::CommandEncoder, params: &DenoiseParams) -> Result<()> {
+        Renderer::encode_denoise(self, enc, params)
+    }
+    fn encode_denoised_view(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        schedule: &mut Schedule,
+        now: f64,
+        exposure: f32,
+    ) -> Result<()> {
+        Renderer::encode_denoised_view(self, enc, schedule, now, exposure)
     }
 }

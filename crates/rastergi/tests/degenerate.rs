@@ -14,8 +14,8 @@ use rastergi::environment::Environment;
 use rastergi::film::Show;
 use rastergi::gather::{GatherDirections, GatherMethod, HitLight};
 use rastergi::image_io::validate_finite;
-use rastergi::renderer::RenderSettings;
 use rastergi::scene::{Camera, Light, Material, Scene};
+use rastergi::settings::RenderSettings;
 
 fn quad(s: &mut Scene, corners: [Vec3; 4], material: u32) {
     s.add_triangle([corners[0], corners[1], corners[2]], material);

@@ -7,9 +7,10 @@ use rastergi::denoise::{DenoiseParams, Denoiser, EXTRA_SLOTS, GUIDE_SLOTS, cpu};
 use rastergi::film::{COMPONENTS, Show};
 use rastergi::image_io::LinearImage;
 use rastergi::metrics::{Comparison, compare, emitter_mask, rmse};
-use rastergi::renderer::{RenderSettings, Renderer};
+use rastergi::renderer::Renderer;
 use rastergi::sampling::{pcg_hash, unit_f32};
 use rastergi::scene::cornell_box;
+use rastergi::settings::RenderSettings;
 
 /// A uniform number in [0, 1) from three indices.
 fn hash(a: u32, b: u32, c: u32) -> f32 {

@@ -8,8 +8,8 @@ use std::f64::consts::PI;
 use glam::{DVec3, Vec3};
 use rastergi::film::Show;
 use rastergi::metrics::emitter_mask;
-use rastergi::renderer::RenderSettings;
 use rastergi::scene::{Camera, Material, Scene, cornell_box};
+use rastergi::settings::RenderSettings;
 
 /// Form factor from a point to the rectangle [0,X]×[0,Z] parallel to its plane at height h,
 /// with the point under the corner (Howell's catalogue, C-11), signed by the corner's quadrant.

@@ -6,8 +6,9 @@ mod common;
 
 use rastergi::display::{DisplayPass, needs_decode, text_scale};
 use rastergi::gpu::Gpu;
-use rastergi::renderer::{RenderSettings, Renderer};
+use rastergi::renderer::Renderer;
 use rastergi::scene::cornell_box;
+use rastergi::settings::RenderSettings;
 
 /// Draws the renderer's film (resolved for the full image at `exposure`) with `overlay` onto
 /// a `format` texture of the film's size and reads it back as RGBA8 rows.

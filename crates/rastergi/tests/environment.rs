@@ -17,8 +17,9 @@ use rastergi::gpu_scene::PreparedScene;
 use rastergi::path_tracer::PathTracer;
 use rastergi::photons::map::GridSpec;
 use rastergi::photons::{PhotonSettings, cpu, gpu::GpuPhotonMap};
-use rastergi::renderer::{Overrides, RenderSettings, Renderer};
+use rastergi::renderer::{Overrides, Renderer};
 use rastergi::scene::{Camera, Material, Scene};
+use rastergi::settings::RenderSettings;
 
 const ALBEDO: f32 = 0.5;
 /// Half the side of the floor, y = 0, x and z in [−A, A].

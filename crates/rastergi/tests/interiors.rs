@@ -10,9 +10,9 @@ use glam::Vec3;
 use rastergi::environment::Environment;
 use rastergi::film::Show;
 use rastergi::gpu_scene::PreparedScene;
-use rastergi::renderer::{PhotonRegionChoice, RenderSettings};
 use rastergi::scene::Scene;
 use rastergi::scene::generate::sunroom;
+use rastergi::settings::{PhotonRegionChoice, RenderSettings};
 
 const WIDTH: u32 = 96;
 const HEIGHT: u32 = 72;

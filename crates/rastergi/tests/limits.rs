@@ -7,8 +7,9 @@ mod common;
 
 use glam::Vec3;
 use rastergi::path_tracer::PathTracer;
-use rastergi::renderer::{RenderSettings, Renderer};
+use rastergi::renderer::Renderer;
 use rastergi::scene::{Material, Scene, cornell_box};
+use rastergi::settings::RenderSettings;
 
 fn settings() -> RenderSettings {
     RenderSettings { width: 32, height: 32, photons: 1 << 12, grid_resolution: 16, ..RenderSettings::default() }

@@ -153,7 +153,7 @@ fn path_tracer_matches_mitsuba(scene: &rastergi::scene::Scene, iterations: u32, 
     let ref_b = common::box_half(&read_exr(&common::data(&format!("{stem}_b.exr"))).unwrap());
     let (width, height) = (ref_a.width, ref_a.height);
     let render = |seed| {
-        let settings = rastergi::renderer::RenderSettings { width, height, seed, ..Default::default() };
+        let settings = rastergi::settings::RenderSettings { width, height, seed, ..Default::default() };
         common::path_trace(&gpu, scene, settings, iterations)
     };
     let (a, b) = (render(1), render(2));
@@ -538,7 +538,7 @@ fn the_eye_sees_through_attenuating_solid_glass_as_beer_lambert_says() {
     let back = (1.0 - r).powi(2) * r * a * a / (Vec3::ONE - r * r * a * a);
     let want = l * (Vec3::splat(r) + back + slab_transmittance(sigma, d));
     let gpu = common::gpu();
-    let settings = rastergi::renderer::RenderSettings { width: 32, height: 32, seed: 3, ..Default::default() };
+    let settings = rastergi::settings::RenderSettings { width: 32, height: 32, seed: 3, ..Default::default() };
     for (label, img) in [
         ("path tracer", common::path_trace(&gpu, &s, settings.clone(), 64)),
         ("eye chains", common::render(&gpu, &s, settings.clone(), 64, Show::Full)),
@@ -684,7 +684,7 @@ fn a_polished_sphere_reflects_the_stage_as_the_path_tracer_shows_it() {
     (m.metallic, m.roughness, m.specular) = (0.0, 0.0, 1.0);
     assert!(m.has_delta_lobe() && !m.passes_rays());
     let gpu = common::gpu();
-    let settings = |seed| rastergi::renderer::RenderSettings { width: 64, height: 64, seed, ..Default::default() };
+    let settings = |seed| rastergi::settings::RenderSettings { width: 64, height: 64, seed, ..Default::default() };
     // The path tracer at 2 × 512 iterations (2 × 1024 until issue 44: block-mean error 0.29 %
     // and channel means 0.25 % off against the 1.5 % and 1 % bounds, with the reference's
     // noise the larger part of the comparison's; √2 more of it leaves both far inside).

@@ -13,8 +13,9 @@ use rastergi::gpu_scene::PreparedScene;
 use rastergi::image_io::LinearImage;
 use rastergi::metrics::{compare, emitter_mask, masked_mean, rmse};
 use rastergi::path_tracer::PathTracer;
-use rastergi::renderer::{RenderSettings, Renderer};
+use rastergi::renderer::Renderer;
 use rastergi::scene::{Camera, Material, Scene, cornell_box};
+use rastergi::settings::RenderSettings;
 
 /// The mean of `iterations` path-traced iterations.
 fn path_trace(gpu: &Gpu, scene: &Scene, settings: RenderSettings, iterations: u32) -> LinearImage {

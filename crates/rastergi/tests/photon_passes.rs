@@ -7,8 +7,9 @@ mod common;
 use rastergi::film::Show;
 use rastergi::gather::{GatherMethod, HitLight};
 use rastergi::photons::passes::pass_resolution;
-use rastergi::renderer::{RenderSettings, Renderer};
+use rastergi::renderer::Renderer;
 use rastergi::scene::generate::rooms;
+use rastergi::settings::RenderSettings;
 
 fn settings(passes: u32) -> RenderSettings {
     RenderSettings {

@@ -9,8 +9,8 @@ use rastergi::gpu_scene::{GpuScene, PreparedScene};
 use rastergi::metrics::emitter_mask;
 use rastergi::photons::map::{GridSpec, PhotonMap};
 use rastergi::photons::{PhotonSettings, cpu, gpu::GpuPhotonMap};
-use rastergi::renderer::RenderSettings;
 use rastergi::scene::{Camera, Material, Scene, cornell_box};
+use rastergi::settings::RenderSettings;
 
 fn gpu_map(gpu: &rastergi::gpu::Gpu, scene: &Scene, settings: &PhotonSettings) -> PhotonMap {
     let prepared = PreparedScene::new(scene);

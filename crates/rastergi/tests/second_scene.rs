@@ -30,9 +30,10 @@ use rastergi::gpu::Gpu;
 use rastergi::image_io::LinearImage;
 use rastergi::metrics::{compare, emitter_mask, masked_mean, rmse};
 use rastergi::path_tracer::PathTracer;
-use rastergi::renderer::{RenderSettings, Renderer};
+use rastergi::renderer::Renderer;
 use rastergi::scene::Scene;
 use rastergi::scene::generate::atrium;
+use rastergi::settings::RenderSettings;
 
 const WIDTH: u32 = 64;
 const HEIGHT: u32 = 48;

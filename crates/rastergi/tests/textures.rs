@@ -16,9 +16,10 @@ use rastergi::gpu_scene::{GpuScene, PreparedScene};
 use rastergi::metrics::{emitter_mask, rmse};
 use rastergi::photons::map::PhotonMap;
 use rastergi::photons::{PhotonSettings, cpu, gpu::GpuPhotonMap};
-use rastergi::renderer::{RenderSettings, Renderer};
+use rastergi::renderer::Renderer;
 use rastergi::sampling::Rng;
 use rastergi::scene::{Camera, Material, Scene, Texture, cornell_box, load_gltf};
+use rastergi::settings::RenderSettings;
 use rastergi::textures::{TextureAtlas, sample_on_gpu, srgb_to_linear};
 
 fn texture(name: &str, w: u32, h: u32, mut f: impl FnMut(u32, u32) -> [u8; 3]) -> Texture {
@@ -122,7 +123,7 @@ fn gbuffer_level_of_detail_is_a_pixels_footprint_in_texels() {
 /// then average the texels themselves.
 #[test]
 fn bilinear_texture_filter_reads_level_zero_at_every_visible_point() {
-    use rastergi::renderer::TextureFilter;
+    use rastergi::settings::TextureFilter;
     let gpu = common::gpu();
     let size = 64;
     let scene = frontal_square(64.0, 3.0);

@@ -13,7 +13,8 @@ use rastergi::image_io::{LinearImage, read_exr};
 use rastergi::metrics::{compare, emitter_mask};
 use rastergi::path_tracer::PathTracer;
 use rastergi::progressive::Progressive;
-use rastergi::renderer::{RenderSettings, Renderer};
+use rastergi::renderer::Renderer;
+use rastergi::settings::RenderSettings;
 
 use super::load_valid_scene;
 use crate::args::{GpuArgs, gpu};

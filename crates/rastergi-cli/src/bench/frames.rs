@@ -23,7 +23,8 @@ use rastergi::film::Show;
 use rastergi::fit;
 use rastergi::gather::GatherMethod;
 use rastergi::gpu::Gpu;
-use rastergi::renderer::{RenderSettings, Renderer};
+use rastergi::renderer::Renderer;
+use rastergi::settings::RenderSettings;
 
 use super::load_valid_scene;
 use crate::args::{GatherArg, GpuArgs, gpu};

@@ -9,8 +9,9 @@ use anyhow::Result;
 use clap::Args;
 use rastergi::gather::GatherMethod;
 use rastergi::gpu::Gpu;
-use rastergi::renderer::{RenderSettings, Renderer, default_bundle};
+use rastergi::renderer::{Renderer, default_bundle};
 use rastergi::scene::Scene;
+use rastergi::settings::RenderSettings;
 
 use super::converge::{Reference, measure, mitsuba_curve, mitsuba_name, print_targets, sorted_targets};
 use super::load_valid_scene;
@@ -52,7 +53,7 @@ pub struct GatherArgs {
     #[arg(long, value_name = "VARIANT", requires = "mitsuba")]
     mitsuba_variant: Option<String>,
     /// Gather directions per iteration.
-    #[arg(long, default_value_t = rastergi::renderer::DEFAULT_DIRECTIONS, value_parser = clap::value_parser!(u32).range(1..=16))]
+    #[arg(long, default_value_t = rastergi::settings::DEFAULT_DIRECTIONS, value_parser = clap::value_parser!(u32).range(1..=16))]
     directions: u32,
     /// Print the GPU time of every pass (timestamp queries) for each size and method.
     #[arg(long)]

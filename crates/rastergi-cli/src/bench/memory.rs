@@ -4,7 +4,8 @@
 use anyhow::Result;
 use clap::Args;
 use rastergi::gpu::Gpu;
-use rastergi::renderer::{RenderSettings, Renderer};
+use rastergi::renderer::Renderer;
+use rastergi::settings::RenderSettings;
 
 use super::load_valid_scene;
 use crate::args::{GatherArg, GpuArgs, gpu};

@@ -3,8 +3,8 @@
 
 use std::sync::Arc;
 
-use rastergi::renderer::RenderSettings;
 use rastergi::scene::Scene;
+use rastergi::settings::RenderSettings;
 
 use super::controls::SunAngles;
 use crate::args::SceneArgs;

@@ -6,8 +6,8 @@
 use rastergi::camera_control::{CameraControl, Mode, MoveKeys};
 use rastergi::film::Show;
 use rastergi::gather::{GatherDirections, GatherMethod};
-use rastergi::renderer::RenderSettings;
 use rastergi::scene::Camera;
+use rastergi::settings::RenderSettings;
 
 use super::script::Action;
 use crate::render::Method;

@@ -477,8 +477,8 @@ mod tests {
     use egui_kittest::kittest::{NodeT, Queryable};
     use glam::Vec3;
     use rastergi::camera_control::CameraControl;
-    use rastergi::renderer::RenderSettings;
     use rastergi::scene::{Aabb, Camera};
+    use rastergi::settings::RenderSettings;
 
     /// Controls with a sun and an environment, and the actions the panel gave, applied as the
     /// viewer applies them.

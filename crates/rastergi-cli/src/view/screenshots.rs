@@ -62,7 +62,7 @@ impl Screenshots {
         exposure: f32,
         denoised: bool,
     ) -> Result<(PathBuf, PathBuf)> {
-        let (display, linear) = match renderer.as_renderer().filter(|_| denoised) {
+        let (display, linear) = match renderer.denoising().filter(|_| denoised) {
             Some(r) => {
                 let params = DenoiseParams::default();
                 (r.read_display_denoised(&params, exposure)?, r.read_denoised(&params)?)

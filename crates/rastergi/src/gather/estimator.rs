@@ -25,6 +25,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3};
 
 use super::MAX_DIRECTIONS;
+use crate::binding::{Group, Slot};
 use crate::error::Result;
 use crate::film::Film;
 use crate::frame::FrameBinding;
@@ -90,6 +91,23 @@ pub fn estimate_source(pieces: &[&str]) -> String {
     let mut all = vec![LOOKUP_WGSL, UNIFORMS, include_str!("estimator.wgsl")];
     all.extend_from_slice(pieces);
     shader::per_pixel(&all)
+}
+
+/// An estimate pass's bind group 2: the gather's uniforms and the G-buffer (bindings 0 and 1,
+/// read), then `own` (from binding 2).
+pub fn estimate_group(label: &'static str, own: &[Slot]) -> Group {
+    let mut g =
+        Group::compute(label, &[Slot::uniform::<GatherUniforms>(0, "gather"), Slot::uint_texture(1, "gbuffer")]);
+    g.slots.extend_from_slice(own);
+    g
+}
+
+/// The resources of [`estimate_group`]'s first two slots.
+pub fn estimate_resources<'a>(
+    uniforms: &'a wgpu::Buffer,
+    gbuffer: &'a GBufferPass,
+) -> [(&'static str, wgpu::BindingResource<'a>); 2] {
+    [("gather", uniforms.as_entire_binding()), ("gbuffer", wgpu::BindingResource::TextureView(&gbuffer.view))]
 }
 
 /// What a gather's passes bind besides the [`GatherUniforms`], for building them: the scene,

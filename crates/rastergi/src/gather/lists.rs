@@ -14,13 +14,15 @@
 //!   lattice points, Nosarzewska), so Σ(A/s² + P/s + 1) nodes always suffice.
 
 use super::Gather;
-use super::estimator::{GatherInputs, GatherSetup, GatherUniforms, RAY_VIEW_LOOKUP};
+use super::estimator::{
+    GatherInputs, GatherSetup, GatherUniforms, RAY_VIEW_LOOKUP, estimate_group, estimate_resources,
+};
 use super::ray_view::{ray_view_module, ray_view_pipeline, texel_size};
 use crate::binding::{Group, Slot};
 use crate::error::{Error, Result};
 use crate::gpu::{Gpu, dispatch_pixels};
 use crate::gpu_scene::GpuScene;
-use crate::profile::{Profiler, compute_pass};
+use crate::profile::{Profiler, compute_pass, render_pass};
 
 /// Render target of the list pass (nothing is written to it; a pass needs an attachment).
 const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Uint;
@@ -61,15 +63,9 @@ pub fn fill_group() -> Group {
 
 /// The projection's bind group 2: the G-buffer and the lists read, the film written.
 pub fn project_group() -> Group {
-    Group::compute(
+    estimate_group(
         "gather list project",
-        &[
-            Slot::uniform::<GatherUniforms>(0, "gather"),
-            Slot::uint_texture(1, "gbuffer"),
-            Slot::read::<u32>(2, "heads"),
-            Slot::read::<[u32; 2]>(3, "nodes"),
-            Slot::write::<[f32; 4]>(4, "film"),
-        ],
+        &[Slot::read::<u32>(2, "heads"), Slot::read::<[u32; 2]>(3, "nodes"), Slot::write::<[f32; 4]>(4, "film")],
     )
 }
 
@@ -117,12 +113,14 @@ impl ListGather {
         let (project_layout, project_group) = project_group().layout_and_bind(
             device,
             &[
-                ("gather", uniforms.as_entire_binding()),
-                ("gbuffer", wgpu::BindingResource::TextureView(&setup.gbuffer.view)),
-                ("heads", heads.as_entire_binding()),
-                ("nodes", nodes.as_entire_binding()),
-                ("film", setup.film.accumulation.as_entire_binding()),
-            ],
+                estimate_resources(uniforms, setup.gbuffer).as_slice(),
+                &[
+                    ("heads", heads.as_entire_binding()),
+                    ("nodes", nodes.as_entire_binding()),
+                    ("film", setup.film.accumulation.as_entire_binding()),
+                ],
+            ]
+            .concat(),
         );
 
         let module = ray_view_module(device);
@@ -159,19 +157,8 @@ impl ListGather {
         enc.clear_buffer(&self.heads, 0, None);
         enc.clear_buffer(&self.node_count, 0, None);
         {
-            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("gather list fill"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &self.target,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Discard },
-                })],
-                depth_stencil_attachment: None,
-                timestamp_writes: self.profiler.as_ref().and_then(|p| p.render("gather list fill")),
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
+            let ops = wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Discard };
+            let mut pass = render_pass(enc, self.profiler.as_ref(), "gather list fill", (&self.target, ops), None);
             pass.set_pipeline(&self.fill_pipeline);
             pass.set_bind_group(0, &inputs.scene.bind_group, &[]);
             pass.set_bind_group(1, &self.fill_group, &[]);

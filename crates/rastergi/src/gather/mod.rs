@@ -56,7 +56,7 @@ pub use estimator::{GatherInputs, GatherSample, GatherSetup, GatherUniforms, Pix
 use crate::consts::{FILM_DIRECT, FILM_INDIRECT};
 use crate::error::Result;
 use crate::gpu::Gpu;
-use crate::pass::{FrameContext, IterationPass};
+use crate::pass::{FixedSample, FrameContext, IterationPass};
 use crate::sampling::{Rng, pcg_hash, sobol_owen_2d, stream, uniform_sphere, unit_f32};
 
 pub use crate::consts::MAX_DIRECTIONS;
@@ -177,16 +177,6 @@ pub fn shared_scramble(seed: u32, restart: u32) -> u32 {
 /// The key of the per-pixel scramble seeds for the stream (seed, restart).
 pub fn pixel_key(seed: u32, restart: u32) -> u32 {
     pcg_hash(restart ^ pcg_hash(seed ^ stream::GATHER_PIXEL))
-}
-
-/// Values that replace the sampler's for one iteration (tests compare the gathers with other
-/// estimators for the same samples).
-#[derive(Clone, Copy, Debug, Default)]
-pub struct FixedSample {
-    /// One direction ω instead of the iteration's.
-    pub direction: Option<Vec3>,
-    /// The ray view's sub-texel offset instead of a random one.
-    pub texel_jitter: Option<Vec2>,
 }
 
 /// The gather's random choices: the scramble of the shared directions and the key of the

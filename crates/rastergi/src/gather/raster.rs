@@ -20,13 +20,15 @@
 //!   would lose contact shadows).
 
 use super::Gather;
-use super::estimator::{GatherInputs, GatherSetup, GatherUniforms, RAY_VIEW_LOOKUP, submit_and_renew};
+use super::estimator::{
+    GatherInputs, GatherSetup, GatherUniforms, RAY_VIEW_LOOKUP, estimate_group, estimate_resources, submit_and_renew,
+};
 use super::ray_view::{DEPTH_FORMAT, ray_view_module, ray_view_pipeline};
 use crate::binding::{Group, Slot};
 use crate::error::Result;
 use crate::gpu::{Gpu, dispatch_pixels};
 use crate::gpu_scene::GpuScene;
-use crate::profile::{Profiler, compute_pass};
+use crate::profile::{Profiler, compute_pass, render_pass};
 
 /// Ray-view texel: (triangle + 1, b1 bits, b2 bits, depth bits); 0 where empty.
 const LAYER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;
@@ -80,11 +82,9 @@ pub fn peel_group() -> Group {
 /// The projection's bind group 2: the G-buffer and a peeled layer read; which visible points
 /// found their texel, the film, and the points behind written.
 pub fn project_group() -> Group {
-    Group::compute(
+    estimate_group(
         "gather project",
         &[
-            Slot::uniform::<GatherUniforms>(0, "gather"),
-            Slot::uint_texture(1, "gbuffer"),
             Slot::uint_texture(2, "layer"),
             Slot::write::<u32>(3, "found"),
             Slot::write::<[f32; 4]>(4, "film"),
@@ -153,15 +153,13 @@ impl RasterGather {
             peel.bind(device, &peel_layout, &resources)
         };
         let project_group = |layer: &wgpu::TextureView| {
-            let resources = [
-                ("gather", uniforms.as_entire_binding()),
-                ("gbuffer", wgpu::BindingResource::TextureView(&gbuffer.view)),
+            let own = [
                 ("layer", wgpu::BindingResource::TextureView(layer)),
                 ("found", found.as_entire_binding()),
                 ("film", film.accumulation.as_entire_binding()),
                 ("behind", behind.as_entire_binding()),
             ];
-            project.bind(device, &project_layout, &resources)
+            project.bind(device, &project_layout, &[estimate_resources(uniforms, gbuffer).as_slice(), &own].concat())
         };
         let peel_groups = [peel_group(&layers[1]), peel_group(&layers[0])];
         let project_groups = [project_group(&layers[0]), project_group(&layers[1])];
@@ -227,19 +225,8 @@ impl RasterGather {
     fn encode_count(&self, enc: &mut wgpu::CommandEncoder, scene: &GpuScene) {
         enc.clear_buffer(&self.counts, 0, None);
         enc.clear_buffer(&self.max_count, 0, None);
-        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("gather count"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &self.layers[0],
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
-            })],
-            depth_stencil_attachment: None,
-            timestamp_writes: self.profiler.as_ref().and_then(|p| p.render("gather count")),
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let ops = wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store };
+        let mut pass = render_pass(enc, self.profiler.as_ref(), "gather count", (&self.layers[0], ops), None);
         pass.set_pipeline(&self.count_pipeline);
         pass.set_bind_group(0, &scene.bind_group, &[]);
         pass.set_bind_group(1, &self.count_group, &[]);
@@ -261,49 +248,17 @@ impl RasterGather {
         // "Layer −1" (read by the first peel) is empty with depth bits above any depth.
         let beyond = f64::from(2.0f32.to_bits());
         {
-            let _ = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("gather layer init"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &self.layers[1],
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color { r: 0.0, g: 0.0, b: 0.0, a: beyond }),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
+            let clear = wgpu::LoadOp::Clear(wgpu::Color { r: 0.0, g: 0.0, b: 0.0, a: beyond });
+            let ops = wgpu::Operations { load: clear, store: wgpu::StoreOp::Store };
+            let _ = render_pass(enc, None, "gather layer init", (&self.layers[1], ops), None);
         }
         for k in 0..layers as usize {
             let cur = k % 2;
             {
-                let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("gather peel"),
-                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                        view: &self.layers[cur],
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                            store: wgpu::StoreOp::Store,
-                        },
-                    })],
-                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                        view: &self.depth,
-                        depth_ops: Some(wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(0.0),
-                            store: wgpu::StoreOp::Discard,
-                        }),
-                        stencil_ops: None,
-                    }),
-                    timestamp_writes: self.profiler.as_ref().and_then(|p| p.render("gather peel")),
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
+                let clear = wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT);
+                let ops = wgpu::Operations { load: clear, store: wgpu::StoreOp::Store };
+                let (layer, depth) = (&self.layers[cur], Some(&self.depth));
+                let mut pass = render_pass(enc, self.profiler.as_ref(), "gather peel", (layer, ops), depth);
                 pass.set_pipeline(&self.peel_pipeline);
                 pass.set_bind_group(0, &inputs.scene.bind_group, &[]);
                 pass.set_bind_group(1, &self.peel_groups[cur], &[]);

@@ -14,7 +14,7 @@
 //! cheap and the scene shallow.
 
 use super::Gather;
-use super::estimator::{GatherInputs, GatherSetup, GatherUniforms};
+use super::estimator::{GatherInputs, GatherSetup, estimate_group, estimate_resources};
 use crate::binding::{Group, Slot};
 use crate::error::Result;
 use crate::gpu::{Gpu, dispatch_pixels};
@@ -28,14 +28,7 @@ pub struct TraceGather {
 
 /// The traced gather's bind group 2: the G-buffer read, the film written.
 pub fn group() -> Group {
-    Group::compute(
-        "gather trace",
-        &[
-            Slot::uniform::<GatherUniforms>(0, "gather"),
-            Slot::uint_texture(1, "gbuffer"),
-            Slot::write::<[f32; 4]>(2, "film"),
-        ],
-    )
+    estimate_group("gather trace", &[Slot::write::<[f32; 4]>(2, "film")])
 }
 
 impl TraceGather {
@@ -44,10 +37,10 @@ impl TraceGather {
         let (layout, bind_group) = group().layout_and_bind(
             device,
             &[
-                ("gather", uniforms.as_entire_binding()),
-                ("gbuffer", wgpu::BindingResource::TextureView(&setup.gbuffer.view)),
-                ("film", setup.film.accumulation.as_entire_binding()),
-            ],
+                estimate_resources(uniforms, setup.gbuffer).as_slice(),
+                &[("film", setup.film.accumulation.as_entire_binding())],
+            ]
+            .concat(),
         );
         let pipeline = setup.estimate_pipeline(device, "gather trace", &[include_str!("trace.wgsl")], &layout);
         TraceGather { pipeline, bind_group, profiler: gpu.profiler.clone() }

@@ -13,8 +13,8 @@ use crate::error::Result;
 use crate::film::Show;
 use crate::gather::{GatherDirections, GatherMethod, HitLight};
 use crate::gpu::{Backends, Gpu, GpuOptions, parse_backend};
-use crate::renderer::{PhotonRegionChoice, RenderSettings, TextureFilter};
 use crate::scene::Scene;
+use crate::settings::{PhotonRegionChoice, RenderSettings, TextureFilter};
 
 // `--backend` and `--rays`: which GPU and which ray traversal (no doc comment: clap would
 // take it for the help of the subcommands that flatten it).
@@ -296,7 +296,7 @@ pub struct SceneArgs {
     pub gather_directions: GatherDirectionsArg,
     /// Gather directions per iteration (1–16): they share the iteration's G-buffer and direct
     /// light, so the noisier indirect light gets more samples per second.
-    #[arg(long, default_value_t = crate::renderer::DEFAULT_DIRECTIONS, value_parser = clap::value_parser!(u32).range(1..=16))]
+    #[arg(long, default_value_t = crate::settings::DEFAULT_DIRECTIONS, value_parser = clap::value_parser!(u32).range(1..=16))]
     pub directions: u32,
     /// Where the light at a gather ray's hit comes from: the photon map (`map`), or direct
     /// light by a shadow ray plus a map of indirect light only (`exact`).

@@ -28,8 +28,9 @@ use crate::gather::{GatherDirections, GatherMethod, HitLight};
 use crate::gpu::{Gpu, GpuOptions};
 use crate::path_tracer::PathTracer;
 use crate::progressive::Progressive;
-use crate::renderer::{PhotonRegionChoice, RenderSettings, Renderer, TextureFilter};
+use crate::renderer::Renderer;
 use crate::scene::{Light, Scene};
+use crate::settings::{PhotonRegionChoice, RenderSettings, TextureFilter};
 
 /// Which renderer makes the image.
 #[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
@@ -159,7 +160,7 @@ impl Default for Options {
             bundle: None,
             gather: GatherMethod::Auto,
             gather_directions: GatherDirections::default(),
-            directions: crate::renderer::DEFAULT_DIRECTIONS,
+            directions: crate::settings::DEFAULT_DIRECTIONS,
             hit_light: HitLight::Map,
             photon_region: PhotonRegionChoice::Camera,
             texture_filter: TextureFilter::Footprint,

@@ -8,8 +8,9 @@ use std::path::PathBuf;
 use rastergi::film::Show;
 use rastergi::gpu::{Gpu, GpuOptions};
 use rastergi::image_io::{LinearImage, read_exr};
-use rastergi::renderer::{RenderSettings, Renderer};
+use rastergi::renderer::Renderer;
 use rastergi::scene::Scene;
+use rastergi::settings::RenderSettings;
 
 /// The test's device: one per test (each test runs on a thread of its own), so that a test's
 /// renderers reuse each other's compiled pipelines (`rastergi::compiled`) while a device

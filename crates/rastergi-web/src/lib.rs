@@ -22,14 +22,14 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicU32, Ordering};
 
 use rastergi::camera_control::{CameraControl, DRAG_RADIANS_PER_PIXEL, MoveKeys};
-use rastergi::denoise::Schedule;
 use rastergi::display::WindowSurface;
 use rastergi::film::Show;
 use rastergi::gather::GatherMethod;
 use rastergi::gpu::{Gpu, GpuOptions};
-use rastergi::progressive::{Denoising, Progressive};
+use rastergi::progressive::Progressive;
 
 use rastergi::scene::{Files, GltfOptions, MemoryFiles, Scene, SunAngles};
+use rastergi::session::interactive::Interactive;
 use rastergi::session::{Method, Session};
 use wasm_bindgen::prelude::*;
 
@@ -48,8 +48,6 @@ struct Options {
     photons: Option<u32>,
     gather: GatherMethod,
     method: Method,
-    show: Show,
-    exposure: f32,
     /// The sun (the scene's last distant light).
     sun: Option<SunAngles>,
     /// Show the denoised full image (the photon-map renderer's denoiser).
@@ -65,12 +63,11 @@ pub struct Viewer {
     surface: WindowSurface,
     scene_name: String,
     scene: Scene,
-    renderer: Box<dyn Progressive>,
+    /// The renderer as the canvas shows it (component, exposure, denoised image).
+    view: Interactive,
     control: CameraControl,
     options: Options,
     in_flight: Arc<AtomicU32>,
-    /// When the denoiser last ran for the canvas (while the denoised image is shown).
-    denoised: Schedule,
 }
 
 /// Opens the browser's WebGPU adapter for `canvas` and shows the Cornell box at
@@ -114,8 +111,6 @@ pub async fn create_viewer(
         // The raster gathers bind more storage buffers than browsers grant (10).
         gather: GatherMethod::Trace,
         method: Method::Gather,
-        show: Show::Full,
-        exposure: 0.0,
         sun: None,
         denoise: false,
     };
@@ -128,12 +123,16 @@ pub async fn create_viewer(
         surface,
         scene_name: "cornell".into(),
         scene,
-        renderer,
+        view: Interactive::new(renderer, Show::Full, 0.0),
         control,
         options,
         in_flight: Arc::new(AtomicU32::new(0)),
-        denoised: Schedule::default(),
     })
+}
+
+/// Seconds since the epoch (the denoiser's schedule).
+fn now() -> f64 {
+    js_sys::Date::now() / 1000.0
 }
 
 fn error(e: impl std::fmt::Display) -> JsError {
@@ -230,8 +229,8 @@ impl Viewer {
         // Built before anything is replaced: a scene that fails leaves the page as it was.
         let renderer = build(&self.gpu, &scene, &options).map_err(error)?;
         self.control = CameraControl::new(&scene.camera, &scene.bounds());
-        (self.scene_name, self.scene, self.renderer, self.options) = (name, scene, renderer, options);
-        self.denoised.clear();
+        self.view.replace(renderer, false).map_err(error)?;
+        (self.scene_name, self.scene, self.options) = (name, scene, options);
         Ok(())
     }
 
@@ -246,7 +245,7 @@ impl Viewer {
         let mut options = self.options.clone();
         match key {
             "show" => {
-                self.options.show = match value {
+                self.view.show = match value {
                     "full" => Show::Full,
                     "direct" => Show::Direct,
                     "indirect" => Show::Indirect,
@@ -255,7 +254,7 @@ impl Viewer {
                 return Ok(());
             }
             "exposure" => {
-                self.options.exposure = value.parse().ok().filter(|e: &f32| e.is_finite()).ok_or_else(bad)?;
+                self.view.exposure = value.parse().ok().filter(|e: &f32| e.is_finite()).ok_or_else(bad)?;
                 return Ok(());
             }
             "denoise" => {
@@ -264,14 +263,9 @@ impl Viewer {
                     "off" => false,
                     _ => return Err(bad()),
                 };
-                if let Some(r) = self.renderer.denoising_mut().filter(|r| on && !r.denoiser_enabled()) {
-                    // A failure (its buffers beyond the device's limits) leaves the denoiser off.
-                    r.enable_denoiser().map_err(error)?;
-                    // The guides hold the iterations from now on: the image restarts with them.
-                    self.renderer.reset();
-                }
+                // A failure (its buffers beyond the device's limits) leaves the denoiser off.
+                self.view.set_denoise(on).map_err(error)?;
                 self.options.denoise = on;
-                self.denoised.clear();
                 return Ok(());
             }
             "method" => {
@@ -309,11 +303,9 @@ impl Viewer {
             "seed" => options.seed = value.parse().map_err(|_| bad())?,
             _ => return Err(JsError::new(&format!("unknown setting '{key}'"))),
         }
-        let camera = self.renderer.camera();
-        let mut renderer = build(&self.gpu, &self.scene, &options).map_err(error)?;
-        renderer.set_camera(camera).map_err(error)?;
-        (self.renderer, self.options) = (renderer, options);
-        self.denoised.clear();
+        let renderer = build(&self.gpu, &self.scene, &options).map_err(error)?;
+        self.view.replace(renderer, true).map_err(error)?;
+        self.options = options;
         Ok(())
     }
 
@@ -321,9 +313,9 @@ impl Viewer {
     /// is [`FRAMES_IN_FLIGHT`] behind), then the image drawn onto the canvas. Returns the
     /// iterations accumulated.
     pub fn frame(&mut self, limit: u32) -> Result<u32, JsError> {
-        let done = limit > 0 && self.renderer.samples() >= limit;
+        let done = limit > 0 && self.view.renderer().samples() >= limit;
         if !done && self.in_flight.load(Ordering::Acquire) < FRAMES_IN_FLIGHT {
-            self.renderer.iterate().map_err(error)?;
+            self.view.renderer_mut().iterate().map_err(error)?;
             self.in_flight.fetch_add(1, Ordering::AcqRel);
             let in_flight = self.in_flight.clone();
             self.gpu.queue.on_submitted_work_done(move || {
@@ -331,10 +323,10 @@ impl Viewer {
             });
         }
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
-        self.encode_resolve(&mut enc).map_err(error)?;
-        self.surface.present(&self.gpu, enc, Some(self.renderer.film()), &[]).map_err(error)?;
+        self.view.encode_resolve(&mut enc, now()).map_err(error)?;
+        self.surface.present(&self.gpu, enc, Some(self.view.renderer().film()), &[]).map_err(error)?;
         self.gpu.check().map_err(error)?;
-        Ok(self.renderer.samples())
+        Ok(self.view.renderer().samples())
     }
 
     /// Whether every submitted iteration has finished on the GPU.
@@ -396,38 +388,14 @@ impl Viewer {
 
     fn moved(&mut self, moved: bool) -> Result<(), JsError> {
         if moved {
-            self.renderer.set_camera(self.control.camera()).map_err(error)?;
-            self.denoised.clear();
-        }
-        Ok(())
-    }
-
-    /// The photon-map renderer while the canvas shows its denoised image.
-    fn denoising(&self) -> Option<&dyn Denoising> {
-        let shown = self.options.denoise && self.options.show == Show::Full;
-        self.renderer.denoising().filter(|r| shown && r.denoiser_enabled())
-    }
-
-    /// Encodes the resolve of what the canvas shows into the film's display buffer: the raw
-    /// image of the shown component, or the denoised full image, filtered again first when
-    /// the schedule says so ([`Schedule`]).
-    fn encode_resolve(&mut self, enc: &mut wgpu::CommandEncoder) -> rastergi::Result<()> {
-        let exposure = self.options.exposure;
-        let mut schedule = self.denoised;
-        if let Some(r) = self.denoising() {
-            r.encode_denoised_view(enc, &mut schedule, js_sys::Date::now() / 1000.0, exposure)?;
-            self.denoised = schedule;
-        } else {
-            let show = if self.renderer.has(self.options.show) { self.options.show } else { Show::Full };
-            self.renderer.encode_resolve(enc, show, exposure);
-            self.denoised.clear();
+            self.view.set_camera(self.control.camera()).map_err(error)?;
         }
         Ok(())
     }
 
     /// Iterations accumulated since the last restart.
     pub fn samples(&self) -> u32 {
-        self.renderer.samples()
+        self.view.renderer().samples()
     }
 
     #[wasm_bindgen(js_name = sceneName)]
@@ -437,13 +405,13 @@ impl Viewer {
 
     /// What is rendering, for the page's status line.
     pub fn describe(&self) -> String {
-        let s = self.renderer.settings();
+        let s = self.view.renderer().settings();
         let what = match self.options.method {
             Method::Gather => format!(
                 "photon map ({} photons a pass) + {:?} gather{}",
                 s.photons,
                 s.gather,
-                if self.denoising().is_some() { ", denoised" } else { "" }
+                if self.view.denoising().is_some() { ", denoised" } else { "" }
             ),
             Method::Path => "path tracer".to_string(),
         };
@@ -473,7 +441,7 @@ impl Viewer {
     /// number, or `null` before the halves hold enough iterations.
     #[wasm_bindgen(js_name = errorEstimate)]
     pub fn error_estimate(&self) -> js_sys::Promise {
-        let state = self.renderer.film().read_state_async(&self.gpu);
+        let state = self.view.renderer().film().read_state_async(&self.gpu);
         wasm_bindgen_futures::future_to_promise(async move {
             let state = state.await.map_err(|e| JsValue::from(error(e)))?;
             Ok(state.error_estimate().map_or(JsValue::NULL, JsValue::from))
@@ -486,12 +454,12 @@ impl Viewer {
     #[wasm_bindgen(js_name = savePng)]
     pub fn save_png(&mut self) -> js_sys::Promise {
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
-        self.denoised.clear();
-        if let Err(e) = self.encode_resolve(&mut enc) {
+        self.view.invalidate();
+        if let Err(e) = self.view.encode_resolve(&mut enc, now()) {
             return js_sys::Promise::reject(&JsValue::from(error(e)));
         }
         self.gpu.queue.submit([enc.finish()]);
-        let image = self.renderer.film().read_display_buffer_async(&self.gpu);
+        let image = self.view.renderer().film().read_display_buffer_async(&self.gpu);
         wasm_bindgen_futures::future_to_promise(async move {
             let image = image.await.map_err(|e| JsValue::from(error(e)))?;
             let mut png = Vec::new();

@@ -15,6 +15,7 @@
 
 #[cfg(feature = "clap")]
 pub mod args;
+pub mod interactive;
 pub mod run;
 #[cfg(test)]
 mod tests;

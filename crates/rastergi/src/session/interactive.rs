@@ -114,3 +114,66 @@ fn enable(renderer: &mut dyn Progressive) -> Result<()> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::{Gpu, GpuOptions};
+    use crate::path_tracer::PathTracer;
+    use crate::renderer::Renderer;
+    use crate::settings::RenderSettings;
+
+    fn settings() -> RenderSettings {
+        let gather = crate::gather::GatherMethod::Trace;
+        RenderSettings { width: 16, height: 16, photons: 1 << 12, grid_resolution: 8, gather, ..Default::default() }
+    }
+
+    /// The loop's promises, checked on the renderers: a camera move and turning the denoiser
+    /// on restart the image; the denoised image is shown only where the renderer has a
+    /// denoiser, its guides on and the full image shown; a new renderer keeps the view's
+    /// camera and gets the denoiser; the display buffer after a denoised resolve is what the
+    /// renderer's own denoised read gives.
+    #[test]
+    fn the_view_restarts_and_denoises_as_a_viewer_expects() {
+        let gpu = Gpu::new(&GpuOptions::default()).expect("tests need a GPU adapter (lavapipe on CI)");
+        let scene = crate::scene::cornell_box();
+        let renderer = Box::new(Renderer::new(&gpu, &scene, settings()).unwrap());
+        let mut view = Interactive::new(renderer, Show::Full, 0.0);
+        for _ in 0..2 {
+            view.renderer_mut().iterate().unwrap();
+        }
+        assert!(view.denoising().is_none(), "no denoiser before it is asked for");
+        view.set_denoise(true).unwrap();
+        assert_eq!(view.renderer().samples(), 0, "turning the denoiser on must restart the image");
+        assert!(view.denoising().is_some());
+        view.show = Show::Direct;
+        assert!(view.denoising().is_none(), "the denoised image is the full one");
+        view.show = Show::Full;
+        for _ in 0..3 {
+            view.renderer_mut().iterate().unwrap();
+        }
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        view.encode_resolve(&mut enc, 0.0).unwrap();
+        gpu.queue.submit([enc.finish()]);
+        let shown = view.renderer().film().read_display_buffer(&gpu).unwrap();
+        let params = crate::denoise::DenoiseParams::default();
+        let denoised = view.denoising().unwrap().read_display_denoised(&params, 0.0).unwrap();
+        assert!(shown.rgba == denoised.rgba, "the display does not show the denoised image");
+
+        let mut camera = view.renderer().camera();
+        camera.eye += glam::Vec3::new(0.1, 0.0, 0.0);
+        view.set_camera(camera.clone()).unwrap();
+        assert_eq!(view.renderer().samples(), 0, "a camera move must restart the image");
+        let next = Box::new(Renderer::new(&gpu, &scene, settings()).unwrap());
+        view.replace(next, true).unwrap();
+        assert_eq!(view.renderer().camera(), camera, "a new renderer must keep the view's camera");
+        assert!(view.denoising().is_some(), "a new renderer must get the denoiser that is on");
+        // The path tracer has none: the raw image is shown.
+        let path = Box::new(PathTracer::new(&gpu, &scene, settings()).unwrap());
+        view.replace(path, true).unwrap();
+        assert!(view.denoise() && view.denoising().is_none());
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        view.encode_resolve(&mut enc, 0.0).unwrap();
+        gpu.queue.submit([enc.finish()]);
+    }
+}

@@ -162,7 +162,7 @@ mod tests {
 
         let mut camera = view.renderer().camera();
         camera.eye += glam::Vec3::new(0.1, 0.0, 0.0);
-        view.set_camera(camera.clone()).unwrap();
+        view.set_camera(camera).unwrap();
         assert_eq!(view.renderer().samples(), 0, "a camera move must restart the image");
         let next = Box::new(Renderer::new(&gpu, &scene, settings()).unwrap());
         view.replace(next, true).unwrap();

@@ -6,7 +6,7 @@ mod common;
 use std::path::Path;
 use std::time::Duration;
 
-use common::Run;
+use common::{Run, files_in};
 
 /// Longer than any of these runs takes on lavapipe; a run past it is killed and fails the test.
 const TIMEOUT: Duration = Duration::from_secs(300);
@@ -28,12 +28,15 @@ fn rastergi(dir: &Path, args: &[&str]) -> Run {
     common::rastergi(dir, args, TIMEOUT)
 }
 
-/// The names of the files in `dir`, sorted.
-fn files_in(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> =
-        std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
-    names.sort();
-    names
+/// Renders `scene` to x.png in `dir` with `args`, which must be refused with exit status
+/// `code` (1: one error line; 2: a usage error) and a message containing `fragment`, before
+/// x.png is written.
+fn refused_render(dir: &Path, scene: &str, args: &[&str], code: i32, fragment: &str) {
+    let run = rastergi(dir, &[&["render", scene, "--out", "x.png"], args].concat());
+    assert_eq!(run.status.code(), Some(code), "{args:?}:\n{}", run.stderr);
+    let message = if code == 1 { run.sole_error_line().to_owned() } else { run.stderr.clone() };
+    assert!(message.contains(fragment), "{args:?}: {message}");
+    assert!(!dir.join("x.png").exists());
 }
 
 #[test]
@@ -128,48 +131,28 @@ fn missing_scene_file_is_one_error_line_naming_it_and_writes_nothing() {
     assert!(files_in(dir.path()).is_empty(), "{:?}", files_in(dir.path()));
 }
 
+/// Refused before anything renders: one error line naming the fault, and no file written.
 #[test]
-fn unsupported_output_format_fails_before_rendering() {
-    let dir = tempfile::tempdir().unwrap();
-    // Billions of iterations: had it started rendering, the run would hit the timeout.
-    let run = rastergi(dir.path(), &["render", "cornell", "--iterations", "4000000000", "--out", "x.jpg"]);
-    let line = run.error_line();
-    assert!(line.contains("x.jpg") && line.contains(".png") && line.contains(".exr"), "{line}");
-    assert!(files_in(dir.path()).is_empty());
-}
-
-#[test]
-fn missing_output_directory_fails_before_rendering() {
-    let dir = tempfile::tempdir().unwrap();
-    let run = rastergi(dir.path(), &["render", "cornell", "--iterations", "4000000000", "--out", "no/such/dir/x.png"]);
-    let line = run.error_line();
-    assert!(line.contains("no/such/dir") && line.contains("does not exist"), "{line}");
-    assert!(files_in(dir.path()).is_empty());
-}
-
-#[test]
-fn width_beyond_the_gpu_limit_is_a_clear_error() {
-    let dir = tempfile::tempdir().unwrap();
-    let run = rastergi(dir.path(), &["render", "cornell", "--width", "100000", "--iterations", "1", "--out", "x.png"]);
-    let line = run.error_line();
-    assert!(line.contains("100000") && line.contains("limit"), "{line}");
-    assert!(files_in(dir.path()).is_empty());
-}
-
-#[test]
-fn zero_field_of_view_is_a_camera_error() {
-    let dir = tempfile::tempdir().unwrap();
-    let run = rastergi(dir.path(), &["render", "cornell", "--fov", "0", "--out", "x.png"]);
-    let line = run.error_line();
-    assert!(line.contains("camera") && line.contains("field of view"), "{line}");
-}
-
-#[test]
-fn eye_at_the_target_is_a_camera_error() {
-    let dir = tempfile::tempdir().unwrap();
-    let run = rastergi(dir.path(), &["render", "cornell", "--eye", "0,0,0", "--target", "0,0,0", "--out", "x.png"]);
-    let line = run.error_line();
-    assert!(line.contains("camera") && line.contains("eye and target"), "{line}");
+fn bad_outputs_sizes_and_cameras_are_one_error_line_and_write_nothing() {
+    // Billions of iterations: had a run started rendering, it would hit the timeout.
+    let cases: [(&[&str], &[&str]); 5] = [
+        // An unsupported output format.
+        (&["--iterations", "4000000000", "--out", "x.jpg"], &["x.jpg", ".png", ".exr"]),
+        // A missing output directory.
+        (&["--iterations", "4000000000", "--out", "no/such/dir/x.png"], &["no/such/dir", "does not exist"]),
+        // A width beyond the GPU's limit.
+        (&["--width", "100000", "--iterations", "1", "--out", "x.png"], &["100000", "limit"]),
+        // Camera errors: a zero field of view, the eye at the target.
+        (&["--fov", "0", "--out", "x.png"], &["camera", "field of view"]),
+        (&["--eye", "0,0,0", "--target", "0,0,0", "--out", "x.png"], &["camera", "eye and target"]),
+    ];
+    for (args, words) in cases {
+        let dir = tempfile::tempdir().unwrap();
+        let run = rastergi(dir.path(), &[&["render", "cornell"], args].concat());
+        let line = run.error_line();
+        assert!(words.iter().all(|w| line.contains(w)), "{args:?}: {line}");
+        assert!(files_in(dir.path()).is_empty(), "{args:?} wrote {:?}", files_in(dir.path()));
+    }
 }
 
 #[test]
@@ -341,6 +324,16 @@ fn bench_rays_refuses_a_batch_beyond_the_gpus_buffers_before_making_it() {
     assert!(!run.status.success() && run.stderr.contains("--size"), "{}", run.stderr);
 }
 
+/// A view straight down at [`floor_obj`]'s floor from 3 m, 16 × 16 pixels.
+const FLOOR_VIEW: [&str; 10] =
+    ["--eye", "0,3,0.01", "--target", "0,0,0", "--fov", "40", "--width", "16", "--height", "16"];
+
+/// Checks that `run` succeeded without the warnings of a scene that has no light of its own.
+fn assert_lit_by_its_own_lights(run: &Run) {
+    assert!(run.status.success(), "{}", run.stderr);
+    assert!(!run.stderr.contains("has no light") && !run.stderr.contains("neutral grey"), "{}", run.stderr);
+}
+
 /// A 4 m square floor at y = 0 facing up (grey 0.5, no light), as OBJ in `dir`.
 fn floor_obj(dir: &Path) -> &'static str {
     std::fs::write(dir.join("floor.obj"), "v -2 0 -2\nv 2 0 -2\nv 2 0 2\nv -2 0 2\nf 1 3 2\nf 1 4 3\n").unwrap();
@@ -351,17 +344,16 @@ fn floor_obj(dir: &Path) -> &'static str {
 fn a_scene_without_light_is_lit_by_a_neutral_environment_or_the_sun() {
     let dir = tempfile::tempdir().unwrap();
     let floor = floor_obj(dir.path());
-    let camera = ["--eye", "0,3,0.01", "--target", "0,0,0", "--fov", "40", "--width", "16", "--height", "16"];
     // Without light it is lit by the neutral environment, with one line saying so; with
     // `--env none` too, it renders black, with one line saying that.
     let grey =
-        rastergi(dir.path(), &[&["render", floor, "--iterations", "1", "--out", "grey.exr"], &camera[..]].concat());
+        rastergi(dir.path(), &[&["render", floor, "--iterations", "1", "--out", "grey.exr"], &FLOOR_VIEW[..]].concat());
     assert!(grey.status.success(), "{}", grey.stderr);
     let warnings: Vec<&str> = grey.our_stderr().into_iter().filter(|l| l.contains("neutral grey")).collect();
     assert_eq!(warnings.len(), 1, "one warning line:\n{}", grey.stderr);
     assert!(warnings[0].contains("floor.obj: no lights") && warnings[0].contains("--env none"), "{}", warnings[0]);
     let none = ["render", floor, "--iterations", "1", "--env", "none", "--out", "dark.exr"];
-    let dark = rastergi(dir.path(), &[&none[..], &camera[..]].concat());
+    let dark = rastergi(dir.path(), &[&none[..], &FLOOR_VIEW[..]].concat());
     assert!(dark.status.success(), "{}", dark.stderr);
     let warnings: Vec<&str> = dark.our_stderr().into_iter().filter(|l| l.contains("has no light")).collect();
     assert_eq!(warnings.len(), 1, "one warning line:\n{}", dark.stderr);
@@ -372,10 +364,9 @@ fn a_scene_without_light_is_lit_by_a_neutral_environment_or_the_sun() {
     let sun = ["--sun", "90,30,2", "--sun-size", "0"];
     let lit = rastergi(
         dir.path(),
-        &[&["render", floor, "--iterations", "4", "--out", "lit.exr"], &camera[..], &sun[..]].concat(),
+        &[&["render", floor, "--iterations", "4", "--out", "lit.exr"], &FLOOR_VIEW[..], &sun[..]].concat(),
     );
-    assert!(lit.status.success(), "{}", lit.stderr);
-    assert!(!lit.stderr.contains("has no light") && !lit.stderr.contains("neutral grey"), "{}", lit.stderr);
+    assert_lit_by_its_own_lights(&lit);
     let img = rastergi::image_io::read_exr(&dir.path().join("lit.exr")).unwrap();
     let expected = 0.5 / std::f32::consts::PI;
     for p in &img.pixels {
@@ -393,9 +384,7 @@ fn sun_options_out_of_range_are_usage_errors() {
         (&["--sun", "0,45,1", "--sun-size", "90"][..], "diameter"),
         (&["--sun-size", "1"][..], "--sun"),
     ] {
-        let run = rastergi(dir.path(), &[&["render", "cornell", "--out", "x.png"], args].concat());
-        assert_eq!(run.status.code(), Some(2), "{args:?}:\n{}", run.stderr);
-        assert!(run.stderr.contains(fragment), "{args:?}: {}", run.stderr);
+        refused_render(dir.path(), "cornell", args, 2, fragment);
         assert!(files_in(dir.path()).is_empty());
     }
 }
@@ -404,14 +393,12 @@ fn sun_options_out_of_range_are_usage_errors() {
 fn a_physical_sky_lights_an_open_floor_as_mitsubas_sunsky_does() {
     let dir = tempfile::tempdir().unwrap();
     let floor = floor_obj(dir.path());
-    let camera = ["--eye", "0,3,0.01", "--target", "0,0,0", "--fov", "40", "--width", "16", "--height", "16"];
     let sky = ["--sky", "3", "--sun", "90,30", "--sun-size", "0", "--gather", "trace"];
     let run = rastergi(
         dir.path(),
-        &[&["render", floor, "--iterations", "16", "--out", "sky.exr"], &camera[..], &sky[..]].concat(),
+        &[&["render", floor, "--iterations", "16", "--out", "sky.exr"], &FLOOR_VIEW[..], &sky[..]].concat(),
     );
-    assert!(run.status.success(), "{}", run.stderr);
-    assert!(!run.stderr.contains("has no light") && !run.stderr.contains("neutral grey"), "{}", run.stderr);
+    assert_lit_by_its_own_lights(&run);
     // Mitsuba 3.9.1's sunsky (turbidity 3, albedo 0.3, the sun 30° up, its Z-up frame turned
     // to Y up) on an open floor of albedo ½: its sky's irradiance there (a 2000 × 4000
     // midpoint quadrature of `emitter.eval` over the hemisphere) is (0.144370, 0.221091,
@@ -443,11 +430,7 @@ fn physical_sky_errors_are_one_line_and_write_nothing() {
         ("cornell", &["--sun", "0,45"][..], 1, "needs --sky"),
         ("sunroom", &["--sky", "3", "--env", "sky.exr"][..], 1, "give one of them"),
     ] {
-        let run = rastergi(d, &[&["render", scene, "--out", "x.png"], args].concat());
-        assert_eq!(run.status.code(), Some(code), "{args:?}:\n{}", run.stderr);
-        let message = if code == 1 { run.sole_error_line().to_owned() } else { run.stderr.clone() };
-        assert!(message.contains(fragment), "{args:?}: {message}");
-        assert!(!d.join("x.png").exists());
+        refused_render(d, scene, args, code, fragment);
     }
 }
 
@@ -462,7 +445,6 @@ fn an_environment_map_lights_an_open_floor_from_exr_and_hdr_alike() {
     rastergi::image_io::write_exr(&d.join("sky.exr"), &sky).unwrap();
     let hdr = image::Rgb32FImage::from_pixel(w, h, image::Rgb([0.5f32; 3]));
     image::DynamicImage::ImageRgb32F(hdr).save_with_format(d.join("sky.hdr"), image::ImageFormat::Hdr).unwrap();
-    let camera = ["--eye", "0,3,0.01", "--target", "0,0,0", "--fov", "40", "--width", "16", "--height", "16"];
     let mut images = Vec::new();
     for (file, scale) in [("sky.exr", "1"), ("sky.hdr", "1"), ("sky.exr", "2")] {
         let out = format!("{file}-{scale}.exr");
@@ -481,9 +463,8 @@ fn an_environment_map_lights_an_open_floor_from_exr_and_hdr_alike() {
             "--gather",
             "trace",
         ];
-        let run = rastergi(d, &[&args[..], &camera[..]].concat());
-        assert!(run.status.success(), "{}", run.stderr);
-        assert!(!run.stderr.contains("has no light") && !run.stderr.contains("neutral grey"), "{}", run.stderr);
+        let run = rastergi(d, &[&args[..], &FLOOR_VIEW[..]].concat());
+        assert_lit_by_its_own_lights(&run);
         images.push(rastergi::image_io::read_exr(&d.join(out)).unwrap());
     }
     assert_eq!(images[0], images[1], "the same sky from .exr and .hdr renders the same image");
@@ -508,11 +489,7 @@ fn environment_map_errors_are_one_line_and_write_nothing() {
         (&["--env-scale", "2"][..], 2, "--env"),
         (&["--env", "sky.exr", "--env-scale=-1"][..], 2, "finite number"),
     ] {
-        let run = rastergi(d, &[&["render", "cornell", "--out", "x.png"], args].concat());
-        assert_eq!(run.status.code(), Some(code), "{args:?}:\n{}", run.stderr);
-        let message = if code == 1 { run.sole_error_line().to_owned() } else { run.stderr.clone() };
-        assert!(message.contains(fragment), "{args:?}: {message}");
-        assert!(!d.join("x.png").exists());
+        refused_render(d, "cornell", args, code, fragment);
     }
 }
 
@@ -529,8 +506,7 @@ fn point_and_spot_options_light_the_floor_below_them() {
     for (light, out) in [(["--point", "0,1,0,1,1,1"], "point.exr"), (["--spot", "0,1,0,0,0,0,1,1,1,10"], "spot.exr")] {
         let args = [&["render", floor, "--iterations", "8", "--out", out][..], &light[..], &camera[..]].concat();
         let run = rastergi(dir.path(), &args);
-        assert!(run.status.success(), "{}", run.stderr);
-        assert!(!run.stderr.contains("has no light") && !run.stderr.contains("neutral grey"), "{}", run.stderr);
+        assert_lit_by_its_own_lights(&run);
         let img = rastergi::image_io::read_exr(&dir.path().join(out)).unwrap();
         let c = centre(&img);
         assert!(c.iter().all(|&v| (0.98 * rho_over_pi..=1.0001 * rho_over_pi).contains(&v)), "{out}: centre {c:?}");
@@ -549,10 +525,7 @@ fn point_and_spot_options_light_the_floor_below_them() {
         (&["--spot", "0,1,0,0,1,0,1,1,1,10"][..], "aim point"),
         (&["--spot", "0,1,0,0,0,0,1,1,1,100"][..], "cone angles"),
     ] {
-        let run = rastergi(dir.path(), &[&["render", "cornell", "--out", "x.png"], args].concat());
-        assert_eq!(run.status.code(), Some(2), "{args:?}:\n{}", run.stderr);
-        assert!(run.stderr.contains(fragment), "{args:?}: {}", run.stderr);
-        assert!(!dir.path().join("x.png").exists());
+        refused_render(dir.path(), "cornell", args, 2, fragment);
     }
 }
 

@@ -73,12 +73,18 @@ fn write(dir: &Path, name: &str, image: &LinearImage) {
     write_exr(&dir.join(name), image).unwrap();
 }
 
+/// Writes `image` and `reference`, each a file name and its image, as EXR files in `dir` and
+/// runs `rastergi compare IMAGE REFERENCE options…` there.
+fn compare(dir: &Path, image: (&str, &LinearImage), reference: (&str, &LinearImage), options: &[&str]) -> Run {
+    write(dir, image.0, image.1);
+    write(dir, reference.0, reference.1);
+    rastergi(dir, &[&["compare", image.0, reference.0], options].concat())
+}
+
 #[test]
 fn identical_images_have_zero_error_and_infinite_psnr() {
     let dir = tempfile::tempdir().unwrap();
-    write(dir.path(), "a.exr", &ramp(40, 24));
-    write(dir.path(), "b.exr", &ramp(40, 24));
-    let run = rastergi(dir.path(), &["compare", "a.exr", "b.exr"]);
+    let run = compare(dir.path(), ("a.exr", &ramp(40, 24)), ("b.exr", &ramp(40, 24)), &[]);
     run.assert_success();
     assert_eq!(run.number("relative RMSE"), 0.0);
     assert_eq!(run.number("block-mean error"), 0.0);
@@ -93,9 +99,8 @@ fn constant_offset_is_reported_exactly() {
     let dir = tempfile::tempdir().unwrap();
     let (w, h, delta) = (40, 24, 0.05);
     let reference = ramp(w, h);
-    write(dir.path(), "ref.exr", &reference);
-    write(dir.path(), "img.exr", &map(&reference, |p| p.map(|v| v + delta as f32)));
-    let run = rastergi(dir.path(), &["compare", "img.exr", "ref.exr"]);
+    let image = map(&reference, |p| p.map(|v| v + delta as f32));
+    let run = compare(dir.path(), ("img.exr", &image), ("ref.exr", &reference), &[]);
     run.assert_success();
 
     let means = ramp_channel_means(w, h);
@@ -118,9 +123,8 @@ fn gaussian_noise_of_known_level_is_reported_within_sampling_error() {
     let (w, h, sigma) = (64u32, 64u32, 0.05f64);
     let reference = ramp(w, h);
     let mut normal = rastergi::sampling::gaussian_deviates(12345);
-    write(dir.path(), "ref.exr", &reference);
-    write(dir.path(), "noisy.exr", &map(&reference, |p| p.map(|v| v + (sigma * normal()) as f32)));
-    let run = rastergi(dir.path(), &["compare", "noisy.exr", "ref.exr"]);
+    let noisy = map(&reference, |p| p.map(|v| v + (sigma * normal()) as f32));
+    let run = compare(dir.path(), ("noisy.exr", &noisy), ("ref.exr", &reference), &[]);
     run.assert_success();
 
     let mean = ramp_channel_means(w, h).iter().sum::<f64>() / 3.0;
@@ -175,10 +179,8 @@ fn emitter_mask_leaves_out_hot_reference_pixels_and_their_neighbours() {
     let mut image = reference.clone();
     image.pixels[3 * 8 + 4] = [15.0, 10.0, 5.0]; // the emitter
     image.pixels[2 * 8 + 5] = [0.7; 3]; // its neighbour, partly covering it
-    write(dir.path(), "ref.exr", &reference);
-    write(dir.path(), "img.exr", &image);
 
-    let run = rastergi(dir.path(), &["compare", "img.exr", "ref.exr", "--mask-emitters"]);
+    let run = compare(dir.path(), ("img.exr", &image), ("ref.exr", &reference), &["--mask-emitters"]);
     run.assert_success();
     assert!(run.stdout.contains("compared pixels:  55 of 64"), "{}", run.stdout);
     assert_eq!(run.number("relative RMSE"), 0.0, "{}", run.stdout);
@@ -204,10 +206,8 @@ fn difference_image_is_red_where_brighter_blue_where_darker() {
     image.pixels[7] = [30.0; 3];
     let mut masked_reference = reference.clone();
     masked_reference.pixels[7] = [30.0; 3];
-    write(dir.path(), "ref.exr", &reference);
-    write(dir.path(), "img.exr", &image);
     write(dir.path(), "hot.exr", &masked_reference);
-    let run = rastergi(dir.path(), &["compare", "img.exr", "ref.exr", "--diff", "d.png"]);
+    let run = compare(dir.path(), ("img.exr", &image), ("ref.exr", &reference), &["--diff", "d.png"]);
     run.assert_success();
     assert!(run.stdout.contains("full colour at |d| >= 0.1"), "the scale is printed:\n{}", run.stdout);
 
@@ -256,9 +256,7 @@ fn missing_and_corrupt_files_are_one_error_line_naming_them() {
 #[test]
 fn images_of_different_sizes_are_refused() {
     let dir = tempfile::tempdir().unwrap();
-    write(dir.path(), "a.exr", &ramp(32, 32));
-    write(dir.path(), "b.exr", &ramp(32, 24));
-    let run = rastergi(dir.path(), &["compare", "a.exr", "b.exr"]);
+    let run = compare(dir.path(), ("a.exr", &ramp(32, 32)), ("b.exr", &ramp(32, 24)), &[]);
     let line = run.error_line();
     assert!(line.contains("a.exr is 32 x 32") && line.contains("b.exr is 32 x 24"), "{line}");
     assert!(run.stdout.is_empty(), "no metrics printed:\n{}", run.stdout);
@@ -271,9 +269,7 @@ fn nan_and_infinite_pixels_are_counted_and_located() {
     let mut image = reference.clone();
     image.pixels[5 * 16 + 3][1] = f32::NAN; // x 3, y 5: the first
     image.pixels[6 * 16][0] = f32::INFINITY;
-    write(dir.path(), "ref.exr", &reference);
-    write(dir.path(), "nan.exr", &image);
-    let run = rastergi(dir.path(), &["compare", "nan.exr", "ref.exr"]);
+    let run = compare(dir.path(), ("nan.exr", &image), ("ref.exr", &reference), &[]);
     let line = run.error_line();
     assert!(line.contains("nan.exr") && line.contains("2 pixels are NaN or infinite"), "{line}");
     assert!(line.contains("x = 3, y = 5"), "{line}");
@@ -291,18 +287,14 @@ fn diff_to_a_non_png_path_is_refused_before_anything_is_written() {
     assert!(line.contains("diff.exr") && line.contains(".png"), "{line}");
     let run = rastergi(dir.path(), &["compare", "a.exr", "a.exr", "--diff", "no/such/dir/d.png"]);
     assert!(run.error_line().contains("does not exist"), "{}", run.stderr);
-    let mut files: Vec<String> =
-        std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
-    files.sort();
-    assert_eq!(files, ["a.exr"]);
+    assert_eq!(common::files_in(dir.path()), ["a.exr"]);
 }
 
 #[test]
 fn black_reference_makes_relative_errors_undefined() {
     let dir = tempfile::tempdir().unwrap();
-    write(dir.path(), "black.exr", &LinearImage { width: 4, height: 4, pixels: vec![[0.0; 3]; 16] });
-    write(dir.path(), "a.exr", &ramp(4, 4));
-    let run = rastergi(dir.path(), &["compare", "a.exr", "black.exr"]);
+    let black = LinearImage { width: 4, height: 4, pixels: vec![[0.0; 3]; 16] };
+    let run = compare(dir.path(), ("a.exr", &ramp(4, 4)), ("black.exr", &black), &[]);
     let line = run.error_line();
     assert!(line.contains("black.exr") && line.contains("undefined"), "{line}");
 }

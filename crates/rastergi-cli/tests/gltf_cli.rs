@@ -4,6 +4,8 @@
 use std::path::Path;
 use std::process::{Command, Output};
 
+use rastergi::image_io::{LinearImage, read_exr};
+
 /// Runs the binary with `args` in `dir`.
 fn rastergi(dir: &Path, args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_rastergi")).args(args).current_dir(dir).output().unwrap()
@@ -95,9 +97,19 @@ fn gltf_scenes_render_from_the_camera_chosen_with_camera() {
     assert_ne!(read("front.png"), read("top.png"), "the two cameras see the same image");
 }
 
+/// [`write_scene`]'s scene in `dir` from above (camera 1), 16², 8 iterations of the traced
+/// gather, with `options`, rendered to `out` (EXR), which must succeed: the image and stderr.
+fn from_above(dir: &Path, options: &[&str], out: &str) -> (LinearImage, String) {
+    let base = ["render", "scene.gltf", "--camera", "1", "--width", "16", "--height", "16", "--iterations", "8"];
+    let run = rastergi(dir, &[&base[..], &["--gather", "trace", "--out", out], options].concat());
+    let log = String::from_utf8_lossy(&run.stderr).into_owned();
+    assert!(run.status.success(), "{log}");
+    (read_exr(&dir.join(out)).unwrap(), log)
+}
+
 /// Over one view rendered without (`dark`) and with (`lit`) some light: what `lit` shows
 /// where `dark` is black, and the green `lit` gains everywhere else.
-fn where_black(lit: &rastergi::image_io::LinearImage, dark: &rastergi::image_io::LinearImage) -> (Vec<[f32; 3]>, f32) {
+fn where_black(lit: &LinearImage, dark: &LinearImage) -> (Vec<[f32; 3]>, f32) {
     let (mut black, mut gain) = (Vec::new(), 0.0f32);
     for (l, d) in lit.pixels.iter().zip(&dark.pixels) {
         if d.iter().all(|&v| v == 0.0) {
@@ -116,15 +128,9 @@ fn a_physical_sky_lights_a_gltf_scene() {
     // around it, which look below the horizon, stay black (Mitsuba 3's sunsky is black there).
     let dir = tempfile::tempdir().unwrap();
     write_scene(dir.path());
-    let base = ["render", "scene.gltf", "--camera", "1", "--width", "16", "--height", "16", "--iterations", "8"];
-    let sky = ["--sky", "3", "--sun", "90,30", "--gather", "trace", "--out", "sky.exr"];
-    let run = rastergi(dir.path(), &[&base[..], &sky[..]].concat());
-    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
-    let plain = ["--gather", "trace", "--env", "none", "--out", "plain.exr"];
-    let run = rastergi(dir.path(), &[&base[..], &plain[..]].concat());
-    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
-    let read = |name: &str| rastergi::image_io::read_exr(&dir.path().join(name)).unwrap();
-    let (background, floor_gain) = where_black(&read("sky.exr"), &read("plain.exr"));
+    let (sky, _) = from_above(dir.path(), &["--sky", "3", "--sun", "90,30"], "sky.exr");
+    let (plain, _) = from_above(dir.path(), &["--env", "none"], "plain.exr");
+    let (background, floor_gain) = where_black(&sky, &plain);
     for s in &background {
         assert_eq!(*s, [0.0; 3], "a pixel below the horizon shows the sky");
     }
@@ -141,20 +147,14 @@ fn a_physical_sky_lights_a_gltf_scene() {
 fn a_gltf_model_without_lights_is_lit_by_a_neutral_environment() {
     let dir = tempfile::tempdir().unwrap();
     write_scene(dir.path());
-    let base = ["render", "scene.gltf", "--camera", "1", "--width", "16", "--height", "16", "--iterations", "8"];
-    let run = rastergi(dir.path(), &[&base[..], &["--gather", "trace", "--out", "lit.exr"]].concat());
-    let log = String::from_utf8_lossy(&run.stderr);
-    assert!(run.status.success(), "{log}");
+    let (lit, log) = from_above(dir.path(), &[], "lit.exr");
     let said: Vec<&str> = log.lines().filter(|l| l.contains("neutral grey environment")).collect();
     assert_eq!(said.len(), 1, "{log}");
     assert!(said[0].contains("scene.gltf: no lights but its emissive surfaces"), "{log}");
-    let run = rastergi(dir.path(), &[&base[..], &["--gather", "trace", "--env", "none", "--out", "dark.exr"]].concat());
-    let log = String::from_utf8_lossy(&run.stderr);
-    assert!(run.status.success() && !log.contains("neutral"), "{log}");
-    let read = |name: &str| rastergi::image_io::read_exr(&dir.path().join(name)).unwrap();
-    let lit = read("lit.exr");
+    let (dark, log) = from_above(dir.path(), &["--env", "none"], "dark.exr");
+    assert!(!log.contains("neutral"), "{log}");
     // Black without the environment: the background, or the emitter's unlit black back.
-    let (black, floor_gain) = where_black(&lit, &read("dark.exr"));
+    let (black, floor_gain) = where_black(&lit, &dark);
     let mut background = 0;
     for l in &black {
         let sky = l.iter().all(|&v| (v - 0.3).abs() < 1e-5);

@@ -19,30 +19,13 @@ fn rastergi(dir: &Path, args: &[&str]) -> Run {
 /// The Cornell box at 32² with the traced gather and photon passes of 4 iterations (so
 /// renders cross pass boundaries), seed `seed`, plus `more`.
 fn gather_args<'a>(seed: &'a str, more: &[&'a str]) -> Vec<&'a str> {
-    let mut a = vec![
-        "render",
-        "cornell",
-        "--width",
-        "32",
-        "--height",
-        "32",
-        "--gather",
-        "trace",
-        "--photons",
-        "20000",
-        "--pass-iterations",
-        "4",
-        "--seed",
-        seed,
-    ];
-    a.extend_from_slice(more);
-    a
+    let gather = ["--gather", "trace", "--photons", "20000", "--pass-iterations", "4", "--seed", seed];
+    common::render_cornell("32", &[&gather[..], more].concat())
 }
 
+/// The Cornell box at 32² with the path tracer, seed `seed`, plus `more`.
 fn path_args<'a>(seed: &'a str, more: &[&'a str]) -> Vec<&'a str> {
-    let mut a = vec!["render", "cornell", "--width", "32", "--height", "32", "--method", "path", "--seed", seed];
-    a.extend_from_slice(more);
-    a
+    common::render_cornell("32", &[&["--method", "path", "--seed", seed][..], more].concat())
 }
 
 fn ok(run: &Run) {
@@ -231,12 +214,6 @@ fn the_time_limit_stops_a_render_that_would_not_end_and_writes_its_image() {
     assert!(dir.path().join("t.png").exists());
 }
 
-/// The references of the Cornell box at 128² (Mitsuba 3, two independent renders).
-fn reference_pair() -> (LinearImage, LinearImage) {
-    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../rastergi/tests/data");
-    (read_exr(&data.join("cornell_path_128_a.exr")).unwrap(), read_exr(&data.join("cornell_path_128_b.exr")).unwrap())
-}
-
 #[test]
 fn the_target_error_stops_when_the_estimate_reaches_it_and_the_estimate_is_the_true_noise() {
     // The path tracer (unbiased: its error is its noise) against Mitsuba's pair: the error
@@ -245,33 +222,15 @@ fn the_target_error_stops_when_the_estimate_reaches_it_and_the_estimate_is_the_t
     // 16 iterations keep the Sobol' sequences' halves stratified).
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let args = [
-        "render",
-        "cornell",
-        "--width",
-        "128",
-        "--height",
-        "128",
-        "--method",
-        "path",
-        "--seed",
-        "4",
-        "--iterations",
-        "100000",
-        "--target-error",
-        "0.07",
-        "--out",
-        "e.exr",
-        "--checkpoint",
-        "e.ckpt",
-    ];
-    let run = rastergi(d, &args);
+    let options = ["--iterations", "100000", "--target-error", "0.07", "--out", "e.exr", "--checkpoint", "e.ckpt"];
+    let run =
+        rastergi(d, &common::render_cornell("128", &[&["--method", "path", "--seed", "4"][..], &options].concat()));
     ok(&run);
     assert!(run.stderr.contains("--target-error 0.07 reached"), "{}", run.stderr);
     let c = Checkpoint::read(&d.join("e.ckpt")).unwrap();
     let estimate = c.film.error_estimate().unwrap();
     assert!(estimate <= 0.07, "stopped at an estimate of {estimate}");
-    let (ra, rb) = reference_pair();
+    let (ra, rb) = common::cornell_reference_pair();
     let image = exr(d, "e.exr");
     // Over the pixels the estimate covers: those that never saw the light itself.
     let (mut mse, mut mean, mut n) = (0.0f64, 0.0f64, 0.0f64);

@@ -20,27 +20,23 @@ fn stderr(o: &Output) -> String {
 #[test]
 fn cornell_keeps_its_documented_defaults_and_atrium_gets_fitted_ones() {
     let dir = tempfile::tempdir().unwrap();
-    // At the size its figures were measured at, 256², the Cornell box keeps 2²⁰ photons and
-    // grid 64 (256² · 64/4 = 2²⁰ photons is where the image's cap begins, fit::photons_for_image).
     let documented = ["--width", "256", "--height", "256", "--iterations", "1", "--out", "out.exr"];
-    let run = rastergi(dir.path(), &[&["render", "cornell"], &documented[..]].concat());
-    let log = stderr(&run);
-    assert!(run.status.success(), "{log}");
-    assert!(log.contains("photons 1048576 (fitted), grid 64 (fitted)"), "{log}");
-    assert!(log.contains("gather ray view: 512x512 texels"), "{log}");
-    // A 16² thumbnail: the grid is the scene's, the photons of a pass the floor of the image's
-    // cap (16² · 64/4 = 4096 < 2¹⁶).
     let small = ["--width", "16", "--height", "16", "--iterations", "1", "--out", "out.exr"];
-    let run = rastergi(dir.path(), &[&["render", "cornell"], &small[..]].concat());
-    let log = stderr(&run);
-    assert!(run.status.success(), "{log}");
-    assert!(log.contains("photons 65536 (fitted), grid 64 (fitted)"), "{log}");
-    assert!(log.contains("gather ray view: 128x128 texels"), "{log}");
-    let run = rastergi(dir.path(), &[&["render", "atrium"], &small[..]].concat());
-    let log = stderr(&run);
-    assert!(run.status.success(), "{log}");
-    assert!(log.contains("photons 65536 (fitted), grid 83 (fitted)"), "{log}");
-    assert!(log.contains("gather ray view: 1030x1030 texels"), "{log}");
+    for (scene, size, fitted, ray_view) in [
+        // At the size its figures were measured at, 256², the Cornell box keeps 2²⁰ photons and
+        // grid 64 (256² · 64/4 = 2²⁰ photons is where the image's cap begins, fit::photons_for_image).
+        ("cornell", &documented, "photons 1048576 (fitted), grid 64 (fitted)", "512x512"),
+        // A 16² thumbnail: the grid is the scene's, the photons of a pass the floor of the image's
+        // cap (16² · 64/4 = 4096 < 2¹⁶).
+        ("cornell", &small, "photons 65536 (fitted), grid 64 (fitted)", "128x128"),
+        ("atrium", &small, "photons 65536 (fitted), grid 83 (fitted)", "1030x1030"),
+    ] {
+        let run = rastergi(dir.path(), &[&["render", scene], &size[..]].concat());
+        let log = stderr(&run);
+        assert!(run.status.success(), "{log}");
+        assert!(log.contains(fitted), "{log}");
+        assert!(log.contains(&format!("gather ray view: {ray_view} texels")), "{log}");
+    }
     // A fixed map (one pass) keeps the scene's count.
     let fixed = [&["render", "atrium", "--photon-passes", "1"], &small[..]].concat();
     let log = stderr(&rastergi(dir.path(), &fixed));

@@ -78,16 +78,16 @@ fn screenshots(dir: &Path, stdout: &str) -> Vec<Shot> {
         .collect()
 }
 
-/// The Cornell box in the viewer (64², few photons) with `seed`, driven by `script` in `d`,
-/// which must succeed: its run and screenshots.
-fn scripted_view(d: &Path, script: &str, seed: u32) -> (Run, Vec<Shot>) {
+/// The Cornell box in the viewer (64², few photons) with `options`, driven by `script` in
+/// `d`, which must succeed: its run and screenshots.
+fn scripted_view(d: &Path, script: &str, options: &[&str]) -> (Run, Vec<Shot>) {
     std::fs::write(d.join("script.txt"), script).unwrap();
-    let seed = seed.to_string();
-    let mut args = vec!["cornell", "--seed", &seed, "--script", "script.txt"];
+    let mut args = vec!["cornell", "--script", "script.txt"];
+    args.extend_from_slice(options);
     args.extend_from_slice(SIZE);
     args.extend_from_slice(PHOTONS);
     let run = view(d, &args);
-    run.check_success("view");
+    run.check_success(&format!("view {}", options.join(" ")));
     let shots = screenshots(d, &run.stdout);
     (run, shots)
 }
@@ -127,7 +127,7 @@ fn screenshots_after_a_scripted_move_match_headless_renders_of_the_same_view() {
     let script = format!(
         "after {N} iterations: orbit 8,4\nafter {N} iterations: exposure 1\nscreenshot\nshow direct\nscreenshot\nquit\n"
     );
-    let (run, shots) = scripted_view(d, &script, SEED);
+    let (run, shots) = scripted_view(d, &script, &["--seed", &SEED.to_string()]);
     assert!(run.stdout.contains("Keys and mouse:"), "the keys are printed at start:\n{}", run.stdout);
     assert_eq!(shots.len(), 2, "{}", run.stdout);
     assert_eq!(std::fs::read(d.join("rastergi-0001.png")).unwrap(), b"an earlier screenshot");
@@ -184,14 +184,8 @@ fn resizing_and_retracing_rebuild_the_image_at_the_window_size() {
     let d = dir.path();
     let script = "after 2 iterations: resize 48,40\nafter 3 iterations: screenshot\nphotons 8192\ngrid 8\n\
                   after 2 iterations: screenshot\nquit\n";
-    std::fs::write(d.join("script.txt"), script).unwrap();
-    let mut args = vec!["cornell", "--script", "script.txt", "--screenshot-dir", "shots"];
-    args.extend_from_slice(SIZE);
-    args.extend_from_slice(PHOTONS);
     std::fs::create_dir(d.join("shots")).unwrap();
-    let run = view(d, &args);
-    run.check_success("view");
-    let shots = screenshots(d, &run.stdout);
+    let (run, shots) = scripted_view(d, script, &["--screenshot-dir", "shots"]);
     assert_eq!(shots.len(), 2, "{}", run.stdout);
     assert_eq!((shots[0].iterations, shots[0].size), (3, (48, 40)));
     assert_eq!((shots[1].iterations, shots[1].size), (2, (48, 40)), "the new photon map restarted the image");
@@ -215,13 +209,7 @@ fn turning_the_sun_re_traces_and_shows_what_a_render_with_that_sun_shows() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let script = "show direct\nafter 4 iterations: screenshot\nsun 340,15\nafter 4 iterations: screenshot\nquit\n";
-    std::fs::write(d.join("script.txt"), script).unwrap();
-    let mut args = vec!["cornell", "--script", "script.txt", "--sun", "20,25,1.5"];
-    args.extend_from_slice(SIZE);
-    args.extend_from_slice(PHOTONS);
-    let run = view(d, &args);
-    run.check_success("view");
-    let shots = screenshots(d, &run.stdout);
+    let (run, shots) = scripted_view(d, script, &["--sun", "20,25,1.5"]);
     assert_eq!(shots.len(), 2, "{}", run.stdout);
     assert_eq!(shots[1].iterations, 4, "the new sun restarted the image");
     for (shot, sun) in shots.iter().zip(["20,25,1.5", "340,15,1.5"]) {
@@ -246,7 +234,7 @@ fn the_panels_actions_switch_the_method_the_gather_and_the_scene_as_render_optio
     let script = "method path\nafter 4 iterations: screenshot\nmethod gather\ngather trace\n\
                   gather-directions shared\ndirections 2\nafter 4 iterations: screenshot\nopen no-such.obj\nopen rooms\n\
                   after 2 iterations: screenshot\nquit\n";
-    let (run, shots) = scripted_view(d, script, SEED);
+    let (run, shots) = scripted_view(d, script, &["--seed", &SEED.to_string()]);
     assert_eq!(shots.len(), 3, "{}", run.stdout);
     let gather = ["--gather", "trace", "--gather-directions", "shared", "--directions", "2"];
     let cases = [
@@ -279,18 +267,8 @@ fn the_denoiser_toggle_shows_what_render_denoise_writes() {
     const SEED: u32 = 4;
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    std::fs::write(
-        d.join("script.txt"),
-        "after 4 iterations: screenshot\nexposure 1\nscreenshot\ndenoise off\nscreenshot\nquit\n",
-    )
-    .unwrap();
-    let seed = SEED.to_string();
-    let mut args = vec!["cornell", "--seed", &seed, "--script", "script.txt", "--denoise", "--gather", "trace"];
-    args.extend_from_slice(SIZE);
-    args.extend_from_slice(PHOTONS);
-    let run = view(d, &args);
-    run.check_success("view --denoise");
-    let shots = screenshots(d, &run.stdout);
+    let script = "after 4 iterations: screenshot\nexposure 1\nscreenshot\ndenoise off\nscreenshot\nquit\n";
+    let (run, shots) = scripted_view(d, script, &["--seed", &SEED.to_string(), "--denoise", "--gather", "trace"]);
     assert_eq!(shots.len(), 3, "{}", run.stdout);
     let lines: Vec<&str> = run.stdout.lines().filter(|l| l.starts_with("screenshot: ")).collect();
     for (line, denoised) in lines.iter().zip([true, true, false]) {
@@ -320,7 +298,7 @@ fn the_denoiser_toggle_shows_what_render_denoise_writes() {
     // start then, so the image restarts and the screenshot holds the 3 iterations since;
     // turned off, the same iterations raw.
     let script = "after 2 iterations: denoise on\nafter 3 iterations: screenshot\ndenoise off\nscreenshot\nquit\n";
-    let (run, shots) = scripted_view(d, script, SEED);
+    let (run, shots) = scripted_view(d, script, &["--seed", &SEED.to_string()]);
     assert_eq!(shots.len(), 2, "{}", run.stdout);
     assert!(shots.iter().all(|s| s.iterations == 3), "{}", run.stdout);
     assert!(run.stdout.contains("show full denoised,"), "{}", run.stdout);

@@ -15,7 +15,7 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use rastergi::image_io::{LinearImage, read_exr, read_png};
+use rastergi::image_io::{LinearImage, read_png};
 use rastergi::metrics::{emitter_mask, masked_mean, rmse};
 
 fn repo() -> PathBuf {
@@ -80,24 +80,8 @@ fn the_web_page_renders_the_cornell_box_as_the_native_renderer_does() {
 
     let native = |seed: &str, denoise: bool| {
         let out = dir.path().join(format!("native-{seed}-{denoise}.png"));
-        let mut args = vec![
-            "render",
-            "cornell",
-            "--width",
-            "128",
-            "--height",
-            "128",
-            "--iterations",
-            "64",
-            "--gather",
-            "trace",
-            "--seed",
-            seed,
-            "--exposure",
-            "0",
-            "--out",
-            out.to_str().unwrap(),
-        ];
+        let options = ["--iterations", "64", "--gather", "trace", "--seed", seed, "--exposure", "0", "--out"];
+        let mut args = common::render_cornell("128", &[&options[..], &[out.to_str().unwrap()]].concat());
         if denoise {
             args.push("--denoise");
         }
@@ -118,8 +102,7 @@ fn the_web_page_renders_the_cornell_box_as_the_native_renderer_does() {
     }
     // The denoised image is denoised: closer to Mitsuba's (emitters masked; the light is
     // clamped in the PNGs).
-    let data = |f: &str| read_exr(&repo().join("crates/rastergi/tests/data").join(f)).unwrap();
-    let (ra, rb) = (data("cornell_path_128_a.exr"), data("cornell_path_128_b.exr"));
+    let (ra, rb) = common::cornell_reference_pair();
     let pixels = ra.pixels.iter().zip(&rb.pixels).map(|(a, b)| std::array::from_fn(|c| (a[c] + b[c]) / 2.0)).collect();
     let reference = LinearImage { width: ra.width, height: ra.height, pixels };
     let mask = emitter_mask(&reference, 1.0);

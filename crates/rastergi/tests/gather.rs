@@ -113,11 +113,21 @@ fn mismatches_against_cpu_raycast(method: GatherMethod, directions: GatherDirect
     (mismatched, compared)
 }
 
+/// The fraction of the pixel estimates of `method` with `directions` that differ from the
+/// CPU ray cast, printed with `label`.
+fn mismatch_fraction(label: &str, method: GatherMethod, directions: GatherDirections) -> f64 {
+    let (mismatched, compared) = mismatches_against_cpu_raycast(method, directions);
+    let fraction = mismatched as f64 / compared as f64;
+    println!(
+        "{label}: {mismatched} of {compared} pixel estimates differ from the ray cast ({:.3} %)",
+        100.0 * fraction
+    );
+    fraction
+}
+
 #[test]
 fn raster_gather_matches_cpu_raycast_for_same_directions_except_at_ray_view_edges() {
-    let (mismatched, compared) = mismatches_against_cpu_raycast(GatherMethod::Raster, GatherDirections::Shared);
-    let fraction = mismatched as f64 / compared as f64;
-    println!("raster: {mismatched} of {compared} pixel estimates differ from the ray cast ({:.2} %)", 100.0 * fraction);
+    let fraction = mismatch_fraction("raster", GatherMethod::Raster, GatherDirections::Shared);
     // A rasterized gather samples each ray-view texel at one point: a gather ray passing
     // within a texel of a silhouette in the ray view may see the other surface. With a
     // 512² bundle over the scene's bounding sphere (diameter 3.5: texels ≈ 0.007 wide) and
@@ -129,9 +139,7 @@ fn raster_gather_matches_cpu_raycast_for_same_directions_except_at_ray_view_edge
 
 #[test]
 fn list_gather_matches_cpu_raycast_for_same_directions_except_at_ray_view_edges() {
-    let (mismatched, compared) = mismatches_against_cpu_raycast(GatherMethod::Lists, GatherDirections::Shared);
-    let fraction = mismatched as f64 / compared as f64;
-    println!("lists: {mismatched} of {compared} pixel estimates differ from the ray cast ({:.2} %)", 100.0 * fraction);
+    let fraction = mismatch_fraction("lists", GatherMethod::Lists, GatherDirections::Shared);
     // The same texel approximation as the peeled raster gather, hence the same bound; a
     // fragment pool too small for the view would lose fragments everywhere and fail it.
     assert!(fraction < 0.05, "{:.2} % of the gather estimates disagree with the ray cast", 100.0 * fraction);
@@ -139,9 +147,7 @@ fn list_gather_matches_cpu_raycast_for_same_directions_except_at_ray_view_edges(
 
 #[test]
 fn traced_gather_matches_cpu_raycast_for_same_directions() {
-    let (mismatched, compared) = mismatches_against_cpu_raycast(GatherMethod::Trace, GatherDirections::Shared);
-    let fraction = mismatched as f64 / compared as f64;
-    println!("trace: {mismatched} of {compared} pixel estimates differ from the ray cast ({:.3} %)", 100.0 * fraction);
+    let fraction = mismatch_fraction("trace", GatherMethod::Trace, GatherDirections::Shared);
     // The same ray against the same BVH in f32 on both sides: they can only disagree for a
     // ray that passes within rounding error of a triangle edge, where the two Möller–Trumbore
     // evaluations may pick different neighbours — a vanishing fraction of 23 000 rays.
@@ -150,12 +156,7 @@ fn traced_gather_matches_cpu_raycast_for_same_directions() {
 
 #[test]
 fn per_pixel_traced_gather_matches_cpu_raycast_of_the_same_sobol_directions() {
-    let (mismatched, compared) = mismatches_against_cpu_raycast(GatherMethod::Trace, GatherDirections::PerPixel);
-    let fraction = mismatched as f64 / compared as f64;
-    println!(
-        "per-pixel: {mismatched} of {compared} pixel estimates differ from the ray cast ({:.3} %)",
-        100.0 * fraction
-    );
+    let fraction = mismatch_fraction("per-pixel", GatherMethod::Trace, GatherDirections::PerPixel);
     // The Sobol' points agree bit for bit (tested below); the directions from them may differ
     // in the last bits (the GPU's sin, cos and sqrt), which moves a ray across a triangle edge
     // only where it passes within rounding error of one: 4 rays per estimate, so 4× the

@@ -59,9 +59,16 @@ fn add_room(s: &mut Scene, lo: Vec3, hi: Vec3, m: u32) {
     s.add_quad([c(1., 0., 0.), c(1., 0., 1.), c(1., 1., 1.), c(1., 1., 0.)], m); // right, -x
 }
 
-/// The emitted power of [`closed_box`] of albedo `a`, and its photon map for `settings` (on a
-/// grid of `settings.grid_resolution` cells along the box) traced on the GPU and by the CPU twin.
-fn closed_box_maps(a: f64, settings: PhotonSettings) -> (glam::DVec3, [(&'static str, PhotonMap); 2]) {
+/// The emitted power of [`closed_box`] of albedo `a`, and its photon map of `count` photons
+/// with `seed` (all deposits or, with `indirect_only`, those after the first surface; on a
+/// grid of 16 cells along the box) traced on the GPU and by the CPU twin.
+fn closed_box_maps(
+    a: f64,
+    count: u32,
+    seed: u32,
+    indirect_only: bool,
+) -> (glam::DVec3, [(&'static str, PhotonMap); 2]) {
+    let settings = PhotonSettings { count, seed, grid_resolution: 16, indirect_only, region: None };
     let gpu = common::gpu();
     let scene = closed_box(a as f32);
     let grid = GridSpec::new(&scene.bounds(), settings.grid_resolution);
@@ -69,14 +76,18 @@ fn closed_box_maps(a: f64, settings: PhotonSettings) -> (glam::DVec3, [(&'static
     (scene.emitted_power().as_dvec3(), [("gpu", gpu_map(&gpu, &scene, &settings)), ("cpu", cpu_map)])
 }
 
+/// Checks a map's `got` for channel `c` against `expected` to four relative standard
+/// deviations `sigma`, printing both as the `what` of map `name`.
+fn assert_within_four_sigma(name: &str, c: usize, what: &str, got: f64, expected: f64, sigma: f64) {
+    println!("{name} channel {c}: {what} {got:.5} expected {expected:.5}");
+    assert!((got / expected - 1.0).abs() < 4.0 * sigma, "{name} channel {c}: {got} vs {expected} (σ = {sigma})");
+}
+
 #[test]
 fn closed_box_average_irradiance_matches_power_over_area_times_one_minus_albedo() {
     let a = 0.5f64;
     let n = 1u32 << 20;
-    let (power, maps) = closed_box_maps(
-        a,
-        PhotonSettings { count: n, seed: 5, grid_resolution: 16, indirect_only: false, region: None },
-    );
+    let (power, maps) = closed_box_maps(a, n, 5, false);
     // Every surface side that reflects: 6 walls of area 4, both sides of the 0.4×0.4 light.
     let area = 24.0 + 2.0 * 0.16;
     // Each photon deposits Φ at every hit and survives with probability a at flux Φ·a/a:
@@ -88,12 +99,7 @@ fn closed_box_average_irradiance_matches_power_over_area_times_one_minus_albedo(
         let flux = map.total_flux();
         for c in 0..3 {
             let expected = power[c] / (area * (1.0 - a));
-            let got = flux[c] / total_area(&map);
-            println!("{name} channel {c}: average irradiance {got:.5} expected {expected:.5}");
-            assert!(
-                (got / expected - 1.0).abs() < 4.0 * sigma,
-                "{name} channel {c}: {got} vs {expected} (σ = {sigma})"
-            );
+            assert_within_four_sigma(name, c, "average irradiance", flux[c] / total_area(&map), expected, sigma);
         }
     }
 }
@@ -225,21 +231,12 @@ fn an_indirect_only_map_holds_the_albedo_times_the_full_maps_energy() {
     // map's. Var[K − 1] = a/(1−a)² again: relative standard deviation sqrt(1/(aN)).
     let a = 0.5f64;
     let n = 1u32 << 20;
-    let (power, maps) = closed_box_maps(
-        a,
-        PhotonSettings { count: n, seed: 6, grid_resolution: 16, indirect_only: true, region: None },
-    );
+    let (power, maps) = closed_box_maps(a, n, 6, true);
     let sigma = (1.0 / (a * n as f64)).sqrt();
     for (name, map) in maps {
         let flux = map.total_flux();
         for c in 0..3 {
-            let expected = power[c] * a / (1.0 - a);
-            println!("{name} channel {c}: indirect flux {:.5} expected {expected:.5}", flux[c]);
-            assert!(
-                (flux[c] / expected - 1.0).abs() < 4.0 * sigma,
-                "{name} channel {c}: {} vs {expected} (σ = {sigma})",
-                flux[c]
-            );
+            assert_within_four_sigma(name, c, "indirect flux", flux[c], power[c] * a / (1.0 - a), sigma);
         }
     }
 }

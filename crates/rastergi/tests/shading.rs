@@ -6,7 +6,6 @@ mod common;
 
 use std::path::Path;
 
-use base64::Engine;
 use glam::Vec3;
 use rastergi::environment::Environment;
 use rastergi::film::Show;
@@ -57,26 +56,14 @@ fn obj_vertex_normals_are_read_per_corner_and_normalised() {
 /// A glTF file of one triangle in the z = 0 plane with the given NORMALs, under a node of
 /// scale `scale`.
 fn gltf_triangle(dir: &Path, normals: [[f32; 3]; 3], scale: [f32; 3]) -> std::path::PathBuf {
-    let positions: [[f32; 3]; 3] = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
-    let bytes: Vec<u8> = positions.iter().chain(&normals).flatten().flat_map(|v| v.to_le_bytes()).collect();
-    let uri =
-        format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(&bytes));
     let doc = json!({
         "asset": { "version": "2.0" },
-        "buffers": [{ "byteLength": bytes.len(), "uri": uri }],
-        "bufferViews": [
-            { "buffer": 0, "byteOffset": 0, "byteLength": 36 },
-            { "buffer": 0, "byteOffset": 36, "byteLength": 36 }
-        ],
-        "accessors": [
-            { "bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0] },
-            { "bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC3" }
-        ],
         "meshes": [{ "primitives": [{ "attributes": { "POSITION": 0, "NORMAL": 1, "COLOR_0": 1, "TEXCOORD_1": 0 } }] }],
         "nodes": [{ "mesh": 0, "scale": scale }],
         "scenes": [{ "nodes": [0] }],
         "scene": 0
     });
+    let doc = common::with_unit_triangle(doc, &[("VEC3", normals.as_flattened())]);
     let path = dir.join("t.gltf");
     std::fs::write(&path, serde_json::to_vec(&doc).unwrap()).unwrap();
     path

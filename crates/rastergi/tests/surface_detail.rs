@@ -274,27 +274,11 @@ fn gltf_alpha_normal_maps_emissive_textures_and_texture_transforms_are_read() {
     let dir = tempfile::tempdir().unwrap();
     image::RgbaImage::from_pixel(2, 2, image::Rgba([255, 128, 0, 100])).save(dir.path().join("base.png")).unwrap();
     image::RgbaImage::from_pixel(2, 2, image::Rgba([128, 128, 255, 255])).save(dir.path().join("normal.png")).unwrap();
-    let positions: [[f32; 3]; 3] = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
     let uvs: [[f32; 2]; 3] = [[0.0, 1.0], [1.0, 1.0], [0.0, 0.0]];
-    let mut bytes: Vec<u8> = positions.iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
-    bytes.extend(uvs.iter().flatten().flat_map(|v| v.to_le_bytes()));
-    let uri = format!(
-        "data:application/octet-stream;base64,{}",
-        base64::Engine::encode(&base64::engine::general_purpose::STANDARD, &bytes)
-    );
     let transform = json!({ "KHR_texture_transform": { "offset": [0, 1], "rotation": std::f32::consts::FRAC_PI_2, "scale": [0.5, 0.5] } });
     let doc = json!({
         "asset": { "version": "2.0" },
         "extensionsUsed": ["KHR_texture_transform"],
-        "buffers": [{ "byteLength": bytes.len(), "uri": uri }],
-        "bufferViews": [
-            { "buffer": 0, "byteOffset": 0, "byteLength": 36 },
-            { "buffer": 0, "byteOffset": 36, "byteLength": 24 }
-        ],
-        "accessors": [
-            { "bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0] },
-            { "bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2" }
-        ],
         "images": [{ "uri": "base.png" }, { "uri": "normal.png" }],
         "textures": [{ "source": 0 }, { "source": 1 }],
         "materials": [
@@ -319,6 +303,7 @@ fn gltf_alpha_normal_maps_emissive_textures_and_texture_transforms_are_read() {
         "scenes": [{ "nodes": [0] }],
         "scene": 0
     });
+    let doc = common::with_unit_triangle(doc, &[("VEC2", uvs.as_flattened())]);
     let path = dir.path().join("m.gltf");
     std::fs::write(&path, serde_json::to_vec(&doc).unwrap()).unwrap();
     let scene = load_gltf(&path).unwrap();
@@ -399,30 +384,11 @@ fn gltf_tangents_follow_the_transform_and_flip_handedness_when_mirrored() {
     // A triangle in z = 0 (front +z) with TANGENT (1, 0, 0, +1): bitangent w · n × t = +y.
     let dir = tempfile::tempdir().unwrap();
     image::RgbaImage::from_pixel(1, 1, image::Rgba([128, 128, 255, 255])).save(dir.path().join("n.png")).unwrap();
-    let positions: [[f32; 3]; 3] = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
     let uvs: [[f32; 2]; 3] = [[0.0, 1.0], [1.0, 1.0], [0.0, 0.0]];
     let tangents: [[f32; 4]; 3] = [[1.0, 0.0, 0.0, 1.0]; 3];
-    let mut bytes: Vec<u8> = positions.iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
-    bytes.extend(uvs.iter().flatten().flat_map(|v| v.to_le_bytes()));
-    bytes.extend(tangents.iter().flatten().flat_map(|v| v.to_le_bytes()));
-    let uri = format!(
-        "data:application/octet-stream;base64,{}",
-        base64::Engine::encode(&base64::engine::general_purpose::STANDARD, &bytes)
-    );
     let file = |scale: [f32; 3]| {
         let doc = json!({
             "asset": { "version": "2.0" },
-            "buffers": [{ "byteLength": bytes.len(), "uri": uri }],
-            "bufferViews": [
-                { "buffer": 0, "byteOffset": 0, "byteLength": 36 },
-                { "buffer": 0, "byteOffset": 36, "byteLength": 24 },
-                { "buffer": 0, "byteOffset": 60, "byteLength": 48 }
-            ],
-            "accessors": [
-                { "bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0] },
-                { "bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2" },
-                { "bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC4" }
-            ],
             "images": [{ "uri": "n.png" }],
             "textures": [{ "source": 0 }],
             "materials": [{ "normalTexture": { "index": 0 } }],
@@ -431,6 +397,7 @@ fn gltf_tangents_follow_the_transform_and_flip_handedness_when_mirrored() {
             "scenes": [{ "nodes": [0] }],
             "scene": 0
         });
+        let doc = common::with_unit_triangle(doc, &[("VEC2", uvs.as_flattened()), ("VEC4", tangents.as_flattened())]);
         let path = dir.path().join("t.gltf");
         std::fs::write(&path, serde_json::to_vec(&doc).unwrap()).unwrap();
         load_gltf(&path).unwrap()

@@ -521,25 +521,23 @@ mod tests {
         )
     }
 
+    /// Clicks the widgets labelled `labels` in turn, running a frame after each.
+    fn click(h: &mut Harness<'static, Model>, labels: &[&str]) {
+        for label in labels {
+            h.get_by_label(label).click();
+            h.run();
+        }
+    }
+
     #[test]
     fn the_panels_widgets_give_the_scripts_actions() {
         let mut h = harness();
         h.run();
-        h.get_by_label("path tracer").click();
-        h.run();
+        click(&mut h, &["path tracer"]);
         assert_eq!(h.state().actions, [Action::Method(Method::Path)]);
         assert!(h.query_by_label("photons").is_none(), "no photon map settings for the path tracer");
         assert!(h.get_by_label("denoise").accesskit_node().is_disabled(), "the path tracer has no denoiser");
-        h.get_by_label("photon map + gather").click();
-        h.run();
-        h.get_by_label("shared").click();
-        h.run();
-        h.get_by_label("Screenshot").click();
-        h.run();
-        h.get_by_label("denoise").click();
-        h.run();
-        h.get_by_label("indirect").click();
-        h.run();
+        click(&mut h, &["photon map + gather", "shared", "Screenshot", "denoise", "indirect"]);
         assert!(h.get_by_label("denoise").accesskit_node().is_disabled(), "the denoiser filters the full image alone");
         assert_eq!(
             h.state().actions[1..],
@@ -561,18 +559,7 @@ mod tests {
     fn the_panels_menus_choose_the_gather_the_photons_and_a_scene() {
         let mut h = harness();
         h.run();
-        h.get_by_label("gather").click();
-        h.run();
-        h.get_by_label("trace").click();
-        h.run();
-        h.get_by_label("photons").click();
-        h.run();
-        h.get_by_label("2^20 = 1048576").click();
-        h.run();
-        h.get_by_label("built in").click();
-        h.run();
-        h.get_by_label("atrium").click();
-        h.run();
+        click(&mut h, &["gather", "trace", "photons", "2^20 = 1048576", "built in", "atrium"]);
         assert_eq!(
             h.state().actions,
             [Action::Gather(GatherMethod::Trace), Action::Photons(1 << 20), Action::Open("atrium".into())]

@@ -7,6 +7,8 @@ use std::path::Path;
 use std::process::{Command, ExitStatus, Stdio};
 use std::time::{Duration, Instant};
 
+use rastergi::image_io::{LinearImage, read_exr};
+
 /// A finished run: its exit status and what it printed.
 pub struct Run {
     pub status: ExitStatus,
@@ -74,9 +76,29 @@ pub fn run(dir: &Path, program: &str, args: &[&str], env: &[(&str, Option<&str>)
     Run { status, stdout: read(&stdout_path), stderr: read(&stderr_path) }
 }
 
+/// The arguments of `rastergi render cornell` at `size` × `size` pixels, then `more`.
+pub fn render_cornell<'a>(size: &'a str, more: &[&'a str]) -> Vec<&'a str> {
+    [&["render", "cornell", "--width", size, "--height", size][..], more].concat()
+}
+
+/// The Cornell box's references at 128² (Mitsuba 3, two independent renders of its path
+/// tracer).
+pub fn cornell_reference_pair() -> (LinearImage, LinearImage) {
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../rastergi/tests/data");
+    (read_exr(&data.join("cornell_path_128_a.exr")).unwrap(), read_exr(&data.join("cornell_path_128_b.exr")).unwrap())
+}
+
 /// Runs the `rastergi` binary with `args` in `dir`.
 pub fn rastergi(dir: &Path, args: &[&str], timeout: Duration) -> Run {
     run(dir, env!("CARGO_BIN_EXE_rastergi"), args, &[], timeout)
+}
+
+/// The names of the files in `dir`, sorted.
+pub fn files_in(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> =
+        std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    names.sort();
+    names
 }
 
 /// The first Python that imports `modules` (comma-separated, e.g. "maturin, pytest") among

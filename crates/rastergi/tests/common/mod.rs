@@ -5,6 +5,9 @@ pub mod textured_room;
 
 use std::path::PathBuf;
 
+use base64::Engine as _;
+use serde_json::{Value, json};
+
 use rastergi::film::Show;
 use rastergi::gpu::{Gpu, GpuOptions};
 use rastergi::image_io::{LinearImage, read_exr};
@@ -296,4 +299,28 @@ pub fn maps_agree_within_noise(
     assert!((mean_z2 - 1.0).abs() < 0.25, "GPU and CPU maps differ beyond noise: mean z² = {mean_z2}");
     assert!(max_z < 6.0, "a slot differs beyond noise: |z| = {max_z}");
     (cells, mean_z2)
+}
+
+/// `doc`, a glTF document, with the `buffers`, `bufferViews` and `accessors` of one triangle,
+/// (0, 0, 0), (1, 0, 0), (0, 1, 0): accessor 0 its positions, then one float accessor per
+/// entry of `attributes` (its type, "VEC2" to "VEC4", and its values for the three corners),
+/// all in one buffer embedded as a base64 `data:` URI.
+pub fn with_unit_triangle(mut doc: Value, attributes: &[(&str, &[f32])]) -> Value {
+    let positions: [[f32; 3]; 3] = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    let mut bytes: Vec<u8> = positions.as_flattened().iter().flat_map(|v| v.to_le_bytes()).collect();
+    let mut views = vec![json!({ "buffer": 0, "byteOffset": 0, "byteLength": 36 })];
+    let mut accessors = vec![
+        json!({ "bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0] }),
+    ];
+    for (kind, values) in attributes {
+        accessors.push(json!({ "bufferView": views.len(), "componentType": 5126, "count": 3, "type": kind }));
+        views.push(json!({ "buffer": 0, "byteOffset": bytes.len(), "byteLength": 4 * values.len() }));
+        bytes.extend(values.iter().flat_map(|v| v.to_le_bytes()));
+    }
+    let uri =
+        format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(&bytes));
+    doc["buffers"] = json!([{ "byteLength": bytes.len(), "uri": uri }]);
+    doc["bufferViews"] = json!(views);
+    doc["accessors"] = json!(accessors);
+    doc
 }

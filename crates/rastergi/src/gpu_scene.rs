@@ -5,16 +5,16 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3, Vec4};
 
-use crate::accel::{RayPath, Rays, SceneAccel};
 use crate::bvh::Bvh;
 use crate::bvh::wide::WideNode;
 use crate::error::Result;
+use crate::gpu::accel::{RayPath, Rays, SceneAccel};
 use wgpu::util::DeviceExt;
 
 use crate::environment::{Environment, GpuEnvironment};
+use crate::gpu::limits::check_storage_buffer;
 use crate::gpu::{Gpu, atlas_texture_entry, bind_group_layout, float_table_entry, storage_entry, uniform_entry};
 use crate::lights::{LightEntry, LightTable};
-use crate::limits::check_storage_buffer;
 use crate::scene::{Aabb, AlphaMode, Material, Scene, TextureRef, UvTransform};
 use crate::textures::TextureAtlas;
 
@@ -104,7 +104,7 @@ pub struct GpuMaterialMaps {
     pub clearcoat_roughness_map: GpuTextureSlot,
 }
 
-pub use crate::consts::GpuSceneOffsets;
+pub use crate::gpu::consts::GpuSceneOffsets;
 
 /// The GGX albedo tables as gpu_scene.wgsl reads them: the cells and means, N × (N + 1)
 /// RGBA32F, and the rough glass's, N × (cells / N) R32F. Computed and filled only where some
@@ -218,7 +218,7 @@ impl GpuMaterial {
     }
 }
 
-pub use crate::consts::{
+pub use crate::gpu::consts::{
     MATERIAL_ALPHA_BLEND, MATERIAL_ALPHA_MASK, MATERIAL_LAMBERTIAN, MATERIAL_SINGLE_SCATTERING, MATERIAL_TEXTURED,
     MATERIAL_THIN, MATERIAL_TWO_SIDED, NO_TEXTURE, TRIANGLE_HAS_HOLES,
 };
@@ -467,17 +467,17 @@ impl GpuScene {
     }
 
     /// A shader module of `source` (a composed shader that reads this scene) on this scene's
-    /// ray path ([`crate::shader::for_rays`]).
+    /// ray path ([`crate::gpu::shader::for_rays`]).
     pub fn module(&self, device: &wgpu::Device, label: &str, source: &str) -> wgpu::ShaderModule {
         self.module_for(device, label, source, self.rays)
     }
 
     /// [`Self::module`] on ray path `path` (the hardware one needs [`Self::accel`]).
     pub fn module_for(&self, device: &wgpu::Device, label: &str, source: &str, path: RayPath) -> wgpu::ShaderModule {
-        crate::shader::module(device, label, &crate::shader::for_rays(source, path))
+        crate::gpu::shader::module(device, label, &crate::gpu::shader::for_rays(source, path))
     }
 
-    /// Uploads `prepared`, after checking that its buffers fit the device (see [`crate::limits`]).
+    /// Uploads `prepared`, after checking that its buffers fit the device (see [`crate::gpu::limits`]).
     pub fn new(gpu: &Gpu, prepared: &PreparedScene) -> Result<GpuScene> {
         let limits = gpu.device.limits();
         check_scene(&limits, &prepared.scene)?;
@@ -542,7 +542,7 @@ impl GpuScene {
         }
         let env = s.environment.as_deref();
         let env_data = env.map_or(vec![0.0f32; 4], Environment::gpu_data);
-        crate::limits::check_storage_buffer(
+        crate::gpu::limits::check_storage_buffer(
             &limits,
             "the environment map",
             env_data.len() as u64,
@@ -573,7 +573,7 @@ impl GpuScene {
             ..GpuSceneOffsets::default()
         };
         data.words[..size_of::<GpuSceneOffsets>() / 4].copy_from_slice(bytemuck::cast_slice(&[offsets]));
-        crate::limits::check_storage_buffer(
+        crate::gpu::limits::check_storage_buffer(
             &limits,
             "the scene's texture coordinates, normals, tangents, lights and environment map",
             data.words.len() as u64,
@@ -583,9 +583,9 @@ impl GpuScene {
         let none = wgpu::BufferUsages::empty();
         // Ray queries where the device has them and the compute path was not asked for: the
         // triangles are then also the BLAS's vertices (accel::build).
-        let ray_queries = gpu.rays != Rays::Compute && crate::accel::device_has_ray_queries(&gpu.device);
+        let ray_queries = gpu.rays != Rays::Compute && crate::gpu::accel::device_has_ray_queries(&gpu.device);
         if gpu.rays == Rays::Hardware && !ray_queries {
-            return Err(crate::accel::not_offered(&gpu.info.name));
+            return Err(crate::gpu::accel::not_offered(&gpu.info.name));
         }
         let blas_input = if ray_queries { wgpu::BufferUsages::BLAS_INPUT } else { none };
         let buffers = [
@@ -607,11 +607,11 @@ impl GpuScene {
         // estimates, tests/gather.rs).
         let compute = wgpu::ShaderStages::COMPUTE;
         let accel = if ray_queries && !triangles.is_empty() {
-            Some(crate::accel::build(gpu, &buffers[0], triangles.len() as u32)?)
+            Some(crate::gpu::accel::build(gpu, &buffers[0], triangles.len() as u32)?)
         } else {
             None
         };
-        let tlas_entry = accel.as_ref().map(|_| crate::accel::tlas_entry());
+        let tlas_entry = accel.as_ref().map(|_| crate::gpu::accel::tlas_entry());
         let layout = bind_group_layout(
             &gpu.device,
             "scene",
@@ -643,7 +643,7 @@ impl GpuScene {
         entries.push(wgpu::BindGroupEntry { binding: 14, resource: wgpu::BindingResource::TextureView(&glass) });
         if let Some(a) = &accel {
             entries.push(wgpu::BindGroupEntry {
-                binding: crate::accel::TLAS_BINDING,
+                binding: crate::gpu::accel::TLAS_BINDING,
                 resource: wgpu::BindingResource::AccelerationStructure(&a.tlas),
             });
         }
@@ -742,7 +742,7 @@ pub fn check_bvh_nodes(limits: &wgpu::Limits, nodes: usize) -> Result<()> {
 mod limit_tests {
     use super::*;
 
-    use crate::limits::test_limits as limits;
+    use crate::gpu::limits::test_limits as limits;
 
     #[test]
     fn a_scene_whose_triangles_exceed_the_binding_limit_is_refused_with_the_sizes() {

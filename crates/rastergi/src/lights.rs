@@ -15,7 +15,7 @@ use crate::scene::{Light, Scene, triangle_area, triangle_normal};
 
 /// [`LightEntry::triangle`] bit of an entry that is a [`PunctualLight`] (the other bits: its
 /// index in [`LightTable::punctual`]); [`PunctualLight::kind`] values.
-pub use crate::consts::{ENVIRONMENT_LIGHT, LIGHT_DISTANT, LIGHT_POINT, LIGHT_SPOT, PUNCTUAL_LIGHT};
+pub use crate::gpu::consts::{ENVIRONMENT_LIGHT, LIGHT_DISTANT, LIGHT_POINT, LIGHT_SPOT, PUNCTUAL_LIGHT};
 
 /// One light of the distribution, as stored on the GPU (`LightEntry` in `gpu_scene.wgsl`).
 #[repr(C)]
@@ -291,7 +291,7 @@ pub struct PhotonAim {
     pub radius: f32,
 }
 
-pub use crate::consts::{AIM_FRACTION, NEAR_FRACTION, NEAR_SCALE};
+pub use crate::gpu::consts::{AIM_FRACTION, NEAR_FRACTION, NEAR_SCALE};
 
 /// The start of a photon crossing the sphere (`centre`, `radius`) along `axis`, from (u1, u2):
 /// its origin on the disc of that radius perpendicular to `axis` before the sphere, and

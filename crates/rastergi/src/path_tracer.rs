@@ -40,14 +40,14 @@
 use bytemuck::{Pod, Zeroable};
 
 use crate::error::Result;
-use crate::film::{Film, Show};
-use crate::frame::{FrameBinding, FrameUniforms, pixel_jitter};
+use crate::gpu::shader;
 use crate::gpu::{Gpu, bind_group_layout, buffer_bind_group, groups, storage_entry, uniform_entry};
 use crate::gpu_scene::{GpuScene, PreparedScene};
 use crate::image_io::{DisplayImage, LinearImage};
+use crate::passes::film::{Film, Show};
+use crate::passes::frame::{FrameBinding, FrameUniforms, pixel_jitter};
 use crate::renderer::RenderSettings;
 use crate::scene::{Camera, Scene};
-use crate::shader;
 
 /// Scattering events after which every path ends (a safety cap; roulette ends them first).
 pub const MAX_BOUNCES: u32 = 1024;
@@ -200,12 +200,12 @@ impl PathTracer {
     pub fn iterate(&mut self) {
         let (w, h) = (self.settings.width, self.settings.height);
         // The film's error estimate: blocks of BLOCK_ITERATIONS iterations.
-        self.film.begin_iteration(&self.gpu, self.film.samples / crate::film::BLOCK_ITERATIONS);
+        self.film.begin_iteration(&self.gpu, self.film.samples / crate::passes::film::BLOCK_ITERATIONS);
         self.write_uniforms(self.film.samples);
         let mut enc =
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("path tracer") });
         {
-            let mut pass = crate::profile::compute_pass(&mut enc, self.gpu.profiler.as_ref(), "path tracer");
+            let mut pass = crate::gpu::profile::compute_pass(&mut enc, self.gpu.profiler.as_ref(), "path tracer");
             pass.set_pipeline(&self.trace);
             pass.set_bind_group(0, &self.scene.bind_group, &[]);
             pass.set_bind_group(1, &self.frame.bind_group, &[]);
@@ -227,12 +227,12 @@ impl PathTracer {
     }
 
     /// The film's sums and their odd half, read back (checkpoints, the error estimate).
-    pub fn film_state(&self) -> Result<crate::film::FilmState> {
+    pub fn film_state(&self) -> Result<crate::passes::film::FilmState> {
         self.film.read_state(&self.gpu)
     }
 
     /// Continues from a checkpoint's film: the next iteration is the one after its last.
-    pub fn resume(&mut self, film: &crate::film::FilmState) -> Result<()> {
+    pub fn resume(&mut self, film: &crate::passes::film::FilmState) -> Result<()> {
         self.film.restore(&self.gpu, film)
     }
 

@@ -5,8 +5,8 @@
 
 use crate::checkpoint::Progress;
 use crate::error::Result;
-use crate::film::{Film, FilmState, Show};
 use crate::image_io::{DisplayImage, LinearImage};
+use crate::passes::film::{Film, FilmState, Show};
 use crate::path_tracer::PathTracer;
 use crate::renderer::{RenderSettings, Renderer};
 use crate::scene::Camera;

@@ -6,8 +6,8 @@
 
 use glam::Vec3;
 
-pub use crate::consts::stream;
 use crate::error::Result;
+pub use crate::gpu::consts::stream;
 use crate::gpu::{Gpu, storage_entry};
 
 /// One round of the PCG permutation, also used as an integer hash.
@@ -190,8 +190,8 @@ pub fn sobol_owen_on_gpu(gpu: &Gpu, queries: &[(u32, u32)]) -> Result<Vec<[u32; 
             }
             points[gid.x] = sobol_owen_2d(queries[gid.x].x, queries[gid.x].y);
         }";
-    let source = crate::shader::compose(&[crate::shader::SAMPLING, main]);
-    let module = crate::shader::module(device, "sobol points", &source);
+    let source = crate::gpu::shader::compose(&[crate::gpu::shader::SAMPLING, main]);
+    let module = crate::gpu::shader::module(device, "sobol points", &source);
     gpu.run_once(
         "sobol points",
         &module,

@@ -38,13 +38,13 @@
 use glam::{Vec2, Vec3, Vec4};
 
 use crate::error::{Error, Result};
+use crate::gpu::shader;
 use crate::gpu::{Gpu, atlas_texture_entry, storage_entry};
 use crate::par::prelude::*;
 use crate::scene::Texture;
-use crate::shader;
 
 /// Texels per row of the atlas texture.
-pub use crate::consts::ATLAS_ROW as ROW;
+pub use crate::gpu::consts::ATLAS_ROW as ROW;
 /// Rows of the atlas texture at most (WebGPU guarantees 8192 texels per side).
 pub const MAX_ROWS: u32 = 8192;
 /// Texels the atlas holds at most: 256 MiB of `rgba16float`.

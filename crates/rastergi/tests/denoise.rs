@@ -3,10 +3,10 @@
 
 mod common;
 
-use rastergi::denoise::{DenoiseParams, Denoiser, EXTRA_SLOTS, GUIDE_SLOTS, cpu};
-use rastergi::film::{COMPONENTS, Show};
 use rastergi::image_io::LinearImage;
 use rastergi::metrics::{Comparison, compare, emitter_mask, rmse};
+use rastergi::passes::denoise::{DenoiseParams, Denoiser, EXTRA_SLOTS, GUIDE_SLOTS, cpu};
+use rastergi::passes::film::{COMPONENTS, Show};
 use rastergi::renderer::{RenderSettings, Renderer};
 use rastergi::sampling::{pcg_hash, unit_f32};
 use rastergi::scene::cornell_box;

@@ -6,8 +6,8 @@ mod common;
 use std::f64::consts::PI;
 
 use glam::{DVec3, Vec3};
-use rastergi::film::Show;
 use rastergi::metrics::emitter_mask;
+use rastergi::passes::film::Show;
 use rastergi::renderer::RenderSettings;
 use rastergi::scene::{Camera, Material, Scene, cornell_box};
 

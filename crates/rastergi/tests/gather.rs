@@ -6,11 +6,11 @@ mod common;
 use std::f64::consts::PI;
 
 use glam::{Vec2, Vec3};
-use rastergi::film::Show;
 use rastergi::gather::{GatherDirections, GatherMethod, HitLight};
 use rastergi::gpu_scene::PreparedScene;
 use rastergi::image_io::LinearImage;
 use rastergi::metrics::{compare, emitter_mask, masked_mean, rmse};
+use rastergi::passes::film::Show;
 use rastergi::renderer::{Overrides, RenderSettings, Renderer};
 use rastergi::sampling::{
     cosine_hemisphere, pcg_hash, pixel_seed, sobol_owen_2d, sobol_owen_on_gpu, uniform_sphere, unit_f32,

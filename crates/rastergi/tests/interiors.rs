@@ -8,8 +8,8 @@ mod common;
 
 use glam::Vec3;
 use rastergi::environment::Environment;
-use rastergi::film::Show;
 use rastergi::gpu_scene::PreparedScene;
+use rastergi::passes::film::Show;
 use rastergi::renderer::{PhotonRegionChoice, RenderSettings};
 use rastergi::scene::Scene;
 use rastergi::scene::generate::sunroom;

@@ -6,8 +6,8 @@ mod common;
 use std::f64::consts::PI;
 
 use glam::{Vec2, Vec3};
-use rastergi::film::Show;
 use rastergi::gpu_scene::PreparedScene;
+use rastergi::passes::film::Show;
 use rastergi::path_tracer::PathTracer;
 use rastergi::photons::map::GridSpec;
 use rastergi::photons::{PhotonSettings, cpu, gpu::GpuPhotonMap};

@@ -517,7 +517,7 @@ fn photons_under_glass(
 #[test]
 fn the_eye_sees_through_attenuating_solid_glass_as_beer_lambert_says() {
     use rastergi::environment::Environment;
-    use rastergi::film::Show;
+    use rastergi::passes::film::Show;
     use rastergi::scene::{Camera, Material, Scene};
     let sigma = Vec3::new(0.2, 1.0, 3.0);
     let d = 0.5;
@@ -580,8 +580,8 @@ fn gpu_and_cpu_photons_agree_through_glass_and_off_mirrors() {
 /// on a rough metal follow its lobe.
 #[test]
 fn photon_map_and_gather_on_spheres_of_each_material_match_mitsuba() {
-    use rastergi::film::Show;
     use rastergi::metrics::emitter_mask;
+    use rastergi::passes::film::Show;
     let gpu = common::gpu();
     // The rough metal and the mix at 128 iterations: their relative RMSE was 1.4 % at 256
     // (noise 1.3 %), so about 2 % at 128 against the 5 % bound, and their block-mean errors
@@ -619,8 +619,8 @@ fn photon_map_and_gather_on_spheres_of_each_material_match_mitsuba() {
 /// the time.
 #[test]
 fn cornell_box_with_glass_and_mirror_spheres_matches_mitsuba_caustic_included() {
-    use rastergi::film::Show;
     use rastergi::metrics::emitter_mask;
+    use rastergi::passes::film::Show;
     let camera =
         rastergi::scene::Camera { eye: Vec3::new(0.0, 0.0, 3.9), target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 39.3077 };
     let scene = material_scene("cornell_spheres", camera);
@@ -640,7 +640,7 @@ fn cornell_box_with_glass_and_mirror_spheres_matches_mitsuba_caustic_included() 
     // The caustic: the floor under the glass sphere (centre (0.335, −0.7, 0.38), radius 0.3, on
     // the floor y = −1), the pixels within a 0.25 × 0.25 square of floor around the point
     // below its centre, seen through the camera.
-    let vp = rastergi::frame::view_projection(&scene.camera, SIZE, SIZE, 1e-3, glam::Vec2::ZERO);
+    let vp = rastergi::passes::frame::view_projection(&scene.camera, SIZE, SIZE, 1e-3, glam::Vec2::ZERO);
     let half = SIZE as f32 / 2.0;
     let pixel = |p: Vec3| {
         let c = vp * p.extend(1.0);
@@ -677,8 +677,8 @@ fn cornell_box_with_glass_and_mirror_spheres_matches_mitsuba_caustic_included() 
 /// (against 2 × 1024 path-traced iterations; see below for 2 × 512).
 #[test]
 fn a_polished_sphere_reflects_the_stage_as_the_path_tracer_shows_it() {
-    use rastergi::film::Show;
     use rastergi::metrics::{emitter_mask, rmse};
+    use rastergi::passes::film::Show;
     let mut scene = material_scene("mat_mix", stage_camera());
     let m = scene.materials.iter_mut().find(|m| m.name == "sphere").expect("the sphere's material");
     (m.metallic, m.roughness, m.specular) = (0.0, 0.0, 1.0);
@@ -714,8 +714,8 @@ fn a_polished_sphere_reflects_the_stage_as_the_path_tracer_shows_it() {
 /// however long it ran (`rastergi compare` of 1024-iteration renders, issue 31's note).
 #[test]
 fn a_room_with_a_rough_metal_floor_and_a_polished_table_converges_to_the_path_tracer() {
-    use rastergi::film::Show;
     use rastergi::metrics::emitter_mask;
+    use rastergi::passes::film::Show;
     let scene = rastergi::scene::generate::glossy_room();
     let gpu = common::gpu();
     let probe = rastergi::image_io::read_exr(&common::data("glossy_room_path_64_a.exr")).unwrap();

@@ -7,11 +7,11 @@ mod common;
 use std::f64::consts::PI;
 
 use glam::{DVec3, Vec3};
-use rastergi::frame::pixel_jitter;
 use rastergi::gpu::Gpu;
 use rastergi::gpu_scene::PreparedScene;
 use rastergi::image_io::LinearImage;
 use rastergi::metrics::{compare, emitter_mask, masked_mean, rmse};
+use rastergi::passes::frame::pixel_jitter;
 use rastergi::path_tracer::PathTracer;
 use rastergi::renderer::{RenderSettings, Renderer};
 use rastergi::scene::{Camera, Material, Scene, cornell_box};

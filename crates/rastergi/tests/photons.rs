@@ -4,9 +4,9 @@
 mod common;
 
 use glam::Vec3;
-use rastergi::film::Show;
 use rastergi::gpu_scene::{GpuScene, PreparedScene};
 use rastergi::metrics::emitter_mask;
+use rastergi::passes::film::Show;
 use rastergi::photons::map::{GridSpec, PhotonMap};
 use rastergi::photons::{PhotonSettings, cpu, gpu::GpuPhotonMap};
 use rastergi::renderer::RenderSettings;

@@ -5,7 +5,7 @@
 
 mod common;
 
-use rastergi::accel::{RayPath, Rays};
+use rastergi::gpu::accel::{RayPath, Rays};
 use rastergi::gpu::{Gpu, GpuOptions};
 use rastergi::gpu_scene::{GpuScene, PreparedScene};
 use rastergi::rays::{RayCaster, RayKind, disagreements, make_rays, trace_cpu};
@@ -136,7 +136,7 @@ fn cornell_with_glass() -> Scene {
 /// paths, none between the hardware path and the twin.
 #[test]
 fn every_tracing_pass_renders_the_same_image_on_both_paths() {
-    use rastergi::film::Show;
+    use rastergi::passes::film::Show;
     use rastergi::path_tracer::PathTracer;
     use rastergi::renderer::Renderer;
     let Some(hardware) = hardware_gpu() else { return };

@@ -10,10 +10,10 @@ use std::f64::consts::PI;
 
 use common::textured_room::{self as room, Variant};
 use glam::{Vec2, Vec3};
-use rastergi::film::Show;
 use rastergi::gpu::Gpu;
 use rastergi::gpu_scene::{GpuScene, PreparedScene};
 use rastergi::metrics::{emitter_mask, rmse};
+use rastergi::passes::film::Show;
 use rastergi::photons::map::PhotonMap;
 use rastergi::photons::{PhotonSettings, cpu, gpu::GpuPhotonMap};
 use rastergi::renderer::{RenderSettings, Renderer};

@@ -8,11 +8,11 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Result, anyhow};
 use rastergi::camera_control::CameraControl;
-use rastergi::denoise;
-use rastergi::display::{Presented, WindowSurface};
-use rastergi::film::Show;
 use rastergi::gather::GatherMethod;
 use rastergi::gpu::{Gpu, GpuOptions};
+use rastergi::passes::denoise;
+use rastergi::passes::display::{Presented, WindowSurface};
+use rastergi::passes::film::Show;
 use rastergi::path_tracer::PathTracer;
 use rastergi::renderer::{RenderSettings, Renderer};
 use rastergi::scene::Scene;

@@ -53,15 +53,15 @@ use glam::{Vec2, Vec3};
 
 pub use estimator::{GatherInputs, GatherSample, GatherSetup, GatherUniforms, PixelSamples};
 
-use crate::consts::{FILM_DIRECT, FILM_INDIRECT};
 use crate::error::Result;
-use crate::frame::FrameBinding;
 use crate::gpu::Gpu;
+use crate::gpu::consts::{FILM_DIRECT, FILM_INDIRECT};
 use crate::gpu_scene::GpuScene;
+use crate::passes::frame::FrameBinding;
 use crate::photons::gpu::GpuPhotonMap;
 use crate::sampling::{Rng, pcg_hash, sobol_owen_2d, stream, uniform_sphere, unit_f32};
 
-pub use crate::consts::MAX_DIRECTIONS;
+pub use crate::gpu::consts::MAX_DIRECTIONS;
 
 /// How the nearest surface along the gather direction is found.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -509,7 +509,7 @@ impl GatherPass {
     /// The directions per pixel that [`encode`](Self::encode) will gather along with the same
     /// arguments, and whether each point draws its own from its scattering (per-pixel; else
     /// uniform on the hemisphere): the direct pass weighs its environment samples against them
-    /// ([`crate::frame::FrameUniforms::gather_count`]).
+    /// ([`crate::passes::frame::FrameUniforms::gather_count`]).
     pub fn strategy(&self, directions: u32, fixed: &FixedSample) -> (u32, bool) {
         let count = if fixed.direction.is_some() { 1 } else { directions.clamp(1, MAX_DIRECTIONS) };
         let trial = (!self.chosen).then(|| self.next_candidate());

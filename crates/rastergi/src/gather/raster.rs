@@ -23,11 +23,11 @@ use super::Gather;
 use super::estimator::{GatherInputs, GatherSetup, GatherUniforms, RAY_VIEW_LOOKUP, submit_and_renew};
 use super::ray_view::{DEPTH_FORMAT, ray_view_module, ray_view_pipeline};
 use crate::error::Result;
+use crate::gpu::profile::{Profiler, compute_pass};
 use crate::gpu::{
     Gpu, bind_group, bind_group_layout, dispatch_pixels, storage_entry, uint_texture_entry, uniform_entry,
 };
 use crate::gpu_scene::GpuScene;
-use crate::profile::{Profiler, compute_pass};
 
 /// Ray-view texel: (triangle + 1, b1 bits, b2 bits, depth bits); 0 where empty.
 const LAYER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;
@@ -55,7 +55,7 @@ impl RasterGather {
     /// The passes and ray-view textures for a `bundle`² ray view reading `uniforms`.
     pub fn new(gpu: &Gpu, setup: &GatherSetup, uniforms: &wgpu::Buffer, bundle: u32) -> Result<RasterGather> {
         let device = &gpu.device;
-        crate::limits::check_bundle(&device.limits(), bundle)?;
+        crate::gpu::limits::check_bundle(&device.limits(), bundle)?;
         let (gbuffer, film) = (setup.gbuffer, setup.film);
         let texture = |label: &str, format: wgpu::TextureFormat, usage: wgpu::TextureUsages| {
             device

@@ -16,10 +16,10 @@
 use super::Gather;
 use super::estimator::{GatherInputs, GatherSetup, GatherUniforms};
 use crate::error::Result;
+use crate::gpu::profile::{Profiler, compute_pass};
 use crate::gpu::{
     Gpu, bind_group, bind_group_layout, dispatch_pixels, storage_entry, uint_texture_entry, uniform_entry,
 };
-use crate::profile::{Profiler, compute_pass};
 
 pub struct TraceGather {
     pipeline: wgpu::ComputePipeline,

@@ -20,10 +20,10 @@ use glam::UVec3;
 use super::map::{GridSpec, MAX_SEPARATORS, MapLayout, PhotonMap, Separator, TABLE_WGSL, TrianglePlane};
 use super::{MAX_BOUNCES, PhotonSettings};
 use crate::error::Result;
+use crate::gpu::profile::compute_pass;
+use crate::gpu::shader;
 use crate::gpu::{Gpu, bind_group_layout, buffer_bind_group, storage_entry, uniform_entry};
 use crate::gpu_scene::{GpuScene, PreparedScene};
-use crate::profile::compute_pass;
-use crate::shader;
 
 /// Fixed-point units per Φ_max.
 const QUANTUM_BITS: u32 = 24;

@@ -51,9 +51,9 @@ use super::clip::{clip_to_box, clip_to_half_space, polygon_area};
 use super::separators::{CellPlanes, Fragment, separators_of};
 pub use super::separators::{MAX_SEPARATORS, MIN_REGION, Separator, Separators, region_of};
 pub use super::table::{EMPTY, SlotTable};
-use crate::consts::CAUSTIC_CELL;
-pub use crate::consts::{MIN_LOOKUP_AREA, NEAR_FACE};
-use crate::limits::{check_storage_buffer, mib};
+use crate::gpu::consts::CAUSTIC_CELL;
+pub use crate::gpu::consts::{MIN_LOOKUP_AREA, NEAR_FACE};
+use crate::gpu::limits::{check_storage_buffer, mib};
 use crate::scene::{Aabb, Scene, triangle_normal};
 
 /// The slot table's search in WGSL (`find_slot`, the twin of [`SlotTable::find`]). The GPU
@@ -66,7 +66,7 @@ pub const LOOKUP_WGSL: &str = concat!(include_str!("table.wgsl"), "\n", include_
 pub const FACE_DIVISIONS: usize = 3;
 /// Orientation bins: 6 cube faces × FACE_DIVISIONS².
 pub const BINS: usize = 6 * FACE_DIVISIONS * FACE_DIVISIONS;
-pub use crate::consts::{OFFSET_SHIFT, OFFSET_STEP, REGION_SHIFT};
+pub use crate::gpu::consts::{OFFSET_SHIFT, OFFSET_STEP, REGION_SHIFT};
 
 /// The bin of a surface side with normal n: face 2·axis + sign of
 /// the dominant axis, then the 3 × 3 cell of the other two coordinates (in axis order after
@@ -588,7 +588,7 @@ impl MapLayout {
             let estimate = twins * 2.0 * cells_met;
             let fits = |slots: f64| {
                 let entries = (2.0 * slots).max(16.0).log2().ceil().exp2() as u64;
-                entries.saturating_mul(16) <= crate::limits::max_storage_buffer(limits)
+                entries.saturating_mul(16) <= crate::gpu::limits::max_storage_buffer(limits)
                     && entries.saturating_mul(24) <= limits.max_buffer_size
             };
             let outcome = if fits(estimate) || resolution == 1 {
@@ -809,7 +809,7 @@ impl PhotonMap {
 /// top bit marks caustic twins, `CAUSTIC_CELL`).
 pub fn check_photon_grid(_limits: &wgpu::Limits, grid: &GridSpec) -> crate::error::Result<()> {
     let d = grid.dims;
-    if grid.cell_count() >= crate::consts::CAUSTIC_CELL as u64 {
+    if grid.cell_count() >= crate::gpu::consts::CAUSTIC_CELL as u64 {
         return Err(crate::error::Error::Limits(format!(
             "a photon grid of {}x{}x{} cells has more than 2^31 cells; choose a smaller --grid",
             d.x, d.y, d.z
@@ -842,7 +842,7 @@ pub fn check_photon_slots(limits: &wgpu::Limits, layout: &MapLayout) -> crate::e
 
 #[cfg(test)]
 mod tests {
-    use crate::limits::test_limits as limits;
+    use crate::gpu::limits::test_limits as limits;
 
     use super::*;
     use crate::sampling::{Rng, uniform_sphere};

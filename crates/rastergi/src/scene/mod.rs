@@ -237,7 +237,7 @@ impl Material {
     }
 
     /// Whether eye and gather rays go on through it rather than stop (`surface_passes_rays` in
-    /// WGSL, [`crate::specular`]): no diffuse base, and perfectly specular — a smooth metal — or
+    /// WGSL, [`crate::passes::specular`]): no diffuse base, and perfectly specular — a smooth metal — or
     /// glass, rough or smooth; or one whose roughness a texture sets (a transmissionTexture only
     /// lowers the transmission below its factor, so the factor decides); not a smooth metal
     /// under a rough clear coat. Scenes with such materials get the eye's specular chains and
@@ -257,7 +257,7 @@ impl Material {
 
     /// Whether it has a perfectly specular lobe besides others (polished plastic: a smooth
     /// specular layer over a diffuse base; a smooth, partly metallic surface): the eye's
-    /// chains follow that lobe stochastically ([`crate::specular`]). Or may have, where a
+    /// chains follow that lobe stochastically ([`crate::passes::specular`]). Or may have, where a
     /// texture sets the roughness; or a smooth clear coat (or one a texture may make smooth).
     pub fn has_delta_lobe(&self) -> bool {
         let smooth = self.roughness * self.roughness < crate::bsdf::SMOOTH_ALPHA || self.metal_rough_texture.is_some();

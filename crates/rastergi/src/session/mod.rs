@@ -22,10 +22,10 @@ mod tests;
 use glam::Vec3;
 
 use crate::error::{Error, Result};
-use crate::film::Show;
 use crate::fit;
 use crate::gather::{GatherDirections, GatherMethod, HitLight};
 use crate::gpu::{Gpu, GpuOptions};
+use crate::passes::film::Show;
 use crate::path_tracer::PathTracer;
 use crate::progressive::Progressive;
 use crate::renderer::{PhotonRegionChoice, RenderSettings, Renderer, TextureFilter};

@@ -5,14 +5,14 @@ pub mod textured_room;
 
 use std::path::PathBuf;
 
-use rastergi::film::Show;
 use rastergi::gpu::{Gpu, GpuOptions};
 use rastergi::image_io::{LinearImage, read_exr};
+use rastergi::passes::film::Show;
 use rastergi::renderer::{RenderSettings, Renderer};
 use rastergi::scene::Scene;
 
 /// The test's device: one per test (each test runs on a thread of its own), so that a test's
-/// renderers reuse each other's compiled pipelines (`rastergi::compiled`) while a device
+/// renderers reuse each other's compiled pipelines (`rastergi::gpu::compiled`) while a device
 /// error stays within the test that caused it.
 pub fn gpu() -> Gpu {
     thread_local! {

@@ -29,14 +29,14 @@
 //! form a (0, m − 1, 2)-net on it. A second, independently scrambled point for the choice
 //! would split the block between the triangles at random, losing the net on each.
 
-use crate::film::Film;
-use crate::frame::FrameBinding;
-use crate::gbuffer::{GBUFFER_FILM_WGSL, GBufferPass, PixelPass, PixelShader};
 use crate::gpu::Gpu;
+use crate::gpu::shader;
 use crate::gpu_scene::GpuScene;
 use crate::lights::LightTable;
+use crate::passes::film::Film;
+use crate::passes::frame::FrameBinding;
+use crate::passes::gbuffer::{GBUFFER_FILM_WGSL, GBufferPass, PixelPass, PixelShader};
 use crate::sampling::{pcg_hash, pixel_seed, sobol_owen_2d, stream, unit_f32};
-use crate::shader;
 
 /// The key of the light samples' per-pixel scramble seeds for `seed` (no restart: a reset
 /// replays them). `pcg_hash(frame.seed ^ STREAM_DIRECT)` in `direct.wgsl`.

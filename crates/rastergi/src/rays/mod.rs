@@ -22,10 +22,10 @@
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
-use crate::accel::RayPath;
 use crate::bvh::Hit;
-use crate::consts::{LIGHT_POINT, LIGHT_SPOT, PUNCTUAL_LIGHT};
 use crate::error::Result;
+use crate::gpu::accel::RayPath;
+use crate::gpu::consts::{LIGHT_POINT, LIGHT_SPOT, PUNCTUAL_LIGHT};
 use crate::gpu::{Gpu, bind_group, bind_group_layout, compute_pipeline, groups, storage_entry};
 use crate::gpu_scene::{GpuScene, PreparedScene, alpha_uniform};
 use crate::par::prelude::*;
@@ -325,7 +325,13 @@ impl RayCaster {
         }
         let limits = gpu.device.limits();
         let stride = std::mem::size_of::<GpuRay>() as u64;
-        crate::limits::check_storage_buffer(&limits, "the rays", rays.len() as u64, stride, "choose a smaller --size")?;
+        crate::gpu::limits::check_storage_buffer(
+            &limits,
+            "the rays",
+            rays.len() as u64,
+            stride,
+            "choose a smaller --size",
+        )?;
         let input = gpu.storage_buffer("rays", bytemuck::cast_slice(rays), wgpu::BufferUsages::empty());
         let out_size = (rays.len() * std::mem::size_of::<GpuRayHit>()) as u64;
         let output =
@@ -387,10 +393,10 @@ pub fn probe(gpu: &Gpu, prepared: &PreparedScene, scene: &GpuScene) -> Result<(f
 
 /// The kernel's composed shader.
 pub fn source() -> String {
-    crate::shader::compose(&[
-        crate::shader::SAMPLING,
-        crate::shader::SCENE,
-        crate::shader::BVH,
+    crate::gpu::shader::compose(&[
+        crate::gpu::shader::SAMPLING,
+        crate::gpu::shader::SCENE,
+        crate::gpu::shader::BVH,
         include_str!("rays.wgsl"),
     ])
 }

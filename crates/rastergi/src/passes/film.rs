@@ -41,9 +41,9 @@
 use bytemuck::{Pod, Zeroable};
 
 use crate::error::Result;
+use crate::gpu::shader;
 use crate::gpu::{Gpu, bind_group_layout, buffer_bind_group, compute_pipeline, groups, storage_entry, uniform_entry};
 use crate::image_io::{DisplayImage, LinearImage};
-use crate::shader;
 
 /// Iterations per block of the error estimate where no photon pass sets the blocks (see the
 /// module's notes).
@@ -51,7 +51,7 @@ pub const BLOCK_ITERATIONS: u32 = 16;
 
 /// Components accumulated per pixel: component c of pixel p at `c·W·H + p` (`film.wgsl`).
 pub const COMPONENTS: u64 = 3;
-pub use crate::consts::{FILM_DIRECT, FILM_INDIRECT, FILM_PHOTON_VIEW};
+pub use crate::gpu::consts::{FILM_DIRECT, FILM_INDIRECT, FILM_PHOTON_VIEW};
 /// Bytes per pixel of the film's GPU storage (accumulation, its odd half, resolved copies).
 pub const BYTES_PER_PIXEL: u64 = 2 * COMPONENTS * 16 + 16 + 4;
 
@@ -310,7 +310,7 @@ impl Film {
             _pad: [0; 3],
         };
         gpu.queue.write_buffer(uniforms, 0, bytemuck::bytes_of(&u));
-        let mut pass = crate::profile::compute_pass(enc, gpu.profiler.as_ref(), label);
+        let mut pass = crate::gpu::profile::compute_pass(enc, gpu.profiler.as_ref(), label);
         pass.set_pipeline(pipeline);
         pass.set_bind_group(0, bind_group, &[]);
         pass.dispatch_workgroups(groups(self.width, 8), groups(self.height, 8), 1);

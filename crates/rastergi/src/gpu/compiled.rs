@@ -204,9 +204,9 @@ pub fn count(device: &wgpu::Device) -> Option<usize> {
 
 #[cfg(test)]
 mod tests {
-    use crate::film::Show;
     use crate::gpu::{Gpu, GpuOptions};
     use crate::image_io::LinearImage;
+    use crate::passes::film::Show;
     use crate::renderer::{RenderSettings, Renderer};
 
     /// The Cornell box at 32², 4 iterations of the traced gather, seed 3.

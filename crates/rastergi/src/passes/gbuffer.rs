@@ -7,14 +7,14 @@
 //! shader would.
 
 use crate::error::Result;
-use crate::film::Film;
-use crate::frame::FrameBinding;
+use crate::gpu::profile::{Profiler, compute_pass};
+use crate::gpu::shader;
 use crate::gpu::{
     Gpu, bind_group, bind_group_layout, dispatch_pixels, scene_raster_pipeline, storage_entry, uint_texture_entry,
 };
 use crate::gpu_scene::GpuScene;
-use crate::profile::{Profiler, compute_pass};
-use crate::shader;
+use crate::passes::film::Film;
+use crate::passes::frame::FrameBinding;
 
 /// The pass's composed shader.
 pub fn source() -> String {
@@ -29,7 +29,7 @@ pub struct GBufferPass {
     pub texture: wgpu::Texture,
     pub view: wgpu::TextureView,
     depth_view: wgpu::TextureView,
-    profiler: Option<crate::profile::Profiler>,
+    profiler: Option<crate::gpu::profile::Profiler>,
 }
 
 impl GBufferPass {

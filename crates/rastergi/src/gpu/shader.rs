@@ -6,41 +6,41 @@
 //! their WGSL declarations. Structs shared by both are checked by the layout test
 //! (`layout_test.rs`), which parses every composed shader with naga.
 
-use crate::consts::{
+use crate::gpu::consts::{
     CAUSTIC_CELL, ENVIRONMENT_LIGHT, FILM_DIRECT, FILM_INDIRECT, FILM_PHOTON_VIEW, LIGHT_DISTANT, LIGHT_POINT,
     LIGHT_SPOT, MATERIAL_ALPHA_BLEND, MATERIAL_ALPHA_MASK, MATERIAL_LAMBERTIAN, MATERIAL_SINGLE_SCATTERING,
     MATERIAL_TEXTURED, MATERIAL_THIN, MATERIAL_TWO_SIDED, MAX_DIRECTIONS, MAX_HOLE_CROSSINGS, MAX_SEPARATORS,
     MIN_LOOKUP_AREA, NO_TEXTURE, OFFSET_SHIFT, OFFSET_STEP, PUNCTUAL_LIGHT, REGION_SHIFT, TRIANGLE_HAS_HOLES, stream,
 };
 
-pub const SAMPLING: &str = include_str!("sampling.wgsl");
+pub const SAMPLING: &str = include_str!("../sampling.wgsl");
 /// The scene's bind group: geometry, materials, lights and the environment.
 pub const SCENE: &str = concat!(
-    include_str!("gpu_scene.wgsl"),
+    include_str!("../gpu_scene.wgsl"),
     "\n",
-    include_str!("textures.wgsl"),
+    include_str!("../textures.wgsl"),
     "\n",
-    include_str!("environment.wgsl"),
+    include_str!("../environment.wgsl"),
     "\n",
-    include_str!("bsdf.wgsl")
+    include_str!("../bsdf/bsdf.wgsl")
 );
 /// The texture atlas's sampling (`atlas_sample`); the includer binds `textures` and defines
 /// `atlas_entry_word` (needs [`constants`]).
-pub const TEXTURES: &str = include_str!("textures.wgsl");
+pub const TEXTURES: &str = include_str!("../textures.wgsl");
 /// The scattering model alone (it needs [`SAMPLING`]).
-pub const BSDF: &str = include_str!("bsdf.wgsl");
+pub const BSDF: &str = include_str!("../bsdf/bsdf.wgsl");
 /// Tracing's interface (`trace`, `occluded`, `bvh.wgsl`) with the compute path's `traverse`
 /// (`bvh_compute.wgsl`); [`for_rays`] swaps the latter for the hardware one.
-pub const BVH: &str = concat!(include_str!("bvh.wgsl"), "\n", include_str!("bvh_compute.wgsl"));
+pub const BVH: &str = concat!(include_str!("../bvh/bvh.wgsl"), "\n", include_str!("../bvh/bvh_compute.wgsl"));
 /// The compute path's `traverse`, as [`BVH`] holds it.
-pub const TRAVERSE_COMPUTE: &str = include_str!("bvh_compute.wgsl");
+pub const TRAVERSE_COMPUTE: &str = include_str!("../bvh/bvh_compute.wgsl");
 /// The hardware path's `traverse`: a ray query over the scene's TLAS (`accel.rs`).
 pub const TRAVERSE_HARDWARE: &str = include_str!("bvh_hardware.wgsl");
-pub const FRAME: &str = include_str!("frame.wgsl");
+pub const FRAME: &str = include_str!("../passes/frame.wgsl");
 /// The G-buffer texel → visible point decode (`visible_point`), for per-pixel passes.
-pub const VISIBLE_POINT: &str = include_str!("visible_point.wgsl");
+pub const VISIBLE_POINT: &str = include_str!("../passes/visible_point.wgsl");
 /// Film writes by component (`film_add`), for passes that bind `film`.
-pub const FILM: &str = include_str!("film.wgsl");
+pub const FILM: &str = include_str!("../passes/film.wgsl");
 
 /// WGSL declarations of the constants Rust and WGSL share, from their Rust values.
 pub fn constants() -> String {
@@ -56,7 +56,7 @@ pub fn constants() -> String {
         ("MAX_HOLE_CROSSINGS", MAX_HOLE_CROSSINGS),
         ("TRIANGLE_HAS_HOLES", TRIANGLE_HAS_HOLES),
         ("NO_TEXTURE", NO_TEXTURE),
-        ("ATLAS_ROW", crate::consts::ATLAS_ROW),
+        ("ATLAS_ROW", crate::gpu::consts::ATLAS_ROW),
         ("FILM_DIRECT", FILM_DIRECT),
         ("FILM_INDIRECT", FILM_INDIRECT),
         ("FILM_PHOTON_VIEW", FILM_PHOTON_VIEW),
@@ -76,13 +76,13 @@ pub fn constants() -> String {
         ("LIGHT_POINT", LIGHT_POINT),
         ("LIGHT_SPOT", LIGHT_SPOT),
         ("LIGHT_DISTANT", LIGHT_DISTANT),
-        ("NO_CHILD", crate::consts::NO_CHILD),
-        ("GGX_ALBEDO_N", crate::consts::GGX_ALBEDO_N as u32),
-        ("GGX_ALBEDO_CELLS", (crate::consts::GGX_ALBEDO_N * crate::consts::GGX_ALBEDO_N) as u32),
-        ("GLASS_ALBEDO_ETAS", crate::consts::GLASS_ETAS as u32),
-        ("GLASS_ALBEDO_CELLS", crate::consts::GLASS_CELLS as u32),
+        ("NO_CHILD", crate::gpu::consts::NO_CHILD),
+        ("GGX_ALBEDO_N", crate::gpu::consts::GGX_ALBEDO_N as u32),
+        ("GGX_ALBEDO_CELLS", (crate::gpu::consts::GGX_ALBEDO_N * crate::gpu::consts::GGX_ALBEDO_N) as u32),
+        ("GLASS_ALBEDO_ETAS", crate::gpu::consts::GLASS_ETAS as u32),
+        ("GLASS_ALBEDO_CELLS", crate::gpu::consts::GLASS_CELLS as u32),
     ];
-    use crate::consts::GpuSceneOffsets as O;
+    use crate::gpu::consts::GpuSceneOffsets as O;
     let word = |offset: usize| (offset / 4) as u32;
     let header = [
         ("DATA_UVS", word(std::mem::offset_of!(O, uvs))),
@@ -101,11 +101,11 @@ pub fn constants() -> String {
     let f32s = [
         ("OFFSET_STEP", OFFSET_STEP),
         ("MIN_LOOKUP_AREA", MIN_LOOKUP_AREA),
-        ("AIM_FRACTION", crate::consts::AIM_FRACTION),
-        ("NEAR_FRACTION", crate::consts::NEAR_FRACTION),
-        ("NEAR_SCALE", crate::consts::NEAR_SCALE),
-        ("NEAR_FACE", crate::consts::NEAR_FACE),
-        ("GLASS_ALBEDO_ETA_MAX", crate::consts::GLASS_ETA_MAX),
+        ("AIM_FRACTION", crate::gpu::consts::AIM_FRACTION),
+        ("NEAR_FRACTION", crate::gpu::consts::NEAR_FRACTION),
+        ("NEAR_SCALE", crate::gpu::consts::NEAR_SCALE),
+        ("NEAR_FACE", crate::gpu::consts::NEAR_FACE),
+        ("GLASS_ALBEDO_ETA_MAX", crate::gpu::consts::GLASS_ETA_MAX),
     ];
     let mut s = String::from("// Generated from the Rust constants (shader.rs).\n");
     for (name, value) in u32s {
@@ -138,9 +138,9 @@ pub fn per_pixel(pieces: &[&str]) -> String {
 /// `source` (a composed shader) for ray path `path`: unchanged for the compute path; for the
 /// hardware path its compute `traverse` replaced by the ray query's and `enable wgpu_ray_query;`
 /// put first. A shader without [`BVH`] casts no rays and is returned as it is.
-pub fn for_rays(source: &str, path: crate::accel::RayPath) -> std::borrow::Cow<'_, str> {
+pub fn for_rays(source: &str, path: crate::gpu::accel::RayPath) -> std::borrow::Cow<'_, str> {
     match path {
-        crate::accel::RayPath::Hardware if source.contains(TRAVERSE_COMPUTE) => std::borrow::Cow::Owned(format!(
+        crate::gpu::accel::RayPath::Hardware if source.contains(TRAVERSE_COMPUTE) => std::borrow::Cow::Owned(format!(
             "enable wgpu_ray_query;\n{}",
             source.replacen(TRAVERSE_COMPUTE, TRAVERSE_HARDWARE, 1)
         )),
@@ -148,7 +148,7 @@ pub fn for_rays(source: &str, path: crate::accel::RayPath) -> std::borrow::Cow<'
     }
 }
 
-/// The shader module of `source`: the device's one of it ([`crate::compiled`]).
+/// The shader module of `source`: the device's one of it ([`crate::gpu::compiled`]).
 pub fn module(device: &wgpu::Device, label: &str, source: &str) -> wgpu::ShaderModule {
-    crate::compiled::module(device, label, source)
+    crate::gpu::compiled::module(device, label, source)
 }

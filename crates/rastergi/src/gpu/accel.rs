@@ -5,7 +5,7 @@
 //! primitive, `traverse(o, d, t_min, t_max, skip_a, skip_b, skip_c, any_hit)`: the closest (or
 //! any) triangle hit in the open interval (t_min, t_max) other than the three skipped, holes
 //! or not. It has two implementations, chosen per pipeline when its module is composed
-//! ([`crate::shader::for_rays`]):
+//! ([`crate::gpu::shader::for_rays`]):
 //! * [`RayPath::Compute`]: `bvh_compute.wgsl`, the compressed 4-wide BVH walked by the compute
 //!   shader (its CPU twin is `Bvh::intersect`);
 //! * [`RayPath::Hardware`]: `bvh_hardware.wgsl`, a WGSL `ray_query` over a top-level

@@ -1,6 +1,6 @@
 //! The one check of every Rust/WGSL twin: each composed shader is parsed with naga, and every
 //! struct that Rust also lays out must have the Rust size and member offsets (`size_of`,
-//! `offset_of!`), wherever it appears; the constants that [`crate::shader::constants`]
+//! `offset_of!`), wherever it appears; the constants that [`crate::gpu::shader::constants`]
 //! generates must hold the Rust values in every shader. Members whose names start with `_`
 //! are padding on both sides and are matched by size alone.
 
@@ -9,13 +9,13 @@ use std::mem::{offset_of, size_of};
 use std::path::Path;
 
 use crate::bvh::wide::WideNode;
-use crate::display::DisplayUniforms;
 use crate::environment::GpuEnvironment;
-use crate::film::ResolveUniforms;
-use crate::frame::FrameUniforms;
 use crate::gather::GatherUniforms;
 use crate::gpu_scene::{GpuMaterial, GpuMaterialMaps, GpuTextureSlot, GpuTriangle};
 use crate::lights::{LightEntry, PunctualLight};
+use crate::passes::display::DisplayUniforms;
+use crate::passes::film::ResolveUniforms;
+use crate::passes::frame::FrameUniforms;
 use crate::path_tracer::PathParams;
 use crate::photons::gpu::{GridLevels, PhotonGridUniforms, PhotonParams};
 use crate::photons::map::TrianglePlane;
@@ -144,7 +144,7 @@ fn twins() -> Vec<Twin> {
         twin!(GridLevels, "GridLevels", [origin, cell, dims, factor, fine_lo, fine_cell, fine_hi, fine_base]),
         twin!(ResolveUniforms, "Resolve", [resolution, samples, show, scale]),
         twin!(
-            crate::denoise::DenoiseUniforms,
+            crate::passes::denoise::DenoiseUniforms,
             "Denoise",
             [
                 resolution,
@@ -174,18 +174,18 @@ fn twins() -> Vec<Twin> {
 fn shaders() -> Vec<(&'static str, String)> {
     use crate::gather::estimator::{RAY_VIEW_LOOKUP, estimate_source};
     vec![
-        ("gbuffer", crate::gbuffer::source()),
-        ("direct", crate::direct::source()),
-        ("photon view", crate::photon_view::source()),
+        ("gbuffer", crate::passes::gbuffer::source()),
+        ("direct", crate::passes::direct::source()),
+        ("photon view", crate::passes::photon_view::source()),
         ("gather ray view", crate::gather::ray_view::ray_view_source()),
-        ("gather project", estimate_source(&[RAY_VIEW_LOOKUP, include_str!("gather/raster.wgsl")])),
-        ("gather list project", estimate_source(&[RAY_VIEW_LOOKUP, include_str!("gather/lists.wgsl")])),
-        ("gather trace", estimate_source(&[include_str!("gather/trace.wgsl")])),
+        ("gather project", estimate_source(&[RAY_VIEW_LOOKUP, include_str!("../gather/raster.wgsl")])),
+        ("gather list project", estimate_source(&[RAY_VIEW_LOOKUP, include_str!("../gather/lists.wgsl")])),
+        ("gather trace", estimate_source(&[include_str!("../gather/trace.wgsl")])),
         ("photon trace", crate::photons::gpu::trace_source()),
-        ("resolve", crate::film::resolve_source()),
-        ("denoiser guides", crate::denoise::guides_source()),
-        ("denoiser", crate::denoise::filter_source()),
-        ("display", crate::display::SOURCE.to_string()),
+        ("resolve", crate::passes::film::resolve_source()),
+        ("denoiser guides", crate::passes::denoise::guides_source()),
+        ("denoiser", crate::passes::denoise::filter_source()),
+        ("display", crate::passes::display::SOURCE.to_string()),
         ("path tracer", crate::path_tracer::source()),
         ("rays", crate::rays::source()),
     ]
@@ -254,7 +254,7 @@ fn every_rust_wgsl_twin_has_the_same_size_and_offsets_in_every_shader() {
 #[test]
 fn every_shader_holds_the_rust_constants() {
     // The generated declarations, parsed back: what every composed shader must hold.
-    let generated = crate::shader::constants();
+    let generated = crate::gpu::shader::constants();
     let expected = u32_constants(&naga::front::wgsl::parse_str(&generated).expect("the generated constants parse"));
     assert!(expected.len() >= 9, "{expected:?}");
     assert_eq!(expected["MAX_DIRECTIONS"], crate::gather::MAX_DIRECTIONS);
@@ -278,10 +278,10 @@ fn every_shader_holds_the_rust_constants() {
 /// its binding, the compute BVH's nodes no longer read by `traverse`.
 #[test]
 fn every_tracing_shader_composes_and_validates_for_hardware_ray_queries() {
-    use crate::accel::{RayPath, TLAS_BINDING};
+    use crate::gpu::accel::{RayPath, TLAS_BINDING};
     let mut traced = Vec::new();
     for (label, source) in shaders() {
-        let hardware = crate::shader::for_rays(&source, RayPath::Hardware);
+        let hardware = crate::gpu::shader::for_rays(&source, RayPath::Hardware);
         if hardware == source {
             continue;
         }
@@ -336,7 +336,7 @@ fn entry_points_in_the_code() -> BTreeSet<(String, String)> {
 /// The entry points docs/design.md's "Where each pass lives" names: cells of the form
 /// `` `file.wgsl`: `a`, `b` ``.
 fn entry_points_in_the_design_page() -> BTreeSet<(String, String)> {
-    let design = include_str!("../../../docs/design.md");
+    let design = include_str!("../../../../docs/design.md");
     let section = design.split("## Where each pass lives").nth(1).expect("the section").split("\n## ").next().unwrap();
     let mut out = BTreeSet::new();
     for cell in section.lines().filter(|l| l.starts_with('|')).flat_map(|l| l.split('|')) {

@@ -2,14 +2,14 @@
 //! visible point, L = ρ/π · E(x) (no emission), for debugging the map and for comparing it
 //! with a full reference: it is what the final gather reads at its secondary points.
 
-use crate::film::Film;
-use crate::frame::FrameBinding;
-use crate::gbuffer::{GBUFFER_FILM_WGSL, GBufferPass, PixelPass, PixelShader};
 use crate::gpu::Gpu;
+use crate::gpu::shader;
 use crate::gpu_scene::GpuScene;
+use crate::passes::film::Film;
+use crate::passes::frame::FrameBinding;
+use crate::passes::gbuffer::{GBUFFER_FILM_WGSL, GBufferPass, PixelPass, PixelShader};
 use crate::photons::gpu::GpuPhotonMap;
 use crate::photons::map::LOOKUP_WGSL;
-use crate::shader;
 
 /// The pass's composed shader.
 pub fn source() -> String {

@@ -15,9 +15,9 @@
 use bytemuck::{Pod, Zeroable};
 
 use crate::error::{Error, Result};
-use crate::film::Film;
+use crate::gpu::shader;
 use crate::gpu::{Gpu, bind_group, bind_group_layout, storage_entry, uniform_entry};
-use crate::shader;
+use crate::passes::film::Film;
 
 /// Re-exported so front ends can hand over a window without a direct wgpu dependency.
 pub use wgpu::SurfaceTarget;

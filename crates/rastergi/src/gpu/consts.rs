@@ -1,5 +1,5 @@
 //! The constants that Rust and WGSL share, declared once here (a leaf module: it imports
-//! nothing) and re-exported by the modules they belong to; [`crate::shader::constants`]
+//! nothing) and re-exported by the modules they belong to; [`crate::gpu::shader::constants`]
 //! generates their WGSL declarations, so no shader restates a value.
 
 /// Most gather directions per iteration ([`crate::gather`]).
@@ -39,7 +39,7 @@ pub const LIGHT_POINT: u32 = 0;
 pub const LIGHT_SPOT: u32 = 1;
 pub const LIGHT_DISTANT: u32 = 2;
 
-/// Film component: emission + direct light (the path tracer's full image) ([`crate::film`]).
+/// Film component: emission + direct light (the path tracer's full image) ([`crate::passes::film`]).
 pub const FILM_DIRECT: u32 = 0;
 /// Film component: indirect light from the final gather.
 pub const FILM_INDIRECT: u32 = 1;
@@ -77,7 +77,7 @@ pub const REGION_SHIFT: u32 = 6;
 pub const OFFSET_SHIFT: u32 = REGION_SHIFT + MAX_SEPARATORS as u32;
 
 /// The random streams: every stream key is `seed ^ id` with one of these ids, so no two
-/// passes draw correlated numbers. WGSL gets the ids it uses from [`crate::shader::constants`].
+/// passes draw correlated numbers. WGSL gets the ids it uses from [`crate::gpu::shader::constants`].
 pub mod stream {
     /// The key of the direct pass's per-pixel light-sample scramble seeds (not keyed by the
     /// restart: an Owen-scrambled Sobol' sequence per pixel, indexed by sample).

@@ -2,21 +2,30 @@
 
 use std::fmt::Write as _;
 
+pub mod accel;
+pub mod compiled;
+pub mod consts;
+#[cfg(test)]
+mod layout_test;
+pub mod limits;
+pub mod profile;
+pub(crate) mod shader;
+
 use crate::error::{Error, Result};
-use crate::profile::Profiler;
+use crate::gpu::profile::Profiler;
 
 /// What the user asked for when choosing a GPU.
 #[derive(Clone, Debug, Default)]
 pub struct GpuOptions {
     /// Backends to consider; `None` means `WGPU_BACKEND` if set, else Vulkan/Metal/DX12.
     pub backends: Option<wgpu::Backends>,
-    /// Time every pass with GPU timestamps ([`crate::profile`]), where the adapter can.
+    /// Time every pass with GPU timestamps ([`crate::gpu::profile`]), where the adapter can.
     pub profile: bool,
     /// Open the device with at most this many storage buffers per shader stage (the
     /// adapter's own limit where it is lower): [`WEB_STORAGE_BUFFERS`] gives a native device a
     /// browser's limit, so that tests check what a web page can run.
     pub max_storage_buffers: Option<u32>,
-    /// Which traversal the passes' rays take ([`crate::accel`]); `None` means `RASTERGI_RAYS`
+    /// Which traversal the passes' rays take ([`crate::gpu::accel`]); `None` means `RASTERGI_RAYS`
     /// if set, else the compute BVH (so that a library caller or a test gets the hardware path
     /// only where it asks: `--rays` of the front ends defaults to `auto`).
     pub rays: Option<Rays>,
@@ -58,8 +67,8 @@ pub struct Gpu {
     /// The first error the device reported outside a call that returns one (a lost device, a
     /// GPU timeout, an allocation that failed): [`Gpu::wait`] and every readback return it.
     fault: std::sync::Arc<std::sync::Mutex<Fault>>,
-    /// Releases the device's compiled objects ([`crate::compiled`]) with the last clone.
-    _compiled: std::sync::Arc<crate::compiled::Release>,
+    /// Releases the device's compiled objects ([`crate::gpu::compiled`]) with the last clone.
+    _compiled: std::sync::Arc<crate::gpu::compiled::Release>,
 }
 
 /// What the device reported outside the calls that return errors.
@@ -186,7 +195,7 @@ impl Gpu {
                 fault.lock().unwrap_or_else(|e| e.into_inner()).lost.get_or_insert(why);
             });
         }
-        let _compiled = std::sync::Arc::new(crate::compiled::register(&device));
+        let _compiled = std::sync::Arc::new(crate::gpu::compiled::register(&device));
         Ok(Gpu { adapter, device, queue, info, profiler, rays, fault, _compiled })
     }
 
@@ -512,13 +521,13 @@ pub fn uniform_entry<T>(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::B
 }
 
 /// A bind group layout of `entries` (each names its binding): the device's one of them
-/// ([`crate::compiled`]).
+/// ([`crate::gpu::compiled`]).
 pub fn bind_group_layout(
     device: &wgpu::Device,
     label: &str,
     entries: &[wgpu::BindGroupLayoutEntry],
 ) -> wgpu::BindGroupLayout {
-    crate::compiled::bind_group_layout(device, label, entries)
+    crate::gpu::compiled::bind_group_layout(device, label, entries)
 }
 
 /// Bind-group-layout entry for an unfiltered float 2D texture read with `textureLoad` (the
@@ -578,7 +587,7 @@ pub fn scene_raster_pipeline(
     depth: Option<wgpu::TextureFormat>,
 ) -> wgpu::RenderPipeline {
     let (module, layouts) = shader;
-    crate::compiled::raster_pipeline(device, shader, fs, &target, depth, || {
+    crate::gpu::compiled::raster_pipeline(device, shader, fs, &target, depth, || {
         let layout = pipeline_layout(device, label, layouts);
         let start = web_time::Instant::now();
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
@@ -616,7 +625,7 @@ pub fn scene_raster_pipeline(
 /// A compute pipeline for `module`'s entry point `entry`, with bind groups `layouts` and values
 /// for the shader's pipeline-overridable constants (`override` declarations; none: `&[]`), e.g.
 /// [`crate::gpu_scene::GpuScene::pipeline_constants`]: the device's one of them, compiled on
-/// first use ([`crate::compiled`]).
+/// first use ([`crate::gpu::compiled`]).
 pub fn compute_pipeline(
     device: &wgpu::Device,
     label: &str,
@@ -625,7 +634,7 @@ pub fn compute_pipeline(
     layouts: &[&wgpu::BindGroupLayout],
     constants: &[(&str, f64)],
 ) -> wgpu::ComputePipeline {
-    crate::compiled::compute_pipeline(device, module, entry, layouts, constants, || {
+    crate::gpu::compiled::compute_pipeline(device, module, entry, layouts, constants, || {
         let layout = pipeline_layout(device, label, layouts);
         let start = web_time::Instant::now();
         let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {

@@ -31,7 +31,7 @@ pub struct FrameUniforms {
     /// combined by multiple importance sampling (`env_gather_weight`, `gather_density`).
     pub gather_count: u32,
     pub gather_importance: u32,
-    /// 1 where the eye's specular chains ran this iteration ([`crate::specular`]): the visible
+    /// 1 where the eye's specular chains ran this iteration ([`crate::passes::specular`]): the visible
     /// points are read through `eye_paths`.
     pub eye_chains: u32,
     /// 1 where the eye's visible points read textures at their footprint's level of detail,
@@ -108,7 +108,7 @@ pub fn view_projection(camera: &Camera, width: u32, height: u32, near: f32, jitt
     shift * proj * view
 }
 
-/// The uniform buffer, the eye paths of the specular chains ([`crate::specular`]: per pixel
+/// The uniform buffer, the eye paths of the specular chains ([`crate::passes::specular`]: per pixel
 /// the origin of the ray that found the visible point, its throughput and the point itself)
 /// and their bind group.
 pub struct FrameBinding {

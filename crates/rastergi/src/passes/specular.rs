@@ -12,12 +12,12 @@
 //! a diffuse base) stays the visible point; its delta reflection is not followed (stated in
 //! docs/design.md).
 
-use crate::film::Film;
-use crate::frame::FrameBinding;
-use crate::gbuffer::{GBUFFER_FILM_WGSL, GBufferPass, PixelPass, PixelShader};
 use crate::gpu::Gpu;
+use crate::gpu::shader;
 use crate::gpu_scene::GpuScene;
-use crate::shader;
+use crate::passes::film::Film;
+use crate::passes::frame::FrameBinding;
+use crate::passes::gbuffer::{GBUFFER_FILM_WGSL, GBufferPass, PixelPass, PixelShader};
 
 /// The pass's composed shader.
 pub fn source() -> String {

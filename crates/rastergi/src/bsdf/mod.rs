@@ -925,8 +925,8 @@ pub fn on_gpu(
             a[13] = la.x; a[14] = la.y; a[15] = la.z;
             answers[gid.x] = Answer(a);
         }";
-    let source = crate::shader::compose(&[crate::shader::SAMPLING, crate::shader::BSDF, main]);
-    let module = crate::shader::module(device, "bsdf", &source);
+    let source = crate::gpu::shader::compose(&[crate::gpu::shader::SAMPLING, crate::gpu::shader::BSDF, main]);
+    let module = crate::gpu::shader::module(device, "bsdf", &source);
     gpu.run_once(
         "bsdf",
         &module,

@@ -82,14 +82,14 @@
 use bytemuck::{Pod, Zeroable};
 
 use crate::error::Result;
-use crate::film::{COMPONENTS, FILM_DIRECT, FILM_INDIRECT, Film};
-use crate::frame::FrameBinding;
-use crate::gbuffer::{GBUFFER_FILM_WGSL, GBufferPass, PixelPass, PixelShader};
+use crate::gpu::shader;
 use crate::gpu::{Gpu, bind_group_layout, buffer_bind_group, compute_pipeline, groups, storage_entry, uniform_entry};
 use crate::gpu_scene::GpuScene;
 use crate::image_io::LinearImage;
+use crate::passes::film::{COMPONENTS, FILM_DIRECT, FILM_INDIRECT, Film};
+use crate::passes::frame::FrameBinding;
+use crate::passes::gbuffer::{GBUFFER_FILM_WGSL, GBufferPass, PixelPass, PixelShader};
 use crate::scene::Camera;
-use crate::shader;
 
 /// Guide slots per pixel: slot k of pixel p at `k·W·H + p` (vec4 each): 0 albedo sum and
 /// distance sum, 1 normal sum and coverage count, 2 the moments (m₁, m₂) of the direct and
@@ -485,7 +485,7 @@ impl Denoiser {
             if write {
                 gpu.queue.write_buffer(&self.uniforms[d], 0, bytemuck::bytes_of(&uniform(step)));
             }
-            let mut pass = crate::profile::compute_pass(enc, gpu.profiler.as_ref(), "denoise");
+            let mut pass = crate::gpu::profile::compute_pass(enc, gpu.profiler.as_ref(), "denoise");
             pass.set_pipeline(pipeline);
             pass.set_bind_group(0, &self.groups[d], &[]);
             pass.dispatch_workgroups(groups(self.width, 8), groups(self.height, 8), 1);
@@ -502,7 +502,7 @@ impl Denoiser {
 
     /// The denoised image's buffer (`width × height` vec4, linear RGB and 1), as the last
     /// submitted [`encode`](Self::encode) left it: the source of the film's
-    /// [`ImageResolve`](crate::film::ImageResolve) for the window.
+    /// [`ImageResolve`](crate::passes::film::ImageResolve) for the window.
     pub fn image(&self) -> &wgpu::Buffer {
         &self.image
     }

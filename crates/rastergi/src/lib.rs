@@ -37,6 +37,7 @@ pub mod scene;
 pub mod session;
 pub mod sky;
 mod sky_sun_table;
+pub mod surface;
 pub mod textures;
 
 pub use error::{Error, Result};

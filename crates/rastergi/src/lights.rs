@@ -232,7 +232,7 @@ impl LightTable {
     /// (u3, u4) and origin on the disc, L(ω)·πR²/(pdf(ω)·pmf); with `aim`, the sun's and the
     /// sky's origins aimed ([`disc_start`]: πR² becomes 1/p(x)). `emitted(triangle, b1, b2)`
     /// is the radiance a triangle emits at barycentrics (b1, b2)
-    /// ([`crate::gpu_scene::PreparedScene::emitter_radiance`]).
+    /// ([`crate::surface::PreparedScene::emitter_radiance`]).
     pub fn emit_photon(
         &self,
         scene: &Scene,

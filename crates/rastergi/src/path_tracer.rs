@@ -42,12 +42,13 @@ use bytemuck::{Pod, Zeroable};
 use crate::error::Result;
 use crate::gpu::shader;
 use crate::gpu::{Gpu, bind_group_layout, buffer_bind_group, groups, storage_entry, uniform_entry};
-use crate::gpu_scene::{GpuScene, PreparedScene};
+use crate::gpu_scene::GpuScene;
 use crate::image_io::{DisplayImage, LinearImage};
 use crate::passes::film::{Film, Show};
 use crate::passes::frame::{FrameBinding, FrameUniforms, pixel_jitter};
 use crate::renderer::RenderSettings;
 use crate::scene::{Camera, Scene};
+use crate::surface::PreparedScene;
 
 /// Scattering events after which every path ends (a safety cap; roulette ends them first).
 pub const MAX_BOUNCES: u32 = 1024;

@@ -9,7 +9,7 @@ use crate::gather::{
     DirectionSampler, FixedSample, GatherDirections, GatherFrame, GatherMethod, GatherPass, GatherSetup, HitLight,
 };
 use crate::gpu::Gpu;
-use crate::gpu_scene::{GpuScene, PreparedScene};
+use crate::gpu_scene::GpuScene;
 use crate::image_io::{DisplayImage, LinearImage};
 use crate::passes::denoise::{DenoiseParams, Denoiser, GuideState, Guides, Schedule};
 use crate::passes::film::{Film, FilmState, ImageResolve, Show};
@@ -21,6 +21,7 @@ use crate::photons::gpu::GpuPhotonMap;
 use crate::photons::map::GridSpec;
 use crate::photons::passes::{DEFAULT_PASS_ITERATIONS, PhotonPasses, fitted_pass_iterations};
 use crate::scene::{Camera, Scene};
+use crate::surface::PreparedScene;
 
 /// Settings of a render.
 #[derive(Clone, Debug, PartialEq)]

@@ -12,13 +12,13 @@ use std::sync::Arc;
 use glam::{Vec2, Vec3, Vec4};
 use rastergi::environment::Environment;
 use rastergi::gather::{GatherDirections, GatherMethod};
-use rastergi::gpu_scene::PreparedScene;
 use rastergi::passes::film::Show;
 use rastergi::path_tracer::PathTracer;
 use rastergi::photons::map::GridSpec;
 use rastergi::photons::{PhotonSettings, cpu, gpu::GpuPhotonMap};
 use rastergi::renderer::{Overrides, RenderSettings, Renderer};
 use rastergi::scene::{Camera, Material, Scene};
+use rastergi::surface::PreparedScene;
 
 const ALBEDO: f32 = 0.5;
 /// Half the side of the floor, y = 0, x and z in [−A, A].

@@ -7,7 +7,6 @@ use std::f64::consts::PI;
 
 use glam::{Vec2, Vec3};
 use rastergi::gather::{GatherDirections, GatherMethod, HitLight};
-use rastergi::gpu_scene::PreparedScene;
 use rastergi::image_io::LinearImage;
 use rastergi::metrics::{compare, emitter_mask, masked_mean, rmse};
 use rastergi::passes::film::Show;
@@ -16,6 +15,7 @@ use rastergi::sampling::{
     cosine_hemisphere, pcg_hash, pixel_seed, sobol_owen_2d, sobol_owen_on_gpu, uniform_sphere, unit_f32,
 };
 use rastergi::scene::{Camera, cornell_box, triangle_normal};
+use rastergi::surface::PreparedScene;
 
 /// Renders 6 iterations with `method` at 64² (fixed jitter, bundle 512) and compares each
 /// pixel's estimate with a CPU ray cast of the same estimator at the same visible point:

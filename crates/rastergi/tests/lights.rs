@@ -6,13 +6,13 @@ mod common;
 use std::f64::consts::PI;
 
 use glam::{Vec2, Vec3};
-use rastergi::gpu_scene::PreparedScene;
 use rastergi::passes::film::Show;
 use rastergi::path_tracer::PathTracer;
 use rastergi::photons::map::GridSpec;
 use rastergi::photons::{PhotonSettings, cpu, gpu::GpuPhotonMap};
 use rastergi::renderer::{Overrides, RenderSettings, Renderer};
 use rastergi::scene::{Camera, Light, Material, Scene};
+use rastergi::surface::PreparedScene;
 
 const ALBEDO: f32 = 0.5;
 /// Half the side of the floor, y = 0, x and z in [−A, A].

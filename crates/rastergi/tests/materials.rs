@@ -342,7 +342,7 @@ fn gltf_materials_map_to_the_model() {
     // The textures multiply the factors at every point (the triangles' texture coordinates are
     // all zero; one texel).
     assert!(w.transmission_texture.is_some() && t.specular_texture.is_some() && t.specular_color_texture.is_some());
-    let prepared = rastergi::gpu_scene::PreparedScene::new(&scene);
+    let prepared = rastergi::surface::PreparedScene::new(&scene);
     let at = |name: &str| {
         let k = prepared.scene.material_ids.iter().position(|&i| prepared.scene.materials[i as usize].name == name);
         prepared.bsdf_at(k.unwrap(), 0.3, 0.3, 0.0)
@@ -456,10 +456,11 @@ fn photons_under_glass(
     texture: Option<rastergi::scene::Texture>,
     transmitted: Vec3,
 ) {
-    use rastergi::gpu_scene::{GpuScene, PreparedScene};
+    use rastergi::gpu_scene::GpuScene;
     use rastergi::photons::map::GridSpec;
     use rastergi::photons::{PhotonSettings, cpu, gpu::GpuPhotonMap};
     use rastergi::scene::{Camera, Light, Material, Scene};
+    use rastergi::surface::PreparedScene;
     let camera = Camera { eye: Vec3::new(0.0, 3.0, 0.001), target: Vec3::ZERO, up: Vec3::Z, fov_y_deg: 60.0 };
     let mut s = Scene::new(camera);
     if let Some(t) = texture {
@@ -559,8 +560,9 @@ fn the_eye_sees_through_attenuating_solid_glass_as_beer_lambert_says() {
 /// within their noise (as tests/photons.rs checks the Lambertian box).
 #[test]
 fn gpu_and_cpu_photons_agree_through_glass_and_off_mirrors() {
-    use rastergi::gpu_scene::{GpuScene, PreparedScene};
+    use rastergi::gpu_scene::GpuScene;
     use rastergi::photons::{PhotonSettings, cpu, gpu::GpuPhotonMap};
+    use rastergi::surface::PreparedScene;
     let scene = rastergi::scene::load_obj(&common::data("obj/cornell_spheres.obj")).unwrap();
     let gpu = common::gpu();
     let prepared = PreparedScene::new(&scene);

@@ -7,9 +7,10 @@ mod common;
 
 use rastergi::gpu::accel::{RayPath, Rays};
 use rastergi::gpu::{Gpu, GpuOptions};
-use rastergi::gpu_scene::{GpuScene, PreparedScene};
+use rastergi::gpu_scene::GpuScene;
 use rastergi::rays::{RayCaster, RayKind, disagreements, make_rays, trace_cpu};
 use rastergi::scene::{Scene, cornell_box, load_gltf};
+use rastergi::surface::PreparedScene;
 
 fn gpu_agrees_with_the_cpu_twin(label: &str, scene: &Scene) {
     let gpu = common::gpu();

@@ -9,11 +9,11 @@ use std::path::Path;
 use base64::Engine;
 use glam::Vec3;
 use rastergi::environment::Environment;
-use rastergi::gpu_scene::PreparedScene;
 use rastergi::passes::film::Show;
 use rastergi::path_tracer::PathTracer;
 use rastergi::renderer::{RenderSettings, Renderer};
 use rastergi::scene::{Camera, Material, Scene, load_gltf, load_obj};
+use rastergi::surface::PreparedScene;
 use serde_json::json;
 
 fn close(a: Vec3, b: Vec3, tol: f32) -> bool {

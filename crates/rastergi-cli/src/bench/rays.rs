@@ -10,8 +10,9 @@ use std::time::Instant;
 use anyhow::Result;
 use clap::Args;
 use rastergi::gpu::accel::{RayPath, Rays};
-use rastergi::gpu_scene::{GpuScene, PreparedScene};
+use rastergi::gpu_scene::GpuScene;
 use rastergi::rays::{RayCaster, RayKind, disagreements, make_rays, trace_cpu};
+use rastergi::surface::PreparedScene;
 
 use super::{load_valid_scene, median};
 use crate::args::{GpuArgs, gpu};

@@ -23,7 +23,8 @@ use crate::error::Result;
 use crate::gpu::profile::compute_pass;
 use crate::gpu::shader;
 use crate::gpu::{Gpu, bind_group_layout, buffer_bind_group, storage_entry, uniform_entry};
-use crate::gpu_scene::{GpuScene, PreparedScene};
+use crate::gpu_scene::GpuScene;
+use crate::surface::PreparedScene;
 
 /// Fixed-point units per Φ_max.
 const QUANTUM_BITS: u32 = 24;

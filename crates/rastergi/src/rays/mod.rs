@@ -19,6 +19,8 @@
 //! Rays are laid out in the order of the passes' 8×8 workgroups (tile by tile), so that a
 //! workgroup of the ray kernel holds the rays one workgroup of a pass casts.
 
+pub mod probe;
+
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
@@ -27,10 +29,11 @@ use crate::error::Result;
 use crate::gpu::accel::RayPath;
 use crate::gpu::consts::{LIGHT_POINT, LIGHT_SPOT, PUNCTUAL_LIGHT};
 use crate::gpu::{Gpu, bind_group, bind_group_layout, compute_pipeline, groups, storage_entry};
-use crate::gpu_scene::{GpuScene, PreparedScene, alpha_uniform};
+use crate::gpu_scene::GpuScene;
 use crate::par::prelude::*;
 use crate::sampling::{Rng, cosine_hemisphere, uniform_triangle};
 use crate::scene::{Camera, triangle_normal};
+use crate::surface::{PreparedScene, alpha_uniform};
 
 /// `Ray` in `rays.wgsl`, packed in three vectors.
 #[repr(C)]
@@ -363,32 +366,6 @@ impl RayCaster {
         let bytes = gpu.read_buffer(&output, out_size)?;
         Ok((bytemuck::cast_slice(&bytes)[..rays.len()].to_vec(), times))
     }
-}
-
-/// How many rays the start-up probe of `--rays auto` traces on each path.
-pub const PROBE_RAYS: u32 = 128 * 128;
-
-/// The start-up probe of `--rays auto` (`GpuScene::new`): the seconds the ray kernel takes
-/// on each path, (compute, hardware), to trace the scene's bounce rays from its camera's view at
-/// 128² (incoherent closest hits, the passes' commonest), the faster of two timed runs after
-/// a warm-up each; a scene whose camera sees nothing probes with its photon rays.
-pub fn probe(gpu: &Gpu, prepared: &PreparedScene, scene: &GpuScene) -> Result<(f64, f64)> {
-    let side = (PROBE_RAYS as f64).sqrt() as u32;
-    let mut rays = make_rays(prepared, &prepared.scene.camera, (side, side), RayKind::Bounce, 1);
-    if rays.is_empty() {
-        rays = make_rays(prepared, &prepared.scene.camera, (side, side), RayKind::Photon, 1);
-    }
-    if rays.is_empty() {
-        return Ok((0.0, 0.0));
-    }
-    let mut seconds = [0.0; 2];
-    for (path, s) in [RayPath::Compute, RayPath::Hardware].into_iter().zip(&mut seconds) {
-        let (_, times) = RayCaster::on(gpu, scene, path).trace(gpu, scene, &rays, 2)?;
-        *s = times.iter().map(|t| t.as_secs_f64()).fold(f64::INFINITY, f64::min);
-    }
-    // Per PROBE_RAYS rays, whatever the batch held.
-    let scale = PROBE_RAYS as f64 / rays.len() as f64;
-    Ok((seconds[0] * scale, seconds[1] * scale))
 }
 
 /// The kernel's composed shader.

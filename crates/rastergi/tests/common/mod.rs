@@ -203,7 +203,7 @@ pub fn photon_view_pixels(
     gpu: &Gpu,
     scene: &Scene,
     size: u32,
-) -> (LinearImage, rastergi::gpu_scene::PreparedScene, Vec<PhotonViewPixel>) {
+) -> (LinearImage, rastergi::surface::PreparedScene, Vec<PhotonViewPixel>) {
     let settings = RenderSettings {
         width: size,
         height: size,
@@ -217,7 +217,7 @@ pub fn photon_view_pixels(
     let img = r.read_linear(Show::PhotonMap).unwrap();
     let gbuffer = r.read_gbuffer().unwrap();
     let map = r.photon_map().unwrap().read(gpu).unwrap();
-    let prepared = rastergi::gpu_scene::PreparedScene::new(scene);
+    let prepared = rastergi::surface::PreparedScene::new(scene);
     let pixels = gbuffer
         .iter()
         .enumerate()

@@ -35,8 +35,6 @@ pub mod renderer;
 pub mod sampling;
 pub mod scene;
 pub mod session;
-pub mod sky;
-mod sky_sun_table;
 pub mod surface;
 pub mod textures;
 

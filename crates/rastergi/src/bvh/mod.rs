@@ -9,8 +9,9 @@
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
-use crate::scene::Aabb;
+use bounds::Aabb;
 
+pub mod bounds;
 pub mod wide;
 
 const BINS: usize = 16;

@@ -8,7 +8,6 @@
 //! The albedo may vary over a surface: a material's constant albedo times an sRGB texture read
 //! at the triangle's interpolated texture coordinates.
 
-mod bounds;
 mod camera;
 mod cornell;
 pub mod default_camera;
@@ -20,10 +19,12 @@ mod light;
 mod material;
 mod mitsuba;
 mod obj;
+pub mod sky;
+mod sky_sun_table;
 mod tangents;
 mod texture;
 
-pub use bounds::Aabb;
+pub use crate::bvh::bounds::Aabb;
 pub use camera::Camera;
 pub use cornell::cornell_box;
 pub use files::{Files, MemoryFiles};

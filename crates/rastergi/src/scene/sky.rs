@@ -36,7 +36,7 @@ use glam::Vec3;
 use crate::environment::{Environment, uv_to_direction};
 use crate::error::{Error, Result};
 use crate::scene::Light;
-use crate::sky_sun_table::SUN_IRRADIANCE;
+use crate::scene::sky_sun_table::SUN_IRRADIANCE;
 
 /// Mitsuba's `MI_CIE_Y_NORMALIZATION` (1 / ∫ ȳ(λ) dλ), by which its RGB `sunsky` scales the
 /// Hosek–Wilkie RGB radiance.

@@ -14,9 +14,14 @@ use crate::gpu::consts::{
 };
 
 pub const SAMPLING: &str = include_str!("../sampling.wgsl");
-/// The scene's bind group: geometry, materials, lights and the environment.
+/// The scene's bind group: geometry, materials, lights and the environment. Its bindings and
+/// their accessors (`gpu_scene.wgsl`), the point on a surface (`surface.wgsl`, the GPU twin of
+/// `surface.rs`) and light sampling (`lights.wgsl`, of `lights.rs`) are one file cut in three:
+/// they follow each other with nothing between.
 pub const SCENE: &str = concat!(
     include_str!("../gpu_scene.wgsl"),
+    include_str!("../surface.wgsl"),
+    include_str!("../lights.wgsl"),
     "\n",
     include_str!("../textures.wgsl"),
     "\n",

@@ -1,6 +1,7 @@
 //! Shared test harness: the GPU (lavapipe on CI), renders and references.
 #![allow(dead_code)]
 
+pub mod materials;
 pub mod mitsuba;
 pub mod textured_room;
 

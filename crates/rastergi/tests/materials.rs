@@ -51,7 +51,7 @@ fn the_gpu_bsdf_agrees_with_its_cpu_twin() {
             queries.push((b, wo, wi, u, t));
         }
     }
-    let answers = rastergi::bsdf::on_gpu(&gpu, &queries).unwrap();
+    let answers = rastergi::bsdf::gpu_check::on_gpu(&gpu, &queries).unwrap();
     let close = |a: f32, b: f32| (a - b).abs() <= 1e-4 * a.abs().max(b.abs()) + 1e-6;
     let (mut compared, mut skipped) = (0, 0);
     for ((b, wo, wi, u, t), g) in queries.iter().zip(&answers) {

@@ -13,7 +13,7 @@ use crate::gpu::consts::{
     MIN_LOOKUP_AREA, NO_TEXTURE, OFFSET_SHIFT, OFFSET_STEP, PUNCTUAL_LIGHT, REGION_SHIFT, TRIANGLE_HAS_HOLES, stream,
 };
 
-pub const SAMPLING: &str = include_str!("../sampling.wgsl");
+pub const SAMPLING: &str = include_str!("../sampling/sampling.wgsl");
 /// The scene's bind group: geometry, materials, lights and the environment. Its bindings and
 /// their accessors (`gpu_scene.wgsl`), the point on a surface (`surface.wgsl`, the GPU twin of
 /// `surface.rs`) and light sampling (`lights.wgsl`, of `lights.rs`) are one file cut in three:

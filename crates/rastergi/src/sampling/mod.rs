@@ -4,11 +4,11 @@
 //! (seed, a, b) — e.g. (seed, pixel, iteration) or (seed, photon, batch) — so every sample
 //! is reproducible from `--seed` and independent of scheduling.
 
+pub mod gpu_check;
+
 use glam::Vec3;
 
-use crate::error::Result;
 pub use crate::gpu::consts::stream;
-use crate::gpu::{Gpu, storage_entry};
 
 /// One round of the PCG permutation, also used as an integer hash.
 #[inline]
@@ -169,39 +169,6 @@ pub fn gaussian_deviates(seed: u64) -> impl FnMut() -> f64 {
 /// The scramble seed of pixel (x, y) for a frame's `key`; mirrors `pixel_seed` in WGSL.
 pub fn pixel_seed(key: u32, x: u32, y: u32) -> u32 {
     pcg_hash(x ^ pcg_hash(y ^ key))
-}
-
-/// [`sobol_owen_2d`] of each (index, seed) evaluated by its WGSL twin in a compute shader (for
-/// tests: the two must agree bit for bit).
-pub fn sobol_owen_on_gpu(gpu: &Gpu, queries: &[(u32, u32)]) -> Result<Vec<[u32; 2]>> {
-    let device = &gpu.device;
-    let input: Vec<[u32; 2]> = queries.iter().map(|&(i, s)| [i, s]).collect();
-    let input = gpu.storage_buffer("sobol queries", bytemuck::cast_slice(&input), wgpu::BufferUsages::empty());
-    let size = (queries.len() as u64 * 8).max(8);
-    let output = gpu.zeroed_buffer("sobol points", size, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
-    let c = wgpu::ShaderStages::COMPUTE;
-    let main = "
-        @group(0) @binding(0) var<storage, read> queries: array<vec2u>;
-        @group(0) @binding(1) var<storage, read_write> points: array<vec2u>;
-        @compute @workgroup_size(64)
-        fn main(@builtin(global_invocation_id) gid: vec3u) {
-            if gid.x >= arrayLength(&queries) {
-                return;
-            }
-            points[gid.x] = sobol_owen_2d(queries[gid.x].x, queries[gid.x].y);
-        }";
-    let source = crate::gpu::shader::compose(&[crate::gpu::shader::SAMPLING, main]);
-    let module = crate::gpu::shader::module(device, "sobol points", &source);
-    gpu.run_once(
-        "sobol points",
-        &module,
-        &[storage_entry::<[u32; 2]>(0, c, true), storage_entry::<[u32; 2]>(1, c, false)],
-        &[input.as_entire_binding(), output.as_entire_binding()],
-        queries.len() as u32,
-    );
-    let bytes = gpu.read_buffer(&output, size)?;
-    let points: &[[u32; 2]] = bytemuck::cast_slice(&bytes);
-    Ok(points[..queries.len()].to_vec())
 }
 
 #[cfg(test)]

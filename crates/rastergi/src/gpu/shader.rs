@@ -13,6 +13,26 @@ use crate::gpu::consts::{
     MIN_LOOKUP_AREA, NO_TEXTURE, OFFSET_SHIFT, OFFSET_STEP, PUNCTUAL_LIGHT, REGION_SHIFT, TRIANGLE_HAS_HOLES, stream,
 };
 
+/// The scattering model's files in order (`bsdf/`: the dispatch, then its lobes and tables), for
+/// [`SCENE`] and [`BSDF`].
+macro_rules! bsdf_wgsl {
+    () => {
+        concat!(
+            include_str!("../bsdf/bsdf.wgsl"),
+            "\n",
+            include_str!("../bsdf/microfacet.wgsl"),
+            "\n",
+            include_str!("../bsdf/dielectric.wgsl"),
+            "\n",
+            include_str!("../bsdf/layered.wgsl"),
+            "\n",
+            include_str!("../bsdf/diffuse.wgsl"),
+            "\n",
+            include_str!("../bsdf/albedo.wgsl")
+        )
+    };
+}
+
 pub const SAMPLING: &str = include_str!("../sampling/sampling.wgsl");
 /// The scene's bind group: geometry, materials, lights and the environment. Its bindings and
 /// their accessors (`gpu_scene.wgsl`), the point on a surface (`surface.wgsl`, the GPU twin of
@@ -27,13 +47,13 @@ pub const SCENE: &str = concat!(
     "\n",
     include_str!("../environment.wgsl"),
     "\n",
-    include_str!("../bsdf/bsdf.wgsl")
+    bsdf_wgsl!()
 );
 /// The texture atlas's sampling (`atlas_sample`); the includer binds `textures` and defines
 /// `atlas_entry_word` (needs [`constants`]).
 pub const TEXTURES: &str = include_str!("../textures.wgsl");
 /// The scattering model alone (it needs [`SAMPLING`]).
-pub const BSDF: &str = include_str!("../bsdf/bsdf.wgsl");
+pub const BSDF: &str = bsdf_wgsl!();
 /// Tracing's interface (`trace`, `occluded`, `bvh.wgsl`) with the compute path's `traverse`
 /// (`bvh_compute.wgsl`); [`for_rays`] swaps the latter for the hardware one.
 pub const BVH: &str = concat!(include_str!("../bvh/bvh.wgsl"), "\n", include_str!("../bvh/bvh_compute.wgsl"));

@@ -2,13 +2,17 @@
 //!
 //! The modules follow the data flow of a render:
 //!
-//! scene → [`bvh`] → [`gpu_scene`] → [`photons`] (trace into the grid [`photons::map`]) → per
-//! iteration ([`passes`]: [`passes::gbuffer`] → [`passes::specular`] chains → [`passes::direct`] →
+//! [`scene`] (loaders, materials, camera, lights, the sky) → [`bvh`] → [`surface`] (the prepared
+//! scene the CPU twins query) → [`gpu_scene`] (its upload; [`rays::probe`] picks the ray path) →
+//! [`photons`] (trace into the grid [`photons::map`]) → per iteration, the [`passes`]
+//! ([`passes::frame`] → [`passes::gbuffer`] → [`passes::specular`] chains → [`passes::direct`] →
 //! [`gather`] ([`gather::raster`], [`gather::lists`] or [`gather::trace`])) → [`passes::film`]
-//! (accumulate, resolve) → [`image_io`]. [`path_tracer`] is the reference; both it and the
-//! [`renderer`] are [`progressive`] renderers. [`gpu`] holds the device, the shader composition
-//! and the GPU's shared constants and limits; [`gpu::profile`] times the passes. [`session`] turns
-//! a front end's options into a scene and a renderer, and runs it.
+//! (accumulate, resolve) → [`passes::denoise`] → [`passes::display`] or [`image_io`].
+//! [`path_tracer`] is the reference; both it and the [`renderer`] are [`progressive`] renderers.
+//! Beneath them: [`bsdf`] (the scattering model by lobe, each beside its WGSL twin),
+//! [`sampling`], [`lights`], [`environment`], [`textures`], and [`gpu`] (the device, shader
+//! composition, the constants Rust and WGSL share, limits, pass timings in [`gpu::profile`]).
+//! [`session`] turns a front end's options into a scene and a renderer, and runs it.
 //!
 //! [`renderer::Renderer::iterate`] is the one place that shows the order of the passes.
 

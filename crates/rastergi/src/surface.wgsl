@@ -92,7 +92,7 @@ fn shading_normal(tri: u32, b1: f32, b2: f32, n: vec3f, mi: u32, textured: bool,
     return perturb_normal(n, ns, t, slot_sample(map, uv, 0.0).rgb, materials[mi].maps.normal_scale);
 }
 
-// gpu_scene::perturb_normal: ns perturbed by the normal-map texel c in the frame (t', b, ns).
+// surface::perturb_normal: ns perturbed by the normal-map texel c in the frame (t', b, ns).
 fn perturb_normal(n: vec3f, ns: vec3f, t: vec4f, c: vec3f, scale: f32) -> vec3f {
     var tangent = t.xyz - ns * dot(ns, t.xyz);
     if dot(tangent, tangent) < 1e-12 {

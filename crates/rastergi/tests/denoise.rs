@@ -1,4 +1,4 @@
-//! The denoiser (`denoise.rs`): the GPU filter against its CPU twin, the convergence rule on
+//! The denoiser (`passes/denoise/`): the GPU filter against its CPU twin, the convergence rule on
 //! a synthetic image, and the Cornell box against the committed Mitsuba reference.
 
 mod common;

@@ -10,7 +10,7 @@ use glam::Vec3;
 use rastergi::bsdf::{Bsdf, Transport};
 use rastergi::sampling::{Rng, uniform_sphere};
 
-/// `bsdf.wgsl` on the GPU against `bsdf.rs` for every kind of material, random directions on
+/// `bsdf.wgsl` on the GPU against `bsdf/` for every kind of material, random directions on
 /// both sides and random uniforms: f and the density to 10⁻⁴ relative (f32 on two compilers;
 /// pairs within 2° of a microfacet's critical angle, where the Fresnel term's slope is
 /// unbounded, are left out), and the same sample (direction, weight, kind).

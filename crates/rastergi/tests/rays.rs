@@ -1,4 +1,4 @@
-//! The ray kernel of `bench rays` (rays.rs) against the CPU twin, every kind of ray, on the
+//! The ray kernel of `bench rays` (rays/mod.rs) against the CPU twin, every kind of ray, on the
 //! Cornell box and a glTF room with a rotated light: the same closest hits, the same answers
 //! of the shadow rays. Then the hardware path (ray queries, `accel.rs`) against the same twin,
 //! and against the compute path hit for hit.

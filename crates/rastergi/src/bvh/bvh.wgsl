@@ -1,5 +1,5 @@
 // Ray tracing's one interface, trace / occluded (the twins of Bvh::intersect / Bvh::occluded in
-// bvh.rs: the same hits), over `traverse`, which one of two files defines (accel.rs): the
+// bvh/mod.rs: the same hits), over `traverse`, which one of two files defines (gpu/accel.rs): the
 // compute BVH (bvh_compute.wgsl) or the hardware ray query (bvh_hardware.wgsl).
 
 struct RayHit {

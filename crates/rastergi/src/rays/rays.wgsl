@@ -1,4 +1,4 @@
-// Ray kernel of `rastergi bench rays` (rays.rs): one invocation per ray, traced by `trace`
+// Ray kernel of `rastergi bench rays` (rays/mod.rs): one invocation per ray, traced by `trace`
 // (bvh.wgsl) exactly as the passes call it. The alpha stream keeps its seed 0 (the CPU twin's).
 
 // origin: xyz and t_min; dir: xyz and t_max; skip_any: the triangle to skip, any hit (1).

@@ -1,4 +1,4 @@
-// Random numbers and sampling: bit-for-bit twins of sampling.rs.
+// Random numbers and sampling: bit-for-bit twins of sampling/mod.rs.
 
 const PI: f32 = 3.14159265358979;
 

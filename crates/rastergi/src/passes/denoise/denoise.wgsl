@@ -1,4 +1,4 @@
-// The denoiser's filter (denoise.rs): prepare (film sums and guides → demodulated reflected
+// The denoiser's filter (denoise/mod.rs): prepare (film sums and guides → demodulated reflected
 // light and the variance of its mean, per component), the guide: one à-trous level per
 // dispatch (step params.step), the regression (a weighted first-order fit around every
 // pixel, weighted by the guide), compose (remodulate, add the components and the emission).
@@ -222,7 +222,7 @@ fn tri(i: u32, j: u32) -> u32 {
     return i * (i + 1u) / 2u + j;
 }
 
-// The fit of component c at pixel xy (module notes, denoise.rs): Σ w x xᵀ β = Σ w x L over
+// The fit of component c at pixel xy (module notes, denoise/mod.rs): Σ w x xᵀ β = Σ w x L over
 // the disc of radius r, w = exp(−d²/(2 (BANDWIDTH r)²)) · exp(−|Y(G_q) − Y(G_p)| / s), G the
 // guide (`src`), s = σ_g · √(g₃ ⊛ σ²)(p), solved by Cholesky with the ridge on the diagonal.
 // The sums are kept in blocks of fixed shape (x_n x_nᵀ, x_a x_nᵀ, x_a x_aᵀ, L x_nᵀ, L x_aᵀ),

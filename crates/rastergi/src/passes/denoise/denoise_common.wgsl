@@ -1,4 +1,4 @@
-// Shared by the denoiser's passes (denoise.rs): the luminance and the albedo a light value is
+// Shared by the denoiser's passes (denoise/mod.rs): the luminance and the albedo a light value is
 // divided by (its own where a channel exceeds DEMODULATION_MIN, else 1).
 
 fn luminance(c: vec3f) -> f32 {

@@ -1,4 +1,4 @@
-// Denoiser guides (denoise.rs, Guides): per pixel, after every pass of the iteration has added
+// Denoiser guides (denoise/mod.rs, Guides): per pixel, after every pass of the iteration has added
 // to the film, the sums of the visible point's albedo, distance, shading normal and coverage,
 // the sum of the emission the eye sees (what the direct pass adds before any light is
 // reflected: an emitter's front face, the environment where the camera ray escapes, times the

@@ -1,4 +1,4 @@
-// Photon map lookups (photons/map.rs), bind group 3 of the passes that read the map: per slot
+// Photon map lookups (photons/map/), bind group 3 of the passes that read the map: per slot
 // table entry (Φ_rgb/h², A/h²), the table's keys, and every triangle's plane keys.
 
 struct PhotonGrid {

@@ -11,7 +11,7 @@ use crate::textures::TextureAtlas;
 
 /// A scene prepared for rendering: triangles permuted into BVH order, with the BVH and the
 /// light table over them and the textures as the GPU samples them. CPU twins use this
-/// directly; [`GpuScene`] uploads it.
+/// directly; [`GpuScene`](crate::gpu_scene::GpuScene) uploads it.
 #[derive(Clone, Debug)]
 pub struct PreparedScene {
     pub scene: Scene,

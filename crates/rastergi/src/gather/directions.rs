@@ -49,7 +49,7 @@ impl DirectionSampler {
         DirectionSampler { seed, restart: 0 }
     }
 
-    /// The key of the per-pixel scramble seeds of this restart ([`PixelSamples::key`]).
+    /// The key of the per-pixel scramble seeds of this restart ([`PixelSamples::key`](super::PixelSamples::key)).
     pub fn pixel_key(&self) -> u32 {
         pixel_key(self.seed, self.restart)
     }

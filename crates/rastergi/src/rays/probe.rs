@@ -10,7 +10,7 @@ use crate::surface::PreparedScene;
 use super::{RayCaster, RayKind, make_rays};
 
 impl GpuScene {
-    /// Uploads `prepared` ([`GpuScene::upload`]) and, under `--rays auto` where the device has ray
+    /// Uploads `prepared` (`GpuScene::upload`) and, under `--rays auto` where the device has ray
     /// queries, chooses the ray path by the start-up [`probe`].
     pub fn new(gpu: &Gpu, prepared: &PreparedScene) -> Result<GpuScene> {
         let mut scene = GpuScene::upload(gpu, prepared)?;

@@ -42,7 +42,7 @@ impl Default for UvTransform {
     }
 }
 
-/// A texture as a material reads it: an index into [`Scene::textures`] and the placement of
+/// A texture as a material reads it: an index into [`Scene::textures`](super::Scene::textures) and the placement of
 /// the triangle's texture coordinates on it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TextureRef {
@@ -75,8 +75,8 @@ pub struct Material {
     pub name: String,
     /// Diffuse albedo ρ in linear RGB; the BRDF is ρ/π. With a texture, ρ = albedo × texel.
     pub albedo: Vec3,
-    /// Index into [`Scene::textures`] of an albedo texture (sRGB, decoded to linear), read at
-    /// the triangle's texture coordinates ([`Scene::uvs`]) placed by `albedo_transform`.
+    /// Index into [`Scene::textures`](super::Scene::textures) of an albedo texture (sRGB, decoded to linear), read at
+    /// the triangle's texture coordinates ([`Scene::uvs`](super::Scene::uvs)) placed by `albedo_transform`.
     pub albedo_texture: Option<usize>,
     pub albedo_transform: UvTransform,
     /// Radiance emitted from the front face, linear RGB; with a texture, Le = emission × texel.
@@ -124,7 +124,7 @@ pub struct Material {
     /// the glass is a solid (not `thin`) and transmits; media do not nest.
     pub attenuation: Vec3,
     /// Rough metal with its multiple-scattering energy compensation ([`crate::bsdf`]); false:
-    /// single scattering, the model of Mitsuba 3's `roughconductor` ([`Scene::single_scattering`]).
+    /// single scattering, the model of Mitsuba 3's `roughconductor` ([`Scene::single_scattering`](super::Scene::single_scattering)).
     pub multiple_scattering: bool,
     /// The clear coat's weight k (`KHR_materials_clearcoat`'s clearcoatFactor, MTL `Pc`; 0:
     /// none) and perceptual roughness (clearcoatRoughnessFactor, MTL `Pcr`; its GGX α is the

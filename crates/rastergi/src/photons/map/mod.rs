@@ -6,7 +6,7 @@
 //!   part of the scene's surfaces with that plane key inside the cell (triangles clipped to
 //!   the cell). Irradiance of a slot: E = Φ / A. Where the surface has holes (cut-outs,
 //!   stochastic opacity), photons stop only with the probability c(x) that it is there
-//!   ([`Scene::coverage_at`]), so A = ∫ c dA over the piece ([`mean_coverage`]): the holes
+//!   ([`Scene::coverage_at`](crate::scene::Scene::coverage_at)), so A = ∫ c dA over the piece ([`mean_coverage`]): the holes
 //!   would otherwise dilute the irradiance of what is solid.
 //! * **Orientation bins** ([`orientation_bin`]): the cube face of the dominant axis and sign
 //!   of the side's normal, each face divided 3 × 3 by the other two coordinates over the

@@ -11,10 +11,10 @@ evaluates the sun alone (sky_scale 0) at the centre of its disc and multiplies t
 radiance by the disc's solid angle 2 pi (1 - cos(0.5358 deg / 2)), which gives the
 irradiance on a surface facing the sun.
 
-Run with Mitsuba 3 (3.9.1 made crates/rastergi/src/sky_sun_table.rs):
+Run with Mitsuba 3 (3.9.1 made crates/rastergi/src/scene/sky_sun_table.rs):
   DRJIT_LIBLLVM_PATH=/usr/lib/x86_64-linux-gnu/libLLVM-19.so \
     ~/.local/share/rastergi/venv/bin/python scripts/sunsky_sun_table.py \
-    > crates/rastergi/src/sky_sun_table.rs
+    > crates/rastergi/src/scene/sky_sun_table.rs
 """
 import math
 

@@ -19,9 +19,9 @@ use pyo3::exceptions::{PyFileNotFoundError, PyRuntimeError, PyTypeError, PyValue
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rastergi::error::Error;
-use rastergi::film::Show;
 use rastergi::gpu::GpuOptions;
 use rastergi::image_io::{ImageFormat, LinearImage, display_encode, write_exr, write_png};
+use rastergi::passes::film::Show;
 use rastergi::progressive::Progressive;
 use rastergi::scene::Camera;
 use rastergi::session::args::{SceneArgs, ShowArg};
@@ -98,7 +98,7 @@ fn parse(argv: Vec<String>) -> PyResult<RenderOptions> {
 
 /// The process's device for `options`' backends: one for every renderer made in Python, so
 /// that a renderer made after another of the same shader variants reuses its compiled
-/// pipelines (`rastergi::compiled`: set-up about 1 s shorter per renderer on lavapipe). A
+/// pipelines (`rastergi::gpu::compiled`: set-up about 1 s shorter per renderer on lavapipe). A
 /// device that reported an error (lost, out of memory) is replaced by a fresh one.
 fn shared_gpu(options: &GpuOptions) -> Result<rastergi::gpu::Gpu> {
     static GPUS: Mutex<Vec<(String, rastergi::gpu::Gpu)>> = Mutex::new(Vec::new());
@@ -215,7 +215,7 @@ fn render<'py>(py: Python<'py>, argv: Vec<String>) -> PyResult<Bound<'py, PyArra
     let denoise = o.denoise;
     let image = py
         .detach(move || match renderer.denoising().filter(|_| denoise) {
-            Some(r) => r.read_denoised(&rastergi::denoise::DenoiseParams::default()),
+            Some(r) => r.read_denoised(&rastergi::passes::denoise::DenoiseParams::default()),
             None => renderer.read_linear(show),
         })
         .map_err(|e| py_err(e.into()))?;

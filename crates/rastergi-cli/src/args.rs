@@ -34,7 +34,7 @@ pub fn print_profile(gpu: &Gpu, profile: bool, title: &str, per: u64, per_name: 
     let (times, dropped) = p.report(&gpu.device, &gpu.queue)?;
     p.clear(&gpu.device, &gpu.queue)?;
     println!("{title} (GPU timestamps, {}):", gpu.info.name);
-    println!("{}", rastergi::profile::table(&times, per, per_name));
+    println!("{}", rastergi::gpu::profile::table(&times, per, per_name));
     if dropped > 0 {
         println!("({dropped} passes not timed: the query set was full)");
     }

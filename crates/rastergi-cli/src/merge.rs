@@ -6,9 +6,8 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::Args;
-use rastergi::checkpoint;
-use rastergi::fit;
 use rastergi::image_io::{ImageFormat, display_encode, write_exr, write_png};
+use rastergi::{checkpoint, fit};
 
 use crate::args::ShowArg;
 

@@ -98,7 +98,7 @@ fn a_signal_at_a_random_moment_leaves_a_valid_image_and_a_checkpoint_that_resume
         let line = format!("interrupted (SIG{name}): {out} holds {n} of 1000000 iterations");
         assert!(stderr.contains(&line), "expected '{line}' in:\n{stderr}");
         // The image is the checkpoint's; resuming it to n + 6 equals n + 6 at once.
-        let (image, expected) = (exr(d, &out), c.film.image(rastergi::film::Show::Full));
+        let (image, expected) = (exr(d, &out), c.film.image(rastergi::passes::film::Show::Full));
         let close = image
             .pixels
             .iter()
@@ -218,7 +218,7 @@ fn the_time_limit_stops_a_render_that_would_not_end_and_writes_its_image() {
 fn the_target_error_stops_when_the_estimate_reaches_it_and_the_estimate_is_the_true_noise() {
     // The path tracer (unbiased: its error is its noise) against Mitsuba's pair: the error
     // estimated from the halves, against the RMSE measured against the references less their
-    // own noise. The estimate errs on the safe side by about a tenth (rastergi::film: blocks of
+    // own noise. The estimate errs on the safe side by about a tenth (rastergi::passes::film: blocks of
     // 16 iterations keep the Sobol' sequences' halves stratified).
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();

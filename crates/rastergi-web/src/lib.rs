@@ -22,10 +22,10 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicU32, Ordering};
 
 use rastergi::camera_control::{CameraControl, DRAG_RADIANS_PER_PIXEL, MoveKeys};
-use rastergi::display::WindowSurface;
-use rastergi::film::Show;
 use rastergi::gather::GatherMethod;
 use rastergi::gpu::{Gpu, GpuOptions};
+use rastergi::passes::display::WindowSurface;
+use rastergi::passes::film::Show;
 use rastergi::progressive::Progressive;
 
 use rastergi::scene::{Files, GltfOptions, MemoryFiles, Scene, SunAngles};

@@ -251,7 +251,7 @@ fn max_pitch() -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::frame::view_projection;
+    use crate::passes::frame::view_projection;
     use glam::Vec2;
 
     fn cornell_camera() -> Camera {

@@ -30,8 +30,8 @@
 use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
-use crate::film::FilmState;
 use crate::gather::{GatherDirections, GatherMethod};
+use crate::passes::film::FilmState;
 
 const MAGIC: &[u8; 8] = b"RGICKPT\0";
 const VERSION: u32 = 1;
@@ -166,7 +166,7 @@ impl Checkpoint {
         let [photon_pass, iterations_in_pass, m, d, width, height, samples, half_samples] = u;
         let gather = gather_from_code(m, d).ok_or_else(|| bad("unknown gather code"))?;
         let count = r.u64().ok_or_else(|| bad("too short"))? as usize;
-        if count as u64 != 4 * crate::film::COMPONENTS * width as u64 * height as u64 {
+        if count as u64 != 4 * crate::passes::film::COMPONENTS * width as u64 * height as u64 {
             return Err(bad("its film size does not match its image size"));
         }
         let floats = |r: &mut Reader| -> Option<Vec<f32>> {
@@ -360,7 +360,7 @@ mod tests {
     use super::*;
 
     fn sample() -> Checkpoint {
-        let n = 4 * crate::film::COMPONENTS as usize * 6;
+        let n = 4 * crate::passes::film::COMPONENTS as usize * 6;
         Checkpoint {
             scene_hash: 0x1234_5678_9abc_def0,
             seed: 7,

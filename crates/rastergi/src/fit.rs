@@ -32,11 +32,11 @@
 
 use glam::Vec3;
 
-use crate::gpu_scene::PreparedScene;
 use crate::image_io::LinearImage;
 use crate::photons::map::{GridSpec, PhotonRegion};
 use crate::sampling::{Rng, cosine_hemisphere};
 use crate::scene::{Aabb, Camera, Scene, triangle_area, triangle_normal};
+use crate::surface::PreparedScene;
 
 /// The default ray-view resolution: twice the image's larger side, within [128, 2048], so a
 /// ray-view texel is about as wide as an eye pixel's footprint on a scene seen whole.

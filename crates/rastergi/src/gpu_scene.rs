@@ -3,21 +3,20 @@
 //! every pass that reads the scene (`gpu_scene.wgsl`).
 
 use bytemuck::{Pod, Zeroable};
-use glam::{Vec2, Vec3, Vec4};
+use glam::Vec3;
 
-use crate::accel::{RayPath, Rays, SceneAccel};
-use crate::bvh::Bvh;
 use crate::bvh::wide::WideNode;
 use crate::error::Result;
+use crate::gpu::accel::{RayPath, Rays, SceneAccel};
 use wgpu::util::DeviceExt;
 
-use crate::binding::{Group, Slot};
 use crate::environment::{Environment, GpuEnvironment};
 use crate::gpu::Gpu;
-use crate::lights::{LightEntry, LightTable};
-use crate::limits::check_storage_buffer;
-use crate::scene::{Aabb, AlphaMode, Material, Scene, TextureRef, UvTransform};
-use crate::textures::TextureAtlas;
+use crate::gpu::binding::{Group, Slot};
+use crate::gpu::limits::check_storage_buffer;
+use crate::lights::LightEntry;
+use crate::scene::{Aabb, AlphaMode, Material, TextureRef, UvTransform};
+use crate::surface::PreparedScene;
 
 /// `Triangle` in `gpu_scene.wgsl`.
 #[repr(C)]
@@ -105,7 +104,7 @@ pub struct GpuMaterialMaps {
     pub clearcoat_roughness_map: GpuTextureSlot,
 }
 
-pub use crate::consts::GpuSceneOffsets;
+pub use crate::gpu::consts::GpuSceneOffsets;
 
 /// The scene's bind group 0, read by every pass: triangles, materials, the texture atlas, the
 /// scene data (coordinates, normals, tangents, lights, environment), the environment's
@@ -132,7 +131,7 @@ pub fn group(tlas: bool) -> Group {
         ],
     );
     if tlas {
-        g.slots.push(Slot::tlas(crate::accel::TLAS_BINDING, "scene_tlas").only(compute));
+        g.slots.push(Slot::tlas(crate::gpu::accel::TLAS_BINDING, "scene_tlas").only(compute));
     }
     g
 }
@@ -249,187 +248,10 @@ impl GpuMaterial {
     }
 }
 
-pub use crate::consts::{
+pub use crate::gpu::consts::{
     MATERIAL_ALPHA_BLEND, MATERIAL_ALPHA_MASK, MATERIAL_LAMBERTIAN, MATERIAL_SINGLE_SCATTERING, MATERIAL_TEXTURED,
     MATERIAL_THIN, MATERIAL_TWO_SIDED, NO_TEXTURE, TRIANGLE_HAS_HOLES,
 };
-
-/// A scene prepared for rendering: triangles permuted into BVH order, with the BVH and the
-/// light table over them and the textures as the GPU samples them. CPU twins use this
-/// directly; [`GpuScene`] uploads it.
-#[derive(Clone, Debug)]
-pub struct PreparedScene {
-    pub scene: Scene,
-    pub bvh: Bvh,
-    pub lights: LightTable,
-    pub bounds: Aabb,
-    pub textures: TextureAtlas,
-}
-
-impl PreparedScene {
-    pub fn new(scene: &Scene) -> PreparedScene {
-        let bvh = Bvh::build(&scene.triangles);
-        let mut scene = scene.clone();
-        scene.triangles = bvh.permute(&scene.triangles);
-        scene.material_ids = bvh.permute(&scene.material_ids);
-        if !scene.uvs.is_empty() {
-            scene.uvs = bvh.permute(&scene.uvs);
-        }
-        if !scene.normals.is_empty() {
-            scene.normals = bvh.permute(&scene.normals);
-        }
-        if !scene.tangents.is_empty() {
-            scene.tangents = bvh.permute(&scene.tangents);
-        }
-        let bvh = Bvh { order: (0..scene.triangles.len() as u32).collect(), ..bvh };
-        let lights = LightTable::new(&scene);
-        let bounds = scene.bounds();
-        let textures = TextureAtlas::new(&scene.textures);
-        PreparedScene { scene, bvh, lights, bounds, textures }
-    }
-
-    /// Texture coordinates at barycentrics (b1, b2) of triangle `tri` (`surface_uv` in WGSL).
-    pub fn uv_at(&self, tri: usize, b1: f32, b2: f32) -> Vec2 {
-        match self.scene.uvs.get(tri) {
-            Some(uv) => uv[0] * (1.0 - b1 - b2) + uv[1] * b1 + uv[2] * b2,
-            None => Vec2::ZERO,
-        }
-    }
-
-    /// The shading normal at barycentrics (b1, b2) of triangle `tri` (`shading_normal` in
-    /// WGSL): the corners' normals interpolated and normalised, turned into the geometric
-    /// normal's hemisphere (the geometric normal where the triangle has none), then perturbed
-    /// by the material's normal map, if any ([`perturb_normal`]).
-    pub fn shading_normal_at(&self, tri: usize, b1: f32, b2: f32) -> Vec3 {
-        let n = crate::scene::triangle_normal(&self.scene.triangles[tri]);
-        let interpolated = self.scene.normals.get(tri).map(|c| c[0] * (1.0 - b1 - b2) + c[1] * b1 + c[2] * b2);
-        let ns = match interpolated {
-            Some(v) if v.length() >= 1e-6 => {
-                let v = v.normalize();
-                if v.dot(n) >= 0.0 { v } else { -v }
-            }
-            _ => n,
-        };
-        let m = self.scene.material_of(tri);
-        let (Some(map), Some(t)) = (m.normal_texture, self.scene.tangents.get(tri)) else { return ns };
-        let t = t[0] * (1.0 - b1 - b2) + t[1] * b1 + t[2] * b2;
-        let texel = self.textures.sample(map.texture as u32, map.transform.apply(self.uv_at(tri, b1, b2)), 0.0);
-        perturb_normal(n, ns, t, texel, m.normal_scale)
-    }
-
-    /// A texture of the material of `tri` read at barycentrics (b1, b2) and level of detail
-    /// `lod` (linear RGBA).
-    fn texel(&self, slot: TextureRef, tri: usize, b1: f32, b2: f32, lod: f32) -> Vec4 {
-        self.textures.sample_rgba(slot.texture as u32, slot.transform.apply(self.uv_at(tri, b1, b2)), lod)
-    }
-
-    /// The albedo at barycentrics (b1, b2) of triangle `tri`, its texture read at level of
-    /// detail `lod`: the twin of `surface_at(…).albedo` in WGSL.
-    pub fn albedo_at(&self, tri: usize, b1: f32, b2: f32, lod: f32) -> Vec3 {
-        let m = self.scene.material_of(tri);
-        match m.albedo_texture {
-            Some(texture) => {
-                m.albedo
-                    * self.texel(TextureRef { texture, transform: m.albedo_transform }, tri, b1, b2, lod).truncate()
-            }
-            None => m.albedo,
-        }
-    }
-
-    /// The scattering model at barycentrics (b1, b2) of triangle `tri`, its albedo texture read
-    /// at `lod` (`surface_bsdf(surface_at(…))` in WGSL).
-    pub fn bsdf_at(&self, tri: usize, b1: f32, b2: f32, lod: f32) -> crate::bsdf::Bsdf {
-        let m = self.scene.material_of(tri);
-        let texel = |t: Option<TextureRef>| t.map(|t| self.texel(t, tri, b1, b2, 0.0));
-        let texels = crate::scene::Texels {
-            metal_rough: texel(m.metal_rough_texture).map_or(Vec3::ONE, |t| t.truncate()),
-            transmission: texel(m.transmission_texture).map_or(1.0, |t| t.x),
-            specular: texel(m.specular_texture).map_or(1.0, |t| t.w),
-            specular_color: texel(m.specular_color_texture).map_or(Vec3::ONE, |t| t.truncate()),
-            clearcoat: texel(m.clearcoat_texture).map_or(1.0, |t| t.x),
-            clearcoat_roughness: texel(m.clearcoat_roughness_texture).map_or(1.0, |t| t.y),
-        };
-        m.bsdf(self.albedo_at(tri, b1, b2, lod), &texels)
-    }
-
-    /// The emitted radiance at barycentrics (b1, b2) of triangle `tri` (`surface_at(…).emission`).
-    pub fn emission_at(&self, tri: usize, b1: f32, b2: f32) -> Vec3 {
-        let m = self.scene.material_of(tri);
-        match m.emission_texture {
-            Some(t) => m.emission * self.texel(t, tri, b1, b2, 0.0).truncate(),
-            None => m.emission,
-        }
-    }
-
-    /// The radiance an emitter sends from barycentrics (b1, b2) of triangle `tri` as a light
-    /// sample or a photon sees it: its emission there, nothing from a cut-out's hole, α × it
-    /// on a stochastic surface (the expectation of meeting it). `emitter_radiance` in WGSL.
-    pub fn emitter_radiance(&self, tri: usize, b1: f32, b2: f32) -> Vec3 {
-        let le = self.emission_at(tri, b1, b2);
-        match self.scene.material_of(tri).alpha_mode {
-            AlphaMode::Opaque => le,
-            AlphaMode::Mask { .. } if self.passes_through(tri, b1, b2, 0.0) => Vec3::ZERO,
-            AlphaMode::Mask { .. } => le,
-            AlphaMode::Blend => le * self.opacity_at(tri, b1, b2, 0.0),
-        }
-    }
-
-    /// The opacity α at barycentrics (b1, b2) of triangle `tri`, its texture read at `lod`
-    /// (`surface_opacity` in WGSL).
-    pub fn opacity_at(&self, tri: usize, b1: f32, b2: f32, lod: f32) -> f32 {
-        let m = self.scene.material_of(tri);
-        m.opacity * m.opacity_texture.map_or(1.0, |t| self.texel(t, tri, b1, b2, lod).w)
-    }
-
-    /// Whether a ray meeting triangle `tri` at (b1, b2) passes through it (`passes_through`
-    /// in WGSL): through a cut-out's holes (α < cutoff), through a stochastic surface when
-    /// the uniform `u` ≥ α; never through an opaque one.
-    pub fn passes_through(&self, tri: usize, b1: f32, b2: f32, u: f32) -> bool {
-        match self.scene.material_of(tri).alpha_mode {
-            AlphaMode::Opaque => false,
-            AlphaMode::Mask { cutoff } => self.opacity_at(tri, b1, b2, 0.0) < cutoff,
-            AlphaMode::Blend => u >= self.opacity_at(tri, b1, b2, 0.0),
-        }
-    }
-
-    /// Distance used to offset ray origins and as the minimum hit distance: a small multiple
-    /// of float precision at the scene's scale.
-    pub fn ray_epsilon(&self) -> f32 {
-        let b = self.bounds;
-        let scale = b.min.abs().max(b.max.abs()).max_element().max(b.extent().max_element());
-        1e-5 * scale.max(1e-3)
-    }
-}
-
-/// A shading normal `ns` (unit, on the side of the geometric normal `n`) perturbed by a
-/// normal-map texel (linear RGB c): with the tangent t (xyz interpolated, w the handedness)
-/// made orthogonal to ns, t' = normalize(t − (ns·t) ns), and the bitangent b = w · ns × t',
-/// the tangent-space normal m = (2c − 1) · (scale, scale, 1) gives
-/// normalize(m.x t' + m.y b + m.z ns), bent into n's hemisphere where it falls below the
-/// surface ([`crate::sampling::bend_towards`] towards n). Without a usable tangent ns is kept.
-/// `perturb_normal` in WGSL.
-pub fn perturb_normal(n: Vec3, ns: Vec3, t: Vec4, texel: Vec3, scale: f32) -> Vec3 {
-    let tangent = t.truncate() - ns * ns.dot(t.truncate());
-    if tangent.length_squared() < 1e-12 {
-        return ns;
-    }
-    let tangent = tangent.normalize();
-    let bitangent = ns.cross(tangent) * if t.w < 0.0 { -1.0 } else { 1.0 };
-    let m = (2.0 * texel - Vec3::ONE) * Vec3::new(scale, scale, 1.0);
-    let v = tangent * m.x + bitangent * m.y + ns * m.z;
-    if v.length_squared() < 1e-12 {
-        return ns;
-    }
-    crate::sampling::bend_towards(v.normalize(), n)
-}
-
-/// The uniform that decides whether a ray meeting triangle `tri` at (b1, b2) passes through a
-/// stochastic surface, hashed from the point and the stream's `seed` (as in `passes_through`
-/// in WGSL).
-pub fn alpha_uniform(tri: u32, b1: f32, b2: f32, seed: u32) -> f32 {
-    use crate::sampling::{pcg_hash, unit_f32};
-    unit_f32(pcg_hash(pcg_hash(pcg_hash(tri ^ seed) ^ b1.to_bits()) ^ b2.to_bits()))
-}
 
 pub struct GpuScene {
     pub layout: wgpu::BindGroupLayout,
@@ -498,18 +320,20 @@ impl GpuScene {
     }
 
     /// A shader module of `source` (a composed shader that reads this scene) on this scene's
-    /// ray path ([`crate::shader::for_rays`]).
+    /// ray path ([`crate::gpu::shader::for_rays`]).
     pub fn module(&self, device: &wgpu::Device, label: &str, source: &str) -> wgpu::ShaderModule {
         self.module_for(device, label, source, self.rays)
     }
 
     /// [`Self::module`] on ray path `path` (the hardware one needs [`Self::accel`]).
     pub fn module_for(&self, device: &wgpu::Device, label: &str, source: &str, path: RayPath) -> wgpu::ShaderModule {
-        crate::shader::module(device, label, &crate::shader::for_rays(source, path))
+        crate::gpu::shader::module(device, label, &crate::gpu::shader::for_rays(source, path))
     }
 
-    /// Uploads `prepared`, after checking that its buffers fit the device (see [`crate::limits`]).
-    pub fn new(gpu: &Gpu, prepared: &PreparedScene) -> Result<GpuScene> {
+    /// Uploads `prepared`, after checking that its buffers fit the device (see [`crate::gpu::limits`]),
+    /// on the ray path that `--rays` asked for (auto: hardware where offered): the first half of
+    /// [`GpuScene::new`], whose start-up probe then chooses under auto (`rays/probe.rs`).
+    pub(crate) fn upload(gpu: &Gpu, prepared: &PreparedScene) -> Result<GpuScene> {
         let limits = gpu.device.limits();
         check_scene(&limits, &prepared.scene)?;
         let nodes = prepared.bvh.wide();
@@ -573,7 +397,7 @@ impl GpuScene {
         }
         let env = s.environment.as_deref();
         let env_data = env.map_or(vec![0.0f32; 4], Environment::gpu_data);
-        crate::limits::check_storage_buffer(
+        crate::gpu::limits::check_storage_buffer(
             &limits,
             "the environment map",
             env_data.len() as u64,
@@ -604,7 +428,7 @@ impl GpuScene {
             ..GpuSceneOffsets::default()
         };
         data.words[..size_of::<GpuSceneOffsets>() / 4].copy_from_slice(bytemuck::cast_slice(&[offsets]));
-        crate::limits::check_storage_buffer(
+        crate::gpu::limits::check_storage_buffer(
             &limits,
             "the scene's texture coordinates, normals, tangents, lights and environment map",
             data.words.len() as u64,
@@ -614,9 +438,9 @@ impl GpuScene {
         let none = wgpu::BufferUsages::empty();
         // Ray queries where the device has them and the compute path was not asked for: the
         // triangles are then also the BLAS's vertices (accel::build).
-        let ray_queries = gpu.rays != Rays::Compute && crate::accel::device_has_ray_queries(&gpu.device);
+        let ray_queries = gpu.rays != Rays::Compute && crate::gpu::accel::device_has_ray_queries(&gpu.device);
         if gpu.rays == Rays::Hardware && !ray_queries {
-            return Err(crate::accel::not_offered(&gpu.info.name));
+            return Err(crate::gpu::accel::not_offered(&gpu.info.name));
         }
         let blas_input = if ray_queries { wgpu::BufferUsages::BLAS_INPUT } else { none };
         let buffers = [
@@ -631,7 +455,7 @@ impl GpuScene {
             usage: wgpu::BufferUsages::UNIFORM,
         });
         let accel = if ray_queries && !triangles.is_empty() {
-            Some(crate::accel::build(gpu, &buffers[0], triangles.len() as u32)?)
+            Some(crate::gpu::accel::build(gpu, &buffers[0], triangles.len() as u32)?)
         } else {
             None
         };
@@ -660,7 +484,7 @@ impl GpuScene {
             (_, None) if ray_queries => (RayPath::Compute, "the scene has no triangles".to_owned()),
             (_, None) => (RayPath::Compute, format!("{} offers no hardware ray queries", gpu.info.name)),
         };
-        let mut scene = GpuScene {
+        let scene = GpuScene {
             layout,
             bind_group,
             triangle_count: triangles.len() as u32,
@@ -685,22 +509,6 @@ impl GpuScene {
             rays_why,
             accel,
         };
-        if gpu.rays == Rays::Auto && scene.accel.is_some() {
-            let (compute, hardware) = crate::rays::probe(gpu, prepared, &scene)?;
-            let rate = |s: f64| format!("{:.1} Mrays/s", crate::rays::PROBE_RAYS as f64 / s / 1e6);
-            scene.rays = if hardware <= compute { RayPath::Hardware } else { RayPath::Compute };
-            scene.rays_why = if compute > 0.0 {
-                format!(
-                    "auto: the start-up probe measured hardware {} against compute {} on this scene",
-                    rate(hardware),
-                    rate(compute)
-                )
-            } else {
-                "auto: offered, and the scene gave the probe no rays (its camera sees nothing, it has no lights)"
-                    .to_owned()
-            };
-        }
-        log::info!("rays: {} ({})", scene.rays.name(), scene.rays_why);
         Ok(scene)
     }
 }
@@ -742,7 +550,7 @@ pub fn check_bvh_nodes(limits: &wgpu::Limits, nodes: usize) -> Result<()> {
 mod limit_tests {
     use super::*;
 
-    use crate::limits::test_limits as limits;
+    use crate::gpu::limits::test_limits as limits;
 
     #[test]
     fn a_scene_whose_triangles_exceed_the_binding_limit_is_refused_with_the_sizes() {

@@ -15,7 +15,9 @@ use crate::scene::{Light, Scene, triangle_area, triangle_normal};
 
 /// [`LightEntry::triangle`] bit of an entry that is a [`PunctualLight`] (the other bits: its
 /// index in [`LightTable::punctual`]); [`PunctualLight::kind`] values.
-pub use crate::consts::{ENVIRONMENT_LIGHT, LIGHT_DISTANT, LIGHT_POINT, LIGHT_SPOT, PUNCTUAL_LIGHT};
+pub use crate::gpu::consts::{
+    AIM_FRACTION, ENVIRONMENT_LIGHT, LIGHT_DISTANT, LIGHT_POINT, LIGHT_SPOT, NEAR_FRACTION, NEAR_SCALE, PUNCTUAL_LIGHT,
+};
 
 /// One light of the distribution, as stored on the GPU (`LightEntry` in `gpu_scene.wgsl`).
 #[repr(C)]
@@ -232,7 +234,7 @@ impl LightTable {
     /// (u3, u4) and origin on the disc, L(ω)·πR²/(pdf(ω)·pmf); with `aim`, the sun's and the
     /// sky's origins aimed ([`disc_start`]: πR² becomes 1/p(x)). `emitted(triangle, b1, b2)`
     /// is the radiance a triangle emits at barycentrics (b1, b2)
-    /// ([`crate::gpu_scene::PreparedScene::emitter_radiance`]).
+    /// ([`crate::surface::PreparedScene::emitter_radiance`]).
     pub fn emit_photon(
         &self,
         scene: &Scene,
@@ -290,8 +292,6 @@ pub struct PhotonAim {
     pub centre: Vec3,
     pub radius: f32,
 }
-
-pub use crate::consts::{AIM_FRACTION, NEAR_FRACTION, NEAR_SCALE};
 
 /// The start of a photon crossing the sphere (`centre`, `radius`) along `axis`, from (u1, u2):
 /// its origin on the disc of that radius perpendicular to `axis` before the sphere, and

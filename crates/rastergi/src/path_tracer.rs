@@ -39,18 +39,18 @@
 
 use bytemuck::{Pod, Zeroable};
 
-use crate::binding::{Group, Slot};
 use crate::checkpoint::Progress;
 use crate::error::Result;
-use crate::film::{Film, FilmState, Show};
-use crate::frame::{FrameBinding, FrameUniforms, pixel_jitter};
-use crate::gpu::{Gpu, groups};
-use crate::gpu_scene::{GpuScene, PreparedScene};
+use crate::gpu::binding::{Group, Slot};
+use crate::gpu::{Gpu, groups, shader};
+use crate::gpu_scene::GpuScene;
 use crate::image_io::{DisplayImage, LinearImage};
+use crate::passes::film::{Film, FilmState, Show};
+use crate::passes::frame::{FrameBinding, FrameUniforms, pixel_jitter};
 use crate::progressive::Progressive;
 use crate::scene::{Camera, Scene};
 use crate::settings::RenderSettings;
-use crate::shader;
+use crate::surface::PreparedScene;
 
 /// Scattering events after which every path ends (a safety cap; roulette ends them first).
 pub const MAX_BOUNCES: u32 = 1024;
@@ -221,12 +221,12 @@ impl PathTracer {
     pub fn iterate(&mut self) {
         let (w, h) = (self.settings.width, self.settings.height);
         // The film's error estimate: blocks of BLOCK_ITERATIONS iterations.
-        self.film.begin_iteration(&self.gpu, self.film.samples / crate::film::BLOCK_ITERATIONS);
+        self.film.begin_iteration(&self.gpu, self.film.samples / crate::passes::film::BLOCK_ITERATIONS);
         self.write_uniforms(self.film.samples);
         let mut enc =
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("path tracer") });
         {
-            let mut pass = crate::profile::compute_pass(&mut enc, self.gpu.profiler.as_ref(), "path tracer");
+            let mut pass = crate::gpu::profile::compute_pass(&mut enc, self.gpu.profiler.as_ref(), "path tracer");
             pass.set_pipeline(&self.trace);
             pass.set_bind_group(0, &self.scene.bind_group, &[]);
             pass.set_bind_group(1, &self.frame.bind_group, &[]);
@@ -248,12 +248,12 @@ impl PathTracer {
     }
 
     /// The film's sums and their odd half, read back (checkpoints, the error estimate).
-    pub fn film_state(&self) -> Result<crate::film::FilmState> {
+    pub fn film_state(&self) -> Result<crate::passes::film::FilmState> {
         self.film.read_state(&self.gpu)
     }
 
     /// Continues from a checkpoint's film: the next iteration is the one after its last.
-    pub fn resume(&mut self, film: &crate::film::FilmState) -> Result<()> {
+    pub fn resume(&mut self, film: &crate::passes::film::FilmState) -> Result<()> {
         self.film.restore(&self.gpu, film)
     }
 

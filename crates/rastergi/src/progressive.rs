@@ -5,10 +5,10 @@
 //! estimates since the last restart (a camera move or [`Progressive::reset`]).
 
 use crate::checkpoint::Progress;
-use crate::denoise::{DenoiseParams, GuideState, Schedule};
 use crate::error::Result;
-use crate::film::{Film, FilmState, Show};
 use crate::image_io::{DisplayImage, LinearImage};
+use crate::passes::denoise::{DenoiseParams, GuideState, Schedule};
+use crate::passes::film::{Film, FilmState, Show};
 use crate::scene::Camera;
 use crate::settings::RenderSettings;
 
@@ -58,7 +58,7 @@ pub trait Progressive: wgpu::WasmNotSend {
     }
 }
 
-/// A renderer's denoiser ([`crate::denoise`]): its guides, accumulated from when it is
+/// A renderer's denoiser ([`crate::passes::denoise`]): its guides, accumulated from when it is
 /// enabled, and the filtered image.
 pub trait Denoising {
     /// Starts accumulating the guides (fails where their buffers exceed the device's limits);

@@ -4,17 +4,17 @@
 use glam::{Vec2, Vec3};
 
 use crate::checkpoint::Progress;
-use crate::denoise::{DenoiseParams, Denoiser, GuideState, Guides, Schedule};
 use crate::error::Result;
-use crate::film::{Film, FilmState, ImageResolve, Show};
-use crate::frame::{FrameBinding, FrameUniforms, pixel_jitter};
 use crate::gather::{DirectionSampler, GatherDirections, GatherMethod, GatherPass, GatherSetup, HitLight};
-use crate::gbuffer::{GBufferPass, PixelPass};
 use crate::gpu::Gpu;
-use crate::gpu_scene::{GpuScene, PreparedScene};
+use crate::gpu_scene::GpuScene;
 use crate::image_io::{DisplayImage, LinearImage};
-use crate::pass::{FixedSample, FrameContext, IterationPass};
-use crate::photon_view::PhotonView;
+use crate::passes::denoise::{DenoiseParams, Denoiser, GuideState, Guides, Schedule};
+use crate::passes::film::{Film, FilmState, ImageResolve, Show};
+use crate::passes::frame::{FrameBinding, FrameUniforms, pixel_jitter};
+use crate::passes::gbuffer::{GBufferPass, PixelPass};
+use crate::passes::photon_view::PhotonView;
+use crate::passes::{FixedSample, FrameContext, IterationPass};
 use crate::photons::PhotonSettings;
 use crate::photons::gpu::GpuPhotonMap;
 use crate::photons::map::GridSpec;
@@ -22,6 +22,7 @@ use crate::photons::passes::{PhotonPasses, fitted_pass_iterations};
 use crate::progressive::{Denoising, Progressive};
 use crate::scene::{Camera, Scene};
 use crate::settings::{PhotonRegionChoice, RenderSettings, TextureFilter};
+use crate::surface::PreparedScene;
 
 /// Fixed values for one iteration's random choices, so tests can compare the passes with
 /// other estimators for the same samples.
@@ -72,17 +73,17 @@ impl ImagePasses {
         let (width, height) = (settings.width, settings.height);
         let film = Film::new(gpu, width, height)?;
         let gbuffer = GBufferPass::new(gpu, scene, frame, width, height);
-        let specular = scene.eye_chains.then(|| crate::specular::pass(gpu, scene, frame, &gbuffer, &film));
-        let direct = crate::direct::pass(gpu, scene, frame, &gbuffer, &film);
+        let specular = scene.eye_chains.then(|| crate::passes::specular::pass(gpu, scene, frame, &gbuffer, &film));
+        let direct = crate::passes::direct::pass(gpu, scene, frame, &gbuffer, &film);
         let photon_view = match map {
             Some(map) if settings.show_photon_map => {
-                Some(crate::photon_view::pass(gpu, scene, frame, &gbuffer, &film, map, PhotonView::Map))
+                Some(crate::passes::photon_view::pass(gpu, scene, frame, &gbuffer, &film, map, PhotonView::Map))
             }
             _ => None,
         };
         let caustics = match map {
             Some(map) if scene.caustics => {
-                Some(crate::photon_view::pass(gpu, scene, frame, &gbuffer, &film, map, PhotonView::Caustics))
+                Some(crate::passes::photon_view::pass(gpu, scene, frame, &gbuffer, &film, map, PhotonView::Caustics))
             }
             _ => None,
         };
@@ -108,14 +109,14 @@ impl ImagePasses {
     fn enable_denoiser(&mut self, gpu: &Gpu, scene: &GpuScene, frame: &FrameBinding) -> Result<()> {
         if self.denoise.is_none() {
             let (w, h) = (self.film.width, self.film.height);
-            gpu.check_image_size(w, h, crate::denoise::LARGEST_BUFFER_PER_PIXEL)?;
+            gpu.check_image_size(w, h, crate::passes::denoise::LARGEST_BUFFER_PER_PIXEL)?;
             let guides = Guides::new(gpu, (scene, frame), &self.gbuffer, &self.film);
             let denoiser = Denoiser::new(
                 gpu,
                 (w, h),
                 &self.film.accumulation,
                 (&guides.buffer, &guides.extra),
-                crate::denoise::LEVELS,
+                crate::passes::denoise::LEVELS,
             );
             let resolve = self.film.image_resolve(gpu, denoiser.image());
             self.denoise = Some(DenoisePasses { guides, denoiser, resolve });
@@ -143,7 +144,7 @@ impl Renderer {
     pub fn new(gpu: &Gpu, scene: &Scene, settings: RenderSettings) -> Result<Renderer> {
         scene.validate()?;
         // Fail on an impossible image size before the BVH and the photon map are built.
-        gpu.check_image_size(settings.width, settings.height, crate::film::COMPONENTS * 16)?;
+        gpu.check_image_size(settings.width, settings.height, crate::passes::film::COMPONENTS * 16)?;
         // Fail on a scene, photon grid or bundle too large for this GPU before the BVH is built.
         let limits = gpu.device.limits();
         crate::gpu_scene::check_scene(&limits, scene)?;
@@ -151,7 +152,7 @@ impl Renderer {
         if settings.photons > 0 {
             crate::photons::map::check_photon_grid(&limits, &GridSpec::new(&scene.bounds(), settings.grid_resolution))?;
             if settings.gather != GatherMethod::Trace {
-                crate::limits::check_bundle(&limits, settings.bundle_for(detail_bundle))?;
+                crate::gpu::limits::check_bundle(&limits, settings.bundle_for(detail_bundle))?;
             }
         }
         let start = web_time::Instant::now();
@@ -307,7 +308,7 @@ impl Renderer {
         // or runs of BLOCK_ITERATIONS iterations where the map is fixed.
         let block = match &self.photons {
             Some(p) if p.progressive() => p.pass(),
-            _ => iteration / crate::film::BLOCK_ITERATIONS,
+            _ => iteration / crate::passes::film::BLOCK_ITERATIONS,
         };
         self.passes.film.begin_iteration(&self.gpu, block);
         let seed = self.settings.seed;
@@ -457,7 +458,7 @@ impl Renderer {
     /// [`read_guides`](Self::read_guides) can be called. Enable it before the first iteration:
     /// the guides hold the iterations since (the viewer, turning it on mid-render, restarts the
     /// image). Fails where the image's extra buffers
-    /// ([`crate::denoise::LARGEST_BUFFER_PER_PIXEL`]) exceed the GPU's limits.
+    /// ([`crate::passes::denoise::LARGEST_BUFFER_PER_PIXEL`]) exceed the GPU's limits.
     pub fn enable_denoiser(&mut self) -> Result<()> {
         self.passes.enable_denoiser(&self.gpu, &self.scene, &self.frame)?;
         self.denoise = true;
@@ -475,10 +476,10 @@ impl Renderer {
         })
     }
 
-    /// The denoised full image ([`crate::denoise`]), linear RGB.
+    /// The denoised full image ([`crate::passes::denoise`]), linear RGB.
     pub fn read_denoised(&self, params: &DenoiseParams) -> Result<LinearImage> {
         let d = self.denoiser()?;
-        let angle = crate::denoise::pixel_angle(&self.camera, self.settings.height);
+        let angle = crate::passes::denoise::pixel_angle(&self.camera, self.settings.height);
         d.denoiser.apply(&self.gpu, (self.passes.film.samples, d.guides.samples), angle, params)
     }
 
@@ -487,7 +488,7 @@ impl Renderer {
     /// [`encode_resolve_denoised`](Self::encode_resolve_denoised)).
     pub fn encode_denoise(&self, enc: &mut wgpu::CommandEncoder, params: &DenoiseParams) -> Result<()> {
         let d = self.denoiser()?;
-        let angle = crate::denoise::pixel_angle(&self.camera, self.settings.height);
+        let angle = crate::passes::denoise::pixel_angle(&self.camera, self.settings.height);
         d.denoiser.encode(&self.gpu, enc, (self.passes.film.samples, d.guides.samples), angle, params);
         Ok(())
     }

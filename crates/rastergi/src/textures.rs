@@ -37,15 +37,14 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
-use crate::binding::{Group, Slot};
 use crate::error::{Error, Result};
-use crate::gpu::Gpu;
+use crate::gpu::binding::{Group, Slot};
+use crate::gpu::{Gpu, shader};
 use crate::par::prelude::*;
 use crate::scene::Texture;
-use crate::shader;
 
 /// Texels per row of the atlas texture.
-pub use crate::consts::ATLAS_ROW as ROW;
+pub use crate::gpu::consts::ATLAS_ROW as ROW;
 /// Rows of the atlas texture at most (WebGPU guarantees 8192 texels per side).
 pub const MAX_ROWS: u32 = 8192;
 /// Texels the atlas holds at most: 256 MiB of `rgba16float`.

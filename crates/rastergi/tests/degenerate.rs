@@ -11,9 +11,9 @@ mod common;
 
 use glam::Vec3;
 use rastergi::environment::Environment;
-use rastergi::film::Show;
 use rastergi::gather::{GatherDirections, GatherMethod, HitLight};
 use rastergi::image_io::validate_finite;
+use rastergi::passes::film::Show;
 use rastergi::scene::{Camera, Light, Material, Scene};
 use rastergi::settings::RenderSettings;
 
@@ -111,6 +111,6 @@ fn degenerate_triangles_in_a_sunbeam_leave_every_pass_finite() {
     for _ in 0..8 {
         denoised.iterate().unwrap();
     }
-    check("denoised".into(), denoised.read_denoised(&rastergi::denoise::DenoiseParams::default()).unwrap());
+    check("denoised".into(), denoised.read_denoised(&rastergi::passes::denoise::DenoiseParams::default()).unwrap());
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }

@@ -1,12 +1,12 @@
-//! The denoiser (`denoise.rs`): the GPU filter against its CPU twin, the convergence rule on
+//! The denoiser (`passes/denoise/`): the GPU filter against its CPU twin, the convergence rule on
 //! a synthetic image, and the Cornell box against the committed Mitsuba reference.
 
 mod common;
 
-use rastergi::denoise::{DenoiseParams, Denoiser, EXTRA_SLOTS, GUIDE_SLOTS, cpu};
-use rastergi::film::{COMPONENTS, Show};
 use rastergi::image_io::LinearImage;
 use rastergi::metrics::{Comparison, compare, emitter_mask, rmse};
+use rastergi::passes::denoise::{DenoiseParams, Denoiser, EXTRA_SLOTS, GUIDE_SLOTS, cpu};
+use rastergi::passes::film::{COMPONENTS, Show};
 use rastergi::renderer::Renderer;
 use rastergi::sampling::{pcg_hash, unit_f32};
 use rastergi::scene::cornell_box;

@@ -6,8 +6,8 @@ mod common;
 use std::f64::consts::PI;
 
 use glam::{DVec3, Vec3};
-use rastergi::film::Show;
 use rastergi::metrics::emitter_mask;
+use rastergi::passes::film::Show;
 use rastergi::scene::{Camera, Material, Scene, cornell_box};
 use rastergi::settings::RenderSettings;
 
@@ -106,7 +106,7 @@ fn direct_light_under_a_rectangular_emitter_matches_the_closed_form_within_the_m
     // The pass shades from x + n·ε (the shadow ray's origin): the closed form at that height.
     // ε = 2e-4 under an emitter at height 1 is about 4e-4 more light, a mean error of 0.0085 σ:
     // hidden by independent samples' noise, 6 standard errors of the stratified samples'.
-    let eps = rastergi::gpu_scene::PreparedScene::new(&scene).ray_epsilon() as f64;
+    let eps = rastergi::surface::PreparedScene::new(&scene).ray_epsilon() as f64;
 
     // Per pixel: the closed form averaged over the pixel (box filter, 4×4 points) and the
     // standard deviation σ of an n-sample mean of the light-sampling estimator with

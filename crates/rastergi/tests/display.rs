@@ -4,8 +4,8 @@
 
 mod common;
 
-use rastergi::display::{DisplayPass, needs_decode, text_scale};
 use rastergi::gpu::Gpu;
+use rastergi::passes::display::{DisplayPass, needs_decode, text_scale};
 use rastergi::renderer::Renderer;
 use rastergi::scene::cornell_box;
 use rastergi::settings::RenderSettings;
@@ -27,7 +27,7 @@ fn draw(gpu: &Gpu, renderer: &Renderer, format: wgpu::TextureFormat, overlay: &[
     let view = texture.create_view(&Default::default());
     let mut pass = DisplayPass::new(gpu, format);
     let mut enc = gpu.device.create_command_encoder(&Default::default());
-    renderer.encode_resolve(&mut enc, rastergi::film::Show::Full, 0.5);
+    renderer.encode_resolve(&mut enc, rastergi::passes::film::Show::Full, 0.5);
     pass.encode(gpu, &mut enc, &view, (w, h), Some(renderer.film()), overlay);
     let row = (w * 4).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
     let buffer = gpu.zeroed_buffer(
@@ -62,7 +62,7 @@ fn window_shows_the_screenshot_bytes_on_plain_and_srgb_targets() {
     let gpu = common::gpu();
     // Not square: a swapped width and height would show.
     let r = renderer(&gpu, 24, 16);
-    let expected = r.read_display(rastergi::film::Show::Full, 0.5).unwrap().rgba;
+    let expected = r.read_display(rastergi::passes::film::Show::Full, 0.5).unwrap().rgba;
     assert!(expected.chunks(4).any(|p| p[0] > 40 && p[0] < 250), "a lit, unsaturated pixel to compare");
     for format in [wgpu::TextureFormat::Rgba8Unorm, wgpu::TextureFormat::Rgba8UnormSrgb] {
         let shown = draw(&gpu, &r, format, &[]);

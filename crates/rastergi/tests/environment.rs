@@ -11,15 +11,15 @@ use std::sync::Arc;
 
 use glam::{Vec2, Vec3, Vec4};
 use rastergi::environment::Environment;
-use rastergi::film::Show;
 use rastergi::gather::{GatherDirections, GatherMethod};
-use rastergi::gpu_scene::PreparedScene;
+use rastergi::passes::film::Show;
 use rastergi::path_tracer::PathTracer;
 use rastergi::photons::map::GridSpec;
 use rastergi::photons::{PhotonSettings, cpu, gpu::GpuPhotonMap};
 use rastergi::renderer::{Overrides, Renderer};
 use rastergi::scene::{Camera, Material, Scene};
 use rastergi::settings::RenderSettings;
+use rastergi::surface::PreparedScene;
 
 const ALBEDO: f32 = 0.5;
 /// Half the side of the floor, y = 0, x and z in [−A, A].
@@ -195,8 +195,8 @@ fn camera_rays_that_escape_see_the_environment() {
     let img = r.read_linear(Show::Full).unwrap();
     let gbuffer = r.read_gbuffer().unwrap();
     let prepared = PreparedScene::new(&scene);
-    let near = rastergi::frame::near_plane(&prepared.bounds);
-    let inv = rastergi::frame::view_projection(&scene.camera, SIZE, SIZE, near, Vec2::ZERO).inverse();
+    let near = rastergi::passes::frame::near_plane(&prepared.bounds);
+    let inv = rastergi::passes::frame::view_projection(&scene.camera, SIZE, SIZE, near, Vec2::ZERO).inverse();
     let mut sky_pixels = 0;
     for (i, g) in gbuffer.iter().enumerate() {
         if g[0] != 0 {
@@ -323,7 +323,7 @@ fn directional_albedo(b: &rastergi::bsdf::Bsdf, cos_o: f32) -> Vec3 {
 
 /// The cosine between the floor's normal and the direction to the eye at each pixel's centre.
 fn floor_pixel_cosines() -> Vec<f32> {
-    let vp = rastergi::frame::view_projection(&floor_camera(), SIZE, SIZE, 1e-3, Vec2::ZERO);
+    let vp = rastergi::passes::frame::view_projection(&floor_camera(), SIZE, SIZE, 1e-3, Vec2::ZERO);
     let inv = vp.inverse();
     let mut c = Vec::new();
     for y in 0..SIZE {

@@ -6,17 +6,15 @@ mod common;
 use std::f64::consts::PI;
 
 use glam::{Vec2, Vec3};
-use rastergi::film::Show;
 use rastergi::gather::{GatherDirections, GatherMethod, HitLight};
-use rastergi::gpu_scene::PreparedScene;
 use rastergi::image_io::LinearImage;
 use rastergi::metrics::{compare, emitter_mask, masked_mean, rmse};
+use rastergi::passes::film::Show;
 use rastergi::renderer::{Overrides, Renderer};
-use rastergi::sampling::{
-    cosine_hemisphere, pcg_hash, pixel_seed, sobol_owen_2d, sobol_owen_on_gpu, uniform_sphere, unit_f32,
-};
+use rastergi::sampling::{cosine_hemisphere, pcg_hash, pixel_seed, sobol_owen_2d, uniform_sphere, unit_f32};
 use rastergi::scene::{Camera, cornell_box, triangle_normal};
 use rastergi::settings::RenderSettings;
+use rastergi::surface::PreparedScene;
 
 /// Renders 6 iterations with `method` at 64² (fixed jitter, bundle 512) and compares each
 /// pixel's estimate with a CPU ray cast of the same estimator at the same visible point:
@@ -171,7 +169,7 @@ fn scrambled_sobol_on_the_gpu_agrees_bit_for_bit_with_its_cpu_twin() {
     let mut queries: Vec<(u32, u32)> = (0..4096).map(|i| (i % 64, pcg_hash(i / 64))).collect();
     queries.extend((0..4096u32).map(|i| (pcg_hash(i ^ 0x55), pcg_hash(i))));
     queries.extend([(0, 0), (u32::MAX, 0), (0, u32::MAX), (u32::MAX, u32::MAX), (1 << 31, 1)]);
-    let gpu_points = sobol_owen_on_gpu(&gpu, &queries).unwrap();
+    let gpu_points = rastergi::sampling::gpu_check::sobol_owen_on_gpu(&gpu, &queries).unwrap();
     for (&(index, seed), g) in queries.iter().zip(&gpu_points) {
         assert_eq!(*g, sobol_owen_2d(index, seed), "index {index}, seed {seed:#x}");
     }

@@ -12,8 +12,8 @@ use std::time::{Duration, Instant};
 
 use common::textured_room::{self as room, Variant};
 use glam::{Vec2, Vec3};
-use rastergi::film::Show;
 use rastergi::metrics::{compare, emitter_mask, masked_mean, rmse};
+use rastergi::passes::film::Show;
 use rastergi::scene::{GltfOptions, Scene, load_gltf, load_gltf_with, load_obj, triangle_normal};
 use rastergi::settings::RenderSettings;
 use serde_json::{Value, json};

@@ -8,11 +8,11 @@ mod common;
 
 use glam::Vec3;
 use rastergi::environment::Environment;
-use rastergi::film::Show;
-use rastergi::gpu_scene::PreparedScene;
+use rastergi::passes::film::Show;
 use rastergi::scene::Scene;
 use rastergi::scene::generate::sunroom;
 use rastergi::settings::{PhotonRegionChoice, RenderSettings};
+use rastergi::surface::PreparedScene;
 
 const WIDTH: u32 = 96;
 const HEIGHT: u32 = 72;

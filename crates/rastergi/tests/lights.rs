@@ -6,14 +6,14 @@ mod common;
 use std::f64::consts::PI;
 
 use glam::{Vec2, Vec3};
-use rastergi::film::Show;
-use rastergi::gpu_scene::PreparedScene;
+use rastergi::passes::film::Show;
 use rastergi::path_tracer::PathTracer;
 use rastergi::photons::map::GridSpec;
 use rastergi::photons::{PhotonSettings, cpu, gpu::GpuPhotonMap};
 use rastergi::renderer::{Overrides, Renderer};
 use rastergi::scene::{Camera, Light, Material, Scene};
 use rastergi::settings::RenderSettings;
+use rastergi::surface::PreparedScene;
 
 const ALBEDO: f32 = 0.5;
 /// Half the side of the floor, y = 0, x and z in [−A, A].

@@ -19,7 +19,7 @@ fn settings() -> RenderSettings {
 fn a_scene_beyond_the_storage_binding_limit_is_refused_with_its_size() {
     let gpu = common::gpu();
     let limits = gpu.device.limits();
-    let max = rastergi::limits::max_storage_buffer(&limits);
+    let max = rastergi::gpu::limits::max_storage_buffer(&limits);
     let stride = std::mem::size_of::<rastergi::gpu_scene::GpuTriangle>() as u64;
     let n = max / stride + 1;
     if n > 8_000_000 {
@@ -53,7 +53,7 @@ fn a_photon_grid_or_bundle_beyond_the_device_is_refused_with_the_option_to_chang
     let grid = RenderSettings { grid_resolution: 1024, ..settings() };
     let r = Renderer::new(&gpu, &scene, grid).expect("a 1024³ grid degrades to a coarser one");
     let map = r.photon_map().expect("a photon map");
-    let max = rastergi::limits::max_storage_buffer(&gpu.device.limits());
+    let max = rastergi::gpu::limits::max_storage_buffer(&gpu.device.limits());
     println!("1024 asked, {} used; {} table entries", map.grid().dims.max_element(), map.layout.table.capacity());
     assert!(map.layout.table.capacity() as u64 * 16 <= max);
     if max < 1 << 30 {
@@ -76,9 +76,9 @@ fn a_photon_grid_or_bundle_beyond_the_device_is_refused_with_the_option_to_chang
 /// one line.
 #[test]
 fn what_a_web_page_runs_fits_a_browsers_storage_buffer_limit() {
-    use rastergi::film::Show;
     use rastergi::gather::GatherMethod;
     use rastergi::gpu::{Gpu, GpuOptions, WEB_STORAGE_BUFFERS};
+    use rastergi::passes::film::Show;
     let full = common::gpu();
     let web =
         Gpu::new(&GpuOptions { max_storage_buffers: Some(WEB_STORAGE_BUFFERS), ..GpuOptions::default() }).unwrap();

@@ -7,15 +7,15 @@ mod common;
 use std::f64::consts::PI;
 
 use glam::{DVec3, Vec3};
-use rastergi::frame::pixel_jitter;
 use rastergi::gpu::Gpu;
-use rastergi::gpu_scene::PreparedScene;
 use rastergi::image_io::LinearImage;
 use rastergi::metrics::{compare, emitter_mask, masked_mean, rmse};
+use rastergi::passes::frame::pixel_jitter;
 use rastergi::path_tracer::PathTracer;
 use rastergi::renderer::Renderer;
 use rastergi::scene::{Camera, Material, Scene, cornell_box};
 use rastergi::settings::RenderSettings;
+use rastergi::surface::PreparedScene;
 
 /// The mean of `iterations` path-traced iterations.
 fn path_trace(gpu: &Gpu, scene: &Scene, settings: RenderSettings, iterations: u32) -> LinearImage {

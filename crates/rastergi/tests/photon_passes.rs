@@ -4,8 +4,8 @@
 
 mod common;
 
-use rastergi::film::Show;
 use rastergi::gather::{GatherMethod, HitLight};
+use rastergi::passes::film::Show;
 use rastergi::photons::passes::pass_resolution;
 use rastergi::renderer::Renderer;
 use rastergi::scene::generate::rooms;

@@ -4,13 +4,14 @@
 mod common;
 
 use glam::Vec3;
-use rastergi::film::Show;
-use rastergi::gpu_scene::{GpuScene, PreparedScene};
+use rastergi::gpu_scene::GpuScene;
 use rastergi::metrics::emitter_mask;
+use rastergi::passes::film::Show;
 use rastergi::photons::map::{GridSpec, PhotonMap};
 use rastergi::photons::{PhotonSettings, cpu, gpu::GpuPhotonMap};
 use rastergi::scene::{Camera, Material, Scene, cornell_box};
 use rastergi::settings::RenderSettings;
+use rastergi::surface::PreparedScene;
 
 fn gpu_map(gpu: &rastergi::gpu::Gpu, scene: &Scene, settings: &PhotonSettings) -> PhotonMap {
     let prepared = PreparedScene::new(scene);

@@ -1,15 +1,16 @@
-//! The ray kernel of `bench rays` (rays.rs) against the CPU twin, every kind of ray, on the
+//! The ray kernel of `bench rays` (rays/mod.rs) against the CPU twin, every kind of ray, on the
 //! Cornell box and a glTF room with a rotated light: the same closest hits, the same answers
 //! of the shadow rays. Then the hardware path (ray queries, `accel.rs`) against the same twin,
 //! and against the compute path hit for hit.
 
 mod common;
 
-use rastergi::accel::{RayPath, Rays};
+use rastergi::gpu::accel::{RayPath, Rays};
 use rastergi::gpu::{Gpu, GpuOptions};
-use rastergi::gpu_scene::{GpuScene, PreparedScene};
+use rastergi::gpu_scene::GpuScene;
 use rastergi::rays::{RayCaster, RayKind, disagreements, make_rays, trace_cpu};
 use rastergi::scene::{Scene, cornell_box, load_gltf};
+use rastergi::surface::PreparedScene;
 
 fn gpu_agrees_with_the_cpu_twin(label: &str, scene: &Scene) {
     let gpu = common::gpu();
@@ -136,7 +137,7 @@ fn cornell_with_glass() -> Scene {
 /// paths, none between the hardware path and the twin.
 #[test]
 fn every_tracing_pass_renders_the_same_image_on_both_paths() {
-    use rastergi::film::Show;
+    use rastergi::passes::film::Show;
     use rastergi::path_tracer::PathTracer;
     use rastergi::renderer::Renderer;
     let Some(hardware) = hardware_gpu() else { return };

@@ -23,12 +23,12 @@
 
 mod common;
 
-use rastergi::film::Show;
 use rastergi::fit;
 use rastergi::gather::GatherMethod;
 use rastergi::gpu::Gpu;
 use rastergi::image_io::LinearImage;
 use rastergi::metrics::{compare, emitter_mask, masked_mean, rmse};
+use rastergi::passes::film::Show;
 use rastergi::path_tracer::PathTracer;
 use rastergi::renderer::Renderer;
 use rastergi::scene::Scene;

@@ -8,12 +8,12 @@ use std::path::Path;
 
 use glam::Vec3;
 use rastergi::environment::Environment;
-use rastergi::film::Show;
-use rastergi::gpu_scene::PreparedScene;
+use rastergi::passes::film::Show;
 use rastergi::path_tracer::PathTracer;
 use rastergi::renderer::Renderer;
 use rastergi::scene::{Camera, Material, Scene, load_gltf, load_obj};
 use rastergi::settings::RenderSettings;
+use rastergi::surface::PreparedScene;
 use serde_json::json;
 
 fn close(a: Vec3, b: Vec3, tol: f32) -> bool {

@@ -4,7 +4,7 @@
 mod common;
 
 use glam::{Vec2, Vec3, Vec4};
-use rastergi::film::Show;
+use rastergi::passes::film::Show;
 use rastergi::scene::{
     AlphaMode, Camera, Light, Material, Scene, Texture, TextureRef, UvTransform, load_gltf, load_obj,
 };

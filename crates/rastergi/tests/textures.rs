@@ -10,16 +10,17 @@ use std::f64::consts::PI;
 
 use common::textured_room::{self as room, Variant};
 use glam::{Vec2, Vec3};
-use rastergi::film::Show;
 use rastergi::gpu::Gpu;
-use rastergi::gpu_scene::{GpuScene, PreparedScene};
+use rastergi::gpu_scene::GpuScene;
 use rastergi::metrics::{emitter_mask, rmse};
+use rastergi::passes::film::Show;
 use rastergi::photons::map::PhotonMap;
 use rastergi::photons::{PhotonSettings, cpu, gpu::GpuPhotonMap};
 use rastergi::renderer::Renderer;
 use rastergi::sampling::Rng;
 use rastergi::scene::{Camera, Material, Scene, Texture, cornell_box, load_gltf};
 use rastergi::settings::RenderSettings;
+use rastergi::surface::PreparedScene;
 use rastergi::textures::{TextureAtlas, sample_on_gpu, srgb_to_linear};
 
 fn texture(name: &str, w: u32, h: u32, mut f: impl FnMut(u32, u32) -> [u8; 3]) -> Texture {

@@ -9,8 +9,8 @@
 mod common;
 
 use glam::Vec3;
-use rastergi::film::Show;
 use rastergi::metrics::{compare, masked_mean};
+use rastergi::passes::film::Show;
 use rastergi::scene::{Light, Scene, load_gltf};
 
 fn room() -> Scene {

@@ -8,9 +8,9 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use clap::Args;
-use rastergi::film::Show;
 use rastergi::image_io::{LinearImage, read_exr};
 use rastergi::metrics::{compare, emitter_mask};
+use rastergi::passes::film::Show;
 use rastergi::path_tracer::PathTracer;
 use rastergi::progressive::Progressive;
 use rastergi::renderer::Renderer;

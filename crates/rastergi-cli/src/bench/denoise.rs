@@ -1,9 +1,9 @@
 //! `rastergi bench denoise`: the cost of one application of the denoiser
-//! ([`rastergi::denoise`]) on the accumulated image of a scene, at the window's size.
+//! ([`rastergi::passes::denoise`]) on the accumulated image of a scene, at the window's size.
 
 use anyhow::Result;
 use clap::Args;
-use rastergi::denoise::DenoiseParams;
+use rastergi::passes::denoise::DenoiseParams;
 use rastergi::renderer::Renderer;
 use rastergi::settings::RenderSettings;
 

@@ -18,11 +18,11 @@ use std::time::Instant;
 use anyhow::Result;
 use clap::Args;
 use rastergi::camera_control::CameraControl;
-use rastergi::display::OffscreenTarget;
-use rastergi::film::Show;
 use rastergi::fit;
 use rastergi::gather::GatherMethod;
 use rastergi::gpu::Gpu;
+use rastergi::passes::display::OffscreenTarget;
+use rastergi::passes::film::Show;
 use rastergi::renderer::Renderer;
 use rastergi::settings::RenderSettings;
 

@@ -5,8 +5,9 @@ use std::time::Instant;
 
 use anyhow::Result;
 use clap::Args;
-use rastergi::gpu_scene::{GpuScene, PreparedScene};
+use rastergi::gpu_scene::GpuScene;
 use rastergi::photons::{PhotonSettings, cpu, gpu::GpuPhotonMap};
+use rastergi::surface::PreparedScene;
 
 use super::{load_valid_scene, median};
 use crate::args::{GpuArgs, gpu_profiled, print_profile};

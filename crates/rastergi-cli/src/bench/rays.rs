@@ -9,9 +9,10 @@ use std::time::Instant;
 
 use anyhow::Result;
 use clap::Args;
-use rastergi::accel::{RayPath, Rays};
-use rastergi::gpu_scene::{GpuScene, PreparedScene};
+use rastergi::gpu::accel::{RayPath, Rays};
+use rastergi::gpu_scene::GpuScene;
 use rastergi::rays::{RayCaster, RayKind, disagreements, make_rays, trace_cpu};
+use rastergi::surface::PreparedScene;
 
 use super::{load_valid_scene, median};
 use crate::args::{GpuArgs, gpu};
@@ -55,7 +56,7 @@ pub fn run(a: &RaysArgs) -> Result<()> {
     // Before any ray is made: a batch the GPU cannot bind is refused in one line.
     let ray_bytes = std::mem::size_of::<rastergi::rays::GpuRay>() as u64;
     let count = a.size as u64 * a.size as u64;
-    rastergi::limits::check_storage_buffer(
+    rastergi::gpu::limits::check_storage_buffer(
         &gpu.device.limits(),
         "the rays",
         count,

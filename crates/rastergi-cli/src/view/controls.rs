@@ -4,8 +4,8 @@
 //! application ([`Response`]); also the camera and the shown image as text.
 
 use rastergi::camera_control::{CameraControl, Mode, MoveKeys};
-use rastergi::film::Show;
 use rastergi::gather::{GatherDirections, GatherMethod};
+use rastergi::passes::film::Show;
 use rastergi::scene::Camera;
 use rastergi::settings::RenderSettings;
 

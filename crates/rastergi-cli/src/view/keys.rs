@@ -1,6 +1,6 @@
 //! The keyboard: winit's key events as the viewer's [`Key`]s.
 
-use rastergi::film::Show;
+use rastergi::passes::film::Show;
 use winit::event::KeyEvent;
 use winit::keyboard::{Key as LogicalKey, KeyCode, NamedKey, PhysicalKey};
 

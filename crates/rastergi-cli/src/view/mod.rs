@@ -6,7 +6,7 @@
 //! if the camera moved, `Renderer::set_camera` restarts the image; run as many iterations as
 //! fit in [`frames::FRAME_BUDGET`] of GPU time (at least one); resolve the film (or, with the
 //! denoiser on, its denoised image, filtered again only when due: `app.rs`) and draw it
-//! ([`rastergi::display`]) with the control panel over it; present. Building a renderer
+//! ([`rastergi::passes::display`]) with the control panel over it; present. Building a renderer
 //! (photon tracing, or opening a scene) runs on a worker thread so the window stays live
 //! meanwhile; new settings build a new renderer at the window's size (the film is the window's size) and shows the
 //! old image, scaled, until it is ready. A resize alone keeps the scene and photon map and

@@ -13,8 +13,8 @@ use std::path::{Path, PathBuf};
 use clap::ValueEnum;
 use egui::{Color32, ComboBox, RichText, Slider, Stroke, Ui};
 use egui_wgpu::wgpu;
-use rastergi::film::Show;
 use rastergi::gather::{GatherDirections, GatherMethod, MAX_DIRECTIONS};
+use rastergi::passes::film::Show;
 
 use super::controls::{Controls, SunAngles, show_name};
 use super::script::Action;

@@ -5,9 +5,9 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
-use rastergi::denoise::DenoiseParams;
-use rastergi::film::Show;
 use rastergi::image_io::{write_exr, write_png};
+use rastergi::passes::denoise::DenoiseParams;
+use rastergi::passes::film::Show;
 use rastergi::progressive::Progressive;
 
 /// Screenshot names `rastergi-NNNN.png` / `.exr` in a directory, counting up.

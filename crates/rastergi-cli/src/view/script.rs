@@ -58,8 +58,8 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
 use clap::ValueEnum;
-use rastergi::film::Show;
 use rastergi::gather::{GatherDirections, GatherMethod};
+use rastergi::passes::film::Show;
 
 use crate::args::{GatherArg, GatherDirectionsArg, ShowArg};
 use crate::render::Method;

@@ -31,7 +31,7 @@ use super::{fresnel_dielectric, ggx_g1, reflect, refract, vndf_sample};
 use crate::par::prelude::*;
 
 /// Cells along μ and along α.
-pub use crate::consts::GGX_ALBEDO_N as N;
+pub use crate::gpu::consts::GGX_ALBEDO_N as N;
 /// Strata per axis of the (u₁, u₂) grid of each cell's integral.
 const STRATA: usize = 64;
 
@@ -185,8 +185,7 @@ pub fn ggx_albedo() -> &'static GgxAlbedo {
     TABLE.get_or_init(GgxAlbedo::committed)
 }
 
-pub use crate::consts::GLASS_ETA_MAX;
-pub use crate::consts::{GLASS_CELLS, GLASS_ETAS};
+pub use crate::gpu::consts::{GLASS_CELLS, GLASS_ETA_MAX, GLASS_ETAS};
 /// Strata per axis of each glass cell's integral: the integrand jumps where total internal
 /// reflection begins, and 24 × 24 midpoints left the albedo from inside 1.5 % off at roughness
 /// 1 (64 × 64: within 0.1 % of a quadrature of `eval` and of sampling).

@@ -25,7 +25,7 @@ use glam::{UVec4, Vec3, Vec4};
 use super::{Bvh, BvhNode, Hit, intersect_triangle};
 
 /// Marks an unused child slot (its count byte in [`WideNode::counts`] is `NO_CHILD & 0xff`).
-pub use crate::consts::NO_CHILD;
+pub use crate::gpu::consts::NO_CHILD;
 /// The count byte of an unused slot.
 const NO_CHILD_BYTE: u32 = NO_CHILD & 0xff;
 

@@ -25,16 +25,15 @@ use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3};
 
 use super::MAX_DIRECTIONS;
-use crate::binding::{Group, Slot};
 use crate::error::Result;
-use crate::film::Film;
-use crate::frame::FrameBinding;
-use crate::gbuffer::GBufferPass;
-use crate::gpu::Gpu;
+use crate::gpu::binding::{Group, Slot};
+use crate::gpu::{Gpu, shader};
 use crate::gpu_scene::GpuScene;
+use crate::passes::film::Film;
+use crate::passes::frame::FrameBinding;
+use crate::passes::gbuffer::GBufferPass;
 use crate::photons::gpu::GpuPhotonMap;
 use crate::photons::map::LOOKUP_WGSL;
-use crate::shader;
 
 /// `struct Gather` in WGSL.
 pub const UNIFORMS: &str = include_str!("uniforms.wgsl");

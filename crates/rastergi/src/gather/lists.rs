@@ -18,11 +18,11 @@ use super::estimator::{
     GatherInputs, GatherSetup, GatherUniforms, RAY_VIEW_LOOKUP, estimate_group, estimate_resources,
 };
 use super::ray_view::{ray_view_module, ray_view_pipeline, texel_size};
-use crate::binding::{Group, Slot};
 use crate::error::{Error, Result};
+use crate::gpu::binding::{Group, Slot};
+use crate::gpu::profile::{Profiler, compute_pass, render_pass};
 use crate::gpu::{Gpu, dispatch_pixels};
 use crate::gpu_scene::GpuScene;
-use crate::profile::{Profiler, compute_pass, render_pass};
 
 /// Render target of the list pass (nothing is written to it; a pass needs an attachment).
 const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Uint;
@@ -74,7 +74,7 @@ impl ListGather {
     /// binding.
     pub fn new(gpu: &Gpu, setup: &GatherSetup, uniforms: &wgpu::Buffer, bundle: u32) -> Result<ListGather> {
         let device = &gpu.device;
-        crate::limits::check_bundle(&device.limits(), bundle)?;
+        crate::gpu::limits::check_bundle(&device.limits(), bundle)?;
         let capacity = node_capacity(setup.scene, bundle);
         let max = device.limits().max_storage_buffer_binding_size.min(device.limits().max_buffer_size);
         if capacity.saturating_mul(8) > max {

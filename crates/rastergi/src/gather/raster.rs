@@ -24,11 +24,11 @@ use super::estimator::{
     GatherInputs, GatherSetup, GatherUniforms, RAY_VIEW_LOOKUP, estimate_group, estimate_resources, submit_and_renew,
 };
 use super::ray_view::{DEPTH_FORMAT, ray_view_module, ray_view_pipeline};
-use crate::binding::{Group, Slot};
 use crate::error::Result;
+use crate::gpu::binding::{Group, Slot};
+use crate::gpu::profile::{Profiler, compute_pass, render_pass};
 use crate::gpu::{Gpu, dispatch_pixels};
 use crate::gpu_scene::GpuScene;
-use crate::profile::{Profiler, compute_pass, render_pass};
 
 /// Ray-view texel: (triangle + 1, b1 bits, b2 bits, depth bits); 0 where empty.
 const LAYER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;
@@ -97,7 +97,7 @@ impl RasterGather {
     /// The passes and ray-view textures for a `bundle`² ray view reading `uniforms`.
     pub fn new(gpu: &Gpu, setup: &GatherSetup, uniforms: &wgpu::Buffer, bundle: u32) -> Result<RasterGather> {
         let device = &gpu.device;
-        crate::limits::check_bundle(&device.limits(), bundle)?;
+        crate::gpu::limits::check_bundle(&device.limits(), bundle)?;
         let (gbuffer, film) = (setup.gbuffer, setup.film);
         let texture = |label: &str, format: wgpu::TextureFormat, usage: wgpu::TextureUsages| {
             device

@@ -16,10 +16,9 @@ use glam::{Mat4, Vec2, Vec3};
 
 use super::MAX_DIRECTIONS;
 use super::estimator::{GatherSample, GatherUniforms, PixelSamples};
-use crate::gpu::scene_raster_pipeline;
+use crate::gpu::{scene_raster_pipeline, shader};
 use crate::sampling::orthonormal_basis;
 use crate::scene::Aabb;
-use crate::shader;
 
 /// Depth target of the peeling pass.
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;

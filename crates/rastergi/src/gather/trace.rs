@@ -15,10 +15,10 @@
 
 use super::Gather;
 use super::estimator::{GatherInputs, GatherSetup, estimate_group, estimate_resources};
-use crate::binding::{Group, Slot};
 use crate::error::Result;
+use crate::gpu::binding::{Group, Slot};
+use crate::gpu::profile::{Profiler, compute_pass};
 use crate::gpu::{Gpu, dispatch_pixels};
-use crate::profile::{Profiler, compute_pass};
 
 pub struct TraceGather {
     pipeline: wgpu::ComputePipeline,

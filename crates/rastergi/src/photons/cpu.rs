@@ -3,11 +3,11 @@
 
 use super::{MAX_BOUNCES, PhotonSettings, STREAM_PHOTON};
 use crate::bsdf::{Frame, Transport};
-use crate::gpu_scene::{PreparedScene, alpha_uniform};
 use crate::par::prelude::*;
 use crate::photons::map::{GridSpec, MapLayout, PhotonMap};
 use crate::sampling::{Rng, bend_towards, cosine_hemisphere, pcg_hash};
 use crate::scene::triangle_normal;
+use crate::surface::{PreparedScene, alpha_uniform};
 
 /// Flux deposited per slot, with the squares and counts used for noise estimates.
 pub struct Tally {

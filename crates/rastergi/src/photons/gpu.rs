@@ -19,12 +19,12 @@ use glam::UVec3;
 
 use super::map::{GridSpec, MAX_SEPARATORS, MapLayout, PhotonMap, Separator, TABLE_WGSL, TrianglePlane};
 use super::{MAX_BOUNCES, PhotonSettings};
-use crate::binding::{Group, Slot};
 use crate::error::Result;
-use crate::gpu::Gpu;
-use crate::gpu_scene::{GpuScene, PreparedScene};
-use crate::profile::compute_pass;
-use crate::shader;
+use crate::gpu::binding::{Group, Slot};
+use crate::gpu::profile::compute_pass;
+use crate::gpu::{Gpu, shader};
+use crate::gpu_scene::GpuScene;
+use crate::surface::PreparedScene;
 
 /// Fixed-point units per Φ_max.
 const QUANTUM_BITS: u32 = 24;

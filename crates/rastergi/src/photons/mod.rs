@@ -40,7 +40,7 @@ pub mod passes;
 pub mod separators;
 pub mod table;
 
-use crate::gpu_scene::PreparedScene;
+use crate::surface::PreparedScene;
 
 /// Safety cap on bounces (Russian roulette ends almost every path long before).
 pub const MAX_BOUNCES: u32 = 256;

@@ -22,7 +22,8 @@ use super::gpu::GpuPhotonMap;
 use super::map::MapLayout;
 use crate::error::Result;
 use crate::gpu::Gpu;
-use crate::gpu_scene::{GpuScene, PreparedScene};
+use crate::gpu_scene::GpuScene;
+use crate::surface::PreparedScene;
 
 /// The schedule's α: cell area ∝ pass^−(1−α).
 pub const ALPHA: f64 = 2.0 / 3.0;

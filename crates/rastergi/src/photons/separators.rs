@@ -23,7 +23,7 @@ pub(crate) struct Fragment {
 /// A separator plane (n, d), n unit: a point x lies on its negative side where n·x − d < 0.
 pub type Separator = [f32; 4];
 
-pub use crate::consts::MAX_SEPARATORS;
+pub use crate::gpu::consts::MAX_SEPARATORS;
 /// A separator splits a slot only where each side holds at least this fraction of its area.
 pub const MIN_REGION: f64 = 0.02;
 

@@ -8,11 +8,11 @@ use clap::{Args, ValueEnum};
 use glam::Vec3;
 
 use super::{DEFAULT_SUN_SIZE, Method, Options, Sun};
-use crate::accel::{Rays, parse_rays};
 use crate::error::Result;
-use crate::film::Show;
 use crate::gather::{GatherDirections, GatherMethod, HitLight};
+use crate::gpu::accel::{Rays, parse_rays};
 use crate::gpu::{Backends, Gpu, GpuOptions, parse_backend};
+use crate::passes::film::Show;
 use crate::scene::Scene;
 use crate::settings::{PhotonRegionChoice, RenderSettings, TextureFilter};
 

@@ -3,9 +3,9 @@
 //! are the viewer's choices; the denoised image is filtered again on a [`Schedule`] (more
 //! iterations, or time) and resolved for display in between.
 
-use crate::denoise::Schedule;
 use crate::error::Result;
-use crate::film::Show;
+use crate::passes::denoise::Schedule;
+use crate::passes::film::Show;
 use crate::progressive::{Denoising, Progressive};
 use crate::scene::Camera;
 
@@ -156,7 +156,7 @@ mod tests {
         view.encode_resolve(&mut enc, 0.0).unwrap();
         gpu.queue.submit([enc.finish()]);
         let shown = view.renderer().film().read_display_buffer(&gpu).unwrap();
-        let params = crate::denoise::DenoiseParams::default();
+        let params = crate::passes::denoise::DenoiseParams::default();
         let denoised = view.denoising().unwrap().read_display_denoised(&params, 0.0).unwrap();
         assert!(shown.rgba == denoised.rgba, "the display does not show the denoised image");
 

@@ -23,10 +23,10 @@ mod tests;
 use glam::Vec3;
 
 use crate::error::{Error, Result};
-use crate::film::Show;
 use crate::fit;
 use crate::gather::{GatherDirections, GatherMethod, HitLight};
 use crate::gpu::{Gpu, GpuOptions};
+use crate::passes::film::Show;
 use crate::path_tracer::PathTracer;
 use crate::progressive::Progressive;
 use crate::renderer::Renderer;
@@ -389,11 +389,11 @@ pub fn physical_sky(turbidity: f32, light: Light) -> Result<(crate::environment:
     let Light::Distant { direction, angular_radius, .. } = light else {
         return Err(Error::Invalid("--sky needs a distant light as the sun".into()));
     };
-    let sky = crate::sky::SunSky { turbidity, ..crate::sky::SunSky::new(-direction, Vec3::Y) };
+    let sky = crate::scene::sky::SunSky { turbidity, ..crate::scene::sky::SunSky::new(-direction, Vec3::Y) };
     if sky.sun_elevation() < 0.0 {
         log::warn!("--sky: the sun is below the horizon, so the sky and the sun are black");
     }
-    let environment = sky.environment(crate::sky::SKY_WIDTH, crate::sky::SKY_HEIGHT)?;
+    let environment = sky.environment(crate::scene::sky::SKY_WIDTH, crate::scene::sky::SKY_HEIGHT)?;
     let sun = sky.sun_light().map(|l| match l {
         Light::Distant { direction, irradiance, .. } => {
             log::info!("--sky {turbidity}: the sun's irradiance is {irradiance} W/m² (RGB)");

@@ -13,7 +13,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use web_time::{Duration, Instant};
 
 use crate::error::Result;
-use crate::film::FilmState;
+use crate::passes::film::FilmState;
 use crate::progressive::Progressive;
 
 /// When a render stops (besides its stop flag and its observer).

@@ -1,22 +1,23 @@
 //! Shared test harness: the GPU (lavapipe on CI), renders and references.
 #![allow(dead_code)]
 
+pub mod materials;
+pub mod mitsuba;
 pub mod textured_room;
 
 use std::path::PathBuf;
 
 use base64::Engine as _;
-use serde_json::{Value, json};
-
-use rastergi::film::Show;
 use rastergi::gpu::{Gpu, GpuOptions};
 use rastergi::image_io::{LinearImage, read_exr};
+use rastergi::passes::film::Show;
 use rastergi::renderer::Renderer;
 use rastergi::scene::Scene;
 use rastergi::settings::RenderSettings;
+use serde_json::{Value, json};
 
 /// The test's device: one per test (each test runs on a thread of its own), so that a test's
-/// renderers reuse each other's compiled pipelines (`rastergi::compiled`) while a device
+/// renderers reuse each other's compiled pipelines (`rastergi::gpu::compiled`) while a device
 /// error stays within the test that caused it.
 pub fn gpu() -> Gpu {
     thread_local! {
@@ -207,7 +208,7 @@ pub fn photon_view_pixels(
     gpu: &Gpu,
     scene: &Scene,
     size: u32,
-) -> (LinearImage, rastergi::gpu_scene::PreparedScene, Vec<PhotonViewPixel>) {
+) -> (LinearImage, rastergi::surface::PreparedScene, Vec<PhotonViewPixel>) {
     let settings = RenderSettings {
         width: size,
         height: size,
@@ -221,7 +222,7 @@ pub fn photon_view_pixels(
     let img = r.read_linear(Show::PhotonMap).unwrap();
     let gbuffer = r.read_gbuffer().unwrap();
     let map = r.photon_map().unwrap().read(gpu).unwrap();
-    let prepared = rastergi::gpu_scene::PreparedScene::new(scene);
+    let prepared = rastergi::surface::PreparedScene::new(scene);
     let pixels = gbuffer
         .iter()
         .enumerate()

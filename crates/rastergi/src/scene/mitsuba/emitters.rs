@@ -6,9 +6,8 @@ use std::sync::Arc;
 use glam::{Mat4, Vec2, Vec3};
 
 use super::materials::Value;
-use super::values;
 use super::xml::{self, Elem, Plugin};
-use super::{Loader, Res};
+use super::{Loader, Res, values};
 use crate::scene::{Files, Light};
 
 impl<'a> Loader<'a> {
@@ -75,7 +74,9 @@ impl<'a> Loader<'a> {
             }
             "sun" | "sky" | "sunsky" => {
                 let sky = self.sunsky(e, &p)?;
-                let env = sky.environment(crate::sky::SKY_WIDTH, crate::sky::SKY_HEIGHT).map_err(|m| self.err(e, m))?;
+                let env = sky
+                    .environment(crate::scene::sky::SKY_WIDTH, crate::scene::sky::SKY_HEIGHT)
+                    .map_err(|m| self.err(e, m))?;
                 if sky.sun_elevation() < 0.0 {
                     self.warn(format!("the {ty} emitter's sun is below the horizon: it and its sky are black"));
                 }
@@ -106,14 +107,14 @@ impl<'a> Loader<'a> {
     }
 
     /// A `sunsky` (Mitsuba 3 and 0.6), or 0.6's `sun` (the sun alone) or `sky` (the sky alone),
-    /// as a [`SunSky`](crate::sky::SunSky). Mitsuba 3's frame is Z up, 0.6's Y up, each turned
+    /// as a [`SunSky`](crate::scene::sky::SunSky). Mitsuba 3's frame is Z up, 0.6's Y up, each turned
     /// by the emitter's `to_world`; `sun_direction` is in world space in both. Without it, the sun stands where
     /// the place and time put it (Mitsuba 3's defaults: Tokyo, 2010-07-10 15:00). 0.6's
     /// differences: its albedo defaults to 0.15 (3: 0.3); `scale` sets both `sun_scale` and
     /// `sky_scale`; `sun_radius_scale` × 0.5358° is the aperture (0: a delta direction); its
     /// sun followed Preetham's model and its sky was tabulated at `resolution`, neither
     /// reproduced here (`stretch`, `resolution`, `extend` are not used: a warning names them).
-    fn sunsky(&mut self, e: &'a Elem, p: &Plugin<'a>) -> Res<crate::sky::SunSky> {
+    fn sunsky(&mut self, e: &'a Elem, p: &Plugin<'a>) -> Res<crate::scene::sky::SunSky> {
         let ty = p.ty();
         let legacy = self.doc.legacy() || ty != "sunsky";
         let m = self.transform(p, "to_world")?;
@@ -128,7 +129,7 @@ impl<'a> Loader<'a> {
             }
             None => {
                 let f = |s: &Self, k: &str, d: f32| s.float(p, k, d).map(f64::from);
-                let local = crate::sky::sun_direction_at(
+                let local = crate::scene::sky::sun_direction_at(
                     f(self, "latitude", 35.6894)?,
                     f(self, "longitude", 139.6917)?,
                     f(self, "timezone", 9.0)?,
@@ -145,7 +146,7 @@ impl<'a> Loader<'a> {
             }
         };
         let scale = if legacy { self.float(p, "scale", 1.0)? } else { 1.0 };
-        let mut sky = crate::sky::SunSky::new(sun, up);
+        let mut sky = crate::scene::sky::SunSky::new(sun, up);
         sky.turbidity = self.float(p, "turbidity", 3.0)?;
         if ty != "sun" {
             sky.albedo = match self.value(p, "albedo", Vec3::splat(if legacy { 0.15 } else { 0.3 }))? {
@@ -163,9 +164,9 @@ impl<'a> Loader<'a> {
             if !(r.is_finite() && r >= 0.0) {
                 return Err(self.err(e, format!("sun_radius_scale {r} must be a finite number ≥ 0")));
             }
-            sky.sun_aperture_deg = (crate::sky::SUN_APERTURE_DEG * r).max(f32::MIN_POSITIVE);
+            sky.sun_aperture_deg = (crate::scene::sky::SUN_APERTURE_DEG * r).max(f32::MIN_POSITIVE);
         } else {
-            sky.sun_aperture_deg = self.float(p, "sun_aperture", crate::sky::SUN_APERTURE_DEG)?;
+            sky.sun_aperture_deg = self.float(p, "sun_aperture", crate::scene::sky::SUN_APERTURE_DEG)?;
             if self.boolean(p, "complex_sun", false)? {
                 self.warn(format!(
                     "emitter '{ty}': complex_sun (limb darkening) is not reproduced; the sun's disc is uniform"

@@ -5,9 +5,8 @@
 use glam::Vec3;
 
 use super::spectra::{conductor_f0, diffuse_fresnel, named_conductor, named_ior};
-use super::values;
 use super::xml::{Elem, Plugin};
-use super::{Loader, Res};
+use super::{Loader, Res, values};
 use crate::bsdf::{fresnel_dielectric, ggx_g1, vndf_sample};
 use crate::scene::{AlphaMode, Material, TextureRef};
 

@@ -3,9 +3,8 @@
 
 use glam::Vec3;
 
-use super::values;
 use super::xml::{Elem, Plugin};
-use super::{Loader, Res};
+use super::{Loader, Res, values};
 use crate::scene::Camera;
 
 impl<'a> Loader<'a> {

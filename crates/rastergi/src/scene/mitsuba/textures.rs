@@ -8,9 +8,8 @@ use glam::Vec3;
 
 use super::materials::Value;
 use super::spectra::{linear_to_srgb, srgb_to_linear};
-use super::values;
 use super::xml::{Elem, Plugin, resolve};
-use super::{Loader, Res};
+use super::{Loader, Res, values};
 use crate::scene::{Texture, TextureRef, UvTransform};
 
 /// Side of a generated checkerboard texture (two cells per side).

@@ -1,0 +1,652 @@
+//! The winit application of `rastergi view`: the window and its surface, renderers (and
+//! scenes opened meanwhile) built on a worker thread, the frame loop (held keys, script
+//! steps, batched iterations, resolve, the panel, present), resizes and screenshots. Input is
+//! interpreted by [`super::controls`]; the panel by [`super::panel`].
+
+mod events;
+
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use anyhow::{Result, anyhow};
+use rastergi::camera_control::CameraControl;
+use rastergi::gather::GatherMethod;
+use rastergi::gpu::{Gpu, GpuOptions};
+use rastergi::passes::denoise;
+use rastergi::passes::display::{Presented, WindowSurface};
+use rastergi::passes::film::Show;
+use rastergi::path_tracer::PathTracer;
+use rastergi::renderer::Renderer;
+use rastergi::scene::Scene;
+use rastergi::settings::RenderSettings;
+use winit::application::ApplicationHandler;
+use winit::dpi::PhysicalSize;
+use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoopProxy};
+use winit::window::{Window, WindowId};
+
+use super::build::{Build, Opened, env_scale, prepare, same_but_size};
+use super::controls::{Controls, Response, SunAngles, camera_options, show_name};
+use super::frames::{Active, Rate, iterate_frame};
+use super::keys::key_of;
+use super::panel::{self, Figures, Panel, PanelPainter, PanelState};
+use super::screenshots::Screenshots;
+use super::script::{Action, ScriptRun, Step, When};
+use crate::args::SceneArgs;
+use crate::render::Method;
+
+/// A resize rebuilds the size-dependent passes once the window size has been still this long.
+const RESIZE_SETTLE: Duration = Duration::from_millis(150);
+/// How long a script's `resize` may wait for the window to take the new size.
+const RESIZE_TIMEOUT: Duration = Duration::from_secs(10);
+
+/// A renderer being built on a worker thread (with the scene it opened, if it opened one).
+pub enum UserEvent {
+    Built { generation: u64, result: Result<(Active, Build, Option<Opened>), String> },
+}
+
+/// The live figures the panel shows, refreshed about once a second.
+#[derive(Default)]
+struct Measured {
+    at: Option<Instant>,
+    error: Option<f64>,
+    /// The film holds too few blocks for the estimate to mean much yet.
+    rough: bool,
+    memory: Option<u64>,
+    /// (iterations, estimated error) since the last restart.
+    history: Vec<(u32, f64)>,
+}
+
+/// The viewer: its window, GPU, renderer, controls, panel and script.
+pub struct App {
+    /// The command line's scene options (a scene opened later gets them too, but the camera).
+    args: SceneArgs,
+    scene_name: String,
+    scene: Arc<Scene>,
+    scene_id: u64,
+    base: RenderSettings,
+    gpu_options: GpuOptions,
+    proxy: EventLoopProxy<UserEvent>,
+    window: Option<Arc<Window>>,
+    gpu: Option<Gpu>,
+    surface: Option<WindowSurface>,
+    panel: Option<Panel>,
+    renderer: Option<(Active, Build)>,
+    /// The generation of the build in flight, if any; results of older ones are dropped.
+    building: Option<u64>,
+    generation: u64,
+    /// A scene to open once no build is in flight.
+    pending_open: Option<String>,
+    pub(super) controls: Controls,
+    /// The window's inner size (0 while minimised on some platforms).
+    size: (u32, u32),
+    /// When the size last changed, until a renderer of that size is on its way.
+    resized_at: Option<Instant>,
+    occluded: bool,
+    retry_at: Option<Instant>,
+    /// Mouse buttons held (left, right) and the last cursor position.
+    dragging: (bool, bool),
+    cursor: Option<(f64, f64)>,
+    last_frame: Instant,
+    batch: u32,
+    rate: Rate,
+    measured: Measured,
+    /// When the denoiser last ran for the window, while the denoised image is shown since.
+    denoised: denoise::Schedule,
+    /// The origin of `denoised`'s times.
+    clock: Instant,
+    title_at: Instant,
+    status: String,
+    script: Option<ScriptRun>,
+    screenshots: Screenshots,
+    error: Option<anyhow::Error>,
+}
+
+impl App {
+    /// The viewer of `scene` for the options `a`, before its window opens (that happens once
+    /// the event loop starts): renderers get `base` at the window's size, the script's `steps`
+    /// run as they fall due, and build results come back through `proxy`.
+    pub fn new(
+        a: &SceneArgs,
+        scene: Scene,
+        base: RenderSettings,
+        steps: Option<Vec<Step>>,
+        screenshots: Screenshots,
+        proxy: EventLoopProxy<UserEvent>,
+    ) -> App {
+        let camera = CameraControl::new(&scene.camera, &scene.bounds());
+        let mut controls = Controls::new(camera, a.show.show(), a.exposure.unwrap_or(0.0), &base);
+        controls.sun = scene.sun().map(SunAngles::of_direction);
+        controls.env_scale = env_scale(a, &scene);
+        App {
+            args: a.clone(),
+            scene_name: a.scene.clone(),
+            scene: Arc::new(scene),
+            scene_id: 0,
+            controls,
+            base,
+            gpu_options: a.gpu.options(),
+            proxy,
+            window: None,
+            gpu: None,
+            surface: None,
+            panel: None,
+            renderer: None,
+            building: None,
+            generation: 0,
+            pending_open: None,
+            size: (a.width.unwrap_or(256), a.height.unwrap_or(256)),
+            resized_at: None,
+            occluded: false,
+            retry_at: None,
+            dragging: (false, false),
+            cursor: None,
+            last_frame: Instant::now(),
+            batch: 1,
+            rate: Rate { since: Instant::now(), count: 0, per_second: 0.0 },
+            measured: Measured::default(),
+            denoised: denoise::Schedule::default(),
+            clock: Instant::now(),
+            title_at: Instant::now(),
+            status: String::new(),
+            script: steps.map(|steps| ScriptRun { steps, next: 0, last: Instant::now(), resizing: None }),
+            screenshots,
+            error: None,
+        }
+    }
+
+    /// Once the event loop has returned: the error that stopped the viewer, if any.
+    pub fn finish(self) -> Result<()> {
+        match self.error {
+            Some(e) => Err(e),
+            None => Ok(()),
+        }
+    }
+
+    /// Stops with an error (reported once the event loop has returned).
+    fn fail(&mut self, event_loop: &ActiveEventLoop, e: anyhow::Error) {
+        if self.error.is_none() {
+            self.error = Some(e);
+        }
+        event_loop.exit();
+    }
+
+    /// The renderer the current window and controls ask for.
+    fn wanted(&self) -> Build {
+        Build {
+            settings: self.controls.settings(&self.base, self.size.0, self.size.1),
+            method: self.controls.method,
+            sun: self.controls.sun,
+            env_scale: self.controls.env_scale,
+            scene: self.scene_id,
+        }
+    }
+
+    /// Whether the current renderer (if any) is the one wanted.
+    fn renderer_matches(&self, wanted: &Build) -> bool {
+        self.renderer.as_ref().is_some_and(|(_, built)| built == wanted)
+    }
+
+    /// Whether the current renderer is the wanted one and nothing is about to replace it.
+    fn settled(&self) -> bool {
+        self.building.is_none() && self.pending_open.is_none() && self.renderer_matches(&self.wanted())
+    }
+
+    /// Starts building the wanted renderer on a worker thread; with `open`, for that scene
+    /// (loaded there too, its photons and grid fitted as on the command line).
+    fn start_build(&mut self, open: Option<String>) {
+        let Some(gpu) = self.gpu.clone() else { return };
+        let mut wanted = self.wanted();
+        if wanted.settings.width == 0 || wanted.settings.height == 0 {
+            return;
+        }
+        self.generation += 1;
+        self.building = Some(self.generation);
+        self.resized_at = None;
+        let generation = self.generation;
+        let current = (self.scene.clone(), self.controls.camera.camera());
+        let args = open.as_ref().map(|name| SceneArgs {
+            scene: name.clone(),
+            eye: None,
+            target: None,
+            up: None,
+            fov: None,
+            camera: None,
+            ..self.args.clone()
+        });
+        self.status = match &open {
+            Some(name) => format!("opening {name}..."),
+            None if wanted.method == Method::Path => "starting the path tracer...".into(),
+            None => format!("tracing {} photons...", wanted.settings.photons),
+        };
+        let loaded_scale = self.args.env_scale;
+        let denoise = self.controls.denoise;
+        let proxy = self.proxy.clone();
+        std::thread::spawn(move || {
+            let build = std::panic::AssertUnwindSafe(|| -> Result<(Active, Build, Option<Opened>)> {
+                let (scene, opened) = match args {
+                    Some(a) => {
+                        let mut scene = a.load_scene()?;
+                        // The camera as the controls will hold it, so that it does not
+                        // restart the image when the renderer arrives.
+                        scene.camera = CameraControl::new(&scene.camera, &scene.bounds()).camera();
+                        let fitted = a.settings(&scene, 1, 1, true);
+                        let opened = Opened {
+                            name: a.scene.clone(),
+                            photons: fitted.photons,
+                            grid: fitted.grid_resolution,
+                            sun: scene.sun().map(SunAngles::of_direction),
+                            env_scale: env_scale(&a, &scene).and(wanted.env_scale),
+                            scene: Arc::new(scene),
+                        };
+                        (wanted.settings.photons, wanted.settings.grid_resolution) = (opened.photons, opened.grid);
+                        (wanted.sun, wanted.env_scale) = (opened.sun, opened.env_scale);
+                        wanted.scene += 1;
+                        ((*opened.scene).clone(), Some(opened))
+                    }
+                    None => {
+                        let (scene, camera) = current;
+                        let mut scene = (*scene).clone();
+                        scene.camera = camera;
+                        (scene, None)
+                    }
+                };
+                let scene = prepare(scene, &wanted, loaded_scale);
+                let active = match wanted.method {
+                    Method::Gather => {
+                        let mut r = Renderer::new(&gpu, &scene, wanted.settings.clone())?;
+                        // The guides from the first iteration on: nothing to restart. A failure
+                        // is reported when the viewer tries again (sync_denoiser).
+                        if denoise && let Err(e) = r.enable_denoiser() {
+                            log::warn!("the denoiser: {e}");
+                        }
+                        Active::PhotonMap(Box::new(r))
+                    }
+                    Method::Path => {
+                        Active::PathTracer(Box::new(PathTracer::new(&gpu, &scene, wanted.settings.clone())?))
+                    }
+                };
+                Ok((active, wanted, opened))
+            });
+            // A panic (wgpu reports validation errors so) must still answer, or the viewer
+            // would wait forever; the panic message itself is already on stderr.
+            let result = match std::panic::catch_unwind(build) {
+                Ok(built) => built.map_err(|e| format!("{e:#}")),
+                Err(_) => Err("building the renderer failed (see the message above)".to_owned()),
+            };
+            // The viewer may have closed meanwhile; then nobody is listening.
+            let _ = proxy.send_event(UserEvent::Built { generation, result });
+        });
+    }
+
+    fn redraw(&self) {
+        if let Some(w) = &self.window {
+            w.request_redraw();
+        }
+    }
+
+    fn apply(&mut self, event_loop: &ActiveEventLoop, r: Response) {
+        // While a new renderer is being built the old image stays as it is; the new one
+        // starts from the camera of the moment it arrives.
+        if r.camera_moved
+            && self.building.is_none()
+            && let Err(e) = self.sync_camera()
+        {
+            return self.fail(event_loop, e);
+        }
+        if r.retrace {
+            // Applied by about_to_wait once no build is in flight.
+            self.status = "re-building the renderer".into();
+            if let Some(s) =
+                self.controls.sun.filter(|&s| self.renderer.as_ref().is_some_and(|(_, b)| b.sun != Some(s)))
+            {
+                self.status = format!("sun {:.0}°, {:.0}°: re-tracing", s.azimuth, s.elevation);
+            }
+        }
+        if let Some(name) = r.open {
+            self.status = format!("opening {name}...");
+            self.pending_open = Some(name);
+        }
+        if r.screenshot {
+            self.screenshot();
+        }
+        if r.quit {
+            event_loop.exit();
+        }
+    }
+
+    /// Gives the renderer the controls' camera if it has another one (restarting the image).
+    fn sync_camera(&mut self) -> Result<()> {
+        let camera = self.controls.camera.camera();
+        if let Some((active, _)) = &mut self.renderer {
+            let r = active.get_mut();
+            if r.camera() != camera {
+                r.set_camera(camera)?;
+                self.denoised.clear();
+            }
+        }
+        Ok(())
+    }
+
+    /// What the image shows: the controls' choice where the renderer has it, else the full image.
+    fn shown(&self) -> Show {
+        match &self.renderer {
+            Some((active, _)) if !active.get().has(self.controls.show) => Show::Full,
+            _ => self.controls.show,
+        }
+    }
+
+    /// The photon-map renderer while the window shows its denoised image: the denoiser asked
+    /// for, its guides accumulating, the full image shown.
+    fn denoising(&self) -> Option<&Renderer> {
+        match &self.renderer {
+            Some((Active::PhotonMap(r), _))
+                if self.controls.denoise && r.denoiser_enabled() && self.shown() == Show::Full =>
+            {
+                Some(r)
+            }
+            _ => None,
+        }
+    }
+
+    /// Turns the denoiser's guides on where the controls ask for the denoiser and the renderer
+    /// (the photon map's) has none yet. The guides hold the iterations from then on, so an
+    /// image that has iterations restarts. Where the GPU cannot hold them the toggle goes off
+    /// with a warning.
+    fn sync_denoiser(&mut self) {
+        if !self.controls.denoise {
+            return;
+        }
+        let Some((Active::PhotonMap(r), _)) = &mut self.renderer else { return };
+        if r.denoiser_enabled() {
+            return;
+        }
+        match r.enable_denoiser() {
+            Ok(()) => {
+                if r.samples() > 0 {
+                    log::info!("denoiser on: the image restarts (its guides start now)");
+                    r.reset();
+                }
+                self.denoised.clear();
+            }
+            Err(e) => {
+                eprintln!("warning: the denoiser cannot be turned on: {e}");
+                self.status = format!("no denoiser: {e}");
+                self.controls.denoise = false;
+            }
+        }
+    }
+
+    /// Encodes the resolve of what the window shows into the film's display buffer: the raw
+    /// image of `show`, or the denoised one, filtered again first when it is due
+    /// ([`denoise::Schedule`]).
+    fn encode_resolve(&mut self, enc: &mut egui_wgpu::wgpu::CommandEncoder, show: Show) -> Result<()> {
+        let exposure = self.controls.exposure;
+        let mut schedule = self.denoised;
+        if let Some(r) = self.denoising() {
+            r.encode_denoised_view(enc, &mut schedule, self.clock.elapsed().as_secs_f64(), exposure)?;
+            self.denoised = schedule;
+        } else {
+            if let Some((active, _)) = &self.renderer {
+                active.get().encode_resolve(enc, show, exposure);
+            }
+            self.denoised.clear();
+        }
+        Ok(())
+    }
+
+    fn screenshot(&mut self) {
+        let show = self.shown();
+        let denoised = self.denoising().is_some();
+        let Some((active, _)) = &self.renderer else {
+            self.status = "no image yet to save".into();
+            return;
+        };
+        let (renderer, exposure) = (active.get(), self.controls.exposure);
+        match self.screenshots.save(renderer, show, exposure, denoised) {
+            Ok((png, exr)) => {
+                println!(
+                    "screenshot: {} {} ({} iterations, {}x{}, show {}{}, exposure {}; camera {})",
+                    png.display(),
+                    exr.display(),
+                    renderer.samples(),
+                    renderer.settings().width,
+                    renderer.settings().height,
+                    show_name(show),
+                    if denoised { " denoised" } else { "" },
+                    exposure,
+                    camera_options(&renderer.camera())
+                );
+                // The denoiser's image now holds the current iterations' filter.
+                if denoised {
+                    self.denoised.ran(renderer.samples(), self.clock.elapsed().as_secs_f64());
+                }
+                self.status = format!("saved {}", png.display());
+            }
+            Err(e) => {
+                eprintln!("warning: the screenshot failed: {e:#}");
+                self.status = format!("screenshot failed: {e:#}");
+            }
+        }
+    }
+
+    /// Runs the script's steps that are due. Steps wait while no renderer of the window's
+    /// size and settings is ready.
+    fn run_script(&mut self, event_loop: &ActiveEventLoop) {
+        loop {
+            let ready = self.settled();
+            let Some(run) = &mut self.script else { return };
+            if let Some((size, since)) = run.resizing {
+                if ready && self.size == size {
+                    run.resizing = None;
+                    run.last = Instant::now();
+                } else if since.elapsed() > RESIZE_TIMEOUT {
+                    let e = anyhow!("script: the window did not take the size {}x{} asked for", size.0, size.1);
+                    return self.fail(event_loop, e);
+                } else {
+                    return;
+                }
+            }
+            let Some(step) = run.steps.get(run.next).cloned() else { return };
+            if !ready {
+                return;
+            }
+            let samples = self.renderer.as_ref().map_or(0, |(r, _)| r.get().samples());
+            let due = match step.when {
+                When::Now => true,
+                When::Iterations(n) => samples >= n,
+                When::Elapsed(t) => run.last.elapsed() >= t,
+            };
+            if !due {
+                return;
+            }
+            run.next += 1;
+            run.last = Instant::now();
+            log::info!("script line {}: {:?}", step.line, step.action);
+            if let Action::Resize { width, height } = step.action {
+                run.resizing = Some(((width, height), Instant::now()));
+                if let Some(w) = &self.window {
+                    let _ = w.request_inner_size(PhysicalSize::new(width, height));
+                }
+                continue;
+            }
+            let r = self.controls.action(&step.action, self.size.1 as f32);
+            self.apply(event_loop, r);
+        }
+    }
+
+    /// The most iterations this frame may run: the script's next `after N iterations` must
+    /// find exactly N.
+    fn iteration_limit(&self) -> u32 {
+        let samples = self.renderer.as_ref().map_or(0, |(r, _)| r.get().samples());
+        match &self.script {
+            Some(run) if run.resizing.is_none() => match run.steps.get(run.next) {
+                Some(Step { when: When::Iterations(n), .. }) => n.saturating_sub(samples),
+                _ => u32::MAX,
+            },
+            _ => u32::MAX,
+        }
+    }
+
+    /// Runs this frame's iterations: as many as fit in [`FRAME_BUDGET`] by the last frame's
+    /// time per iteration, at least one, stopping where the script waits for a count. Only a
+    /// renderer that fits the window and is not about to be replaced iterates.
+    fn iterate_batch(&mut self) -> Result<()> {
+        let current = self.settled();
+        let limit = self.batch.min(self.iteration_limit());
+        let Some((active, _)) = self.renderer.as_mut().filter(|_| current) else { return Ok(()) };
+        let done = iterate_frame(active.get_mut(), limit, &mut self.batch)?;
+        if done > 0 {
+            self.rate.add(done);
+        }
+        Ok(())
+    }
+
+    /// Refreshes the panel's figures about once a second: the estimated error (a read-back of
+    /// the film), its history since the restart, and the device's allocated memory.
+    fn measure(&mut self) -> Result<()> {
+        if self.measured.at.is_some_and(|t| t.elapsed() < Duration::from_secs(1)) {
+            return Ok(());
+        }
+        self.measured.at = Some(Instant::now());
+        let Some((active, _)) = &self.renderer else { return Ok(()) };
+        let r = active.get();
+        let samples = r.samples();
+        let history = &mut self.measured.history;
+        if history.last().is_some_and(|&(n, _)| n > samples) {
+            history.clear();
+        }
+        self.measured.error = r.film_state()?.error_estimate();
+        // As for `render --target-error`: the halves need a few blocks each before their
+        // difference means much.
+        self.measured.rough = r.film().blocks() < 4;
+        if let Some(e) = self.measured.error.filter(|_| !self.measured.rough)
+            && history.last().is_none_or(|&(n, _)| n < samples)
+        {
+            history.push((samples, e));
+        }
+        if let Some(gpu) = &self.gpu {
+            self.measured.memory =
+                gpu.device.generate_allocator_report().map(|r| r.allocations.iter().map(|a| a.size).sum());
+        }
+        Ok(())
+    }
+
+    /// One displayed frame: input over time, script, iterations, resolve, panel, draw, present.
+    fn frame(&mut self, event_loop: &ActiveEventLoop) {
+        let now = Instant::now();
+        // A stall (a slow build, a dragged window) must not turn into a long flight.
+        let dt = now.duration_since(self.last_frame).min(Duration::from_millis(100));
+        self.last_frame = now;
+        let r = self.controls.tick(dt.as_secs_f32());
+        self.apply(event_loop, r);
+        self.run_script(event_loop);
+        if self.error.is_some() {
+            return;
+        }
+        let Some(gpu) = self.gpu.clone() else { return };
+        self.sync_denoiser();
+        if let Err(e) = self.iterate_batch() {
+            return self.fail(event_loop, e);
+        }
+        let panel_shown = self.controls.panel && self.panel.is_some();
+        if panel_shown && let Err(e) = self.measure() {
+            return self.fail(event_loop, e);
+        }
+        let (panel_output, actions) = match panel_shown.then(|| self.run_panel()).flatten() {
+            Some((output, actions)) => (Some(output), actions),
+            None => (None, Vec::new()),
+        };
+        let show = self.shown();
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        if let Err(e) = self.encode_resolve(&mut enc, show) {
+            return self.fail(event_loop, e);
+        }
+        let (Some(surface), Some(window)) = (&mut self.surface, &self.window) else { return };
+        let film = self.renderer.as_ref().map(|(r, _)| r.get().film());
+        let presented = match (panel_output, &mut self.panel) {
+            (Some(mut output), Some(panel)) => {
+                panel.input.handle_platform_output(window, std::mem::take(&mut output.platform_output));
+                let (ctx, painter) = (&panel.ctx, &mut panel.painter);
+                surface.present_with(&gpu, enc, film, &[], |enc, view, size| {
+                    painter.encode(&gpu, ctx, output, enc, view, size)
+                })
+            }
+            _ => surface.present(&gpu, enc, film, &[]),
+        };
+        match presented {
+            Ok(Presented::Shown) => self.retry_at = None,
+            Ok(Presented::Skipped) => self.retry_at = Some(Instant::now() + Duration::from_millis(100)),
+            Err(e) => return self.fail(event_loop, e.into()),
+        }
+        // The panel's actions act from the next frame, as a script's do.
+        for action in actions {
+            log::info!("panel: {action:?}");
+            let r = self.controls.action(&action, self.size.1 as f32);
+            self.apply(event_loop, r);
+        }
+        if self.title_at.elapsed() >= Duration::from_millis(500) {
+            self.title_at = Instant::now();
+            if let Some(w) = &self.window {
+                w.set_title(&self.title());
+            }
+        }
+    }
+
+    /// Runs the panel's egui pass: its output, for drawing, and the actions its widgets gave.
+    fn run_panel(&mut self) -> Option<(egui::FullOutput, Vec<Action>)> {
+        let window = self.window.clone()?;
+        let renderer = self.renderer.as_ref().map(|(active, _)| active.get());
+        let photon_map = match &self.renderer {
+            Some((Active::PhotonMap(r), _)) => Some(r),
+            _ => None,
+        };
+        let size = renderer.map_or(self.size, |r| (r.settings().width, r.settings().height));
+        let figures = Figures {
+            scene: &self.scene_name,
+            size,
+            samples: renderer.map_or(0, |r| r.samples()),
+            iterations_per_second: self.rate.per_second,
+            error: self.measured.error,
+            error_is_rough: self.measured.rough,
+            photon_pass: photon_map
+                .filter(|r| r.settings().photons > 0)
+                .map(|r| (r.photon_pass(), r.settings().photons)),
+            gather_in_use: photon_map.map(|r| r.gather_method()).filter(|&g| g != GatherMethod::Auto),
+            memory: self.measured.memory,
+            history: &self.measured.history,
+            status: &self.status,
+        };
+        let panel = self.panel.as_mut()?;
+        let raw = panel.input.take_egui_input(&window);
+        let mut actions = Vec::new();
+        let output = panel.ctx.run_pass(raw, |ctx| {
+            actions = panel::window(ctx, &self.controls, &figures, &mut panel.state);
+        });
+        Some((output, actions))
+    }
+
+    fn title(&self) -> String {
+        let samples = self.renderer.as_ref().map_or(0, |(r, _)| r.get().samples());
+        format!(
+            "rastergi - {} - {} iterations, {:.1}/s - {}{} - {}",
+            self.scene_name,
+            samples,
+            self.rate.per_second,
+            show_name(self.shown()),
+            if self.denoising().is_some() { " denoised" } else { "" },
+            self.controls.camera.mode.name()
+        )
+    }
+
+    /// The controls back to the settings of the renderer that stays (its build failed).
+    fn revert_controls(&mut self) {
+        let Some((_, b)) = &self.renderer else { return };
+        let c = &mut self.controls;
+        (c.photons, c.grid, c.photon_passes) =
+            (b.settings.photons, b.settings.grid_resolution, b.settings.photon_passes);
+        (c.gather, c.gather_directions, c.directions) =
+            (b.settings.gather, b.settings.gather_directions, b.settings.directions);
+        (c.method, c.sun, c.env_scale) = (b.method, b.sun, b.env_scale);
+    }
+}

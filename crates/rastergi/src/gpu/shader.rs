@@ -1,0 +1,179 @@
+//! WGSL composition: a pass's shader is the shared sources (constants, sampling, scene, BVH
+//! traversal, per-frame uniforms, visible points, film writes) followed by the pass's own file.
+//! WGSL resolves module-scope names in any order, so the pieces are simply concatenated.
+//!
+//! Constants that Rust and WGSL share are written once, in Rust: [`constants`] generates
+//! their WGSL declarations. Structs shared by both are checked by the layout test
+//! (`layout_test.rs`), which parses every composed shader with naga.
+
+use crate::gpu::consts::{
+    CAUSTIC_CELL, ENVIRONMENT_LIGHT, FILM_DIRECT, FILM_INDIRECT, FILM_PHOTON_VIEW, LIGHT_DISTANT, LIGHT_POINT,
+    LIGHT_SPOT, MATERIAL_ALPHA_BLEND, MATERIAL_ALPHA_MASK, MATERIAL_LAMBERTIAN, MATERIAL_SINGLE_SCATTERING,
+    MATERIAL_TEXTURED, MATERIAL_THIN, MATERIAL_TWO_SIDED, MAX_DIRECTIONS, MAX_HOLE_CROSSINGS, MAX_SEPARATORS,
+    MIN_LOOKUP_AREA, NO_TEXTURE, OFFSET_SHIFT, OFFSET_STEP, PUNCTUAL_LIGHT, REGION_SHIFT, TRIANGLE_HAS_HOLES, stream,
+};
+
+/// The scattering model's files in order (`bsdf/`: the dispatch, then its lobes and tables), for
+/// [`SCENE`] and [`BSDF`].
+macro_rules! bsdf_wgsl {
+    () => {
+        concat!(
+            include_str!("../bsdf/bsdf.wgsl"),
+            "\n",
+            include_str!("../bsdf/microfacet.wgsl"),
+            "\n",
+            include_str!("../bsdf/dielectric.wgsl"),
+            "\n",
+            include_str!("../bsdf/layered.wgsl"),
+            "\n",
+            include_str!("../bsdf/diffuse.wgsl"),
+            "\n",
+            include_str!("../bsdf/albedo.wgsl")
+        )
+    };
+}
+
+pub const SAMPLING: &str = include_str!("../sampling/sampling.wgsl");
+/// The scene's bind group: geometry, materials, lights and the environment. Its bindings and
+/// their accessors (`gpu_scene.wgsl`), the point on a surface (`surface.wgsl`, the GPU twin of
+/// `surface.rs`) and light sampling (`lights.wgsl`, of `lights.rs`) are one file cut in three:
+/// they follow each other with nothing between.
+pub const SCENE: &str = concat!(
+    include_str!("../gpu_scene.wgsl"),
+    include_str!("../surface.wgsl"),
+    include_str!("../lights.wgsl"),
+    "\n",
+    include_str!("../textures.wgsl"),
+    "\n",
+    include_str!("../environment.wgsl"),
+    "\n",
+    bsdf_wgsl!()
+);
+/// The texture atlas's sampling (`atlas_sample`); the includer binds `textures` and defines
+/// `atlas_entry_word` (needs [`constants`]).
+pub const TEXTURES: &str = include_str!("../textures.wgsl");
+/// The scattering model alone (it needs [`SAMPLING`]).
+pub const BSDF: &str = bsdf_wgsl!();
+/// Tracing's interface (`trace`, `occluded`, `bvh.wgsl`) with the compute path's `traverse`
+/// (`bvh_compute.wgsl`); [`for_rays`] swaps the latter for the hardware one.
+pub const BVH: &str = concat!(include_str!("../bvh/bvh.wgsl"), "\n", include_str!("../bvh/bvh_compute.wgsl"));
+/// The compute path's `traverse`, as [`BVH`] holds it.
+pub const TRAVERSE_COMPUTE: &str = include_str!("../bvh/bvh_compute.wgsl");
+/// The hardware path's `traverse`: a ray query over the scene's TLAS (`accel.rs`).
+pub const TRAVERSE_HARDWARE: &str = include_str!("bvh_hardware.wgsl");
+pub const FRAME: &str = include_str!("../passes/frame.wgsl");
+/// The G-buffer texel → visible point decode (`visible_point`), for per-pixel passes.
+pub const VISIBLE_POINT: &str = include_str!("../passes/visible_point.wgsl");
+/// Film writes by component (`film_add`), for passes that bind `film`.
+pub const FILM: &str = include_str!("../passes/film.wgsl");
+
+/// WGSL declarations of the constants Rust and WGSL share, from their Rust values.
+pub fn constants() -> String {
+    let u32s = [
+        ("MAX_DIRECTIONS", MAX_DIRECTIONS),
+        ("MATERIAL_TWO_SIDED", MATERIAL_TWO_SIDED),
+        ("MATERIAL_ALPHA_MASK", MATERIAL_ALPHA_MASK),
+        ("MATERIAL_ALPHA_BLEND", MATERIAL_ALPHA_BLEND),
+        ("MATERIAL_TEXTURED", MATERIAL_TEXTURED),
+        ("MATERIAL_THIN", MATERIAL_THIN),
+        ("MATERIAL_LAMBERTIAN", MATERIAL_LAMBERTIAN),
+        ("MATERIAL_SINGLE_SCATTERING", MATERIAL_SINGLE_SCATTERING),
+        ("MAX_HOLE_CROSSINGS", MAX_HOLE_CROSSINGS),
+        ("TRIANGLE_HAS_HOLES", TRIANGLE_HAS_HOLES),
+        ("NO_TEXTURE", NO_TEXTURE),
+        ("ATLAS_ROW", crate::gpu::consts::ATLAS_ROW),
+        ("FILM_DIRECT", FILM_DIRECT),
+        ("FILM_INDIRECT", FILM_INDIRECT),
+        ("FILM_PHOTON_VIEW", FILM_PHOTON_VIEW),
+        ("REGION_SHIFT", REGION_SHIFT),
+        ("OFFSET_SHIFT", OFFSET_SHIFT),
+        ("MAX_SEPARATORS", MAX_SEPARATORS as u32),
+        ("STREAM_DIRECT", stream::DIRECT),
+        ("STREAM_PATH", stream::PATH),
+        ("STREAM_PHOTON", stream::PHOTON),
+        ("STREAM_HIT_LIGHT", stream::HIT_LIGHT),
+        ("STREAM_EYE_CHAIN", stream::EYE_CHAIN),
+        ("STREAM_GATHER_CHAIN", stream::GATHER_CHAIN),
+        ("STREAM_GATHER_LOBE", stream::GATHER_LOBE),
+        ("PUNCTUAL_LIGHT", PUNCTUAL_LIGHT),
+        ("ENVIRONMENT_LIGHT", ENVIRONMENT_LIGHT),
+        ("CAUSTIC_CELL", CAUSTIC_CELL),
+        ("LIGHT_POINT", LIGHT_POINT),
+        ("LIGHT_SPOT", LIGHT_SPOT),
+        ("LIGHT_DISTANT", LIGHT_DISTANT),
+        ("NO_CHILD", crate::gpu::consts::NO_CHILD),
+        ("GGX_ALBEDO_N", crate::gpu::consts::GGX_ALBEDO_N as u32),
+        ("GGX_ALBEDO_CELLS", (crate::gpu::consts::GGX_ALBEDO_N * crate::gpu::consts::GGX_ALBEDO_N) as u32),
+        ("GLASS_ALBEDO_ETAS", crate::gpu::consts::GLASS_ETAS as u32),
+        ("GLASS_ALBEDO_CELLS", crate::gpu::consts::GLASS_CELLS as u32),
+    ];
+    use crate::gpu::consts::GpuSceneOffsets as O;
+    let word = |offset: usize| (offset / 4) as u32;
+    let header = [
+        ("DATA_UVS", word(std::mem::offset_of!(O, uvs))),
+        ("DATA_UV_TRIANGLES", word(std::mem::offset_of!(O, uv_triangles))),
+        ("DATA_NORMALS", word(std::mem::offset_of!(O, normals))),
+        ("DATA_NORMAL_TRIANGLES", word(std::mem::offset_of!(O, normal_triangles))),
+        ("DATA_TANGENTS", word(std::mem::offset_of!(O, tangents))),
+        ("DATA_TANGENT_TRIANGLES", word(std::mem::offset_of!(O, tangent_triangles))),
+        ("DATA_LIGHTS", word(std::mem::offset_of!(O, lights))),
+        ("DATA_LIGHT_COUNT", word(std::mem::offset_of!(O, light_count))),
+        ("DATA_PUNCTUAL", word(std::mem::offset_of!(O, punctual))),
+        ("DATA_ENVIRONMENT", word(std::mem::offset_of!(O, environment))),
+        ("DATA_TEXTURES", word(std::mem::offset_of!(O, textures))),
+    ];
+    let u32s: Vec<(&str, u32)> = u32s.into_iter().chain(header).collect();
+    let f32s = [
+        ("OFFSET_STEP", OFFSET_STEP),
+        ("MIN_LOOKUP_AREA", MIN_LOOKUP_AREA),
+        ("AIM_FRACTION", crate::gpu::consts::AIM_FRACTION),
+        ("NEAR_FRACTION", crate::gpu::consts::NEAR_FRACTION),
+        ("NEAR_SCALE", crate::gpu::consts::NEAR_SCALE),
+        ("NEAR_FACE", crate::gpu::consts::NEAR_FACE),
+        ("GLASS_ALBEDO_ETA_MAX", crate::gpu::consts::GLASS_ETA_MAX),
+    ];
+    let mut s = String::from("// Generated from the Rust constants (shader.rs).\n");
+    for (name, value) in u32s {
+        s += &format!("const {name}: u32 = {value}u;\n");
+    }
+    for (name, value) in f32s {
+        s += &format!("const {name}: f32 = {value:?};\n");
+    }
+    s
+}
+
+/// `pieces` after the shared constants.
+pub fn compose(pieces: &[&str]) -> String {
+    let constants = constants();
+    std::iter::once(constants.as_str()).chain(pieces.iter().copied()).collect::<Vec<_>>().join("\n")
+}
+
+/// The common prelude of every pass that reads the scene, then `pass`.
+pub fn with_scene(pass: &str) -> String {
+    compose(&[SAMPLING, SCENE, BVH, FRAME, pass])
+}
+
+/// The prelude of a per-pixel pass over the G-buffer that adds to the film, then `pieces`.
+pub fn per_pixel(pieces: &[&str]) -> String {
+    let mut all = vec![SAMPLING, SCENE, BVH, FRAME, VISIBLE_POINT, FILM];
+    all.extend_from_slice(pieces);
+    compose(&all)
+}
+
+/// `source` (a composed shader) for ray path `path`: unchanged for the compute path; for the
+/// hardware path its compute `traverse` replaced by the ray query's and `enable wgpu_ray_query;`
+/// put first. A shader without [`BVH`] casts no rays and is returned as it is.
+pub fn for_rays(source: &str, path: crate::gpu::accel::RayPath) -> std::borrow::Cow<'_, str> {
+    match path {
+        crate::gpu::accel::RayPath::Hardware if source.contains(TRAVERSE_COMPUTE) => std::borrow::Cow::Owned(format!(
+            "enable wgpu_ray_query;\n{}",
+            source.replacen(TRAVERSE_COMPUTE, TRAVERSE_HARDWARE, 1)
+        )),
+        _ => std::borrow::Cow::Borrowed(source),
+    }
+}
+
+/// The shader module of `source`: the device's one of it ([`crate::gpu::compiled`]).
+pub fn module(device: &wgpu::Device, label: &str, source: &str) -> wgpu::ShaderModule {
+    crate::gpu::compiled::module(device, label, source)
+}

@@ -1,0 +1,442 @@
+//! Display: draws the film's resolved display image onto a window (or any colour target),
+//! with a text overlay, in one full-screen triangle (`display.wgsl`).
+//!
+//! The film's display buffer holds packed RGBA8 values that `resolve.wgsl` has already
+//! exposed, clamped and sRGB-encoded. A target with a plain `*Unorm` format stores those
+//! bytes as they are. A target with an `*Srgb` format (or a float format, which holds
+//! linear values) encodes whatever the shader writes, so the shader decodes first and the
+//! hardware's encode restores the film's bytes — either way the window shows exactly the
+//! bytes of the PNG screenshot. [`WindowSurface`] prefers a plain format when the surface
+//! offers one.
+//!
+//! The overlay is a grid of ASCII characters drawn with the public-domain 8×8 bitmap font
+//! of the `font8x8` crate over a darkened box in the top-left corner.
+
+use bytemuck::{Pod, Zeroable};
+
+use crate::error::{Error, Result};
+use crate::gpu::binding::{Group, Slot};
+use crate::gpu::{Gpu, shader};
+use crate::passes::film::Film;
+
+/// Re-exported so front ends can hand over a window without a direct wgpu dependency.
+pub use wgpu::SurfaceTarget;
+
+/// Most overlay columns and rows drawn; longer lines and further lines are cut.
+pub const MAX_TEXT_COLS: usize = 96;
+pub const MAX_TEXT_ROWS: usize = 32;
+
+/// The display pass's shader (it reads no scene: nothing to compose).
+pub(crate) const SOURCE: &str = include_str!("display.wgsl");
+
+/// `Display` in `display.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub(crate) struct DisplayUniforms {
+    pub(crate) image_size: [u32; 2],
+    pub(crate) target_size: [u32; 2],
+    pub(crate) decode_srgb: u32,
+    pub(crate) text_cols: u32,
+    pub(crate) text_rows: u32,
+    pub(crate) text_scale: u32,
+}
+
+/// Whether a target of `format` needs the shader to decode sRGB: the hardware encodes on
+/// write to `*Srgb` formats, and float formats hold linear values.
+pub fn needs_decode(format: wgpu::TextureFormat) -> bool {
+    use wgpu::TextureFormat as F;
+    format.is_srgb() || matches!(format, F::Rgba16Float | F::Rgba32Float | F::Rg11b10Ufloat)
+}
+
+/// Pixels per font texel for a target `height` pixels tall: 1 up to 719 rows, 2 up to
+/// 1079, then 3.
+pub fn text_scale(height: u32) -> u32 {
+    (height / 360).clamp(1, 3)
+}
+
+/// The overlay lines laid out in a `cols × rows` grid of ASCII codes (non-ASCII characters
+/// become '?', short lines are padded with spaces), four characters per `u32`.
+fn layout_text(lines: &[String]) -> (u32, u32, Vec<u32>) {
+    let rows = lines.len().min(MAX_TEXT_ROWS);
+    let cols = lines[..rows].iter().map(|l| l.chars().count()).max().unwrap_or(0).min(MAX_TEXT_COLS);
+    let mut bytes = vec![b' '; (cols * rows).next_multiple_of(4).max(4)];
+    for (r, line) in lines[..rows].iter().enumerate() {
+        for (c, ch) in line.chars().take(cols).enumerate() {
+            bytes[r * cols + c] = if ch.is_ascii() && !ch.is_ascii_control() { ch as u8 } else { b'?' };
+        }
+    }
+    let words = bytes.chunks(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
+    (cols as u32, rows as u32, words)
+}
+
+/// The glyphs of characters 0..127, two `u32` of four rows each (see `display.wgsl`).
+fn font_words() -> Vec<u32> {
+    font8x8::legacy::BASIC_LEGACY
+        .iter()
+        .flat_map(|g| [u32::from_le_bytes([g[0], g[1], g[2], g[3]]), u32::from_le_bytes([g[4], g[5], g[6], g[7]])])
+        .collect()
+}
+
+/// The display pass for one target format.
+pub struct DisplayPass {
+    format: wgpu::TextureFormat,
+    pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+    uniforms: wgpu::Buffer,
+    font: wgpu::Buffer,
+    text: wgpu::Buffer,
+    /// Bound in place of a film before there is one.
+    no_image: wgpu::Buffer,
+    /// The bind group of the image buffer drawn last (rebuilt when the film changes).
+    bound: Option<(wgpu::Buffer, wgpu::BindGroup)>,
+}
+
+/// The display's bind group: the uniforms, the film's display image, the font and the
+/// overlay's text, all read by the fragment shader.
+pub fn group() -> Group {
+    Group::new(
+        "display",
+        wgpu::ShaderStages::FRAGMENT,
+        &[
+            Slot::uniform::<DisplayUniforms>(0, "params"),
+            Slot::read::<u32>(1, "image"),
+            Slot::read::<u32>(2, "font"),
+            Slot::read::<u32>(3, "text"),
+        ],
+    )
+}
+
+impl DisplayPass {
+    pub fn new(gpu: &Gpu, format: wgpu::TextureFormat) -> DisplayPass {
+        let device = &gpu.device;
+        let layout = group().layout(device);
+        let module = shader::module(device, "display", SOURCE);
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("display"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("display"),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: Default::default(),
+            depth_stencil: None,
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[Some(format.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let uniforms = gpu.zeroed_buffer(
+            "display uniforms",
+            std::mem::size_of::<DisplayUniforms>() as u64,
+            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        );
+        let font = gpu.storage_buffer("display font", bytemuck::cast_slice(&font_words()), wgpu::BufferUsages::empty());
+        let text = gpu.zeroed_buffer(
+            "display text",
+            (MAX_TEXT_COLS * MAX_TEXT_ROWS) as u64,
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        );
+        let no_image = gpu.zeroed_buffer("display no image", 16, wgpu::BufferUsages::STORAGE);
+        DisplayPass { format, pipeline, layout, uniforms, font, text, no_image, bound: None }
+    }
+
+    pub fn format(&self) -> wgpu::TextureFormat {
+        self.format
+    }
+
+    /// Encodes drawing `film`'s display buffer (as last resolved; the background where there
+    /// is no film) scaled to fit a `target_size` target, and the `overlay` lines on top.
+    /// Reads: the film's display buffer. Writes: `target`, whole.
+    pub fn encode(
+        &mut self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        target: &wgpu::TextureView,
+        target_size: (u32, u32),
+        film: Option<&Film>,
+        overlay: &[String],
+    ) {
+        let (cols, rows, text) = layout_text(overlay);
+        gpu.queue.write_buffer(&self.text, 0, bytemuck::cast_slice(&text));
+        let image_size = film.map_or([0, 0], |f| [f.width, f.height]);
+        let u = DisplayUniforms {
+            image_size,
+            target_size: [target_size.0, target_size.1],
+            decode_srgb: needs_decode(self.format) as u32,
+            text_cols: cols,
+            text_rows: rows,
+            text_scale: text_scale(target_size.1),
+        };
+        gpu.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
+        let image = film.map_or(&self.no_image, |f| f.display_buffer()).clone();
+        if self.bound.as_ref().is_none_or(|(b, _)| *b != image) {
+            let bind_group = group().bind(
+                &gpu.device,
+                &self.layout,
+                &[
+                    ("params", self.uniforms.as_entire_binding()),
+                    ("image", image.as_entire_binding()),
+                    ("font", self.font.as_entire_binding()),
+                    ("text", self.text.as_entire_binding()),
+                ],
+            );
+            self.bound = Some((image, bind_group));
+        }
+        let (_, bind_group) = self.bound.as_ref().expect("bound just above");
+        let ops = wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::BLACK), store: wgpu::StoreOp::Store };
+        let mut pass = crate::gpu::profile::render_pass(enc, None, "display", (target, ops), None);
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, bind_group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+}
+
+/// What became of a frame handed to [`WindowSurface::present`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Presented {
+    Shown,
+    /// The window is occluded or the swapchain timed out: nothing was shown this time.
+    Skipped,
+}
+
+/// A window's surface, configured for the device, and the display pass drawing onto it.
+pub struct WindowSurface {
+    surface: wgpu::Surface<'static>,
+    config: wgpu::SurfaceConfiguration,
+    pass: DisplayPass,
+}
+
+impl WindowSurface {
+    /// Creates a surface for `window` on `display` (the window system's connection, which
+    /// OpenGL needs at instance creation) and opens the best device that can present to it
+    /// (a discrete GPU first, as [`Gpu::new`] does), with the surface configured at
+    /// `width × height` (at least 1×1). Blocks until the device is open: native only.
+    #[cfg(not(target_arch = "wasm32"))]
+    pub fn open<D>(
+        options: &crate::gpu::GpuOptions,
+        display: D,
+        window: impl Into<SurfaceTarget<'static>>,
+        width: u32,
+        height: u32,
+    ) -> Result<(Gpu, WindowSurface)>
+    where
+        D: wgpu::rwh::HasDisplayHandle + std::fmt::Debug + Send + Sync + 'static,
+    {
+        let mut desc = wgpu::InstanceDescriptor::new_with_display_handle(Box::new(display));
+        desc.backends = options.backends();
+        let instance = wgpu::Instance::new(desc);
+        let surface = instance
+            .create_surface(window)
+            .map_err(|e| Error::Gpu(format!("cannot create a surface for the window: {e}")))?;
+        let gpu = Gpu::open(&instance, options, Some(&surface))?;
+        let window = WindowSurface::new(&gpu, surface, width, height)?;
+        Ok((gpu, window))
+    }
+
+    /// Configures `surface` (of a window, or a web page's canvas: `SurfaceTarget::Canvas`)
+    /// for `gpu`, opened for it ([`Gpu::open_async`] with the surface), at `width × height`
+    /// (at least 1×1): a plain 8-bit format where the surface offers one (the shader encodes
+    /// sRGB itself, [`needs_decode`]).
+    pub fn new(gpu: &Gpu, surface: wgpu::Surface<'static>, width: u32, height: u32) -> Result<WindowSurface> {
+        let caps = surface.get_capabilities(&gpu.adapter);
+        use wgpu::TextureFormat as F;
+        let format = caps
+            .formats
+            .iter()
+            .copied()
+            .find(|f| matches!(f, F::Bgra8Unorm | F::Rgba8Unorm))
+            .or_else(|| caps.formats.first().copied())
+            .ok_or_else(|| Error::Gpu(format!("the window surface offers no format on {}", gpu.info.name)))?;
+        let config = wgpu::SurfaceConfiguration {
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            format,
+            color_space: wgpu::SurfaceColorSpace::Auto,
+            width: width.max(1),
+            height: height.max(1),
+            desired_maximum_frame_latency: 2,
+            present_mode: wgpu::PresentMode::AutoVsync,
+            alpha_mode: caps.alpha_modes.first().copied().unwrap_or(wgpu::CompositeAlphaMode::Auto),
+            view_formats: vec![],
+        };
+        surface.configure(&gpu.device, &config);
+        let pass = DisplayPass::new(gpu, format);
+        log::info!("window surface format {format:?} (shader sRGB decode: {})", needs_decode(format));
+        Ok(WindowSurface { surface, config, pass })
+    }
+
+    pub fn format(&self) -> wgpu::TextureFormat {
+        self.config.format
+    }
+
+    pub fn size(&self) -> (u32, u32) {
+        (self.config.width, self.config.height)
+    }
+
+    /// Reconfigures the swapchain for a new window size; zero sizes (minimised) are ignored.
+    pub fn resize(&mut self, gpu: &Gpu, width: u32, height: u32) {
+        if width == 0 || height == 0 || (width, height) == self.size() {
+            return;
+        }
+        self.config.width = width;
+        self.config.height = height;
+        self.surface.configure(&gpu.device, &self.config);
+    }
+
+    /// Submits `enc` (work the frame depends on, such as the film's resolve) followed by
+    /// drawing `film` and `overlay` onto the next swapchain image, and presents it.
+    pub fn present(
+        &mut self,
+        gpu: &Gpu,
+        enc: wgpu::CommandEncoder,
+        film: Option<&Film>,
+        overlay: &[String],
+    ) -> Result<Presented> {
+        self.present_with(gpu, enc, film, overlay, |_, _, _| {})
+    }
+
+    /// [`present`](Self::present), with `draw_over` encoding more drawing (a user interface)
+    /// over the image before it is shown: it gets the encoder, the swapchain image's view
+    /// (whose contents it must load, not clear) and its size. It is not called when no image
+    /// could be acquired.
+    pub fn present_with(
+        &mut self,
+        gpu: &Gpu,
+        mut enc: wgpu::CommandEncoder,
+        film: Option<&Film>,
+        overlay: &[String],
+        draw_over: impl FnOnce(&mut wgpu::CommandEncoder, &wgpu::TextureView, (u32, u32)),
+    ) -> Result<Presented> {
+        // Outdated: reconfigure and try once more. Suboptimal: show it, reconfigure after.
+        let mut acquired = None;
+        for _ in 0..2 {
+            match self.surface.get_current_texture() {
+                wgpu::CurrentSurfaceTexture::Success(t) => acquired = Some((t, false)),
+                wgpu::CurrentSurfaceTexture::Suboptimal(t) => acquired = Some((t, true)),
+                wgpu::CurrentSurfaceTexture::Outdated => {
+                    self.surface.configure(&gpu.device, &self.config);
+                    continue;
+                }
+                wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => {}
+                wgpu::CurrentSurfaceTexture::Lost => {
+                    return Err(Error::Gpu("the window surface was lost".into()));
+                }
+                wgpu::CurrentSurfaceTexture::Validation => {
+                    return Err(Error::Gpu("acquiring the window's next image failed validation".into()));
+                }
+            }
+            break;
+        }
+        let Some((texture, suboptimal)) = acquired else {
+            gpu.queue.submit([enc.finish()]);
+            return Ok(Presented::Skipped);
+        };
+        let view = texture.texture.create_view(&Default::default());
+        self.pass.encode(gpu, &mut enc, &view, self.size(), film, overlay);
+        draw_over(&mut enc, &view, self.size());
+        gpu.queue.submit([enc.finish()]);
+        gpu.queue.present(texture);
+        if suboptimal {
+            self.surface.configure(&gpu.device, &self.config);
+        }
+        Ok(Presented::Shown)
+    }
+}
+
+/// A window stand-in: the display pass drawing into a texture of a window's size instead of
+/// a swapchain image (nothing is presented, so no vsync). `rastergi bench frames` measures
+/// the viewer's frame loop with it.
+pub struct OffscreenTarget {
+    _texture: wgpu::Texture,
+    view: wgpu::TextureView,
+    size: (u32, u32),
+    pass: DisplayPass,
+}
+
+impl OffscreenTarget {
+    /// A `width × height` RGBA8 target (a plain format, as [`WindowSurface`] prefers).
+    pub fn new(gpu: &Gpu, width: u32, height: u32) -> Result<OffscreenTarget> {
+        gpu.check_image_size(width, height, 4)?;
+        let format = wgpu::TextureFormat::Rgba8Unorm;
+        let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("offscreen display target"),
+            size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&Default::default());
+        Ok(OffscreenTarget { _texture: texture, view, size: (width, height), pass: DisplayPass::new(gpu, format) })
+    }
+
+    /// What [`WindowSurface::present`] does, onto the texture: submits `enc` followed by
+    /// drawing `film` and `overlay`.
+    pub fn draw(&mut self, gpu: &Gpu, enc: wgpu::CommandEncoder, film: Option<&Film>, overlay: &[String]) {
+        self.draw_with(gpu, enc, film, overlay, |_, _, _| {});
+    }
+
+    /// What [`WindowSurface::present_with`] does, onto the texture.
+    pub fn draw_with(
+        &mut self,
+        gpu: &Gpu,
+        mut enc: wgpu::CommandEncoder,
+        film: Option<&Film>,
+        overlay: &[String],
+        draw_over: impl FnOnce(&mut wgpu::CommandEncoder, &wgpu::TextureView, (u32, u32)),
+    ) {
+        self.pass.encode(gpu, &mut enc, &self.view, self.size, film, overlay);
+        draw_over(&mut enc, &self.view, self.size);
+        gpu.queue.submit([enc.finish()]);
+    }
+
+    /// The texture's format (a user interface drawn over it must target it).
+    pub fn format(&self) -> wgpu::TextureFormat {
+        self.pass.format()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn text_is_laid_out_four_characters_per_word_and_padded() {
+        let (cols, rows, words) = layout_text(&["ab".into(), "cdeé".into()]);
+        assert_eq!((cols, rows), (4, 2));
+        assert_eq!(words, vec![u32::from_le_bytes(*b"ab  "), u32::from_le_bytes(*b"cde?")]);
+        let (cols, rows, words) = layout_text(&[]);
+        assert_eq!((cols, rows, words.len()), (0, 0, 1));
+        let long = vec!["x".repeat(500); 100];
+        let (cols, rows, words) = layout_text(&long);
+        assert_eq!((cols as usize, rows as usize), (MAX_TEXT_COLS, MAX_TEXT_ROWS));
+        assert!(words.len() * 4 <= MAX_TEXT_COLS * MAX_TEXT_ROWS);
+    }
+
+    #[test]
+    fn font_rows_put_the_leftmost_pixel_in_bit_0() {
+        let font = font_words();
+        assert_eq!(font.len(), 256);
+        let row = |c: usize, y: usize| (font[2 * c + y / 4] >> (8 * (y % 4))) & 0xff;
+        // The stem of 'L' is on the left and its foot is the widest row: with bit 0 the
+        // leftmost pixel, the stem's rows are lit in the low bits only.
+        let l = b'L' as usize;
+        assert!((1..4).all(|y| row(l, y) & 0x0f != 0 && row(l, y) & 0xf0 == 0), "stem on the left");
+        assert!((0..6).all(|y| row(l, 6).count_ones() > row(l, y).count_ones()), "foot widest");
+        assert_eq!(row(b' ' as usize, 3), 0);
+        assert!(needs_decode(wgpu::TextureFormat::Bgra8UnormSrgb) && !needs_decode(wgpu::TextureFormat::Bgra8Unorm));
+    }
+}

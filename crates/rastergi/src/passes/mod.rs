@@ -1,0 +1,63 @@
+//! The per-iteration passes over the image, in the order [`crate::renderer::Renderer::iterate`]
+//! runs them: [`frame`] (the iteration's camera and uniforms) → [`gbuffer`] → [`specular`] chains
+//! → [`direct`] → the final gather ([`crate::gather`]) and [`photon_view`] → [`film`]
+//! (accumulate, resolve) → [`denoise`] → [`display`].
+//!
+//! What the passes of an iteration share: one [`FrameContext`] that each reads, and one
+//! [`IterationPass::encode`] signature. A pass's own resources (its bind groups,
+//! [`crate::gpu::binding`]) are bound to the G-buffer and film it was made with; what changes from
+//! iteration to iteration — the frame's uniforms, the photon map of the current photon pass,
+//! the gather's directions — comes through the context. [`crate::renderer::Renderer::iterate`]
+//! runs them in the order of the data flow.
+
+pub mod denoise;
+pub mod direct;
+pub mod display;
+pub mod film;
+pub mod frame;
+pub mod gbuffer;
+pub mod photon_view;
+pub mod specular;
+
+use glam::{Vec2, Vec3};
+
+use crate::error::Result;
+use crate::gpu::Gpu;
+use crate::gpu_scene::GpuScene;
+use crate::passes::frame::FrameBinding;
+use crate::photons::gpu::GpuPhotonMap;
+
+/// What every pass of one iteration reads besides its own resources.
+pub struct FrameContext<'a> {
+    pub gpu: &'a Gpu,
+    /// Bind group 0 of every pass.
+    pub scene: &'a GpuScene,
+    /// Bind group 1: this iteration's uniforms (camera jitter, seed, gather strategy).
+    pub frame: &'a FrameBinding,
+    /// The current photon pass's map; `None` where the render has none (direct light only).
+    pub map: Option<&'a GpuPhotonMap>,
+    pub width: u32,
+    pub height: u32,
+    /// The iteration's index since the film was last cleared.
+    pub iteration: u32,
+    /// The gather's directions per pixel and iteration (1 to [`crate::gpu::consts::MAX_DIRECTIONS`]).
+    pub directions: u32,
+    /// Random choices fixed for a test ([`crate::renderer::Overrides`]).
+    pub fixed: FixedSample,
+}
+
+/// Values that replace the sampler's for one iteration (tests compare the gather with other
+/// estimators for the same samples).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FixedSample {
+    /// One direction ω instead of the iteration's.
+    pub direction: Option<Vec3>,
+    /// The ray view's sub-texel offset instead of a random one.
+    pub texel_jitter: Option<Vec2>,
+}
+
+/// One pass of an iteration: it adds its commands to `enc` (an implementation that must read
+/// a result back may submit `enc` and leave a new encoder in it).
+pub trait IterationPass {
+    fn encode(&mut self, enc: &mut wgpu::CommandEncoder, ctx: &FrameContext) -> Result<()>;
+}

@@ -1,0 +1,86 @@
+// Photon map lookups (photons/map/), bind group 3 of the passes that read the map: per slot
+// table entry (Φ_rgb/h², A/h²), the table's keys, and every triangle's plane keys.
+
+struct PhotonGrid {
+    grid: GridLevels,
+    // Table capacity − 1 (a power of two minus one) and the longest probe of any slot; the
+    // same for the separators' table.
+    mask: u32,
+    max_probe: u32,
+    sep_mask: u32,
+    sep_max_probe: u32,
+    // 1 where the map holds indirect irradiance only: its readers add the direct part.
+    indirect_only: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}
+
+@group(3) @binding(0) var<storage, read> photon_slots: array<vec4f>;
+@group(3) @binding(1) var<uniform> photon_grid: PhotonGrid;
+// The slots' table keys, then the separators' (table.wgsl).
+@group(3) @binding(2) var<storage, read> slot_keys: array<vec2u>;
+@group(3) @binding(3) var<storage, read> planes: array<TrianglePlane>;
+@group(3) @binding(4) var<storage, read> separator_planes: array<SeparatorRecord>;
+
+// p's region among the separators of base slot (cell, key): 0 where it has none.
+fn photon_region(cell: u32, key: u32, p: vec3f) -> u32 {
+    let sep = find_separators(cell, key, photon_grid.mask + 1u, photon_grid.sep_mask, photon_grid.sep_max_probe);
+    if sep == NO_SLOT {
+        return 0u;
+    }
+    return region_of(separator_planes[sep], p);
+}
+
+// E(p) on side `back` of triangle tri: Σ w_i Φ_i / Σ w_i A_i over the slots of its plane in
+// the 8 cells around p, w_i trilinear on cell centres (PhotonMap::irradiance_on).
+fn photon_irradiance(p: vec3f, tri: u32, back: bool) -> vec3f {
+    return photon_lookup(p, tri, back, 0u);
+}
+
+// The caustic map's E(p) (PhotonMap::caustic_irradiance_on): the same lookup over the slots'
+// caustic twins (zero where the map has none).
+fn caustic_irradiance(p: vec3f, tri: u32, back: bool) -> vec3f {
+    return photon_lookup(p, tri, back, CAUSTIC_CELL);
+}
+
+// The lookup over the slots whose cell index has the bits `twin` set.
+fn photon_lookup(p: vec3f, tri: u32, back: bool, twin: u32) -> vec3f {
+    let plane = planes[tri];
+    // The level holding p: its 8 cells around p (the other level's hold no slots of this one).
+    let l = lattice_at(photon_grid.grid, p);
+    let origin = l.origin;
+    let h = l.cell;
+    // The separators of p's own slot: cells beyond them (across a wall) do not count.
+    let home = lattice_cell(l, p);
+    let home_key = plane_key(plane, cell_centre(origin, h, home), h, back);
+    let own = find_separators(lattice_index(l, home), home_key, photon_grid.mask + 1u, photon_grid.sep_mask, photon_grid.sep_max_probe);
+    var own_record: SeparatorRecord;
+    if own != NO_SLOT {
+        own_record = separator_planes[own];
+    }
+    // Areas are in units of the coarse cell's side².
+    let scale = h / photon_grid.grid.cell;
+    let min_area = MIN_LOOKUP_AREA * scale * scale;
+    let g = (p - origin) / h - 0.5;
+    let base = floor(g);
+    let f = g - base;
+    var sum = vec4f(0.0);
+    for (var k = 0u; k < 8u; k++) {
+        let o = vec3u(k & 1u, (k >> 1u) & 1u, (k >> 2u) & 1u);
+        let w3 = select(1.0 - f, f, o == vec3u(1u));
+        let c = vec3u(clamp(vec3i(base) + vec3i(o), l.lo, l.hi));
+        let centre = cell_centre(origin, h, c);
+        if own != NO_SLOT && any(c != home) && region_of(own_record, p) != region_of(own_record, centre) {
+            continue;
+        }
+        let cell = lattice_index(l, c);
+        let key = plane_key(plane, centre, h, back);
+        let s = find_slot(cell | twin, key | (photon_region(cell, key, p) << REGION_SHIFT), photon_grid.mask, photon_grid.max_probe);
+        // Slots of almost no area are left out (PhotonMap::irradiance_on_plane).
+        if s != NO_SLOT && photon_slots[s].a >= min_area {
+            sum += (w3.x * w3.y * w3.z) * photon_slots[s];
+        }
+    }
+    return select(vec3f(0.0), sum.rgb / sum.a, sum.a > 0.0);
+}

@@ -1,5 +1,6 @@
-//! The GPU context: adapter choice and device (here), buffers and read-backs (`buffers.rs`), and the
-//! binding and pipeline helpers every pass uses (`binding.rs`, re-exported here).
+//! The GPU context: adapter choice and device (here), buffers and read-backs (`buffers.rs`), the
+//! declared bind groups every pass binds ([`binding`]) and the pipeline helpers it builds with
+//! (`pipeline.rs`, re-exported here).
 
 use std::fmt::Write as _;
 

@@ -1,7 +1,7 @@
 """glTF 2.0 scenes for scripts/mitsuba_reference.py (`--scene PATH.gltf` or `.glb`).
 
 Mitsuba 3 has no glTF loader, so the file is read here, independently of rastergi's loader
-(crates/rastergi/src/scene/gltf.rs) but by the same rules, into the groups that
+(crates/rastergi/src/scene/gltf/mod.rs) but by the same rules, into the groups that
 mitsuba_reference.py renders for OBJ files, plus the file's lights and camera:
 - the displayed scene (`scene`, else the first; without scenes every root node), walked
   depth first from its root nodes in order; a node's world transform is parent x local

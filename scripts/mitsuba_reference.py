@@ -15,7 +15,7 @@ cornell-box.md (it is Mitsuba's `mi.cornell_box()` geometry and materials, but
 with a box pixel filter and a vertical field of view).
 
 OBJ scenes are read here, not by Mitsuba (whose `obj` loader ignores MTL), the
-way rastergi reads them (crates/rastergi/src/scene/obj.rs, through tobj):
+way rastergi reads them (crates/rastergi/src/scene/obj/mod.rs, through tobj):
 `v`, `vn` and `f` lines (`l` lines of three or more vertices count as faces, as in
 tobj), relative (negative) indices, polygons triangulated as fans (v0, vi,
 vi+1), `mtllib` and `usemtl`; `vt` (read only for faces of a material with `map_d`), `o`,

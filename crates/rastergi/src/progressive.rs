@@ -6,6 +6,7 @@
 
 use crate::checkpoint::Progress;
 use crate::error::Result;
+use crate::gather::GatherMethod;
 use crate::image_io::{DisplayImage, LinearImage};
 use crate::passes::denoise::{DenoiseParams, GuideState, Schedule};
 use crate::passes::film::{Film, FilmState, Show};
@@ -48,6 +49,17 @@ pub trait Progressive: wgpu::WasmNotSend {
     /// Continues from a checkpoint's state: the next iteration is the one the checkpointed
     /// render would have run next.
     fn resume(&mut self, progress: &Progress, film: &FilmState) -> Result<()>;
+    /// Changes the image size in place where the renderer can (the photon-map renderer keeps
+    /// its scene and photon map, rebuilding only the passes of the image's size; the image
+    /// restarts); `Ok(false)` where it must be built anew instead.
+    fn resize(&mut self, _width: u32, _height: u32) -> Result<bool> {
+        Ok(false)
+    }
+    /// The photon map's current pass and the final gather in use (the one `Auto` chose, once
+    /// it has), where the renderer is the photon-map renderer.
+    fn photon_pass_and_gather(&self) -> Option<(u32, GatherMethod)> {
+        None
+    }
     /// The renderer's denoiser, where it has one (the photon-map renderer; not the path
     /// tracer).
     fn denoising(&self) -> Option<&dyn Denoising> {

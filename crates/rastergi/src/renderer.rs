@@ -599,6 +599,13 @@ impl Progressive for Renderer {
     fn resume(&mut self, progress: &Progress, film: &FilmState) -> Result<()> {
         Renderer::resume(self, progress, film)
     }
+    fn resize(&mut self, width: u32, height: u32) -> Result<bool> {
+        Renderer::resize(self, width, height)?;
+        Ok(true)
+    }
+    fn photon_pass_and_gather(&self) -> Option<(u32, GatherMethod)> {
+        Some((self.photon_pass(), self.gather_method()))
+    }
     fn denoising(&self) -> Option<&dyn Denoising> {
         Some(self)
     }

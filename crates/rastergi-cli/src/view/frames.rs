@@ -5,9 +5,7 @@
 use std::time::{Duration, Instant};
 
 use anyhow::Result;
-use rastergi::path_tracer::PathTracer;
 use rastergi::progressive::Progressive;
-use rastergi::renderer::Renderer;
 
 /// GPU time aimed at per displayed frame: iterations are batched up to this.
 pub const FRAME_BUDGET: Duration = Duration::from_millis(30);
@@ -52,26 +50,4 @@ pub fn iterate_frame(renderer: &mut dyn Progressive, limit: u32, batch: &mut u32
         *batch = ((FRAME_BUDGET.as_secs_f64() / per_iteration.max(1e-6)) as u32).clamp(1, MAX_BATCH);
     }
     Ok(done)
-}
-
-/// The renderer the viewer runs: the photon map and gather, or the reference path tracer.
-pub enum Active {
-    PhotonMap(Box<Renderer>),
-    PathTracer(Box<PathTracer>),
-}
-
-impl Active {
-    pub(super) fn get(&self) -> &dyn Progressive {
-        match self {
-            Active::PhotonMap(r) => r.as_ref(),
-            Active::PathTracer(r) => r.as_ref(),
-        }
-    }
-
-    pub(super) fn get_mut(&mut self) -> &mut dyn Progressive {
-        match self {
-            Active::PhotonMap(r) => r.as_mut(),
-            Active::PathTracer(r) => r.as_mut(),
-        }
-    }
 }

@@ -51,6 +51,22 @@ impl Interactive {
         Ok(())
     }
 
+    /// Changes the image size in place where the renderer can (see [`Progressive::resize`]);
+    /// `Ok(false)`: it must be rebuilt at the new size ([`Interactive::replace`]).
+    pub fn resize(&mut self, width: u32, height: u32) -> Result<bool> {
+        let resized = self.renderer.resize(width, height)?;
+        if resized {
+            self.denoised.clear();
+        }
+        Ok(resized)
+    }
+
+    /// The denoised image was filtered at the current iterations at `now` (a screenshot
+    /// filtered it to save it): the display need not filter it again until it is due.
+    pub fn filtered(&mut self, now: f64) {
+        self.denoised.ran(self.renderer.samples(), now);
+    }
+
     /// Moves the camera: the image restarts.
     pub fn set_camera(&mut self, camera: Camera) -> Result<()> {
         self.renderer.set_camera(camera)?;

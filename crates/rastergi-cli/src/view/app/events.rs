@@ -63,8 +63,8 @@ impl ApplicationHandler<UserEvent> for App {
                     self.title_at = Instant::now() - Duration::from_secs(1);
                 }
                 self.measured = Measured::default();
-                self.denoised.clear();
-                self.renderer = Some((active, build));
+                // The denoiser (enabled by the build where asked) is taken up by sync_denoiser.
+                self.renderer = Some((Interactive::new(active, self.controls.show, self.controls.exposure), build));
                 if let Some(run) = &mut self.script {
                     run.last = Instant::now();
                 }
@@ -199,14 +199,14 @@ impl ApplicationHandler<UserEvent> for App {
                     // size-dependent passes of the photon map renderer are rebuilt.
                     let size = (wanted.settings.width, wanted.settings.height);
                     match &mut self.renderer {
-                        Some((Active::PhotonMap(r), built)) if same_but_size(built, &wanted) => {
-                            self.resized_at = None;
-                            if let Err(e) = r.resize(size.0, size.1) {
-                                return self.fail(event_loop, e.into());
+                        Some((view, built)) if same_but_size(built, &wanted) => match view.resize(size.0, size.1) {
+                            Ok(true) => {
+                                self.resized_at = None;
+                                *built = wanted;
                             }
-                            self.denoised.clear();
-                            *built = wanted;
-                        }
+                            Ok(false) => self.start_build(None),
+                            Err(e) => return self.fail(event_loop, e.into()),
+                        },
                         _ => self.start_build(None),
                     }
                 }

@@ -12,12 +12,11 @@ use anyhow::{Result, anyhow};
 use rastergi::camera_control::CameraControl;
 use rastergi::gather::GatherMethod;
 use rastergi::gpu::{Gpu, GpuOptions};
-use rastergi::passes::denoise;
 use rastergi::passes::display::{Presented, WindowSurface};
 use rastergi::passes::film::Show;
-use rastergi::path_tracer::PathTracer;
-use rastergi::renderer::Renderer;
+use rastergi::progressive::{Denoising, Progressive};
 use rastergi::scene::Scene;
+use rastergi::session::interactive::Interactive;
 use rastergi::settings::RenderSettings;
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
@@ -27,7 +26,7 @@ use winit::window::{Window, WindowId};
 
 use super::build::{Build, Opened, env_scale, prepare, same_but_size};
 use super::controls::{Controls, Response, SunAngles, camera_options, show_name};
-use super::frames::{Active, Rate, iterate_frame};
+use super::frames::{Rate, iterate_frame};
 use super::keys::key_of;
 use super::panel::{self, Figures, Panel, PanelPainter, PanelState};
 use super::screenshots::Screenshots;
@@ -40,9 +39,12 @@ const RESIZE_SETTLE: Duration = Duration::from_millis(150);
 /// How long a script's `resize` may wait for the window to take the new size.
 const RESIZE_TIMEOUT: Duration = Duration::from_secs(10);
 
+/// A built renderer, what it was built for, and the scene it opened (if it opened one).
+pub type Arrived = (Box<dyn Progressive>, Build, Option<Opened>);
+
 /// A renderer being built on a worker thread (with the scene it opened, if it opened one).
 pub enum UserEvent {
-    Built { generation: u64, result: Result<(Active, Build, Option<Opened>), String> },
+    Built { generation: u64, result: Result<Arrived, String> },
 }
 
 /// The live figures the panel shows, refreshed about once a second.
@@ -71,7 +73,9 @@ pub struct App {
     gpu: Option<Gpu>,
     surface: Option<WindowSurface>,
     panel: Option<Panel>,
-    renderer: Option<(Active, Build)>,
+    /// The renderer as the window shows it (the library's interactive loop), and what it was
+    /// built for.
+    renderer: Option<(Interactive, Build)>,
     /// The generation of the build in flight, if any; results of older ones are dropped.
     building: Option<u64>,
     generation: u64,
@@ -91,9 +95,7 @@ pub struct App {
     batch: u32,
     rate: Rate,
     measured: Measured,
-    /// When the denoiser last ran for the window, while the denoised image is shown since.
-    denoised: denoise::Schedule,
-    /// The origin of `denoised`'s times.
+    /// The origin of the denoiser schedule's times.
     clock: Instant,
     title_at: Instant,
     status: String,
@@ -145,7 +147,6 @@ impl App {
             batch: 1,
             rate: Rate { since: Instant::now(), count: 0, per_second: 0.0 },
             measured: Measured::default(),
-            denoised: denoise::Schedule::default(),
             clock: Instant::now(),
             title_at: Instant::now(),
             status: String::new(),
@@ -223,7 +224,7 @@ impl App {
         let denoise = self.controls.denoise;
         let proxy = self.proxy.clone();
         std::thread::spawn(move || {
-            let build = std::panic::AssertUnwindSafe(|| -> Result<(Active, Build, Option<Opened>)> {
+            let build = std::panic::AssertUnwindSafe(|| -> Result<Arrived> {
                 let (scene, opened) = match args {
                     Some(a) => {
                         let mut scene = a.load_scene()?;
@@ -252,21 +253,16 @@ impl App {
                     }
                 };
                 let scene = prepare(scene, &wanted, loaded_scale);
-                let active = match wanted.method {
-                    Method::Gather => {
-                        let mut r = Renderer::new(&gpu, &scene, wanted.settings.clone())?;
-                        // The guides from the first iteration on: nothing to restart. A failure
-                        // is reported when the viewer tries again (sync_denoiser).
-                        if denoise && let Err(e) = r.enable_denoiser() {
-                            log::warn!("the denoiser: {e}");
-                        }
-                        Active::PhotonMap(Box::new(r))
-                    }
-                    Method::Path => {
-                        Active::PathTracer(Box::new(PathTracer::new(&gpu, &scene, wanted.settings.clone())?))
-                    }
-                };
-                Ok((active, wanted, opened))
+                let (mut renderer, _) =
+                    rastergi::session::new_renderer(&gpu, &scene, wanted.settings.clone(), wanted.method, false)?;
+                // The guides from the first iteration on: nothing to restart. A failure is
+                // reported when the viewer tries again (sync_denoiser).
+                if let Some(d) = renderer.denoising_mut().filter(|_| denoise)
+                    && let Err(e) = d.enable_denoiser()
+                {
+                    log::warn!("the denoiser: {e}");
+                }
+                Ok((renderer, wanted, opened))
             });
             // A panic (wgpu reports validation errors so) must still answer, or the viewer
             // would wait forever; the panic message itself is already on stderr.
@@ -318,12 +314,10 @@ impl App {
     /// Gives the renderer the controls' camera if it has another one (restarting the image).
     fn sync_camera(&mut self) -> Result<()> {
         let camera = self.controls.camera.camera();
-        if let Some((active, _)) = &mut self.renderer {
-            let r = active.get_mut();
-            if r.camera() != camera {
-                r.set_camera(camera)?;
-                self.denoised.clear();
-            }
+        if let Some((view, _)) = &mut self.renderer
+            && view.renderer().camera() != camera
+        {
+            view.set_camera(camera)?;
         }
         Ok(())
     }
@@ -331,22 +325,17 @@ impl App {
     /// What the image shows: the controls' choice where the renderer has it, else the full image.
     fn shown(&self) -> Show {
         match &self.renderer {
-            Some((active, _)) if !active.get().has(self.controls.show) => Show::Full,
+            Some((view, _)) if !view.renderer().has(self.controls.show) => Show::Full,
             _ => self.controls.show,
         }
     }
 
-    /// The photon-map renderer while the window shows its denoised image: the denoiser asked
+    /// The renderer's denoiser while the window shows its denoised image: the denoiser asked
     /// for, its guides accumulating, the full image shown.
-    fn denoising(&self) -> Option<&Renderer> {
-        match &self.renderer {
-            Some((Active::PhotonMap(r), _))
-                if self.controls.denoise && r.denoiser_enabled() && self.shown() == Show::Full =>
-            {
-                Some(r)
-            }
-            _ => None,
-        }
+    fn denoising(&self) -> Option<&dyn Denoising> {
+        // The controls' toggle counts at once; the loop takes it up before the next iterations
+        // (sync_denoiser).
+        self.renderer.as_ref().filter(|_| self.controls.denoise).and_then(|(view, _)| view.denoising())
     }
 
     /// Turns the denoiser's guides on where the controls ask for the denoiser and the renderer
@@ -354,25 +343,23 @@ impl App {
     /// image that has iterations restarts. Where the GPU cannot hold them the toggle goes off
     /// with a warning.
     fn sync_denoiser(&mut self) {
-        if !self.controls.denoise {
+        let Some((view, _)) = &mut self.renderer else { return };
+        view.show = self.controls.show;
+        if view.denoise() == self.controls.denoise {
             return;
         }
-        let Some((Active::PhotonMap(r), _)) = &mut self.renderer else { return };
-        if r.denoiser_enabled() {
-            return;
-        }
-        match r.enable_denoiser() {
+        let had = view.renderer().samples() > 0;
+        match view.set_denoise(self.controls.denoise) {
             Ok(()) => {
-                if r.samples() > 0 {
+                if had && view.renderer().samples() == 0 {
                     log::info!("denoiser on: the image restarts (its guides start now)");
-                    r.reset();
                 }
-                self.denoised.clear();
             }
             Err(e) => {
                 eprintln!("warning: the denoiser cannot be turned on: {e}");
                 self.status = format!("no denoiser: {e}");
                 self.controls.denoise = false;
+                let _ = view.set_denoise(false);
             }
         }
     }
@@ -381,16 +368,10 @@ impl App {
     /// image of `show`, or the denoised one, filtered again first when it is due
     /// ([`denoise::Schedule`]).
     fn encode_resolve(&mut self, enc: &mut egui_wgpu::wgpu::CommandEncoder, show: Show) -> Result<()> {
-        let exposure = self.controls.exposure;
-        let mut schedule = self.denoised;
-        if let Some(r) = self.denoising() {
-            r.encode_denoised_view(enc, &mut schedule, self.clock.elapsed().as_secs_f64(), exposure)?;
-            self.denoised = schedule;
-        } else {
-            if let Some((active, _)) = &self.renderer {
-                active.get().encode_resolve(enc, show, exposure);
-            }
-            self.denoised.clear();
+        let now = self.clock.elapsed().as_secs_f64();
+        if let Some((view, _)) = &mut self.renderer {
+            (view.show, view.exposure) = (show, self.controls.exposure);
+            view.encode_resolve(enc, now)?;
         }
         Ok(())
     }
@@ -402,7 +383,7 @@ impl App {
             self.status = "no image yet to save".into();
             return;
         };
-        let (renderer, exposure) = (active.get(), self.controls.exposure);
+        let (renderer, exposure) = (active.renderer(), self.controls.exposure);
         match self.screenshots.save(renderer, show, exposure, denoised) {
             Ok((png, exr)) => {
                 println!(
@@ -418,8 +399,8 @@ impl App {
                     camera_options(&renderer.camera())
                 );
                 // The denoiser's image now holds the current iterations' filter.
-                if denoised {
-                    self.denoised.ran(renderer.samples(), self.clock.elapsed().as_secs_f64());
+                if denoised && let Some((view, _)) = &mut self.renderer {
+                    view.filtered(self.clock.elapsed().as_secs_f64());
                 }
                 self.status = format!("saved {}", png.display());
             }
@@ -451,7 +432,7 @@ impl App {
             if !ready {
                 return;
             }
-            let samples = self.renderer.as_ref().map_or(0, |(r, _)| r.get().samples());
+            let samples = self.renderer.as_ref().map_or(0, |(r, _)| r.renderer().samples());
             let due = match step.when {
                 When::Now => true,
                 When::Iterations(n) => samples >= n,
@@ -478,7 +459,7 @@ impl App {
     /// The most iterations this frame may run: the script's next `after N iterations` must
     /// find exactly N.
     fn iteration_limit(&self) -> u32 {
-        let samples = self.renderer.as_ref().map_or(0, |(r, _)| r.get().samples());
+        let samples = self.renderer.as_ref().map_or(0, |(r, _)| r.renderer().samples());
         match &self.script {
             Some(run) if run.resizing.is_none() => match run.steps.get(run.next) {
                 Some(Step { when: When::Iterations(n), .. }) => n.saturating_sub(samples),
@@ -494,8 +475,8 @@ impl App {
     fn iterate_batch(&mut self) -> Result<()> {
         let current = self.settled();
         let limit = self.batch.min(self.iteration_limit());
-        let Some((active, _)) = self.renderer.as_mut().filter(|_| current) else { return Ok(()) };
-        let done = iterate_frame(active.get_mut(), limit, &mut self.batch)?;
+        let Some((view, _)) = self.renderer.as_mut().filter(|_| current) else { return Ok(()) };
+        let done = iterate_frame(view.renderer_mut(), limit, &mut self.batch)?;
         if done > 0 {
             self.rate.add(done);
         }
@@ -509,8 +490,8 @@ impl App {
             return Ok(());
         }
         self.measured.at = Some(Instant::now());
-        let Some((active, _)) = &self.renderer else { return Ok(()) };
-        let r = active.get();
+        let Some((view, _)) = &self.renderer else { return Ok(()) };
+        let r = view.renderer();
         let samples = r.samples();
         let history = &mut self.measured.history;
         if history.last().is_some_and(|&(n, _)| n > samples) {
@@ -563,7 +544,7 @@ impl App {
             return self.fail(event_loop, e);
         }
         let (Some(surface), Some(window)) = (&mut self.surface, &self.window) else { return };
-        let film = self.renderer.as_ref().map(|(r, _)| r.get().film());
+        let film = self.renderer.as_ref().map(|(r, _)| r.renderer().film());
         let presented = match (panel_output, &mut self.panel) {
             (Some(mut output), Some(panel)) => {
                 panel.input.handle_platform_output(window, std::mem::take(&mut output.platform_output));
@@ -596,11 +577,8 @@ impl App {
     /// Runs the panel's egui pass: its output, for drawing, and the actions its widgets gave.
     fn run_panel(&mut self) -> Option<(egui::FullOutput, Vec<Action>)> {
         let window = self.window.clone()?;
-        let renderer = self.renderer.as_ref().map(|(active, _)| active.get());
-        let photon_map = match &self.renderer {
-            Some((Active::PhotonMap(r), _)) => Some(r),
-            _ => None,
-        };
+        let renderer = self.renderer.as_ref().map(|(view, _)| view.renderer());
+        let photon_map = renderer.and_then(|r| r.photon_pass_and_gather().map(|m| (m, r.settings().photons)));
         let size = renderer.map_or(self.size, |r| (r.settings().width, r.settings().height));
         let figures = Figures {
             scene: &self.scene_name,
@@ -609,10 +587,8 @@ impl App {
             iterations_per_second: self.rate.per_second,
             error: self.measured.error,
             error_is_rough: self.measured.rough,
-            photon_pass: photon_map
-                .filter(|r| r.settings().photons > 0)
-                .map(|r| (r.photon_pass(), r.settings().photons)),
-            gather_in_use: photon_map.map(|r| r.gather_method()).filter(|&g| g != GatherMethod::Auto),
+            photon_pass: photon_map.filter(|&(_, photons)| photons > 0).map(|((pass, _), photons)| (pass, photons)),
+            gather_in_use: photon_map.map(|((_, gather), _)| gather).filter(|&g| g != GatherMethod::Auto),
             memory: self.measured.memory,
             history: &self.measured.history,
             status: &self.status,
@@ -627,7 +603,7 @@ impl App {
     }
 
     fn title(&self) -> String {
-        let samples = self.renderer.as_ref().map_or(0, |(r, _)| r.get().samples());
+        let samples = self.renderer.as_ref().map_or(0, |(r, _)| r.renderer().samples());
         format!(
             "rastergi - {} - {} iterations, {:.1}/s - {}{} - {}",
             self.scene_name,

@@ -453,48 +453,14 @@ impl Renderer {
         self.passes.film.read_display(&self.gpu, show, exposure)
     }
 
-    /// Accumulates the denoiser's guides from the next iteration on (a per-pixel pass after
-    /// the others; the image itself is unchanged) so that [`read_denoised`](Self::read_denoised),
-    /// [`read_guides`](Self::read_guides) can be called. Enable it before the first iteration:
-    /// the guides hold the iterations since (the viewer, turning it on mid-render, restarts the
-    /// image). Fails where the image's extra buffers
-    /// ([`crate::passes::denoise::LARGEST_BUFFER_PER_PIXEL`]) exceed the GPU's limits.
-    pub fn enable_denoiser(&mut self) -> Result<()> {
-        self.passes.enable_denoiser(&self.gpu, &self.scene, &self.frame)?;
-        self.denoise = true;
-        Ok(())
-    }
-
-    /// Whether the denoiser's guides are accumulated ([`enable_denoiser`](Self::enable_denoiser)).
-    pub fn denoiser_enabled(&self) -> bool {
-        self.denoise
-    }
-
     fn denoiser(&self) -> Result<&DenoisePasses> {
         self.passes.denoise.as_ref().ok_or_else(|| {
             crate::error::Error::Gpu("the denoiser was not enabled (Renderer::enable_denoiser)".to_owned())
         })
     }
 
-    /// The denoised full image ([`crate::passes::denoise`]), linear RGB.
-    pub fn read_denoised(&self, params: &DenoiseParams) -> Result<LinearImage> {
-        let d = self.denoiser()?;
-        let angle = crate::passes::denoise::pixel_angle(&self.camera, self.settings.height);
-        d.denoiser.apply(&self.gpu, (self.passes.film.samples, d.guides.samples), angle, params)
-    }
-
-    /// Encodes the denoiser into `enc` without reading it back: its output image holds the
-    /// filtered image once `enc` has run (timing; the window, with
-    /// [`encode_resolve_denoised`](Self::encode_resolve_denoised)).
-    pub fn encode_denoise(&self, enc: &mut wgpu::CommandEncoder, params: &DenoiseParams) -> Result<()> {
-        let d = self.denoiser()?;
-        let angle = crate::passes::denoise::pixel_angle(&self.camera, self.settings.height);
-        d.denoiser.encode(&self.gpu, enc, (self.passes.film.samples, d.guides.samples), angle, params);
-        Ok(())
-    }
-
     /// Encodes the resolve of the denoiser's output image (as the last
-    /// [`encode_denoise`](Self::encode_denoise) before it in submission order filtered it) at
+    /// [`encode_denoise`](Denoising::encode_denoise) before it in submission order filtered it) at
     /// `exposure` into the film's linear and display buffers, with the display encoding of
     /// [`encode_resolve`](Self::encode_resolve): what the window draws is then the denoised
     /// full image. Changing the exposure needs no new filter. No read-back.
@@ -502,45 +468,6 @@ impl Renderer {
         let d = self.denoiser()?;
         self.passes.film.encode_resolve_image(&self.gpu, enc, &d.resolve, exposure);
         Ok(())
-    }
-
-    /// What a window showing the denoised image encodes each frame (`rastergi view`, the web
-    /// page): the resolve at `exposure`, after a new filter where `schedule` says the image's
-    /// current iterations are due one at `now` (seconds, any fixed origin), which it records.
-    pub fn encode_denoised_view(
-        &self,
-        enc: &mut wgpu::CommandEncoder,
-        schedule: &mut Schedule,
-        now: f64,
-        exposure: f32,
-    ) -> Result<()> {
-        let samples = self.samples();
-        let due = schedule.due(samples, now);
-        if due {
-            self.encode_denoise(enc, &DenoiseParams::default())?;
-        }
-        self.encode_resolve_denoised(enc, exposure)?;
-        if due {
-            schedule.ran(samples, now);
-        }
-        Ok(())
-    }
-
-    /// The display encoding of the denoised full image (filtered now): 2^exposure · value,
-    /// clamped to [0,1], sRGB, 8 bits, as [`read_display`](Self::read_display) of the raw one.
-    pub fn read_display_denoised(&self, params: &DenoiseParams, exposure: f32) -> Result<DisplayImage> {
-        let mut enc =
-            self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("denoise") });
-        self.encode_denoise(&mut enc, params)?;
-        self.encode_resolve_denoised(&mut enc, exposure)?;
-        self.gpu.queue.submit([enc.finish()]);
-        self.passes.film.read_display_buffer(&self.gpu)
-    }
-
-    /// The denoiser's guide sums read back: the albedo and normal AOVs
-    /// ([`GuideState::albedo`], [`GuideState::normal`]).
-    pub fn read_guides(&self) -> Result<GuideState> {
-        self.denoiser()?.guides.read(&self.gpu)
     }
 
     /// Raw G-buffer texels `(triangle + 1, b1 bits, b2 bits, texture level of detail bits)`,
@@ -615,24 +542,39 @@ impl Progressive for Renderer {
 }
 
 impl Denoising for Renderer {
+    /// Accumulates the denoiser's guides from the next iteration on (a per-pixel pass after
+    /// the others; the image itself is unchanged) so that [`read_denoised`](Denoising::read_denoised),
+    /// [`read_guides`](Denoising::read_guides) can be called. Enable it before the first iteration:
+    /// the guides hold the iterations since (the viewer, turning it on mid-render, restarts the
+    /// image). Fails where the image's extra buffers
+    /// ([`crate::passes::denoise::LARGEST_BUFFER_PER_PIXEL`]) exceed the GPU's limits.
     fn enable_denoiser(&mut self) -> Result<()> {
-        Renderer::enable_denoiser(self)
+        self.passes.enable_denoiser(&self.gpu, &self.scene, &self.frame)?;
+        self.denoise = true;
+        Ok(())
     }
+    /// Whether the denoiser's guides are accumulated ([`enable_denoiser`](Denoising::enable_denoiser)).
     fn denoiser_enabled(&self) -> bool {
-        Renderer::denoiser_enabled(self)
+        self.denoise
     }
+    /// The denoised full image ([`crate::passes::denoise`]), linear RGB.
     fn read_denoised(&self, params: &DenoiseParams) -> Result<LinearImage> {
-        Renderer::read_denoised(self, params)
+        let d = self.denoiser()?;
+        let angle = crate::passes::denoise::pixel_angle(&self.camera, self.settings.height);
+        d.denoiser.apply(&self.gpu, (self.passes.film.samples, d.guides.samples), angle, params)
     }
-    fn read_display_denoised(&self, params: &DenoiseParams, exposure: f32) -> Result<DisplayImage> {
-        Renderer::read_display_denoised(self, params, exposure)
-    }
-    fn read_guides(&self) -> Result<GuideState> {
-        Renderer::read_guides(self)
-    }
+    /// Encodes the denoiser into `enc` without reading it back: its output image holds the
+    /// filtered image once `enc` has run (timing; the window, with
+    /// [`encode_resolve_denoised`](Self::encode_resolve_denoised)).
     fn encode_denoise(&self, enc: &mut wgpu::CommandEncoder, params: &DenoiseParams) -> Result<()> {
-        Renderer::encode_denoise(self, enc, params)
+        let d = self.denoiser()?;
+        let angle = crate::passes::denoise::pixel_angle(&self.camera, self.settings.height);
+        d.denoiser.encode(&self.gpu, enc, (self.passes.film.samples, d.guides.samples), angle, params);
+        Ok(())
     }
+    /// What a window showing the denoised image encodes each frame (`rastergi view`, the web
+    /// page): the resolve at `exposure`, after a new filter where `schedule` says the image's
+    /// current iterations are due one at `now` (seconds, any fixed origin), which it records.
     fn encode_denoised_view(
         &self,
         enc: &mut wgpu::CommandEncoder,
@@ -640,6 +582,30 @@ impl Denoising for Renderer {
         now: f64,
         exposure: f32,
     ) -> Result<()> {
-        Renderer::encode_denoised_view(self, enc, schedule, now, exposure)
+        let samples = self.samples();
+        let due = schedule.due(samples, now);
+        if due {
+            self.encode_denoise(enc, &DenoiseParams::default())?;
+        }
+        self.encode_resolve_denoised(enc, exposure)?;
+        if due {
+            schedule.ran(samples, now);
+        }
+        Ok(())
+    }
+    /// The display encoding of the denoised full image (filtered now): 2^exposure · value,
+    /// clamped to [0,1], sRGB, 8 bits, as [`read_display`](Self::read_display) of the raw one.
+    fn read_display_denoised(&self, params: &DenoiseParams, exposure: f32) -> Result<DisplayImage> {
+        let mut enc =
+            self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("denoise") });
+        self.encode_denoise(&mut enc, params)?;
+        self.encode_resolve_denoised(&mut enc, exposure)?;
+        self.gpu.queue.submit([enc.finish()]);
+        self.passes.film.read_display_buffer(&self.gpu)
+    }
+    /// The denoiser's guide sums read back: the albedo and normal AOVs
+    /// ([`GuideState::albedo`], [`GuideState::normal`]).
+    fn read_guides(&self) -> Result<GuideState> {
+        self.denoiser()?.guides.read(&self.gpu)
     }
 }

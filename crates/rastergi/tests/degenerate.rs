@@ -14,6 +14,7 @@ use rastergi::environment::Environment;
 use rastergi::gather::{GatherDirections, GatherMethod, HitLight};
 use rastergi::image_io::validate_finite;
 use rastergi::passes::film::Show;
+use rastergi::progressive::Denoising;
 use rastergi::scene::{Camera, Light, Material, Scene};
 use rastergi::settings::RenderSettings;
 

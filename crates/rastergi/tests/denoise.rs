@@ -7,6 +7,7 @@ use rastergi::image_io::LinearImage;
 use rastergi::metrics::{Comparison, compare, emitter_mask, rmse};
 use rastergi::passes::denoise::{DenoiseParams, Denoiser, EXTRA_SLOTS, GUIDE_SLOTS, cpu};
 use rastergi::passes::film::{COMPONENTS, Show};
+use rastergi::progressive::Denoising;
 use rastergi::renderer::Renderer;
 use rastergi::sampling::{pcg_hash, unit_f32};
 use rastergi::scene::cornell_box;

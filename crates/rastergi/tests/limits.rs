@@ -7,6 +7,7 @@ mod common;
 
 use glam::Vec3;
 use rastergi::path_tracer::PathTracer;
+use rastergi::progressive::Denoising;
 use rastergi::renderer::Renderer;
 use rastergi::scene::{Material, Scene, cornell_box};
 use rastergi::settings::RenderSettings;

@@ -4,6 +4,7 @@
 use anyhow::Result;
 use clap::Args;
 use rastergi::passes::denoise::DenoiseParams;
+use rastergi::progressive::Denoising;
 use rastergi::renderer::Renderer;
 use rastergi::settings::RenderSettings;
 

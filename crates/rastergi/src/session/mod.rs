@@ -28,7 +28,7 @@ use crate::gather::{GatherDirections, GatherMethod, HitLight};
 use crate::gpu::{Gpu, GpuOptions};
 use crate::passes::film::Show;
 use crate::path_tracer::PathTracer;
-use crate::progressive::Progressive;
+use crate::progressive::{Denoising, Progressive};
 use crate::renderer::Renderer;
 use crate::scene::{Light, Scene};
 use crate::settings::{PhotonRegionChoice, RenderSettings, TextureFilter};

@@ -50,8 +50,6 @@ struct Options {
     method: Method,
     /// The sun (the scene's last distant light).
     sun: Option<SunAngles>,
-    /// Show the denoised full image (the photon-map renderer's denoiser).
-    denoise: bool,
 }
 
 /// The renderer of a page: the device, the canvas, the scene and its progressive image.
@@ -112,7 +110,6 @@ pub async fn create_viewer(
         gather: GatherMethod::Trace,
         method: Method::Gather,
         sun: None,
-        denoise: false,
     };
     let scene = rastergi::scene::cornell_box();
     let renderer = build(&gpu, &scene, &options).map_err(error)?;
@@ -150,7 +147,6 @@ impl Options {
             photons: self.photons,
             gather: self.gather,
             method: self.method,
-            denoiser: self.denoise,
             ..rastergi::session::Options::default()
         }
     }
@@ -265,7 +261,6 @@ impl Viewer {
                 };
                 // A failure (its buffers beyond the device's limits) leaves the denoiser off.
                 self.view.set_denoise(on).map_err(error)?;
-                self.options.denoise = on;
                 return Ok(());
             }
             "method" => {

@@ -221,7 +221,6 @@ impl App {
             None => format!("tracing {} photons...", wanted.settings.photons),
         };
         let loaded_scale = self.args.env_scale;
-        let denoise = self.controls.denoise;
         let proxy = self.proxy.clone();
         std::thread::spawn(move || {
             let build = std::panic::AssertUnwindSafe(|| -> Result<Arrived> {
@@ -253,15 +252,10 @@ impl App {
                     }
                 };
                 let scene = prepare(scene, &wanted, loaded_scale);
-                let (mut renderer, _) =
+                // The denoiser, where asked for, is enabled by sync_denoiser before the first
+                // iteration: its guides hold them all, nothing restarts.
+                let (renderer, _) =
                     rastergi::session::new_renderer(&gpu, &scene, wanted.settings.clone(), wanted.method, false)?;
-                // The guides from the first iteration on: nothing to restart. A failure is
-                // reported when the viewer tries again (sync_denoiser).
-                if let Some(d) = renderer.denoising_mut().filter(|_| denoise)
-                    && let Err(e) = d.enable_denoiser()
-                {
-                    log::warn!("the denoiser: {e}");
-                }
                 Ok((renderer, wanted, opened))
             });
             // A panic (wgpu reports validation errors so) must still answer, or the viewer
@@ -333,9 +327,11 @@ impl App {
     /// The renderer's denoiser while the window shows its denoised image: the denoiser asked
     /// for, its guides accumulating, the full image shown.
     fn denoising(&self) -> Option<&dyn Denoising> {
-        // The controls' toggle counts at once; the loop takes it up before the next iterations
-        // (sync_denoiser).
-        self.renderer.as_ref().filter(|_| self.controls.denoise).and_then(|(view, _)| view.denoising())
+        // The controls' toggle and the shown component count at once; the loop takes them up
+        // before the next iterations (sync_denoiser) and at the resolve.
+        let shown = self.controls.denoise && self.shown() == Show::Full;
+        let (view, _) = self.renderer.as_ref().filter(|_| shown)?;
+        view.renderer().denoising().filter(|d| d.denoiser_enabled())
     }
 
     /// Turns the denoiser's guides on where the controls ask for the denoiser and the renderer
@@ -344,7 +340,6 @@ impl App {
     /// with a warning.
     fn sync_denoiser(&mut self) {
         let Some((view, _)) = &mut self.renderer else { return };
-        view.show = self.controls.show;
         if view.denoise() == self.controls.denoise {
             return;
         }

@@ -22,7 +22,7 @@
 //! `sun_aperture` (default 0.5358°), scaled so that its irradiance does not depend on the
 //! aperture: the irradiance on a surface facing it is E_c(T, η), the solar model's spectral
 //! irradiance converted to linear sRGB, interpolated linearly in turbidity and in elevation
-//! between the nodes 2°, 5°, …, 89° (clamped outside them). [`SUN_IRRADIANCE`] holds those
+//! between the nodes 2°, 5°, …, 89° (clamped outside them). [`sun_irradiance_table`] holds those
 //! nodes, read back from Mitsuba 3 by `scripts/sunsky_sun_table.py` (the solar model is not in
 //! `hw-skymodel`). At the lowest elevations the blue channel is slightly negative there
 //! (−0.0076 W/m² at T = 1, η = 2°; Mitsuba leaves it so); here it is clamped to 0.
@@ -36,7 +36,7 @@ use glam::Vec3;
 use crate::environment::{Environment, uv_to_direction};
 use crate::error::{Error, Result};
 use crate::scene::Light;
-use crate::scene::sky_sun_table::SUN_IRRADIANCE;
+use crate::scene::sky_sun_table::sun_irradiance_table;
 
 /// Mitsuba's `MI_CIE_Y_NORMALIZATION` (1 / ∫ ȳ(λ) dλ), by which its RGB `sunsky` scales the
 /// Hosek–Wilkie RGB radiance.
@@ -162,7 +162,8 @@ impl SunSky {
         }
         let t = (self.turbidity.clamp(1.0, 10.0) - 1.0).min(9.0);
         let e = ((eta.to_degrees() - 2.0) / 3.0).clamp(0.0, 29.0);
-        let node = |ti: usize, ei: usize| Vec3::from(SUN_IRRADIANCE[ti][ei]);
+        let table = sun_irradiance_table();
+        let node = |ti: usize, ei: usize| Vec3::from(table[ti][ei]);
         let (t0, e0) = ((t as usize).min(8), (e as usize).min(28));
         let (ft, fe) = (t - t0 as f32, e - e0 as f32);
         let lerp_e = |ti: usize| node(ti, e0) * (1.0 - fe) + node(ti, e0 + 1) * fe;

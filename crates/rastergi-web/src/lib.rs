@@ -24,7 +24,7 @@ use std::sync::atomic::{AtomicU32, Ordering};
 use rastergi::camera_control::{CameraControl, DRAG_RADIANS_PER_PIXEL, MoveKeys};
 use rastergi::gather::GatherMethod;
 use rastergi::gpu::{Gpu, GpuOptions};
-use rastergi::passes::display::WindowSurface;
+use rastergi::passes::display::DisplayTarget;
 use rastergi::passes::film::Show;
 use rastergi::progressive::Progressive;
 
@@ -58,7 +58,7 @@ pub struct Viewer {
     /// Kept for the device's lifetime: the browser loses a device whose instance is dropped.
     _instance: wgpu::Instance,
     gpu: Gpu,
-    surface: WindowSurface,
+    surface: DisplayTarget,
     scene_name: String,
     scene: Scene,
     /// The renderer as the canvas shows it (component, exposure, denoised image).
@@ -100,7 +100,7 @@ pub async fn create_viewer(
             rastergi::gpu::WEB_STORAGE_BUFFERS
         )));
     }
-    let surface = WindowSurface::new(&gpu, surface, canvas_width, canvas_height).map_err(error)?;
+    let surface = DisplayTarget::new(&gpu, surface, canvas_width, canvas_height).map_err(error)?;
     let options = Options {
         width,
         height,

@@ -4,7 +4,7 @@
 //! ([`crate::view::iterate_frame`]: as many as fit in [`FRAME_BUDGET`] at the last frame's
 //! time per iteration, 1 to [`MAX_BATCH`]), the resolve of the display image, the display
 //! pass and the control panel (its egui pass, tessellation and egui-wgpu drawing), into a
-//! texture of the window's size instead of a swapchain image ([`OffscreenTarget`]): nothing
+//! texture of the window's size instead of a swapchain image ([`DisplayTarget::offscreen`]): nothing
 //! is presented, so there is no vsync and the figure is what the GPU sustains. The renderer
 //! has the viewer's settings (photons and grid fitted to the scene, the photon-map view
 //! accumulated, `--gather auto`).
@@ -21,7 +21,7 @@ use rastergi::camera_control::CameraControl;
 use rastergi::fit;
 use rastergi::gather::GatherMethod;
 use rastergi::gpu::Gpu;
-use rastergi::passes::display::OffscreenTarget;
+use rastergi::passes::display::DisplayTarget;
 use rastergi::passes::film::Show;
 use rastergi::renderer::Renderer;
 use rastergi::settings::RenderSettings;
@@ -65,7 +65,7 @@ struct HeadlessPanel {
 struct Loop {
     gpu: Gpu,
     renderer: Renderer,
-    target: OffscreenTarget,
+    target: DisplayTarget,
     panel: HeadlessPanel,
     batch: u32,
 }
@@ -79,7 +79,7 @@ impl Loop {
         self.renderer.encode_resolve(&mut enc, Show::Full, 0.0);
         let film = Some(self.renderer.film());
         if !with_panel {
-            self.target.draw(&self.gpu, enc, film, &[]);
+            self.target.present(&self.gpu, enc, film, &[])?;
             return Ok(done);
         }
         let r = &self.renderer;
@@ -106,7 +106,8 @@ impl Loop {
             panel::window(ctx, &p.controls, &figures, &mut p.state);
         });
         let (gpu, ctx, painter) = (&self.gpu, &p.ctx, &mut p.painter);
-        self.target.draw_with(gpu, enc, film, &[], |enc, view, size| painter.encode(gpu, ctx, output, enc, view, size));
+        self.target
+            .present_with(gpu, enc, film, &[], |enc, view, size| painter.encode(gpu, ctx, output, enc, view, size))?;
         Ok(done)
     }
 
@@ -144,7 +145,7 @@ pub fn run(a: &FramesArgs) -> Result<()> {
     let renderer = Renderer::new(&gpu, &scene, settings)?;
     renderer.wait()?;
     let setup = start.elapsed().as_secs_f64();
-    let target = OffscreenTarget::new(&gpu, a.window.width, a.window.height)?;
+    let target = DisplayTarget::offscreen(&gpu, a.window.width, a.window.height)?;
     let painter = PanelPainter::new(&gpu.device, target.format());
     let panel = HeadlessPanel { ctx: egui::Context::default(), painter, state: PanelState::default(), controls };
     println!(

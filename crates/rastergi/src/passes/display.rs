@@ -6,7 +6,7 @@
 //! bytes as they are. A target with an `*Srgb` format (or a float format, which holds
 //! linear values) encodes whatever the shader writes, so the shader decodes first and the
 //! hardware's encode restores the film's bytes — either way the window shows exactly the
-//! bytes of the PNG screenshot. [`WindowSurface`] prefers a plain format when the surface
+//! bytes of the PNG screenshot. [`DisplayTarget`] prefers a plain format when the surface
 //! offers one.
 //!
 //! The overlay is a grid of ASCII characters drawn with the public-domain 8×8 bitmap font
@@ -16,6 +16,7 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::error::{Error, Result};
 use crate::gpu::binding::{Group, Slot};
+use crate::gpu::structs::{GpuStruct, gpu_struct};
 use crate::gpu::{Gpu, shader};
 use crate::passes::film::Film;
 
@@ -26,19 +27,25 @@ pub use wgpu::SurfaceTarget;
 pub const MAX_TEXT_COLS: usize = 96;
 pub const MAX_TEXT_ROWS: usize = 32;
 
-/// The display pass's shader (it reads no scene: nothing to compose).
-pub(crate) const SOURCE: &str = include_str!("display.wgsl");
+/// The display pass's shader (it reads no scene: its uniforms and its file).
+pub(crate) fn source() -> String {
+    [DisplayUniforms::wgsl().as_str(), include_str!("display.wgsl")].join("\n")
+}
 
-/// `Display` in `display.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub(crate) struct DisplayUniforms {
-    pub(crate) image_size: [u32; 2],
-    pub(crate) target_size: [u32; 2],
-    pub(crate) decode_srgb: u32,
-    pub(crate) text_cols: u32,
-    pub(crate) text_rows: u32,
-    pub(crate) text_scale: u32,
+gpu_struct! {
+    /// The display pass's uniforms (`display.wgsl`).
+    pub(crate) struct DisplayUniforms as "Display" {
+        /// Film size; 0×0 when there is no image yet (the background shows).
+        pub(crate) image_size: [u32; 2],
+        pub(crate) target_size: [u32; 2],
+        /// 1 when the target stores linear values (an *Srgb or float format): decode first,
+        /// so the hardware's encode restores the film's bytes.
+        pub(crate) decode_srgb: u32,
+        /// Overlay text grid: columns, rows, pixels per font texel.
+        pub(crate) text_cols: u32,
+        pub(crate) text_rows: u32,
+        pub(crate) text_scale: u32,
+    }
 }
 
 /// Whether a target of `format` needs the shader to decode sRGB: the hardware encodes on
@@ -110,7 +117,7 @@ impl DisplayPass {
     pub fn new(gpu: &Gpu, format: wgpu::TextureFormat) -> DisplayPass {
         let device = &gpu.device;
         let layout = group().layout(device);
-        let module = shader::module(device, "display", SOURCE);
+        let module = shader::module(device, "display", &source());
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("display"),
             bind_group_layouts: &[Some(&layout)],
@@ -203,7 +210,7 @@ impl DisplayPass {
     }
 }
 
-/// What became of a frame handed to [`WindowSurface::present`].
+/// What became of a frame handed to [`DisplayTarget::present`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Presented {
     Shown,
@@ -211,14 +218,29 @@ pub enum Presented {
     Skipped,
 }
 
-/// A window's surface, configured for the device, and the display pass drawing onto it.
-pub struct WindowSurface {
-    surface: wgpu::Surface<'static>,
-    config: wgpu::SurfaceConfiguration,
+/// Where the display pass draws: a window's surface (or a web page's canvas), configured for
+/// the device, or a texture of a window's size standing in for one ([`DisplayTarget::offscreen`]:
+/// `rastergi bench frames` measures the viewer's frame loop with it, the same code as a window's
+/// but for acquiring and presenting the image).
+pub struct DisplayTarget {
+    target: Target,
     pass: DisplayPass,
 }
 
-impl WindowSurface {
+enum Target {
+    Surface {
+        surface: wgpu::Surface<'static>,
+        config: wgpu::SurfaceConfiguration,
+    },
+    /// Nothing is presented, so no vsync.
+    Texture {
+        _texture: wgpu::Texture,
+        view: wgpu::TextureView,
+        size: (u32, u32),
+    },
+}
+
+impl DisplayTarget {
     /// Creates a surface for `window` on `display` (the window system's connection, which
     /// OpenGL needs at instance creation) and opens the best device that can present to it
     /// (a discrete GPU first, as [`Gpu::new`] does), with the surface configured at
@@ -230,7 +252,7 @@ impl WindowSurface {
         window: impl Into<SurfaceTarget<'static>>,
         width: u32,
         height: u32,
-    ) -> Result<(Gpu, WindowSurface)>
+    ) -> Result<(Gpu, DisplayTarget)>
     where
         D: wgpu::rwh::HasDisplayHandle + std::fmt::Debug + Send + Sync + 'static,
     {
@@ -241,7 +263,7 @@ impl WindowSurface {
             .create_surface(window)
             .map_err(|e| Error::Gpu(format!("cannot create a surface for the window: {e}")))?;
         let gpu = Gpu::open(&instance, options, Some(&surface))?;
-        let window = WindowSurface::new(&gpu, surface, width, height)?;
+        let window = DisplayTarget::new(&gpu, surface, width, height)?;
         Ok((gpu, window))
     }
 
@@ -249,7 +271,7 @@ impl WindowSurface {
     /// for `gpu`, opened for it ([`Gpu::open_async`] with the surface), at `width × height`
     /// (at least 1×1): a plain 8-bit format where the surface offers one (the shader encodes
     /// sRGB itself, [`needs_decode`]).
-    pub fn new(gpu: &Gpu, surface: wgpu::Surface<'static>, width: u32, height: u32) -> Result<WindowSurface> {
+    pub fn new(gpu: &Gpu, surface: wgpu::Surface<'static>, width: u32, height: u32) -> Result<DisplayTarget> {
         let caps = surface.get_capabilities(&gpu.adapter);
         use wgpu::TextureFormat as F;
         let format = caps
@@ -273,100 +295,12 @@ impl WindowSurface {
         surface.configure(&gpu.device, &config);
         let pass = DisplayPass::new(gpu, format);
         log::info!("window surface format {format:?} (shader sRGB decode: {})", needs_decode(format));
-        Ok(WindowSurface { surface, config, pass })
+        Ok(DisplayTarget { target: Target::Surface { surface, config }, pass })
     }
 
-    pub fn format(&self) -> wgpu::TextureFormat {
-        self.config.format
-    }
-
-    pub fn size(&self) -> (u32, u32) {
-        (self.config.width, self.config.height)
-    }
-
-    /// Reconfigures the swapchain for a new window size; zero sizes (minimised) are ignored.
-    pub fn resize(&mut self, gpu: &Gpu, width: u32, height: u32) {
-        if width == 0 || height == 0 || (width, height) == self.size() {
-            return;
-        }
-        self.config.width = width;
-        self.config.height = height;
-        self.surface.configure(&gpu.device, &self.config);
-    }
-
-    /// Submits `enc` (work the frame depends on, such as the film's resolve) followed by
-    /// drawing `film` and `overlay` onto the next swapchain image, and presents it.
-    pub fn present(
-        &mut self,
-        gpu: &Gpu,
-        enc: wgpu::CommandEncoder,
-        film: Option<&Film>,
-        overlay: &[String],
-    ) -> Result<Presented> {
-        self.present_with(gpu, enc, film, overlay, |_, _, _| {})
-    }
-
-    /// [`present`](Self::present), with `draw_over` encoding more drawing (a user interface)
-    /// over the image before it is shown: it gets the encoder, the swapchain image's view
-    /// (whose contents it must load, not clear) and its size. It is not called when no image
-    /// could be acquired.
-    pub fn present_with(
-        &mut self,
-        gpu: &Gpu,
-        mut enc: wgpu::CommandEncoder,
-        film: Option<&Film>,
-        overlay: &[String],
-        draw_over: impl FnOnce(&mut wgpu::CommandEncoder, &wgpu::TextureView, (u32, u32)),
-    ) -> Result<Presented> {
-        // Outdated: reconfigure and try once more. Suboptimal: show it, reconfigure after.
-        let mut acquired = None;
-        for _ in 0..2 {
-            match self.surface.get_current_texture() {
-                wgpu::CurrentSurfaceTexture::Success(t) => acquired = Some((t, false)),
-                wgpu::CurrentSurfaceTexture::Suboptimal(t) => acquired = Some((t, true)),
-                wgpu::CurrentSurfaceTexture::Outdated => {
-                    self.surface.configure(&gpu.device, &self.config);
-                    continue;
-                }
-                wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => {}
-                wgpu::CurrentSurfaceTexture::Lost => {
-                    return Err(Error::Gpu("the window surface was lost".into()));
-                }
-                wgpu::CurrentSurfaceTexture::Validation => {
-                    return Err(Error::Gpu("acquiring the window's next image failed validation".into()));
-                }
-            }
-            break;
-        }
-        let Some((texture, suboptimal)) = acquired else {
-            gpu.queue.submit([enc.finish()]);
-            return Ok(Presented::Skipped);
-        };
-        let view = texture.texture.create_view(&Default::default());
-        self.pass.encode(gpu, &mut enc, &view, self.size(), film, overlay);
-        draw_over(&mut enc, &view, self.size());
-        gpu.queue.submit([enc.finish()]);
-        gpu.queue.present(texture);
-        if suboptimal {
-            self.surface.configure(&gpu.device, &self.config);
-        }
-        Ok(Presented::Shown)
-    }
-}
-
-/// A window stand-in: the display pass drawing into a texture of a window's size instead of
-/// a swapchain image (nothing is presented, so no vsync). `rastergi bench frames` measures
-/// the viewer's frame loop with it.
-pub struct OffscreenTarget {
-    _texture: wgpu::Texture,
-    view: wgpu::TextureView,
-    size: (u32, u32),
-    pass: DisplayPass,
-}
-
-impl OffscreenTarget {
-    /// A `width × height` RGBA8 target (a plain format, as [`WindowSurface`] prefers).
-    pub fn new(gpu: &Gpu, width: u32, height: u32) -> Result<OffscreenTarget> {
+    /// A `width × height` RGBA8 texture standing in for a window (a plain format, as
+    /// [`new`](Self::new) prefers for a surface).
+    pub fn offscreen(gpu: &Gpu, width: u32, height: u32) -> Result<DisplayTarget> {
         gpu.check_image_size(width, height, 4)?;
         let format = wgpu::TextureFormat::Rgba8Unorm;
         let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
@@ -380,33 +314,109 @@ impl OffscreenTarget {
             view_formats: &[],
         });
         let view = texture.create_view(&Default::default());
-        Ok(OffscreenTarget { _texture: texture, view, size: (width, height), pass: DisplayPass::new(gpu, format) })
+        let target = Target::Texture { _texture: texture, view, size: (width, height) };
+        Ok(DisplayTarget { target, pass: DisplayPass::new(gpu, format) })
     }
 
-    /// What [`WindowSurface::present`] does, onto the texture: submits `enc` followed by
-    /// drawing `film` and `overlay`.
-    pub fn draw(&mut self, gpu: &Gpu, enc: wgpu::CommandEncoder, film: Option<&Film>, overlay: &[String]) {
-        self.draw_with(gpu, enc, film, overlay, |_, _, _| {});
+    /// The format of the images drawn into (a user interface drawn over them must target it).
+    pub fn format(&self) -> wgpu::TextureFormat {
+        self.pass.format()
     }
 
-    /// What [`WindowSurface::present_with`] does, onto the texture.
-    pub fn draw_with(
+    pub fn size(&self) -> (u32, u32) {
+        match &self.target {
+            Target::Surface { config, .. } => (config.width, config.height),
+            Target::Texture { size, .. } => *size,
+        }
+    }
+
+    /// Reconfigures the swapchain for a new window size; zero sizes (minimised) are ignored,
+    /// and so is any size for an offscreen target (it keeps its own).
+    pub fn resize(&mut self, gpu: &Gpu, width: u32, height: u32) {
+        if width == 0 || height == 0 || (width, height) == self.size() {
+            return;
+        }
+        if let Target::Surface { surface, config } = &mut self.target {
+            config.width = width;
+            config.height = height;
+            surface.configure(&gpu.device, config);
+        }
+    }
+
+    /// Submits `enc` (work the frame depends on, such as the film's resolve) followed by
+    /// drawing `film` and `overlay` onto the next image, and presents it.
+    pub fn present(
+        &mut self,
+        gpu: &Gpu,
+        enc: wgpu::CommandEncoder,
+        film: Option<&Film>,
+        overlay: &[String],
+    ) -> Result<Presented> {
+        self.present_with(gpu, enc, film, overlay, |_, _, _| {})
+    }
+
+    /// [`present`](Self::present), with `draw_over` encoding more drawing (a user interface)
+    /// over the image before it is shown: it gets the encoder, the image's view (whose
+    /// contents it must load, not clear) and its size. It is not called when no image could
+    /// be acquired.
+    pub fn present_with(
         &mut self,
         gpu: &Gpu,
         mut enc: wgpu::CommandEncoder,
         film: Option<&Film>,
         overlay: &[String],
         draw_over: impl FnOnce(&mut wgpu::CommandEncoder, &wgpu::TextureView, (u32, u32)),
-    ) {
-        self.pass.encode(gpu, &mut enc, &self.view, self.size, film, overlay);
-        draw_over(&mut enc, &self.view, self.size);
+    ) -> Result<Presented> {
+        let size = self.size();
+        let (surface, config) = match &mut self.target {
+            Target::Surface { surface, config } => (surface, config),
+            Target::Texture { view, .. } => {
+                self.pass.encode(gpu, &mut enc, view, size, film, overlay);
+                draw_over(&mut enc, view, size);
+                gpu.queue.submit([enc.finish()]);
+                return Ok(Presented::Shown);
+            }
+        };
+        let Some((texture, suboptimal)) = acquire(gpu, surface, config)? else {
+            gpu.queue.submit([enc.finish()]);
+            return Ok(Presented::Skipped);
+        };
+        let view = texture.texture.create_view(&Default::default());
+        self.pass.encode(gpu, &mut enc, &view, size, film, overlay);
+        draw_over(&mut enc, &view, size);
         gpu.queue.submit([enc.finish()]);
+        gpu.queue.present(texture);
+        if suboptimal {
+            surface.configure(&gpu.device, config);
+        }
+        Ok(Presented::Shown)
     }
+}
 
-    /// The texture's format (a user interface drawn over it must target it).
-    pub fn format(&self) -> wgpu::TextureFormat {
-        self.pass.format()
+/// The surface's next image and whether it is suboptimal (show it, reconfigure after); `None`
+/// where the window is occluded or the swapchain timed out. Outdated: reconfigure and try once
+/// more.
+fn acquire(
+    gpu: &Gpu,
+    surface: &wgpu::Surface<'static>,
+    config: &wgpu::SurfaceConfiguration,
+) -> Result<Option<(wgpu::SurfaceTexture, bool)>> {
+    for _ in 0..2 {
+        return match surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(t) => Ok(Some((t, false))),
+            wgpu::CurrentSurfaceTexture::Suboptimal(t) => Ok(Some((t, true))),
+            wgpu::CurrentSurfaceTexture::Outdated => {
+                surface.configure(&gpu.device, config);
+                continue;
+            }
+            wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => Ok(None),
+            wgpu::CurrentSurfaceTexture::Lost => Err(Error::Gpu("the window surface was lost".into())),
+            wgpu::CurrentSurfaceTexture::Validation => {
+                Err(Error::Gpu("acquiring the window's next image failed validation".into()))
+            }
+        };
     }
+    Ok(None)
 }
 
 #[cfg(test)]

@@ -20,7 +20,7 @@ impl ApplicationHandler<UserEvent> for App {
             self.size = (size.width, size.height);
         }
         let display = event_loop.owned_display_handle();
-        match WindowSurface::open(&self.gpu_options, display, window.clone(), self.size.0, self.size.1) {
+        match DisplayTarget::open(&self.gpu_options, display, window.clone(), self.size.0, self.size.1) {
             Ok((gpu, surface)) => {
                 let ctx = egui::Context::default();
                 let max_texture_side = gpu.device.limits().max_texture_dimension_2d as usize;

@@ -12,7 +12,7 @@ use anyhow::{Result, anyhow};
 use rastergi::camera_control::CameraControl;
 use rastergi::gather::GatherMethod;
 use rastergi::gpu::{Gpu, GpuOptions};
-use rastergi::passes::display::{Presented, WindowSurface};
+use rastergi::passes::display::{DisplayTarget, Presented};
 use rastergi::passes::film::Show;
 use rastergi::progressive::{Denoising, Progressive};
 use rastergi::scene::Scene;
@@ -71,7 +71,7 @@ pub struct App {
     proxy: EventLoopProxy<UserEvent>,
     window: Option<Arc<Window>>,
     gpu: Option<Gpu>,
-    surface: Option<WindowSurface>,
+    surface: Option<DisplayTarget>,
     panel: Option<Panel>,
     /// The renderer as the window shows it (the library's interactive loop), and what it was
     /// built for.

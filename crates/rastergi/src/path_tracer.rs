@@ -42,6 +42,7 @@ use bytemuck::{Pod, Zeroable};
 use crate::checkpoint::Progress;
 use crate::error::Result;
 use crate::gpu::binding::{Group, Slot};
+use crate::gpu::structs::{GpuStruct, gpu_struct};
 use crate::gpu::{Gpu, groups, shader};
 use crate::gpu_scene::GpuScene;
 use crate::image_io::{DisplayImage, LinearImage};
@@ -58,25 +59,30 @@ pub const MAX_BOUNCES: u32 = 1024;
 /// roulette may end the path.
 pub const RR_START: u32 = 1;
 
-/// `PathParams` in `path_tracer.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct PathParams {
-    /// Σ over the emissive triangles of area · (Le.r + Le.g + Le.b).
-    pub light_weight: f32,
-    pub light_count: u32,
-    pub max_bounces: u32,
-    pub rr_start: u32,
+gpu_struct! {
+    /// The path tracer's uniforms (`path_tracer.wgsl`).
+    pub struct PathParams as "PathParams" {
+        /// Σ over the emissive triangles of area · (Le.r + Le.g + Le.b), the light table's
+        /// normaliser: an emitter point with radiance Le has density (Le.r + Le.g + Le.b) / this.
+        pub light_weight: f32,
+        pub light_count: u32,
+        /// Scattering events after which a path ends regardless of Russian roulette.
+        pub max_bounces: u32,
+        /// Russian roulette decides from the scattering event with this index (0 = primary
+        /// hit) on.
+        pub rr_start: u32,
+    }
 }
 
 /// The path tracer's composed shader.
 pub fn source() -> String {
     shader::compose(&[
+        &PathParams::wgsl(),
         shader::SAMPLING,
         shader::SCENE,
         shader::BVH,
-        shader::FRAME,
-        shader::FILM,
+        &crate::passes::frame::wgsl(),
+        crate::passes::FILM,
         include_str!("path_tracer.wgsl"),
     ])
 }
@@ -168,32 +174,6 @@ impl PathTracer {
         })
     }
 
-    pub fn settings(&self) -> &RenderSettings {
-        &self.settings
-    }
-
-    pub fn camera(&self) -> Camera {
-        self.camera
-    }
-
-    /// Iterations (paths per pixel) accumulated since the last reset.
-    pub fn samples(&self) -> u32 {
-        self.film.samples
-    }
-
-    /// Moves the camera; the image starts converging again.
-    pub fn set_camera(&mut self, camera: Camera) -> Result<()> {
-        camera.validate()?;
-        self.camera = camera;
-        self.reset();
-        Ok(())
-    }
-
-    /// Discards the accumulated iterations.
-    pub fn reset(&mut self) {
-        self.film.clear(&self.gpu);
-    }
-
     /// The uniforms of `iteration`: exactly the rasterizer's jittered view-projection
     /// (`Renderer`'s near plane, which the rays do not depend on) and its inverse.
     fn uniforms(&self, iteration: u32) -> (FrameUniforms, PathParams) {
@@ -235,31 +215,6 @@ impl PathTracer {
         }
         self.gpu.queue.submit([enc.finish()]);
         self.film.samples += 1;
-    }
-
-    /// Blocks until the submitted iterations have finished on the GPU.
-    pub fn wait(&self) -> Result<()> {
-        self.gpu.wait()
-    }
-
-    /// The film: the radiance sums in its full component (for drawing it in a window).
-    pub fn film(&self) -> &Film {
-        &self.film
-    }
-
-    /// The film's sums and their odd half, read back (checkpoints, the error estimate).
-    pub fn film_state(&self) -> Result<crate::passes::film::FilmState> {
-        self.film.read_state(&self.gpu)
-    }
-
-    /// Continues from a checkpoint's film: the next iteration is the one after its last.
-    pub fn resume(&mut self, film: &crate::passes::film::FilmState) -> Result<()> {
-        self.film.restore(&self.gpu, film)
-    }
-
-    /// Encodes the resolve of the image at `exposure` into the film's linear and display buffers.
-    pub fn encode_resolve(&self, enc: &mut wgpu::CommandEncoder, exposure: f32) {
-        self.film.encode_resolve(&self.gpu, enc, Show::Full, exposure);
     }
 
     /// The mean radiance so far, linear RGB.
@@ -312,35 +267,41 @@ impl Progressive for PathTracer {
         "rastergi path tracer"
     }
     fn settings(&self) -> &RenderSettings {
-        PathTracer::settings(self)
+        &self.settings
     }
     fn iterate(&mut self) -> Result<()> {
         PathTracer::iterate(self);
         Ok(())
     }
     fn wait(&self) -> Result<()> {
-        PathTracer::wait(self)
+        self.gpu.wait()
     }
+    /// Iterations (paths per pixel) accumulated since the last reset.
     fn samples(&self) -> u32 {
-        PathTracer::samples(self)
+        self.film.samples
     }
     fn camera(&self) -> Camera {
-        PathTracer::camera(self)
+        self.camera
     }
     fn set_camera(&mut self, camera: Camera) -> Result<()> {
-        PathTracer::set_camera(self, camera)
+        camera.validate()?;
+        self.camera = camera;
+        self.reset();
+        Ok(())
     }
     fn reset(&mut self) {
-        PathTracer::reset(self)
+        self.film.clear(&self.gpu);
     }
+    /// The film: the radiance sums in its full component.
     fn film(&self) -> &Film {
-        PathTracer::film(self)
+        &self.film
     }
+    /// Only [`Show::Full`]: the path tracer does not split the image.
     fn has(&self, show: Show) -> bool {
         show == Show::Full
     }
     fn encode_resolve(&self, enc: &mut wgpu::CommandEncoder, _show: Show, exposure: f32) {
-        PathTracer::encode_resolve(self, enc, exposure)
+        self.film.encode_resolve(&self.gpu, enc, Show::Full, exposure);
     }
     fn read_linear(&self, _show: Show) -> Result<LinearImage> {
         PathTracer::read_linear(self)
@@ -352,9 +313,10 @@ impl Progressive for PathTracer {
         Progress::default()
     }
     fn film_state(&self) -> Result<FilmState> {
-        PathTracer::film_state(self)
+        self.film.read_state(&self.gpu)
     }
+    /// Continues from a checkpoint's film: the next iteration is the one after its last.
     fn resume(&mut self, _progress: &Progress, film: &FilmState) -> Result<()> {
-        PathTracer::resume(self, film)
+        self.film.restore(&self.gpu, film)
     }
 }

@@ -1,18 +1,6 @@
 // Reference path tracer (path_tracer.rs): one path per pixel per iteration, next-event
 // estimation and BSDF sampling combined by multiple importance sampling (power heuristic).
 
-// `PathParams` in path_tracer.rs.
-struct PathParams {
-    // Σ over the emissive triangles of area · (Le.r + Le.g + Le.b), the light table's
-    // normaliser: an emitter point with radiance Le has density (Le.r + Le.g + Le.b) / this.
-    light_weight: f32,
-    light_count: u32,
-    // Scattering events after which a path ends regardless of Russian roulette.
-    max_bounces: u32,
-    // Russian roulette decides from the scattering event with this index (0 = primary hit) on.
-    rr_start: u32,
-}
-
 // Film: component 0 of the accumulation receives the whole radiance estimate.
 @group(2) @binding(0) var<storage, read_write> film: array<vec4f>;
 @group(2) @binding(1) var<uniform> params: PathParams;

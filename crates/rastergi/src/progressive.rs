@@ -8,7 +8,7 @@ use crate::checkpoint::Progress;
 use crate::error::Result;
 use crate::gather::GatherMethod;
 use crate::image_io::{DisplayImage, LinearImage};
-use crate::passes::denoise::{DenoiseParams, GuideState, Schedule};
+use crate::passes::denoise::{DenoiseParams, GuideState};
 use crate::passes::film::{Film, FilmState, Show};
 use crate::scene::Camera;
 use crate::settings::RenderSettings;
@@ -86,13 +86,10 @@ pub trait Denoising {
     fn read_guides(&self) -> Result<GuideState>;
     /// Encodes the filter without reading it back (timing).
     fn encode_denoise(&self, enc: &mut wgpu::CommandEncoder, params: &DenoiseParams) -> Result<()>;
-    /// Encodes the resolve of the denoised image for display at `exposure`, filtering again
-    /// first where `schedule` says it is due at `now` (seconds).
-    fn encode_denoised_view(
-        &self,
-        enc: &mut wgpu::CommandEncoder,
-        schedule: &mut Schedule,
-        now: f64,
-        exposure: f32,
-    ) -> Result<()>;
+    /// Encodes the resolve of the denoiser's output image (as the last
+    /// [`encode_denoise`](Denoising::encode_denoise) before it in submission order filtered it)
+    /// at `exposure` into the film's linear and display buffers, with the display encoding of
+    /// [`Progressive::encode_resolve`]: what a window draws is then the denoised full image.
+    /// Changing the exposure needs no new filter.
+    fn encode_resolve_denoised(&self, enc: &mut wgpu::CommandEncoder, exposure: f32) -> Result<()>;
 }

@@ -9,7 +9,7 @@ use crate::gather::{DirectionSampler, GatherDirections, GatherMethod, GatherPass
 use crate::gpu::Gpu;
 use crate::gpu_scene::GpuScene;
 use crate::image_io::{DisplayImage, LinearImage};
-use crate::passes::denoise::{DenoiseParams, Denoiser, GuideState, Guides, Schedule};
+use crate::passes::denoise::{DenoiseParams, Denoiser, GuideState, Guides};
 use crate::passes::film::{Film, FilmState, ImageResolve, Show};
 use crate::passes::frame::{FrameBinding, FrameUniforms, pixel_jitter};
 use crate::passes::gbuffer::{GBufferPass, PixelPass};
@@ -459,17 +459,6 @@ impl Renderer {
         })
     }
 
-    /// Encodes the resolve of the denoiser's output image (as the last
-    /// [`encode_denoise`](Denoising::encode_denoise) before it in submission order filtered it) at
-    /// `exposure` into the film's linear and display buffers, with the display encoding of
-    /// [`encode_resolve`](Self::encode_resolve): what the window draws is then the denoised
-    /// full image. Changing the exposure needs no new filter. No read-back.
-    pub fn encode_resolve_denoised(&self, enc: &mut wgpu::CommandEncoder, exposure: f32) -> Result<()> {
-        let d = self.denoiser()?;
-        self.passes.film.encode_resolve_image(&self.gpu, enc, &d.resolve, exposure);
-        Ok(())
-    }
-
     /// Raw G-buffer texels `(triangle + 1, b1 bits, b2 bits, texture level of detail bits)`,
     /// row by row (for tests and tools).
     pub fn read_gbuffer(&self) -> Result<Vec<[u32; 4]>> {
@@ -572,25 +561,9 @@ impl Denoising for Renderer {
         d.denoiser.encode(&self.gpu, enc, (self.passes.film.samples, d.guides.samples), angle, params);
         Ok(())
     }
-    /// What a window showing the denoised image encodes each frame (`rastergi view`, the web
-    /// page): the resolve at `exposure`, after a new filter where `schedule` says the image's
-    /// current iterations are due one at `now` (seconds, any fixed origin), which it records.
-    fn encode_denoised_view(
-        &self,
-        enc: &mut wgpu::CommandEncoder,
-        schedule: &mut Schedule,
-        now: f64,
-        exposure: f32,
-    ) -> Result<()> {
-        let samples = self.samples();
-        let due = schedule.due(samples, now);
-        if due {
-            self.encode_denoise(enc, &DenoiseParams::default())?;
-        }
-        self.encode_resolve_denoised(enc, exposure)?;
-        if due {
-            schedule.ran(samples, now);
-        }
+    fn encode_resolve_denoised(&self, enc: &mut wgpu::CommandEncoder, exposure: f32) -> Result<()> {
+        let d = self.denoiser()?;
+        self.passes.film.encode_resolve_image(&self.gpu, enc, &d.resolve, exposure);
         Ok(())
     }
     /// The display encoding of the denoised full image (filtered now): 2^exposure · value,

@@ -9,6 +9,7 @@ mod common;
 use glam::Vec3;
 use rastergi::environment::Environment;
 use rastergi::passes::film::Show;
+use rastergi::progressive::Progressive;
 use rastergi::scene::Scene;
 use rastergi::scene::generate::sunroom;
 use rastergi::settings::{PhotonRegionChoice, RenderSettings};

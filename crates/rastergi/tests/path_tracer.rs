@@ -12,6 +12,7 @@ use rastergi::image_io::LinearImage;
 use rastergi::metrics::{compare, emitter_mask, masked_mean, rmse};
 use rastergi::passes::frame::pixel_jitter;
 use rastergi::path_tracer::PathTracer;
+use rastergi::progressive::Progressive;
 use rastergi::renderer::Renderer;
 use rastergi::scene::{Camera, Material, Scene, cornell_box};
 use rastergi::settings::RenderSettings;

@@ -30,6 +30,7 @@ use rastergi::image_io::LinearImage;
 use rastergi::metrics::{compare, emitter_mask, masked_mean, rmse};
 use rastergi::passes::film::Show;
 use rastergi::path_tracer::PathTracer;
+use rastergi::progressive::Progressive;
 use rastergi::renderer::Renderer;
 use rastergi::scene::Scene;
 use rastergi::scene::generate::atrium;

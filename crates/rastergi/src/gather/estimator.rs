@@ -27,42 +27,46 @@ use glam::{Vec2, Vec3};
 use super::MAX_DIRECTIONS;
 use crate::error::Result;
 use crate::gpu::binding::{Group, Slot};
+use crate::gpu::structs::{GpuStruct, gpu_struct};
 use crate::gpu::{Gpu, shader};
 use crate::gpu_scene::GpuScene;
 use crate::passes::film::Film;
 use crate::passes::frame::FrameBinding;
 use crate::passes::gbuffer::GBufferPass;
 use crate::photons::gpu::GpuPhotonMap;
-use crate::photons::map::LOOKUP_WGSL;
 
-/// `struct Gather` in WGSL.
-pub const UNIFORMS: &str = include_str!("uniforms.wgsl");
+/// The gather's uniforms in WGSL (`struct Gather`, [`GatherUniforms`]), read by the ray-view
+/// raster stages and the estimator passes.
+pub fn uniforms_wgsl() -> String {
+    GatherUniforms::wgsl()
+}
+
 /// `ray_view_texel` and `plane_distance` in WGSL, for the raster gathers' estimator passes.
 pub const RAY_VIEW_LOOKUP: &str = include_str!("ray_view_lookup.wgsl");
 
-/// `Gather` in `uniforms.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct GatherUniforms {
-    /// Raster: the ray view of `direction`.
-    pub view_proj: [[f32; 4]; 4],
-    /// Raster: the direction being rasterized.
-    pub direction: [f32; 3],
-    pub bundle: u32,
-    /// Directions this iteration: each estimate is weighted 1/count.
-    pub count: u32,
-    /// Trace: 1 where each pixel draws its own directions ([`PixelSamples`]), else 0.
-    pub per_pixel: u32,
-    /// Trace, per-pixel: [`PixelSamples::key`].
-    pub pixel_key: u32,
-    /// The sample index of the iteration's first direction, i·K: direction k has index
-    /// `first_index + k` (its per-pixel Sobol' point, its light sample at the hit).
-    pub first_index: u32,
-    /// Raster: the index among the iteration's directions of the ray view's.
-    pub current: u32,
-    pub _pad: [u32; 3],
-    /// Trace, shared directions: all the iteration's directions (xyz).
-    pub directions: [[f32; 4]; MAX_DIRECTIONS as usize],
+gpu_struct! {
+    /// The gather's uniforms (`struct Gather` in WGSL).
+    pub struct GatherUniforms as "Gather" {
+        /// Raster: the ray view of `direction`.
+        pub view_proj: [[f32; 4]; 4] as "mat4x4f",
+        /// Raster: the direction being rasterized.
+        pub direction: [f32; 3],
+        pub bundle: u32,
+        /// Directions this iteration: each estimate is weighted 1/count.
+        pub count: u32,
+        /// Trace: 1 where each pixel draws its own directions ([`PixelSamples`]), else 0.
+        pub per_pixel: u32,
+        /// Trace, per-pixel: [`PixelSamples::key`].
+        pub pixel_key: u32,
+        /// The sample index of the iteration's first direction, i·K: direction k has index
+        /// `first_index + k` (its per-pixel Sobol' point, its light sample at the hit).
+        pub first_index: u32,
+        /// Raster: the index among the iteration's directions of the ray view's.
+        pub current: u32,
+        pub _pad: [u32; 3],
+        /// Trace, shared directions: all the iteration's directions (xyz).
+        pub directions: [[f32; 4]; MAX_DIRECTIONS as usize] as "array<vec4f, MAX_DIRECTIONS>",
+    }
 }
 
 /// One gather direction of an iteration: ω and the ray view's sub-texel offset.
@@ -87,9 +91,10 @@ pub struct PixelSamples {
 /// The composed shader of an estimator pass: the scene prelude, the visible point, the film
 /// writes, the photon-map lookup, the uniforms, the estimator and `pieces`.
 pub fn estimate_source(pieces: &[&str]) -> String {
-    let mut all = vec![LOOKUP_WGSL, UNIFORMS, include_str!("estimator.wgsl")];
+    let (lookup, uniforms) = (crate::photons::gpu::lookup_wgsl(), uniforms_wgsl());
+    let mut all = vec![lookup.as_str(), &uniforms, include_str!("estimator.wgsl")];
     all.extend_from_slice(pieces);
-    shader::per_pixel(&all)
+    crate::passes::per_pixel(&all)
 }
 
 /// An estimate pass's bind group 2: the gather's uniforms and the G-buffer (bindings 0 and 1,

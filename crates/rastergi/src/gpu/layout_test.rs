@@ -9,6 +9,7 @@ use std::mem::{offset_of, size_of};
 use std::path::Path;
 
 use crate::gpu::binding::{Group, Kind};
+use crate::gpu::structs::GpuStruct;
 
 use crate::bvh::wide::WideNode;
 use crate::environment::GpuEnvironment;
@@ -42,26 +43,21 @@ macro_rules! twin {
     };
 }
 
+/// The twin of a struct declared once by [`crate::gpu::structs::gpu_struct!`]: its generated WGSL
+/// declaration is checked as a hand-written one would be.
+fn generated<T: GpuStruct>() -> Twin {
+    let members = T::members().into_iter().filter(|m| m.pad_lanes == 0);
+    Twin {
+        rust: std::any::type_name::<T>(),
+        wgsl: T::WGSL_NAME,
+        size: size_of::<T>(),
+        fields: members.map(|m| (m.name, m.offset)).collect(),
+    }
+}
+
 fn twins() -> Vec<Twin> {
     vec![
-        twin!(
-            FrameUniforms,
-            "Frame",
-            [
-                view_proj,
-                inv_view_proj,
-                eye,
-                iteration,
-                resolution,
-                seed,
-                light_samples,
-                ray_epsilon,
-                gather_count,
-                gather_importance,
-                eye_chains,
-                texture_footprint
-            ]
-        ),
+        generated::<FrameUniforms>(),
         twin!(
             GpuEnvironment,
             "Environment",
@@ -115,57 +111,15 @@ fn twins() -> Vec<Twin> {
             "PunctualLight",
             [position, kind, direction, cos_outer, intensity, cos_inner, disc_centre, disc_radius]
         ),
-        twin!(
-            GatherUniforms,
-            "Gather",
-            [view_proj, direction, bundle, count, per_pixel, pixel_key, first_index, current, directions]
-        ),
-        twin!(
-            PhotonParams,
-            "PhotonParams",
-            [
-                grid,
-                aim,
-                first_photon,
-                batch_size,
-                seed,
-                inv_photon_count,
-                quantum,
-                ray_epsilon,
-                max_bounces,
-                groups_x,
-                mask,
-                max_probe,
-                pass_index,
-                sep_mask,
-                sep_max_probe,
-                first_deposit
-            ]
-        ),
-        twin!(PhotonGridUniforms, "PhotonGrid", [grid, mask, max_probe, sep_mask, sep_max_probe, indirect_only]),
-        twin!(GridLevels, "GridLevels", [origin, cell, dims, factor, fine_lo, fine_cell, fine_hi, fine_base]),
-        twin!(ResolveUniforms, "Resolve", [resolution, samples, show, scale]),
-        twin!(
-            crate::passes::denoise::DenoiseUniforms,
-            "Denoise",
-            [
-                resolution,
-                samples,
-                guide_samples,
-                step,
-                sigma_l,
-                sigma_n,
-                sigma_z,
-                pixel_angle,
-                radius_direct,
-                radius_indirect,
-                sigma_g,
-                ridge
-            ]
-        ),
-        twin!(DisplayUniforms, "Display", [image_size, target_size, decode_srgb, text_cols, text_rows, text_scale]),
-        twin!(TrianglePlane, "TrianglePlane", [normal, offset, bins]),
-        twin!(PathParams, "PathParams", [light_weight, light_count, max_bounces, rr_start]),
+        generated::<GatherUniforms>(),
+        generated::<PhotonParams>(),
+        generated::<PhotonGridUniforms>(),
+        generated::<GridLevels>(),
+        generated::<ResolveUniforms>(),
+        generated::<crate::passes::denoise::DenoiseUniforms>(),
+        generated::<DisplayUniforms>(),
+        generated::<TrianglePlane>(),
+        generated::<PathParams>(),
         twin!(crate::bsdf::albedo::GpuGgxAlbedo, "GgxAlbedoTable", [cells, means, glass]),
         twin!(crate::rays::GpuRay, "Ray", [origin, dir, skip_any]),
         twin!(crate::rays::GpuRayHit, "RayHit", [t, tri, b1, b2]),
@@ -189,7 +143,7 @@ fn shaders() -> Vec<(&'static str, String)> {
         ("film half", include_str!("../passes/film_half.wgsl").to_string()),
         ("denoiser guides", crate::passes::denoise::guides_source()),
         ("denoiser", crate::passes::denoise::filter_source()),
-        ("display", crate::passes::display::SOURCE.to_string()),
+        ("display", crate::passes::display::source()),
         ("path tracer", crate::path_tracer::source()),
         ("rays", crate::rays::source()),
     ]

@@ -15,6 +15,7 @@ pub mod limits;
 mod pipeline;
 pub mod profile;
 pub(crate) mod shader;
+pub mod structs;
 
 pub use buffers::block_on;
 pub use pipeline::*;

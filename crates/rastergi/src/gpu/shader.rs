@@ -1,5 +1,6 @@
 //! WGSL composition: a pass's shader is the shared sources (constants, sampling, scene, BVH
-//! traversal, per-frame uniforms, visible points, film writes) followed by the pass's own file.
+//! traversal; the passes add the per-frame uniforms, visible points and film writes,
+//! [`crate::passes::per_pixel`]) followed by the pass's own file.
 //! WGSL resolves module-scope names in any order, so the pieces are simply concatenated.
 //!
 //! Constants that Rust and WGSL share are written once, in Rust: [`constants`] generates
@@ -61,11 +62,6 @@ pub const BVH: &str = concat!(include_str!("../bvh/bvh.wgsl"), "\n", include_str
 pub const TRAVERSE_COMPUTE: &str = include_str!("../bvh/bvh_compute.wgsl");
 /// The hardware path's `traverse`: a ray query over the scene's TLAS (`accel.rs`).
 pub const TRAVERSE_HARDWARE: &str = include_str!("bvh_hardware.wgsl");
-pub const FRAME: &str = include_str!("../passes/frame.wgsl");
-/// The G-buffer texel → visible point decode (`visible_point`), for per-pixel passes.
-pub const VISIBLE_POINT: &str = include_str!("../passes/visible_point.wgsl");
-/// Film writes by component (`film_add`), for passes that bind `film`.
-pub const FILM: &str = include_str!("../passes/film.wgsl");
 
 /// WGSL declarations of the constants Rust and WGSL share, from their Rust values.
 pub fn constants() -> String {
@@ -146,18 +142,6 @@ pub fn constants() -> String {
 pub fn compose(pieces: &[&str]) -> String {
     let constants = constants();
     std::iter::once(constants.as_str()).chain(pieces.iter().copied()).collect::<Vec<_>>().join("\n")
-}
-
-/// The common prelude of every pass that reads the scene, then `pass`.
-pub fn with_scene(pass: &str) -> String {
-    compose(&[SAMPLING, SCENE, BVH, FRAME, pass])
-}
-
-/// The prelude of a per-pixel pass over the G-buffer that adds to the film, then `pieces`.
-pub fn per_pixel(pieces: &[&str]) -> String {
-    let mut all = vec![SAMPLING, SCENE, BVH, FRAME, VISIBLE_POINT, FILM];
-    all.extend_from_slice(pieces);
-    compose(&all)
 }
 
 /// `source` (a composed shader) for ray path `path`: unchanged for the compute path; for the

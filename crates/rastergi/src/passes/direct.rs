@@ -70,7 +70,7 @@ pub fn light_sample_uniforms(seed: u32, x: u32, y: u32, j: u32, lights: &LightTa
 
 /// The pass's composed shader.
 pub fn source() -> String {
-    shader::per_pixel(&[GBUFFER_FILM_WGSL, include_str!("direct.wgsl")])
+    crate::passes::per_pixel(&[GBUFFER_FILM_WGSL, include_str!("direct.wgsl")])
 }
 
 /// The direct pass. Reads: scene, frame, G-buffer. Adds to: the film's direct component.

@@ -2,19 +2,6 @@
 // sRGB-encoded by resolve.wgsl — onto a window's surface, with a text overlay on top.
 // One full-screen triangle; each fragment looks up its image pixel and overlay glyph.
 
-struct Display {
-    // Film size; 0×0 when there is no image yet (the background shows).
-    image_size: vec2u,
-    target_size: vec2u,
-    // 1 when the target stores linear values (an *Srgb or float format): decode first,
-    // so the hardware's encode restores the film's bytes.
-    decode_srgb: u32,
-    // Overlay text grid: columns, rows, pixels per font texel.
-    text_cols: u32,
-    text_rows: u32,
-    text_scale: u32,
-}
-
 @group(0) @binding(0) var<uniform> params: Display;
 // One packed RGBA8 (pack4x8unorm) sRGB pixel per element, row 0 at the top.
 @group(0) @binding(1) var<storage, read> image: array<u32>;

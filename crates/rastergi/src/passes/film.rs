@@ -42,6 +42,7 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::error::Result;
 use crate::gpu::binding::{Group, Slot};
+use crate::gpu::structs::{GpuStruct, gpu_struct};
 use crate::gpu::{Gpu, compute_pipeline, groups, shader};
 use crate::image_io::{DisplayImage, LinearImage};
 
@@ -80,21 +81,22 @@ impl Show {
     }
 }
 
-/// `Resolve` in `resolve.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub(crate) struct ResolveUniforms {
-    pub(crate) resolution: [u32; 2],
-    pub(crate) samples: u32,
-    pub(crate) show: u32,
-    /// 2^exposure.
-    pub(crate) scale: f32,
-    pub(crate) _pad: [u32; 3],
+gpu_struct! {
+    /// The resolve's uniforms (`resolve.wgsl`).
+    pub(crate) struct ResolveUniforms as "Resolve" {
+        pub(crate) resolution: [u32; 2],
+        pub(crate) samples: u32,
+        /// 0 full, 1 direct, 2 indirect, 3 photon-map view.
+        pub(crate) show: u32,
+        /// 2^exposure.
+        pub(crate) scale: f32,
+        pub(crate) _pad: [u32; 3],
+    }
 }
 
 /// The resolve pass's composed shader.
 pub fn resolve_source() -> String {
-    shader::compose(&[include_str!("resolve.wgsl")])
+    shader::compose(&[&ResolveUniforms::wgsl(), include_str!("resolve.wgsl")])
 }
 
 pub struct Film {

@@ -6,39 +6,46 @@ use glam::{Mat4, Vec2, Vec3};
 
 use crate::gpu::Gpu;
 use crate::gpu::binding::{Group, Slot};
+use crate::gpu::structs::{GpuStruct, gpu_struct};
 use crate::gpu_scene::GpuScene;
 use crate::sampling::{pcg_hash, sobol_owen_2d, stream, unit_f32};
 use crate::scene::{Aabb, Camera};
 
-/// `Frame` in `frame.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct FrameUniforms {
-    /// World → clip, including this iteration's sub-pixel jitter.
-    pub view_proj: [[f32; 4]; 4],
-    /// Its inverse (camera rays: `camera_ray` in `frame.wgsl`).
-    pub inv_view_proj: [[f32; 4]; 4],
-    pub eye: [f32; 3],
-    pub iteration: u32,
-    pub resolution: [u32; 2],
-    pub seed: u32,
-    pub light_samples: u32,
-    /// Minimum hit distance and origin offset of secondary rays.
-    pub ray_epsilon: f32,
-    /// The final gather's directions per pixel this iteration (0: no gather), and 1 where each
-    /// visible point draws them from its own scattering (per-pixel: cosine-distributed on a
-    /// Lambertian surface, by the BSDF elsewhere) rather than uniform on the hemisphere
-    /// (shared): the gather's escaping rays and the direct pass's environment samples are
-    /// combined by multiple importance sampling (`env_gather_weight`, `gather_density`).
-    pub gather_count: u32,
-    pub gather_importance: u32,
-    /// 1 where the eye's specular chains ran this iteration ([`crate::passes::specular`]): the visible
-    /// points are read through `eye_paths`.
-    pub eye_chains: u32,
-    /// 1 where the eye's visible points read textures at their footprint's level of detail,
-    /// 0 where at level 0 ([`crate::settings::TextureFilter`]).
-    pub texture_footprint: u32,
-    pub _pad: [u32; 3],
+gpu_struct! {
+    /// The per-iteration uniforms (bind group 1, `frame.wgsl`).
+    pub struct FrameUniforms as "Frame" {
+        /// World → clip, including this iteration's sub-pixel jitter.
+        pub view_proj: [[f32; 4]; 4] as "mat4x4f",
+        /// Its inverse (camera rays: `camera_ray` in `frame.wgsl`).
+        pub inv_view_proj: [[f32; 4]; 4] as "mat4x4f",
+        pub eye: [f32; 3],
+        pub iteration: u32,
+        pub resolution: [u32; 2],
+        pub seed: u32,
+        pub light_samples: u32,
+        /// Minimum hit distance and origin offset of secondary rays.
+        pub ray_epsilon: f32,
+        /// The final gather's directions per pixel this iteration (0: no gather), and 1 where each
+        /// visible point draws them from its own scattering (per-pixel: cosine-distributed on a
+        /// Lambertian surface, by the BSDF elsewhere) rather than uniform on the hemisphere
+        /// (shared): the gather's escaping rays and the direct pass's environment samples are
+        /// combined by multiple importance sampling (`env_gather_weight`, `gather_density`).
+        pub gather_count: u32,
+        pub gather_importance: u32,
+        /// 1 where the eye's specular chains ran this iteration ([`crate::passes::specular`]): the visible
+        /// points are read through `eye_paths`.
+        pub eye_chains: u32,
+        /// 1 where the eye's visible points read textures at their footprint's level of detail,
+        /// 0 where at level 0 ([`crate::settings::TextureFilter`]).
+        pub texture_footprint: u32,
+        pub _pad: [u32; 3],
+    }
+}
+
+/// The per-iteration uniforms' WGSL: [`FrameUniforms`]' declaration, then `frame.wgsl` (its
+/// bindings and the camera and random-stream helpers every pass of an iteration uses).
+pub fn wgsl() -> String {
+    [FrameUniforms::wgsl().as_str(), include_str!("frame.wgsl")].join("\n")
 }
 
 impl FrameUniforms {

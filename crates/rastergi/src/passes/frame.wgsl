@@ -1,26 +1,5 @@
 // Per-iteration uniforms, bind group 1 (frame.rs).
 
-struct Frame {
-    view_proj: mat4x4f,
-    inv_view_proj: mat4x4f,
-    eye: vec3f,
-    iteration: u32,
-    resolution: vec2u,
-    seed: u32,
-    light_samples: u32,
-    ray_epsilon: f32,
-    // The gather's directions per pixel this iteration (0: none) and whether each point draws
-    // them from its own scattering (1: per-pixel directions, gather_direction) or they are
-    // uniform on the hemisphere (0: shared directions).
-    gather_count: u32,
-    gather_importance: u32,
-    // 1: the eye's specular chains ran (specular.wgsl); read visible points via eye_paths.
-    eye_chains: u32,
-    // 1: the eye's visible points read textures at their footprint's level of detail; 0: at
-    // level 0 (RenderSettings::texture_filter).
-    texture_footprint: u32,
-}
-
 @group(1) @binding(0) var<uniform> frame: Frame;
 // Per pixel, written by the specular chains (specular.wgsl) where frame.eye_chains is set:
 // [3p] the origin of the ray that found the visible point (w = 1 where a chain replaced the

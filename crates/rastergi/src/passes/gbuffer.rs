@@ -18,7 +18,7 @@ use crate::photons::gpu::GpuPhotonMap;
 
 /// The pass's composed shader.
 pub fn source() -> String {
-    shader::with_scene(include_str!("gbuffer.wgsl"))
+    crate::passes::with_scene(include_str!("gbuffer.wgsl"))
 }
 
 pub const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;

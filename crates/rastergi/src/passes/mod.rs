@@ -23,9 +23,29 @@ use glam::{Vec2, Vec3};
 
 use crate::error::Result;
 use crate::gpu::Gpu;
+use crate::gpu::shader::{self, BVH, SAMPLING, SCENE};
 use crate::gpu_scene::GpuScene;
 use crate::passes::frame::FrameBinding;
 use crate::photons::gpu::GpuPhotonMap;
+
+/// The G-buffer texel → visible point decode (`visible_point`), for per-pixel passes.
+pub const VISIBLE_POINT: &str = include_str!("visible_point.wgsl");
+/// Film writes by component (`film_add`), for passes that bind `film`.
+pub const FILM: &str = include_str!("film.wgsl");
+
+/// The common prelude of every pass that reads the scene (its bind group 0) and the frame
+/// (bind group 1, [`frame::wgsl`]), then `pass`.
+pub fn with_scene(pass: &str) -> String {
+    shader::compose(&[SAMPLING, SCENE, BVH, &frame::wgsl(), pass])
+}
+
+/// The prelude of a per-pixel pass over the G-buffer that adds to the film, then `pieces`.
+pub fn per_pixel(pieces: &[&str]) -> String {
+    let frame = frame::wgsl();
+    let mut all = vec![SAMPLING, SCENE, BVH, frame.as_str(), VISIBLE_POINT, FILM];
+    all.extend_from_slice(pieces);
+    shader::compose(&all)
+}
 
 /// What every pass of one iteration reads besides its own resources.
 pub struct FrameContext<'a> {

@@ -8,11 +8,14 @@ use crate::passes::film::Film;
 use crate::passes::frame::FrameBinding;
 use crate::passes::gbuffer::{GBUFFER_FILM_WGSL, GBufferPass, GroupThree, PixelPass, PixelShader};
 use crate::photons::gpu::GpuPhotonMap;
-use crate::photons::map::LOOKUP_WGSL;
 
 /// The pass's composed shader.
 pub fn source() -> String {
-    shader::per_pixel(&[GBUFFER_FILM_WGSL, LOOKUP_WGSL, include_str!("photon_view.wgsl")])
+    crate::passes::per_pixel(&[
+        GBUFFER_FILM_WGSL,
+        &crate::photons::gpu::lookup_wgsl(),
+        include_str!("photon_view.wgsl"),
+    ])
 }
 
 /// What a photon-view [`pass`] adds to the film.

@@ -2,17 +2,6 @@
 // or a linear image that is already a mean, such as the denoiser's, → the same two
 // (`resolve_image`, with `film` bound to that image: one vec4 per pixel).
 
-struct Resolve {
-    resolution: vec2u,
-    samples: u32,
-    // 0 full, 1 direct, 2 indirect, 3 photon-map view.
-    show: u32,
-    scale: f32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
-}
-
 @group(0) @binding(0) var<uniform> params: Resolve;
 @group(0) @binding(1) var<storage, read> film: array<vec4f>;
 @group(0) @binding(2) var<storage, read_write> linear_out: array<vec4f>;

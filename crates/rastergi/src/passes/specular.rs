@@ -20,7 +20,7 @@ use crate::passes::gbuffer::{GBUFFER_FILM_WGSL, GBufferPass, GroupThree, PixelPa
 
 /// The pass's composed shader.
 pub fn source() -> String {
-    shader::per_pixel(&[GBUFFER_FILM_WGSL, include_str!("specular.wgsl")])
+    crate::passes::per_pixel(&[GBUFFER_FILM_WGSL, include_str!("specular.wgsl")])
 }
 
 /// The specular-chain pass. Reads: scene, frame, G-buffer. Writes: the eye paths. Adds to: the

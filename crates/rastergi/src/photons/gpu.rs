@@ -17,11 +17,12 @@
 use bytemuck::{Pod, Zeroable};
 use glam::UVec3;
 
-use super::map::{GridSpec, MAX_SEPARATORS, MapLayout, PhotonMap, Separator, TABLE_WGSL, TrianglePlane};
+use super::map::{GridSpec, MAX_SEPARATORS, MapLayout, PhotonMap, Separator, TrianglePlane};
 use super::{MAX_BOUNCES, PhotonSettings};
 use crate::error::Result;
 use crate::gpu::binding::{Group, Slot};
 use crate::gpu::profile::compute_pass;
+use crate::gpu::structs::{GpuStruct, gpu_struct};
 use crate::gpu::{Gpu, shader};
 use crate::gpu_scene::GpuScene;
 use crate::surface::PreparedScene;
@@ -32,21 +33,23 @@ const QUANTUM_BITS: u32 = 24;
 const BATCH: u32 = 1 << 20;
 const WORKGROUP: u32 = 64;
 
-/// `GridLevels` in `table.wgsl`: a [`GridSpec`]'s two levels.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct GridLevels {
-    pub origin: [f32; 3],
-    pub cell: f32,
-    pub dims: [u32; 3],
-    /// Fine cells per coarse cell and axis; 1: no fine level.
-    pub factor: u32,
-    /// The refined coarse cells, fine_lo ..< fine_hi, and the fine cells' side.
-    pub fine_lo: [u32; 3],
-    pub fine_cell: f32,
-    pub fine_hi: [u32; 3],
-    /// The index of the first fine cell (after every coarse one).
-    pub fine_base: u32,
+gpu_struct! {
+    /// A [`GridSpec`]'s two levels (read by `table.wgsl`): coarse cells of side `cell` from
+    /// `origin`, `dims` per axis; the coarse cells fine_lo ..< fine_hi split into factor³ cells
+    /// of side fine_cell, indexed from fine_base (factor 1: none).
+    pub struct GridLevels as "GridLevels" {
+        pub origin: [f32; 3],
+        pub cell: f32,
+        pub dims: [u32; 3],
+        /// Fine cells per coarse cell and axis; 1: no fine level.
+        pub factor: u32,
+        /// The refined coarse cells, fine_lo ..< fine_hi, and the fine cells' side.
+        pub fine_lo: [u32; 3],
+        pub fine_cell: f32,
+        pub fine_hi: [u32; 3],
+        /// The index of the first fine cell (after every coarse one).
+        pub fine_base: u32,
+    }
 }
 
 impl From<&GridSpec> for GridLevels {
@@ -65,53 +68,68 @@ impl From<&GridSpec> for GridLevels {
     }
 }
 
-/// `PhotonParams` in `trace.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub(crate) struct PhotonParams {
-    pub(crate) grid: GridLevels,
-    /// Where sun and sky photons are aimed: (centre, radius), radius 0 for nowhere.
-    pub(crate) aim: [f32; 4],
-    pub(crate) first_photon: u32,
-    pub(crate) batch_size: u32,
-    pub(crate) seed: u32,
-    pub(crate) inv_photon_count: f32,
-    /// Fixed-point units per watt: 2²⁴ / Φ_max.
-    pub(crate) quantum: f32,
-    pub(crate) ray_epsilon: f32,
-    pub(crate) max_bounces: u32,
-    pub(crate) groups_x: u32,
-    /// Table capacity − 1.
-    pub(crate) mask: u32,
-    pub(crate) max_probe: u32,
-    /// The photon pass: the second key of every photon's random stream.
-    pub(crate) pass_index: u32,
-    /// The separators' table: capacity − 1 and the longest probe.
-    pub(crate) sep_mask: u32,
-    pub(crate) sep_max_probe: u32,
-    /// The first bounce that deposits: 0, or 1 for a map of indirect light only.
-    pub(crate) first_deposit: u32,
-    pub(crate) _pad: [u32; 2],
+gpu_struct! {
+    /// The photon tracer's uniforms (`trace.wgsl`).
+    pub(crate) struct PhotonParams as "PhotonParams" {
+        pub(crate) grid: GridLevels,
+        /// Where sun and sky photons are aimed: (centre, radius), radius 0 for nowhere.
+        pub(crate) aim: [f32; 4],
+        pub(crate) first_photon: u32,
+        pub(crate) batch_size: u32,
+        pub(crate) seed: u32,
+        pub(crate) inv_photon_count: f32,
+        /// Fixed-point units per watt: 2²⁴ / Φ_max.
+        pub(crate) quantum: f32,
+        pub(crate) ray_epsilon: f32,
+        pub(crate) max_bounces: u32,
+        pub(crate) groups_x: u32,
+        /// Table capacity − 1 and the longest probe of any slot (`table.wgsl`).
+        pub(crate) mask: u32,
+        pub(crate) max_probe: u32,
+        /// The photon pass: the second key of every photon's random stream.
+        pub(crate) pass_index: u32,
+        /// The separators' table: capacity − 1 and the longest probe.
+        pub(crate) sep_mask: u32,
+        pub(crate) sep_max_probe: u32,
+        /// The first bounce that deposits: 0, or 1 for a map of indirect light only.
+        pub(crate) first_deposit: u32,
+        pub(crate) _pad: [u32; 2],
+    }
 }
 
-/// `PhotonGrid` in `map.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct PhotonGridUniforms {
-    pub grid: GridLevels,
-    /// Table capacity − 1, the longest probe, and the same for the separators' table.
-    pub mask: u32,
-    pub max_probe: u32,
-    pub sep_mask: u32,
-    pub sep_max_probe: u32,
-    /// 1 where the map holds indirect irradiance only (deposits from the second surface on).
-    pub indirect_only: u32,
-    pub _pad: [u32; 3],
+gpu_struct! {
+    /// The photon map's lookup uniforms (`map.wgsl`, bind group 3 of the passes that read the
+    /// map).
+    pub struct PhotonGridUniforms as "PhotonGrid" {
+        pub grid: GridLevels,
+        /// Table capacity − 1, the longest probe, and the same for the separators' table.
+        pub mask: u32,
+        pub max_probe: u32,
+        pub sep_mask: u32,
+        pub sep_max_probe: u32,
+        /// 1 where the map holds indirect irradiance only (deposits from the second surface on).
+        pub indirect_only: u32,
+        pub _pad: [u32; 3],
+    }
+}
+
+/// The slot table's search in WGSL (`table.wgsl`: `find_slot`, the twin of
+/// [`super::map::SlotTable::find`]), after the structs it reads. The GPU needs no bins: it reads
+/// every triangle's plane keys.
+pub fn table_wgsl() -> String {
+    [GridLevels::wgsl().as_str(), &TrianglePlane::wgsl(), include_str!("table.wgsl")].join("\n")
+}
+
+/// The map's lookup in WGSL (`photon_irradiance`, bind group 3, `map/map.wgsl`), after the
+/// table's search and the lookup's uniforms.
+pub fn lookup_wgsl() -> String {
+    [table_wgsl().as_str(), &PhotonGridUniforms::wgsl(), include_str!("map/map.wgsl")].join("\n")
 }
 
 /// The photon tracer's composed shader (`trace.wgsl`: the trace and resolve kernels).
 pub fn trace_source() -> String {
-    shader::compose(&[shader::SAMPLING, shader::SCENE, shader::BVH, TABLE_WGSL, include_str!("trace.wgsl")])
+    let (table, params) = (table_wgsl(), PhotonParams::wgsl());
+    shader::compose(&[shader::SAMPLING, shader::SCENE, shader::BVH, &table, &params, include_str!("trace.wgsl")])
 }
 
 /// Bytes per table entry on the GPU while rendering (key 8, lookup value 16) and, while the

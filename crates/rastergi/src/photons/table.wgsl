@@ -5,15 +5,6 @@
 
 const NO_SLOT: u32 = 0xffffffffu;
 
-// A triangle's plane (photons::map::TrianglePlane): front normal, n·v0, the bins of both sides.
-struct TrianglePlane {
-    normal: vec3f,
-    offset: f32,
-    bins: vec2u,
-    _pad0: u32,
-    _pad1: u32,
-}
-
 // The plane key of side `back` of `plane` in the cell centred at `centre` with side `cell`
 // (TrianglePlane::key): the bin, and the distance from the centre to the plane in steps of
 // OFFSET_STEP cells, rounded as floor(d + 1/2).
@@ -29,20 +20,6 @@ fn plane_key(plane: TrianglePlane, centre: vec3f, cell: f32, back: bool) -> u32 
 // The centre of cell c of a grid at `origin` with cells of side `cell`.
 fn cell_centre(origin: vec3f, cell: f32, c: vec3u) -> vec3f {
     return origin + (vec3f(c) + 0.5) * cell;
-}
-
-// The photon grid's two levels (photons::map::GridSpec): coarse cells of side `cell` from
-// `origin`, `dims` per axis; the coarse cells fine_lo ..< fine_hi split into factor³ cells of
-// side fine_cell, indexed from fine_base (factor 1: none).
-struct GridLevels {
-    origin: vec3f,
-    cell: f32,
-    dims: vec3u,
-    factor: u32,
-    fine_lo: vec3u,
-    fine_cell: f32,
-    fine_hi: vec3u,
-    fine_base: u32,
 }
 
 // One level's cells (photons::map::Lattice): coordinates lo ..= hi, indices from base.
@@ -90,11 +67,13 @@ fn slot_hash(cell: u32, plane: u32) -> u32 {
     return pcg_hash(cell ^ pcg_hash(plane));
 }
 
-// The entry of slot (cell, plane), NO_SLOT if the map has none; `mask` = capacity − 1.
-fn find_slot(cell: u32, plane: u32, mask: u32, max_probe: u32) -> u32 {
+// The entry of key (cell, plane) in the open-addressed table of `slot_keys` that starts at
+// entry `base`, NO_SLOT if the table has none; `mask` = its capacity − 1, `max_probe` its
+// longest probe (linear probing from the key's hash).
+fn find_entry(cell: u32, plane: u32, base: u32, mask: u32, max_probe: u32) -> u32 {
     var i = slot_hash(cell, plane) & mask;
     for (var probe = 0u; probe < max_probe; probe++) {
-        let k = slot_keys[i];
+        let k = slot_keys[base + i];
         if k.x == cell && k.y == plane {
             return i;
         }
@@ -104,6 +83,11 @@ fn find_slot(cell: u32, plane: u32, mask: u32, max_probe: u32) -> u32 {
         i = (i + 1u) & mask;
     }
     return NO_SLOT;
+}
+
+// The entry of slot (cell, plane), NO_SLOT if the map has none; `mask` = capacity − 1.
+fn find_slot(cell: u32, plane: u32, mask: u32, max_probe: u32) -> u32 {
+    return find_entry(cell, plane, 0u, mask, max_probe);
 }
 
 // The separators of a base slot (photons::map::Separators): a point's region has bit k set
@@ -126,16 +110,5 @@ fn region_of(r: SeparatorRecord, p: vec3f) -> u32 {
 // the separators' table, which follows the slots' in `slot_keys` (from entry `base`, the
 // slots' capacity: one binding for both, under WebGPU's 10 storage buffers per stage).
 fn find_separators(cell: u32, plane: u32, base: u32, mask: u32, max_probe: u32) -> u32 {
-    var i = slot_hash(cell, plane) & mask;
-    for (var probe = 0u; probe < max_probe; probe++) {
-        let k = slot_keys[base + i];
-        if k.x == cell && k.y == plane {
-            return i;
-        }
-        if k.x == NO_SLOT {
-            return NO_SLOT;
-        }
-        i = (i + 1u) & mask;
-    }
-    return NO_SLOT;
+    return find_entry(cell, plane, base, mask, max_probe);
 }

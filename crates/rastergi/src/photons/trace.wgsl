@@ -2,32 +2,6 @@
 // fixed-point counters per (slot, channel); then resolve the counters into the slots' lookup
 // values. Draw for draw the twin of photons/cpu.rs.
 
-struct PhotonParams {
-    grid: GridLevels,
-    // Where sun and sky photons are aimed: (centre, radius), radius 0 for nowhere.
-    aim: vec4f,
-    first_photon: u32,
-    batch_size: u32,
-    seed: u32,
-    inv_photon_count: f32,
-    quantum: f32,
-    ray_epsilon: f32,
-    max_bounces: u32,
-    groups_x: u32,
-    // Table capacity − 1 and the longest probe of any slot (table.wgsl).
-    mask: u32,
-    max_probe: u32,
-    // The photon pass: the second key of every photon's stream.
-    pass_index: u32,
-    // The separators' table: capacity − 1 and the longest probe.
-    sep_mask: u32,
-    sep_max_probe: u32,
-    // The first bounce that deposits: 0, or 1 for a map of indirect light only.
-    first_deposit: u32,
-    _pad1: u32,
-    _pad2: u32,
-}
-
 @group(1) @binding(0) var<uniform> params: PhotonParams;
 // Per channel (one binding each, so a large grid fits the per-binding limit) and slot two
 // words: (low, high) of the 64-bit fixed-point sum.

@@ -4,7 +4,7 @@
 //! iterations, or time) and resolved for display in between.
 
 use crate::error::Result;
-use crate::passes::denoise::Schedule;
+use crate::passes::denoise::{DenoiseParams, Schedule};
 use crate::passes::film::Show;
 use crate::progressive::{Denoising, Progressive};
 use crate::scene::Camera;
@@ -107,10 +107,16 @@ impl Interactive {
     /// the shown component, or the denoised full image, filtered again first when the schedule
     /// says so at `now` (seconds from any fixed origin).
     pub fn encode_resolve(&mut self, enc: &mut wgpu::CommandEncoder, now: f64) -> Result<()> {
-        let mut schedule = self.denoised;
+        let samples = self.renderer.samples();
+        let due = self.denoised.due(samples, now);
         if let Some(r) = self.denoising() {
-            r.encode_denoised_view(enc, &mut schedule, now, self.exposure)?;
-            self.denoised = schedule;
+            if due {
+                r.encode_denoise(enc, &DenoiseParams::default())?;
+            }
+            r.encode_resolve_denoised(enc, self.exposure)?;
+            if due {
+                self.denoised.ran(samples, now);
+            }
         } else {
             let show = if self.renderer.has(self.show) { self.show } else { Show::Full };
             self.renderer.encode_resolve(enc, show, self.exposure);

@@ -11,6 +11,7 @@ use base64::Engine as _;
 use rastergi::gpu::{Gpu, GpuOptions};
 use rastergi::image_io::{LinearImage, read_exr};
 use rastergi::passes::film::Show;
+use rastergi::progressive::Progressive;
 use rastergi::renderer::Renderer;
 use rastergi::scene::Scene;
 use rastergi::settings::RenderSettings;

@@ -83,6 +83,7 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::error::Result;
 use crate::gpu::binding::{Group, Slot};
+use crate::gpu::structs::{GpuStruct, gpu_struct};
 use crate::gpu::{Gpu, compute_pipeline, groups, shader};
 use crate::gpu_scene::GpuScene;
 use crate::image_io::LinearImage;
@@ -201,23 +202,30 @@ impl Default for DenoiseParams {
     }
 }
 
-/// `Denoise` in `denoise.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub(crate) struct DenoiseUniforms {
-    pub(crate) resolution: [u32; 2],
-    pub(crate) samples: u32,
-    pub(crate) guide_samples: u32,
-    pub(crate) step: u32,
-    pub(crate) sigma_l: f32,
-    pub(crate) sigma_n: f32,
-    pub(crate) sigma_z: f32,
-    pub(crate) pixel_angle: f32,
-    pub(crate) radius_direct: u32,
-    pub(crate) radius_indirect: u32,
-    pub(crate) sigma_g: f32,
-    pub(crate) ridge: f32,
-    pub(crate) _pad: [u32; 3],
+gpu_struct! {
+    /// The filter's uniforms, one buffer per dispatch (`denoise.wgsl`).
+    pub(crate) struct DenoiseUniforms as "Denoise" {
+        pub(crate) resolution: [u32; 2],
+        /// Iterations in the film's sums and in the guides' (fewer after a resume).
+        pub(crate) samples: u32,
+        pub(crate) guide_samples: u32,
+        /// The à-trous level's step in pixels.
+        pub(crate) step: u32,
+        /// The edge-stopping functions' widths ([`DenoiseParams`]).
+        pub(crate) sigma_l: f32,
+        pub(crate) sigma_n: f32,
+        pub(crate) sigma_z: f32,
+        /// 2 tan(fov_y/2) / height: a pixel's angle at the image's centre.
+        pub(crate) pixel_angle: f32,
+        /// The regression's window radius in pixels, per component.
+        pub(crate) radius_direct: u32,
+        pub(crate) radius_indirect: u32,
+        /// The regression's guide weight: standard deviations of the mean at which it is 1/e.
+        pub(crate) sigma_g: f32,
+        /// The regression's ridge: a fraction of each regressor's own weighted square.
+        pub(crate) ridge: f32,
+        pub(crate) _pad: [u32; 3],
+    }
 }
 
 /// A pixel's angle at the image's centre for `camera` at `height` rows: 2 tan(fov/2)/height.
@@ -237,12 +245,12 @@ fn constants() -> String {
 
 /// The guides pass's composed shader.
 pub fn guides_source() -> String {
-    shader::per_pixel(&[GBUFFER_FILM_WGSL, &constants(), include_str!("denoise_guides.wgsl")])
+    crate::passes::per_pixel(&[GBUFFER_FILM_WGSL, &constants(), include_str!("denoise_guides.wgsl")])
 }
 
 /// The filter's composed shader.
 pub fn filter_source() -> String {
-    shader::compose(&[&constants(), include_str!("denoise.wgsl")])
+    shader::compose(&[&constants(), &DenoiseUniforms::wgsl(), include_str!("denoise.wgsl")])
 }
 
 /// The accumulated guides of a render (module notes): a per-pixel pass after the iteration's

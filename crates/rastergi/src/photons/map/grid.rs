@@ -3,6 +3,7 @@
 
 use glam::{DVec3, UVec3, Vec3};
 
+use crate::gpu::structs::gpu_struct;
 use crate::photons::table::EMPTY;
 use crate::scene::Aabb;
 
@@ -31,17 +32,18 @@ pub fn orientation_bin(n: Vec3) -> usize {
     (face * FACE_DIVISIONS + u) * FACE_DIVISIONS + v
 }
 
-/// A triangle's plane as the map keys it (`TrianglePlane` in `map.wgsl` and `trace.wgsl`).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct TrianglePlane {
-    /// The front side's unit normal.
-    pub normal: [f32; 3],
-    /// n·v₀: the plane is {x : n·x = offset}.
-    pub offset: f32,
-    /// The orientation bins of the front and back sides.
-    pub bins: [u32; 2],
-    pub _pad: [u32; 2],
+gpu_struct! {
+    /// A triangle's plane as the map keys it (read by `table.wgsl`'s `plane_key`).
+    #[derive(PartialEq)]
+    pub struct TrianglePlane as "TrianglePlane" {
+        /// The front side's unit normal.
+        pub normal: [f32; 3],
+        /// n·v₀: the plane is {x : n·x = offset}.
+        pub offset: f32,
+        /// The orientation bins of the front and back sides.
+        pub bins: [u32; 2],
+        pub _pad: [u32; 2],
+    }
 }
 
 impl TrianglePlane {

@@ -1,21 +1,6 @@
 // Photon map lookups (photons/map/), bind group 3 of the passes that read the map: per slot
 // table entry (Φ_rgb/h², A/h²), the table's keys, and every triangle's plane keys.
 
-struct PhotonGrid {
-    grid: GridLevels,
-    // Table capacity − 1 (a power of two minus one) and the longest probe of any slot; the
-    // same for the separators' table.
-    mask: u32,
-    max_probe: u32,
-    sep_mask: u32,
-    sep_max_probe: u32,
-    // 1 where the map holds indirect irradiance only: its readers add the direct part.
-    indirect_only: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
-}
-
 @group(3) @binding(0) var<storage, read> photon_slots: array<vec4f>;
 @group(3) @binding(1) var<uniform> photon_grid: PhotonGrid;
 // The slots' table keys, then the separators' (table.wgsl).

@@ -56,12 +56,6 @@ use crate::gpu::limits::{check_storage_buffer, mib};
 pub use grid::*;
 pub use layout::*;
 
-/// The slot table's search in WGSL (`find_slot`, the twin of [`SlotTable::find`]). The GPU
-/// needs no bins: it reads every triangle's plane keys.
-pub const TABLE_WGSL: &str = include_str!("../table.wgsl");
-/// The map's lookup in WGSL (`photon_irradiance`, bind group 3), with the table's search.
-pub const LOOKUP_WGSL: &str = concat!(include_str!("../table.wgsl"), "\n", include_str!("map.wgsl"));
-
 /// A photon map on the CPU: flux (RGB) and area per table entry. Built by the CPU tracer, or
 /// read back from the GPU; its lookup is the twin of `photon_irradiance` in WGSL.
 #[derive(Clone, Debug)]

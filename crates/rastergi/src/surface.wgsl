@@ -40,6 +40,26 @@ fn triangle_vertex(vi: u32) -> TriangleVertex {
     return TriangleVertex(t.v0, vec2f(0.0, 0.0), tri);
 }
 
+// A raster pass's vertex (`vs_main` of the G-buffer and of the gather's ray views): clip
+// position, and the barycentrics and triangle its fragments read; with texture coordinates
+// where the pass asks for them (the G-buffer's level of detail: their screen-space
+// derivatives), else zero.
+struct RasterVertex {
+    @builtin(position) clip: vec4f,
+    @location(0) bary: vec2f,
+    @location(1) @interpolate(flat) tri: u32,
+    @location(2) uv: vec2f,
+}
+
+fn raster_vertex(vi: u32, view_proj: mat4x4f, with_uv: bool) -> RasterVertex {
+    let v = triangle_vertex(vi);
+    var uv = vec2f(0.0);
+    if with_uv {
+        uv = surface_uv(v.tri, v.bary.x, v.bary.y);
+    }
+    return RasterVertex(view_proj * vec4f(v.pos, 1.0), v.bary, v.tri, uv);
+}
+
 fn triangle_normal(t: Triangle) -> vec3f {
     return normalize(cross(t.v1 - t.v0, t.v2 - t.v0));
 }

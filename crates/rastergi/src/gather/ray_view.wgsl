@@ -4,25 +4,14 @@
 
 @group(1) @binding(0) var<uniform> gather: Gather;
 
-struct VertexOut {
-    @builtin(position) clip: vec4f,
-    @location(0) bary: vec2f,
-    @location(1) @interpolate(flat) tri: u32,
-}
-
 @vertex
-fn vs_main(@builtin(vertex_index) vi: u32) -> VertexOut {
-    let v = triangle_vertex(vi);
-    var out: VertexOut;
-    out.clip = gather.view_proj * vec4f(v.pos, 1.0);
-    out.bary = v.bary;
-    out.tri = v.tri;
-    return out;
+fn vs_main(@builtin(vertex_index) vi: u32) -> RasterVertex {
+    return raster_vertex(vi, gather.view_proj, false);
 }
 
 // Whether the fragment is a hole of its surface (passes_through), decided the same way in the
 // count, the peel and the lists: the stream of stochastic opacity is the direction's.
-fn is_hole(in: VertexOut) -> bool {
+fn is_hole(in: RasterVertex) -> bool {
     alpha_seed = pcg_hash(gather.pixel_key ^ pcg_hash(gather.first_index + gather.current));
     return (triangles[in.tri].flags & TRIANGLE_HAS_HOLES) != 0u && passes_through(in.tri, in.bary.x, in.bary.y, 0.0);
 }
@@ -32,7 +21,7 @@ fn is_hole(in: VertexOut) -> bool {
 @group(1) @binding(2) var<storage, read_write> max_count: atomic<u32>;
 
 @fragment
-fn fs_count(in: VertexOut) -> @location(0) vec4u {
+fn fs_count(in: RasterVertex) -> @location(0) vec4u {
     if is_hole(in) {
         discard;
     }
@@ -46,7 +35,7 @@ fn fs_count(in: VertexOut) -> @location(0) vec4u {
 @group(1) @binding(1) var previous_layer: texture_2d<u32>;
 
 @fragment
-fn fs_peel(in: VertexOut) -> @location(0) vec4u {
+fn fs_peel(in: RasterVertex) -> @location(0) vec4u {
     if is_hole(in) {
         discard;
     }
@@ -65,7 +54,7 @@ fn fs_peel(in: VertexOut) -> @location(0) vec4u {
 @group(1) @binding(3) var<storage, read_write> node_count: atomic<u32>;
 
 @fragment
-fn fs_list(in: VertexOut) -> @location(0) vec4u {
+fn fs_list(in: RasterVertex) -> @location(0) vec4u {
     if is_hole(in) {
         discard;
     }

@@ -1,23 +1,9 @@
 // Eye pass (gbuffer.rs): vertices pulled from the scene's triangle buffer; each fragment
 // stores (triangle + 1, b1, b2, texture level of detail) of the nearest surface.
 
-struct VertexOut {
-    @builtin(position) clip: vec4f,
-    @location(0) bary: vec2f,
-    @location(1) @interpolate(flat) tri: u32,
-    // Texture coordinates, interpolated for their screen-space derivatives.
-    @location(2) uv: vec2f,
-}
-
 @vertex
-fn vs_main(@builtin(vertex_index) vi: u32) -> VertexOut {
-    let v = triangle_vertex(vi);
-    var out: VertexOut;
-    out.clip = frame.view_proj * vec4f(v.pos, 1.0);
-    out.bary = v.bary;
-    out.tri = v.tri;
-    out.uv = surface_uv(v.tri, v.bary.x, v.bary.y);
-    return out;
+fn vs_main(@builtin(vertex_index) vi: u32) -> RasterVertex {
+    return raster_vertex(vi, frame.view_proj, true);
 }
 
 // The level of detail comes from the texture coordinates' change to the neighbouring pixels
@@ -27,7 +13,7 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> VertexOut {
 // material lets the eye through (a cut-out's hole, stochastic opacity), the fragment is
 // discarded and the surface behind it is seen.
 @fragment
-fn fs_main(in: VertexOut) -> @location(0) vec4u {
+fn fs_main(in: RasterVertex) -> @location(0) vec4u {
     let dx = dpdx(in.uv);
     let dy = dpdy(in.uv);
     let t = triangles[in.tri];

@@ -6,30 +6,6 @@
 // p at p and of the indirect at W·H + p. The CPU twin is denoise::cpu; keep the two the same
 // operations.
 
-struct Denoise {
-    resolution: vec2u,
-    // Iterations in the film's sums and in the guides' (fewer after a resume).
-    samples: u32,
-    guide_samples: u32,
-    // The à-trous level's step in pixels.
-    step: u32,
-    sigma_l: f32,
-    sigma_n: f32,
-    sigma_z: f32,
-    // 2 tan(fov_y/2) / height: a pixel's angle at the image's centre.
-    pixel_angle: f32,
-    // The regression's window radius in pixels, per component.
-    radius_direct: u32,
-    radius_indirect: u32,
-    // The regression's guide weight: standard deviations of the mean at which it is 1/e.
-    sigma_g: f32,
-    // The regression's ridge: a fraction of each regressor's own weighted square.
-    ridge: f32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
-}
-
 @group(0) @binding(0) var<uniform> params: Denoise;
 @group(0) @binding(1) var<storage, read> film: array<vec4f>;
 @group(0) @binding(2) var<storage, read> guides: array<vec4f>;
@@ -107,28 +83,47 @@ fn guide(p: u32) -> Guide {
     return out;
 }
 
-// The variance of component c (0 direct, 1 indirect) of `src` (from_light false) or `light`
-// at pixel xy blurred by the 3×3 binomial kernel (clamped to the image).
-fn blurred_variance(xy: vec2i, c: u32, from_light: bool) -> f32 {
+const BINOMIAL3 = array<f32, 3>(0.25, 0.5, 0.25);
+
+// What `blur3` blurs, per component (direct, indirect): the luminances of `src`, the
+// variances of `src` (its w) or the variances of `light` (its w).
+const BLUR_LUMINANCE: u32 = 0u;
+const BLUR_VARIANCE: u32 = 1u;
+const BLUR_LIGHT_VARIANCE: u32 = 2u;
+
+fn blur_value(k: u32, n: u32, what: u32) -> vec2f {
+    switch what {
+        case BLUR_LUMINANCE: {
+            return vec2f(luminance(src[k].rgb), luminance(src[n + k].rgb));
+        }
+        case BLUR_VARIANCE: {
+            return vec2f(src[k].w, src[n + k].w);
+        }
+        default: {
+            return vec2f(light[k].w, light[n + k].w);
+        }
+    }
+}
+
+// `what` (direct, indirect) at pixel xy blurred by the 3×3 binomial kernel, clamped to the
+// image (the weights inside it renormalised).
+fn blur3(xy: vec2i, what: u32) -> vec2f {
     let n = pixel_count();
     let res = vec2i(params.resolution);
-    var sum = 0.0;
+    var sum = vec2f(0.0);
     var wsum = 0.0;
     for (var dy = -1; dy <= 1; dy++) {
         for (var dx = -1; dx <= 1; dx++) {
             let q = xy + vec2i(dx, dy);
             if all(q >= vec2i(0)) && all(q < res) {
                 let w = BINOMIAL3[dx + 1] * BINOMIAL3[dy + 1];
-                let k = c * n + u32(q.y * res.x + q.x);
-                sum += w * select(src[k].w, light[k].w, from_light);
+                sum += w * blur_value(u32(q.y * res.x + q.x), n, what);
                 wsum += w;
             }
         }
     }
     return sum / wsum;
 }
-
-const BINOMIAL3 = array<f32, 3>(0.25, 0.5, 0.25);
 
 // The luminance guide of the level: the luminances of `src` blurred by the 3×3 binomial
 // kernel, so that the edge-stopping compares local means, not single noisy values.
@@ -137,24 +132,9 @@ fn blur_luminance(@builtin(global_invocation_id) gid: vec3u) {
     if any(gid.xy >= params.resolution) {
         return;
     }
-    let n = pixel_count();
-    let res = vec2i(params.resolution);
-    let xy = vec2i(gid.xy);
-    var sum = vec2f(0.0);
-    var wsum = 0.0;
-    for (var dy = -1; dy <= 1; dy++) {
-        for (var dx = -1; dx <= 1; dx++) {
-            let q = xy + vec2i(dx, dy);
-            if all(q >= vec2i(0)) && all(q < res) {
-                let w = BINOMIAL3[dx + 1] * BINOMIAL3[dy + 1];
-                let k = u32(q.y * res.x + q.x);
-                sum += w * vec2f(luminance(src[k].rgb), luminance(src[n + k].rgb));
-                wsum += w;
-            }
-        }
-    }
-    lum[gid.y * params.resolution.x + gid.x] = sum / wsum;
+    lum[gid.y * params.resolution.x + gid.x] = blur3(vec2i(gid.xy), BLUR_LUMINANCE);
 }
+
 const B3 = array<f32, 5>(0.0625, 0.25, 0.375, 0.25, 0.0625);
 
 @compute @workgroup_size(8, 8)
@@ -169,8 +149,9 @@ fn atrous(@builtin(global_invocation_id) gid: vec3u) {
     let gp = guide(p);
     let ld = lum[p].x;
     let li = lum[p].y;
-    let sd = params.sigma_l * LUMINANCE_NOISE * sqrt(blurred_variance(xy, 0u, false)) + LUMINANCE_EPSILON;
-    let si = params.sigma_l * LUMINANCE_NOISE * sqrt(blurred_variance(xy, 1u, false)) + LUMINANCE_EPSILON;
+    let variance = blur3(xy, BLUR_VARIANCE);
+    let sd = params.sigma_l * LUMINANCE_NOISE * sqrt(variance.x) + LUMINANCE_EPSILON;
+    let si = params.sigma_l * LUMINANCE_NOISE * sqrt(variance.y) + LUMINANCE_EPSILON;
     var sum_d = vec3f(0.0);
     var sum_i = vec3f(0.0);
     var var_d = 0.0;
@@ -236,7 +217,7 @@ fn fit(xy: vec2i, c: u32) -> vec3f {
     let r = i32(radius);
     let bandwidth = BANDWIDTH * f32(max(radius, 1u));
     let yp = luminance(src[c * n + p].rgb);
-    let s = params.sigma_g * sqrt(blurred_variance(xy, c, true)) + LUMINANCE_EPSILON;
+    let s = params.sigma_g * sqrt(blur3(xy, BLUR_LIGHT_VARIANCE)[c]) + LUMINANCE_EPSILON;
     var ann = mat3x3f();
     var aan = mat3x4f();
     var aaa = mat4x4f();

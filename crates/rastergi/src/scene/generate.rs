@@ -206,42 +206,16 @@ pub fn glossy_room() -> Scene {
     let (lo, hi) = (Vec3::new(-2.0, 0.0, -1.5), Vec3::new(2.0, 2.5, 1.5));
     let c = |x: f32, y: f32, z: f32| Vec3::new(x, y, z);
     // The shell, facing in: floor, ceiling, back (z = lo), front (z = hi), left red, right green.
-    add_quad_facing(
-        &mut s,
-        [c(lo.x, 0.0, lo.z), c(hi.x, 0.0, lo.z), c(hi.x, 0.0, hi.z), c(lo.x, 0.0, hi.z)],
-        Vec3::Y,
-        floor,
-    );
-    add_quad_facing(
-        &mut s,
-        [c(lo.x, hi.y, lo.z), c(hi.x, hi.y, lo.z), c(hi.x, hi.y, hi.z), c(lo.x, hi.y, hi.z)],
-        -Vec3::Y,
-        white,
-    );
-    add_quad_facing(
-        &mut s,
-        [c(lo.x, 0.0, lo.z), c(hi.x, 0.0, lo.z), c(hi.x, hi.y, lo.z), c(lo.x, hi.y, lo.z)],
-        Vec3::Z,
-        white,
-    );
-    add_quad_facing(
-        &mut s,
-        [c(lo.x, 0.0, hi.z), c(hi.x, 0.0, hi.z), c(hi.x, hi.y, hi.z), c(lo.x, hi.y, hi.z)],
-        -Vec3::Z,
-        white,
-    );
-    add_quad_facing(
-        &mut s,
-        [c(lo.x, 0.0, lo.z), c(lo.x, 0.0, hi.z), c(lo.x, hi.y, hi.z), c(lo.x, hi.y, lo.z)],
-        Vec3::X,
-        red,
-    );
-    add_quad_facing(
-        &mut s,
-        [c(hi.x, 0.0, lo.z), c(hi.x, 0.0, hi.z), c(hi.x, hi.y, hi.z), c(hi.x, hi.y, lo.z)],
-        -Vec3::X,
-        green,
-    );
+    for (corners, facing, material) in [
+        ([c(lo.x, 0.0, lo.z), c(hi.x, 0.0, lo.z), c(hi.x, 0.0, hi.z), c(lo.x, 0.0, hi.z)], Vec3::Y, floor),
+        ([c(lo.x, hi.y, lo.z), c(hi.x, hi.y, lo.z), c(hi.x, hi.y, hi.z), c(lo.x, hi.y, hi.z)], -Vec3::Y, white),
+        ([c(lo.x, 0.0, lo.z), c(hi.x, 0.0, lo.z), c(hi.x, hi.y, lo.z), c(lo.x, hi.y, lo.z)], Vec3::Z, white),
+        ([c(lo.x, 0.0, hi.z), c(hi.x, 0.0, hi.z), c(hi.x, hi.y, hi.z), c(lo.x, hi.y, hi.z)], -Vec3::Z, white),
+        ([c(lo.x, 0.0, lo.z), c(lo.x, 0.0, hi.z), c(lo.x, hi.y, hi.z), c(lo.x, hi.y, lo.z)], Vec3::X, red),
+        ([c(hi.x, 0.0, lo.z), c(hi.x, 0.0, hi.z), c(hi.x, hi.y, hi.z), c(hi.x, hi.y, lo.z)], -Vec3::X, green),
+    ] {
+        add_quad_facing(&mut s, corners, facing, material);
+    }
     // The table: a top 1.4 × 0.05 × 0.8 m at 0.75 m on four legs 5 cm square.
     let (t_lo, t_hi) = (c(-1.2, 0.70, -0.9), c(0.2, 0.75, -0.1));
     add_box(&mut s, t_lo, t_hi, top);

@@ -14,37 +14,39 @@ use crate::environment::{Environment, GpuEnvironment};
 use crate::gpu::Gpu;
 use crate::gpu::binding::{Group, Slot};
 use crate::gpu::limits::check_storage_buffer;
-use crate::lights::LightEntry;
+use crate::gpu::shader;
+use crate::gpu::structs::{GpuStruct, gpu_struct};
+use crate::lights::{LightEntry, PunctualLight};
 use crate::scene::{Aabb, AlphaMode, Material, TextureRef, UvTransform};
 use crate::surface::PreparedScene;
 
-/// `Triangle` in `gpu_scene.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct GpuTriangle {
-    pub v0: [f32; 3],
-    pub material: u32,
-    pub v1: [f32; 3],
-    /// [`TRIANGLE_HAS_HOLES`] where the material may let rays through.
-    pub flags: u32,
-    pub v2: [f32; 3],
-    /// The triangle's entry in the light table where it emits, else [`NO_LIGHT`]: the density
-    /// with which light samples find its points, for multiple importance sampling.
-    pub light: u32,
+gpu_struct! {
+    /// `Triangle` in WGSL.
+    pub struct GpuTriangle as "Triangle" {
+        pub v0: [f32; 3],
+        pub material: u32,
+        pub v1: [f32; 3],
+        /// [`TRIANGLE_HAS_HOLES`] where the material may let rays through.
+        pub flags: u32,
+        pub v2: [f32; 3],
+        /// The triangle's entry in the light table where it emits, else [`NO_LIGHT`]: the density
+        /// with which light samples find its points, for multiple importance sampling.
+        pub light: u32,
+    }
 }
 
 /// [`GpuTriangle::light`] of a triangle that is not in the light table.
 pub const NO_LIGHT: u32 = u32::MAX;
 
-/// `TextureSlot` in `gpu_scene.wgsl`: a texture a material reads, its index in the texture
-/// atlas ([`NO_TEXTURE`] for none) and the rows (`u`, `v`) of its [`UvTransform`].
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct GpuTextureSlot {
-    pub u: [f32; 3],
-    pub texture: u32,
-    pub v: [f32; 3],
-    pub _pad: u32,
+gpu_struct! {
+    /// `TextureSlot` in WGSL: a texture a material reads, its index in the texture
+    /// atlas ([`NO_TEXTURE`] for none) and the rows (`u`, `v`) of its [`UvTransform`].
+    pub struct GpuTextureSlot as "TextureSlot" {
+        pub u: [f32; 3],
+        pub texture: u32,
+        pub v: [f32; 3],
+        pub _pad: u32,
+    }
 }
 
 impl GpuTextureSlot {
@@ -54,54 +56,75 @@ impl GpuTextureSlot {
     }
 }
 
-/// `Material` in `gpu_scene.wgsl`: what every surface point reads of
-/// [`crate::scene::Material`], its flags ([`MATERIAL_TWO_SIDED`], [`MATERIAL_ALPHA_MASK`],
-/// [`MATERIAL_ALPHA_BLEND`], [`MATERIAL_TEXTURED`]) and its opacity factor. Its textures are
-/// in [`GpuMaterialMaps`], read only where the flags say: loading them with every material
-/// cost 30 % of the gather on lavapipe (it gathers every word of every lane).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct GpuMaterial {
-    pub albedo: [f32; 3],
-    pub flags: u32,
-    pub emission: [f32; 3],
-    pub opacity: f32,
-    /// The scattering model ([`crate::bsdf::Bsdf`]; `Material`'s fields of the same names).
-    pub metallic: f32,
-    pub roughness: f32,
-    pub specular: f32,
-    pub ior: f32,
-    pub transmission: f32,
-    /// [`Material::medium`]: σ inside solid glass.
-    pub attenuation: [f32; 3],
-    /// [`Material::specular_color`].
-    pub specular_color: [f32; 3],
-    /// [`Material::clearcoat`], [`Material::clearcoat_roughness`].
-    pub clearcoat: f32,
-    pub clearcoat_roughness: f32,
-    pub _pad: [u32; 3],
+gpu_struct! {
+    /// `Material` in WGSL: what every surface point reads of
+    /// [`crate::scene::Material`], its flags ([`MATERIAL_TWO_SIDED`], [`MATERIAL_ALPHA_MASK`],
+    /// [`MATERIAL_ALPHA_BLEND`], [`MATERIAL_TEXTURED`]) and its opacity factor. Its textures are
+    /// in [`GpuMaterialMaps`], read only where the flags say: loading them with every material
+    /// cost 30 % of the gather on lavapipe (it gathers every word of every lane).
+    pub struct GpuMaterial as "Material" {
+        pub albedo: [f32; 3],
+        pub flags: u32,
+        pub emission: [f32; 3],
+        pub opacity: f32,
+        /// The scattering model ([`crate::bsdf::Bsdf`]; `Material`'s fields of the same names):
+        /// perceptual roughness, α = roughness².
+        pub metallic: f32,
+        pub roughness: f32,
+        pub specular: f32,
+        pub ior: f32,
+        pub transmission: f32,
+        /// [`Material::medium`]: σ inside solid glass, per channel (three floats, not a
+        /// 16-byte-aligned vector).
+        pub attenuation: [f32; 3] as "array<f32, 3>",
+        /// [`Material::specular_color`].
+        pub specular_color: [f32; 3],
+        /// [`Material::clearcoat`], [`Material::clearcoat_roughness`].
+        pub clearcoat: f32,
+        pub clearcoat_roughness: f32,
+        pub _pad: [u32; 3],
+    }
 }
 
-/// `MaterialMaps` in `gpu_scene.wgsl`: a material's textures and their parameters, at the
-/// material's index.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct GpuMaterialMaps {
-    pub alpha_cutoff: f32,
-    pub normal_scale: f32,
-    pub _pad: [u32; 2],
-    pub albedo_map: GpuTextureSlot,
-    pub emission_map: GpuTextureSlot,
-    pub opacity_map: GpuTextureSlot,
-    pub normal_map: GpuTextureSlot,
-    pub metal_rough_map: GpuTextureSlot,
-    /// transmissionTexture (R), specularTexture (A), specularColorTexture (RGB).
-    pub transmission_map: GpuTextureSlot,
-    pub specular_map: GpuTextureSlot,
-    pub specular_color_map: GpuTextureSlot,
-    /// clearcoatTexture (R), clearcoatRoughnessTexture (G).
-    pub clearcoat_map: GpuTextureSlot,
-    pub clearcoat_roughness_map: GpuTextureSlot,
+gpu_struct! {
+    /// `MaterialMaps` in WGSL: a material's textures and their parameters, at the
+    /// material's index.
+    pub struct GpuMaterialMaps as "MaterialMaps" {
+        pub alpha_cutoff: f32,
+        pub normal_scale: f32,
+        pub _pad: [u32; 2],
+        pub albedo_map: GpuTextureSlot,
+        pub emission_map: GpuTextureSlot,
+        pub opacity_map: GpuTextureSlot,
+        pub normal_map: GpuTextureSlot,
+        /// Linear: roughness × G, metallic × B.
+        pub metal_rough_map: GpuTextureSlot,
+        /// transmissionTexture (R), specularTexture (A), specularColorTexture (RGB).
+        pub transmission_map: GpuTextureSlot,
+        pub specular_map: GpuTextureSlot,
+        pub specular_color_map: GpuTextureSlot,
+        /// clearcoatTexture (R), clearcoatRoughnessTexture (G).
+        pub clearcoat_map: GpuTextureSlot,
+        pub clearcoat_roughness_map: GpuTextureSlot,
+    }
+}
+
+/// The scene's WGSL, bind group 0 of every pass that reads it: the structs it shares with Rust
+/// (generated, [`crate::gpu::structs`]), then [`shader::SCENE_FILES`]: its bindings and
+/// accessors, the point on a surface, light sampling, the textures, the environment and the
+/// BSDF.
+pub fn wgsl() -> String {
+    let structs = [
+        GpuTriangle::wgsl(),
+        GpuTextureSlot::wgsl(),
+        GpuMaterial::wgsl(),
+        GpuMaterialMaps::wgsl(),
+        GpuMaterialRecord::wgsl(),
+        WideNode::wgsl(),
+        LightEntry::wgsl(),
+        PunctualLight::wgsl(),
+    ];
+    [structs.concat().as_str(), shader::SCENE_FILES].join("\n")
 }
 
 pub use crate::gpu::consts::GpuSceneOffsets;
@@ -191,12 +214,12 @@ impl SceneData {
     }
 }
 
-/// `MaterialRecord` in `gpu_scene.wgsl`: a material and its textures, one binding for both.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct GpuMaterialRecord {
-    pub material: GpuMaterial,
-    pub maps: GpuMaterialMaps,
+gpu_struct! {
+    /// `MaterialRecord` in WGSL: a material and its textures, one binding for both.
+    pub struct GpuMaterialRecord as "MaterialRecord" {
+        pub material: GpuMaterial,
+        pub maps: GpuMaterialMaps,
+    }
 }
 
 impl GpuMaterial {

@@ -7,9 +7,10 @@
 //! through its own disc). The same table drives the photon pass (emission), the direct pass and the
 //! gather's exact hit light (light samples) and the path tracer.
 
-use bytemuck::{Pod, Zeroable};
+use bytemuck::Zeroable;
 use glam::Vec3;
 
+use crate::gpu::structs::gpu_struct;
 use crate::sampling::{cosine_hemisphere, orthonormal_basis, uniform_sphere, uniform_triangle};
 use crate::scene::{Light, Scene, triangle_area, triangle_normal};
 
@@ -19,40 +20,42 @@ pub use crate::gpu::consts::{
     AIM_FRACTION, ENVIRONMENT_LIGHT, LIGHT_DISTANT, LIGHT_POINT, LIGHT_SPOT, NEAR_FRACTION, NEAR_SCALE, PUNCTUAL_LIGHT,
 };
 
-/// One light of the distribution, as stored on the GPU (`LightEntry` in `gpu_scene.wgsl`).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
-pub struct LightEntry {
-    /// Index of the triangle in the scene, or [`PUNCTUAL_LIGHT`] | index of the punctual light.
-    pub triangle: u32,
-    /// Cumulative probability up to and including this entry.
-    pub cdf: f32,
-    /// Probability of choosing this entry.
-    pub pmf: f32,
-    /// Area of the triangle (1 for a punctual light).
-    pub area: f32,
+gpu_struct! {
+    /// One light of the distribution, as stored on the GPU (`LightEntry` in WGSL).
+    #[derive(PartialEq)]
+    pub struct LightEntry as "LightEntry" {
+        /// Index of the triangle in the scene, or [`PUNCTUAL_LIGHT`] | index of the punctual light.
+        pub triangle: u32,
+        /// Cumulative probability up to and including this entry.
+        pub cdf: f32,
+        /// Probability of choosing this entry.
+        pub pmf: f32,
+        /// Area of the triangle (1 for a punctual light).
+        pub area: f32,
+    }
 }
 
-/// A point, spot or distant light as stored on the GPU (`PunctualLight` in `gpu_scene.wgsl`).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
-pub struct PunctualLight {
-    /// Point and spot: where the light is.
-    pub position: [f32; 3],
-    /// [`LIGHT_POINT`], [`LIGHT_SPOT`] or [`LIGHT_DISTANT`].
-    pub kind: u32,
-    /// Spot: where it shines; distant: the way the light travels (unit).
-    pub direction: [f32; 3],
-    /// Spot: cos θ_o; distant: the cosine of its angular radius (1: one direction).
-    pub cos_outer: f32,
-    /// Intensity I (W/sr) or, distant, irradiance E (W/m²).
-    pub intensity: [f32; 3],
-    /// Spot: cos θ_i.
-    pub cos_inner: f32,
-    /// Distant: the centre of the scene's bounding sphere, which photons cross from a disc.
-    pub disc_centre: [f32; 3],
-    /// Distant: the photon disc's radius (the bounding sphere's, enlarged by 1 %).
-    pub disc_radius: f32,
+gpu_struct! {
+    /// A point, spot or distant light as stored on the GPU (`PunctualLight` in WGSL).
+    #[derive(PartialEq)]
+    pub struct PunctualLight as "PunctualLight" {
+        /// Point and spot: where the light is.
+        pub position: [f32; 3],
+        /// [`LIGHT_POINT`], [`LIGHT_SPOT`] or [`LIGHT_DISTANT`].
+        pub kind: u32,
+        /// Spot: where it shines; distant: the way the light travels (unit).
+        pub direction: [f32; 3],
+        /// Spot: cos θ_o; distant: the cosine of its angular radius (1: one direction).
+        pub cos_outer: f32,
+        /// Intensity I (W/sr) or, distant, irradiance E (W/m²).
+        pub intensity: [f32; 3],
+        /// Spot: cos θ_i.
+        pub cos_inner: f32,
+        /// Distant: the centre of the scene's bounding sphere, which photons cross from a disc.
+        pub disc_centre: [f32; 3],
+        /// Distant: the photon disc's radius (the bounding sphere's, enlarged by 1 %).
+        pub disc_radius: f32,
+    }
 }
 
 impl PunctualLight {
@@ -194,7 +197,7 @@ impl LightTable {
     }
 
     /// The entry whose cdf interval holds u ∈ [0,1): the first with `u < cdf`.
-    /// Mirrors `light_pick` in `gpu_scene.wgsl`.
+    /// Mirrors `light_pick` in WGSL.
     pub fn pick(&self, u: f32) -> &LightEntry {
         let i = self.entries.partition_point(|e| e.cdf <= u);
         &self.entries[i.min(self.entries.len() - 1)]

@@ -37,8 +37,6 @@
 //! The radiance is accumulated into component 0 of a [`Film`], whose other components stay
 //! zero, so the film's resolve, EXR/PNG output and display work unchanged with [`Show::Full`].
 
-use bytemuck::{Pod, Zeroable};
-
 use crate::checkpoint::Progress;
 use crate::error::Result;
 use crate::gpu::binding::{Group, Slot};
@@ -79,7 +77,7 @@ pub fn source() -> String {
     shader::compose(&[
         &PathParams::wgsl(),
         shader::SAMPLING,
-        shader::SCENE,
+        &crate::gpu_scene::wgsl(),
         shader::BVH,
         &crate::passes::frame::wgsl(),
         crate::passes::FILM,

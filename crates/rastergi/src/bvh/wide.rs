@@ -19,32 +19,34 @@
 //! compressed nodes still trace 1.07–1.23× more rays per second (`bench rays`, Cornell at 1024²,
 //! atrium and spheres:1000000 at 512², every kind; docs/performance.md).
 
-use bytemuck::{Pod, Zeroable};
+use bytemuck::Zeroable;
 use glam::{UVec4, Vec3, Vec4};
 
 use super::{Bvh, BvhNode, Hit, intersect_triangle};
+use crate::gpu::structs::gpu_struct;
 
 /// Marks an unused child slot (its count byte in [`WideNode::counts`] is `NO_CHILD & 0xff`).
 pub use crate::gpu::consts::NO_CHILD;
 /// The count byte of an unused slot.
 const NO_CHILD_BYTE: u32 = NO_CHILD & 0xff;
 
-/// A compressed node of the 4-wide tree (`WideNode` in `gpu_scene.wgsl`; module docs).
-/// Axis a's step is s_a = f32::from_bits(byte a of `exponents` << 23), and child i's box is
-/// origin[a] + byte i of lo[a] · s_a – origin[a] + byte i of hi[a] · s_a. Byte i of `counts` is
-/// 0 for an interior child (`child[i]` indexes the wide nodes), the triangle count of a leaf
-/// (triangles `child[i] ..`, BVH order), or `NO_CHILD & 0xff` for an unused slot (which the
-/// traversal skips by its count).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
-pub struct WideNode {
-    pub origin: [f32; 3],
-    pub exponents: u32,
-    pub lo: [u32; 3],
-    pub counts: u32,
-    pub hi: [u32; 3],
-    pub _pad: u32,
-    pub child: [u32; 4],
+gpu_struct! {
+    /// A compressed node of the 4-wide tree (`WideNode` in WGSL; module docs).
+    /// Axis a's step is s_a = f32::from_bits(byte a of `exponents` << 23), and child i's box is
+    /// origin[a] + byte i of lo[a] · s_a – origin[a] + byte i of hi[a] · s_a. Byte i of `counts` is
+    /// 0 for an interior child (`child[i]` indexes the wide nodes), the triangle count of a leaf
+    /// (triangles `child[i] ..`, BVH order), or `NO_CHILD & 0xff` for an unused slot (which the
+    /// traversal skips by its count).
+    #[derive(PartialEq)]
+    pub struct WideNode as "WideNode" {
+        pub origin: [f32; 3],
+        pub exponents: u32,
+        pub lo: [u32; 3],
+        pub counts: u32,
+        pub hi: [u32; 3],
+        pub _pad: u32,
+        pub child: [u32; 4],
+    }
 }
 
 /// The four bytes of `w`, lowest first.

@@ -21,14 +21,13 @@
 //! implementation) and `gather_direction` (per-pixel: the traced gather only); each of an
 //! iteration's K directions adds its estimate weighted 1/K.
 
-use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3};
 
 use super::MAX_DIRECTIONS;
 use crate::error::Result;
+use crate::gpu::Gpu;
 use crate::gpu::binding::{Group, Slot};
 use crate::gpu::structs::{GpuStruct, gpu_struct};
-use crate::gpu::{Gpu, shader};
 use crate::gpu_scene::GpuScene;
 use crate::passes::film::Film;
 use crate::passes::frame::FrameBinding;

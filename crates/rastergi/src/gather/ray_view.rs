@@ -53,8 +53,8 @@ pub fn ray_view_module(device: &wgpu::Device) -> wgpu::ShaderModule {
 
 /// The composed source of [`ray_view_module`].
 pub fn ray_view_source() -> String {
-    let uniforms = super::estimator::uniforms_wgsl();
-    shader::compose(&[shader::SAMPLING, shader::SCENE, &uniforms, include_str!("ray_view.wgsl")])
+    let (scene, uniforms) = (crate::gpu_scene::wgsl(), super::estimator::uniforms_wgsl());
+    shader::compose(&[shader::SAMPLING, &scene, &uniforms, include_str!("ray_view.wgsl")])
 }
 
 /// A ray-view raster pipeline ([`scene_raster_pipeline`]): fragment stage `fs` into a

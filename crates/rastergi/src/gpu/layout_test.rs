@@ -63,54 +63,15 @@ fn twins() -> Vec<Twin> {
             "Environment",
             [disc_centre, disc_radius, width, height, pmf, row_cdf, column_cdf, cell_pmf]
         ),
-        twin!(GpuTriangle, "Triangle", [v0, material, v1, flags, v2, light]),
-        twin!(crate::gpu_scene::GpuMaterialRecord, "MaterialRecord", [material, maps]),
-        twin!(GpuTextureSlot, "TextureSlot", [u, texture, v]),
+        generated::<GpuTriangle>(),
+        generated::<crate::gpu_scene::GpuMaterialRecord>(),
+        generated::<GpuTextureSlot>(),
         twin!(crate::textures::AtlasEntry, "AtlasEntry", [width, height, levels, first]),
-        twin!(
-            GpuMaterial,
-            "Material",
-            [
-                albedo,
-                flags,
-                emission,
-                opacity,
-                metallic,
-                roughness,
-                specular,
-                ior,
-                transmission,
-                attenuation,
-                specular_color,
-                clearcoat,
-                clearcoat_roughness
-            ]
-        ),
-        twin!(
-            GpuMaterialMaps,
-            "MaterialMaps",
-            [
-                alpha_cutoff,
-                normal_scale,
-                albedo_map,
-                emission_map,
-                opacity_map,
-                normal_map,
-                metal_rough_map,
-                transmission_map,
-                specular_map,
-                specular_color_map,
-                clearcoat_map,
-                clearcoat_roughness_map
-            ]
-        ),
-        twin!(WideNode, "WideNode", [origin, exponents, lo, counts, hi, child]),
-        twin!(LightEntry, "LightEntry", [triangle, cdf, pmf, area]),
-        twin!(
-            PunctualLight,
-            "PunctualLight",
-            [position, kind, direction, cos_outer, intensity, cos_inner, disc_centre, disc_radius]
-        ),
+        generated::<GpuMaterial>(),
+        generated::<GpuMaterialMaps>(),
+        generated::<WideNode>(),
+        generated::<LightEntry>(),
+        generated::<PunctualLight>(),
         generated::<GatherUniforms>(),
         generated::<PhotonParams>(),
         generated::<PhotonGridUniforms>(),

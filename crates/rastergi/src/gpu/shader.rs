@@ -15,7 +15,7 @@ use crate::gpu::consts::{
 };
 
 /// The scattering model's files in order (`bsdf/`: the dispatch, then its lobes and tables), for
-/// [`SCENE`] and [`BSDF`].
+/// [`SCENE_FILES`] and [`BSDF`].
 macro_rules! bsdf_wgsl {
     () => {
         concat!(
@@ -35,11 +35,12 @@ macro_rules! bsdf_wgsl {
 }
 
 pub const SAMPLING: &str = include_str!("../sampling/sampling.wgsl");
-/// The scene's bind group: geometry, materials, lights and the environment. Its bindings and
-/// their accessors (`gpu_scene.wgsl`), the point on a surface (`surface.wgsl`, the GPU twin of
-/// `surface.rs`) and light sampling (`lights.wgsl`, of `lights.rs`) are one file cut in three:
-/// they follow each other with nothing between.
-pub const SCENE: &str = concat!(
+/// The scene's bind group (geometry, materials, lights and the environment) without the structs
+/// it shares with Rust: a pass composes [`crate::gpu_scene::wgsl`], which puts them first. Its
+/// bindings and their accessors (`gpu_scene.wgsl`), the point on a surface (`surface.wgsl`, the
+/// GPU twin of `surface.rs`) and light sampling (`lights.wgsl`, of `lights.rs`) are one file
+/// cut in three: they follow each other with nothing between.
+pub(crate) const SCENE_FILES: &str = concat!(
     include_str!("../gpu_scene.wgsl"),
     include_str!("../surface.wgsl"),
     include_str!("../lights.wgsl"),

@@ -29,7 +29,7 @@
 //! form a (0, m − 1, 2)-net on it. A second, independently scrambled point for the choice
 //! would split the block between the triangles at random, losing the net on each.
 
-use crate::gpu::{Gpu, shader};
+use crate::gpu::Gpu;
 use crate::gpu_scene::GpuScene;
 use crate::lights::LightTable;
 use crate::passes::film::Film;

@@ -12,8 +12,6 @@
 //! The overlay is a grid of ASCII characters drawn with the public-domain 8×8 bitmap font
 //! of the `font8x8` crate over a darkened box in the top-left corner.
 
-use bytemuck::{Pod, Zeroable};
-
 use crate::error::{Error, Result};
 use crate::gpu::binding::{Group, Slot};
 use crate::gpu::structs::{GpuStruct, gpu_struct};

@@ -38,8 +38,6 @@
 //! bright and almost noise-free, and with it in the mean the estimate of a sky-lit interior
 //! was about a fifth of its true error (issue 45).
 
-use bytemuck::{Pod, Zeroable};
-
 use crate::error::Result;
 use crate::gpu::binding::{Group, Slot};
 use crate::gpu::structs::{GpuStruct, gpu_struct};

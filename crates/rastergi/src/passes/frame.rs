@@ -1,7 +1,6 @@
 //! Per-iteration uniforms shared by the eye passes (bind group 1, `frame.wgsl`): the jittered
 //! camera, the image size, the iteration index and the seed.
 
-use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec2, Vec3};
 
 use crate::gpu::Gpu;

@@ -23,7 +23,7 @@ use glam::{Vec2, Vec3};
 
 use crate::error::Result;
 use crate::gpu::Gpu;
-use crate::gpu::shader::{self, BVH, SAMPLING, SCENE};
+use crate::gpu::shader::{self, BVH, SAMPLING};
 use crate::gpu_scene::GpuScene;
 use crate::passes::frame::FrameBinding;
 use crate::photons::gpu::GpuPhotonMap;
@@ -36,13 +36,13 @@ pub const FILM: &str = include_str!("film.wgsl");
 /// The common prelude of every pass that reads the scene (its bind group 0) and the frame
 /// (bind group 1, [`frame::wgsl`]), then `pass`.
 pub fn with_scene(pass: &str) -> String {
-    shader::compose(&[SAMPLING, SCENE, BVH, &frame::wgsl(), pass])
+    shader::compose(&[SAMPLING, &crate::gpu_scene::wgsl(), BVH, &frame::wgsl(), pass])
 }
 
 /// The prelude of a per-pixel pass over the G-buffer that adds to the film, then `pieces`.
 pub fn per_pixel(pieces: &[&str]) -> String {
-    let frame = frame::wgsl();
-    let mut all = vec![SAMPLING, SCENE, BVH, frame.as_str(), VISIBLE_POINT, FILM];
+    let (scene, frame) = (crate::gpu_scene::wgsl(), frame::wgsl());
+    let mut all = vec![SAMPLING, scene.as_str(), BVH, frame.as_str(), VISIBLE_POINT, FILM];
     all.extend_from_slice(pieces);
     shader::compose(&all)
 }

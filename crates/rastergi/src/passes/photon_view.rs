@@ -2,7 +2,7 @@
 //! visible point, L = ρ/π · E(x) (no emission), for debugging the map and for comparing it
 //! with a full reference: it is what the final gather reads at its secondary points.
 
-use crate::gpu::{Gpu, shader};
+use crate::gpu::Gpu;
 use crate::gpu_scene::GpuScene;
 use crate::passes::film::Film;
 use crate::passes::frame::FrameBinding;

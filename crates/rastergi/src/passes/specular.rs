@@ -12,7 +12,7 @@
 //! a diffuse base) stays the visible point; its delta reflection is not followed (stated in
 //! docs/design.md).
 
-use crate::gpu::{Gpu, shader};
+use crate::gpu::Gpu;
 use crate::gpu_scene::GpuScene;
 use crate::passes::film::Film;
 use crate::passes::frame::FrameBinding;

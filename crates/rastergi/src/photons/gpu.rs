@@ -14,7 +14,6 @@
 //! A resolve kernel turns the counters into the lookup values: per table entry (Φ_rgb/h²,
 //! A/h²), h the cell side; `map.wgsl` reads them with the table's keys and the plane keys.
 
-use bytemuck::{Pod, Zeroable};
 use glam::UVec3;
 
 use super::map::{GridSpec, MAX_SEPARATORS, MapLayout, PhotonMap, Separator, TrianglePlane};
@@ -128,8 +127,8 @@ pub fn lookup_wgsl() -> String {
 
 /// The photon tracer's composed shader (`trace.wgsl`: the trace and resolve kernels).
 pub fn trace_source() -> String {
-    let (table, params) = (table_wgsl(), PhotonParams::wgsl());
-    shader::compose(&[shader::SAMPLING, shader::SCENE, shader::BVH, &table, &params, include_str!("trace.wgsl")])
+    let (scene, table, params) = (crate::gpu_scene::wgsl(), table_wgsl(), PhotonParams::wgsl());
+    shader::compose(&[shader::SAMPLING, &scene, shader::BVH, &table, &params, include_str!("trace.wgsl")])
 }
 
 /// Bytes per table entry on the GPU while rendering (key 8, lookup value 16) and, while the

@@ -376,7 +376,7 @@ impl RayCaster {
 pub fn source() -> String {
     crate::gpu::shader::compose(&[
         crate::gpu::shader::SAMPLING,
-        crate::gpu::shader::SCENE,
+        &crate::gpu_scene::wgsl(),
         crate::gpu::shader::BVH,
         include_str!("rays.wgsl"),
     ])

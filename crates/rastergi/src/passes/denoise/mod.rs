@@ -79,8 +79,6 @@
 //! 1024, where the denoised image differs from the raw one by less than the raw image's
 //! noise).
 
-use bytemuck::{Pod, Zeroable};
-
 use crate::error::Result;
 use crate::gpu::binding::{Group, Slot};
 use crate::gpu::structs::{GpuStruct, gpu_struct};

@@ -390,6 +390,21 @@ def _unit_number(words, path, n):
     return v
 
 
+def _obj_index(word, count, where, not_a_number, missing):
+    """The 0-based index into a list of `count` entries that a face corner's OBJ index `word`
+    names: 1-based when positive, counted back from the end when negative. Raises SceneError
+    "`where`: `not_a_number`" when `word` is not an integer and "`where`: `missing`" when the
+    entry does not exist (0 included)."""
+    try:
+        i = int(word)
+    except ValueError:
+        raise SceneError(f"{where}: {not_a_number}")
+    i = i - 1 if i > 0 else count + i
+    if not 0 <= i < count:
+        raise SceneError(f"{where}: {missing}")
+    return i
+
+
 def load_mtl(path):
     """Materials of an MTL file: name -> {"kd": [r,g,b] or None, "ke": [r,g,b] or None,
     "d": opacity in [0, 1] or None, "map_d": absolute path of the opacity image or None,
@@ -556,41 +571,23 @@ def load_obj(path):
             idx = []
             for w in words[1:]:
                 parts = w.split("/")
-                try:
-                    i = int(parts[0])
-                except ValueError:
-                    raise SceneError(f"{path}: line {n}: an '{key}' line holds something "
-                                     "other than vertex indices")
-                i = i - 1 if i > 0 else len(positions) + i
-                if not 0 <= i < len(positions):
-                    raise SceneError(f"{path}: line {n}: a face refers to a vertex that "
-                                     "does not exist")
+                i = _obj_index(parts[0], len(positions), f"{path}: line {n}",
+                               f"an '{key}' line holds something other than vertex indices",
+                               "a face refers to a vertex that does not exist")
                 j = None  # v/vt/vn or v//vn: the corner's normal
                 if key == "f" and len(parts) >= 3 and parts[2] != "":
-                    try:
-                        j = int(parts[2])
-                    except ValueError:
-                        raise SceneError(f"{path}: line {n}: a face's normal index "
-                                         f"'{parts[2]}' is not a number")
-                    j = j - 1 if j > 0 else len(normals) + j
-                    if not 0 <= j < len(normals):
-                        raise SceneError(f"{path}: line {n}: a face refers to a normal "
-                                         "('vn') that does not exist")
+                    j = _obj_index(parts[2], len(normals), f"{path}: line {n}",
+                                   f"a face's normal index '{parts[2]}' is not a number",
+                                   "a face refers to a normal ('vn') that does not exist")
                 t = None  # v/vt or v/vt/vn: the corner's texture coordinate (map_d only)
                 if masked:
                     if key != "f" or len(parts) < 2 or parts[1] == "":
                         raise SceneError(f"{path}: line {n}: faces of the material "
                                          f"'{current}' (map_d) need texture coordinates "
                                          "(f v/vt) at every corner")
-                    try:
-                        t = int(parts[1])
-                    except ValueError:
-                        raise SceneError(f"{path}: line {n}: a face's texture coordinate index "
-                                         f"'{parts[1]}' is not a number")
-                    t = t - 1 if t > 0 else len(texcoords) + t
-                    if not 0 <= t < len(texcoords):
-                        raise SceneError(f"{path}: line {n}: a face refers to a texture "
-                                         "coordinate ('vt') that does not exist")
+                    t = _obj_index(parts[1], len(texcoords), f"{path}: line {n}",
+                                   f"a face's texture coordinate index '{parts[1]}' is not a number",
+                                   "a face refers to a texture coordinate ('vt') that does not exist")
                 idx.append((i, j, t))
             with_normals = [j is not None for _, j, _ in idx]
             if any(with_normals) and not all(with_normals):

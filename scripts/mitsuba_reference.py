@@ -155,46 +155,39 @@ repository root. On a 2-core machine with llvm_ad_rgb a direct-lighting render
 takes about 1.5 minutes and a full path-traced one about 2.7 minutes:
 
     D=crates/rastergi/tests/data
-    python3 scripts/mitsuba_reference.py --width 128 --height 128 --spp 32768 --max-depth 2  --seed 1 --out $D/cornell_direct_128_a.exr
-    python3 scripts/mitsuba_reference.py --width 128 --height 128 --spp 32768 --max-depth 2  --seed 2 --out $D/cornell_direct_128_b.exr
-    python3 scripts/mitsuba_reference.py --width 128 --height 128 --spp 16384 --max-depth -1 --seed 3 --out $D/cornell_path_128_a.exr
-    python3 scripts/mitsuba_reference.py --width 128 --height 128 --spp 16384 --max-depth -1 --seed 4 --out $D/cornell_path_128_b.exr
+    # pair NAME SEED OPTIONS...: $D/NAME_a.exr with --seed SEED, $D/NAME_b.exr with SEED + 1
+    pair() {
+        name=$1 seed=$2; shift 2
+        python3 scripts/mitsuba_reference.py "$@" --seed $seed --out $D/${name}_a.exr
+        python3 scripts/mitsuba_reference.py "$@" --seed $((seed + 1)) --out $D/${name}_b.exr
+    }
+    pair cornell_direct_128 1 --width 128 --height 128 --spp 32768 --max-depth 2
+    pair cornell_path_128   3 --width 128 --height 128 --spp 16384 --max-depth -1
     # the courtyard under the test sky (environment map only; README.md there)
     python3 scripts/make_test_sky.py --out $D/env/sky_64x32.exr
     COURT="--scene $D/obj/courtyard.obj --eye 0,3,5.5 --target 0,0.3,0 --up 0,1,0 --fov 45 --env $D/env/sky_64x32.exr --width 128 --height 128 --spp 4096"
-    python3 scripts/mitsuba_reference.py $COURT --max-depth -1 --seed 11 --out $D/courtyard_env_path_128_a.exr
-    python3 scripts/mitsuba_reference.py $COURT --max-depth -1 --seed 12 --out $D/courtyard_env_path_128_b.exr
-    python3 scripts/mitsuba_reference.py $COURT --max-depth 2  --seed 13 --out $D/courtyard_env_direct_128_a.exr
-    python3 scripts/mitsuba_reference.py $COURT --max-depth 2  --seed 14 --out $D/courtyard_env_direct_128_b.exr
+    pair courtyard_env_path_128   11 $COURT --max-depth -1
+    pair courtyard_env_direct_128 13 $COURT --max-depth 2
     # smooth (vn) and flat shading normals under the test sky (README.md there)
     python3 scripts/make_sphere_scenes.py
     SPH="--eye 0,1.6,3.2 --target 0,0.6,0 --up 0,1,0 --fov 40 --env $D/env/sky_64x32.exr --width 128 --height 128 --spp 4096 --max-depth -1"
-    python3 scripts/mitsuba_reference.py --scene $D/obj/sphere_smooth.obj $SPH --seed 21 --out $D/sphere_smooth_path_128_a.exr
-    python3 scripts/mitsuba_reference.py --scene $D/obj/sphere_smooth.obj $SPH --seed 22 --out $D/sphere_smooth_path_128_b.exr
-    python3 scripts/mitsuba_reference.py --scene $D/obj/sphere_flat.obj   $SPH --seed 23 --out $D/sphere_flat_path_128_a.exr
-    python3 scripts/mitsuba_reference.py --scene $D/obj/sphere_flat.obj   $SPH --seed 24 --out $D/sphere_flat_path_128_b.exr
+    pair sphere_smooth_path_128 21 --scene $D/obj/sphere_smooth.obj $SPH
+    pair sphere_flat_path_128   23 --scene $D/obj/sphere_flat.obj $SPH
     # an alpha-masked card and a 50 % veil under a point light (README.md there)
     python3 scripts/make_alpha_card_scene.py
     CARD="--scene $D/obj/alpha_card.obj --eye 0,2.6,2.4 --target 0,0.35,0 --up 0,1,0 --fov 45 --point 0.15,2.2,0.1,6,6,6 --width 128 --height 128 --spp 4096 --max-depth -1"
-    python3 scripts/mitsuba_reference.py $CARD --seed 31 --out $D/alpha_card_path_128_a.exr
-    python3 scripts/mitsuba_reference.py $CARD --seed 32 --out $D/alpha_card_path_128_b.exr
+    pair alpha_card_path_128 31 $CARD
     # metal and glass: a sphere on a stage in five materials, and the Cornell box with a
     # glass and a mirror sphere (README.md there; about 15-60 s per render)
     python3 scripts/make_material_scenes.py
     MAT="--eye 0,1.2,2.6 --target 0,0.45,0 --up 0,1,0 --fov 40 --width 64 --height 64 --spp 16384 --max-depth -1"
-    python3 scripts/mitsuba_reference.py --scene $D/obj/mat_metal_rough.obj $MAT --seed 41 --out $D/mat_metal_rough_path_64_a.exr
-    python3 scripts/mitsuba_reference.py --scene $D/obj/mat_metal_rough.obj $MAT --seed 42 --out $D/mat_metal_rough_path_64_b.exr
-    python3 scripts/mitsuba_reference.py --scene $D/obj/mat_mirror.obj      $MAT --seed 43 --out $D/mat_mirror_path_64_a.exr
-    python3 scripts/mitsuba_reference.py --scene $D/obj/mat_mirror.obj      $MAT --seed 44 --out $D/mat_mirror_path_64_b.exr
-    python3 scripts/mitsuba_reference.py --scene $D/obj/mat_mix.obj         $MAT --seed 45 --out $D/mat_mix_path_64_a.exr
-    python3 scripts/mitsuba_reference.py --scene $D/obj/mat_mix.obj         $MAT --seed 46 --out $D/mat_mix_path_64_b.exr
-    python3 scripts/mitsuba_reference.py --scene $D/obj/mat_glass.obj       $MAT --seed 47 --out $D/mat_glass_path_64_a.exr
-    python3 scripts/mitsuba_reference.py --scene $D/obj/mat_glass.obj       $MAT --seed 48 --out $D/mat_glass_path_64_b.exr
-    python3 scripts/mitsuba_reference.py --scene $D/obj/mat_rough_glass.obj $MAT --seed 49 --out $D/mat_rough_glass_path_64_a.exr
-    python3 scripts/mitsuba_reference.py --scene $D/obj/mat_rough_glass.obj $MAT --seed 50 --out $D/mat_rough_glass_path_64_b.exr
+    s=41  # seeds 41, 43, ..., 49
+    for m in metal_rough mirror mix glass rough_glass; do
+        pair mat_${m}_path_64 $s --scene $D/obj/mat_$m.obj $MAT
+        s=$((s + 2))
+    done
     CS="--scene $D/obj/cornell_spheres.obj --eye 0,0,3.9 --target 0,0,0 --up 0,1,0 --fov 39.3077 --width 128 --height 128 --spp 8192 --max-depth -1"
-    python3 scripts/mitsuba_reference.py $CS --seed 51 --out $D/cornell_spheres_path_128_a.exr
-    python3 scripts/mitsuba_reference.py $CS --seed 52 --out $D/cornell_spheres_path_128_b.exr
+    pair cornell_spheres_path_128 51 $CS
 
 (--chunk-spp defaults to 256; the images depend on it through the chunk seeds,
 and on the Mitsuba version and variant. Results are not bit-reproducible
@@ -221,6 +214,7 @@ the plain per-pixel mean of the samples.
 """
 
 import argparse
+import functools
 import math
 import os
 import sys
@@ -390,6 +384,32 @@ def _unit_number(words, path, n):
     return v
 
 
+def _deferred_numbers(line, path):
+    """The line number and numbers (rounded to float32, as floats) of an OBJ line kept as
+    (line number, words) to be read where it is used; a SceneError naming its keyword if a
+    word after the keyword is not a number."""
+    ln, words = line
+    try:
+        return ln, [float(np.float32(w)) for w in words[1:]]
+    except ValueError:
+        raise SceneError(f"{path}: line {ln}: a '{words[0]}' line does not hold numbers")
+
+
+def _obj_index(word, count, where, not_a_number, missing):
+    """The 0-based index into a list of `count` entries that a face corner's OBJ index `word`
+    names: 1-based when positive, counted back from the end when negative. Raises SceneError
+    "`where`: `not_a_number`" when `word` is not an integer and "`where`: `missing`" when the
+    entry does not exist (0 included)."""
+    try:
+        i = int(word)
+    except ValueError:
+        raise SceneError(f"{where}: {not_a_number}")
+    i = i - 1 if i > 0 else count + i
+    if not 0 <= i < count:
+        raise SceneError(f"{where}: {missing}")
+    return i
+
+
 def load_mtl(path):
     """Materials of an MTL file: name -> {"kd": [r,g,b] or None, "ke": [r,g,b] or None,
     "d": opacity in [0, 1] or None, "map_d": absolute path of the opacity image or None,
@@ -482,9 +502,7 @@ def load_obj(path):
     directory = os.path.dirname(path)
     positions = []
     normals = []  # `vn` lines: (line number, words); parsed where a face uses them
-    parsed_normals = {}  # index into normals -> unit float32 normal
     texcoords = []  # `vt` lines: (line number, words); parsed where a masked face uses them
-    parsed_texcoords = {}  # index into texcoords -> float32 (u, v)
     library = {}  # material name -> material, from the mtllib lines so far
     # (material name (None: no material), with vertex normals) -> list of corner triples,
     # each corner (position index, normal index or None, texture coordinate index or None;
@@ -492,37 +510,28 @@ def load_obj(path):
     groups = {}
     current = None
 
+    # Parsed once, where a face first uses them (functools.cache: an error is not cached).
+    @functools.cache
     def unit_normal(j):
         """The `vn` line j, normalised (float32, as read); an error if it is not a normal."""
-        if j not in parsed_normals:
-            ln, words = normals[j]
-            try:
-                vals = [float(np.float32(w)) for w in words[1:]]
-            except ValueError:
-                raise SceneError(f"{path}: line {ln}: a 'vn' line does not hold numbers")
-            if len(vals) != 3:
-                raise SceneError(f"{path}: line {ln}: a 'vn' line needs three numbers x y z")
-            v = np.array(vals, dtype=np.float64)
-            length = float(np.sqrt(v @ v))
-            if not (np.isfinite(v).all() and length > 0):
-                raise SceneError(f"{path}: line {ln}: a 'vn' normal used by a face is zero "
-                                 "or not finite")
-            parsed_normals[j] = (v / length).astype(np.float32)
-        return parsed_normals[j]
+        ln, vals = _deferred_numbers(normals[j], path)
+        if len(vals) != 3:
+            raise SceneError(f"{path}: line {ln}: a 'vn' line needs three numbers x y z")
+        v = np.array(vals, dtype=np.float64)
+        length = float(np.sqrt(v @ v))
+        if not (np.isfinite(v).all() and length > 0):
+            raise SceneError(f"{path}: line {ln}: a 'vn' normal used by a face is zero "
+                             "or not finite")
+        return (v / length).astype(np.float32)
 
+    @functools.cache
     def texcoord(j):
         """The `vt` line j as float32 (u, v) (v 0 when absent, as tobj); an error if it is not
         a pair of finite numbers."""
-        if j not in parsed_texcoords:
-            ln, words = texcoords[j]
-            try:
-                vals = [float(np.float32(w)) for w in words[1:]]
-            except ValueError:
-                raise SceneError(f"{path}: line {ln}: a 'vt' line does not hold numbers")
-            if not 1 <= len(vals) <= 3 or not all(math.isfinite(v) for v in vals):
-                raise SceneError(f"{path}: line {ln}: a 'vt' line needs finite numbers u [v [w]]")
-            parsed_texcoords[j] = np.array((vals + [0.0])[:2], dtype=np.float32)
-        return parsed_texcoords[j]
+        ln, vals = _deferred_numbers(texcoords[j], path)
+        if not 1 <= len(vals) <= 3 or not all(math.isfinite(v) for v in vals):
+            raise SceneError(f"{path}: line {ln}: a 'vt' line needs finite numbers u [v [w]]")
+        return np.array((vals + [0.0])[:2], dtype=np.float32)
 
     for n, raw in enumerate(text.splitlines(), 1):
         line = raw.strip()
@@ -556,41 +565,23 @@ def load_obj(path):
             idx = []
             for w in words[1:]:
                 parts = w.split("/")
-                try:
-                    i = int(parts[0])
-                except ValueError:
-                    raise SceneError(f"{path}: line {n}: an '{key}' line holds something "
-                                     "other than vertex indices")
-                i = i - 1 if i > 0 else len(positions) + i
-                if not 0 <= i < len(positions):
-                    raise SceneError(f"{path}: line {n}: a face refers to a vertex that "
-                                     "does not exist")
+                i = _obj_index(parts[0], len(positions), f"{path}: line {n}",
+                               f"an '{key}' line holds something other than vertex indices",
+                               "a face refers to a vertex that does not exist")
                 j = None  # v/vt/vn or v//vn: the corner's normal
                 if key == "f" and len(parts) >= 3 and parts[2] != "":
-                    try:
-                        j = int(parts[2])
-                    except ValueError:
-                        raise SceneError(f"{path}: line {n}: a face's normal index "
-                                         f"'{parts[2]}' is not a number")
-                    j = j - 1 if j > 0 else len(normals) + j
-                    if not 0 <= j < len(normals):
-                        raise SceneError(f"{path}: line {n}: a face refers to a normal "
-                                         "('vn') that does not exist")
+                    j = _obj_index(parts[2], len(normals), f"{path}: line {n}",
+                                   f"a face's normal index '{parts[2]}' is not a number",
+                                   "a face refers to a normal ('vn') that does not exist")
                 t = None  # v/vt or v/vt/vn: the corner's texture coordinate (map_d only)
                 if masked:
                     if key != "f" or len(parts) < 2 or parts[1] == "":
                         raise SceneError(f"{path}: line {n}: faces of the material "
                                          f"'{current}' (map_d) need texture coordinates "
                                          "(f v/vt) at every corner")
-                    try:
-                        t = int(parts[1])
-                    except ValueError:
-                        raise SceneError(f"{path}: line {n}: a face's texture coordinate index "
-                                         f"'{parts[1]}' is not a number")
-                    t = t - 1 if t > 0 else len(texcoords) + t
-                    if not 0 <= t < len(texcoords):
-                        raise SceneError(f"{path}: line {n}: a face refers to a texture "
-                                         "coordinate ('vt') that does not exist")
+                    t = _obj_index(parts[1], len(texcoords), f"{path}: line {n}",
+                                   f"a face's texture coordinate index '{parts[1]}' is not a number",
+                                   "a face refers to a texture coordinate ('vt') that does not exist")
                 idx.append((i, j, t))
             with_normals = [j is not None for _, j, _ in idx]
             if any(with_normals) and not all(with_normals):

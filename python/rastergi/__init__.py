@@ -26,7 +26,7 @@ import difflib
 import os
 import tempfile
 from dataclasses import dataclass
-from typing import Any, NamedTuple, Optional, Sequence, Tuple, Union
+from typing import Any, Generic, NamedTuple, Optional, Sequence, Tuple, TypeVar, Union
 
 import numpy as np
 
@@ -169,6 +169,31 @@ def _vec3(name: str, value: Any) -> Vec3:
     return v  # type: ignore[return-value]
 
 
+T = TypeVar("T")
+
+
+class _Native(Generic[T]):
+    """A read-only attribute of :class:`Renderer`, typed ``T``, that is its native renderer's
+    attribute of the same name (as a ``property`` returning ``self._native.<name>``)."""
+
+    def __init__(self, doc: Optional[str] = None) -> None:
+        self.__doc__ = doc
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self._name = name
+
+    def __get__(self, obj: Any, owner: Optional[type] = None) -> T:
+        if obj is None:  # looked up on the class, as a property returns itself
+            return self  # type: ignore[return-value]
+        return getattr(obj._native, self._name)
+
+    def __set__(self, obj: Any, value: Any) -> None:
+        raise AttributeError(f"property '{self._name}' of '{type(obj).__name__}' object has no setter")
+
+    def __delete__(self, obj: Any) -> None:
+        raise AttributeError(f"property '{self._name}' of '{type(obj).__name__}' object has no deleter")
+
+
 class Renderer:
     """A progressive renderer: its scene, photon map and image stay between calls.
 
@@ -212,10 +237,7 @@ class Renderer:
         """Discards the iterations so far."""
         self._native.reset()
 
-    @property
-    def samples(self) -> int:
-        """Iterations in the image: since the renderer was made or its camera last changed."""
-        return self._native.samples
+    samples = _Native[int]("""Iterations in the image: since the renderer was made or its camera last changed.""")
 
     @property
     def camera(self) -> Camera:
@@ -223,30 +245,14 @@ class Renderer:
         eye, target, up, fov = self._native.camera
         return Camera(eye, target, up, fov)
 
-    @property
-    def error_estimate(self) -> Optional[float]:
+    error_estimate = _Native[Optional[float]](
         """The image's relative RMSE estimated without a reference, from two independent
         halves of the iterations (as ``rastergi render --target-error``); None before there
-        are enough."""
-        return self._native.error_estimate
-
-    @property
-    def width(self) -> int:
-        return self._native.width
-
-    @property
-    def height(self) -> int:
-        return self._native.height
-
-    @property
-    def method(self) -> str:
-        """``"gather"`` or ``"path"``."""
-        return self._native.method
-
-    @property
-    def show(self) -> str:
-        """What :meth:`image` shows by default."""
-        return self._native.show
+        are enough.""")
+    width = _Native[int]()
+    height = _Native[int]()
+    method = _Native[str]("""``"gather"`` or ``"path"``.""")
+    show = _Native[str]("""What :meth:`image` shows by default.""")
 
     def __repr__(self) -> str:
         return f"<rastergi.Renderer {self.width}x{self.height} method={self.method} samples={self.samples}>"

@@ -121,16 +121,23 @@ fn where_black(lit: &LinearImage, dark: &LinearImage) -> (Vec<[f32; 3]>, f32) {
     (black, gain)
 }
 
+/// [`write_scene`]'s scene seen from above (see [`from_above`]) with `options` and with
+/// `--env none`: the first image, the two runs' stderr, and [`where_black`] of the two images.
+fn with_and_without_environment(options: &[&str]) -> (LinearImage, [String; 2], Vec<[f32; 3]>, f32) {
+    let dir = tempfile::tempdir().unwrap();
+    write_scene(dir.path());
+    let (lit, lit_log) = from_above(dir.path(), options, "lit.exr");
+    let (dark, dark_log) = from_above(dir.path(), &["--env", "none"], "dark.exr");
+    let (black, gain) = where_black(&lit, &dark);
+    (lit, [lit_log, dark_log], black, gain)
+}
+
 #[test]
 fn a_physical_sky_lights_a_gltf_scene() {
     // From above (camera 1: straight down, 3 m up), the 2 × 2 floor under the emitter, without
     // and with `--sky 3 --sun 90,30`: the sky and its sun light the floor, and the pixels
     // around it, which look below the horizon, stay black (Mitsuba 3's sunsky is black there).
-    let dir = tempfile::tempdir().unwrap();
-    write_scene(dir.path());
-    let (sky, _) = from_above(dir.path(), &["--sky", "3", "--sun", "90,30"], "sky.exr");
-    let (plain, _) = from_above(dir.path(), &["--env", "none"], "plain.exr");
-    let (background, floor_gain) = where_black(&sky, &plain);
+    let (_, _, background, floor_gain) = with_and_without_environment(&["--sky", "3", "--sun", "90,30"]);
     for s in &background {
         assert_eq!(*s, [0.0; 3], "a pixel below the horizon shows the sky");
     }
@@ -145,16 +152,12 @@ fn a_physical_sky_lights_a_gltf_scene() {
 /// (with `--env none` they are black); the floor gets its light beside the emitter's.
 #[test]
 fn a_gltf_model_without_lights_is_lit_by_a_neutral_environment() {
-    let dir = tempfile::tempdir().unwrap();
-    write_scene(dir.path());
-    let (lit, log) = from_above(dir.path(), &[], "lit.exr");
+    let (lit, [log, dark_log], black, floor_gain) = with_and_without_environment(&[]);
     let said: Vec<&str> = log.lines().filter(|l| l.contains("neutral grey environment")).collect();
     assert_eq!(said.len(), 1, "{log}");
     assert!(said[0].contains("scene.gltf: no lights but its emissive surfaces"), "{log}");
-    let (dark, log) = from_above(dir.path(), &["--env", "none"], "dark.exr");
-    assert!(!log.contains("neutral"), "{log}");
+    assert!(!dark_log.contains("neutral"), "{dark_log}");
     // Black without the environment: the background, or the emitter's unlit black back.
-    let (black, floor_gain) = where_black(&lit, &dark);
     let mut background = 0;
     for l in &black {
         let sky = l.iter().all(|&v| (v - 0.3).abs() < 1e-5);

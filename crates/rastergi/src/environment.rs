@@ -113,6 +113,13 @@ impl Environment {
         Ok(Environment { width, height, texels, row_cdf, column_cdf, cell_pmf, integral: integral.as_vec3() })
     }
 
+    /// The environment of `width × height` texels whose texel in column `i`, row `j` (row 0
+    /// at the zenith) is `radiance(i, j)`, called row by row; checked as [`Environment::new`].
+    pub fn from_fn(width: u32, height: u32, mut radiance: impl FnMut(u32, u32) -> Vec3) -> Result<Environment> {
+        let texels = (0..height).flat_map(|j| (0..width).map(move |i| (i, j))).map(|(i, j)| radiance(i, j)).collect();
+        Environment::new(width, height, texels)
+    }
+
     /// This environment with its radiance scaled by `factor` (finite, ≥ 0): the sampling
     /// distribution is unchanged (it is proportional to the radiance), the texels and the
     /// integral are × `factor`; × 0 gives a black environment with no distribution, as
@@ -351,20 +358,12 @@ mod tests {
     /// A small sky with structure: a gradient, a dark ground and one bright pixel.
     fn sky() -> Environment {
         let (w, h) = (16u32, 9u32);
-        let mut t = Vec::new();
-        for j in 0..h {
-            for i in 0..w {
-                let theta = j as f32 * std::f32::consts::PI / (h - 1) as f32;
-                let v =
-                    if theta < 1.5 { Vec3::new(0.3, 0.5, 1.0) * (0.4 + 0.6 * theta.cos()) } else { Vec3::splat(0.05) };
-                t.push(if (i, j) == (3, 2) {
-                    Vec3::new(200.0, 180.0, 160.0)
-                } else {
-                    v + Vec3::splat(i as f32 * 0.01)
-                });
-            }
-        }
-        Environment::new(w, h, t).unwrap()
+        Environment::from_fn(w, h, |i, j| {
+            let theta = j as f32 * std::f32::consts::PI / (h - 1) as f32;
+            let v = if theta < 1.5 { Vec3::new(0.3, 0.5, 1.0) * (0.4 + 0.6 * theta.cos()) } else { Vec3::splat(0.05) };
+            if (i, j) == (3, 2) { Vec3::new(200.0, 180.0, 160.0) } else { v + Vec3::splat(i as f32 * 0.01) }
+        })
+        .unwrap()
     }
 
     #[test]

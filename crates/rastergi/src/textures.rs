@@ -427,8 +427,6 @@ pub fn sample_on_gpu(gpu: &Gpu, atlas: &TextureAtlas, queries: &[(u32, Vec2, f32
         gpu.storage_buffer("texture entries", bytemuck::cast_slice(&atlas.gpu_entries()), wgpu::BufferUsages::empty());
     let input: Vec<[f32; 4]> = queries.iter().map(|&(t, st, lod)| [st.x, st.y, lod, f32::from_bits(t)]).collect();
     let input = gpu.storage_buffer("texture queries", bytemuck::cast_slice(&input), wgpu::BufferUsages::empty());
-    let size = (queries.len() as u64 * 16).max(16);
-    let output = gpu.zeroed_buffer("texture samples", size, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
     let source = format!(
         "{}{}
         @group(0) @binding(0) var textures: texture_2d<f32>;
@@ -450,7 +448,7 @@ pub fn sample_on_gpu(gpu: &Gpu, atlas: &TextureAtlas, queries: &[(u32, Vec2, f32
         shader::TEXTURES
     );
     let module = shader::module(device, "texture samples", &source);
-    gpu.run_once(
+    let samples: Vec<[f32; 4]> = gpu.run_once_read(
         "texture samples",
         &module,
         &Group::compute(
@@ -466,13 +464,11 @@ pub fn sample_on_gpu(gpu: &Gpu, atlas: &TextureAtlas, queries: &[(u32, Vec2, f32
             ("textures", wgpu::BindingResource::TextureView(&view)),
             ("entries", entries.as_entire_binding()),
             ("queries", input.as_entire_binding()),
-            ("samples", output.as_entire_binding()),
         ],
-        queries.len() as u32,
-    );
-    let bytes = gpu.read_buffer(&output, size)?;
-    let samples: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
-    Ok(samples[..queries.len()].iter().map(|&s| Vec4::from_array(s)).collect())
+        "samples",
+        queries.len(),
+    )?;
+    Ok(samples.into_iter().map(Vec4::from_array).collect())
 }
 
 #[cfg(test)]

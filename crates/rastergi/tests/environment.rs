@@ -51,21 +51,18 @@ fn floor_of(material: Material, env: Environment) -> Scene {
 /// A sky with structure: brighter towards the zenith, a bright patch, a dark ground.
 fn gradient_sky() -> Environment {
     let (w, h) = (32u32, 17u32);
-    let mut t = Vec::new();
-    for j in 0..h {
-        for i in 0..w {
-            let theta = j as f32 * std::f32::consts::PI / (h - 1) as f32;
-            let sky = Vec3::new(0.3, 0.5, 1.0) * (0.4 + 0.6 * theta.cos().max(0.0)) + Vec3::splat(0.02 * i as f32);
-            t.push(if (i, j) == (5, 4) {
-                Vec3::new(40.0, 36.0, 30.0)
-            } else if j > 8 {
-                Vec3::splat(0.05)
-            } else {
-                sky
-            });
+    Environment::from_fn(w, h, |i, j| {
+        let theta = j as f32 * std::f32::consts::PI / (h - 1) as f32;
+        let sky = Vec3::new(0.3, 0.5, 1.0) * (0.4 + 0.6 * theta.cos().max(0.0)) + Vec3::splat(0.02 * i as f32);
+        if (i, j) == (5, 4) {
+            Vec3::new(40.0, 36.0, 30.0)
+        } else if j > 8 {
+            Vec3::splat(0.05)
+        } else {
+            sky
         }
-    }
-    Environment::new(w, h, t).unwrap()
+    })
+    .unwrap()
 }
 
 /// The mean of the floor's pixels per iteration over `iterations` (the film's sums read after

@@ -111,55 +111,55 @@ fn mismatches_against_cpu_raycast(method: GatherMethod, directions: GatherDirect
     (mismatched, compared)
 }
 
-/// The fraction of the pixel estimates of `method` with `directions` that differ from the
-/// CPU ray cast, printed with `label`.
-fn mismatch_fraction(label: &str, method: GatherMethod, directions: GatherDirections) -> f64 {
+/// Asserts that fewer than `bound` (a fraction) of the pixel estimates of `method` with
+/// `directions` differ from the CPU ray cast; prints the fraction with `label`.
+fn assert_mismatch_fraction_below(label: &str, method: GatherMethod, directions: GatherDirections, bound: f64) {
     let (mismatched, compared) = mismatches_against_cpu_raycast(method, directions);
     let fraction = mismatched as f64 / compared as f64;
     println!(
         "{label}: {mismatched} of {compared} pixel estimates differ from the ray cast ({:.3} %)",
         100.0 * fraction
     );
-    fraction
+    assert!(
+        fraction < bound,
+        "{label}: {:.3} % of the gather estimates disagree with the ray cast (bound {:.3} %)",
+        100.0 * fraction,
+        100.0 * bound
+    );
 }
 
-#[test]
-fn raster_gather_matches_cpu_raycast_for_same_directions_except_at_ray_view_edges() {
-    let fraction = mismatch_fraction("raster", GatherMethod::Raster, GatherDirections::Shared);
-    // A rasterized gather samples each ray-view texel at one point: a gather ray passing
-    // within a texel of a silhouette in the ray view may see the other surface. With a
-    // 512² bundle over the scene's bounding sphere (diameter 3.5: texels ≈ 0.007 wide) and
-    // the box's ~14 silhouette edges of length ≈ 1–2 units in any view, the texels next to
-    // an edge cover ≈ 2·14·1.5·0.007/(π·1.75²) ≈ 3 % of the view; eye pixels whose rays pass
-    // there are at most that fraction, so 5 % bounds it with margin.
-    assert!(fraction < 0.05, "{:.2} % of the gather estimates disagree with the ray cast", 100.0 * fraction);
+/// A test per row `name: label, method, directions, bound;` (method a [`GatherMethod`],
+/// directions a [`GatherDirections`]) that runs [`assert_mismatch_fraction_below`].
+macro_rules! gather_matches_cpu_raycast_tests {
+    ($($(#[$doc:meta])* $name:ident: $label:literal, $method:ident, $directions:ident, $bound:literal;)*) => {$(
+        $(#[$doc])*
+        #[test]
+        fn $name() {
+            assert_mismatch_fraction_below($label, GatherMethod::$method, GatherDirections::$directions, $bound);
+        }
+    )*};
 }
 
-#[test]
-fn list_gather_matches_cpu_raycast_for_same_directions_except_at_ray_view_edges() {
-    let fraction = mismatch_fraction("lists", GatherMethod::Lists, GatherDirections::Shared);
-    // The same texel approximation as the peeled raster gather, hence the same bound; a
-    // fragment pool too small for the view would lose fragments everywhere and fail it.
-    assert!(fraction < 0.05, "{:.2} % of the gather estimates disagree with the ray cast", 100.0 * fraction);
-}
-
-#[test]
-fn traced_gather_matches_cpu_raycast_for_same_directions() {
-    let fraction = mismatch_fraction("trace", GatherMethod::Trace, GatherDirections::Shared);
-    // The same ray against the same BVH in f32 on both sides: they can only disagree for a
-    // ray that passes within rounding error of a triangle edge, where the two Möller–Trumbore
-    // evaluations may pick different neighbours — a vanishing fraction of 23 000 rays.
-    assert!(fraction < 0.002, "{:.3} % of the traced gather's estimates disagree with the ray cast", 100.0 * fraction);
-}
-
-#[test]
-fn per_pixel_traced_gather_matches_cpu_raycast_of_the_same_sobol_directions() {
-    let fraction = mismatch_fraction("per-pixel", GatherMethod::Trace, GatherDirections::PerPixel);
-    // The Sobol' points agree bit for bit (tested below); the directions from them may differ
-    // in the last bits (the GPU's sin, cos and sqrt), which moves a ray across a triangle edge
-    // only where it passes within rounding error of one: 4 rays per estimate, so 4× the
-    // shared bound.
-    assert!(fraction < 0.008, "{:.3} % of the per-pixel estimates disagree with the ray cast", 100.0 * fraction);
+gather_matches_cpu_raycast_tests! {
+    /// A rasterized gather samples each ray-view texel at one point: a gather ray passing
+    /// within a texel of a silhouette in the ray view may see the other surface. With a
+    /// 512² bundle over the scene's bounding sphere (diameter 3.5: texels ≈ 0.007 wide) and
+    /// the box's ~14 silhouette edges of length ≈ 1–2 units in any view, the texels next to
+    /// an edge cover ≈ 2·14·1.5·0.007/(π·1.75²) ≈ 3 % of the view; eye pixels whose rays pass
+    /// there are at most that fraction, so 5 % bounds it with margin.
+    raster_gather_matches_cpu_raycast_for_same_directions_except_at_ray_view_edges: "raster", Raster, Shared, 0.05;
+    /// The same texel approximation as the peeled raster gather, hence the same bound; a
+    /// fragment pool too small for the view would lose fragments everywhere and fail it.
+    list_gather_matches_cpu_raycast_for_same_directions_except_at_ray_view_edges: "lists", Lists, Shared, 0.05;
+    /// The same ray against the same BVH in f32 on both sides: they can only disagree for a
+    /// ray that passes within rounding error of a triangle edge, where the two Möller–Trumbore
+    /// evaluations may pick different neighbours — a vanishing fraction of 23 000 rays.
+    traced_gather_matches_cpu_raycast_for_same_directions: "trace", Trace, Shared, 0.002;
+    /// The Sobol' points agree bit for bit (tested below); the directions from them may differ
+    /// in the last bits (the GPU's sin, cos and sqrt), which moves a ray across a triangle edge
+    /// only where it passes within rounding error of one: 4 rays per estimate, so 4× the
+    /// shared bound.
+    per_pixel_traced_gather_matches_cpu_raycast_of_the_same_sobol_directions: "per-pixel", Trace, PerPixel, 0.008;
 }
 
 #[test]

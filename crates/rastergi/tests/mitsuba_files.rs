@@ -130,10 +130,11 @@ fn a_serialized_file_written_here_loads_by_shape_index() {
 
 #[test]
 fn malformed_xml_is_named_by_file_line_and_column() {
-    let dir = scratch(&[("bad.xml", b"<scene version=\"0.6.0\">\n  <shape type=\"cube\">\n    <float name=\"x\" value=\"1\">\n  </shape>\n</scene>\n")]);
-    let e = load_err(&dir.path().join("bad.xml"));
-    assert!(e.contains("bad.xml: line 4, column"), "{e}");
-    assert!(e.contains("not well-formed XML"), "{e}");
+    let e = load_err_of(
+        "bad.xml",
+        b"<scene version=\"0.6.0\">\n  <shape type=\"cube\">\n    <float name=\"x\" value=\"1\">\n  </shape>\n</scene>\n",
+        &["bad.xml: line 4, column", "not well-formed XML"],
+    );
     assert_eq!(e.lines().count(), 1);
     // Not a scene, not UTF-8, not there.
     let dir = scratch(&[("a.xml", b"<gltf/>"), ("b.xml", b"<scene version=\"0.6\">\xff</scene>")]);
@@ -141,28 +142,29 @@ fn malformed_xml_is_named_by_file_line_and_column() {
     assert!(load_err(&dir.path().join("b.xml")).contains("UTF-8"));
     assert!(load_err(&dir.path().join("none.xml")).contains("none.xml: no such file"));
     // An unknown reference and a duplicate id are errors where they are.
-    let dir = scratch(&[(
+    load_err_of(
         "r.xml",
         b"<scene version=\"3.0.0\">\n<bsdf type=\"diffuse\" id=\"a\"/>\n<shape type=\"cube\">\n<ref id=\"b\"/></shape></scene>",
-    )]);
-    let e = load_err(&dir.path().join("r.xml"));
-    assert!(e.contains("r.xml: line 4, column 1") && e.contains("no object has the id 'b'"), "{e}");
+        &["r.xml: line 4, column 1", "no object has the id 'b'"],
+    );
 }
 
 #[test]
 fn a_missing_mesh_or_texture_is_named() {
-    let dir = scratch(&[(
-        "m.xml",
-        b"<scene version=\"0.6.0\">\n\t<shape type=\"obj\">\n\t\t<string name=\"filename\" value=\"models/gone.obj\"/>\n\t</shape>\n</scene>",
-    )]);
-    let e = load_err(&dir.path().join("m.xml"));
-    assert!(e.contains("m.xml: line 2, column 2") && e.contains("models/gone.obj: no such file"), "{e}");
-    let dir = scratch(&[(
-        "t.xml",
-        b"<scene version=\"0.6.0\">\n<shape type=\"cube\"><bsdf type=\"diffuse\">\n<texture type=\"bitmap\" name=\"reflectance\"><string name=\"filename\" value=\"wood.jpg\"/></texture>\n</bsdf></shape></scene>",
-    )]);
-    let e = load_err(&dir.path().join("t.xml"));
-    assert!(e.contains("t.xml: line 3, column 1") && e.contains("wood.jpg: no such file"), "{e}");
+    for (name, xml, needles) in [
+        (
+            "m.xml",
+            b"<scene version=\"0.6.0\">\n\t<shape type=\"obj\">\n\t\t<string name=\"filename\" value=\"models/gone.obj\"/>\n\t</shape>\n</scene>" as &[u8],
+            ["m.xml: line 2, column 2", "models/gone.obj: no such file"],
+        ),
+        (
+            "t.xml",
+            b"<scene version=\"0.6.0\">\n<shape type=\"cube\"><bsdf type=\"diffuse\">\n<texture type=\"bitmap\" name=\"reflectance\"><string name=\"filename\" value=\"wood.jpg\"/></texture>\n</bsdf></shape></scene>" as &[u8],
+            ["t.xml: line 3, column 1", "wood.jpg: no such file"],
+        ),
+    ] {
+        load_err_of(name, xml, &needles);
+    }
 }
 
 #[test]
@@ -331,6 +333,22 @@ fn shared(scene: &str) -> Option<PathBuf> {
     }
 }
 
+/// The shared scene `scene` (a path in `../shared/scenes`) loaded, if this machine has it,
+/// with how many of its triangles emit; prints, after `label`, its triangle count, of them
+/// the emitting ones (`light`: what they are) and the time the load took.
+fn load_shared(scene: &str, label: &str, light: &str) -> Option<(MitsubaScene, usize)> {
+    let path = shared(scene)?;
+    let start = Instant::now();
+    let m = load(&path);
+    let emitting = m.scene.emissive_triangles().len();
+    println!(
+        "{label}: {} triangles ({emitting} of them {light}) in {:.2} s",
+        m.scene.triangles.len(),
+        start.elapsed().as_secs_f64()
+    );
+    Some((m, emitting))
+}
+
 /// The camera a Mitsuba lookat names: eye, unit view direction, and up made orthogonal.
 fn lookat(origin: Vec3, target: Vec3, up: Vec3) -> (Vec3, Vec3, Vec3) {
     let dir = (target - origin).normalize();
@@ -340,15 +358,7 @@ fn lookat(origin: Vec3, target: Vec3, up: Vec3) -> (Vec3, Vec3, Vec3) {
 
 #[test]
 fn the_shared_staircase_and_sponza_load_as_their_files_say() {
-    if let Some(path) = shared("staircase/scene.xml") {
-        let start = Instant::now();
-        let m = load(&path);
-        let light = m.scene.emissive_triangles().len();
-        println!(
-            "staircase: {} triangles ({light} of them the light) in {:.2} s",
-            m.scene.triangles.len(),
-            start.elapsed().as_secs_f64()
-        );
+    if let Some((m, light)) = load_shared("staircase/scene.xml", "staircase", "the light") {
         // 262,661 in the 774 OBJ meshes, and the rectangle of the light.
         assert_eq!(m.scene.triangles.len() - light, 262_661);
         assert_eq!(m.film, Some((720, 1280)));
@@ -367,16 +377,7 @@ fn the_shared_staircase_and_sponza_load_as_their_files_say() {
         assert_eq!(emitters.len(), 2);
         assert_eq!(m.scene.material_of(emitters[0] as usize).emission, Vec3::splat(30.0));
     }
-    if let Some(path) = shared("sponza/scene.xml") {
-        let start = Instant::now();
-        let m = load(&path);
-        let tessellated_light = m.scene.emissive_triangles().len();
-        println!(
-            "sponza: {} triangles ({} of them the tessellated spherical light) in {:.2} s",
-            m.scene.triangles.len(),
-            tessellated_light,
-            start.elapsed().as_secs_f64()
-        );
+    if let Some((m, tessellated_light)) = load_shared("sponza/scene.xml", "sponza", "the tessellated spherical light") {
         assert_eq!(m.scene.triangles.len() - tessellated_light, 66_445);
         assert_eq!(m.film, Some((1280, 720)));
         let (eye, dir, up) = lookat(

@@ -8,8 +8,8 @@ use rastergi::progressive::Denoising;
 use rastergi::renderer::Renderer;
 use rastergi::settings::RenderSettings;
 
-use super::load_valid_scene;
-use crate::args::{GpuArgs, gpu};
+use super::window_scene_and_gpu;
+use crate::args::GpuArgs;
 
 #[derive(Args, Debug)]
 pub struct DenoiseArgs {
@@ -26,8 +26,7 @@ pub struct DenoiseArgs {
 }
 
 pub fn run(a: &DenoiseArgs) -> Result<()> {
-    let scene = load_valid_scene(&a.window.scene)?;
-    let gpu = gpu(&a.gpu)?;
+    let (scene, gpu) = window_scene_and_gpu(&a.window, &a.gpu)?;
     let (w, h) = (a.window.width, a.window.height);
     let settings = RenderSettings { width: w, height: h, photons: 1 << 16, seed: 1, ..Default::default() };
     let mut r = Renderer::new(&gpu, &scene, settings)?;

@@ -26,8 +26,8 @@ use rastergi::passes::film::Show;
 use rastergi::renderer::Renderer;
 use rastergi::settings::RenderSettings;
 
-use super::load_valid_scene;
-use crate::args::{GatherArg, GpuArgs, gpu};
+use super::window_scene_and_gpu;
+use crate::args::{GatherArg, GpuArgs};
 use crate::view::controls::Controls;
 use crate::view::panel::{self, Figures, PanelPainter, PanelState};
 use crate::view::{FRAME_BUDGET, MAX_BATCH, iterate_frame};
@@ -127,8 +127,7 @@ impl Loop {
 
 pub fn run(a: &FramesArgs) -> Result<()> {
     anyhow::ensure!(a.seconds.is_finite() && a.seconds > 0.0, "--seconds must be positive, got {}", a.seconds);
-    let scene = load_valid_scene(&a.window.scene)?;
-    let gpu = gpu(&a.gpu)?;
+    let (scene, gpu) = window_scene_and_gpu(&a.window, &a.gpu)?;
     let grid = a.grid.unwrap_or_else(|| fit::grid_resolution(&scene.bounds()));
     let photons = a.photons.unwrap_or_else(|| fit::photon_count(&scene, grid));
     let settings = RenderSettings {

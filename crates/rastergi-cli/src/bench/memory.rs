@@ -7,8 +7,8 @@ use rastergi::gpu::Gpu;
 use rastergi::renderer::Renderer;
 use rastergi::settings::RenderSettings;
 
-use super::load_valid_scene;
-use crate::args::{GatherArg, GpuArgs, gpu};
+use super::window_scene_and_gpu;
+use crate::args::{GatherArg, GpuArgs};
 
 #[derive(Args, Debug)]
 pub struct MemoryArgs {
@@ -32,8 +32,7 @@ pub struct MemoryArgs {
 }
 
 pub fn run(a: &MemoryArgs) -> Result<()> {
-    let scene = load_valid_scene(&a.window.scene)?;
-    let gpu = gpu(&a.gpu)?;
+    let (scene, gpu) = window_scene_and_gpu(&a.window, &a.gpu)?;
     println!(
         "GPU memory: {} at {}x{}, grid {}, bundle {}², gather {:?}, on {} ({:?})",
         a.window.scene, a.window.width, a.window.height, a.grid, a.bundle, a.gather, gpu.info.name, gpu.info.backend

@@ -20,9 +20,10 @@ use std::time::Duration;
 
 use anyhow::Result;
 use clap::Subcommand;
+use rastergi::gpu::Gpu;
 use rastergi::scene::Scene;
 
-use crate::args::load_scene;
+use crate::args::{GpuArgs, gpu, load_scene};
 
 #[derive(Subcommand, Debug)]
 pub enum BenchCommand {
@@ -80,6 +81,13 @@ fn load_valid_scene(name: &str) -> Result<Scene> {
     let scene = load_scene(name)?;
     scene.validate()?;
     Ok(scene)
+}
+
+/// The set-up of the window benchmarks (`frames`, `memory`, `denoise`): the scene of `window`,
+/// validated as [`load_valid_scene`] does, then the GPU `gpu_args` choose.
+fn window_scene_and_gpu(window: &WindowArgs, gpu_args: &GpuArgs) -> Result<(Scene, Gpu)> {
+    let scene = load_valid_scene(&window.scene)?;
+    Ok((scene, gpu(gpu_args)?))
 }
 
 /// The median of timed runs (at least one).

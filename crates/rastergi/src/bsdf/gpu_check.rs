@@ -55,8 +55,6 @@ pub fn on_gpu(
         })
         .collect();
     let input = gpu.storage_buffer("bsdf queries", bytemuck::cast_slice(&input), wgpu::BufferUsages::empty());
-    let size = (queries.len() as u64 * 64).max(64);
-    let output = gpu.zeroed_buffer("bsdf answers", size, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
     let table = gpu.storage_buffer(
         "bsdf ggx albedo",
         bytemuck::bytes_of(&*ggx_albedo().gpu(true)),
@@ -95,7 +93,7 @@ pub fn on_gpu(
         }";
     let source = crate::gpu::shader::compose(&[crate::gpu::shader::SAMPLING, crate::gpu::shader::BSDF, main]);
     let module = crate::gpu::shader::module(device, "bsdf", &source);
-    gpu.run_once(
+    let answers: Vec<[f32; 16]> = gpu.run_once_read(
         "bsdf",
         &module,
         &Group::compute(
@@ -106,16 +104,11 @@ pub fn on_gpu(
                 Slot::read::<albedo::GpuGgxAlbedo>(2, "ggx_table"),
             ],
         ),
-        &[
-            ("queries", input.as_entire_binding()),
-            ("answers", output.as_entire_binding()),
-            ("ggx_table", table.as_entire_binding()),
-        ],
-        queries.len() as u32,
-    );
-    let bytes = gpu.read_buffer(&output, size)?;
-    let answers: &[[f32; 16]] = bytemuck::cast_slice(&bytes);
-    Ok(answers[..queries.len()]
+        &[("queries", input.as_entire_binding()), ("ggx_table", table.as_entire_binding())],
+        "answers",
+        queries.len(),
+    )?;
+    Ok(answers
         .iter()
         .map(|a| GpuAnswer {
             eval: Vec3::new(a[0], a[1], a[2]),

@@ -28,6 +28,26 @@ impl Gpu {
         }
         self.queue.submit([enc.finish()]);
     }
+
+    /// [`Gpu::run_once`] with one more resource, `output`: a zeroed storage buffer made here for
+    /// `n` values of `T`, which the invocations write and which is read back once they are done.
+    pub fn run_once_read<T: bytemuck::Pod>(
+        &self,
+        label: &str,
+        module: &wgpu::ShaderModule,
+        group: &crate::gpu::binding::Group,
+        resources: &[(&str, wgpu::BindingResource)],
+        output: &str,
+        n: usize,
+    ) -> crate::error::Result<Vec<T>> {
+        let size = (n.max(1) * size_of::<T>()) as u64;
+        let buffer = self.zeroed_buffer(label, size, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
+        let mut resources = resources.to_vec();
+        resources.push((output, buffer.as_entire_binding()));
+        self.run_once(label, module, group, &resources, n as u32);
+        let bytes = self.read_buffer(&buffer, size)?;
+        Ok(bytemuck::cast_slice::<u8, T>(&bytes)[..n].to_vec())
+    }
 }
 
 /// Runs `pipeline` once per pixel of a `width × height` image (8×8 workgroups) with bind

@@ -11,8 +11,6 @@ pub fn sobol_owen_on_gpu(gpu: &Gpu, queries: &[(u32, u32)]) -> Result<Vec<[u32; 
     let device = &gpu.device;
     let input: Vec<[u32; 2]> = queries.iter().map(|&(i, s)| [i, s]).collect();
     let input = gpu.storage_buffer("sobol queries", bytemuck::cast_slice(&input), wgpu::BufferUsages::empty());
-    let size = (queries.len() as u64 * 8).max(8);
-    let output = gpu.zeroed_buffer("sobol points", size, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
     let main = "
         @group(0) @binding(0) var<storage, read> queries: array<vec2u>;
         @group(0) @binding(1) var<storage, read_write> points: array<vec2u>;
@@ -25,14 +23,12 @@ pub fn sobol_owen_on_gpu(gpu: &Gpu, queries: &[(u32, u32)]) -> Result<Vec<[u32; 
         }";
     let source = crate::gpu::shader::compose(&[crate::gpu::shader::SAMPLING, main]);
     let module = crate::gpu::shader::module(device, "sobol points", &source);
-    gpu.run_once(
+    gpu.run_once_read(
         "sobol points",
         &module,
         &Group::compute("sobol points", &[Slot::read::<[u32; 2]>(0, "queries"), Slot::write::<[u32; 2]>(1, "points")]),
-        &[("queries", input.as_entire_binding()), ("points", output.as_entire_binding())],
-        queries.len() as u32,
-    );
-    let bytes = gpu.read_buffer(&output, size)?;
-    let points: &[[u32; 2]] = bytemuck::cast_slice(&bytes);
-    Ok(points[..queries.len()].to_vec())
+        &[("queries", input.as_entire_binding())],
+        "points",
+        queries.len(),
+    )
 }

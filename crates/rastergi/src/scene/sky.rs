@@ -176,14 +176,10 @@ impl SunSky {
     pub fn environment(&self, width: u32, height: u32) -> Result<Environment> {
         self.validate().map_err(Error::InvalidScene)?;
         let state = self.state();
-        let texels = (0..height)
-            .flat_map(|j| (0..width).map(move |i| (i, j)))
-            .map(|(i, j)| {
-                let uv = glam::Vec2::new((i as f32 + 0.5) / width as f32, j as f32 / (height - 1) as f32);
-                state.as_ref().map_or(Vec3::ZERO, |s| self.sky_radiance_with(s, uv_to_direction(uv)))
-            })
-            .collect();
-        Environment::new(width, height, texels)
+        Environment::from_fn(width, height, |i, j| {
+            let uv = glam::Vec2::new((i as f32 + 0.5) / width as f32, j as f32 / (height - 1) as f32);
+            state.as_ref().map_or(Vec3::ZERO, |s| self.sky_radiance_with(s, uv_to_direction(uv)))
+        })
     }
 
     /// The sun as a distant light: its irradiance, its disc of the sun's aperture; `None`

@@ -22,6 +22,17 @@ pub fn load_err(path: &Path) -> String {
     }
 }
 
+/// The error of loading the scene file `name` holding `xml`, written alone into a scratch
+/// folder; asserts that it holds each of `needles`.
+pub fn load_err_of(name: &str, xml: &[u8], needles: &[&str]) -> String {
+    let dir = scratch(&[(name, xml)]);
+    let e = load_err(&dir.path().join(name));
+    for needle in needles {
+        assert!(e.contains(needle), "'{needle}' not in: {e}");
+    }
+    e
+}
+
 pub fn material<'a>(scene: &'a Scene, name: &str) -> &'a Material {
     scene.materials.iter().find(|m| m.name == name).unwrap_or_else(|| {
         panic!("no material '{name}' among {:?}", scene.materials.iter().map(|m| &m.name).collect::<Vec<_>>())

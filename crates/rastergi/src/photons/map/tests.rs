@@ -18,6 +18,20 @@ fn scene_of_quads(quads: &[[Vec3; 4]]) -> Scene {
     s
 }
 
+/// The grid of 4³ cells 0.25 wide from the origin and the layout in it of a scene holding
+/// one square, from (0, 0, z) to (1, 1, z).
+fn unit_square_layout(z: f32) -> (GridSpec, MapLayout) {
+    let s = scene_of_quads(&[[
+        Vec3::new(0.0, 0.0, z),
+        Vec3::new(1.0, 0.0, z),
+        Vec3::new(1.0, 1.0, z),
+        Vec3::new(0.0, 1.0, z),
+    ]]);
+    let grid = GridSpec::uniform(Vec3::ZERO, 0.25, UVec3::new(4, 4, 4));
+    let layout = MapLayout::new(&s, &grid);
+    (grid, layout)
+}
+
 /// The angle between two unit vectors, in degrees.
 fn angle(a: Vec3, b: Vec3) -> f32 {
     a.dot(b).clamp(-1.0, 1.0).acos().to_degrees()
@@ -218,14 +232,7 @@ fn the_cornell_light_and_the_ceiling_above_it_never_share_a_slot() {
 fn a_unit_square_on_a_cell_boundary_plane_splits_its_area_exactly() {
     // A square in the plane z = 0.3, from (0,0) to (1,1), in a grid of cells 0.25 wide:
     // every cell it crosses gets exactly 0.0625.
-    let s = scene_of_quads(&[[
-        Vec3::new(0.0, 0.0, 0.3),
-        Vec3::new(1.0, 0.0, 0.3),
-        Vec3::new(1.0, 1.0, 0.3),
-        Vec3::new(0.0, 1.0, 0.3),
-    ]]);
-    let grid = GridSpec::uniform(Vec3::ZERO, 0.25, UVec3::new(4, 4, 4));
-    let layout = MapLayout::new(&s, &grid);
+    let (grid, layout) = unit_square_layout(0.3);
     for y in 0..4 {
         for x in 0..4 {
             let c = UVec3::new(x, y, 1);
@@ -241,14 +248,7 @@ fn a_unit_square_on_a_cell_boundary_plane_splits_its_area_exactly() {
 
 #[test]
 fn a_square_exactly_on_a_cell_boundary_counts_once_in_the_cell_its_photons_land_in() {
-    let s = scene_of_quads(&[[
-        Vec3::new(0.0, 0.0, 0.5),
-        Vec3::new(1.0, 0.0, 0.5),
-        Vec3::new(1.0, 1.0, 0.5),
-        Vec3::new(0.0, 1.0, 0.5),
-    ]]);
-    let grid = GridSpec::uniform(Vec3::ZERO, 0.25, UVec3::new(4, 4, 4));
-    let layout = MapLayout::new(&s, &grid);
+    let (grid, layout) = unit_square_layout(0.5);
     let total: f64 = layout.area.iter().sum();
     assert!((total - 1.0).abs() < 1e-9, "area counted {total} times");
     assert_eq!(grid.coarse().cell_of(Vec3::new(0.3, 0.3, 0.5)).z, 2);

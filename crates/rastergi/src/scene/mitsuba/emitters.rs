@@ -206,15 +206,12 @@ fn rotated(env: &crate::environment::Environment, m: Mat4) -> Option<crate::envi
     }
     let inverse = linear.inverse();
     let (w, h) = (env.width, env.height);
-    let texels = (0..h)
-        .flat_map(|j| (0..w).map(move |i| (i, j)))
-        .map(|(i, j)| {
-            let uv = Vec2::new((i as f32 + 0.5) / w as f32, j as f32 / (h - 1).max(1) as f32);
-            let d = crate::environment::uv_to_direction(uv);
-            env.eval((inverse * d).normalize_or_zero())
-        })
-        .collect();
-    crate::environment::Environment::new(w, h, texels).ok()
+    crate::environment::Environment::from_fn(w, h, |i, j| {
+        let uv = Vec2::new((i as f32 + 0.5) / w as f32, j as f32 / (h - 1).max(1) as f32);
+        let d = crate::environment::uv_to_direction(uv);
+        env.eval((inverse * d).normalize_or_zero())
+    })
+    .ok()
 }
 
 /// Linear sRGB of an equal-energy emission spectrum of value 1, as Mitsuba 3's RGB variants

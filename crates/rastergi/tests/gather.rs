@@ -417,8 +417,11 @@ fn indirect_light_lightens_shadows_darkens_corners_and_bleeds_colour() {
 /// `Auto` on this CPU adapter takes the traced gather at once; with `auto_trials_on_cpu` it
 /// tries raster, lists and trace on its first iterations, has chosen after at most
 /// `AUTO_ITERATIONS`, and every trial iteration counts towards the image: its mean agrees with
-/// the traced gather's over the same iterations (the same seed: the same photon map, so the
-/// two differ by the gathers' and the direct light's noise, measured from a second seed).
+/// the chosen gather's over the same iterations (the same seed: the same photon map, so the
+/// two differ by the gathers' and the direct light's noise, measured from a second seed). The
+/// choice is the trials' timing: usually the traced gather here, but on a loaded machine the
+/// fragment lists, whose mean is 1.5 % below the traced gather's on this small image (the raster
+/// gathers' silhouette texels) — so the reference is the gather chosen, not the traced one.
 #[test]
 fn auto_takes_the_traced_gather_on_a_cpu_adapter_and_its_trials_all_count() {
     use rastergi::gather::AUTO_ITERATIONS;
@@ -453,8 +456,9 @@ fn auto_takes_the_traced_gather_on_a_cpu_adapter_and_its_trials_all_count() {
     let chosen_after = chosen_after.expect("Auto chose a gather");
     assert!(chosen_after <= AUTO_ITERATIONS, "chosen after {chosen_after} iterations");
     let auto_img = auto.read_linear(Show::Full).unwrap();
-    let traced = |seed| common::render(&gpu, &scene, settings(GatherMethod::Trace, false, seed), n, Show::Full);
-    let (t3, t4) = (traced(3), traced(4));
+    let chosen = auto.gather_method();
+    let reference = |seed| common::render(&gpu, &scene, settings(chosen, false, seed), n, Show::Full);
+    let (t3, t4) = (reference(3), reference(4));
     let mask = emitter_mask(&t3, 3.0);
     let mean = |img: &LinearImage| masked_mean(img, Some(&mask));
     // σ of one image's mean from two seeds (different maps too, so an overestimate of the
@@ -462,16 +466,16 @@ fn auto_takes_the_traced_gather_on_a_cpu_adapter_and_its_trials_all_count() {
     let sigma = (mean(&t3) - mean(&t4)).abs() / 2f64.sqrt();
     let diff = (mean(&auto_img) - mean(&t3)).abs();
     println!(
-        "Auto chose {:?} after {chosen_after} iterations; means: auto {:.5}, trace {:.5} (seed 4: {:.5}); \
-         difference {:.5}, σ of a mean {:.5}",
-        auto.gather_method(),
+        "Auto chose {chosen:?} after {chosen_after} iterations; means: auto {:.5}, {chosen:?} alone {:.5} (seed 4: \
+         {:.5}); difference {:.5}, σ of a mean {:.5}",
         mean(&auto_img),
         mean(&t3),
         mean(&t4),
         diff,
         sigma
     );
-    // Measured: 0.65 % (the raster gathers' silhouette texels and noise). The trials' gathers
+    // Measured: 0.15–0.65 % with the traced gather chosen, 0.56 % with the lists chosen (two
+    // busy loops beside it). The trials' gathers
     // lost would lower the mean by ≈ (chosen_after / n) · ⅓ (the indirect share) ≈ 10 %, one
     // of them lost or counted twice by ≈ 1.4 %.
     assert!(diff < 0.012 * mean(&t3), "Auto's trials change the image's mean by {diff} of {}", mean(&t3));

@@ -25,10 +25,11 @@
 use std::path::Path;
 use std::sync::Arc;
 
-use bytemuck::{Pod, Zeroable};
+use bytemuck::Zeroable;
 use glam::{Vec2, Vec3};
 
 use crate::error::{Error, Result};
+use crate::gpu::structs::gpu_struct;
 
 /// Rec. 709 luminance, the weight of the sampling distribution (Mitsuba's `luminance`).
 pub fn luminance(c: Vec3) -> f32 {
@@ -306,26 +307,27 @@ pub fn uv_to_direction(uv: Vec2) -> Vec3 {
     Vec3::new(phi.sin() * theta.sin(), theta.cos(), -phi.cos() * theta.sin())
 }
 
-/// `Environment` in `environment.wgsl` (a uniform): the map's size, where its sections start
-/// in the data buffer, its light-table probability and the photon disc.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
-pub struct GpuEnvironment {
-    /// The centre of the scene's bounding sphere, which photons cross from a disc.
-    pub disc_centre: [f32; 3],
-    /// The photon disc's radius (the bounding sphere's, enlarged by 1 %).
-    pub disc_radius: f32,
-    /// W and H; 0 × 0 where the scene has no environment.
-    pub width: u32,
-    pub height: u32,
-    /// The probability that the light table picks the environment.
-    pub pmf: f32,
-    pub _pad0: u32,
-    /// Offsets (in floats) of the row cdf, the column cdfs and the cell pmfs in the data.
-    pub row_cdf: u32,
-    pub column_cdf: u32,
-    pub cell_pmf: u32,
-    pub _pad1: u32,
+gpu_struct! {
+    /// `Environment` in WGSL (`environment.wgsl`): the map's size, where its sections start in the
+    /// data buffer, its light-table probability and the photon disc.
+    #[derive(PartialEq)]
+    pub struct GpuEnvironment as "Environment" {
+        /// The centre of the scene's bounding sphere, which photons cross from a disc.
+        pub disc_centre: [f32; 3],
+        /// The photon disc's radius (the bounding sphere's, enlarged by 1 %).
+        pub disc_radius: f32,
+        /// W and H; 0 × 0 where the scene has no environment.
+        pub width: u32,
+        pub height: u32,
+        /// The probability that the light table picks the environment.
+        pub pmf: f32,
+        pub _pad0: u32,
+        /// Offsets (in floats) of the row cdf, the column cdfs and the cell pmfs in the data.
+        pub row_cdf: u32,
+        pub column_cdf: u32,
+        pub cell_pmf: u32,
+        pub _pad1: u32,
+    }
 }
 
 impl GpuEnvironment {

@@ -2,24 +2,6 @@
 // convention, bilinear between pixels, sampled cell by cell (row, then column) by luminance
 // × solid angle. Part of the scene's bind group 0.
 
-struct Environment {
-    disc_centre: vec3f,
-    disc_radius: f32,
-    // W × H; 0 × 0 without an environment.
-    width: u32,
-    height: u32,
-    // The light table's probability of picking it.
-    pmf: f32,
-    _pad0: u32,
-    // Offsets in the environment's data (env_data, at scene_offset(DATA_ENVIRONMENT) in
-    // scene_data) of the row cdf (H − 1), the column cdfs ((H − 1)·W) and
-    // the cells' pmfs ((H − 1)·W); the texels (RGB) come first.
-    row_cdf: u32,
-    column_cdf: u32,
-    cell_pmf: u32,
-    _pad1: u32,
-}
-
 @group(0) @binding(9) var<uniform> environment: Environment;
 
 // Word k of the environment's data.

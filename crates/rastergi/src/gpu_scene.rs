@@ -19,6 +19,7 @@ use crate::gpu::structs::{GpuStruct, gpu_struct};
 use crate::lights::{LightEntry, PunctualLight};
 use crate::scene::{Aabb, AlphaMode, Material, TextureRef, UvTransform};
 use crate::surface::PreparedScene;
+use crate::textures::AtlasEntry;
 
 gpu_struct! {
     /// `Triangle` in WGSL.
@@ -123,6 +124,8 @@ pub fn wgsl() -> String {
         WideNode::wgsl(),
         LightEntry::wgsl(),
         PunctualLight::wgsl(),
+        GpuEnvironment::wgsl(),
+        AtlasEntry::wgsl(),
     ];
     [structs.concat().as_str(), shader::SCENE_FILES].join("\n")
 }

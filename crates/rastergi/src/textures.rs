@@ -39,6 +39,7 @@ use glam::{Vec2, Vec3, Vec4};
 
 use crate::error::{Error, Result};
 use crate::gpu::binding::{Group, Slot};
+use crate::gpu::structs::{GpuStruct, gpu_struct};
 use crate::gpu::{Gpu, shader};
 use crate::par::prelude::*;
 use crate::scene::Texture;
@@ -53,15 +54,16 @@ pub const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// Bytes per texel of [`FORMAT`].
 const TEXEL_BYTES: u64 = 8;
 
-/// Where texture k lies in the atlas: its level 0's size, its level count and its first
-/// texel. `AtlasEntry` in `textures.wgsl`, four words each in the scene's data buffer.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, Eq, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct AtlasEntry {
-    pub width: u32,
-    pub height: u32,
-    pub levels: u32,
-    pub first: u32,
+gpu_struct! {
+    /// Where texture k lies in the atlas: its level 0's size, its level count and its first
+    /// texel. `AtlasEntry` in WGSL (`textures.wgsl`), four words each in the scene's data buffer.
+    #[derive(PartialEq, Eq)]
+    pub struct AtlasEntry as "AtlasEntry" {
+        pub width: u32,
+        pub height: u32,
+        pub levels: u32,
+        pub first: u32,
+    }
 }
 
 /// Every texture's mip chain, exactly as uploaded.
@@ -445,7 +447,7 @@ pub fn sample_on_gpu(gpu: &Gpu, atlas: &TextureAtlas, queries: &[(u32, Vec2, f32
             samples[gid.x] = atlas_sample(bitcast<u32>(q.w), q.xy, q.z);
         }}",
         shader::constants(),
-        shader::TEXTURES
+        [AtlasEntry::wgsl().as_str(), shader::TEXTURES].join("\n")
     );
     let module = shader::module(device, "texture samples", &source);
     let samples: Vec<[f32; 4]> = gpu.run_once_read(

@@ -5,13 +5,6 @@
 // (AtlasEntry: width, height, levels, first texel; four words each). ATLAS_ROW is
 // textures::ROW (shader.rs's constants).
 
-struct AtlasEntry {
-    width: u32,
-    height: u32,
-    levels: u32,
-    first: u32,
-}
-
 fn atlas_entry(t: u32) -> AtlasEntry {
     let i = 4u * t;
     return AtlasEntry(atlas_entry_word(i), atlas_entry_word(i + 1u), atlas_entry_word(i + 2u), atlas_entry_word(i + 3u));

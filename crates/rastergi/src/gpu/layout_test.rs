@@ -58,15 +58,11 @@ fn generated<T: GpuStruct>() -> Twin {
 fn twins() -> Vec<Twin> {
     vec![
         generated::<FrameUniforms>(),
-        twin!(
-            GpuEnvironment,
-            "Environment",
-            [disc_centre, disc_radius, width, height, pmf, row_cdf, column_cdf, cell_pmf]
-        ),
+        generated::<GpuEnvironment>(),
         generated::<GpuTriangle>(),
         generated::<crate::gpu_scene::GpuMaterialRecord>(),
         generated::<GpuTextureSlot>(),
-        twin!(crate::textures::AtlasEntry, "AtlasEntry", [width, height, levels, first]),
+        generated::<crate::textures::AtlasEntry>(),
         generated::<GpuMaterial>(),
         generated::<GpuMaterialMaps>(),
         generated::<WideNode>(),

@@ -67,7 +67,7 @@ pub trait GpuStruct: bytemuck::Pod {
             for line in m.doc {
                 s += &format!("    //{line}\n");
             }
-            if m.pad_lanes > 0 {
+            if m.pad_lanes > 1 {
                 for k in 0..m.pad_lanes {
                     s += &format!("    {}{k}: {},\n", m.name, m.wgsl);
                 }

@@ -157,3 +157,44 @@ pub fn member(
     let pad = name.starts_with("_pad");
     Member { name, wgsl: if pad { scalar } else { wgsl }, pad_lanes: if pad { lanes } else { 0 }, offset, doc }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    gpu_struct! {
+        /// A struct with each kind of member (only its declaration is read).
+        #[allow(dead_code)]
+        struct Sample as "Sample" {
+            /// Where: three floats, then a word in the vector's fourth lane.
+            origin: [f32; 3],
+            flags: u32,
+            view: [[f32; 4]; 4] as "mat4x4f",
+            nested: Inner,
+            _pad: [u32; 3],
+        }
+    }
+
+    gpu_struct! {
+        #[allow(dead_code)]
+        struct Inner as "InnerName" {
+            size: [u32; 2],
+            _pad: u32,
+            scale: f32,
+        }
+    }
+
+    /// The declaration written out by hand: types from Rust's, the `as` override, the nested
+    /// struct by its WGSL name, padding as scalars, docs as comments.
+    #[test]
+    fn the_generated_declaration_is_the_wgsl_one_would_write() {
+        let expected = "// Sample (generated from Rust: gpu/structs.rs).\nstruct Sample {\n    \
+                        // Where: three floats, then a word in the vector's fourth lane.\n    \
+                        origin: vec3f,\n    flags: u32,\n    view: mat4x4f,\n    nested: InnerName,\n    \
+                        _pad0: u32,\n    _pad1: u32,\n    _pad2: u32,\n}\n";
+        assert_eq!(Sample::wgsl(), expected);
+        assert_eq!(Inner::wgsl().lines().nth(3), Some("    _pad: u32,"));
+        let offsets: Vec<usize> = Sample::members().iter().map(|m| m.offset).collect();
+        assert_eq!(offsets, [0, 12, 16, 80, 96]);
+    }
+}

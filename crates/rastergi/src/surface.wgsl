@@ -51,11 +51,20 @@ struct RasterVertex {
     @location(2) uv: vec2f,
 }
 
+// A triangle of zero area (collinear corners: published meshes carry them) has no normal and
+// no surface, and no ray hits it; but projected, rounding can leave its corners a sliver
+// apart, and a rasterizer then covers pixels with it at barycentrics far outside [0, 1] (the
+// shared classroom's ceiling: NaN pixels). Its corners are put outside the clip volume, so
+// no raster pass draws it.
 fn raster_vertex(vi: u32, view_proj: mat4x4f, with_uv: bool) -> RasterVertex {
     let v = triangle_vertex(vi);
     var uv = vec2f(0.0);
     if with_uv {
         uv = surface_uv(v.tri, v.bary.x, v.bary.y);
+    }
+    let t = triangles[v.tri];
+    if all(cross(t.v1 - t.v0, t.v2 - t.v0) == vec3f(0.0)) {
+        return RasterVertex(vec4f(2.0, 2.0, 2.0, 1.0), v.bary, v.tri, uv);
     }
     return RasterVertex(view_proj * vec4f(v.pos, 1.0), v.bary, v.tri, uv);
 }

@@ -115,3 +115,88 @@ fn degenerate_triangles_in_a_sunbeam_leave_every_pass_finite() {
     check("denoised".into(), denoised.read_denoised(&rastergi::passes::denoise::DenoiseParams::default()).unwrap());
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+/// The shared Japanese Classroom's ceiling carries collinear triangles (three corners on one
+/// line along x): zero area, no normal. Projected, rounding leaves their corners a sliver apart
+/// and the rasterizer covered pixels with them at barycentrics in the hundreds, whose visible
+/// points were NaN (issue 57: 3 NaN pixels at 320 × 180 in 32 iterations of the direct light).
+/// The same two triangles, the same camera and image size, over a floor: no G-buffer texel of
+/// 64 jittered iterations may name a triangle of zero area, and the film stays finite.
+#[test]
+fn collinear_triangles_cover_no_pixel_of_the_g_buffer() {
+    let camera = Camera {
+        eye: Vec3::new(-1.69049, 1.27158, 5.88653),
+        target: Vec3::new(-1.5391959, 1.2998871, 4.8984466),
+        up: Vec3::new(-0.004284431, 0.99959934, 0.02798101),
+        fov_y_deg: 35.983402,
+    };
+    let mut s = Scene::new(camera);
+    let wall = s.add_material(Material::diffuse("Walls", Vec3::new(0.654071, 0.67408, 0.8)));
+    let (y, z) = (2.758842, 0.254969);
+    s.add_triangle([Vec3::new(3.938532, y, z), Vec3::new(-4.194854, y, z), Vec3::new(-0.248418, y, z)], wall);
+    s.add_triangle([Vec3::new(3.938532, y, z), Vec3::new(-0.248418, y, z), Vec3::new(0.284595, y, z)], wall);
+    quad(
+        &mut s,
+        [Vec3::new(-5.0, 0.0, -5.0), Vec3::new(-5.0, 0.0, 6.0), Vec3::new(5.0, 0.0, 6.0), Vec3::new(5.0, 0.0, -5.0)],
+        wall,
+    );
+    s.lights.push(Light::Distant {
+        direction: Vec3::new(0.3, -1.0, 0.2).normalize(),
+        irradiance: Vec3::splat(3.0),
+        angular_radius: 0.0,
+    });
+    let settings = RenderSettings {
+        width: 320,
+        height: 180,
+        photons: 1 << 16,
+        grid_resolution: 32,
+        gather: GatherMethod::Trace,
+        ..Default::default()
+    };
+    let gpu = common::gpu();
+    let mut r = rastergi::renderer::Renderer::new(&gpu, &s, settings).unwrap();
+    let prepared = rastergi::surface::PreparedScene::new(&s);
+    let zero_area = |t: usize| {
+        let [a, b, c] = prepared.scene.triangles[t];
+        (b - a).cross(c - a) == Vec3::ZERO
+    };
+    let mut covered = 0;
+    for _ in 0..64 {
+        r.iterate().unwrap();
+        covered += r.read_gbuffer().unwrap().iter().filter(|g| g[0] > 0 && zero_area(g[0] as usize - 1)).count();
+    }
+    assert_eq!(covered, 0, "G-buffer texels on zero-area triangles over 64 iterations");
+    validate_finite(&r.read_linear(Show::Full).unwrap()).unwrap();
+}
+
+/// The shared Japanese Classroom (`../shared/scenes/classroom`, its own `sunsky`, camera and
+/// materials) with the command line's fitted settings, 1024 iterations at 48 × 27 and the
+/// photon map's view kept: every component of the film (direct light, indirect light, the
+/// photon map's view) holds finite numbers only. The build before the fix above wrote NaN
+/// into 22 of these pixels' direct light.
+#[test]
+fn the_shared_classroom_stays_finite_in_every_pass_over_1024_iterations() {
+    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes/classroom/scene.xml");
+    if !path.exists() {
+        println!("skipped: {} is not here (the shared public scenes are not on this machine)", path.display());
+        return;
+    }
+    let options = rastergi::session::Options {
+        scene: path.to_string_lossy().into_owned(),
+        width: Some(48),
+        height: Some(27),
+        show: Show::PhotonMap,
+        ..Default::default()
+    };
+    let session = rastergi::session::Session::load(&options).unwrap();
+    let gpu = common::gpu();
+    let mut r = rastergi::renderer::Renderer::new(&gpu, &session.scene, session.settings.clone()).unwrap();
+    for _ in 0..1024 {
+        r.iterate().unwrap();
+    }
+    for show in [Show::Direct, Show::Indirect, Show::PhotonMap, Show::Full] {
+        if let Err(e) = validate_finite(&r.read_linear(show).unwrap()) {
+            panic!("{show:?}: {e}");
+        }
+    }
+}

@@ -16,12 +16,13 @@ use crate::passes::gbuffer::{GBufferPass, PixelPass};
 use crate::passes::photon_view::PhotonView;
 use crate::passes::{FixedSample, FrameContext, IterationPass};
 use crate::photons::PhotonSettings;
+use crate::photons::budget::Budget;
 use crate::photons::gpu::GpuPhotonMap;
 use crate::photons::map::GridSpec;
 use crate::photons::passes::{PhotonPasses, fitted_pass_iterations};
 use crate::progressive::{Denoising, Progressive};
 use crate::scene::{Camera, Scene};
-use crate::settings::{PhotonRegionChoice, RenderSettings, TextureFilter};
+use crate::settings::{PhotonBudget, PhotonRegionChoice, RenderSettings, TextureFilter};
 use crate::surface::PreparedScene;
 
 /// Fixed values for one iteration's random choices, so tests can compare the passes with
@@ -133,6 +134,9 @@ pub struct Renderer {
     frame: FrameBinding,
     /// The photon map of the current pass, and what the next pass needs.
     photons: Option<PhotonPasses>,
+    /// How long the photon passes last, measured ([`crate::photons::budget`]); `None` where
+    /// their length is fixed.
+    budget: Option<Budget>,
     passes: ImagePasses,
     /// The scene's part of the default bundle ([`crate::fit::detail_bundle`]).
     detail_bundle: u32,
@@ -197,9 +201,11 @@ impl Renderer {
                 PhotonPasses::new(gpu, &gpu_scene, prepared, photon_settings, n, k)
             })
             .transpose()?;
+        let mut photons = photons;
         let map = photons.as_ref().map(PhotonPasses::map);
         let sampler = DirectionSampler::new(settings.seed);
         let passes = ImagePasses::new(gpu, &gpu_scene, &frame, map, &settings, detail_bundle, sampler)?;
+        let budget = new_budget(gpu, &settings, &passes.film, photons.as_mut(), true);
         Ok(Renderer {
             gpu: gpu.clone(),
             settings,
@@ -207,6 +213,7 @@ impl Renderer {
             scene: gpu_scene,
             frame,
             photons,
+            budget,
             passes,
             detail_bundle,
             denoise: false,
@@ -230,6 +237,7 @@ impl Renderer {
             self.detail_bundle,
             sampler,
         )?;
+        self.budget = new_budget(&self.gpu, &settings, &self.passes.film, self.photons.as_mut(), false);
         self.settings = settings;
         if self.denoise {
             self.passes.enable_denoiser(&self.gpu, &self.scene, &self.frame)?;
@@ -283,6 +291,9 @@ impl Renderer {
     /// Discards the accumulated iterations.
     pub fn reset(&mut self) {
         self.passes.film.clear(&self.gpu);
+        if let Some(b) = &mut self.budget {
+            b.restart();
+        }
         if let Some(d) = &mut self.passes.denoise {
             d.guides.clear(&self.gpu);
         }
@@ -299,9 +310,15 @@ impl Renderer {
     /// One iteration with some random choices fixed (see [`Overrides`]).
     pub fn iterate_with(&mut self, o: &Overrides) -> Result<()> {
         let (w, h) = (self.settings.width, self.settings.height);
-        // 0. A new photon pass, when the current one has had its iterations.
+        // 0. A new photon pass, when the current one has had its iterations (as many as the
+        //    photon budget chose from its measurements of the passes so far).
         if let Some(photons) = &mut self.photons {
-            photons.advance(&self.gpu, &self.scene)?;
+            match &mut self.budget {
+                Some(budget) => budget.advance(&self.gpu, &self.scene, photons)?,
+                None => {
+                    photons.advance(&self.gpu, &self.scene)?;
+                }
+            }
         }
         let iteration = self.passes.film.samples;
         // The film's blocks for its error estimate: the photon passes (each its own photons),
@@ -413,6 +430,9 @@ impl Renderer {
             }
         }
         self.passes.film.restore(&self.gpu, film)?;
+        if let Some(b) = &mut self.budget {
+            b.restart();
+        }
         if let Some(d) = &mut self.passes.denoise {
             d.guides.restart_from(&self.gpu, &self.passes.film);
         }
@@ -464,6 +484,21 @@ impl Renderer {
     pub fn read_gbuffer(&self) -> Result<Vec<[u32; 4]>> {
         self.passes.gbuffer.read(&self.gpu)
     }
+}
+
+/// The photon budget of a render with these settings ([`RenderSettings::photon_budget`]):
+/// balanced where the passes' length is not given (`pass_iterations` 0) and the map changes
+/// (more than one pass); `fresh` for a new renderer, whose film and first pass are untouched.
+fn new_budget(
+    gpu: &Gpu,
+    settings: &RenderSettings,
+    film: &Film,
+    photons: Option<&mut PhotonPasses>,
+    fresh: bool,
+) -> Option<Budget> {
+    let photons = photons.filter(|p| p.progressive())?;
+    let balanced = settings.pass_iterations == 0 && settings.photon_budget == PhotonBudget::Balanced;
+    balanced.then(|| Budget::new(gpu, &film.accumulation, film.width * film.height, photons, fresh))
 }
 
 impl Progressive for Renderer {

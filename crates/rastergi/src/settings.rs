@@ -34,9 +34,12 @@ pub struct RenderSettings {
     /// Photon passes ([`crate::photons::passes`]): the map is re-traced with fresh photons in
     /// finer cells every `pass_iterations` iterations; 1: one fixed map; 0: no limit.
     pub photon_passes: u32,
-    /// Iterations per photon pass; 0: fitted to the photon count and the image size
-    /// ([`crate::photons::passes::fitted_pass_iterations`]).
+    /// Iterations per photon pass; 0: chosen by `photon_budget`.
     pub pass_iterations: u32,
+    /// How the iterations per photon pass are chosen where `pass_iterations` is 0: balanced by
+    /// measurement ([`crate::photons::budget`]) or fitted to the photon count and the image
+    /// size ([`crate::photons::passes::fitted_pass_iterations`]).
+    pub photon_budget: PhotonBudget,
     /// Gather directions per iteration, 1 to [`crate::gather::MAX_DIRECTIONS`]: they share the iteration's
     /// G-buffer and direct light.
     pub directions: u32,
@@ -60,6 +63,20 @@ pub enum TextureFilter {
     /// Level 0, bilinearly, at the sample's own point: the pixel's samples average it, as
     /// Mitsuba's and pbrt's `bilinear` bitmap lookups do — what to compare with them.
     Bilinear,
+}
+
+/// How long each photon pass lasts ([`RenderSettings::pass_iterations`] 0).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PhotonBudget {
+    /// Measured as the render goes on: the variance the map adds to the image against the
+    /// iterations' own, and what a pass and an iteration cost on this GPU, give the iterations
+    /// per pass that lower the image's error fastest ([`crate::photons::budget`]). The choice
+    /// depends on timings, so two renders of one seed may differ: `Fitted` repeats bit for bit.
+    #[default]
+    Balanced,
+    /// 4 · photons / pixels iterations, at least 16, whatever the scene
+    /// ([`crate::photons::passes::fitted_pass_iterations`]): the same for every run of a seed.
+    Fitted,
 }
 
 /// Where the photon grid is refined ([`crate::fit::photon_region`]).
@@ -130,6 +147,7 @@ impl Default for RenderSettings {
             directions: DEFAULT_DIRECTIONS,
             photon_passes: 0,
             pass_iterations: DEFAULT_PASS_ITERATIONS,
+            photon_budget: PhotonBudget::default(),
             hit_light: HitLight::Map,
             photon_region: PhotonRegionChoice::Camera,
             texture_filter: TextureFilter::Footprint,

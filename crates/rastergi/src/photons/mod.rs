@@ -32,6 +32,7 @@
 //! GPU's fixed-point tally maps that bound to 2²⁴ quanta of a 32-bit add and clamps a deposit
 //! at 2³¹ (128 times the bound).
 
+pub mod budget;
 mod clip;
 pub mod cpu;
 pub mod gpu;

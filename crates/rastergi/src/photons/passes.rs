@@ -8,7 +8,11 @@
 //!   lasts `pass_iterations` iterations of the image; every iteration reads the map of its
 //!   pass, and the image is the mean over all iterations.
 //! * Schedule: pass k uses r_k = round(r₀ · (k + 1)^((1 − α)/2)) cells along the longest axis,
-//!   cell area h_k² ∝ (k + 1)^−(1−α), with α = [`ALPHA`] = 2/3.
+//!   cell area h_k² ∝ (k + 1)^−(1−α), with α = [`ALPHA`] = 2/3; the factor is rounded down to a
+//!   power of 2^(1/8) ([`pass_resolution`]), so that the layout, made on the CPU, is made anew
+//!   at a few passes only (logarithmically many).
+//! * Iterations per pass: fitted ([`fitted_pass_iterations`]) or balanced by measurement
+//!   ([`super::budget`]).
 //! * Why it converges: the map's bias at a point is a blur over about a cell, O(h_k), → 0;
 //!   its variance per slot is ∝ 1/(N·h_k²) ∝ (k + 1)^(1−α), and the mean over K passes of
 //!   independent maps has variance ∝ K^−2 Σ (k + 1)^(1−α) ∝ K^−α → 0. The iterations average
@@ -46,9 +50,17 @@ pub fn first_pass_photons(count: u32) -> u32 {
     (count / 4).max(count.min(1 << 16))
 }
 
-/// Grid resolution of pass `pass` (0-based) for a first pass of `first` cells.
+/// Steps of the schedule per doubling of the resolution: the cells shrink in steps of
+/// 2^(1/8) (9 %) along each axis, so a new layout is made at passes 1, 2, 4, 7, 13, 22, 37, 63,
+/// … (a factor of 1.68 apart) rather than at almost every pass of the first hundred.
+pub const RESOLUTION_STEPS_PER_DOUBLING: f64 = 8.0;
+
+/// Grid resolution of pass `pass` (0-based) for a first pass of `first` cells:
+/// first · (k + 1)^((1 − α)/2), the factor rounded down to a power of 2^(1/8).
 pub fn pass_resolution(first: u32, pass: u32) -> u32 {
-    ((first as f64) * ((pass + 1) as f64).powf(0.5 * (1.0 - ALPHA))).round() as u32
+    let growth = ((pass + 1) as f64).log2() * 0.5 * (1.0 - ALPHA);
+    let step = (growth * RESOLUTION_STEPS_PER_DOUBLING + 1e-9).floor() / RESOLUTION_STEPS_PER_DOUBLING;
+    ((first as f64) * 2f64.powf(step)).round() as u32
 }
 
 /// The photon map of the current pass and what the next pass needs.
@@ -153,12 +165,38 @@ impl PhotonPasses {
         )
     }
 
+    /// Iterations the current pass lasts.
+    pub fn pass_iterations(&self) -> u32 {
+        self.pass_iterations
+    }
+
+    /// Sets how many iterations passes last from the current one on (the photon budget's
+    /// choice: [`super::budget`]).
+    pub fn set_pass_iterations(&mut self, iterations: u32) {
+        self.pass_iterations = iterations.max(1);
+    }
+
+    /// The photons of the current pass (the first of several has a quarter of them).
+    pub fn pass_photons(&self) -> u32 {
+        if self.pass == 0 && self.passes != 1 { first_pass_photons(self.settings.count) } else { self.settings.count }
+    }
+
+    /// The photons of the pass after the current one.
+    pub fn next_pass_photons(&self) -> u32 {
+        self.settings.count
+    }
+
+    /// Whether the next [`advance`](Self::advance) starts a new pass.
+    pub fn pass_ends(&self) -> bool {
+        let more = self.passes == 0 || self.pass + 1 < self.passes;
+        more && self.iterations_in_pass >= self.pass_iterations
+    }
+
     /// Called before each iteration: once the current pass has had its iterations, traces the
     /// next one (a new layout where the schedule asks for finer cells). Returns whether the map
     /// changed.
     pub fn advance(&mut self, gpu: &Gpu, scene: &GpuScene) -> Result<bool> {
-        let more = self.passes == 0 || self.pass + 1 < self.passes;
-        if !(more && self.iterations_in_pass >= self.pass_iterations) {
+        if !self.pass_ends() {
             self.iterations_in_pass += 1;
             return Ok(false);
         }
@@ -205,10 +243,20 @@ mod tests {
         assert_eq!(pass_resolution(64, 63), 128);
         assert_eq!(pass_resolution(64, 4095), 256);
         let mut last = 0;
+        let mut changes = 0;
         for k in 0..1000 {
             let r = pass_resolution(32, k);
             assert!(r >= last);
+            // Within one step (9 %) below the exact schedule.
+            let exact = 32.0 * ((k + 1) as f64).powf(1.0 / 6.0);
+            assert!(
+                r as f64 <= exact + 0.5 && r as f64 >= exact / 2f64.powf(1.0 / 8.0) - 0.5,
+                "pass {k}: {r} against {exact}"
+            );
+            changes += (r != last) as u32;
             last = r;
         }
+        // The first pass, then every factor of 2^(6/8) in passes: 1, 2, 4, 7, 13, … 860.
+        assert_eq!(changes, 14);
     }
 }

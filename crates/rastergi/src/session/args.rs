@@ -92,6 +92,27 @@ pub enum HitLightArg {
     Exact,
 }
 
+/// How long each photon pass lasts where `--pass-iterations` is not given.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
+pub enum PhotonBudgetArg {
+    /// Measured as the render goes on: the iterations per pass of least error per second, from
+    /// the variance the map adds against the iterations' own and what each costs on this GPU
+    /// (depends on timings: give `fitted` for images that repeat bit for bit)
+    Balanced,
+    /// 4 × photons / pixels iterations per pass, at least 16 (the photons capped so that a pass
+    /// lasts at most about 64 iterations): the same for every run of a seed
+    Fitted,
+}
+
+impl PhotonBudgetArg {
+    pub fn budget(self) -> crate::settings::PhotonBudget {
+        match self {
+            PhotonBudgetArg::Balanced => crate::settings::PhotonBudget::Balanced,
+            PhotonBudgetArg::Fitted => crate::settings::PhotonBudget::Fitted,
+        }
+    }
+}
+
 /// Where the photon grid's cells are finer.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
 pub enum PhotonRegionArg {
@@ -277,10 +298,15 @@ pub struct SceneArgs {
     /// (cell area ∝ pass^-1/3). 1: one fixed map traced before the first iteration; 0: no limit.
     #[arg(long, default_value_t = 0)]
     pub photon_passes: u32,
-    /// Iterations per photon pass (default 0: fitted, 4 × photons / pixels and at least 16, so
-    /// tracing takes about a fifth of the time: 64 for cornell at 256², 16 at 512² and above).
+    /// Iterations per photon pass (default 0: as --photon-budget chooses)
     #[arg(long, default_value_t = crate::photons::passes::DEFAULT_PASS_ITERATIONS)]
     pub pass_iterations: u32,
+    /// How many iterations each photon pass lasts where --pass-iterations is not given:
+    /// `balanced` measures the map's noise against the iterations' and the cost of each on
+    /// this GPU and takes the pass length of least error per second; `fitted` takes 4 ×
+    /// photons / pixels iterations (at least 16)
+    #[arg(long, value_enum, default_value_t = PhotonBudgetArg::Balanced)]
+    pub photon_budget: PhotonBudgetArg,
     /// Ray-view resolution of the final gather, texels per side (default: fitted: twice the
     /// image's larger side, raised to 8 texels across the median triangle's shortest edge over
     /// the scene's bounding sphere; 128 to 2048).
@@ -351,6 +377,7 @@ impl SceneArgs {
             grid: self.grid,
             photon_passes: self.photon_passes,
             pass_iterations: self.pass_iterations,
+            photon_budget: self.photon_budget.budget(),
             bundle: self.bundle,
             gather: self.gather.method(),
             gather_directions: self.gather_directions.directions(),

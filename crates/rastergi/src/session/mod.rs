@@ -116,6 +116,8 @@ pub struct Options {
     pub grid: Option<u32>,
     pub photon_passes: u32,
     pub pass_iterations: u32,
+    /// How long each photon pass lasts where `pass_iterations` is 0.
+    pub photon_budget: crate::settings::PhotonBudget,
     /// The gather's ray-view resolution (`None`: fitted).
     pub bundle: Option<u32>,
     pub gather: GatherMethod,
@@ -158,6 +160,7 @@ impl Default for Options {
             grid: None,
             photon_passes: 0,
             pass_iterations: crate::photons::passes::DEFAULT_PASS_ITERATIONS,
+            photon_budget: crate::settings::PhotonBudget::default(),
             bundle: None,
             gather: GatherMethod::Auto,
             gather_directions: GatherDirections::default(),
@@ -277,8 +280,11 @@ impl Options {
     /// where `show_photon_map` is set (the viewer keeps it to switch to it).
     pub fn settings(&self, scene: &Scene, width: u32, height: u32, show_photon_map: bool) -> RenderSettings {
         let grid = self.grid.unwrap_or_else(|| fit::grid_resolution(&scene.bounds()));
-        // Progressive passes at the fitted cadence: no pass longer than about 64 iterations.
-        let progressive = self.photon_passes != 1 && self.pass_iterations == 0;
+        // Progressive passes at the fitted cadence: no pass longer than about 64 iterations (a
+        // balanced budget chooses the passes' length for the scene's photons instead).
+        let progressive = self.photon_passes != 1
+            && self.pass_iterations == 0
+            && self.photon_budget == crate::settings::PhotonBudget::Fitted;
         let photons = self.photons.unwrap_or_else(|| {
             let fitted = fit::photon_count(scene, grid);
             if progressive { fit::photons_for_image(fitted, width as u64 * height as u64) } else { fitted }
@@ -303,6 +309,7 @@ impl Options {
             directions: self.directions,
             photon_passes: self.photon_passes,
             pass_iterations: self.pass_iterations,
+            photon_budget: self.photon_budget,
             hit_light: self.hit_light,
             photon_region: self.photon_region,
             texture_filter: self.texture_filter,

@@ -9,6 +9,7 @@ use glam::Vec3;
 use super::run::{Limits, Observer, Stop, run};
 use super::*;
 use crate::scene::Framing;
+use crate::settings::PhotonBudget;
 
 /// `rastergi render cornell` (no flags): 256², fitted 2^20 photons on a 64-cell grid (the
 /// figures the user guide gives for cornell), every other setting the renderer's default.
@@ -25,8 +26,8 @@ fn cornell_with_no_flags_gets_the_fitted_defaults() {
 
 /// `rastergi render cornell --width 96 --height 40 --seed 7 --photons 5000 --grid 20 --bundle
 /// 300 --gather trace --gather-directions shared --directions 2 --light-samples 3
-/// --photon-passes 4 --pass-iterations 10 --hit-light exact --photon-region scene
-/// --texture-filter bilinear --show photon-map`.
+/// --photon-passes 4 --pass-iterations 10 --photon-budget fitted --hit-light exact
+/// --photon-region scene --texture-filter bilinear --show photon-map`.
 #[test]
 fn given_flags_are_the_settings() {
     let options = Options {
@@ -43,6 +44,7 @@ fn given_flags_are_the_settings() {
         light_samples: 3,
         photon_passes: 4,
         pass_iterations: 10,
+        photon_budget: PhotonBudget::Fitted,
         hit_light: HitLight::Exact,
         photon_region: PhotonRegionChoice::Scene,
         texture_filter: TextureFilter::Bilinear,
@@ -65,6 +67,7 @@ fn given_flags_are_the_settings() {
         directions: 2,
         photon_passes: 4,
         pass_iterations: 10,
+        photon_budget: PhotonBudget::Fitted,
         hit_light: HitLight::Exact,
         photon_region: PhotonRegionChoice::Scene,
         texture_filter: TextureFilter::Bilinear,

@@ -1,0 +1,480 @@
+//! The photon budget: how many iterations each photon pass lasts, chosen by measurement
+//! (`RenderSettings::photon_budget`, issue 57).
+//!
+//! Every iteration of a photon pass reads the same map, so the image's error has two parts:
+//! the map's, which only fresh photons lower, and the iterations' own (the G-buffer's jitter,
+//! the light samples, the gather's directions), which more iterations lower. A pass of N
+//! photons and M iterations gives its mean image a variance (summed over the pixels)
+//!
+//! ```text
+//!   a/N + W/M        at a cost   C + M·c
+//! ```
+//!
+//! (a/N the map's: a map's variance falls as 1/N; W/M the iterations'; C the pass's tracing,
+//! with its layout where the cells shrink; c an iteration). Over a render of time T the mean of
+//! the passes has variance (a/N + W/M)·(C + M·c)/T, least at
+//!
+//! ```text
+//!   M* = √(W·C / ((a/N)·c))
+//! ```
+//!
+//! where the time splits evenly between what each term costs. A fixed rule misses it far: in a
+//! room lit through its windows, at 96 × 72, the map's noise was 15 times the iterations' at the
+//! fitted cadence of 2¹⁷ photons per 76 iterations (photons 13 times as many per iteration were
+//! worth it), and the Cornell box at 128² wants about 3 times its photons per iteration.
+//!
+//! **Measured, not modelled.** At each pass's end a compute pass (`budget.wgsl`) sums over the
+//! pixels (those that never saw light itself, as the error estimate takes them) the squared
+//! difference between the pass's mean and the previous pass's. Their maps are independent and
+//! their iterations nearly so, so
+//!
+//! ```text
+//!   E[Σ (x_k − x_{k−1})²] = a·(1/N_k + 1/N_{k−1}) + W·(1/M_k + 1/M_{k−1}),
+//! ```
+//!
+//! linear in the unknowns a and W: they are fitted by least squares to the last [`HISTORY`]
+//! pairs of passes ([`fit`]). For both to be known the passes must differ: the first three
+//! last [`FIRST_ITERATIONS`] (the first with a quarter of the photons), then twice as many, and
+//! after that every [`EXPLORE`]-th pass lasts twice (or half) the chosen length. The costs are
+//! wall-clock times on this GPU: C from a pass's tracing's start to its end (the GPU waited
+//! for), c per iteration between a pass's start and its end. M* is rounded to a power of two in
+//! [[`MIN_ITERATIONS`], [`MAX_ITERATIONS`]], so that noise in the timings seldom changes it (the
+//! ceiling keeps the cells shrinking: the map's blur, a bias, goes with passes). The
+//! iterations' samples are consecutive points of per-pixel Sobol' sequences, whose blocks are
+//! slightly anti-correlated: W comes out a little high (as the film's error estimate does).
+//!
+//! A camera move clears the film: the pass under way and the next pair are not measured.
+
+use super::passes::PhotonPasses;
+use crate::error::Result;
+use crate::gpu::binding::{Group, Slot};
+use crate::gpu::structs::{GpuStruct, gpu_struct};
+use crate::gpu::{Gpu, compute_pipeline, shader};
+use crate::gpu_scene::GpuScene;
+
+/// Iterations of each of the first three passes, before the measurements choose (the third
+/// lasts twice as long).
+pub const FIRST_ITERATIONS: u32 = 16;
+/// The fewest and most iterations a balanced pass lasts.
+pub const MIN_ITERATIONS: u32 = 2;
+pub const MAX_ITERATIONS: u32 = 256;
+/// Pairs of passes the fit uses.
+pub const HISTORY: usize = 8;
+/// Every EXPLORE-th pass after the first three lasts twice (or half) the chosen length.
+pub const EXPLORE: u32 = 4;
+const WORKGROUP: u64 = 64;
+
+gpu_struct! {
+    /// The budget pass's uniforms (`budget.wgsl`).
+    pub(crate) struct BudgetUniforms as "Budget" {
+        pub(crate) pixels: u32,
+        /// The iterations of the pass that ends.
+        pub(crate) iterations: f32,
+        /// 1 where the previous pass's mean is in the snapshots.
+        pub(crate) has_previous: u32,
+        pub(crate) _pad: u32,
+    }
+}
+
+/// The budget pass's bind group: the film read, the snapshots and the per-workgroup sums written.
+pub fn group() -> Group {
+    Group::compute(
+        "photon budget",
+        &[
+            Slot::uniform::<BudgetUniforms>(0, "params"),
+            Slot::read::<[f32; 4]>(1, "film"),
+            Slot::write::<[f32; 4]>(2, "snapshots"),
+            Slot::write::<[f32; 4]>(3, "partials"),
+        ],
+    )
+}
+
+/// The budget pass's composed shader.
+pub fn source() -> String {
+    shader::compose(&[&BudgetUniforms::wgsl(), include_str!("budget.wgsl")])
+}
+
+/// A pair of consecutive passes as measured: their photons and iterations, and the squared
+/// difference of their means summed over the pixels.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PassPair {
+    pub photons: [u32; 2],
+    pub iterations: [u32; 2],
+    pub squared_difference: f64,
+}
+
+/// The variance model's constants: a (the map's variance × its photons) and W (one iteration's
+/// variance), both summed over the pixels.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Variances {
+    pub map_times_photons: f64,
+    pub iteration: f64,
+}
+
+/// Least squares of E[Σ(x_k − x_{k−1})²] = a·(1/N_k + 1/N_{k−1}) + W·(1/M_k + 1/M_{k−1})
+/// over `pairs`: `None` where they do not tell a from W (all pairs alike). A negative estimate
+/// is clamped at 0 (that part too small to measure).
+pub fn fit(pairs: &[PassPair]) -> Option<Variances> {
+    // In units of the first pair's photons, so the normal equations are well scaled.
+    let unit = pairs.first()?.photons[1] as f64;
+    let (mut uu, mut ux, mut xx, mut uy, mut xy) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    for p in pairs {
+        let u = unit / p.photons[0].max(1) as f64 + unit / p.photons[1].max(1) as f64;
+        let x = 1.0 / p.iterations[0].max(1) as f64 + 1.0 / p.iterations[1].max(1) as f64;
+        let y = p.squared_difference;
+        (uu, ux, xx, uy, xy) = (uu + u * u, ux + u * x, xx + x * x, uy + u * y, xy + x * y);
+    }
+    let det = uu * xx - ux * ux;
+    if det.is_nan() || det <= 1e-6 * uu * xx {
+        return None;
+    }
+    let a = (uy * xx - xy * ux) / det;
+    let w = (xy * uu - uy * ux) / det;
+    if !(a.is_finite() && w.is_finite()) {
+        return None;
+    }
+    Some(Variances { map_times_photons: a.max(0.0) * unit, iteration: w.max(0.0) })
+}
+
+/// The iterations per pass of least variance per unit of time for a pass whose map adds
+/// `map_variance` and whose iterations each `iteration_variance`, costing `pass_seconds` and
+/// `iteration_seconds`: √(W·C / (V_map·c)) as a power of two (the nearest in log scale) within
+/// [MIN_ITERATIONS, MAX_ITERATIONS].
+pub fn balanced_iterations(
+    map_variance: f64,
+    iteration_variance: f64,
+    pass_seconds: f64,
+    iteration_seconds: f64,
+) -> u32 {
+    let m = (iteration_variance * pass_seconds / (map_variance * iteration_seconds)).sqrt();
+    if m.is_nan() || m <= 0.0 {
+        return MIN_ITERATIONS;
+    }
+    if m.is_infinite() {
+        return MAX_ITERATIONS;
+    }
+    let m = 2f64.powi(m.log2().round() as i32);
+    (m.clamp(MIN_ITERATIONS as f64, MAX_ITERATIONS as f64)) as u32
+}
+
+/// The GPU side: snapshots of the film where a pass starts and the sums of its end
+/// (`budget.wgsl`).
+struct PassVariance {
+    pixels: u32,
+    uniforms: wgpu::Buffer,
+    partials: wgpu::Buffer,
+    workgroups: (u32, u32),
+    bind_group: wgpu::BindGroup,
+    /// `start`, `end`.
+    pipelines: [wgpu::ComputePipeline; 2],
+    /// Keeps the snapshots alive with the bind group.
+    _snapshots: wgpu::Buffer,
+}
+
+impl PassVariance {
+    /// Over the film `accumulation` of `pixels` pixels (its components as `passes::film` lays
+    /// them out).
+    fn new(gpu: &Gpu, accumulation: &wgpu::Buffer, pixels: u32) -> PassVariance {
+        let device = &gpu.device;
+        let rw = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
+        let n = (pixels as u64).div_ceil(WORKGROUP).max(1);
+        let x = n.min(65535);
+        let workgroups = (x as u32, n.div_ceil(x) as u32);
+        let uniforms = gpu.zeroed_buffer(
+            "photon budget uniforms",
+            size_of::<BudgetUniforms>() as u64,
+            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        );
+        let snapshots = gpu.zeroed_buffer("photon budget snapshots", pixels.max(1) as u64 * 16, rw);
+        let partials = gpu.zeroed_buffer("photon budget sums", x * workgroups.1 as u64 * 16, rw);
+        let (layout, bind_group) = group().layout_and_bind(
+            device,
+            &[
+                ("params", uniforms.as_entire_binding()),
+                ("film", accumulation.as_entire_binding()),
+                ("snapshots", snapshots.as_entire_binding()),
+                ("partials", partials.as_entire_binding()),
+            ],
+        );
+        let module = shader::module(device, "photon budget", &source());
+        let pipelines =
+            ["start", "end"].map(|e| compute_pipeline(device, "photon budget", &module, e, &[&layout], &[]));
+        PassVariance { pixels, uniforms, partials, workgroups, bind_group, pipelines, _snapshots: snapshots }
+    }
+
+    fn dispatch(&self, gpu: &Gpu, which: usize, iterations: u32, has_previous: bool) {
+        let u = BudgetUniforms {
+            pixels: self.pixels,
+            iterations: iterations.max(1) as f32,
+            has_previous: has_previous as u32,
+            _pad: 0,
+        };
+        gpu.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
+        let mut enc =
+            gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("photon budget") });
+        {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&self.pipelines[which]);
+            pass.set_bind_group(0, &self.bind_group, &[]);
+            pass.dispatch_workgroups(self.workgroups.0, self.workgroups.1, 1);
+        }
+        gpu.queue.submit([enc.finish()]);
+    }
+
+    /// Snapshot of the film where a pass starts whose previous pass was not measured.
+    fn start(&self, gpu: &Gpu) {
+        self.dispatch(gpu, 0, 1, false);
+    }
+
+    /// The end of a pass of `iterations`: (Σe², Σx, pixels counted), read back (waits for the
+    /// GPU); the snapshots become the next pass's start.
+    fn end(&self, gpu: &Gpu, iterations: u32, has_previous: bool) -> Result<[f64; 3]> {
+        self.dispatch(gpu, 1, iterations, has_previous);
+        let bytes = gpu.read_buffer(&self.partials, self.partials.size())?;
+        let mut sums = [0.0f64; 3];
+        for p in bytemuck::cast_slice::<u8, [f32; 4]>(&bytes) {
+            for (s, v) in sums.iter_mut().zip(p) {
+                *s += *v as f64;
+            }
+        }
+        Ok(sums)
+    }
+}
+
+/// One measured pass: its photons and iterations, and the costs.
+#[derive(Clone, Copy, Debug)]
+struct Pass {
+    photons: u32,
+    /// Its start's snapshot is in place (no camera move since).
+    measured: bool,
+    /// When its iterations began, and its tracing's cost.
+    started: web_time::Instant,
+    pass_seconds: Option<f64>,
+}
+
+/// The balanced budget of a render: the GPU's measurements and what they said so far.
+pub struct Budget {
+    gpu: PassVariance,
+    current: Pass,
+    /// The previous pass (photons, iterations), where its mean is in the snapshots.
+    previous: Option<(u32, u32)>,
+    pairs: Vec<PassPair>,
+    /// Recent costs: seconds per pass's tracing, per iteration.
+    pass_seconds: Vec<f64>,
+    iteration_seconds: Vec<f64>,
+    /// Passes begun since the budget was made (the exploration's count).
+    passes: u32,
+    /// The length chosen for the passes that do not explore.
+    chosen: u32,
+}
+
+impl Budget {
+    /// Over the film `accumulation` of `pixels` pixels, for `photons`' passes: their current
+    /// pass is measured where it has had no iteration yet and the film is empty (`fresh`: a new
+    /// renderer), and lasts [`FIRST_ITERATIONS`] unless it has had more.
+    pub fn new(gpu: &Gpu, accumulation: &wgpu::Buffer, pixels: u32, photons: &mut PhotonPasses, fresh: bool) -> Budget {
+        let iterations = FIRST_ITERATIONS.max(photons.iterations_in_pass());
+        photons.set_pass_iterations(iterations);
+        Budget {
+            gpu: PassVariance::new(gpu, accumulation, pixels),
+            current: Pass {
+                photons: photons.pass_photons(),
+                measured: fresh && photons.iterations_in_pass() == 0,
+                started: web_time::Instant::now(),
+                pass_seconds: None,
+            },
+            previous: None,
+            pairs: Vec::new(),
+            pass_seconds: Vec::new(),
+            iteration_seconds: Vec::new(),
+            passes: 1,
+            chosen: FIRST_ITERATIONS,
+        }
+    }
+
+    /// The film was cleared (a camera move): the pass under way is not measured.
+    pub fn restart(&mut self) {
+        self.current.measured = false;
+        self.previous = None;
+    }
+
+    /// The pairs of passes measured so far.
+    pub fn pairs(&self) -> &[PassPair] {
+        &self.pairs
+    }
+
+    /// The iterations of the passes that do not explore, as chosen so far.
+    pub fn chosen(&self) -> u32 {
+        self.chosen
+    }
+
+    /// Step 0 of an iteration (`Renderer::iterate`): the photon pass advances, as
+    /// [`PhotonPasses::advance`] does; where the pass under way has had its iterations, its end
+    /// is measured first and the next pass lasts as long as the measurements say.
+    pub fn advance(&mut self, gpu: &Gpu, scene: &GpuScene, photons: &mut PhotonPasses) -> Result<()> {
+        let done = photons.iterations_in_pass();
+        if !photons.pass_ends() {
+            if done == 0 {
+                self.current.started = web_time::Instant::now();
+            }
+            photons.advance(gpu, scene)?;
+            return Ok(());
+        }
+        self.end_pass(gpu, done)?;
+        let iterations = self.next_iterations();
+        photons.set_pass_iterations(iterations);
+        let began = web_time::Instant::now();
+        photons.advance(gpu, scene)?;
+        gpu.wait()?;
+        let pass_seconds = began.elapsed().as_secs_f64();
+        if self.previous.is_none() {
+            self.gpu.start(gpu);
+        }
+        self.passes += 1;
+        self.current = Pass {
+            photons: photons.pass_photons(),
+            measured: true,
+            started: web_time::Instant::now(),
+            pass_seconds: Some(pass_seconds),
+        };
+        Ok(())
+    }
+
+    /// The pass under way has had its `done` iterations: the squared difference of its mean and
+    /// the previous pass's, and its costs (waits for the GPU).
+    fn end_pass(&mut self, gpu: &Gpu, done: u32) -> Result<()> {
+        let c = self.current;
+        if !(c.measured && done > 0) {
+            gpu.wait()?;
+            self.previous = None;
+            return Ok(());
+        }
+        let [e2, sum_x, pixels] = self.gpu.end(gpu, done, self.previous.is_some())?;
+        let seconds = c.started.elapsed().as_secs_f64() / done as f64;
+        keep_recent(&mut self.iteration_seconds, seconds);
+        if let Some(s) = c.pass_seconds {
+            keep_recent(&mut self.pass_seconds, s);
+        }
+        if let Some((photons, iterations)) = self.previous {
+            self.pairs.push(PassPair {
+                photons: [photons, c.photons],
+                iterations: [iterations, done],
+                squared_difference: e2,
+            });
+            if self.pairs.len() > HISTORY {
+                self.pairs.remove(0);
+            }
+            let mean = sum_x / pixels.max(1.0);
+            let relative = |v: f64| v / pixels.max(1.0) / (mean * mean).max(1e-30);
+            log::info!(
+                "photon budget: passes of {photons} and {} photons, {iterations} and {done} iterations: the means differ by {:.2} % (relative RMS); {}",
+                c.photons,
+                100.0 * relative(e2).sqrt(),
+                match fit(&self.pairs) {
+                    Some(v) => format!(
+                        "fitted per pixel, relative to the mean: the map's variance {:.3e} at {} photons, an iteration's {:.3e}",
+                        relative(v.map_times_photons / c.photons as f64),
+                        c.photons,
+                        relative(v.iteration)
+                    ),
+                    None => "not enough passes to tell the map's variance from the iterations'".into(),
+                }
+            );
+        }
+        self.previous = Some((c.photons, done));
+        Ok(())
+    }
+
+    /// The next pass's iterations: the first three passes' fixed lengths, then the balanced
+    /// length, twice or half of it every [`EXPLORE`]-th pass.
+    fn next_iterations(&mut self) -> u32 {
+        let k = self.passes;
+        if k < 2 {
+            return FIRST_ITERATIONS;
+        }
+        if k == 2 {
+            return 2 * FIRST_ITERATIONS;
+        }
+        let mean = |v: &[f64]| (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64);
+        if let (Some(v), Some(cost), Some(c)) =
+            (fit(&self.pairs), mean(&self.pass_seconds), mean(&self.iteration_seconds))
+        {
+            let photons = self.current.photons.max(1) as f64;
+            self.chosen = balanced_iterations(v.map_times_photons / photons, v.iteration, cost, c);
+            log::info!(
+                "photon budget: {} iterations per pass (tracing {:.0} ms, an iteration {:.1} ms)",
+                self.chosen,
+                cost * 1e3,
+                c * 1e3
+            );
+        }
+        if k.is_multiple_of(EXPLORE) {
+            if self.chosen < MAX_ITERATIONS { 2 * self.chosen } else { self.chosen / 2 }
+        } else {
+            self.chosen
+        }
+    }
+}
+
+/// Appends `v`, keeping the last [`HISTORY`].
+fn keep_recent(values: &mut Vec<f64>, v: f64) {
+    values.push(v);
+    if values.len() > HISTORY {
+        values.remove(0);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The rounded choice is the power of two of least (V_map + W/M)(C + M·c) among all of them
+    /// in range, or within 7 % of it where the optimum lies between two; the unrounded one is
+    /// the continuous optimum (brute force).
+    #[test]
+    fn the_balanced_iterations_minimise_the_variance_per_unit_of_time() {
+        let cases = [(1.0, 1.0, 1.0, 1.0), (0.01, 5.0, 0.2, 0.01), (3.0, 0.1, 0.05, 0.02), (1e-2, 10.0, 0.5, 1e-2)];
+        for (v_map, w, c_pass, c_it) in cases {
+            let m = balanced_iterations(v_map, w, c_pass, c_it);
+            let cost = |m: f64| (v_map + w / m) * (c_pass + m * c_it);
+            let best = (1..=8).map(|k| 1u32 << k).min_by(|&a, &b| cost(a as f64).total_cmp(&cost(b as f64))).unwrap();
+            let exact = (w * c_pass / (v_map * c_it)).sqrt();
+            let brute = (1..=400_000).map(|i| i as f64 * 0.01).min_by(|a, b| cost(*a).total_cmp(&cost(*b))).unwrap();
+            assert!((brute - exact).abs() <= 0.011 * exact.max(1.0), "{brute} against {exact}");
+            assert!(m == best || cost(m as f64) <= cost(best as f64) * 1.07, "{m} against {best}");
+        }
+        assert_eq!(balanced_iterations(0.0, 1.0, 1.0, 1.0), MAX_ITERATIONS);
+        assert_eq!(balanced_iterations(1.0, 0.0, 1.0, 1.0), MIN_ITERATIONS);
+    }
+
+    /// Pairs made from known a and W (with noise of 5 % on each squared difference) give them
+    /// back; pairs that are all alike give nothing.
+    #[test]
+    fn the_fit_recovers_the_map_and_the_iterations_variances() {
+        let (a, w) = (3.0e6, 40.0);
+        let n = 1u32 << 20;
+        let pair = |p: [u32; 2], m: [u32; 2], noise: f64| PassPair {
+            photons: p,
+            iterations: m,
+            squared_difference: (a * (1.0 / p[0] as f64 + 1.0 / p[1] as f64)
+                + w * (1.0 / m[0] as f64 + 1.0 / m[1] as f64))
+                * (1.0 + noise),
+        };
+        let pairs = [
+            pair([n / 4, n], [16, 16], 0.05),
+            pair([n, n], [16, 32], -0.05),
+            pair([n, n], [32, 8], 0.03),
+            pair([n, n], [8, 8], -0.02),
+        ];
+        let v = fit(&pairs).unwrap();
+        assert!((v.map_times_photons / a - 1.0).abs() < 0.15, "{v:?}");
+        assert!((v.iteration / w - 1.0).abs() < 0.15, "{v:?}");
+        let exact =
+            fit(&pairs
+                .map(|p| PassPair { squared_difference: pair(p.photons, p.iterations, 0.0).squared_difference, ..p }))
+            .unwrap();
+        assert!((exact.map_times_photons / a - 1.0).abs() < 1e-9 && (exact.iteration / w - 1.0).abs() < 1e-9);
+        assert_eq!(fit(&[pair([n, n], [16, 16], 0.0), pair([n, n], [16, 16], 0.1)]), None);
+        assert_eq!(fit(&[]), None);
+    }
+}

@@ -16,7 +16,7 @@
 
 use glam::UVec3;
 
-use super::map::{GridSpec, MAX_SEPARATORS, MapLayout, PhotonMap, Separator, TrianglePlane};
+use super::map::{GridSpec, MapLayout, PhotonMap, TrianglePlane};
 use super::{MAX_BOUNCES, PhotonSettings};
 use crate::error::Result;
 use crate::gpu::binding::{Group, Slot};
@@ -92,7 +92,10 @@ gpu_struct! {
         pub(crate) sep_max_probe: u32,
         /// The first bounce that deposits: 0, or 1 for a map of indirect light only.
         pub(crate) first_deposit: u32,
-        pub(crate) _pad: [u32; 2],
+        /// Where the separators' records and the cells' separator flags start in `slot_keys`
+        /// ([`table_entries`]).
+        pub(crate) records: u32,
+        pub(crate) cell_flags: u32,
     }
 }
 
@@ -108,7 +111,12 @@ gpu_struct! {
         pub sep_max_probe: u32,
         /// 1 where the map holds indirect irradiance only (deposits from the second surface on).
         pub indirect_only: u32,
-        pub _pad: [u32; 3],
+        /// Where the separators' records and the cells' separator flags start in `slot_keys`
+        /// ([`table_entries`]).
+        pub records: u32,
+        pub cell_flags: u32,
+        /// The grid's cells (both levels): the flags' runs are this many bits long.
+        pub cells: u32,
     }
 }
 
@@ -233,9 +241,10 @@ impl GpuPhotonMap {
         let area_scaled: Vec<f32> = layout.area.iter().map(|&a| (a / h2) as f32).collect();
         let area_buffer =
             gpu.storage_buffer("photon slot areas", bytemuck::cast_slice(&area_scaled), wgpu::BufferUsages::empty());
-        // The slots' keys, then the separators' (one binding: table.wgsl).
+        // The slots' keys, the separators' keys and records, the cells' flags (one binding:
+        // table.wgsl).
         let sep = &layout.separators;
-        let all_keys: Vec<[u32; 2]> = layout.table.keys.iter().chain(&sep.table.keys).copied().collect();
+        let (all_keys, records, cell_flags) = table_entries(&layout);
         let keys =
             gpu.storage_buffer("photon table keys", bytemuck::cast_slice(&all_keys), wgpu::BufferUsages::empty());
         // Never empty: a scene without triangles still binds one entry.
@@ -245,8 +254,6 @@ impl GpuPhotonMap {
             layout.planes.clone()
         };
         let planes = gpu.storage_buffer("photon planes", bytemuck::cast_slice(&planes), wgpu::BufferUsages::empty());
-        let sep_planes =
-            gpu.storage_buffer("photon separators", bytemuck::cast_slice(&sep.planes), wgpu::BufferUsages::empty());
         let (sep_mask, sep_max_probe) = (sep.table.capacity() as u32 - 1, sep.table.max_probe);
         let slots = gpu.zeroed_buffer(
             "photon map slots",
@@ -272,11 +279,7 @@ impl GpuPhotonMap {
             ("tally_g", channel(1)),
             ("tally_b", channel(2)),
         ];
-        let trace_only = [
-            ("slot_keys", keys.as_entire_binding()),
-            ("planes", planes.as_entire_binding()),
-            ("separator_planes", sep_planes.as_entire_binding()),
-        ];
+        let trace_only = [("slot_keys", keys.as_entire_binding()), ("planes", planes.as_entire_binding())];
         let resolve_only = [("slot_area", area_buffer.as_entire_binding()), ("slots_out", slots.as_entire_binding())];
         let trace_resources: Vec<_> = counters.iter().cloned().chain(trace_only).collect();
         let (trace_layout, trace_group) = trace_group().layout_and_bind(device, &trace_resources);
@@ -311,7 +314,8 @@ impl GpuPhotonMap {
             sep_mask,
             sep_max_probe,
             first_deposit: settings.indirect_only as u32,
-            _pad: [0; 2],
+            records,
+            cell_flags,
         };
         let grid_uniforms = PhotonGridUniforms {
             grid: GridLevels::from(&grid),
@@ -320,9 +324,11 @@ impl GpuPhotonMap {
             sep_mask,
             sep_max_probe,
             indirect_only: settings.indirect_only as u32,
-            _pad: [0; 3],
+            records,
+            cell_flags,
+            cells: grid.cell_count() as u32,
         };
-        let buffers = [&slots, &keys, &planes, &sep_planes];
+        let buffers = [&slots, &keys, &planes];
         let (bind_layout, bind_group) = lookup_binding(gpu, &grid_uniforms, buffers);
         Ok(GpuPhotonMap {
             layout,
@@ -443,11 +449,43 @@ impl GpuPhotonMap {
     }
 }
 
+/// The map's table as one buffer of `[u32; 2]` entries (`slot_keys` in WGSL, `table.wgsl`): the
+/// slots' keys (the table's capacity), the separators' keys (theirs), each separator entry's
+/// record (its [`super::map::MAX_SEPARATORS`] planes, 8 entries of f32 bits), and two bits per
+/// cell of the grid (64 cells an entry, each kind in a run of its own): the cell holds
+/// separators of some slot, and the cell holds some slot (a lookup searches neither the
+/// separators nor the slots of a cell whose flag says it has none: the air above a floor).
+/// With the records' and the flags' first entries. One binding for
+/// all of them: a browser grants 10 storage buffers to a shader stage, and the traced gather
+/// and the photon tracer had used them all.
+pub fn table_entries(layout: &MapLayout) -> (Vec<[u32; 2]>, u32, u32) {
+    let sep = &layout.separators;
+    let mut entries: Vec<[u32; 2]> = layout.table.keys.iter().chain(&sep.table.keys).copied().collect();
+    let records = entries.len() as u32;
+    for record in &sep.planes {
+        let words: &[u32] = bytemuck::cast_slice(record);
+        entries.extend(words.chunks_exact(2).map(|w| [w[0], w[1]]));
+    }
+    let cell_flags = entries.len() as u32;
+    let words = (layout.grid.cell_count() as usize).div_ceil(64).max(1);
+    let flags = |keys: &[[u32; 2]]| {
+        let mut flags = vec![[0u32; 2]; words];
+        for k in keys.iter().filter(|k| k[0] != super::table::EMPTY) {
+            let cell = (k[0] & !crate::gpu::consts::CAUSTIC_CELL) as usize;
+            flags[cell / 64][(cell % 64) / 32] |= 1 << (cell % 32);
+        }
+        flags
+    };
+    entries.extend(flags(&sep.table.keys));
+    entries.extend(flags(&layout.table.keys));
+    (entries, records, cell_flags)
+}
+
 /// The lookup bind group: the slots' values, the table's keys, the plane keys and the grid.
 fn lookup_binding(
     gpu: &Gpu,
     u: &PhotonGridUniforms,
-    [slots, keys, planes, sep_planes]: [&wgpu::Buffer; 4],
+    [slots, keys, planes]: [&wgpu::Buffer; 3],
 ) -> (wgpu::BindGroupLayout, wgpu::BindGroup) {
     let uniforms = gpu.zeroed_buffer(
         "photon grid",
@@ -460,7 +498,6 @@ fn lookup_binding(
         ("photon_grid", uniforms.as_entire_binding()),
         ("slot_keys", keys.as_entire_binding()),
         ("planes", planes.as_entire_binding()),
-        ("separator_planes", sep_planes.as_entire_binding()),
     ];
     lookup_group().layout_and_bind(&gpu.device, &resources)
 }
@@ -480,11 +517,7 @@ const COUNTERS: [Slot; 4] = [
 /// stage.
 pub fn trace_group() -> Group {
     let mut g = Group::compute("photon trace", &COUNTERS);
-    g.slots.extend([
-        Slot::read::<[u32; 2]>(6, "slot_keys"),
-        Slot::read::<TrianglePlane>(7, "planes"),
-        Slot::read::<[Separator; MAX_SEPARATORS]>(8, "separator_planes"),
-    ]);
+    g.slots.extend([Slot::read::<[u32; 2]>(6, "slot_keys"), Slot::read::<TrianglePlane>(7, "planes")]);
     g
 }
 
@@ -506,7 +539,6 @@ pub fn lookup_group() -> Group {
             Slot::uniform::<PhotonGridUniforms>(1, "photon_grid"),
             Slot::read::<[u32; 2]>(2, "slot_keys"),
             Slot::read::<TrianglePlane>(3, "planes"),
-            Slot::read::<[Separator; MAX_SEPARATORS]>(4, "separator_planes"),
         ],
     )
 }

@@ -28,7 +28,7 @@ pub use crate::gpu::consts::MAX_SEPARATORS;
 pub const MIN_REGION: f64 = 0.02;
 
 /// The separators of every base slot that has any, in a table keyed like the slots
-/// (`slot_keys` from the slots' capacity on, `separator_planes` in WGSL).
+/// (`slot_keys` from the slots' capacity on, the records after them: `photons::gpu::table_entries`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Separators {
     pub table: SlotTable,

@@ -106,9 +106,52 @@ fn region_of(r: SeparatorRecord, p: vec3f) -> u32 {
     return region;
 }
 
+// The separators' table follows the slots' in `slot_keys` (from entry `base`, the slots'
+// capacity), then the separators' records (8 entries of f32 bits each, from entry
+// `t.records`), then one bit per cell where the cell holds separators and one where it holds
+// slots (64 an entry, from `t.cell_flags`): one binding for them all
+// (photons::gpu::table_entries), under WebGPU's 10 storage buffers per stage.
+struct TableLayout {
+    base: u32,
+    mask: u32,
+    max_probe: u32,
+    records: u32,
+    cell_flags: u32,
+}
+
+// Bit `cell` of the flags from entry `first` (64 an entry).
+fn cell_flag(first: u32, cell: u32) -> bool {
+    let w = slot_keys[first + cell / 64u];
+    let bit = cell % 64u;
+    return ((select(w.x, w.y, bit >= 32u) >> (bit % 32u)) & 1u) != 0u;
+}
+
+// Whether cell `cell` holds the separators of some slot (the first run of flags).
+fn cell_has_separators(t: TableLayout, cell: u32) -> bool {
+    return cell_flag(t.cell_flags, cell);
+}
+
+// Whether cell `cell` (its index without CAUSTIC_CELL) holds some slot (the second run of flags,
+// one entry per 64 cells of the grid after the first: `cells` the grid's cell count).
+fn cell_has_slots(t: TableLayout, cells: u32, cell: u32) -> bool {
+    return cell_flag(t.cell_flags + (cells + 63u) / 64u, cell);
+}
+
 // The entry of base slot (cell, plane)'s separators, NO_SLOT where it has none: find_slot over
-// the separators' table, which follows the slots' in `slot_keys` (from entry `base`, the
-// slots' capacity: one binding for both, under WebGPU's 10 storage buffers per stage).
-fn find_separators(cell: u32, plane: u32, base: u32, mask: u32, max_probe: u32) -> u32 {
-    return find_entry(cell, plane, base, mask, max_probe);
+// the separators' table, searched only in a cell flagged to hold some.
+fn find_separators(t: TableLayout, cell: u32, plane: u32) -> u32 {
+    if !cell_has_separators(t, cell) {
+        return NO_SLOT;
+    }
+    return find_entry(cell, plane, t.base, t.mask, t.max_probe);
+}
+
+// The record of separators' entry `sep`.
+fn separator_record(t: TableLayout, sep: u32) -> SeparatorRecord {
+    var r: SeparatorRecord;
+    let first = t.records + 2u * MAX_SEPARATORS * sep;
+    for (var k = 0u; k < MAX_SEPARATORS; k++) {
+        r.s[k] = bitcast<vec4f>(vec4u(slot_keys[first + 2u * k], slot_keys[first + 2u * k + 1u]));
+    }
+    return r;
 }

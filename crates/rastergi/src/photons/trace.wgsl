@@ -12,10 +12,9 @@
 @group(1) @binding(4) var<storage, read> slot_area: array<f32>;
 // Per table entry: (Φ_rgb/h², A/h²), what the lookups read (map.wgsl).
 @group(1) @binding(5) var<storage, read_write> slots_out: array<vec4f>;
-// The slots' table keys, then the separators' (table.wgsl).
+// The slots' table keys, then the separators' keys, records and cell flags (table.wgsl).
 @group(1) @binding(6) var<storage, read> slot_keys: array<vec2u>;
 @group(1) @binding(7) var<storage, read> planes: array<TrianglePlane>;
-@group(1) @binding(8) var<storage, read> separator_planes: array<SeparatorRecord>;
 
 // The table entry of a deposit at p on side `back` of triangle tri (MapLayout::deposit_slot).
 // With `twin` = CAUSTIC_CELL, the slot's caustic twin (NO_SLOT where the map has none).
@@ -54,9 +53,10 @@ fn slot_in(l: Lattice, c: vec3u, p: vec3f, tri: u32, back: bool, twin: u32) -> u
     let cell = lattice_index(l, c);
     let key = plane_key(planes[tri], cell_centre(l.origin, l.cell, c), l.cell, back);
     var region = 0u;
-    let sep = find_separators(cell, key, params.mask + 1u, params.sep_mask, params.sep_max_probe);
+    let t = TableLayout(params.mask + 1u, params.sep_mask, params.sep_max_probe, params.records, params.cell_flags);
+    let sep = find_separators(t, cell, key);
     if sep != NO_SLOT {
-        region = region_of(separator_planes[sep], p);
+        region = region_of(separator_record(t, sep), p);
     }
     return find_slot(cell | twin, key | (region << REGION_SHIFT), params.mask, params.max_probe);
 }

@@ -1,20 +1,26 @@
 // Photon map lookups (photons/map/), bind group 3 of the passes that read the map: per slot
-// table entry (Φ_rgb/h², A/h²), the table's keys, and every triangle's plane keys.
+// table entry (Φ_rgb/h², A/h²), the table's keys (with the separators'), and every triangle's
+// plane keys.
 
 @group(3) @binding(0) var<storage, read> photon_slots: array<vec4f>;
 @group(3) @binding(1) var<uniform> photon_grid: PhotonGrid;
-// The slots' table keys, then the separators' (table.wgsl).
+// The slots' table keys, then the separators' keys, records and cell flags (table.wgsl).
 @group(3) @binding(2) var<storage, read> slot_keys: array<vec2u>;
 @group(3) @binding(3) var<storage, read> planes: array<TrianglePlane>;
-@group(3) @binding(4) var<storage, read> separator_planes: array<SeparatorRecord>;
+
+fn map_separators() -> TableLayout {
+    let g = photon_grid;
+    return TableLayout(g.mask + 1u, g.sep_mask, g.sep_max_probe, g.records, g.cell_flags);
+}
 
 // p's region among the separators of base slot (cell, key): 0 where it has none.
 fn photon_region(cell: u32, key: u32, p: vec3f) -> u32 {
-    let sep = find_separators(cell, key, photon_grid.mask + 1u, photon_grid.sep_mask, photon_grid.sep_max_probe);
+    let t = map_separators();
+    let sep = find_separators(t, cell, key);
     if sep == NO_SLOT {
         return 0u;
     }
-    return region_of(separator_planes[sep], p);
+    return region_of(separator_record(t, sep), p);
 }
 
 // E(p) on side `back` of triangle tri: Σ w_i Φ_i / Σ w_i A_i over the slots of its plane in
@@ -39,10 +45,10 @@ fn photon_lookup(p: vec3f, tri: u32, back: bool, twin: u32) -> vec3f {
     // The separators of p's own slot: cells beyond them (across a wall) do not count.
     let home = lattice_cell(l, p);
     let home_key = plane_key(plane, cell_centre(origin, h, home), h, back);
-    let own = find_separators(lattice_index(l, home), home_key, photon_grid.mask + 1u, photon_grid.sep_mask, photon_grid.sep_max_probe);
+    let own = find_separators(map_separators(), lattice_index(l, home), home_key);
     var own_record: SeparatorRecord;
     if own != NO_SLOT {
-        own_record = separator_planes[own];
+        own_record = separator_record(map_separators(), own);
     }
     // Areas are in units of the coarse cell's side².
     let scale = h / photon_grid.grid.cell;
@@ -60,7 +66,18 @@ fn photon_lookup(p: vec3f, tri: u32, back: bool, twin: u32) -> vec3f {
             continue;
         }
         let cell = lattice_index(l, c);
+        // A cell without slots (the air above a floor) holds none of this plane.
+        if !cell_has_slots(map_separators(), photon_grid.cells, cell) {
+            continue;
+        }
         let key = plane_key(plane, centre, h, back);
+        // A plane 8 steps (a cell) or more from a cell's centre misses the cell, and so does
+        // every plane that shares its key (within half a step of it; a cell's surface lies
+        // within √3/2 cells of its centre): no slot of this key exists there (the CPU twin's
+        // search finds none), so the search is skipped.
+        if abs(bitcast<i32>(key) >> OFFSET_SHIFT) >= i32(1.0 / OFFSET_STEP) {
+            continue;
+        }
         let s = find_slot(cell | twin, key | (photon_region(cell, key, p) << REGION_SHIFT), photon_grid.mask, photon_grid.max_probe);
         // Slots of almost no area are left out (PhotonMap::irradiance_on_plane).
         if s != NO_SLOT && photon_slots[s].a >= min_area {

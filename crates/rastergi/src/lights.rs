@@ -199,16 +199,22 @@ impl LightTable {
     /// The entry whose cdf interval holds u ∈ [0,1): the first with `u < cdf`.
     /// Mirrors `light_pick` in WGSL.
     pub fn pick(&self, u: f32) -> &LightEntry {
-        let i = self.entries.partition_point(|e| e.cdf <= u);
-        &self.entries[i.min(self.entries.len() - 1)]
+        &self.entries[self.pick_index(u)]
+    }
+
+    /// The index of the entry [`pick`](Self::pick) picks.
+    pub fn pick_index(&self, u: f32) -> usize {
+        self.entries.partition_point(|e| e.cdf <= u).min(self.entries.len() - 1)
     }
 
     /// The largest flux × N, over entries and channels, that a photon starts with
     /// ([`LightTable::emit_photon`]; a spot's falloff at most 1).
-    pub fn max_photon_flux(&self, scene: &Scene, aimed: bool) -> f64 {
+    pub fn max_photon_flux(&self, scene: &Scene, aimed: bool, guided: bool) -> f64 {
         // Aimed disc photons outside the aim and its surroundings carry 1/(1 − α − β) times
-        // an unaimed one's flux.
+        // an unaimed one's flux; guided ones at most 1/(1 − g) times more
+        // (crate::photons::guide).
         let aim_gain = if aimed { 1.0 / (1.0 - AIM_FRACTION as f64 - NEAR_FRACTION as f64) } else { 1.0 };
+        let aim_gain = if guided { aim_gain / (1.0 - crate::photons::guide::GUIDED_FRACTION as f64) } else { aim_gain };
         (self.entries.iter())
             .map(|e| {
                 let per_pmf = if e.triangle == ENVIRONMENT_LIGHT {
@@ -246,14 +252,35 @@ impl LightTable {
         eps: f32,
         aim: Option<PhotonAim>,
     ) -> (Vec3, Vec3, Vec3, Option<u32>) {
-        let e = self.pick(u[0]);
+        let s = self.emit_photon_guided(scene, emitted, u, eps, aim, None);
+        (s.0, s.1, s.2, s.3)
+    }
+
+    /// [`emit_photon`](Self::emit_photon) with the sun's and the sky's starts guided by
+    /// `guide`'s learned tables ([`crate::photons::guide`]), and the photon's counter bin
+    /// ([`crate::photons::guide::NO_BIN`] for a light that is not guided). Mirrors
+    /// `emit_photon` in `photons/emit.wgsl`.
+    pub fn emit_photon_guided(
+        &self,
+        scene: &Scene,
+        emitted: impl Fn(usize, f32, f32) -> Vec3,
+        u: [f32; 5],
+        eps: f32,
+        aim: Option<PhotonAim>,
+        guide: Option<&crate::photons::guide::GuideTable>,
+    ) -> (Vec3, Vec3, Vec3, Option<u32>, u32) {
+        use crate::photons::guide::{NO_BIN, env_direction_bin, guided_start};
+        let index = self.pick_index(u[0]);
+        let e = &self.entries[index];
+        let guided = guide.and_then(|g| g.light(index as u32));
         if e.triangle == ENVIRONMENT_LIGHT {
             let env = scene.environment.as_ref().expect("an environment entry has a map");
             let (to_sky, pdf) = env.sample(u[3], u[4]);
-            let (centre, radius) = self.disc;
-            let (origin, area) = disc_start(-to_sky, centre, radius, aim, u[1], u[2]);
-            let flux = env.eval(to_sky) * (area / (pdf * e.pmf));
-            return (origin, -to_sky, flux, None);
+            let d = env_direction_bin(to_sky);
+            let cdf = guided.and_then(|g| g.cdf(d));
+            let (origin, inv_p, position) = guided_start(-to_sky, self.disc, aim, cdf, (u[1], u[2]));
+            let flux = env.eval(to_sky) * (inv_p / (pdf * e.pmf));
+            return (origin, -to_sky, flux, None, guided.map_or(NO_BIN, |g| g.bin(d, position)));
         }
         if e.triangle & PUNCTUAL_LIGHT == 0 {
             let tri = &scene.triangles[e.triangle as usize];
@@ -263,7 +290,7 @@ impl LightTable {
             let le = emitted(e.triangle as usize, b1, b2);
             let flux = le * (std::f32::consts::PI * e.area / e.pmf);
             let pos = uniform_triangle(tri, u[1], u[2]);
-            return (pos + n * eps, cosine_hemisphere(n, u[3], u[4]), flux, Some(e.triangle));
+            return (pos + n * eps, cosine_hemisphere(n, u[3], u[4]), flux, Some(e.triangle), NO_BIN);
         }
         let p = &self.punctual[(e.triangle & !PUNCTUAL_LIGHT) as usize];
         let i = Vec3::from(p.intensity);
@@ -271,18 +298,21 @@ impl LightTable {
         match p.kind {
             LIGHT_POINT => {
                 let flux = i * (4.0 * std::f32::consts::PI / e.pmf);
-                (Vec3::from(p.position), uniform_sphere(u[3], u[4]), flux, None)
+                (Vec3::from(p.position), uniform_sphere(u[3], u[4]), flux, None, NO_BIN)
             }
             LIGHT_SPOT => {
                 let d = cone_direction(axis, p.cos_outer, u[3], u[4]);
                 let solid = 2.0 * std::f32::consts::PI * (1.0 - p.cos_outer);
                 let flux = i * (p.falloff(axis.dot(d)) * solid / e.pmf);
-                (Vec3::from(p.position), d, flux, None)
+                (Vec3::from(p.position), d, flux, None, NO_BIN)
             }
             _ => {
-                let (origin, area) = disc_start(axis, Vec3::from(p.disc_centre), p.disc_radius, aim, u[1], u[2]);
-                let flux = i * (area / e.pmf);
-                (origin, cone_direction(axis, p.cos_outer, u[3], u[4]), flux, None)
+                let cdf = guided.and_then(|g| g.cdf(0));
+                let disc = (Vec3::from(p.disc_centre), p.disc_radius);
+                let (origin, inv_p, position) = guided_start(axis, disc, aim, cdf, (u[1], u[2]));
+                let flux = i * (inv_p / e.pmf);
+                let bin = guided.map_or(NO_BIN, |g| g.bin(0, position));
+                (origin, cone_direction(axis, p.cos_outer, u[3], u[4]), flux, None, bin)
             }
         }
     }
@@ -350,6 +380,25 @@ pub fn disc_start(axis: Vec3, centre: Vec3, radius: f32, aim: Option<PhotonAim>,
         + if in_near { NEAR_FRACTION / (PI * near * near) } else { 0.0 }
         + if in_whole { whole / (PI * radius * radius) } else { 0.0 };
     (start + offset, 1.0 / p)
+}
+
+/// The density per unit area of [`disc_start`]'s mixture at `offset` (a vector in the disc's
+/// plane from its centre): the terms of the discs that hold it. Mirrors `disc_density` in
+/// `photons/emit.wgsl`.
+pub fn disc_density(axis: Vec3, centre: Vec3, radius: f32, aim: Option<PhotonAim>, offset: Vec3) -> f32 {
+    use std::f32::consts::PI;
+    let in_disc = offset.length() <= radius;
+    let Some(a) = aim.filter(|a| a.radius > 0.0) else {
+        return if in_disc { 1.0 / (PI * radius * radius) } else { 0.0 };
+    };
+    let d = a.centre - centre;
+    let towards = d - axis * d.dot(axis);
+    let near = a.radius * NEAR_SCALE;
+    let whole = 1.0 - AIM_FRACTION - NEAR_FRACTION;
+    let from_aim = (offset - towards).length();
+    (if from_aim <= a.radius { AIM_FRACTION / (PI * a.radius * a.radius) } else { 0.0 })
+        + if from_aim <= near { NEAR_FRACTION / (PI * near * near) } else { 0.0 }
+        + if in_disc { whole / (PI * radius * radius) } else { 0.0 }
 }
 
 /// A direction uniform within the cone of half-angle cos⁻¹(cos_max) about `axis` (pdf

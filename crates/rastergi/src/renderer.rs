@@ -75,7 +75,9 @@ impl ImagePasses {
         let film = Film::new(gpu, width, height)?;
         let gbuffer = GBufferPass::new(gpu, scene, frame, width, height);
         let specular = scene.eye_chains.then(|| crate::passes::specular::pass(gpu, scene, frame, &gbuffer, &film));
-        let direct = crate::passes::direct::pass(gpu, scene, frame, &gbuffer, &film);
+        // The guided gather's density weighs the direct pass's environment samples.
+        let guided = map.filter(|m| m.guide_cells > 0 && settings.gather_guiding);
+        let direct = crate::passes::direct::pass(gpu, scene, frame, (&gbuffer, &film), guided);
         let photon_view = match map {
             Some(map) if settings.show_photon_map => {
                 Some(crate::passes::photon_view::pass(gpu, scene, frame, &gbuffer, &film, map, PhotonView::Map))
@@ -189,6 +191,7 @@ impl Renderer {
             grid_resolution: settings.grid_resolution,
             indirect_only: settings.hit_light == HitLight::Exact,
             region,
+            guided: settings.photon_guiding,
         };
         let photons = (settings.photons > 0)
             .then(|| {
@@ -198,7 +201,14 @@ impl Renderer {
                     k => k,
                 };
                 let n = settings.photon_passes;
-                PhotonPasses::new(gpu, &gpu_scene, prepared, photon_settings, n, k)
+                // The gather guide's cells over the photon region (or the scene).
+                let field = settings.gather_guiding.then(|| {
+                    let bounds = region.as_ref().map_or(prepared.bounds, |r| r.bounds);
+                    let area: f64 =
+                        prepared.scene.triangles.iter().map(|t| crate::scene::triangle_area(t) as f64).sum();
+                    crate::gather::guide::GuideField::new(&bounds, prepared.lights.power, area)
+                });
+                PhotonPasses::new(gpu, &gpu_scene, prepared, photon_settings, n, k, field)
             })
             .transpose()?;
         let mut photons = photons;
@@ -341,6 +351,7 @@ impl Renderer {
             let (count, per_pixel) = gather.strategy(self.settings.directions, &fixed);
             uniforms.gather_count = count;
             uniforms.gather_importance = per_pixel as u32;
+            uniforms.gather_guided = (per_pixel && self.settings.gather_guiding) as u32;
         }
         self.frame.write(&self.gpu, &uniforms);
         let ctx = FrameContext {
@@ -442,6 +453,12 @@ impl Renderer {
     /// The photon map of the current pass, if the render has one.
     pub fn photon_map(&self) -> Option<&GpuPhotonMap> {
         self.photons.as_ref().map(PhotonPasses::map)
+    }
+
+    /// The photon guide: where the map is read, and what the passes learned of where the sun's
+    /// and the sky's photons land there (`None` without a photon map).
+    pub fn photon_guide(&self) -> Option<&crate::photons::guide::PhotonGuide> {
+        self.photons.as_ref().map(PhotonPasses::guide)
     }
 
     /// The current photon pass (0-based; 0 without a photon map).

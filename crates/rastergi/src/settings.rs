@@ -40,6 +40,12 @@ pub struct RenderSettings {
     /// measurement ([`crate::photons::budget`]) or fitted to the photon count and the image
     /// size ([`crate::photons::passes::fitted_pass_iterations`]).
     pub photon_budget: PhotonBudget,
+    /// The sun's and the sky's photons guided to where the map is read, as learned from the
+    /// passes so far ([`crate::photons::guide`]); else only aimed at the photon region.
+    pub photon_guiding: bool,
+    /// The traced gather's per-pixel directions drawn from a mixture of the visible point's
+    /// scattering and the light its cell's rays found ([`crate::gather::guide`]).
+    pub gather_guiding: bool,
     /// Gather directions per iteration, 1 to [`crate::gather::MAX_DIRECTIONS`]: they share the iteration's
     /// G-buffer and direct light.
     pub directions: u32,
@@ -148,6 +154,8 @@ impl Default for RenderSettings {
             photon_passes: 0,
             pass_iterations: DEFAULT_PASS_ITERATIONS,
             photon_budget: PhotonBudget::default(),
+            photon_guiding: true,
+            gather_guiding: false,
             hit_light: HitLight::Map,
             photon_region: PhotonRegionChoice::Camera,
             texture_filter: TextureFilter::Footprint,

@@ -153,7 +153,14 @@ fn first_hit_flux(light: Light, photons: u32) -> (Vec3, Vec3, Vec3) {
     let gpu = common::gpu();
     let mut scene = floor(light);
     scene.materials[0].albedo = Vec3::ZERO;
-    let settings = PhotonSettings { count: photons, seed: 5, grid_resolution: 8, indirect_only: false, region: None };
+    let settings = PhotonSettings {
+        count: photons,
+        seed: 5,
+        grid_resolution: 8,
+        indirect_only: false,
+        region: None,
+        guided: false,
+    };
     let prepared = PreparedScene::new(&scene);
     let gs = rastergi::gpu_scene::GpuScene::new(&gpu, &prepared).unwrap();
     let g = GpuPhotonMap::build(&gpu, &gs, &prepared, &settings).unwrap().read(&gpu).unwrap().total_flux();

@@ -69,7 +69,7 @@ fn closed_box_maps(
     seed: u32,
     indirect_only: bool,
 ) -> (glam::DVec3, [(&'static str, PhotonMap); 2]) {
-    let settings = PhotonSettings { count, seed, grid_resolution: 16, indirect_only, region: None };
+    let settings = PhotonSettings { count, seed, grid_resolution: 16, indirect_only, region: None, guided: false };
     let gpu = common::gpu();
     let scene = closed_box(a as f32);
     let grid = GridSpec::new(&scene.bounds(), settings.grid_resolution);
@@ -240,4 +240,139 @@ fn an_indirect_only_map_holds_the_albedo_times_the_full_maps_energy() {
             assert_within_four_sigma(name, c, "indirect flux", flux[c], power[c] * a / (1.0 - a), sigma);
         }
     }
+}
+
+/// The sky's photons guided by any table carry the sky's light (`photons::guide`): a constant
+/// sky of radiance L over a 20 m floor, aimed at a region of it, with a table per direction
+/// bin that sends three quarters of its photons to a few random bins of the guide disc. The
+/// floor's top receives A·π·L in closed form; the GPU's map and the CPU twin's hold it within
+/// four standard errors, and the two maps agree slot by slot.
+#[test]
+fn guided_sky_photons_deliver_the_skys_flux_on_the_gpu_and_its_twin() {
+    let radiance = 0.7f32;
+    guided_photons_deliver(
+        |s| {
+            s.environment =
+                Some(std::sync::Arc::new(rastergi::environment::Environment::constant(Vec3::splat(radiance))))
+        },
+        std::f64::consts::PI * radiance as f64 * 400.0,
+    );
+}
+
+/// Photons guided by any table carry the light they would unguided (`photons::guide`): a sun
+/// over a 20 m floor, aimed at a region of it, with a table that sends three quarters of the
+/// photons to a few random bins of the guide disc. The flux the floor receives is E·cos θ·A in
+/// closed form (every photon lands on it); the GPU's map holds it within four standard errors,
+/// the CPU twin's too, and the two maps agree slot by slot (the twins start the same photons
+/// from the same table).
+#[test]
+fn guided_sun_photons_deliver_the_suns_flux_on_the_gpu_and_its_twin() {
+    let towards = Vec3::new(0.3, 0.8, -0.2).normalize();
+    let irradiance = 2.0f32;
+    guided_photons_deliver(
+        |s| {
+            s.lights.push(rastergi::scene::Light::Distant {
+                direction: -towards,
+                irradiance: Vec3::splat(irradiance),
+                angular_radius: 0.0,
+            })
+        },
+        irradiance as f64 * towards.y as f64 * 400.0,
+    );
+}
+
+/// The photons of the lights `light` adds to a 20 m floor, guided by random tables, traced on the
+/// GPU and by the CPU twin: each map holds `expected` watts within four standard errors, and
+/// the two agree slot by slot.
+fn guided_photons_deliver(light: impl Fn(&mut Scene), expected: f64) {
+    use rastergi::photons::guide::{POSITIONS, PhotonGuide, guided_lights};
+    let mut s = Scene::new(Camera { eye: Vec3::new(0.0, 5.0, 12.0), target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 60.0 });
+    let m = s.add_material(Material::diffuse("floor", Vec3::splat(0.0)));
+    let (a, b, c, d) = (
+        Vec3::new(-10.0, 0.0, -10.0),
+        Vec3::new(-10.0, 0.0, 10.0),
+        Vec3::new(10.0, 0.0, 10.0),
+        Vec3::new(10.0, 0.0, -10.0),
+    );
+    s.add_triangle([a, b, c], m);
+    s.add_triangle([a, c, d], m);
+    light(&mut s);
+    let region = rastergi::photons::map::PhotonRegion {
+        bounds: rastergi::scene::Aabb { min: Vec3::new(-3.0, 0.0, -2.0), max: Vec3::new(1.0, 1.0, 2.0) },
+        factor: 2,
+    };
+    let settings = PhotonSettings {
+        count: 1 << 20,
+        seed: 5,
+        grid_resolution: 32,
+        region: Some(region),
+        guided: true,
+        ..Default::default()
+    };
+    let gpu = common::gpu();
+    let prepared = PreparedScene::new(&s);
+    let gs = GpuScene::new(&gpu, &prepared).unwrap();
+    let layout = rastergi::photons::map::MapLayout::within(
+        &prepared.scene,
+        &prepared.bounds,
+        32,
+        settings.region.as_ref(),
+        &gpu.device.limits(),
+    )
+    .unwrap();
+    let mut guide = PhotonGuide::new(&gpu, layout.grid, &guided_lights(&prepared.lights), true, None);
+    // Tables that like 5 % of the bins, at random weights.
+    let mut table = guide.table().clone();
+    assert_eq!(table.lights.len(), 1, "the light is guided");
+    let mut rng = rastergi::sampling::Rng::new(23, 0, 0);
+    let n = (POSITIONS * POSITIONS) as usize;
+    for d in 0..table.lights[0].directions as usize {
+        let weights: Vec<f64> =
+            (0..n).map(|_| if rng.next_f32() < 0.05 { 0.1 + rng.next_f32() as f64 } else { 0.0 }).collect();
+        let sum: f64 = weights.iter().sum();
+        let mut acc = 0.0;
+        let cdf: Vec<f32> = weights
+            .iter()
+            .map(|w| {
+                acc += w / sum;
+                acc as f32
+            })
+            .collect();
+        table.lights[0].cdfs[d] = (sum as f32, cdf);
+    }
+    guide.set_table(&gpu, table.clone());
+    let map = GpuPhotonMap::with_layout(&gpu, &gs, &prepared, &settings, layout.clone(), &guide).unwrap();
+    map.trace(&gpu, &gs);
+    let gpu_map = map.read(&gpu).unwrap();
+    let tally = cpu::trace_flux_guided(&prepared, &layout, &settings, 0, Some(&table));
+    let cpu_map = PhotonMap {
+        layout,
+        flux: tally.flux,
+        flux_sq: tally.flux_sq,
+        deposits: tally.deposits,
+        dropped: tally.dropped,
+    };
+    // The sum's standard error from the twin's per-slot squares (each photon one deposit).
+    let se = cpu_map.flux_sq.iter().sum::<f64>().sqrt();
+    for (name, map) in [("GPU", &gpu_map), ("CPU twin", &cpu_map)] {
+        let total: f64 = map.flux.iter().map(|f| f[1]).sum();
+        println!("{name}: {total:.3} W on the floor against {expected:.3} (se {se:.3})");
+        assert!((total - expected).abs() < 4.0 * se, "{name}: {total} against {expected}");
+    }
+    // The same photons: slot by slot the same flux, but for a photon that f32 rounding lands in
+    // another slot: each slot within two of its deposits' RMS flux, and the slots that differ
+    // at all a few per cent.
+    let (mut compared, mut differ) = (0, 0);
+    for s in 0..cpu_map.flux.len() {
+        let (g, c) = (gpu_map.flux[s][1], cpu_map.flux[s][1]);
+        if cpu_map.deposits[s] == 0 {
+            continue;
+        }
+        let deposit = (cpu_map.flux_sq[s] / cpu_map.deposits[s] as f64).sqrt();
+        assert!((g - c).abs() <= 2.0 * deposit, "a slot holds {g} on the GPU, {c} in the twin (a deposit {deposit})");
+        compared += 1;
+        differ += ((g - c).abs() > 1e-4 * c) as usize;
+    }
+    println!("{compared} slots, {differ} differ by more than 1e-4");
+    assert!(compared > 300 && differ * 20 < compared, "{differ} of {compared} slots differ");
 }

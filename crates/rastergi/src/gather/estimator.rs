@@ -91,7 +91,13 @@ pub struct PixelSamples {
 /// writes, the photon-map lookup, the uniforms, the estimator and `pieces`.
 pub fn estimate_source(pieces: &[&str]) -> String {
     let (lookup, uniforms) = (crate::photons::gpu::lookup_wgsl(), uniforms_wgsl());
-    let mut all = vec![lookup.as_str(), &uniforms, include_str!("estimator.wgsl")];
+    let mut all = vec![
+        lookup.as_str(),
+        &uniforms,
+        include_str!("estimator.wgsl"),
+        super::guide::WGSL,
+        super::guide::DENSITY_WGSL,
+    ];
     all.extend_from_slice(pieces);
     crate::passes::per_pixel(&all)
 }

@@ -176,15 +176,6 @@ fn visible_f(p: VisiblePoint, w: vec3f) -> vec3f {
     return bsdf_eval(v.b, v.wo, to_local(v.frame, w), TRANSPORT_RADIANCE);
 }
 
-// The cosine that weighs direction w at x: the shading normal's, where w lies above the
-// geometric surface (else 0: no light from below it, and no ray into it).
-fn gather_cosine(p: VisiblePoint, w: vec3f) -> f32 {
-    if dot(p.n, w) <= 0.0 {
-        return 0.0;
-    }
-    return max(dot(p.ns, w), 0.0);
-}
-
 // Shared directions, bidirectional: ω uniform on the sphere, and x gathers along whichever of
 // ±ω lies above its geometric surface (w = sign(n·ω)·ω, uniform on x's hemisphere, pdf
 // 1/2π): f(ω_eye, w) · L(h → x) · cos θ_x · 2π, cos θ_x = gather_cosine (the shading

@@ -41,6 +41,7 @@
 
 mod directions;
 pub mod estimator;
+pub mod guide;
 pub mod lists;
 pub mod raster;
 pub mod ray_view;

@@ -24,6 +24,9 @@ pub struct TraceGather {
     pipeline: wgpu::ComputePipeline,
     bind_group: wgpu::BindGroup,
     profiler: Option<Profiler>,
+    /// The guide's tables made after each gather, where the map's guide has cells
+    /// ([`super::guide`]).
+    guide: Option<super::guide::GuideBuild>,
 }
 
 /// The traced gather's bind group 2: the G-buffer read, the film written.
@@ -43,7 +46,9 @@ impl TraceGather {
             .concat(),
         );
         let pipeline = setup.estimate_pipeline(device, "gather trace", &[include_str!("trace.wgsl")], &layout);
-        TraceGather { pipeline, bind_group, profiler: gpu.profiler.clone() }
+        let guide = (setup.map.guide_cells > 0)
+            .then(|| super::guide::GuideBuild::new(gpu, &setup.map.guide, setup.map.guide_cells));
+        TraceGather { pipeline, bind_group, profiler: gpu.profiler.clone(), guide }
     }
 }
 
@@ -51,8 +56,15 @@ impl Gather for TraceGather {
     /// All the iteration's directions in one dispatch: the uniforms hold them all.
     fn encode(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, inputs: &GatherInputs) -> Result<()> {
         inputs.write_uniforms(gpu, 0);
-        let mut pass = compute_pass(enc, self.profiler.as_ref(), "gather trace");
-        dispatch_pixels(&mut pass, &self.pipeline, &inputs.groups(&self.bind_group), inputs.width, inputs.height);
+        {
+            let mut pass = compute_pass(enc, self.profiler.as_ref(), "gather trace");
+            dispatch_pixels(&mut pass, &self.pipeline, &inputs.groups(&self.bind_group), inputs.width, inputs.height);
+        }
+        // The guide's tables from what this gather's rays found, for the next iteration's
+        // direct pass and gather.
+        if let Some(guide) = &self.guide {
+            guide.encode(enc, self.profiler.as_ref());
+        }
         Ok(())
     }
 }

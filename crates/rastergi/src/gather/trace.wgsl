@@ -21,17 +21,48 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     var sum = vec3f(0.0);
     // Rays that escape see the environment: direct light, kept with the direct pass's.
     var sky = vec3f(0.0);
+    // The guide's cell of this visible point (guide.wgsl): what its rays learn goes there, and
+    // where it has learned something, its directions are drawn from the guided mixture.
+    var entry = NO_GUIDE;
+    var total = 0.0;
+    if per_pixel && frame.gather_guided != 0u && p.ok {
+        entry = gather_guide_entry(gather_guide_key(p.x.pos, p.ns), true);
+        total = gather_guide_total(entry);
+    }
     for (var k = 0u; k < gather.count && p.ok; k++) {
         let j = gather.first_index + k;
-        // The direction and the estimator's factor f cos θ_x / pdf.
+        // The direction, the estimator's factor f cos θ_x / pdf, and the pdf the sky's two
+        // estimates are weighed with.
         var w: vec3f;
         var weight = vec3f(0.0);
+        var density = 0.0;
         if per_pixel {
-            let u = sobol_owen_2d(j, seed);
             var lobe = rng_new(frame.seed ^ STREAM_GATHER_LOBE, pixel, j);
-            let d = gather_direction(p, vec2f(unit_f32(u.x), unit_f32(u.y)), rng_f32(&lobe));
-            w = d.w;
-            weight = d.weight;
+            let lobe_u = rng_f32(&lobe);
+            if total > 0.0 {
+                // Half the directions from the point's scattering, half from the guide's table
+                // (alternating, each strategy its own Sobol' points, which keep stratifying it):
+                // the deterministic mixture, weighed with the mixture's density.
+                let half = gather.first_index / 2u + k / 2u;
+                if (k & 1u) == 1u {
+                    let u = sobol_owen_2d(half, pcg_hash(seed ^ STREAM_GATHER_LOBE));
+                    w = gather_guide_sample(entry, total, vec2f(unit_f32(u.x), unit_f32(u.y)));
+                } else {
+                    let u = sobol_owen_2d(half, seed);
+                    w = gather_direction(p, vec2f(unit_f32(u.x), unit_f32(u.y)), lobe_u).w;
+                }
+                density = guided_gather_density(p, entry, total, w);
+                let cos_x = gather_cosine(p, w);
+                if density > 0.0 && cos_x > 0.0 {
+                    weight = visible_f(p, w) * (cos_x / density);
+                }
+            } else {
+                let u = sobol_owen_2d(j, seed);
+                let d = gather_direction(p, vec2f(unit_f32(u.x), unit_f32(u.y)), lobe_u);
+                w = d.w;
+                weight = d.weight;
+                density = gather_density(p, w);
+            }
         } else {
             // Uniform on the hemisphere: pdf 1/2π.
             w = gather_side(p.n, gather.directions[k].xyz);
@@ -39,6 +70,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             if cos_x > 0.0 {
                 weight = visible_f(p, w) * (cos_x * 2.0 * PI);
             }
+            density = gather_density(p, w);
         }
         if all(weight == vec3f(0.0)) {
             continue;
@@ -46,9 +78,12 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         // Nearest hit at t > ε, x's own triangle excluded (the raster gather's plane test).
         let h = trace(p.x.pos, w, frame.ray_epsilon, 3.0e38, p.x.tri, NO_TRIANGLE, false);
         if h.tri != NO_TRIANGLE {
-            sum += weight * gather_radiance(p.x.pos, w, h.tri, p.x.pos + w * h.t, vec2f(h.b1, h.b2), pixel, j);
-        } else {
-            sky += escape_estimate_weighted(p, weight, w);
+            let found = gather_radiance(p.x.pos, w, h.tri, p.x.pos + w * h.t, vec2f(h.b1, h.b2), pixel, j);
+            sum += weight * found;
+            // The light of surfaces this ray found, for the guide (its luminance).
+            gather_guide_learn(entry, w, (found.r + found.g + found.b) / 3.0);
+        } else if has_environment() {
+            sky += weight * env_radiance(w) * env_gather_weight(density, w);
         }
     }
     film_add(FILM_INDIRECT, gid.xy, p.weight * (sum / f32(gather.count)));

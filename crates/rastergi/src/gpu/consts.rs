@@ -65,6 +65,30 @@ pub const AIM_FRACTION: f32 = 0.5;
 pub const NEAR_FRACTION: f32 = 0.25;
 /// The surroundings' disc radius over the aim's.
 pub const NEAR_SCALE: f32 = 4.0;
+/// Position bins per side of a guided light's disc ([`crate::photons::guide`]).
+pub const GUIDE_POSITIONS: u32 = 64;
+/// Bands (of equal solid angle, in cos θ about +Y) and sectors of φ of the sky's direction bins
+/// for guided photons ([`crate::photons::guide`]).
+pub const GUIDE_ENV_BANDS: u32 = 8;
+/// The share of a learned direction's photons drawn from the guide's table.
+pub const GUIDED_FRACTION: f32 = 0.75;
+/// The most lights whose photons are guided (the sky and up to three distant lights).
+pub const MAX_GUIDED_LIGHTS: u32 = 4;
+/// Words of a guided light's header in the guide's table.
+pub const GUIDE_HEADER_WORDS: u32 = 4;
+/// Direction bins of the gather's guide ([`crate::gather::guide`]): bands of equal solid angle
+/// in w_y, and as many sectors of φ; their product.
+pub const GATHER_GUIDE_BANDS: u32 = 16;
+pub const GATHER_GUIDE_BINS: u32 = GATHER_GUIDE_BANDS * GATHER_GUIDE_BANDS;
+/// The share of the guided gather's directions drawn from the guide's table.
+pub const GATHER_GUIDE_FRACTION: f32 = 0.5;
+/// Entries a search of the gather guide's cells probes at most.
+pub const GATHER_GUIDE_PROBES: u32 = 32;
+/// A gather guide cell whose bins counted this many samples has its sums and counts halved.
+pub const GATHER_GUIDE_DECAY: u32 = 1 << 15;
+/// The first word of the guide buffer's header, and of its marks (after the header).
+pub const GUIDE_HEADER: u32 = 0;
+pub const GUIDE_MARKS: u32 = 16;
 /// Bit of a slot's cell index that marks the caustic twin of the slot ([`crate::photons::map`]):
 /// the flux of photons that reached it through specular surfaces alone.
 pub const CAUSTIC_CELL: u32 = 1 << 31;

@@ -90,6 +90,8 @@ fn shaders() -> Vec<(&'static str, String)> {
     vec![
         ("gbuffer", crate::passes::gbuffer::source()),
         ("direct", crate::passes::direct::source()),
+        ("direct with photon map", crate::passes::direct::source_with_map()),
+        ("gather guide build", crate::gather::guide::build_source()),
         ("specular chains", crate::passes::specular::source()),
         ("photon view", crate::passes::photon_view::source()),
         ("gather ray view", crate::gather::ray_view::ray_view_source()),
@@ -216,6 +218,7 @@ fn every_tracing_shader_composes_and_validates_for_hardware_ray_queries() {
     let expected = [
         "gbuffer",
         "direct",
+        "direct with photon map",
         "specular chains",
         "photon view",
         "gather project",
@@ -298,7 +301,8 @@ fn declared_groups(label: &str) -> Vec<Vec<Group>> {
     match label {
         "gbuffer" => vec![scene(), vec![frame::group()]],
         "direct" | "specular chains" => per_pixel(),
-        "photon view" => [per_pixel(), vec![lookup()]].concat(),
+        "photon view" | "direct with photon map" => [per_pixel(), vec![lookup()]].concat(),
+        "gather guide build" => vec![vec![gather::guide::build_group()]],
         "gather ray view" => vec![
             scene(),
             vec![gather::raster::count_group(), gather::raster::peel_group(), gather::lists::fill_group()],

@@ -70,13 +70,61 @@ pub fn light_sample_uniforms(seed: u32, x: u32, y: u32, j: u32, lights: &LightTa
 
 /// The pass's composed shader.
 pub fn source() -> String {
-    crate::passes::per_pixel(&[GBUFFER_FILM_WGSL, include_str!("direct.wgsl")])
+    crate::passes::per_pixel(&[GBUFFER_FILM_WGSL, DENSITY_UNGUIDED, include_str!("direct.wgsl")])
 }
 
+/// The direct pass's shader where a photon map exists: with the map's group (3), whose guide
+/// buffer holds the gather guide's tables, so its environment samples are weighed against the
+/// guided gather's density ([`crate::gather::guide`]).
+pub fn source_with_map() -> String {
+    crate::passes::per_pixel(&[
+        GBUFFER_FILM_WGSL,
+        &crate::photons::gpu::lookup_wgsl(),
+        crate::gather::guide::WGSL,
+        crate::gather::guide::DENSITY_WGSL,
+        DENSITY_GUIDED,
+        include_str!("direct.wgsl"),
+    ])
+}
+
+/// The gather's density of direction w at p that the environment's samples are weighed
+/// against, without a guide.
+const DENSITY_UNGUIDED: &str = "
+fn direct_gather_density(p: VisiblePoint, w: vec3f) -> f32 {
+    return gather_density(p, w);
+}
+";
+
+/// The same with the gather guide: the density the guided gather drew its directions with at
+/// p's cell, as its tables stood this iteration (the gather's own weighs its escapes with).
+const DENSITY_GUIDED: &str = "
+fn direct_gather_density(p: VisiblePoint, w: vec3f) -> f32 {
+    if frame.gather_guided == 0u {
+        return gather_density(p, w);
+    }
+    let e = gather_guide_entry(gather_guide_key(p.x.pos, p.ns), false);
+    return guided_gather_density(p, e, gather_guide_total(e), w);
+}
+";
+
 /// The direct pass. Reads: scene, frame, G-buffer. Adds to: the film's direct component.
-pub fn pass(gpu: &Gpu, scene: &GpuScene, frame: &FrameBinding, gbuffer: &GBufferPass, film: &Film) -> PixelPass {
-    let shader = PixelShader { label: "direct", source: &source(), entry: "main" };
-    PixelPass::new(gpu, (scene, frame), (gbuffer, film), shader, GroupThree::None)
+pub fn pass(
+    gpu: &Gpu,
+    scene: &GpuScene,
+    frame: &FrameBinding,
+    (gbuffer, film): (&GBufferPass, &Film),
+    map: Option<&crate::photons::gpu::GpuPhotonMap>,
+) -> PixelPass {
+    match map {
+        Some(map) => {
+            let shader = PixelShader { label: "direct", source: &source_with_map(), entry: "main" };
+            PixelPass::new(gpu, (scene, frame), (gbuffer, film), shader, GroupThree::PhotonMap(map))
+        }
+        None => {
+            let shader = PixelShader { label: "direct", source: &source(), entry: "main" };
+            PixelPass::new(gpu, (scene, frame), (gbuffer, film), shader, GroupThree::None)
+        }
+    }
 }
 
 #[cfg(test)]

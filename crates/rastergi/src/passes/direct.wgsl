@@ -51,7 +51,7 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
             // The environment is also found by the gather's escaping rays (env_gather_weight).
             var mis = 1.0;
             if l.pdf > 0.0 {
-                mis = 1.0 - env_gather_weight(gather_density(p, l.dir), l.dir);
+                mis = 1.0 - env_gather_weight(direct_gather_density(p, l.dir), l.dir);
             }
             sum += f * l.e * (abs(wi.z) * mis);
         }

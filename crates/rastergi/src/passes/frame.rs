@@ -37,7 +37,11 @@ gpu_struct! {
         /// 1 where the eye's visible points read textures at their footprint's level of detail,
         /// 0 where at level 0 ([`crate::settings::TextureFilter`]).
         pub texture_footprint: u32,
-        pub _pad: [u32; 3],
+        /// 1 where the traced gather's per-pixel directions are guided by what it learned
+        /// ([`crate::gather::guide`]): the direct pass weighs its environment samples against the
+        /// guided density.
+        pub gather_guided: u32,
+        pub _pad: [u32; 2],
     }
 }
 
@@ -77,9 +81,10 @@ impl FrameUniforms {
             ray_epsilon: scene.ray_epsilon,
             gather_count: 0,
             gather_importance: 0,
+            gather_guided: 0,
             eye_chains: 0,
             texture_footprint: 1,
-            _pad: [0; 3],
+            _pad: [0; 2],
         }
     }
 }

@@ -75,6 +75,15 @@ fn visible_bsdf(p: VisiblePoint) -> VisibleBsdf {
     return VisibleBsdf(b, sf, to_local(sf, normalize(p.eye - p.x.pos)));
 }
 
+// The cosine that weighs direction w at x in the gather: the shading normal's, where w lies
+// above the geometric surface (else 0: no light from below it, and no ray into it).
+fn gather_cosine(p: VisiblePoint, w: vec3f) -> f32 {
+    if dot(p.n, w) <= 0.0 {
+        return 0.0;
+    }
+    return max(dot(p.ns, w), 0.0);
+}
+
 // The density of this iteration's final gather directions at p along w (solid angle), for
 // the weights of multiple importance sampling against the direct pass's light samples: 0
 // where the gather counts nothing (no gather, w below the geometric surface or the shading

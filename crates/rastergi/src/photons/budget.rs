@@ -57,7 +57,7 @@ use crate::gpu_scene::GpuScene;
 pub const FIRST_ITERATIONS: u32 = 16;
 /// The fewest and most iterations a balanced pass lasts.
 pub const MIN_ITERATIONS: u32 = 2;
-pub const MAX_ITERATIONS: u32 = 256;
+pub const MAX_ITERATIONS: u32 = 64;
 /// Pairs of passes the fit uses.
 pub const HISTORY: usize = 8;
 /// Every EXPLORE-th pass after the first three lasts twice (or half) the chosen length.

@@ -50,6 +50,18 @@ pub fn trace_pass(prepared: &PreparedScene, grid: &GridSpec, settings: &PhotonSe
 
 /// The photon tracing alone into the slots of `layout` (what `rastergi bench photons` times).
 pub fn trace_flux(prepared: &PreparedScene, layout: &MapLayout, settings: &PhotonSettings, pass: u32) -> Tally {
+    trace_flux_guided(prepared, layout, settings, pass, None)
+}
+
+/// [`trace_flux`] with the sun's and the sky's photons started as `guide`'s tables say
+/// ([`crate::photons::guide`]), as the GPU tracer starts them with the same tables.
+pub fn trace_flux_guided(
+    prepared: &PreparedScene,
+    layout: &MapLayout,
+    settings: &PhotonSettings,
+    pass: u32,
+    guide: Option<&crate::photons::guide::GuideTable>,
+) -> Tally {
     let slots = layout.table.capacity();
     if prepared.lights.is_empty() || settings.count == 0 {
         return Tally::new(slots);
@@ -63,7 +75,7 @@ pub fn trace_flux(prepared: &PreparedScene, layout: &MapLayout, settings: &Photo
             || Tally::new(slots),
             |mut t, chunk| {
                 for i in chunk * CHUNK..((chunk + 1) * CHUNK).min(settings.count) {
-                    trace_photon(prepared, layout, settings, (i, pass), &mut t);
+                    trace_photon(prepared, layout, settings, guide, (i, pass), &mut t);
                 }
                 t
             },
@@ -76,6 +88,7 @@ fn trace_photon(
     prepared: &PreparedScene,
     layout: &MapLayout,
     settings: &PhotonSettings,
+    guide: Option<&crate::photons::guide::GuideTable>,
     (index, pass): (u32, u32),
     t: &mut Tally,
 ) {
@@ -84,8 +97,9 @@ fn trace_photon(
     let alpha_seed = pcg_hash(settings.seed ^ STREAM_PHOTON ^ pcg_hash(pass));
     let mut rng = Rng::new(settings.seed ^ STREAM_PHOTON, index, pass);
     let u = [(); 5].map(|_| rng.next_f32());
-    let (mut origin, mut dir, flux, emitter) =
-        prepared.lights.emit_photon(scene, |t, b1, b2| prepared.emitter_radiance(t, b1, b2), u, eps, settings.aim());
+    let emitted = |t, b1, b2| prepared.emitter_radiance(t, b1, b2);
+    let (mut origin, mut dir, flux, emitter, _) =
+        prepared.lights.emit_photon_guided(scene, emitted, u, eps, settings.aim(), guide);
     let mut flux = flux / settings.count as f32;
     let mut skip = emitter.unwrap_or(u32::MAX);
     let first_deposit = settings.indirect_only as u32;

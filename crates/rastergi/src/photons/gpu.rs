@@ -96,6 +96,13 @@ gpu_struct! {
         /// ([`table_entries`]).
         pub(crate) records: u32,
         pub(crate) cell_flags: u32,
+        /// The photon guide's grid (its cells' marks: where the map is read), where its
+        /// counters and its table start, and its bins ([`super::guide`]).
+        pub(crate) marks: GridLevels,
+        pub(crate) guide_counters: u32,
+        pub(crate) guide_bins: u32,
+        pub(crate) guide_table: u32,
+        pub(crate) _pad: u32,
     }
 }
 
@@ -117,6 +124,8 @@ gpu_struct! {
         pub cell_flags: u32,
         /// The grid's cells (both levels): the flags' runs are this many bits long.
         pub cells: u32,
+        /// The photon guide's grid, whose cells a lookup marks ([`super::guide`]).
+        pub marks: GridLevels,
     }
 }
 
@@ -136,7 +145,15 @@ pub fn lookup_wgsl() -> String {
 /// The photon tracer's composed shader (`trace.wgsl`: the trace and resolve kernels).
 pub fn trace_source() -> String {
     let (scene, table, params) = (crate::gpu_scene::wgsl(), table_wgsl(), PhotonParams::wgsl());
-    shader::compose(&[shader::SAMPLING, &scene, shader::BVH, &table, &params, include_str!("trace.wgsl")])
+    shader::compose(&[
+        shader::SAMPLING,
+        &scene,
+        shader::BVH,
+        &table,
+        &params,
+        include_str!("emit.wgsl"),
+        include_str!("trace.wgsl"),
+    ])
 }
 
 /// Bytes per table entry on the GPU while rendering (key 8, lookup value 16) and, while the
@@ -161,6 +178,10 @@ pub struct GpuPhotonMap {
     trace_pipeline: wgpu::ComputePipeline,
     resolve_pipeline: wgpu::ComputePipeline,
     has_lights: bool,
+    /// The guide buffer the map's passes mark and learn into, and the gather guide's cells
+    /// there (0: none) ([`super::guide::PhotonGuide`]).
+    pub guide: wgpu::Buffer,
+    pub guide_cells: u32,
 }
 
 struct Build {
@@ -212,16 +233,20 @@ impl GpuPhotonMap {
             settings.region.as_ref(),
             &gpu.device.limits(),
         )?;
-        Self::with_layout(gpu, scene, prepared, settings, layout)
+        // A map of its own: no guided lights, its cells marked where read.
+        let guide = super::guide::PhotonGuide::new(gpu, layout.grid, &[], false, None);
+        Self::with_layout(gpu, scene, prepared, settings, layout, &guide)
     }
 
-    /// Allocates the map for `layout` and its pipelines.
+    /// Allocates the map for `layout` and its pipelines, its photons started and its lookups
+    /// marked as `guide` says.
     pub fn with_layout(
         gpu: &Gpu,
         scene: &GpuScene,
         prepared: &PreparedScene,
         settings: &PhotonSettings,
         layout: MapLayout,
+        guide: &super::guide::PhotonGuide,
     ) -> Result<GpuPhotonMap> {
         let grid = layout.grid;
         let capacity = layout.table.capacity() as u64;
@@ -279,7 +304,11 @@ impl GpuPhotonMap {
             ("tally_g", channel(1)),
             ("tally_b", channel(2)),
         ];
-        let trace_only = [("slot_keys", keys.as_entire_binding()), ("planes", planes.as_entire_binding())];
+        let trace_only = [
+            ("slot_keys", keys.as_entire_binding()),
+            ("planes", planes.as_entire_binding()),
+            ("photon_guide", guide.buffer.as_entire_binding()),
+        ];
         let resolve_only = [("slot_area", area_buffer.as_entire_binding()), ("slots_out", slots.as_entire_binding())];
         let trace_resources: Vec<_> = counters.iter().cloned().chain(trace_only).collect();
         let (trace_layout, trace_group) = trace_group().layout_and_bind(device, &trace_resources);
@@ -297,6 +326,7 @@ impl GpuPhotonMap {
         );
         let mask = capacity as u32 - 1;
         let max_probe = layout.table.max_probe;
+        let (guide_counters, guide_table) = super::guide::guide_offsets(guide.mark_words, guide.bins());
         let params = PhotonParams {
             grid: GridLevels::from(&grid),
             aim: settings.aim().map_or([0.0; 4], |a| [a.centre.x, a.centre.y, a.centre.z, a.radius]),
@@ -316,6 +346,11 @@ impl GpuPhotonMap {
             first_deposit: settings.indirect_only as u32,
             records,
             cell_flags,
+            marks: GridLevels::from(&guide.marks),
+            guide_counters,
+            guide_bins: guide.bins(),
+            guide_table,
+            _pad: 0,
         };
         let grid_uniforms = PhotonGridUniforms {
             grid: GridLevels::from(&grid),
@@ -327,8 +362,9 @@ impl GpuPhotonMap {
             records,
             cell_flags,
             cells: grid.cell_count() as u32,
+            marks: GridLevels::from(&guide.marks),
         };
-        let buffers = [&slots, &keys, &planes];
+        let buffers = [&slots, &keys, &planes, &guide.buffer];
         let (bind_layout, bind_group) = lookup_binding(gpu, &grid_uniforms, buffers);
         Ok(GpuPhotonMap {
             layout,
@@ -343,6 +379,8 @@ impl GpuPhotonMap {
             trace_pipeline,
             resolve_pipeline,
             has_lights: scene.light_count > 0,
+            guide: guide.buffer.clone(),
+            guide_cells: guide.field.map_or(0, |f| f.capacity),
         })
     }
 
@@ -485,7 +523,7 @@ pub fn table_entries(layout: &MapLayout) -> (Vec<[u32; 2]>, u32, u32) {
 fn lookup_binding(
     gpu: &Gpu,
     u: &PhotonGridUniforms,
-    [slots, keys, planes]: [&wgpu::Buffer; 3],
+    [slots, keys, planes, guide]: [&wgpu::Buffer; 4],
 ) -> (wgpu::BindGroupLayout, wgpu::BindGroup) {
     let uniforms = gpu.zeroed_buffer(
         "photon grid",
@@ -498,6 +536,7 @@ fn lookup_binding(
         ("photon_grid", uniforms.as_entire_binding()),
         ("slot_keys", keys.as_entire_binding()),
         ("planes", planes.as_entire_binding()),
+        ("photon_guide", guide.as_entire_binding()),
     ];
     lookup_group().layout_and_bind(&gpu.device, &resources)
 }
@@ -517,7 +556,11 @@ const COUNTERS: [Slot; 4] = [
 /// stage.
 pub fn trace_group() -> Group {
     let mut g = Group::compute("photon trace", &COUNTERS);
-    g.slots.extend([Slot::read::<[u32; 2]>(6, "slot_keys"), Slot::read::<TrianglePlane>(7, "planes")]);
+    g.slots.extend([
+        Slot::read::<[u32; 2]>(6, "slot_keys"),
+        Slot::read::<TrianglePlane>(7, "planes"),
+        Slot::write::<u32>(8, "photon_guide"),
+    ]);
     g
 }
 
@@ -539,6 +582,7 @@ pub fn lookup_group() -> Group {
             Slot::uniform::<PhotonGridUniforms>(1, "photon_grid"),
             Slot::read::<[u32; 2]>(2, "slot_keys"),
             Slot::read::<TrianglePlane>(3, "planes"),
+            Slot::write::<u32>(4, "photon_guide").only(wgpu::ShaderStages::COMPUTE),
         ],
     )
 }

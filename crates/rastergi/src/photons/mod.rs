@@ -36,6 +36,7 @@ pub mod budget;
 mod clip;
 pub mod cpu;
 pub mod gpu;
+pub mod guide;
 pub mod map;
 pub mod passes;
 pub mod separators;
@@ -61,11 +62,14 @@ pub struct PhotonSettings {
     /// Where the camera reads the map, in cells `factor` times finer than the rest's
     /// ([`crate::fit::photon_region`]); `None`: one level of cells over the whole scene.
     pub region: Option<map::PhotonRegion>,
+    /// The sun's and the sky's photons guided to where the map is read, as learned over the
+    /// passes ([`guide`]).
+    pub guided: bool,
 }
 
 impl Default for PhotonSettings {
     fn default() -> Self {
-        Self { count: 1 << 20, seed: 0, grid_resolution: 64, indirect_only: false, region: None }
+        Self { count: 1 << 20, seed: 0, grid_resolution: 64, indirect_only: false, region: None, guided: false }
     }
 }
 
@@ -73,7 +77,7 @@ impl PhotonSettings {
     /// The largest flux, over lights and channels, that a photon starts with
     /// ([`crate::lights::LightTable::max_photon_flux`] / N).
     pub fn max_photon_flux(&self, prepared: &PreparedScene) -> f64 {
-        prepared.lights.max_photon_flux(&prepared.scene, self.region.is_some()) / self.count.max(1) as f64
+        prepared.lights.max_photon_flux(&prepared.scene, self.region.is_some(), self.guided) / self.count.max(1) as f64
     }
 
     /// Where sun and sky photons are aimed: the photon region's bounding sphere.

@@ -23,6 +23,7 @@
 
 use super::PhotonSettings;
 use super::gpu::GpuPhotonMap;
+use super::guide::PhotonGuide;
 use super::map::MapLayout;
 use crate::error::Result;
 use crate::gpu::Gpu;
@@ -75,10 +76,13 @@ pub struct PhotonPasses {
     /// The finest resolution the GPU binds, once a pass has hit it.
     finest: Option<u32>,
     map: GpuPhotonMap,
+    /// Where the map is read, and where the sun's and the sky's photons start to land there.
+    guide: PhotonGuide,
 }
 
 impl PhotonPasses {
-    /// Traces pass 0 (`settings.grid_resolution` cells) and keeps what later passes need.
+    /// Traces pass 0 (`settings.grid_resolution` cells) and keeps what later passes need; the
+    /// guide buffer holds the gather guide's cells over `field` where the gather is guided.
     pub fn new(
         gpu: &Gpu,
         scene: &GpuScene,
@@ -86,10 +90,22 @@ impl PhotonPasses {
         settings: PhotonSettings,
         passes: u32,
         pass_iterations: u32,
+        field: Option<crate::gather::guide::GuideField>,
     ) -> Result<PhotonPasses> {
         // Passes to come: a coarse first pass, so the first image comes as fast as it can.
         let first = if passes == 1 { settings.count } else { first_pass_photons(settings.count) };
-        let mut map = GpuPhotonMap::build_with(gpu, scene, &prepared, &settings, first)?;
+        let layout = MapLayout::within(
+            &prepared.scene,
+            &prepared.bounds,
+            settings.grid_resolution,
+            settings.region.as_ref(),
+            &gpu.device.limits(),
+        )?;
+        // The guide marks the cells of the first grid, wherever later passes refine it.
+        let lights = super::guide::guided_lights(&prepared.lights);
+        let guide = PhotonGuide::new(gpu, layout.grid, &lights, settings.guided && passes != 1, field);
+        let mut map = GpuPhotonMap::with_layout(gpu, scene, &prepared, &settings, layout, &guide)?;
+        map.trace_photons(gpu, scene, 0, first);
         if passes == 1 {
             // One fixed map: rendering reads the lookup values alone.
             map.release_build_buffers();
@@ -103,6 +119,7 @@ impl PhotonPasses {
             iterations_in_pass: 0,
             finest: None,
             map,
+            guide,
         })
     }
 
@@ -144,7 +161,7 @@ impl PhotonPasses {
             let current = self.map.grid().dims.max_element();
             if got != current {
                 let settings = PhotonSettings { grid_resolution: got, ..self.settings };
-                self.map = GpuPhotonMap::with_layout(gpu, scene, &self.prepared, &settings, layout)?;
+                self.map = GpuPhotonMap::with_layout(gpu, scene, &self.prepared, &settings, layout, &self.guide)?;
             }
             self.map.trace_pass(gpu, scene, pass);
         }
@@ -213,12 +230,25 @@ impl PhotonPasses {
             }
             if got > current {
                 let settings = PhotonSettings { grid_resolution: got, ..self.settings };
-                self.map = GpuPhotonMap::with_layout(gpu, scene, &self.prepared, &settings, layout)?;
+                self.map = GpuPhotonMap::with_layout(gpu, scene, &self.prepared, &settings, layout, &self.guide)?;
                 log::info!("photon pass {}: {} cells along the longest axis", self.pass, got);
             }
         }
+        // What the last pass's photons found, learned before this pass's start.
+        let (photons, useful) = self.guide.learn(gpu)?;
+        if photons > 0 {
+            log::info!(
+                "photon guide: the last pass's {photons} sun and sky photons landed {useful} times where the map is read ({:.3} each)",
+                useful as f64 / photons as f64
+            );
+        }
         self.map.trace_pass(gpu, scene, self.pass);
         Ok(true)
+    }
+
+    /// The photon guide (where the map is read, what the passes learned).
+    pub fn guide(&self) -> &PhotonGuide {
+        &self.guide
     }
 }
 

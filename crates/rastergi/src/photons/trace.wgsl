@@ -15,6 +15,16 @@
 // The slots' table keys, then the separators' keys, records and cell flags (table.wgsl).
 @group(1) @binding(6) var<storage, read> slot_keys: array<vec2u>;
 @group(1) @binding(7) var<storage, read> planes: array<TrianglePlane>;
+// The photon guide (photons/guide.rs): the cells where the map is read (one bit each), the
+// useful deposits and the photons per start bin, the learned tables (emit.wgsl).
+@group(1) @binding(8) var<storage, read_write> photon_guide: array<atomic<u32>>;
+
+// Whether the map is read in the cell of p (its mark in the guide's grid).
+fn is_read(p: vec3f) -> bool {
+    let l = lattice_at(params.marks, p);
+    let i = lattice_index(l, lattice_cell(l, p));
+    return (atomicLoad(&photon_guide[GUIDE_MARKS + i / 32u]) & (1u << (i % 32u))) != 0u;
+}
 
 // The table entry of a deposit at p on side `back` of triangle tri (MapLayout::deposit_slot).
 // With `twin` = CAUSTIC_CELL, the slot's caustic twin (NO_SLOT where the map has none).
@@ -133,6 +143,8 @@ fn trace_photons(@builtin(global_invocation_id) gid: vec3u) {
     var skip = start.skip;
     // Every scattering so far was a specular (delta) one, and there was one.
     var caustic = false;
+    // Deposits where the map is read (counted for a guided photon's start).
+    var useful = 0u;
     for (var bounce = 0u; bounce < params.max_bounces; bounce++) {
         let hit = trace(origin, dir, params.ray_epsilon, 3.0e38, skip, NO_TRIANGLE, false);
         if hit.tri == NO_TRIANGLE {
@@ -155,6 +167,9 @@ fn trace_photons(@builtin(global_invocation_id) gid: vec3u) {
         let arrive = dot(-dir, ns) / dot(-dir, n);
         if bounce >= params.first_deposit {
             deposit(s.pos, hit.tri, !front, flux * arrive, 0u);
+            if start.bin != NO_BIN && is_read(s.pos) {
+                useful += 1u;
+            }
         }
         // A photon that came through specular surfaces alone adds to the caustic map too.
         if SCENE_PASSES_RAYS && caustic {
@@ -213,6 +228,14 @@ fn trace_photons(@builtin(global_invocation_id) gid: vec3u) {
         }
         origin = s.pos + select(n, -n, below) * params.ray_epsilon;
         skip = hit.tri;
+    }
+    // What the guide learns (guide.rs: PhotonGuide::learn): this start's photons and their
+    // deposits where the map is read.
+    if start.bin != NO_BIN {
+        if useful > 0u {
+            atomicAdd(&photon_guide[params.guide_counters + start.bin], useful);
+        }
+        atomicAdd(&photon_guide[params.guide_counters + params.guide_bins + start.bin], 1u);
     }
 }
 

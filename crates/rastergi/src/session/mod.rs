@@ -118,6 +118,10 @@ pub struct Options {
     pub pass_iterations: u32,
     /// How long each photon pass lasts where `pass_iterations` is 0.
     pub photon_budget: crate::settings::PhotonBudget,
+    /// The sun's and the sky's photons guided to where the map is read.
+    pub photon_guiding: bool,
+    /// The traced gather's directions guided by the light its rays found.
+    pub gather_guiding: bool,
     /// The gather's ray-view resolution (`None`: fitted).
     pub bundle: Option<u32>,
     pub gather: GatherMethod,
@@ -161,6 +165,8 @@ impl Default for Options {
             photon_passes: 0,
             pass_iterations: crate::photons::passes::DEFAULT_PASS_ITERATIONS,
             photon_budget: crate::settings::PhotonBudget::default(),
+            photon_guiding: true,
+            gather_guiding: false,
             bundle: None,
             gather: GatherMethod::Auto,
             gather_directions: GatherDirections::default(),
@@ -310,6 +316,8 @@ impl Options {
             photon_passes: self.photon_passes,
             pass_iterations: self.pass_iterations,
             photon_budget: self.photon_budget,
+            photon_guiding: self.photon_guiding,
+            gather_guiding: self.gather_guiding,
             hit_light: self.hit_light,
             photon_region: self.photon_region,
             texture_filter: self.texture_filter,

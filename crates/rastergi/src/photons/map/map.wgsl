@@ -7,6 +7,20 @@
 // The slots' table keys, then the separators' keys, records and cell flags (table.wgsl).
 @group(3) @binding(2) var<storage, read> slot_keys: array<vec2u>;
 @group(3) @binding(3) var<storage, read> planes: array<TrianglePlane>;
+// The photon guide (photons/guide.rs): its first words mark the cells where the map is read.
+@group(3) @binding(4) var<storage, read_write> photon_guide: array<atomic<u32>>;
+
+// Marks the cell of p, in the guide's grid, as one where the map is read (once: a marked
+// cell is only loaded).
+fn mark_read(p: vec3f) {
+    let l = lattice_at(photon_grid.marks, p);
+    let i = lattice_index(l, lattice_cell(l, p));
+    let bit = 1u << (i % 32u);
+    let word = GUIDE_MARKS + i / 32u;
+    if (atomicLoad(&photon_guide[word]) & bit) == 0u {
+        atomicOr(&photon_guide[word], bit);
+    }
+}
 
 fn map_separators() -> TableLayout {
     let g = photon_grid;
@@ -37,6 +51,7 @@ fn caustic_irradiance(p: vec3f, tri: u32, back: bool) -> vec3f {
 
 // The lookup over the slots whose cell index has the bits `twin` set.
 fn photon_lookup(p: vec3f, tri: u32, back: bool, twin: u32) -> vec3f {
+    mark_read(p);
     let plane = planes[tri];
     // The level holding p: its 8 cells around p (the other level's hold no slots of this one).
     let l = lattice_at(photon_grid.grid, p);

@@ -112,6 +112,15 @@ pub fn photons_for_image(photons: u32, pixels: u64) -> u32 {
     photons.min(cap.min(u32::MAX as u64) as u32)
 }
 
+/// The fitted photon count `photons` of a pass of a balanced render of `pixels` pixels
+/// ([`crate::photons::budget`]): the budget chooses how long a pass lasts, but at most
+/// [`crate::photons::budget::MAX_ITERATIONS`], so a thumbnail of a large scene is capped at 256
+/// photons per pixel (16 times [`photons_for_image`]'s cap): a pass of 2²⁴ photons for a
+/// 48 × 27 image took seconds for a few milliseconds of iterations.
+pub fn photons_for_balanced_image(photons: u32, pixels: u64) -> u32 {
+    photons_for_image(photons, pixels.saturating_mul(16))
+}
+
 /// The fewest photons [`photons_for_image`] leaves a pass (a thumbnail keeps a usable map).
 pub const MIN_PASS_PHOTONS: u32 = 1 << 16;
 

@@ -381,7 +381,12 @@ impl GpuScene {
                 v0: t[0].into(),
                 material: m,
                 v1: t[1].into(),
-                flags: if s.materials[m as usize].has_holes() { TRIANGLE_HAS_HOLES } else { 0 },
+                flags: if s.materials[m as usize].has_holes() { TRIANGLE_HAS_HOLES } else { 0 }
+                    | if (t[1] - t[0]).cross(t[2] - t[0]) == glam::Vec3::ZERO {
+                        crate::gpu::consts::TRIANGLE_ZERO_AREA
+                    } else {
+                        0
+                    },
                 v2: t[2].into(),
                 light,
             })

@@ -71,17 +71,19 @@ pub enum TextureFilter {
     Bilinear,
 }
 
-/// How long each photon pass lasts ([`RenderSettings::pass_iterations`] 0).
+/// How long each photon pass lasts ([`RenderSettings::pass_iterations`] 0). The library's
+/// settings default to `Fitted` (a seed gives one image); the front ends' options
+/// ([`crate::session::Options`]: the command line, the viewer, the page, Python) to `Balanced`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum PhotonBudget {
     /// Measured as the render goes on: the variance the map adds to the image against the
     /// iterations' own, and what a pass and an iteration cost on this GPU, give the iterations
     /// per pass that lower the image's error fastest ([`crate::photons::budget`]). The choice
     /// depends on timings, so two renders of one seed may differ: `Fitted` repeats bit for bit.
-    #[default]
     Balanced,
     /// 4 · photons / pixels iterations, at least 16, whatever the scene
     /// ([`crate::photons::passes::fitted_pass_iterations`]): the same for every run of a seed.
+    #[default]
     Fitted,
 }
 

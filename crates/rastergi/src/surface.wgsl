@@ -26,18 +26,21 @@ struct TriangleVertex {
     pos: vec3f,
     bary: vec2f,
     tri: u32,
+    // The triangle has no area (TRIANGLE_ZERO_AREA).
+    zero_area: bool,
 }
 
 fn triangle_vertex(vi: u32) -> TriangleVertex {
     let tri = vi / 3u;
     let corner = vi % 3u;
     let t = triangles[tri];
+    let zero_area = (t.flags & TRIANGLE_ZERO_AREA) != 0u;
     if corner == 1u {
-        return TriangleVertex(t.v1, vec2f(1.0, 0.0), tri);
+        return TriangleVertex(t.v1, vec2f(1.0, 0.0), tri, zero_area);
     } else if corner == 2u {
-        return TriangleVertex(t.v2, vec2f(0.0, 1.0), tri);
+        return TriangleVertex(t.v2, vec2f(0.0, 1.0), tri, zero_area);
     }
-    return TriangleVertex(t.v0, vec2f(0.0, 0.0), tri);
+    return TriangleVertex(t.v0, vec2f(0.0, 0.0), tri, zero_area);
 }
 
 // A raster pass's vertex (`vs_main` of the G-buffer and of the gather's ray views): clip
@@ -51,19 +54,18 @@ struct RasterVertex {
     @location(2) uv: vec2f,
 }
 
-// A triangle of zero area (collinear corners: published meshes carry them) has no normal and
-// no surface, and no ray hits it; but projected, rounding can leave its corners a sliver
-// apart, and a rasterizer then covers pixels with it at barycentrics far outside [0, 1] (the
-// shared classroom's ceiling: NaN pixels). Its corners are put outside the clip volume, so
-// no raster pass draws it.
+// A triangle of zero area (collinear corners: published meshes carry them; flagged when the
+// scene is uploaded) has no normal and no surface, and no ray hits it; but projected, rounding
+// can leave its corners a sliver apart, and a rasterizer then covers pixels with it at
+// barycentrics far outside [0, 1] (the shared classroom's ceiling: NaN pixels). Its corners
+// are put outside the clip volume, so no raster pass draws it.
 fn raster_vertex(vi: u32, view_proj: mat4x4f, with_uv: bool) -> RasterVertex {
     let v = triangle_vertex(vi);
     var uv = vec2f(0.0);
     if with_uv {
         uv = surface_uv(v.tri, v.bary.x, v.bary.y);
     }
-    let t = triangles[v.tri];
-    if all(cross(t.v1 - t.v0, t.v2 - t.v0) == vec3f(0.0)) {
+    if v.zero_area {
         return RasterVertex(vec4f(2.0, 2.0, 2.0, 1.0), v.bary, v.tri, uv);
     }
     return RasterVertex(view_proj * vec4f(v.pos, 1.0), v.bary, v.tri, uv);

@@ -81,6 +81,10 @@ pub struct Controls {
     pub gather: GatherMethod,
     pub gather_directions: GatherDirections,
     pub directions: u32,
+    /// How long photon passes last, and the guides of photons and of the gather.
+    pub photon_budget: rastergi::settings::PhotonBudget,
+    pub photon_guiding: bool,
+    pub gather_guiding: bool,
     /// The scene's sun (its last distant light), if it has one.
     pub sun: Option<SunAngles>,
     /// The environment map's radiance scale, if the scene has one that can be scaled.
@@ -109,6 +113,9 @@ impl Controls {
             gather: settings.gather,
             gather_directions: settings.gather_directions,
             directions: settings.directions,
+            photon_budget: settings.photon_budget,
+            photon_guiding: settings.photon_guiding,
+            gather_guiding: settings.gather_guiding,
             sun: None,
             env_scale: None,
             panel: true,
@@ -148,6 +155,9 @@ impl Controls {
             gather: self.gather,
             gather_directions: self.gather_directions,
             directions: self.directions,
+            photon_budget: self.photon_budget,
+            photon_guiding: self.photon_guiding,
+            gather_guiding: self.gather_guiding,
             ..base.clone()
         }
     }
@@ -290,6 +300,9 @@ impl Controls {
                 let n = n.clamp(1, rastergi::gather::MAX_DIRECTIONS);
                 r.retrace = std::mem::replace(&mut self.directions, n) != n;
             }
+            Action::PhotonBudget(b) => r.retrace = std::mem::replace(&mut self.photon_budget, b) != b,
+            Action::PhotonGuiding(on) => r.retrace = std::mem::replace(&mut self.photon_guiding, on) != on,
+            Action::GatherGuiding(on) => r.retrace = std::mem::replace(&mut self.gather_guiding, on) != on,
             Action::Speed(s) => self.camera.speed = s.max(1e-6),
             Action::Home => r.camera_moved = self.home(),
             Action::Open(ref name) => r.open = Some(name.clone()),

@@ -15,6 +15,7 @@ use egui::{Color32, ComboBox, RichText, Slider, Stroke, Ui};
 use egui_wgpu::wgpu;
 use rastergi::gather::{GatherDirections, GatherMethod, MAX_DIRECTIONS};
 use rastergi::passes::film::Show;
+use rastergi::settings::PhotonBudget;
 
 use super::controls::{Controls, SunAngles, show_name};
 use super::script::Action;
@@ -304,6 +305,14 @@ fn renderer(ui: &mut Ui, c: &Controls, out: &mut Vec<Action>) {
     if ui.add(Slider::new(&mut n, 1..=MAX_DIRECTIONS).text("directions / iteration")).changed() {
         out.push(Action::Directions(n));
     }
+    let mut guided = c.gather_guiding;
+    if ui
+        .checkbox(&mut guided, "guided gather")
+        .on_hover_text("half of the traced gather's directions drawn towards where its cell found light")
+        .changed()
+    {
+        out.push(Action::GatherGuiding(guided));
+    }
 }
 
 fn photon_map(ui: &mut Ui, c: &Controls, out: &mut Vec<Action>) {
@@ -322,6 +331,24 @@ fn photon_map(ui: &mut Ui, c: &Controls, out: &mut Vec<Action>) {
             }
         }
     });
+    let mut budget = c.photon_budget;
+    ui.horizontal(|ui| {
+        ui.radio_value(&mut budget, PhotonBudget::Balanced, "balanced");
+        ui.radio_value(&mut budget, PhotonBudget::Fitted, "fitted");
+    })
+    .response
+    .on_hover_text("iterations per photon pass: measured (balanced) or 4 × photons / pixels (fitted)");
+    if budget != c.photon_budget {
+        out.push(Action::PhotonBudget(budget));
+    }
+    let mut guided = c.photon_guiding;
+    if ui
+        .checkbox(&mut guided, "guided photons")
+        .on_hover_text("the sun's and the sky's photons sent where the photon map is read")
+        .changed()
+    {
+        out.push(Action::PhotonGuiding(guided));
+    }
     let passes = |p: u32| if p == 0 { "no limit".to_owned() } else { p.to_string() };
     ComboBox::from_label("photon passes").selected_text(passes(c.photon_passes)).show_ui(ui, |ui| {
         for p in PASSES {

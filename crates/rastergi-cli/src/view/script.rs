@@ -121,6 +121,12 @@ pub enum Action {
     GatherDirections(GatherDirections),
     /// Gather directions per iteration.
     Directions(u32),
+    /// How long photon passes last (`balanced` or `fitted`).
+    PhotonBudget(rastergi::settings::PhotonBudget),
+    /// Photons guided to where the map is read (on) or not.
+    PhotonGuiding(bool),
+    /// The traced gather guided by what its rays found (on) or not.
+    GatherGuiding(bool),
     /// Camera speed in scene units per second.
     Speed(f32),
     Home,
@@ -249,6 +255,11 @@ fn parse_action(action: &str) -> Result<Action> {
         "gather" => Action::Gather(choice::<GatherArg>(name, args)?.method()),
         "gather-directions" => Action::GatherDirections(choice::<GatherDirectionsArg>(name, args)?.directions()),
         "directions" => Action::Directions(count(args, "directions", 1, rastergi::gather::MAX_DIRECTIONS)?),
+        "photon-budget" => {
+            Action::PhotonBudget(choice::<rastergi::session::args::PhotonBudgetArg>(name, args)?.budget())
+        }
+        "photon-guiding" => Action::PhotonGuiding(on_off(name, args)?),
+        "gather-guiding" => Action::GatherGuiding(on_off(name, args)?),
         "speed" => match numbers::<1>(args, "SPEED")?[0] {
             s if s > 0.0 => Action::Speed(s),
             _ => bail!("'speed' takes a positive number of scene units per second"),

@@ -27,6 +27,9 @@ pub const NO_TEXTURE: u32 = u32::MAX;
 /// Triangle flag ([`crate::gpu_scene::GpuTriangle::flags`]): its material may have holes, so
 /// a ray that meets it asks the material whether it passes.
 pub const TRIANGLE_HAS_HOLES: u32 = 1;
+/// Triangle flag: its corners are collinear (zero area, exactly: the cross product of its
+/// edges is zero in f32), so no raster pass draws it (`raster_vertex`).
+pub const TRIANGLE_ZERO_AREA: u32 = 2;
 
 /// Light-table entry bit of a point, spot or distant light ([`crate::lights`]); the other
 /// bits index the punctual lights.

@@ -77,6 +77,7 @@ pub fn constants() -> String {
         ("MATERIAL_SINGLE_SCATTERING", MATERIAL_SINGLE_SCATTERING),
         ("MAX_HOLE_CROSSINGS", MAX_HOLE_CROSSINGS),
         ("TRIANGLE_HAS_HOLES", TRIANGLE_HAS_HOLES),
+        ("TRIANGLE_ZERO_AREA", crate::gpu::consts::TRIANGLE_ZERO_AREA),
         ("NO_TEXTURE", NO_TEXTURE),
         ("ATLAS_ROW", crate::gpu::consts::ATLAS_ROW),
         ("FILM_DIRECT", FILM_DIRECT),

@@ -437,7 +437,10 @@ mod tests {
         for (v_map, w, c_pass, c_it) in cases {
             let m = balanced_iterations(v_map, w, c_pass, c_it);
             let cost = |m: f64| (v_map + w / m) * (c_pass + m * c_it);
-            let best = (1..=8).map(|k| 1u32 << k).min_by(|&a, &b| cost(a as f64).total_cmp(&cost(b as f64))).unwrap();
+            let best = (MIN_ITERATIONS.ilog2()..=MAX_ITERATIONS.ilog2())
+                .map(|k| 1u32 << k)
+                .min_by(|&a, &b| cost(a as f64).total_cmp(&cost(b as f64)))
+                .unwrap();
             let exact = (w * c_pass / (v_map * c_it)).sqrt();
             let brute = (1..=400_000).map(|i| i as f64 * 0.01).min_by(|a, b| cost(*a).total_cmp(&cost(*b))).unwrap();
             assert!((brute - exact).abs() <= 0.011 * exact.max(1.0), "{brute} against {exact}");

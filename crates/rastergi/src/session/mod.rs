@@ -164,7 +164,7 @@ impl Default for Options {
             grid: None,
             photon_passes: 0,
             pass_iterations: crate::photons::passes::DEFAULT_PASS_ITERATIONS,
-            photon_budget: crate::settings::PhotonBudget::default(),
+            photon_budget: crate::settings::PhotonBudget::Balanced,
             photon_guiding: true,
             gather_guiding: false,
             bundle: None,
@@ -287,13 +287,16 @@ impl Options {
     pub fn settings(&self, scene: &Scene, width: u32, height: u32, show_photon_map: bool) -> RenderSettings {
         let grid = self.grid.unwrap_or_else(|| fit::grid_resolution(&scene.bounds()));
         // Progressive passes at the fitted cadence: no pass longer than about 64 iterations (a
-        // balanced budget chooses the passes' length for the scene's photons instead).
-        let progressive = self.photon_passes != 1
-            && self.pass_iterations == 0
-            && self.photon_budget == crate::settings::PhotonBudget::Fitted;
+        // balanced budget chooses the passes' length, with a looser cap for thumbnails).
+        let progressive = self.photon_passes != 1 && self.pass_iterations == 0;
         let photons = self.photons.unwrap_or_else(|| {
             let fitted = fit::photon_count(scene, grid);
-            if progressive { fit::photons_for_image(fitted, width as u64 * height as u64) } else { fitted }
+            let pixels = width as u64 * height as u64;
+            match self.photon_budget {
+                _ if !progressive => fitted,
+                crate::settings::PhotonBudget::Fitted => fit::photons_for_image(fitted, pixels),
+                crate::settings::PhotonBudget::Balanced => fit::photons_for_balanced_image(fitted, pixels),
+            }
         });
         log::info!(
             "photons {photons}{}, grid {grid}{}",

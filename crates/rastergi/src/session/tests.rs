@@ -18,17 +18,23 @@ fn cornell_with_no_flags_gets_the_fitted_defaults() {
     let options = Options { scene: "cornell".into(), ..Options::default() };
     let session = Session::load(&options).unwrap();
     // The renderer's own defaults (256², seed 0, one light sample, the traced-or-rasterized
-    // `auto` gather with four per-pixel directions, …) but for the fitted photon map.
-    let defaults = RenderSettings { photons: 1 << 20, grid_resolution: 64, ..RenderSettings::default() };
+    // `auto` gather with four per-pixel directions, …) but for the fitted photon map and the
+    // front ends' balanced photon budget.
+    let defaults = RenderSettings {
+        photons: 1 << 20,
+        grid_resolution: 64,
+        photon_budget: crate::settings::PhotonBudget::Balanced,
+        ..RenderSettings::default()
+    };
     assert_eq!(session.settings, defaults);
     assert_eq!((defaults.width, defaults.height, defaults.directions), (256, 256, 4));
 }
 
 /// `rastergi render cornell --width 96 --height 40 --seed 7 --photons 5000 --grid 20 --bundle
 /// 300 --gather trace --gather-directions shared --directions 2 --light-samples 3
-/// --photon-passes 4 --pass-iterations 10 --photon-budget fitted --photon-guiding off --gather-guiding off
-/// --hit-light exact
-/// --photon-region scene --texture-filter bilinear --show photon-map`.
+/// --photon-passes 4 --pass-iterations 10 --photon-budget fitted --photon-guiding off
+/// --gather-guiding off --hit-light exact --photon-region scene --texture-filter bilinear
+/// --show photon-map`.
 #[test]
 fn given_flags_are_the_settings() {
     let options = Options {

@@ -26,18 +26,8 @@ fn script() -> PathBuf {
 /// The render options of every shard here: the Cornell box at 32², traced gather, few photons,
 /// the fitted photon budget (the balanced budget times its passes by the clock, so a shard
 /// resumed from its checkpoint repeats the uninterrupted render bit for bit only with this one).
-const RENDER: [&str; 10] = [
-    "--width",
-    "32",
-    "--height",
-    "32",
-    "--gather",
-    "trace",
-    "--photons",
-    "20000",
-    "--photon-budget",
-    "fitted",
-];
+const RENDER: [&str; 10] =
+    ["--width", "32", "--height", "32", "--gather", "trace", "--photons", "20000", "--photon-budget", "fitted"];
 
 /// The runner's arguments: the Cornell box with `options`, this build's rastergi, and the
 /// render options of every shard here.

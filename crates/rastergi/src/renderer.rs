@@ -191,7 +191,7 @@ impl Renderer {
             grid_resolution: settings.grid_resolution,
             indirect_only: settings.hit_light == HitLight::Exact,
             region,
-            guided: settings.photon_guiding,
+            guided: settings.photon_guiding && crate::gpu::READ_BACK_BLOCKS,
         };
         let photons = (settings.photons > 0)
             .then(|| {
@@ -514,7 +514,9 @@ fn new_budget(
     fresh: bool,
 ) -> Option<Budget> {
     let photons = photons.filter(|p| p.progressive())?;
-    let balanced = settings.pass_iterations == 0 && settings.photon_budget == PhotonBudget::Balanced;
+    let balanced = settings.pass_iterations == 0
+        && settings.photon_budget == PhotonBudget::Balanced
+        && crate::gpu::READ_BACK_BLOCKS;
     balanced.then(|| Budget::new(gpu, &film.accumulation, film.width * film.height, photons, fresh))
 }
 

@@ -103,6 +103,12 @@ impl Gpu {
     }
 }
 
+/// Whether a read-back may block until the GPU has finished: not in a web page, where only
+/// the asynchronous read-backs work. The balanced photon budget and the photon guide read
+/// their measurements back between iterations, so a web page renders without them (the
+/// fitted budget, unguided photons).
+pub const READ_BACK_BLOCKS: bool = !cfg!(target_arch = "wasm32");
+
 /// Runs a read-back's future to its end. Natively it blocks (the future waits for the GPU in
 /// `device.poll`). A browser cannot block: there the answer arrives only after control returns
 /// to its event loop, so a future that is not ready at once is an error that names the

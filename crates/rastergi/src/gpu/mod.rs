@@ -17,7 +17,7 @@ pub mod profile;
 pub(crate) mod shader;
 pub mod structs;
 
-pub use buffers::block_on;
+pub use buffers::{READ_BACK_BLOCKS, block_on};
 pub use pipeline::*;
 
 use crate::error::{Error, Result};

@@ -289,10 +289,16 @@ impl Options {
         // Progressive passes at the fitted cadence: no pass longer than about 64 iterations (a
         // balanced budget chooses the passes' length, with a looser cap for thumbnails).
         let progressive = self.photon_passes != 1 && self.pass_iterations == 0;
+        // A web page cannot wait for the measurements of the balanced budget and the photon
+        // guide ([`crate::gpu::READ_BACK_BLOCKS`]): it renders with the fitted budget.
+        let (photon_budget, photon_guiding) = match crate::gpu::READ_BACK_BLOCKS {
+            true => (self.photon_budget, self.photon_guiding),
+            false => (crate::settings::PhotonBudget::Fitted, false),
+        };
         let photons = self.photons.unwrap_or_else(|| {
             let fitted = fit::photon_count(scene, grid);
             let pixels = width as u64 * height as u64;
-            match self.photon_budget {
+            match photon_budget {
                 _ if !progressive => fitted,
                 crate::settings::PhotonBudget::Fitted => fit::photons_for_image(fitted, pixels),
                 crate::settings::PhotonBudget::Balanced => fit::photons_for_balanced_image(fitted, pixels),
@@ -318,8 +324,8 @@ impl Options {
             directions: self.directions,
             photon_passes: self.photon_passes,
             pass_iterations: self.pass_iterations,
-            photon_budget: self.photon_budget,
-            photon_guiding: self.photon_guiding,
+            photon_budget,
+            photon_guiding,
             gather_guiding: self.gather_guiding,
             hit_light: self.hit_light,
             photon_region: self.photon_region,

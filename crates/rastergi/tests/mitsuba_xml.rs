@@ -19,7 +19,10 @@ use common::mitsuba::*;
 fn defaults_and_parameters_are_substituted_and_overridden() {
     let scene = load(&data("basic.xml")).scene;
     assert_eq!(material(&scene, "paint").albedo, Vec3::splat(0.25));
-    let defined = MitsubaOptions { defines: vec![("grey".into(), "0.5".into()), ("fov".into(), "90".into())] };
+    let defined = MitsubaOptions {
+        defines: vec![("grey".into(), "0.5".into()), ("fov".into(), "90".into())],
+        ..Default::default()
+    };
     let scene = load_mitsuba(&data("basic.xml"), &defined).unwrap().scene;
     assert_eq!(material(&scene, "paint").albedo, Vec3::splat(0.5));
     // fov 90° along x of a 2:1 film: tan(θ_y/2) = tan(45°)/2.

@@ -9,7 +9,7 @@
 //! | `vertices` | vertices of one mesh (PLY, `.serialized`, OBJ, glTF accessor) | 2²⁶ (67 M) |
 //! | `texels` | texels of the scene's decoded textures together, each image's declared size checked before it is decoded; also the pixels of one environment map or image read (`--env`, `envmap`, `compare`) | 2²⁷ (134 M: 512 MiB of 8-bit RGBA) |
 //! | `decompressed` | bytes decompressed from `.serialized` meshes, in all | 2 GiB (512 MiB on 32-bit targets) |
-//! | `xml-bytes` | bytes of a Mitsuba file and its includes, in all | 256 MiB |
+//! | `xml-bytes` | bytes of a Mitsuba file and its includes, in all; and the nodes (elements, comments, runs of text) a file may hold, one per 32 bytes of it | 64 MiB (2 M nodes) |
 //! | `xml-depth` | nesting of a Mitsuba file's elements | 256 |
 //! | `expansion` | bytes of text made by `$name` substitution and DTD entity references, in all | 64 MiB |
 //!
@@ -98,7 +98,7 @@ impl Default for Budgets {
             vertices: 1 << 26,
             texels: 1 << 27,
             decompressed: if usize::BITS < 64 { 1 << 29 } else { 2 << 30 },
-            xml_bytes: 256 << 20,
+            xml_bytes: 64 << 20,
             xml_depth: 256,
             expansion: 64 << 20,
             device_triangles: None,
@@ -156,7 +156,7 @@ impl Budgets {
         let detail = if detail.is_empty() { String::new() } else { format!(" ({detail})") };
         if b == Budget::Triangles && self.device_triangles == Some(limit) {
             return format!(
-                "needs {need} triangles{detail}, more than the {limit} this GPU binds in one buffer; render it on a GPU with a larger storage-buffer limit"
+                "needs {need} triangles{detail}, more than the {limit} triangles this GPU binds in one buffer; render it on a GPU with a larger storage-buffer limit"
             );
         }
         format!(

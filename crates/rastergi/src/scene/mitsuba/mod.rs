@@ -388,6 +388,9 @@ impl<'a> Loader<'a> {
             Value::Constant(c) if spectrum => Value::Constant(c * emitters::EQUAL_ENERGY_SRGB),
             v => v,
         };
+        if let Err(m) = super::check_light(radiance.factor(), "radiance") {
+            return Err(self.err(p.get("radiance").unwrap_or(e), format!("an area emitter's {m}")));
+        }
         self.warn_unread(&p, "emitter 'area'");
         Ok(radiance)
     }

@@ -195,6 +195,10 @@ pub fn read(bytes: &[u8], budgets: &Budgets, used: u64) -> Result<Mesh, String> 
             budgets.check(Budget::Vertices, e.count as u64, "its vertex element")?;
             mesh.positions.reserve(e.count);
         }
+        if is_face && list.is_some() {
+            // A face makes at least one triangle (a polygon of n corners, n − 2).
+            budgets.check_more(Budget::Triangles, used, e.count as u64, &format!("its {} faces", e.count))?;
+        }
         let mut values = vec![0.0f64; e.properties.len()];
         let mut polygon: Vec<u32> = Vec::new();
         for _ in 0..e.count {
@@ -277,6 +281,6 @@ mod tests {
         let e = read(ascii, &Budgets { triangles: 1, ..Budgets::default() }, 0).unwrap_err();
         assert!(e.contains("2 triangles") && e.contains("budget of 1"), "{e}");
         let e = read(&binary, &Budgets { triangles: 10, ..Budgets::default() }, 10).unwrap_err();
-        assert!(e.starts_with("needs 11 triangles (its faces and the 10 read before)"), "{e}");
+        assert!(e.starts_with("needs 11 triangles (its 1 faces and the 10 read before)"), "{e}");
     }
 }

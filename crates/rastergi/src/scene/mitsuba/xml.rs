@@ -24,8 +24,9 @@ use crate::scene::budget::{Budget, Budgets};
 pub const MAX_INCLUDE_DEPTH: usize = 16;
 /// Most files a scene and its includes may read.
 const MAX_FILES: usize = 256;
-/// Most elements a scene and its includes may hold (a guard against hostile files).
-const MAX_NODES: u32 = 8_000_000;
+/// Bytes of the XML budget per node `roxmltree` may make (an element, a comment, a run of
+/// text; it holds about 250 bytes for each): the default 64 MiB allow 2 M nodes.
+const BYTES_PER_NODE: u64 = 32;
 
 /// Where an element starts: the index of its file in [`Document::files`], line and column
 /// (from 1).
@@ -116,7 +117,6 @@ pub fn parse(files: Files, path: &Path, defines: &[(String, String)], budgets: &
         files,
         paths: Vec::new(),
         params: defines.iter().cloned().collect(),
-        nodes: 0,
         budgets: *budgets,
         bytes: 0,
         expanded: 0,
@@ -129,7 +129,6 @@ struct Parser<'a> {
     files: Files<'a>,
     paths: Vec<PathBuf>,
     params: HashMap<String, String>,
-    nodes: u32,
     budgets: Budgets,
     /// Bytes of the files read so far.
     bytes: u64,
@@ -211,8 +210,19 @@ impl Parser<'_> {
         self.paths.push(path.to_path_buf());
         let mut lines = Lines::new(&text);
         self.check_entities(&text, file, &mut lines)?;
-        let options = roxmltree::ParsingOptions { allow_dtd: true, nodes_limit: MAX_NODES, ..Default::default() };
+        let nodes = (self.budgets.xml_bytes / BYTES_PER_NODE).clamp(1 << 16, u32::MAX as u64);
+        let options = roxmltree::ParsingOptions { allow_dtd: true, nodes_limit: nodes as u32, ..Default::default() };
         let doc = roxmltree::Document::parse_with_options(&text, options).map_err(|e| {
+            if let roxmltree::Error::NodesLimitReached = e {
+                let (limit, name) = (self.budgets.xml_bytes, Budget::XmlBytes.name());
+                return refuse(
+                    self,
+                    format!(
+                        "has more than {nodes} XML nodes (elements, comments, runs of text), as many as the {name} budget of {limit} allows (one per {BYTES_PER_NODE} bytes); raise it with --budget {name}={} where memory allows",
+                        2 * nodes * BYTES_PER_NODE
+                    ),
+                );
+            }
             let at = e.pos();
             let message = e.to_string();
             // roxmltree's messages say " at L:C"; the position is said once, first.
@@ -273,11 +283,7 @@ impl Parser<'_> {
     /// `<include>`.
     fn children(&mut self, node: roxmltree::Node, at: &mut At, out: &mut Vec<Elem>) -> Result<()> {
         for child in node.children().filter(|c| c.is_element()) {
-            self.nodes += 1;
             let pos = at.lines.pos(child, at.file);
-            if self.nodes > MAX_NODES {
-                return Err(self.error(pos, format!("more than {MAX_NODES} elements")));
-            }
             let tag = child.tag_name().name();
             match tag {
                 "default" => {
@@ -333,33 +339,26 @@ impl Parser<'_> {
     }
 
     /// `value` with every `$name` replaced by its parameter's value; the text made counts
-    /// against the expansion budget, checked before it is made.
+    /// against the expansion budget, its length checked before it is made.
     fn substitute(&mut self, value: &str, pos: Pos) -> Result<String> {
         if !value.contains('$') {
             return Ok(value.to_owned());
         }
-        let mut out = String::with_capacity(value.len());
+        // The pieces: text as it is, or a parameter's value.
+        let mut pieces: Vec<&str> = Vec::new();
         let mut rest = value;
         while let Some(i) = rest.find('$') {
-            out.push_str(&rest[..i]);
+            pieces.push(&rest[..i]);
             let after = &rest[i + 1..];
             let n = after.find(|c: char| !(c.is_ascii_alphanumeric() || c == '_')).unwrap_or(after.len());
             if n == 0 {
-                out.push('$');
+                pieces.push("$");
                 rest = after;
                 continue;
             }
             let name = &after[..n];
             match self.params.get(name) {
-                Some(v) => {
-                    let need = self.expanded + (out.len() + v.len()) as u64;
-                    if need > self.budgets.expansion {
-                        let detail = format!("${name} is {} bytes, the text made before {}", v.len(), self.expanded);
-                        let e = self.budgets.refusal(Budget::Expansion, need, &detail);
-                        return Err(self.error(pos, format!("substituting ${name} here {e}")));
-                    }
-                    out.push_str(v)
-                }
+                Some(v) => pieces.push(v),
                 None => {
                     return Err(self.error(
                         pos,
@@ -369,9 +368,16 @@ impl Parser<'_> {
             }
             rest = &after[n..];
         }
-        out.push_str(rest);
-        self.expanded += out.len() as u64;
-        Ok(out)
+        pieces.push(rest);
+        let len: u64 = pieces.iter().map(|p| p.len() as u64).sum();
+        let need = self.expanded.saturating_add(len);
+        if need > self.budgets.expansion {
+            let detail = format!("{len} bytes here, {} made before", self.expanded);
+            let e = self.budgets.refusal(Budget::Expansion, need, &detail);
+            return Err(self.error(pos, format!("substituting parameters {e}")));
+        }
+        self.expanded = need;
+        Ok(pieces.concat())
     }
 }
 
@@ -418,8 +424,9 @@ fn declared_entities(text: &str) -> Option<(HashMap<&str, &str>, usize)> {
 }
 
 /// The bytes the references `&name;` to `entities` after their declarations expand to (each
-/// entity's value with the entities it names expanded in turn, saturating; a cycle counts
-/// as nothing, `roxmltree` refuses it), the offset of the first reference and its name.
+/// entity's value with the references to declared entities in it replaced by their expansions
+/// in turn, saturating; a cycle counts as nothing and nesting beyond `roxmltree`'s 10 levels
+/// as everything, it refuses both), the offset of the first reference and its name.
 fn entity_references<'t>(
     text: &'t str,
     (entities, from): &(HashMap<&'t str, &'t str>, usize),
@@ -450,8 +457,9 @@ fn entity_references<'t>(
         let Some(value) = entities.get(name) else { return 0 };
         memo.insert(name, None);
         let mut n = value.len() as u64;
-        for (_, inner) in references(value) {
-            n = n.saturating_add(size(inner, entities, memo, depth + 1));
+        for (_, inner) in references(value).filter(|(_, name)| entities.contains_key(name)) {
+            let reference = inner.len() as u64 + 2;
+            n = n.saturating_add(size(inner, entities, memo, depth + 1)).saturating_sub(reference);
         }
         memo.insert(name, Some(n));
         n
@@ -566,6 +574,41 @@ mod tests {
         ] {
             assert_eq!(snake_case(a), b);
         }
+    }
+
+    /// Every element's line and column, counted on from the previous element's, are the ones
+    /// roxmltree finds by counting from the start of the text (its `text_pos_at`), in a text
+    /// of tabs, CRLF line ends, several elements on a line and characters of several bytes.
+    #[test]
+    fn element_positions_are_roxmltrees() {
+        let text = "<scene version=\"3\">\r\n\t<shape type=\"é\"><a/><b/></shape>\n<!-- ∑ -->  <c>日本<d/></c>\n\n<e\nx=\"1\"/></scene>";
+        let doc = roxmltree::Document::parse(text).unwrap();
+        let mut lines = Lines::new(text);
+        let mut checked = 0;
+        for node in doc.descendants().filter(|n| n.is_element()) {
+            let expected = doc.text_pos_at(node.range().start);
+            assert_eq!(lines.at(node.range().start), (expected.row, expected.col), "<{}>", node.tag_name().name());
+            checked += 1;
+        }
+        assert_eq!(checked, 7);
+        // Asked out of order, it counts again from the start.
+        let first = doc.root_element().first_element_child().unwrap();
+        let expected = doc.text_pos_at(first.range().start);
+        assert_eq!(lines.at(first.range().start), (expected.row, expected.col));
+    }
+
+    #[test]
+    fn entity_expansion_is_bounded_from_above() {
+        let text = "<!DOCTYPE s [<!ENTITY a \"xy\"><!ENTITY b '&a;&a;&a;'><!ENTITY c \"&b;&b;&unknown;\"><!ENTITY % p \"zzzz\">]><s>&c;&a;&amp;&#65;</s>";
+        let entities = declared_entities(text).unwrap();
+        assert_eq!(entities.0.len(), 3);
+        // Each entity's value with its references replaced: a = 2, b = 3 × 2 = 6, c = 2 × 6 +
+        // 9 (an undeclared name stays as written) = 21; the body names c and a (&amp; and &#65;
+        // are not entities).
+        let (total, first, name) = entity_references(text, &entities);
+        assert_eq!((total, name), (23, "c"));
+        assert_eq!(&text[first..first + 3], "&c;");
+        assert!(declared_entities("<scene/>").is_none());
     }
 
     #[test]

@@ -166,7 +166,8 @@ impl Checkpoint {
         let [photon_pass, iterations_in_pass, m, d, width, height, samples, half_samples] = u;
         let gather = gather_from_code(m, d).ok_or_else(|| bad("unknown gather code"))?;
         let count = r.u64().ok_or_else(|| bad("too short"))? as usize;
-        if count as u64 != 4 * crate::passes::film::COMPONENTS * width as u64 * height as u64 {
+        let expected = (width as u64 * height as u64).checked_mul(4 * crate::passes::film::COMPONENTS);
+        if expected != Some(count as u64) {
             return Err(bad("its film size does not match its image size"));
         }
         let floats = |r: &mut Reader| -> Option<Vec<f32>> {

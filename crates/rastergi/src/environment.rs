@@ -225,7 +225,9 @@ impl Environment {
             }
             "hdr" => {
                 let reader = || image::ImageReader::with_format(std::io::Cursor::new(bytes), image::ImageFormat::Hdr);
-                let (w, h) = reader().into_dimensions().map_err(|e| format!("cannot read Radiance HDR: {e}"))?;
+                let hdr_error =
+                    |e: image::ImageError| format!("cannot read Radiance HDR: {}", crate::error::one_line(e));
+                let (w, h) = reader().into_dimensions().map_err(hdr_error)?;
                 let pixels = w as u64 * h as u64;
                 let budgets = crate::scene::Budgets { texels: max_pixels, ..Default::default() };
                 let check = budgets.check(crate::scene::Budget::Texels, pixels, &format!("{w}x{h}"));
@@ -234,7 +236,7 @@ impl Environment {
                 limits.max_alloc = Some(pixels.saturating_mul(16).max(1 << 20));
                 let mut reader = reader();
                 reader.limits(limits);
-                let img = reader.decode().map_err(|e| format!("cannot read Radiance HDR: {e}"))?.into_rgb32f();
+                let img = reader.decode().map_err(hdr_error)?.into_rgb32f();
                 let (w, h) = img.dimensions();
                 let pixels: Vec<[f32; 3]> = bytemuck::allocation::try_cast_vec(img.into_raw())
                     .unwrap_or_else(|(_, raw)| raw.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect());

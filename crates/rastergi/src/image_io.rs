@@ -137,8 +137,8 @@ pub fn decode_exr(
     max_pixels: u64,
 ) -> std::result::Result<LinearImage, String> {
     use exr::prelude::*;
-    let meta =
-        exr::meta::MetaData::read_from_buffered(&mut reader, false).map_err(|e| format!("cannot read EXR: {e}"))?;
+    let meta = exr::meta::MetaData::read_from_buffered(&mut reader, false)
+        .map_err(|e| format!("cannot read EXR: {}", crate::error::one_line(e)))?;
     for header in meta.headers.iter() {
         let (w, h) = (header.layer_size.width() as u64, header.layer_size.height() as u64);
         let budgets = crate::scene::Budgets { texels: max_pixels, ..Default::default() };
@@ -158,7 +158,7 @@ pub fn decode_exr(
         .first_valid_layer()
         .all_attributes()
         .from_buffered(reader)
-        .map_err(|e| format!("cannot read EXR: {e}"))?;
+        .map_err(|e| format!("cannot read EXR: {}", crate::error::one_line(e)))?;
     let size = img.layer_data.size;
     Ok(LinearImage {
         width: size.width() as u32,
@@ -192,7 +192,8 @@ pub fn srgb_to_linear(v: f32) -> f32 {
 pub fn read_png(path: &Path) -> Result<LinearImage> {
     let mut reader = image::ImageReader::open(path).map_err(|e| image_error(path, format!("cannot be opened: {e}")))?;
     reader.set_format(image::ImageFormat::Png);
-    let decoded = reader.decode().map_err(|e| image_error(path, format!("cannot read PNG: {e}")))?;
+    let decoded =
+        reader.decode().map_err(|e| image_error(path, format!("cannot read PNG: {}", crate::error::one_line(e))))?;
     let rgb = decoded.to_rgb32f();
     Ok(LinearImage {
         width: rgb.width(),

@@ -31,7 +31,7 @@ pub struct Texture {
 fn reader(bytes: &[u8]) -> Result<image::ImageReader<Cursor<&[u8]>>, String> {
     let reader = image::ImageReader::new(Cursor::new(bytes))
         .with_guessed_format()
-        .map_err(|e| format!("cannot be read: {e}"))?;
+        .map_err(|e| format!("cannot be read: {}", crate::error::one_line(e)))?;
     match reader.format() {
         Some(_) => Ok(reader),
         None => Err("is not a PNG or JPEG image".into()),
@@ -42,7 +42,9 @@ impl Texture {
     /// The width and height a PNG or JPEG image declares, read from its header alone: what
     /// decoding it would allocate, to check against a budget first.
     pub fn dimensions(bytes: &[u8]) -> Result<(u32, u32), String> {
-        reader(bytes)?.into_dimensions().map_err(|e| format!("is not a valid PNG or JPEG image ({e})"))
+        reader(bytes)?
+            .into_dimensions()
+            .map_err(|e| format!("is not a valid PNG or JPEG image ({})", crate::error::one_line(e)))
     }
 
     /// Decodes a PNG or JPEG image (the format is recognised from its bytes), at most
@@ -54,7 +56,8 @@ impl Texture {
         limits.max_image_height = Some(MAX_DECODED_SIDE);
         limits.max_alloc = Some(MAX_DECODE_BYTES);
         reader.limits(limits);
-        let image = reader.decode().map_err(|e| format!("is not a valid PNG or JPEG image ({e})"))?;
+        let image =
+            reader.decode().map_err(|e| format!("is not a valid PNG or JPEG image ({})", crate::error::one_line(e)))?;
         let rgba = image.into_rgba8();
         let (width, height) = rgba.dimensions();
         if width == 0 || height == 0 {

@@ -85,7 +85,7 @@ impl<R: Read> Stream<R> {
         (&mut self.r)
             .take(n as u64)
             .read_to_end(&mut out)
-            .map_err(|e| format!("its {what} cannot be decompressed ({e})"))?;
+            .map_err(|e| format!("its {what} cannot be decompressed ({})", crate::error::one_line(e)))?;
         if out.len() < n {
             return Err(format!("ends inside its {what} (truncated)"));
         }

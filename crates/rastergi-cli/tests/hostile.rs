@@ -214,10 +214,8 @@ fn hostile_files_end_in_one_line_quickly_and_within_memory() {
     for v in [0f32, 0., 0., 1., 0., 0., 0., 1., 0.] {
         ply.extend(v.to_le_bytes());
     }
-    for _ in 0..100 {
-        ply.push(3);
-        [0u32, 1, 2].iter().for_each(|i| ply.extend(i.to_le_bytes()));
-    }
+    let face: Vec<u8> = std::iter::once(3u8).chain([0u32, 1, 2].iter().flat_map(|i| i.to_le_bytes())).collect();
+    ply.extend(face.repeat(100));
     write(d, "m.ply", ply);
     write(
         d,

@@ -153,8 +153,9 @@ impl Checkpoint {
         let text_len = r.u32().ok_or_else(|| bad("too short"))? as usize;
         let text = r.take(text_len).ok_or_else(|| bad("too short"))?;
         let text = std::str::from_utf8(text).map_err(|_| bad("its settings are not text"))?;
+        // Lines end at '\n' alone, as written: a '\r' before one is part of its value.
         let settings = text
-            .lines()
+            .split_terminator('\n')
             .map(|l| {
                 l.split_once('=').map(|(k, v)| (k.to_owned(), v.to_owned())).ok_or_else(|| bad("bad settings line"))
             })

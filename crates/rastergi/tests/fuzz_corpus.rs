@@ -41,8 +41,11 @@ fn every_corpus_file_loads_or_is_refused_in_one_line_without_a_panic() {
                     panic!("{}/{name}: still reading after {WATCHDOG:?}", target.name())
                 }
                 Err(mpsc::RecvTimeoutError::Disconnected) => {
-                    let panic = reading.join().err().and_then(|p| p.downcast_ref::<String>().cloned());
-                    panic!("{}/{name}: panicked: {}", target.name(), panic.unwrap_or_default())
+                    let payload = reading.join().err();
+                    let message = payload.as_ref().and_then(|p| {
+                        p.downcast_ref::<String>().cloned().or_else(|| p.downcast_ref::<&str>().map(|s| s.to_string()))
+                    });
+                    panic!("{}/{name}: panicked: {}", target.name(), message.unwrap_or_default())
                 }
             };
             println!("{}/{name}: {}", target.name(), outcome.as_ref().err().map_or("loaded", String::as_str));

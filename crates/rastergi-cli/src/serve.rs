@@ -215,8 +215,9 @@ fn read_head(
     let mut head: Vec<u8> = Vec::with_capacity(1024);
     let mut chunk = [0u8; 4096];
     loop {
-        let line_end = head.iter().position(|&b| b == b'\n');
-        if line_end.is_none() && head.len() > MAX_LINE {
+        // The request line: up to its line break, or all read so far.
+        let line = head.iter().position(|&b| b == b'\n').unwrap_or(head.len());
+        if line > MAX_LINE {
             return Ok(Head::Refused("414 URI Too Long"));
         }
         if let Some(end) = find_end(&head) {

@@ -51,10 +51,14 @@ pub const MAX_LIGHT: f32 = 1e20;
 /// Checks that a radiance, intensity or irradiance (`what`, for the message) is finite, ≥ 0
 /// and at most [`MAX_LIGHT`].
 pub fn check_light(v: Vec3, what: &str) -> std::result::Result<(), String> {
-    if v.is_finite() && v.min_element() >= 0.0 && v.max_element() <= MAX_LIGHT {
-        Ok(())
+    if !(v.is_finite() && v.min_element() >= 0.0) {
+        Err(format!("{what} {v} is negative or not finite"))
+    } else if v.max_element() > MAX_LIGHT {
+        Err(format!(
+            "{what} {v} is beyond {MAX_LIGHT:e}, the most rastergi renders (the sun's disc is about 2e7 W/(m²·sr))"
+        ))
     } else {
-        Err(format!("{what} {v} must be finite, at least 0 and at most {MAX_LIGHT:e}"))
+        Ok(())
     }
 }
 

@@ -114,8 +114,9 @@ pub fn check_output_path(out: &Path, option: &str) -> Result<()> {
     // Where the image will be written first (image_io writes a temporary file and renames it).
     let probe = tempfile::Builder::new().prefix(".rastergi-").tempfile_in(dir);
     if let Err(e) = probe {
-        let why =
-            e.raw_os_error().map_or(e.kind().to_string(), |code| std::io::Error::from_raw_os_error(code).to_string());
+        // tempfile's message ends "at path …" (the probe's own name): the reason alone.
+        let why = e.to_string();
+        let why = why.split(" at path ").next().unwrap_or_default();
         anyhow::bail!(
             "{}: no file can be written in {} ({why}); choose another {option} (checked before rendering)",
             out.display(),

@@ -10,7 +10,7 @@
 //! | `texels` | texels of the scene's decoded textures together, each image's declared size checked before it is decoded; also the pixels of one environment map or image read (`--env`, `envmap`, `compare`) | 2²⁷ (134 M: 512 MiB of 8-bit RGBA) |
 //! | `decompressed` | bytes decompressed from `.serialized` meshes, in all | 2 GiB (512 MiB on 32-bit targets) |
 //! | `xml-bytes` | bytes of a Mitsuba file and its includes, in all; and the nodes (elements, comments, runs of text) a file may hold, one per 32 bytes of it | 64 MiB (2 M nodes) |
-//! | `xml-depth` | nesting of a Mitsuba file's elements | 256 |
+//! | `xml-depth` | nesting of a Mitsuba file's elements (at most [`MAX_XML_DEPTH`]) | 256 |
 //! | `expansion` | bytes of text made by `$name` substitution and DTD entity references, in all | 64 MiB |
 //!
 //! Where the device is the bound, [`Budgets::fit_device`] lowers a budget to what the device
@@ -19,6 +19,10 @@
 //! bounds what is decoded before that.
 
 use std::fmt;
+
+/// The most the XML depth budget may be raised to: the reader descends one call per level
+/// (about 1.5 KiB of stack each), and a thread's stack is 8 MiB at most.
+pub const MAX_XML_DEPTH: u64 = 2048;
 
 /// One of the [`Budgets`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -198,6 +202,9 @@ pub fn parse_budget(s: &str) -> Result<(Budget, u64), String> {
     };
     let n: u64 = digits.parse().map_err(|_| format!("'{value}' is not a whole number such as 1000000 or 64M"))?;
     let n = n.checked_mul(1 << shift).ok_or_else(|| format!("'{value}' is beyond 2⁶⁴"))?;
+    if budget == Budget::XmlDepth && n > MAX_XML_DEPTH {
+        return Err(format!("xml-depth is at most {MAX_XML_DEPTH}: the reader descends one call per level"));
+    }
     Ok((budget, n))
 }
 
@@ -213,6 +220,8 @@ mod tests {
         assert!(parse_budget("triangle=5").unwrap_err().contains("triangles, vertices"));
         assert!(parse_budget("texels=-1").is_err());
         assert!(parse_budget("texels=99999999999G").unwrap_err().contains("2⁶⁴"));
+        assert_eq!(parse_budget("xml-depth=2048").unwrap(), (Budget::XmlDepth, 2048));
+        assert!(parse_budget("xml-depth=2049").unwrap_err().contains("at most 2048"));
         let mut b = Budgets::default();
         b.set(Budget::Vertices, 10);
         assert!(b.check(Budget::Vertices, 10, "x").is_ok());

@@ -18,7 +18,7 @@ use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
 use crate::scene::Files;
-use crate::scene::budget::{Budget, Budgets};
+use crate::scene::budget::{Budget, Budgets, MAX_XML_DEPTH};
 
 /// Includes nested deeper than this are refused (an include cycle ends here).
 pub const MAX_INCLUDE_DEPTH: usize = 16;
@@ -315,8 +315,13 @@ impl Parser<'_> {
                 }
                 _ => {
                     let level = at.level + 1;
-                    if level as u64 > self.budgets.xml_depth {
-                        let e = self.budgets.refusal(Budget::XmlDepth, level as u64, "");
+                    if level as u64 > self.budgets.xml_depth.min(MAX_XML_DEPTH) {
+                        let e = match self.budgets.xml_depth >= MAX_XML_DEPTH {
+                            true => {
+                                format!("is nested {level} deep, more than the {MAX_XML_DEPTH} levels rastergi reads")
+                            }
+                            false => self.budgets.refusal(Budget::XmlDepth, level as u64, ""),
+                        };
                         return Err(self.error(pos, format!("<{tag}> {e}")));
                     }
                     let mut attrs = Vec::with_capacity(child.attributes().len());

@@ -114,13 +114,16 @@ fn load(files: Files, path: &Path, geometry_only: bool, budgets: &Budgets, used:
     } else {
         materials.iter().any(|m| TEXTURE_KEYS.iter().any(|&key| map_file(m, key).is_some()))
     };
-    // Normals that faces refer to out of range are not used (the faces shade flat).
-    let mut smooth = has_keyword(&text, b"vn")
-        && check_references(&text, "vn", 2, "normal")
-            .map_err(|message| log::warn!("{}: {message}; its faces shade flat", path.display()))
-            .is_ok();
+    // Normals that faces refer to out of range are not used (the faces shade flat), nor are
+    // smoothing groups then: their normals go before the file's, so a reference out of range
+    // backwards would reach before the first (tobj's index wraps round and overflows).
+    let normals_in_range = check_references(&text, "vn", 2, "normal")
+        .map_err(|message| log::warn!("{}: {message}; its faces shade flat", path.display()))
+        .is_ok();
+    let mut smooth = has_keyword(&text, b"vn") && normals_in_range;
     // Smoothing groups become vertex normals (written into the text tobj reads).
-    if (smooth || !has_keyword(&text, b"vn"))
+    if normals_in_range
+        && (smooth || !has_keyword(&text, b"vn"))
         && let Some(with_normals) = apply_smoothing_groups(&text)
     {
         text = with_normals;
@@ -317,7 +320,10 @@ fn check_counts(text: &[u8], budgets: &Budgets, used: u64) -> std::result::Resul
             b"v" => vertices += 1,
             b"f" => {
                 // The keyword and the corners.
-                let words = line.split(u8::is_ascii_whitespace).filter(|w| !w.is_empty()).count() as u64;
+                let words = match std::str::from_utf8(line) {
+                    Ok(text) => text.split_whitespace().count(),
+                    Err(_) => line.split(u8::is_ascii_whitespace).filter(|w| !w.is_empty()).count(),
+                } as u64;
                 triangles += words.saturating_sub(3);
             }
             _ => {}
@@ -352,11 +358,25 @@ fn text_of(files: Files, path: &Path) -> Result<Vec<u8>> {
     files.read(path).map_err(|e| file_error(path, format!("cannot be read: {e}")))
 }
 
-/// The first word of a line.
+/// The first word of a line, split at whitespace as tobj splits it (Unicode's: a line that
+/// a no-break space indents is a `vn` line for tobj too). A line that is not UTF-8 is split at
+/// ASCII whitespace (tobj refuses the file at it).
 fn keyword_of(line: &[u8]) -> &[u8] {
-    let indent = line.iter().take_while(|b| b.is_ascii_whitespace()).count();
+    let indent = indent_of(line);
     let line = &line[indent..];
-    &line[..line.iter().position(u8::is_ascii_whitespace).unwrap_or(line.len())]
+    let end = match std::str::from_utf8(line) {
+        Ok(text) => text.find(char::is_whitespace).unwrap_or(text.len()),
+        Err(_) => line.iter().position(u8::is_ascii_whitespace).unwrap_or(line.len()),
+    };
+    &line[..end]
+}
+
+/// The bytes of whitespace before a line's first word (Unicode's, as [`keyword_of`]).
+fn indent_of(line: &[u8]) -> usize {
+    match std::str::from_utf8(line) {
+        Ok(text) => text.len() - text.trim_start().len(),
+        Err(_) => line.iter().take_while(|b| b.is_ascii_whitespace()).count(),
+    }
 }
 
 /// Whether any line starts with `keyword`.
@@ -369,7 +389,7 @@ fn has_keyword(text: &[u8], keyword: &[u8]) -> bool {
 fn comment_out(text: &mut [u8], keyword: &[u8]) {
     for line in text.split_mut(|&b| b == b'\n') {
         if keyword_of(line) == keyword {
-            let indent = line.iter().take_while(|b| b.is_ascii_whitespace()).count();
+            let indent = indent_of(line);
             line[indent] = b'#';
         }
     }

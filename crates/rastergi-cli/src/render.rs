@@ -91,8 +91,10 @@ pub fn raw_path(out: &Path) -> PathBuf {
     out.with_extension(format!("raw.{ext}"))
 }
 
-/// Refuses, before any rendering, an output path the image could never be written to.
-/// `option` names it in the message (`--out`, `--checkpoint`).
+/// Refuses, before any rendering, an output path the image could never be written to: a
+/// directory, a missing directory, or one where no file can be created (read-only, `/proc`,
+/// full): a file is written there as the image will be, beside it, and removed. `option`
+/// names it in the message (`--out`, `--checkpoint`).
 pub fn check_output_path(out: &Path, option: &str) -> Result<()> {
     if out.is_dir() {
         let ending = if option == "--out" { " ending in .exr or .png" } else { "" };
@@ -105,6 +107,18 @@ pub fn check_output_path(out: &Path, option: &str) -> Result<()> {
     if !dir.is_dir() {
         anyhow::bail!(
             "{}: the directory {} does not exist; create it first or choose another {option}",
+            out.display(),
+            dir.display()
+        );
+    }
+    // Where the image will be written first (image_io writes a temporary file and renames it).
+    let probe = tempfile::Builder::new().prefix(".rastergi-").tempfile_in(dir);
+    if let Err(e) = probe {
+        // tempfile's message ends "at path …" (the probe's own name): the reason alone.
+        let why = e.to_string();
+        let why = why.split(" at path ").next().unwrap_or_default();
+        anyhow::bail!(
+            "{}: no file can be written in {} ({why}); choose another {option} (checked before rendering)",
             out.display(),
             dir.display()
         );
@@ -168,6 +182,9 @@ impl Observer for Watch<'_> {
 pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     let format = ImageFormat::from_path(&args.out)?;
     check_output_path(&args.out, "--out")?;
+    if args.denoise {
+        check_output_path(&raw_path(&args.out), "--out (its .raw twin)")?;
+    }
     let guides_wanted = args.denoise || args.albedo.is_some() || args.normal.is_some();
     if guides_wanted && args.method != Method::Gather {
         anyhow::bail!("--denoise, --albedo and --normal need --method gather");
@@ -189,7 +206,10 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
         check_output_path(path, "--checkpoint")?;
     }
     let a = &args.scene;
-    let options = a.options(args.method, guides_wanted);
+    let mut options = a.options(args.method, guides_wanted);
+    // The GPU first: the scene's triangle budget follows what it binds.
+    let gpu = gpu_profiled(&a.gpu, args.profile)?;
+    options.budgets = options.budgets.fit_device(&gpu.device.limits());
     let start = Instant::now();
     let scene = options.load_scene()?;
     log::info!("{}: {} triangles loaded in {:.2} s", a.scene, scene.triangles.len(), start.elapsed().as_secs_f64());
@@ -220,7 +240,6 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
         None => None,
     };
     let caught = catch_signals()?;
-    let gpu = gpu_profiled(&a.gpu, args.profile)?;
     args.method.check_show(options.show)?;
     let seed = settings.seed;
     let start = Instant::now();

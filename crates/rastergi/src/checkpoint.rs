@@ -153,8 +153,9 @@ impl Checkpoint {
         let text_len = r.u32().ok_or_else(|| bad("too short"))? as usize;
         let text = r.take(text_len).ok_or_else(|| bad("too short"))?;
         let text = std::str::from_utf8(text).map_err(|_| bad("its settings are not text"))?;
+        // Lines end at '\n' alone, as written: a '\r' before one is part of its value.
         let settings = text
-            .lines()
+            .split_terminator('\n')
             .map(|l| {
                 l.split_once('=').map(|(k, v)| (k.to_owned(), v.to_owned())).ok_or_else(|| bad("bad settings line"))
             })
@@ -166,7 +167,8 @@ impl Checkpoint {
         let [photon_pass, iterations_in_pass, m, d, width, height, samples, half_samples] = u;
         let gather = gather_from_code(m, d).ok_or_else(|| bad("unknown gather code"))?;
         let count = r.u64().ok_or_else(|| bad("too short"))? as usize;
-        if count as u64 != 4 * crate::passes::film::COMPONENTS * width as u64 * height as u64 {
+        let expected = (width as u64 * height as u64).checked_mul(4 * crate::passes::film::COMPONENTS);
+        if expected != Some(count as u64) {
             return Err(bad("its film size does not match its image size"));
         }
         let floats = |r: &mut Reader| -> Option<Vec<f32>> {

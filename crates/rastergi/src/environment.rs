@@ -62,12 +62,20 @@ impl Environment {
         if width < 2 || height < 3 {
             return Err(bad(format!("{width}x{height} pixels is too small; it needs at least 2x3")));
         }
-        if texels.len() != (width * height) as usize {
+        if texels.len() as u64 != width as u64 * height as u64 {
             return Err(bad(format!("{} values for {width}x{height} pixels", texels.len())));
         }
         if let Some(i) = texels.iter().position(|t| !t.is_finite()) {
             let (x, y) = (i as u32 % width, i as u32 / width);
             return Err(bad(format!("pixel ({x}, {y}) is not finite ({}); repair the image", texels[i])));
+        }
+        if let Some(i) = texels.iter().position(|t| t.max_element() > crate::scene::MAX_LIGHT) {
+            let (x, y) = (i as u32 % width, i as u32 / width);
+            return Err(bad(format!(
+                "pixel ({x}, {y}) is {}, beyond the largest radiance rastergi renders ({:e}); scale the image down",
+                texels[i],
+                crate::scene::MAX_LIGHT
+            )));
         }
         if texels.iter().any(|t| t.min_element() < 0.0) {
             log::warn!("environment map: negative values clamped to zero");
@@ -134,9 +142,19 @@ impl Environment {
         Environment::new(self.width, self.height, texels).expect("the same size and finite values")
     }
 
-    /// A constant environment of radiance `l` (a uniform sky).
+    /// A constant environment of radiance `l` (a uniform sky), for radiances the program
+    /// chooses: it panics where `l` is not finite, negative or beyond
+    /// [`MAX_LIGHT`](crate::scene::MAX_LIGHT). A file's radiance goes through
+    /// [`Environment::checked_constant`].
     pub fn constant(l: Vec3) -> Environment {
-        Environment::new(2, 3, vec![l; 6]).expect("a valid constant environment")
+        Environment::checked_constant(l).expect("a finite radiance ≥ 0 within MAX_LIGHT")
+    }
+
+    /// A constant environment of radiance `l`, or why `l` cannot be one (not finite, negative
+    /// or beyond [`MAX_LIGHT`](crate::scene::MAX_LIGHT)).
+    pub fn checked_constant(l: Vec3) -> std::result::Result<Environment, String> {
+        crate::scene::check_light(l, "radiance")?;
+        Environment::new(2, 3, vec![l; 6]).map_err(|e| e.to_string())
     }
 
     /// The neutral light that models without lights are shown in, as glTF viewers show them
@@ -159,34 +177,76 @@ impl Environment {
     }
 
     /// Reads an equirectangular image (`.exr` linear RGB, or Radiance `.hdr`) and scales its
-    /// radiance by `scale`.
+    /// radiance by `scale`, within the default budgets.
     pub fn load(path: &Path, scale: f32) -> Result<Arc<Environment>> {
+        Environment::load_with(path, scale, &crate::scene::Budgets::default())
+    }
+
+    /// [`Environment::load`] of an image of at most `budgets.texels` pixels.
+    pub fn load_with(path: &Path, scale: f32, budgets: &crate::scene::Budgets) -> Result<Arc<Environment>> {
+        Environment::load_in(crate::scene::Files::Disk, path, scale, budgets)
+    }
+
+    /// [`Environment::load_with`] of the file at `path` of `files`.
+    pub fn load_in(
+        files: crate::scene::Files,
+        path: &Path,
+        scale: f32,
+        budgets: &crate::scene::Budgets,
+    ) -> Result<Arc<Environment>> {
         let bad = |m: String| Error::ImageFile { path: path.to_path_buf(), message: m };
         if !scale.is_finite() || scale < 0.0 {
             return Err(Error::InvalidScene(format!("--env-scale {scale} must be a finite number ≥ 0")));
         }
-        if !path.exists() {
+        if files.missing(path).is_some() {
             return Err(bad("no such environment map; give an .exr or .hdr file".into()));
         }
-        let ext = path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase());
-        let (width, height, pixels) = match ext.as_deref() {
-            Some("exr") => {
-                let img = crate::image_io::read_exr(path)?;
+        if files.is_special(path) {
+            return Err(bad("is not a regular file".into()));
+        }
+        let ext = path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).unwrap_or_default();
+        if !matches!(ext.as_str(), "exr" | "hdr") {
+            return Err(bad("unsupported environment map format; use an .exr or .hdr file".into()));
+        }
+        let bytes = files.read(path).map_err(|e| bad(format!("cannot be read: {e}")))?;
+        Environment::decode(&ext, &bytes, scale, budgets.texels).map(Arc::new).map_err(bad)
+    }
+
+    /// Decodes an equirectangular image (`ext`: `exr`, linear RGB, or `hdr`, Radiance) of at
+    /// most `max_pixels` pixels (its header's size is checked before its pixels are read) and
+    /// scales its radiance by `scale`; each texel must then be finite and within
+    /// [`MAX_LIGHT`](crate::scene::MAX_LIGHT). Errors say what is wrong without naming the
+    /// file.
+    pub fn decode(ext: &str, bytes: &[u8], scale: f32, max_pixels: u64) -> std::result::Result<Environment, String> {
+        let (width, height, pixels) = match ext {
+            "exr" => {
+                let img = crate::image_io::decode_exr(std::io::Cursor::new(bytes), max_pixels)?;
                 (img.width, img.height, img.pixels)
             }
-            Some("hdr") => {
-                let reader = image::ImageReader::open(path).map_err(|e| bad(format!("cannot be opened: {e}")))?;
-                let mut reader = reader;
-                reader.set_format(image::ImageFormat::Hdr);
-                let img = reader.decode().map_err(|e| bad(format!("cannot read Radiance HDR: {e}")))?.to_rgb32f();
-                (img.width(), img.height(), img.pixels().map(|p| p.0).collect())
+            "hdr" => {
+                let reader = || image::ImageReader::with_format(std::io::Cursor::new(bytes), image::ImageFormat::Hdr);
+                let hdr_error =
+                    |e: image::ImageError| format!("cannot read Radiance HDR: {}", crate::error::one_line(e));
+                let (w, h) = reader().into_dimensions().map_err(hdr_error)?;
+                let pixels = w as u64 * h as u64;
+                let budgets = crate::scene::Budgets { texels: max_pixels, ..Default::default() };
+                let check = budgets.check(crate::scene::Budget::Texels, pixels, &format!("{w}x{h}"));
+                check.map_err(|m| format!("its header {m}"))?;
+                let mut limits = image::Limits::default();
+                limits.max_alloc = Some(pixels.saturating_mul(16).max(1 << 20));
+                let mut reader = reader();
+                reader.limits(limits);
+                let img = reader.decode().map_err(hdr_error)?.into_rgb32f();
+                let (w, h) = img.dimensions();
+                let pixels: Vec<[f32; 3]> = bytemuck::allocation::try_cast_vec(img.into_raw())
+                    .unwrap_or_else(|(_, raw)| raw.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect());
+                (w, h, pixels)
             }
-            _ => return Err(bad("unsupported environment map format; use an .exr or .hdr file".into())),
+            _ => return Err("unsupported environment map format; use an .exr or .hdr file".into()),
         };
         let texels = pixels.into_iter().map(|p| Vec3::from(p) * scale).collect();
         Environment::new(width, height, texels)
-            .map(Arc::new)
-            .map_err(|e| bad(e.to_string().trim_start_matches("invalid scene: ").to_string()))
+            .map_err(|e| e.to_string().trim_start_matches("invalid scene: ").to_string())
     }
 
     /// The radiance arriving from direction `d` (unit, pointing away from the scene): bilinear

@@ -5,6 +5,14 @@ use std::path::PathBuf;
 
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
+/// Another crate's error message on one line (`image`'s, `exr`'s, `flate2`'s may hold line
+/// breaks, which would make an error of several lines): line breaks and other control
+/// characters become spaces, runs of white space one.
+pub fn one_line(message: impl std::fmt::Display) -> String {
+    let text = message.to_string();
+    text.split(|c: char| c.is_whitespace() || c.is_control()).filter(|w| !w.is_empty()).collect::<Vec<_>>().join(" ")
+}
+
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
     #[error(

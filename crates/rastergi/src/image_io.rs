@@ -116,15 +116,49 @@ pub fn write_png(path: &Path, image: &DisplayImage) -> Result<()> {
     })
 }
 
-/// Reads the first RGB(A) layer of an EXR file as linear RGB.
+/// Reads the first RGB(A) layer of an EXR file as linear RGB, at most the default texel
+/// budget's pixels ([`crate::scene::Budgets`]).
 pub fn read_exr(path: &Path) -> Result<LinearImage> {
+    read_exr_within(path, crate::scene::Budgets::default().texels)
+}
+
+/// [`read_exr`] of at most `max_pixels` pixels in any layer (the headers are read first, the
+/// pixels only if they are within it).
+pub fn read_exr_within(path: &Path, max_pixels: u64) -> Result<LinearImage> {
+    let file = std::fs::File::open(path).map_err(|e| image_error(path, format!("cannot be opened: {e}")))?;
+    decode_exr(std::io::BufReader::new(file), max_pixels).map_err(|m| image_error(path, m))
+}
+
+/// Decodes the first RGB(A) layer of an EXR image as linear RGB; refuses, before reading a
+/// pixel, an image with a layer of more than `max_pixels` (the size its header declares,
+/// which reading would allocate). Errors say what is wrong without naming the file.
+pub fn decode_exr(
+    mut reader: impl std::io::Read + std::io::Seek,
+    max_pixels: u64,
+) -> std::result::Result<LinearImage, String> {
     use exr::prelude::*;
-    let img = read_first_rgba_layer_from_file(
-        path,
-        |resolution, _| (resolution.width(), vec![[0.0f32; 3]; resolution.width() * resolution.height()]),
-        |(w, px), pos, (r, g, b, _a): (f32, f32, f32, f32)| px[pos.y() * *w + pos.x()] = [r, g, b],
-    )
-    .map_err(|e| image_error(path, format!("cannot read EXR: {e}")))?;
+    let meta = exr::meta::MetaData::read_from_buffered(&mut reader, false)
+        .map_err(|e| format!("cannot read EXR: {}", crate::error::one_line(e)))?;
+    for header in meta.headers.iter() {
+        let (w, h) = (header.layer_size.width() as u64, header.layer_size.height() as u64);
+        let budgets = crate::scene::Budgets { texels: max_pixels, ..Default::default() };
+        let check = budgets.check(crate::scene::Budget::Texels, w.saturating_mul(h), &format!("{w}x{h}"));
+        check.map_err(|m| format!("its header {m}"))?;
+    }
+    reader.seek(std::io::SeekFrom::Start(0)).map_err(|e| format!("cannot be read again: {e}"))?;
+    let img = exr::prelude::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .rgba_channels(
+            |resolution, _| (resolution.width(), vec![[0.0f32; 3]; resolution.width() * resolution.height()]),
+            |(w, px): &mut (usize, Vec<[f32; 3]>), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+                px[pos.y() * *w + pos.x()] = [r, g, b]
+            },
+        )
+        .first_valid_layer()
+        .all_attributes()
+        .from_buffered(reader)
+        .map_err(|e| format!("cannot read EXR: {}", crate::error::one_line(e)))?;
     let size = img.layer_data.size;
     Ok(LinearImage {
         width: size.width() as u32,
@@ -158,7 +192,8 @@ pub fn srgb_to_linear(v: f32) -> f32 {
 pub fn read_png(path: &Path) -> Result<LinearImage> {
     let mut reader = image::ImageReader::open(path).map_err(|e| image_error(path, format!("cannot be opened: {e}")))?;
     reader.set_format(image::ImageFormat::Png);
-    let decoded = reader.decode().map_err(|e| image_error(path, format!("cannot read PNG: {e}")))?;
+    let decoded =
+        reader.decode().map_err(|e| image_error(path, format!("cannot read PNG: {}", crate::error::one_line(e))))?;
     let rgb = decoded.to_rgb32f();
     Ok(LinearImage {
         width: rgb.width(),

@@ -12,7 +12,8 @@
 //! Beneath them: [`bsdf`] (the scattering model by lobe, each beside its WGSL twin),
 //! [`sampling`], [`lights`], [`environment`], [`textures`], and [`gpu`] (the device, shader
 //! composition, the constants Rust and WGSL share, limits, pass timings in [`gpu::profile`]).
-//! [`session`] turns a front end's options into a scene and a renderer, and runs it.
+//! [`session`] turns a front end's options into a scene and a renderer, and runs it;
+//! [`fuzzing`] drives the readers as their fuzz targets do.
 //!
 //! [`renderer::Renderer::iterate`] is the one place that shows the order of the passes.
 
@@ -23,6 +24,7 @@ pub mod checkpoint;
 pub mod environment;
 pub mod error;
 pub mod fit;
+pub mod fuzzing;
 pub mod gather;
 pub mod gpu;
 pub mod gpu_scene;

@@ -168,7 +168,9 @@ fn mip_axis(n: usize, m: usize) -> Vec<Vec<(usize, f32)>> {
 }
 
 /// Applies separable taps to a `sw × sh` image: `xs` along rows (to `xs.len()` columns), then
-/// `ys` along columns.
+/// `ys` along columns. Row by row: each destination row resamples the source rows its taps
+/// name along x (kept while the next row's taps name them too), so the image resampled along x
+/// alone is never held whole (for an 8 k texture halved, 512 MiB of it).
 fn separable(
     src: impl Fn(usize) -> Vec4,
     sw: usize,
@@ -177,16 +179,31 @@ fn separable(
     ys: &[Vec<(usize, f32)>],
 ) -> Vec<Vec4> {
     let dw = xs.len();
-    let mut rows = vec![Vec4::ZERO; dw * sh];
-    for y in 0..sh {
-        for (x, taps) in xs.iter().enumerate() {
-            rows[y * dw + x] = taps.iter().map(|&(i, w)| src(y * sw + i) * w).sum();
-        }
-    }
+    let along_x = |y: usize| -> Vec<Vec4> {
+        xs.iter().map(|taps| taps.iter().map(|&(i, w)| src(y * sw + i) * w).sum()).collect()
+    };
+    debug_assert!(ys.iter().flatten().all(|&(i, _)| i < sh));
     let mut out = vec![Vec4::ZERO; dw * ys.len()];
+    let mut rows: Vec<(usize, Vec<Vec4>)> = Vec::new();
     for (y, taps) in ys.iter().enumerate() {
+        let mut kept: Vec<(usize, Vec<Vec4>)> = Vec::with_capacity(taps.len());
+        for &(i, _) in taps {
+            if kept.iter().any(|(k, _)| *k == i) {
+                continue;
+            }
+            let row = match rows.iter().position(|(k, _)| *k == i) {
+                Some(at) => rows.swap_remove(at).1,
+                None => along_x(i),
+            };
+            kept.push((i, row));
+        }
+        rows = kept;
+        let picked: Vec<(&[Vec4], f32)> = taps
+            .iter()
+            .filter_map(|&(i, w)| rows.iter().find(|(k, _)| *k == i).map(|(_, row)| (row.as_slice(), w)))
+            .collect();
         for x in 0..dw {
-            out[y * dw + x] = taps.iter().map(|&(i, w)| rows[i * dw + x] * w).sum();
+            out[y * dw + x] = picked.iter().map(|&(row, w)| row[x] * w).sum();
         }
     }
     out
@@ -228,30 +245,40 @@ impl TextureAtlas {
     pub fn new(textures: &[Texture]) -> TextureAtlas {
         let sizes: Vec<(u32, u32)> = textures.iter().map(|t| (t.width, t.height)).collect();
         let fitted = fitted_sizes(&sizes);
-        // Each texture's chain on a core of its own (the decoding and the mip levels of a
-        // staircase's ten photographs dominate its start-up), then laid one after another.
-        let chains: Vec<Vec<[u16; 4]>> = (0..textures.len())
+        // The chains one after another, each written in place on a core of its own (the
+        // decoding and the mip levels of a staircase's ten photographs dominate its start-up).
+        let mut entries = Vec::with_capacity(textures.len());
+        let mut first = 0usize;
+        for &(width, height) in &fitted {
+            let levels = level_count(width, height);
+            entries.push(AtlasEntry { width, height, levels, first: first as u32 });
+            first += chain_texels(width, height) as usize;
+        }
+        let mut texels = vec![[0u16; 4]; first];
+        let mut chains: Vec<(usize, &mut [[u16; 4]])> = Vec::with_capacity(textures.len());
+        let mut rest = texels.as_mut_slice();
+        for (i, &(width, height)) in fitted.iter().enumerate() {
+            let (chain, after) = rest.split_at_mut(chain_texels(width, height) as usize);
+            chains.push((i, chain));
+            rest = after;
+        }
+        let _: Vec<()> = chains
             .into_par_iter()
-            .map(|i| {
+            .map(|(i, chain)| {
                 let (t, (width, height)) = (&textures[i], fitted[i]);
                 let (mut level, mut w, mut h) = (decode(t, width, height), width, height);
-                let mut chain = Vec::with_capacity(chain_texels(width, height) as usize);
+                let mut at = 0;
                 for k in 0..level_count(width, height) {
                     if k > 0 {
                         (level, w, h) = downsample(&level, w, h);
                     }
-                    chain.extend(encode(&level));
+                    for texel in encode(&level) {
+                        chain[at] = texel;
+                        at += 1;
+                    }
                 }
-                chain
             })
             .collect();
-        let mut texels = Vec::with_capacity(chains.iter().map(Vec::len).sum());
-        let mut entries = Vec::with_capacity(textures.len());
-        for (chain, &(width, height)) in chains.iter().zip(&fitted) {
-            let levels = level_count(width, height);
-            entries.push(AtlasEntry { width, height, levels, first: texels.len() as u32 });
-            texels.extend_from_slice(chain);
-        }
         if texels.is_empty() {
             texels.push([half::f16::ONE.to_bits(); 4]);
         }

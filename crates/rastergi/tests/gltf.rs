@@ -140,12 +140,13 @@ fn textured_room_has_the_expected_materials_textures_emission_and_camera() {
 fn cameras_are_chosen_by_index_and_a_scene_without_one_is_framed() {
     let dir = tempfile::tempdir().unwrap();
     let path = room::room_gltf(Variant::External).write(dir.path(), "room.gltf");
-    let side = load_gltf_with(&path, &GltfOptions { camera: Some(1) }).unwrap().camera;
+    let side = load_gltf_with(&path, &GltfOptions { camera: Some(1), ..Default::default() }).unwrap().camera;
     let h = 0.5f32.sqrt();
     assert!(close(side.eye, Vec3::new(2.0, 0.0, 2.0), 1e-6), "side camera at {}", side.eye);
     assert!(close((side.target - side.eye).normalize(), Vec3::new(-h, 0.0, -h), 1e-6));
     let refused = |camera, expected: &str| {
-        let e = load_gltf_with(&path, &GltfOptions { camera: Some(camera) }).unwrap_err().to_string();
+        let e =
+            load_gltf_with(&path, &GltfOptions { camera: Some(camera), ..Default::default() }).unwrap_err().to_string();
         assert!(e.contains(expected) && e.contains("room.gltf"), "camera {camera}: {e}");
     };
     refused(2, "orthographic");

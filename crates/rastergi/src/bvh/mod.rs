@@ -5,6 +5,12 @@
 //! SAH cost of a split: C = C_trav + (A_L/A)·N_L·C_tri + (A_R/A)·N_R·C_tri, evaluated at the
 //! boundaries of 16 centroid bins per axis; a node becomes a leaf when no split is cheaper
 //! than N·C_tri (and is always split above [`MAX_LEAF`] triangles).
+//!
+//! The tree is at most [`MAX_DEPTH`] levels deep, what the traversals' fixed stacks hold: below
+//! depth 64 − ⌈log2 N⌉ − 1 (N the triangles; 45 for the staircase's 262 k, whose SAH tree is
+//! 27 deep) every split is at the median, which adds at most ⌈log2 N⌉ levels. SAH splits of
+//! coordinates spread over many orders of magnitude (a hostile file's 1e15 beside 1e37) peel
+//! one triangle off per level and would otherwise nest as deep as there are triangles.
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
@@ -18,6 +24,8 @@ const BINS: usize = 16;
 const MAX_LEAF: usize = 8;
 const COST_TRAVERSAL: f32 = 1.0;
 const COST_TRIANGLE: f32 = 1.0;
+/// Most levels of the tree (a leaf alone is one): the traversals' stacks hold 64 nodes.
+pub const MAX_DEPTH: usize = 64;
 
 /// A flattened node (`BvhNode` in `gpu_scene.wgsl`). Interior nodes (`count == 0`) have their
 /// left child right after them and their right child at `offset`; leaves hold the triangles
@@ -51,6 +59,8 @@ struct Build<'a> {
     bounds: Vec<Aabb>,
     centroids: Vec<Vec3>,
     order: &'a mut [u32],
+    /// The depth from which every split is at the median (module docs).
+    median_from: usize,
 }
 
 impl Bvh {
@@ -68,11 +78,13 @@ impl Bvh {
             .collect();
         let centroids = bounds.iter().map(|b| b.center()).collect();
         let mut nodes = Vec::with_capacity(2 * triangles.len().max(1));
-        let mut build = Build { bounds, centroids, order: &mut order };
+        let levels = (triangles.len().max(1) as u64).next_power_of_two().trailing_zeros() as usize;
+        let median_from = MAX_DEPTH.saturating_sub(levels + 1).max(1);
+        let mut build = Build { bounds, centroids, order: &mut order, median_from };
         if triangles.is_empty() {
             nodes.push(BvhNode { min: [0.0; 3], offset: 0, max: [0.0; 3], count: 0 });
         } else {
-            build.node(&mut nodes, 0, triangles.len());
+            build.node(&mut nodes, 0, triangles.len(), 1);
         }
         Bvh { nodes, order }
     }
@@ -258,15 +270,16 @@ impl Build<'_> {
         (b, c)
     }
 
-    /// Emits the node for order[first .. first+count] and its subtree; returns its index.
-    fn node(&mut self, nodes: &mut Vec<BvhNode>, first: usize, count: usize) -> usize {
+    /// Emits the node for order[first .. first+count] at `depth` (the root's is 1) and its
+    /// subtree; returns its index.
+    fn node(&mut self, nodes: &mut Vec<BvhNode>, first: usize, count: usize, depth: usize) -> usize {
         let (b, cb) = self.range_bounds(first, count);
         let index = nodes.len();
         nodes.push(BvhNode { min: b.min.into(), offset: first as u32, max: b.max.into(), count: count as u32 });
         if count <= 1 {
             return index;
         }
-        let split = self.find_split(first, count, &b, &cb);
+        let split = if depth < self.median_from { self.find_split(first, count, &b, &cb) } else { None };
         let mid = match split {
             Some((axis, pos)) => {
                 let slice = &mut self.order[first..first + count];
@@ -295,15 +308,23 @@ impl Build<'_> {
                 return index;
             }
             let mid = first + count / 2;
-            return self.children(nodes, index, first, count, mid);
+            return self.children(nodes, index, first, count, mid, depth);
         }
-        self.children(nodes, index, first, count, mid)
+        self.children(nodes, index, first, count, mid, depth)
     }
 
-    fn children(&mut self, nodes: &mut Vec<BvhNode>, index: usize, first: usize, count: usize, mid: usize) -> usize {
+    fn children(
+        &mut self,
+        nodes: &mut Vec<BvhNode>,
+        index: usize,
+        first: usize,
+        count: usize,
+        mid: usize,
+        depth: usize,
+    ) -> usize {
         nodes[index].count = 0;
-        self.node(nodes, first, mid - first);
-        let right = self.node(nodes, mid, first + count - mid);
+        self.node(nodes, first, mid - first, depth + 1);
+        let right = self.node(nodes, mid, first + count - mid, depth + 1);
         nodes[index].offset = right as u32;
         index
     }
@@ -430,6 +451,35 @@ mod tests {
         }
         assert!(covered.iter().all(|&c| c == 1));
         assert!(bvh.depth() < 40);
+    }
+
+    /// Triangles at x = 2^k for k from −120 to 127, as a hostile file's coordinates over many
+    /// orders of magnitude: the binned SAH peels a few off per level (all but the largest fall
+    /// in the first bin), 125 levels without the median splits; the tree stays within
+    /// [`MAX_DEPTH`], and rays find what a brute-force test of every triangle finds.
+    #[test]
+    fn coordinates_over_many_magnitudes_keep_the_tree_within_the_stack() {
+        let tris: Vec<[Vec3; 3]> = (-120..=127)
+            .map(|k| {
+                let x = 2f32.powi(k);
+                [Vec3::new(x, 0.0, 0.0), Vec3::new(x, 1.0, 0.0), Vec3::new(x, 0.0, 1.0)]
+            })
+            .collect();
+        let bvh = Bvh::build(&tris);
+        println!("depth {}", bvh.depth());
+        assert!(bvh.depth() <= MAX_DEPTH, "depth {}", bvh.depth());
+        let ordered = bvh.permute(&tris);
+        for k in [-120, -3, 0, 60, 126, 127] {
+            let o = Vec3::new(2f32.powi(k) * 0.75, 0.25, 0.25);
+            for d in [Vec3::X, -Vec3::X] {
+                let expected = ordered
+                    .iter()
+                    .filter_map(|t| intersect_triangle(t, o, d).map(|h| h.0).filter(|&t| t > 0.0))
+                    .fold(f32::INFINITY, f32::min);
+                let hit = bvh.intersect(&ordered, o, d, 0.0, f32::INFINITY, u32::MAX, |_| true);
+                assert_eq!(hit.map_or(f32::INFINITY, |h| h.t), expected, "ray from 0.75 · 2^{k} along {d}");
+            }
+        }
     }
 
     #[test]

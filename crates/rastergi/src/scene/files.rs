@@ -5,7 +5,7 @@
 //! (dropped files arrive without folders).
 
 use std::collections::HashMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// The files a loader reads.
 #[derive(Clone, Copy, Debug)]
@@ -34,14 +34,20 @@ impl MemoryFiles {
 
     /// The file at `path`: by its whole relative path, else by its file name.
     pub fn get(&self, path: &Path) -> Option<&[u8]> {
+        self.key_of(path).and_then(|k| self.files.get(k)).map(Vec::as_slice)
+    }
+
+    /// The name under which [`MemoryFiles::get`] finds the file at `path`.
+    fn key_of(&self, path: &Path) -> Option<&str> {
         let whole = normalise(&path.to_string_lossy());
-        let by_name = || {
-            let name = whole.rsplit('/').next()?;
-            self.files
-                .get(name)
-                .or_else(|| self.files.iter().find(|(k, _)| k.rsplit('/').next() == Some(name)).map(|(_, v)| v))
-        };
-        self.files.get(&whole).or_else(by_name).map(Vec::as_slice)
+        if let Some((k, _)) = self.files.get_key_value(&whole) {
+            return Some(k);
+        }
+        let name = whole.rsplit('/').next()?;
+        match self.files.get_key_value(name) {
+            Some((k, _)) => Some(k),
+            None => self.files.keys().find(|k| k.rsplit('/').next() == Some(name)).map(String::as_str),
+        }
     }
 
     pub fn names(&self) -> impl Iterator<Item = &str> {
@@ -72,6 +78,24 @@ impl Files<'_> {
             Files::Disk if path.exists() => Some("is not a file"),
             Files::Memory(m) if m.get(path).is_some() => None,
             _ => Some("no such file"),
+        }
+    }
+
+    /// The file's size in bytes, where it is a file.
+    pub fn size(&self, path: &Path) -> Option<u64> {
+        match self {
+            Files::Disk => std::fs::metadata(path).ok().filter(|m| m.is_file()).map(|m| m.len()),
+            Files::Memory(m) => m.get(path).map(|b| b.len() as u64),
+        }
+    }
+
+    /// The file `path` names, however it is spelled (`a/../b.png`, `./b.png`, a link): the
+    /// key that caches of files read once use. On disk the canonical path (the path as given
+    /// where it cannot be resolved); in memory the name of the file it finds.
+    pub fn canonical(&self, path: &Path) -> PathBuf {
+        match self {
+            Files::Disk => std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf()),
+            Files::Memory(m) => m.key_of(path).map_or_else(|| path.to_path_buf(), PathBuf::from),
         }
     }
 
@@ -111,5 +135,10 @@ mod tests {
         let files = Files::Memory(&m);
         assert_eq!(files.missing(Path::new("stone.png")), Some("no such file"));
         assert!(files.read(Path::new("stone.png")).unwrap_err().to_string().contains("not among the files given"));
+        // Every spelling of one file is one file.
+        for spelling in ["textures/wood.png", "./textures/../textures/wood.png", "a\\..\\wood.png"] {
+            assert_eq!(files.canonical(Path::new(spelling)), PathBuf::from("textures/wood.png"), "{spelling}");
+        }
+        assert_eq!(files.size(Path::new("scene.bin")), Some(1));
     }
 }

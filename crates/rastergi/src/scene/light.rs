@@ -47,13 +47,7 @@ pub enum Light {
 impl Light {
     /// Checks the values: finite, non-negative, unit directions, cone angles in order.
     pub fn validate(&self) -> std::result::Result<(), String> {
-        let colour = |v: Vec3, what: &str| {
-            if v.is_finite() && v.min_element() >= 0.0 {
-                Ok(())
-            } else {
-                Err(format!("a light has a negative or non-finite {what} ({v})"))
-            }
-        };
+        let colour = |v: Vec3, what: &str| super::check_light(v, &format!("a light's {what}"));
         let unit = |d: Vec3| {
             if d.is_finite() && (d.length() - 1.0).abs() < 1e-3 {
                 Ok(())

@@ -8,6 +8,7 @@
 //! The albedo may vary over a surface: a material's constant albedo times an sRGB texture read
 //! at the triangle's interpolated texture coordinates.
 
+pub mod budget;
 mod camera;
 mod cornell;
 pub mod default_camera;
@@ -25,6 +26,7 @@ mod tangents;
 mod texture;
 
 pub use crate::bvh::bounds::Aabb;
+pub use budget::{Budget, Budgets, parse_budget};
 pub use camera::Camera;
 pub use cornell::cornell_box;
 pub use files::{Files, MemoryFiles};
@@ -32,13 +34,33 @@ pub use gltf::{GltfOptions, load_gltf, load_gltf_in, load_gltf_with};
 pub use light::{Light, SunAngles};
 pub use material::{AlphaMode, MAX_TEXTURES, Material, Texels, TextureRef, UvTransform};
 pub use mitsuba::{MitsubaOptions, MitsubaScene, load_mitsuba, load_mitsuba_in};
-pub use obj::{load_obj, load_obj_in};
+pub use obj::{load_obj, load_obj_in, load_obj_with};
 pub use tangents::mikktspace;
 pub use texture::{MAX_DECODED_SIDE, Texture};
 
 use glam::{Vec2, Vec3, Vec4};
 
 use crate::error::{Error, Result};
+
+/// The largest radiance (W/(m²·sr)), intensity (W/sr) or irradiance (W/m²) a scene may hold:
+/// far above any light's (the sun's disc is about 2·10⁷ W/(m²·sr)), and far enough below
+/// f32's 3.4·10³⁸ that what the passes make of it (powers, sums over photons, iterations and
+/// pixels) stays finite.
+pub const MAX_LIGHT: f32 = 1e20;
+
+/// Checks that a radiance, intensity or irradiance (`what`, for the message) is finite, ≥ 0
+/// and at most [`MAX_LIGHT`].
+pub fn check_light(v: Vec3, what: &str) -> std::result::Result<(), String> {
+    if !(v.is_finite() && v.min_element() >= 0.0) {
+        Err(format!("{what} {v} is negative or not finite"))
+    } else if v.max_element() > MAX_LIGHT {
+        Err(format!(
+            "{what} {v} is beyond {MAX_LIGHT:e}, the most rastergi renders (the sun's disc is about 2e7 W/(m²·sr))"
+        ))
+    } else {
+        Ok(())
+    }
+}
 
 /// A triangle soup with one material per triangle, and its lights.
 #[derive(Clone, Debug)]
@@ -277,8 +299,12 @@ impl Scene {
             .sum()
     }
 
-    /// Checks what every pass relies on: at least one triangle, finite coordinates, valid
-    /// material indices, finite non-negative albedo and emission, a valid camera.
+    /// Checks what every pass relies on: at least one triangle, finite coordinates within a
+    /// finite extent, valid material indices, every number a material hands the GPU finite
+    /// and in its range (albedo in [0, 1], emission within [`check_light`], an index of
+    /// refraction > 0, roughness, metalness, transmission, specular and clear-coat weights in
+    /// [0, 1], attenuation ≥ 0), lights within [`check_light`], a finite total emitted power,
+    /// a valid camera.
     pub fn validate(&self) -> Result<()> {
         if self.triangles.is_empty() {
             return Err(Error::InvalidScene("the scene has no triangles".into()));
@@ -288,6 +314,13 @@ impl Scene {
         }
         if let Some(i) = self.triangles.iter().position(|t| !t.iter().all(|p| p.is_finite())) {
             return Err(Error::InvalidScene(format!("triangle {i} has a non-finite coordinate")));
+        }
+        let b = self.bounds();
+        if !(b.max - b.min).is_finite() {
+            return Err(Error::InvalidScene(format!(
+                "the scene's extent {} is beyond what 32-bit floats hold; scale it down",
+                b.max - b.min
+            )));
         }
         if let Some(&m) = self.material_ids.iter().find(|&&m| m as usize >= self.materials.len()) {
             return Err(Error::InvalidScene(format!("material index {m} is out of range")));
@@ -354,6 +387,38 @@ impl Scene {
                     m.name, m.albedo
                 )));
             }
+            check_light(m.emission, "emission")
+                .map_err(|e| Error::InvalidScene(format!("material '{}': {e}", m.name)))?;
+            let unit = [
+                ("roughness", m.roughness),
+                ("metallic", m.metallic),
+                ("transmission", m.transmission),
+                ("specular", m.specular),
+                ("clearcoat", m.clearcoat),
+                ("clearcoat roughness", m.clearcoat_roughness),
+            ];
+            if let Some((what, v)) = unit.iter().find(|(_, v)| !(0.0..=1.0).contains(v)) {
+                return Err(Error::InvalidScene(format!("material '{}' has a {what} of {v}, outside [0, 1]", m.name)));
+            }
+            if !(m.ior.is_finite() && m.ior > 0.0) {
+                return Err(Error::InvalidScene(format!(
+                    "material '{}' has an index of refraction of {}; it must be a positive number",
+                    m.name, m.ior
+                )));
+            }
+            let ok = |v: Vec3| v.is_finite() && v.min_element() >= 0.0;
+            if !ok(m.specular_color) || !ok(m.attenuation) {
+                return Err(Error::InvalidScene(format!(
+                    "material '{}' has a negative or non-finite specular colour ({}) or attenuation ({})",
+                    m.name, m.specular_color, m.attenuation
+                )));
+            }
+        }
+        let power = self.emitted_power();
+        if !power.is_finite() {
+            return Err(Error::InvalidScene(format!(
+                "the scene's emitters give a power of {power} W, beyond what 32-bit floats hold; lower their emission or the scene's size"
+            )));
         }
         self.camera.validate()
     }

@@ -27,27 +27,45 @@ pub struct Texture {
     pub linear: bool,
 }
 
+/// A PNG or JPEG reader of `bytes` (the format recognised from them).
+fn reader(bytes: &[u8]) -> Result<image::ImageReader<Cursor<&[u8]>>, String> {
+    let reader = image::ImageReader::new(Cursor::new(bytes))
+        .with_guessed_format()
+        .map_err(|e| format!("cannot be read: {}", crate::error::one_line(e)))?;
+    match reader.format() {
+        Some(_) => Ok(reader),
+        None => Err("is not a PNG or JPEG image".into()),
+    }
+}
+
 impl Texture {
-    /// Decodes a PNG or JPEG image (the format is recognised from its bytes).
+    /// The width and height a PNG or JPEG image declares, read from its header alone: what
+    /// decoding it would allocate, to check against a budget first.
+    pub fn dimensions(bytes: &[u8]) -> Result<(u32, u32), String> {
+        reader(bytes)?
+            .into_dimensions()
+            .map_err(|e| format!("is not a valid PNG or JPEG image ({})", crate::error::one_line(e)))
+    }
+
+    /// Decodes a PNG or JPEG image (the format is recognised from its bytes), at most
+    /// [`MAX_DECODED_SIDE`] texels a side.
     pub fn decode(name: &str, bytes: &[u8]) -> Result<Texture, String> {
-        let mut reader = image::ImageReader::new(Cursor::new(bytes))
-            .with_guessed_format()
-            .map_err(|e| format!("cannot be read: {e}"))?;
-        if reader.format().is_none() {
-            return Err("is not a PNG or JPEG image".into());
-        }
+        let mut reader = reader(bytes)?;
         let mut limits = image::Limits::default();
         limits.max_image_width = Some(MAX_DECODED_SIDE);
         limits.max_image_height = Some(MAX_DECODED_SIDE);
         limits.max_alloc = Some(MAX_DECODE_BYTES);
         reader.limits(limits);
-        let image = reader.decode().map_err(|e| format!("is not a valid PNG or JPEG image ({e})"))?;
-        let rgba = image.to_rgba8();
+        let image =
+            reader.decode().map_err(|e| format!("is not a valid PNG or JPEG image ({})", crate::error::one_line(e)))?;
+        let rgba = image.into_rgba8();
         let (width, height) = rgba.dimensions();
         if width == 0 || height == 0 {
             return Err("is an empty image".into());
         }
-        let texels = rgba.pixels().map(|p| p.0).collect();
+        // The decoded bytes become the texels in place where the allocation allows.
+        let texels = bytemuck::allocation::try_cast_vec(rgba.into_raw())
+            .unwrap_or_else(|(_, raw)| raw.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect());
         Ok(Texture { name: name.to_owned(), width, height, texels, linear: false })
     }
 

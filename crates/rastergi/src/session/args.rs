@@ -371,6 +371,11 @@ pub struct SceneArgs {
     /// middle grey (0.18): then the whole stops that bring it there.
     #[arg(long, allow_hyphen_values = true)]
     pub exposure: Option<f32>,
+    /// Raises (or lowers) a budget of what a scene file may make rastergi read and hold:
+    /// NAME=N with NAME one of triangles, vertices, texels, decompressed, xml-bytes, xml-depth,
+    /// expansion (repeatable; the defaults and what each counts: docs/user-guide.md, "Budgets").
+    #[arg(long, value_name = "NAME=N", value_parser = crate::scene::parse_budget)]
+    pub budget: Vec<(crate::scene::Budget, u64)>,
     #[command(flatten)]
     pub gpu: GpuArgs,
 }
@@ -416,7 +421,15 @@ impl SceneArgs {
             method,
             denoiser,
             gpu: self.gpu.options(),
+            budgets: self.budgets(),
         }
+    }
+
+    /// The default budgets with those `--budget` sets.
+    pub fn budgets(&self) -> crate::scene::Budgets {
+        let mut b = crate::scene::Budgets::default();
+        self.budget.iter().for_each(|&(name, n)| b.set(name, n));
+        b
     }
 
     /// The scene with the camera and light options applied ([`Options::load_scene`]).

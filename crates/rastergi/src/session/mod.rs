@@ -137,6 +137,8 @@ pub struct Options {
     pub denoiser: bool,
     /// The GPU's backends and ray traversal.
     pub gpu: GpuOptions,
+    /// What a scene file may make the loaders read and hold (`--budget NAME=N`).
+    pub budgets: crate::scene::Budgets,
 }
 
 impl Default for Options {
@@ -178,6 +180,7 @@ impl Default for Options {
             method: Method::Gather,
             denoiser: false,
             gpu: GpuOptions::default(),
+            budgets: crate::scene::Budgets::default(),
         }
     }
 }
@@ -193,7 +196,7 @@ impl Options {
     #[cfg(not(target_arch = "wasm32"))]
     pub fn load_scene(&self) -> Result<Scene> {
         use std::path::Path;
-        let mut scene = load_scene_with(&self.scene, self.camera, &self.defines)?;
+        let mut scene = load_scene_with(&self.scene, self.camera, &self.defines, &self.budgets)?;
         let c = &mut scene.camera;
         c.eye = self.eye.unwrap_or(c.eye);
         c.target = self.target.unwrap_or(c.target);
@@ -241,7 +244,7 @@ impl Options {
         }
         let no_default_light = self.env.as_deref() == Some(Path::new("none"));
         if let Some(path) = self.env.as_ref().filter(|_| !no_default_light) {
-            let env = crate::environment::Environment::load(path, self.env_scale)?;
+            let env = crate::environment::Environment::load_with(path, self.env_scale, &self.budgets)?;
             if env.is_dark() {
                 log::warn!("{}: the environment map is black everywhere; it adds no light", path.display());
             }
@@ -436,15 +439,21 @@ pub fn extension_of(name: &str) -> Option<String> {
 /// The built-in scene of that name, or the scene file at that path.
 #[cfg(not(target_arch = "wasm32"))]
 pub fn load_scene(name: &str) -> Result<Scene> {
-    load_scene_with(name, None, &[])
+    load_scene_with(name, None, &[], &crate::scene::Budgets::default())
 }
 
-/// [`load_scene`] with the camera of a glTF file chosen by its index and the parameter values
-/// of a Mitsuba file (`-D name=value`).
+/// [`load_scene`] with the camera of a glTF file chosen by its index, the parameter values
+/// of a Mitsuba file (`-D name=value`) and the budgets of what the files may make the loaders
+/// read and hold.
 #[cfg(not(target_arch = "wasm32"))]
-pub fn load_scene_with(name: &str, camera: Option<usize>, defines: &[(String, String)]) -> Result<Scene> {
+pub fn load_scene_with(
+    name: &str,
+    camera: Option<usize>,
+    defines: &[(String, String)],
+    budgets: &crate::scene::Budgets,
+) -> Result<Scene> {
     use crate::scene::generate::BUILTIN_NAMES;
-    use crate::scene::{GltfOptions, MitsubaOptions, load_gltf_with, load_mitsuba, load_obj};
+    use crate::scene::{Files, GltfOptions, MitsubaOptions, load_gltf_with, load_mitsuba, load_obj_with};
     let path = std::path::Path::new(name);
     let extension = extension_of(name);
     if camera.is_some() && !matches!(extension.as_deref(), Some("gltf" | "glb")) {
@@ -456,10 +465,10 @@ pub fn load_scene_with(name: &str, camera: Option<usize>, defines: &[(String, St
         return Ok(scene);
     }
     match extension.as_deref() {
-        Some("obj") => load_obj(path),
-        Some("gltf" | "glb") => load_gltf_with(path, &GltfOptions { camera }),
+        Some("obj") => load_obj_with(Files::Disk, path, budgets),
+        Some("gltf" | "glb") => load_gltf_with(path, &GltfOptions { camera, budgets: *budgets }),
         Some("xml") => {
-            let m = load_mitsuba(path, &MitsubaOptions { defines: defines.to_vec() })?;
+            let m = load_mitsuba(path, &MitsubaOptions { defines: defines.to_vec(), budgets: *budgets })?;
             if let (Some((w, h)), Some(n)) = (m.film, m.sample_count) {
                 log::info!(
                     "{name}: its film is {w}x{h} pixels with {n} samples per pixel (the default size and iterations)"

@@ -164,6 +164,16 @@ impl Loader<'_> {
             return Ok(t);
         }
         let what = named("image", image.index(), image.name());
+        let file = match image.source() {
+            ::gltf::image::Source::Uri { uri, .. } if !uri.starts_with("data:") => {
+                Some(self.files.canonical(&self.dir.join(percent_decode(uri))))
+            }
+            _ => None,
+        };
+        if let Some(&t) = file.as_ref().and_then(|f| self.image_files.get(&(f.clone(), linear))) {
+            self.textures.insert((image.index(), linear), t);
+            return Ok(t);
+        }
         let bytes: Vec<u8> = match image.source() {
             ::gltf::image::Source::View { view, .. } => {
                 let buffer = &self.buffers[view.buffer().index()];
@@ -176,9 +186,18 @@ impl Loader<'_> {
             }
         };
         let name = image.name().map_or_else(|| format!("image {}", image.index()), str::to_owned);
+        let (w, h) = Texture::dimensions(&bytes).map_err(|e| format!("{what} {e}"))?;
+        let n = w as u64 * h as u64;
+        self.budgets
+            .check_more(Budget::Texels, self.texels, n, &format!("{w}x{h}"))
+            .map_err(|e| format!("{what} {e}"))?;
+        self.texels += n;
         let decoded = Texture::decode(&name, &bytes).map_err(|e| format!("{what} {e}"))?;
         let t = self.scene.add_texture(if linear { decoded.into_linear() } else { decoded });
         self.textures.insert((image.index(), linear), t);
+        if let Some(file) = file {
+            self.image_files.insert((file, linear), t);
+        }
         Ok(t)
     }
 }

@@ -133,6 +133,7 @@ impl Loader<'_> {
     pub(super) fn triangle_count(&self, mesh: &::gltf::Mesh, p: &::gltf::Primitive) -> Res<u64> {
         let what = format!("{} primitive {}", named("mesh", mesh.index(), mesh.name()), p.index());
         let positions = self.positions(p, &what)?;
+        self.budgets.check(Budget::Vertices, positions.count as u64, "").map_err(|m| format!("{what} {m}"))?;
         let n = match self.indices(p, &what)? {
             Some(indices) => indices.count,
             None => positions.count,

@@ -48,7 +48,10 @@
 //!
 //! Robustness: every size and index is checked before it is used and before anything is
 //! allocated from it (accessor ranges against their buffer views and the bytes actually
-//! present, the triangle total against [`MAX_TRIANGLES`], the node hierarchy against cycles);
+//! present, the triangle total against the triangle budget ([`GltfOptions::budgets`]), each
+//! mesh's vertices against the vertex budget, each image's declared size against the texel
+//! budget before it is decoded, the node hierarchy against cycles); an image file named by
+//! several images (or spellings of its path) is decoded once;
 //! a file that breaks a rule gives a one-line error naming it and the offending element.
 //!
 //! The loader is one module per concern: [`file`] (the container, buffers and URIs, checks the
@@ -71,16 +74,14 @@ use ::gltf::{Document, Semantic};
 use base64::Engine as _;
 use glam::{Mat4, Quat, Vec2, Vec3, Vec4};
 
-use super::{AlphaMode, Camera, Files, Light, Material, Scene, Texture, TextureRef, UvTransform};
+use super::{AlphaMode, Budget, Budgets, Camera, Files, Light, Material, Scene, Texture, TextureRef, UvTransform};
 use crate::error::{Error, Result};
 
-use file::{check_before_validation, describe_gltf_error, load_buffer, read_uri, split_glb};
+use file::{check_before_validation, describe_gltf_error, load_buffer, percent_decode, read_uri, split_glb};
 use lights::punctual_light;
 use materials::texture_sets;
 use meshes::Primitive;
 
-/// Most triangles a glTF scene may expand to (instances included).
-pub const MAX_TRIANGLES: u64 = 1 << 25;
 /// glTF extensions that a file may require.
 const SUPPORTED_REQUIRED: &[&str] = &[
     "KHR_materials_emissive_strength",
@@ -100,6 +101,8 @@ pub struct GltfOptions {
     /// Index into the file's `cameras` of the camera to use; `None`: the first perspective
     /// camera that a node of the scene uses.
     pub camera: Option<usize>,
+    /// What the file may make the loader read and hold.
+    pub budgets: Budgets,
 }
 
 fn file_error(path: &Path, message: impl Into<String>) -> Error {
@@ -151,6 +154,9 @@ fn load(files: Files, path: &Path, bytes: &[u8], options: &GltfOptions) -> Res<S
         scene: Scene::new(placeholder_camera()),
         materials: HashMap::new(),
         textures: HashMap::new(),
+        image_files: HashMap::new(),
+        budgets: options.budgets,
+        texels: 0,
         warned_sets: false,
         warned_coat_normal: false,
         camera: None,
@@ -180,9 +186,14 @@ struct Loader<'a> {
     scene: Scene,
     /// glTF material index (None: the default material) → scene material.
     materials: HashMap<Option<usize>, u32>,
-    /// glTF image index → scene texture.
     /// Scene textures by (image, read as linear data).
     textures: HashMap<(usize, bool), usize>,
+    /// Scene textures by (canonical image file, read as linear data): images that name one
+    /// file are one texture.
+    image_files: HashMap<(PathBuf, bool), usize>,
+    budgets: Budgets,
+    /// Texels of the images decoded so far.
+    texels: u64,
     /// The camera chosen, once found.
     camera: Option<Camera>,
     warned_sampler: bool,
@@ -260,9 +271,7 @@ impl<'a> Loader<'a> {
                 total += self.triangle_count(mesh, &p)?;
             }
         }
-        if total > MAX_TRIANGLES {
-            return Err(format!("expands to {total} triangles, more than the {MAX_TRIANGLES} rastergi loads"));
-        }
+        self.budgets.check(Budget::Triangles, total, "its meshes, instances included")?;
         self.scene.triangles.reserve(total as usize);
         self.scene.material_ids.reserve(total as usize);
         let mut meshes: HashMap<usize, Vec<Primitive>> = HashMap::new();

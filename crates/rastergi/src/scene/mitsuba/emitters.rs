@@ -8,7 +8,7 @@ use glam::{Mat4, Vec2, Vec3};
 use super::materials::Value;
 use super::xml::{self, Elem, Plugin};
 use super::{Loader, Res, values};
-use crate::scene::{Files, Light};
+use crate::scene::Light;
 
 impl<'a> Loader<'a> {
     /// A top-level emitter: a light or the environment.
@@ -49,19 +49,16 @@ impl<'a> Loader<'a> {
             }
             "envmap" | "constant" => {
                 let env = if ty == "constant" {
-                    crate::environment::Environment::constant(self.colour(&p, "radiance")?)
+                    crate::environment::Environment::checked_constant(self.colour(&p, "radiance")?)
+                        .map_err(|err| self.err(e, err))?
                 } else {
                     let filename =
                         self.string(&p, "filename")?.ok_or_else(|| self.err(e, "an envmap needs a filename"))?;
                     let path = xml::resolve(self.dir_of(e), filename);
                     let scale = self.float(&p, "scale", 1.0)?;
-                    if !matches!(self.files, Files::Disk) {
-                        self.warn(format!("the envmap {} is read from disk only; it is skipped", path.display()));
-                        p.read_all();
-                        return Ok(());
-                    }
-                    let env = crate::environment::Environment::load(&path, scale.max(0.0))
-                        .map_err(|err| self.err(e, format!("the envmap: {err}")))?;
+                    let env =
+                        crate::environment::Environment::load_in(self.files, &path, scale.max(0.0), &self.budgets)
+                            .map_err(|err| self.err(e, format!("the envmap: {err}")))?;
                     let m = self.transform(&p, "to_world")?;
                     rotated(&env, m).unwrap_or_else(|| (*env).clone())
                 };
@@ -183,16 +180,22 @@ impl<'a> Loader<'a> {
     /// value, not grey (`<rgb>` and `<float>` stay as given, as there). Measured on Sponza
     /// (its light is `<spectrum value="16000"/>`): read as grey, the image's channel means were
     /// 0.83, 1.05, 1.10 of Mitsuba 3's on the same file.
+    ///
+    /// The value must be finite, ≥ 0 and at most [`MAX_LIGHT`](crate::scene::MAX_LIGHT).
     fn colour(&mut self, p: &Plugin<'a>, key: &str) -> Res<Vec3> {
-        let spectrum = p.get(key).is_some_and(|e| e.tag == "spectrum");
-        match self.value(p, key, Vec3::ONE)? {
-            Value::Constant(c) if spectrum => Ok(c * EQUAL_ENERGY_SRGB),
-            Value::Constant(c) => Ok(c),
+        let given = p.get(key);
+        let spectrum = given.is_some_and(|e| e.tag == "spectrum");
+        let c = match self.value(p, key, Vec3::ONE)? {
+            Value::Constant(c) if spectrum => c * EQUAL_ENERGY_SRGB,
+            Value::Constant(c) => c,
             Value::Texture { factor, .. } => {
                 self.warn(format!("emitter '{}': a texture as {key} is not supported; its factor is used", p.ty()));
-                Ok(factor)
+                factor
             }
-        }
+        };
+        crate::scene::check_light(c, key)
+            .map_err(|m| self.err(given.unwrap_or(p.elem), format!("emitter '{}': {m}", p.ty())))?;
+        Ok(c)
     }
 }
 

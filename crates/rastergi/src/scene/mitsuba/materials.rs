@@ -183,7 +183,9 @@ impl<'a> Loader<'a> {
                 let specular = self.specular_weight(&p, "specular_reflectance", &name)?;
                 let alpha = roughness * roughness;
                 let key = format!("plastic {eta} {alpha} {specular} {nonlinear}");
-                let rho = self.map_value(rho, &key, plastic_albedo(eta, alpha, specular, nonlinear));
+                let rho = self
+                    .map_value(rho, &key, plastic_albedo(eta, alpha, specular, nonlinear))
+                    .map_err(|m| self.err(e, m))?;
                 let base = Material { specular, ior: eta, roughness, ..Material::diffuse(&name, Vec3::ONE) };
                 self.with_albedo(base, rho, &name)
             }
@@ -477,6 +479,10 @@ impl<'a> Loader<'a> {
         let roughness = self.constant_float(p, "roughness", 0.5, name)?.clamp(0.0, 1.0);
         let transmission = self.constant_float(p, "spec_trans", 0.0, name)?.clamp(0.0, 1.0);
         let ior = if p.has("eta") { self.constant_float(p, "eta", 1.5, name)? } else { 1.5 };
+        if !(ior.is_finite() && ior > 0.0) {
+            let at = p.get("eta").unwrap_or(p.elem);
+            return Err(self.err(at, format!("principled '{name}': eta {ior} must be a positive number")));
+        }
         let base =
             Material { metallic, roughness, transmission, ior, specular: 1.0, ..Material::diffuse(name, Vec3::ONE) };
         Ok(self.with_albedo(base, albedo, name))

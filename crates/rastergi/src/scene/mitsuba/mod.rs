@@ -69,7 +69,7 @@ use std::sync::Arc;
 
 use glam::{Mat4, Vec2, Vec3};
 
-use super::{Camera, Files, Material, Scene};
+use super::{Budget, Budgets, Camera, Files, Material, Scene};
 use crate::error::{Error, Result};
 use materials::Value;
 use shapes::Soup;
@@ -82,6 +82,8 @@ type Res<T> = Result<T>;
 pub struct MitsubaOptions {
     /// Parameter values (`-D name=value`), overriding the file's `<default>`s.
     pub defines: Vec<(String, String)>,
+    /// What the file and the files it names may make the loader read and hold.
+    pub budgets: Budgets,
 }
 
 /// A Mitsuba scene and what its file suggests for rendering it.
@@ -102,7 +104,7 @@ pub fn load_mitsuba(path: &Path, options: &MitsubaOptions) -> Result<MitsubaScen
 
 /// Loads the Mitsuba scene at `path` of `files` (its meshes, textures and includes too).
 pub fn load_mitsuba_in(files: Files, path: &Path, options: &MitsubaOptions) -> Result<MitsubaScene> {
-    let doc = xml::parse(files, path, &options.defines)?;
+    let doc = xml::parse(files, path, &options.defines, &options.budgets)?;
     let mut ids: HashMap<String, &Elem> = HashMap::new();
     let mut duplicate = None;
     doc.root.walk(&mut |e| {
@@ -127,11 +129,17 @@ pub fn load_mitsuba_in(files: Files, path: &Path, options: &MitsubaOptions) -> R
         checkers: HashMap::new(),
         materials: HashMap::new(),
         mesh_files: HashMap::new(),
+        meshes: HashMap::new(),
+        mesh_uses: HashMap::new(),
+        budgets: options.budgets,
+        texels: 0,
+        decompressed: 0,
         warned: HashSet::new(),
         camera: None,
         film: None,
         sample_count: None,
     };
+    loader.count_mesh_uses();
     loader.build()?;
     let Loader { mut scene, camera, film, sample_count, .. } = loader;
     if scene.triangles.is_empty() {
@@ -148,15 +156,26 @@ pub(super) struct Loader<'a> {
     doc: &'a Document,
     ids: HashMap<String, &'a Elem>,
     scene: Scene,
-    /// Textures by (path, read as linear data).
+    /// Textures by (canonical file, read as linear data).
     textures: HashMap<(PathBuf, bool), usize>,
     /// Textures made from others (a plastic's mapped albedo, an opacity) by (source, what).
     derived: HashMap<(usize, String), usize>,
     checkers: HashMap<String, usize>,
     /// Scene materials by (BSDF element, emission).
     materials: HashMap<(usize, [u32; 3], Option<usize>), u32>,
-    /// `.serialized` files' bytes, read once however many shapes they hold.
+    /// `.serialized` files' bytes by canonical file, read once however many shapes they hold.
     mesh_files: HashMap<PathBuf, Arc<Vec<u8>>>,
+    /// Mesh shapes' triangles in their local space by (canonical file, what of it: the
+    /// `shape_index`, flat, flipped texture coordinates), read once however many shapes
+    /// name them.
+    meshes: HashMap<(PathBuf, String), Arc<Soup>>,
+    /// How many shapes are yet to read each mesh file (`u32::MAX`: a shapegroup's, read once
+    /// per instance): a file's meshes leave the cache when its last shape has read them.
+    mesh_uses: HashMap<PathBuf, u32>,
+    budgets: Budgets,
+    /// Texels of the textures decoded or made so far, and bytes decompressed.
+    texels: u64,
+    decompressed: u64,
     warned: HashSet<String>,
     camera: Option<Camera>,
     film: Option<(u32, u32)>,
@@ -296,7 +315,14 @@ impl<'a> Loader<'a> {
             soup.transformed(m, flip ^ mirrored)
         };
         let soup = match ty {
-            "obj" | "ply" | "serialized" => self.mesh(&p, flat)?.transformed(to_world, flip),
+            "obj" | "ply" | "serialized" => {
+                let mesh = self.mesh(&p, flat)?;
+                let (used, adding) = (self.scene.triangles.len() as u64, mesh.triangles.len() as u64);
+                let detail = format!("its {adding}");
+                let check = self.budgets.check_more(Budget::Triangles, used, adding, &detail);
+                check.map_err(|m| self.err(e, format!("the shape {m}")))?;
+                Arc::unwrap_or_clone(mesh).transformed(to_world, flip)
+            }
             "rectangle" => analytic(shapes::rectangle(), Mat4::IDENTITY),
             "cube" => analytic(shapes::cube(), Mat4::IDENTITY),
             "disk" => analytic(shapes::disk(), Mat4::IDENTITY),
@@ -333,7 +359,7 @@ impl<'a> Loader<'a> {
             None => None,
         };
         let material = self.material_for(bsdf, emission)?;
-        self.add(soup, material);
+        self.add(e, soup, material)?;
         self.warn_unread(&p, &format!("shape '{ty}'"));
         Ok(())
     }
@@ -362,6 +388,9 @@ impl<'a> Loader<'a> {
             Value::Constant(c) if spectrum => Value::Constant(c * emitters::EQUAL_ENERGY_SRGB),
             v => v,
         };
+        if let Err(m) = super::check_light(radiance.factor(), "radiance") {
+            return Err(self.err(p.get("radiance").unwrap_or(e), format!("an area emitter's {m}")));
+        }
         self.warn_unread(&p, "emitter 'area'");
         Ok(radiance)
     }
@@ -388,9 +417,9 @@ impl<'a> Loader<'a> {
             None if emission.is_some() => Material::diffuse("emitter", Vec3::ZERO),
             None => Material::diffuse("default", Vec3::splat(0.5)),
         };
-        if !(le.is_finite() && le.min_element() >= 0.0) {
+        if let Err(m) = super::check_light(le, "radiance") {
             let at = bsdf.unwrap_or(&self.doc.root);
-            return Err(self.err(at, format!("an area emitter's radiance {le} is negative or not finite")));
+            return Err(self.err(at, format!("an area emitter's {m}")));
         }
         material.emission = le;
         material.emission_texture = texture;
@@ -399,8 +428,9 @@ impl<'a> Loader<'a> {
         Ok(id)
     }
 
-    /// A mesh file's triangles in the shape's local space.
-    fn mesh(&mut self, p: &Plugin<'a>, flat: bool) -> Res<Soup> {
+    /// A mesh file's triangles in the shape's local space, read once per canonical file (and
+    /// shape index, flat shading, texture-coordinate flip) however many shapes name it.
+    fn mesh(&mut self, p: &Plugin<'a>, flat: bool) -> Res<Arc<Soup>> {
         let e = p.elem;
         let filename =
             self.string(p, "filename")?.ok_or_else(|| self.err(e, format!("a {} shape needs a filename", p.ty())))?;
@@ -408,10 +438,64 @@ impl<'a> Loader<'a> {
         if let Some(what) = self.files.missing(&path) {
             return Err(self.err(e, format!("the mesh {}: {what}", path.display())));
         }
+        let canonical = self.files.canonical(&path);
+        let variant = match p.ty() {
+            "obj" => format!("obj flat {flat} flip {}", self.boolean(p, "flip_tex_coords", true)?),
+            "ply" => format!("ply flat {flat}"),
+            _ => format!("serialized {} flat {flat}", self.integer(p, "shape_index", 0)?),
+        };
+        let key = (canonical, variant);
+        let soup = match self.meshes.get(&key) {
+            Some(soup) => soup.clone(),
+            None => {
+                let soup = Arc::new(self.read_mesh(p, flat, &path, &key.0)?);
+                self.meshes.insert(key.clone(), soup.clone());
+                soup
+            }
+        };
+        let uses = self.mesh_uses.entry(key.0.clone()).or_insert(1);
+        if *uses != u32::MAX {
+            *uses = uses.saturating_sub(1);
+            if *uses == 0 {
+                self.meshes.retain(|k, _| k.0 != key.0);
+                self.mesh_files.remove(&key.0);
+            }
+        }
+        Ok(soup)
+    }
+
+    /// Counts the shapes that name each mesh file ([`Loader::mesh_uses`]).
+    fn count_mesh_uses(&mut self) {
+        let doc: &'a Document = self.doc;
+        let mut uses = HashMap::new();
+        let mut stack: Vec<(&Elem, bool)> = doc.root.children.iter().map(|c| (c, false)).collect();
+        while let Some((e, grouped)) = stack.pop() {
+            if e.tag != "shape" {
+                continue;
+            }
+            let grouped = grouped || e.ty() == "shapegroup";
+            stack.extend(e.children.iter().map(|c| (c, grouped)));
+            if !matches!(e.ty(), "obj" | "ply" | "serialized") {
+                continue;
+            }
+            let Some(name) = e.children.iter().find(|c| c.name() == "filename").and_then(|c| c.attr("value")) else {
+                continue;
+            };
+            let path = self.files.canonical(&xml::resolve(self.dir_of(e), name));
+            let n: &mut u32 = uses.entry(path).or_insert(0);
+            *n = if grouped { u32::MAX } else { n.saturating_add(1) };
+        }
+        self.mesh_uses = uses;
+    }
+
+    /// Reads a mesh file (see [`Self::mesh`]), its counts within the budgets.
+    fn read_mesh(&mut self, p: &Plugin<'a>, flat: bool, path: &Path, canonical: &Path) -> Res<Soup> {
+        let e = p.elem;
         let bad = |l: &Loader, m: String| l.err(e, format!("the mesh {} {m}", path.display()));
+        let (budgets, used) = (self.budgets, self.scene.triangles.len() as u64);
         match p.ty() {
             "obj" => {
-                let scene = super::obj::load_obj_geometry(self.files, &path)?;
+                let scene = super::obj::load_obj_geometry(self.files, path, &budgets, used)?;
                 let flip_uv = !self.boolean(p, "flip_tex_coords", true)?;
                 let uvs = (!scene.uvs.is_empty()).then(|| {
                     scene
@@ -425,32 +509,44 @@ impl<'a> Loader<'a> {
                 Ok(if flat { soup } else { soup.with_smooth_normals() })
             }
             "ply" => {
-                let bytes = self.files.read(&path).map_err(|err| bad(self, format!("cannot be read ({err})")))?;
-                let mesh = ply::read(&bytes).map_err(|m| bad(self, m))?;
+                if self.files.is_special(path) {
+                    return Err(bad(self, "is not a regular file".into()));
+                }
+                let bytes = self.files.read(path).map_err(|err| bad(self, format!("cannot be read ({err})")))?;
+                let mesh = ply::read(&bytes, &budgets, used).map_err(|m| bad(self, m))?;
                 Ok(mesh.into_soup(flat))
             }
             _ => {
                 let index = self.integer(p, "shape_index", 0)?;
                 let index =
                     u32::try_from(index).map_err(|_| self.err(e, format!("shape_index {index} is negative")))?;
-                let bytes = match self.mesh_files.get(&path) {
+                let bytes = match self.mesh_files.get(canonical) {
                     Some(b) => b.clone(),
                     None => {
+                        if self.files.is_special(path) {
+                            return Err(bad(self, "is not a regular file".into()));
+                        }
                         let b = Arc::new(
-                            self.files.read(&path).map_err(|err| bad(self, format!("cannot be read ({err})")))?,
+                            self.files.read(path).map_err(|err| bad(self, format!("cannot be read ({err})")))?,
                         );
-                        self.mesh_files.insert(path.clone(), b.clone());
+                        self.mesh_files.insert(canonical.to_path_buf(), b.clone());
                         b
                     }
                 };
-                let mesh = serialized::read(&bytes, index).map_err(|m| bad(self, m))?;
+                let (mesh, decompressed) =
+                    serialized::read(&bytes, index, &budgets, (used, self.decompressed)).map_err(|m| bad(self, m))?;
+                self.decompressed += decompressed;
                 Ok(mesh.into_soup(flat))
             }
         }
     }
 
-    /// Adds a shape's triangles with `material` (and tangents where it has a normal map).
-    fn add(&mut self, soup: Soup, material: u32) {
+    /// Adds a shape's triangles with `material` (and tangents where it has a normal map),
+    /// once the scene's triangles with them are known to be within budget.
+    fn add(&mut self, e: &Elem, soup: Soup, material: u32) -> Res<()> {
+        let (used, adding) = (self.scene.triangles.len() as u64, soup.triangles.len() as u64);
+        let check = self.budgets.check_more(Budget::Triangles, used, adding, &format!("its {adding}"));
+        check.map_err(|m| self.err(e, format!("the shape {m}")))?;
         let normal_mapped = self.scene.materials[material as usize].normal_texture.is_some();
         let tangents = match (&soup.uvs, normal_mapped) {
             (Some(uvs), true) => Some(super::mikktspace(&soup.triangles, uvs, soup.normals.as_deref())),
@@ -468,5 +564,6 @@ impl<'a> Loader<'a> {
                 self.scene.set_last_tangents(tangents[i]);
             }
         }
+        Ok(())
     }
 }

@@ -3,11 +3,13 @@
 //! s, t; texture_u, texture_v or texture_s, texture_t; read as given, not flipped), and the
 //! `face` element's `vertex_indices` (or `vertex_index`) lists, polygons split into fans.
 //! Other elements and properties are read past. Counts are checked against the bytes left
-//! before anything is allocated from them.
+//! and the vertex budget before anything is allocated from them; the triangles against their
+//! budget as the faces are split ([`Budgets`]).
 
 use glam::{Vec2, Vec3};
 
 use super::shapes::Mesh;
+use crate::scene::{Budget, Budgets};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Kind {
@@ -108,8 +110,9 @@ impl Data<'_> {
     }
 }
 
-/// Reads a PLY file's bytes; errors say what is wrong without naming the file.
-pub fn read(bytes: &[u8]) -> Result<Mesh, String> {
+/// Reads a PLY file's bytes within `budgets`, `used` triangles being the scene's already;
+/// errors say what is wrong without naming the file.
+pub fn read(bytes: &[u8], budgets: &Budgets, used: u64) -> Result<Mesh, String> {
     let end = bytes.windows(10).position(|w| w == b"end_header").ok_or("is not a PLY file (no 'end_header' line)")?;
     let header = std::str::from_utf8(&bytes[..end]).map_err(|_| "has a header that is not text")?;
     // The data starts after the end_header line's line break.
@@ -189,7 +192,12 @@ pub fn read(bytes: &[u8]) -> Result<Mesh, String> {
             if xyz.iter().any(Option::is_none) {
                 return Err("has vertices without x, y and z".into());
             }
+            budgets.check(Budget::Vertices, e.count as u64, "its vertex element")?;
             mesh.positions.reserve(e.count);
+        }
+        if is_face && list.is_some() {
+            // A face makes at least one triangle (a polygon of n corners, n − 2).
+            budgets.check_more(Budget::Triangles, used, e.count as u64, &format!("its {} faces", e.count))?;
         }
         let mut values = vec![0.0f64; e.properties.len()];
         let mut polygon: Vec<u32> = Vec::new();
@@ -225,6 +233,8 @@ pub fn read(bytes: &[u8]) -> Result<Mesh, String> {
                     mesh.uvs.push(Vec2::new(at(Some(u)), at(Some(v))));
                 }
             } else if is_face && list.is_some() {
+                let adding = (mesh.faces.len() + polygon.len().saturating_sub(2)) as u64;
+                budgets.check_more(Budget::Triangles, used, adding, "its faces")?;
                 for k in 2..polygon.len() {
                     mesh.faces.push([polygon[0], polygon[k - 1], polygon[k]]);
                 }
@@ -248,7 +258,7 @@ mod tests {
     #[test]
     fn ascii_and_binary_files_read_alike() {
         let ascii = b"ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nproperty float u\nproperty float v\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0 0 0\n1 0 0 1 0\n1 1 0 1 1\n0 1 0 0 1\n4 0 1 2 3\n";
-        let m = read(ascii).unwrap();
+        let m = read(ascii, &Budgets::default(), 0).unwrap();
         assert_eq!(m.positions.len(), 4);
         assert_eq!(m.faces, vec![[0, 1, 2], [0, 2, 3]]);
         assert_eq!(m.uvs[2], Vec2::new(1.0, 1.0));
@@ -260,9 +270,17 @@ mod tests {
         for i in [0u32, 1, 2] {
             binary.extend(i.to_be_bytes());
         }
-        let m = read(&binary).unwrap();
+        let m = read(&binary, &Budgets::default(), 0).unwrap();
         assert_eq!(m.positions[1], Vec3::new(2.0, 0.0, 0.0));
         assert_eq!(m.faces, vec![[0, 1, 2]]);
-        assert!(read(&binary[..binary.len() - 2]).unwrap_err().contains("truncated"));
+        assert!(read(&binary[..binary.len() - 2], &Budgets::default(), 0).unwrap_err().contains("truncated"));
+        let tight = Budgets { triangles: 1, vertices: 3, ..Budgets::default() };
+        assert!(read(&binary, &tight, 0).is_ok());
+        let e = read(ascii, &tight, 0).unwrap_err();
+        assert!(e.starts_with("needs 4 vertices (its vertex element)") && e.contains("--budget vertices=4"), "{e}");
+        let e = read(ascii, &Budgets { triangles: 1, ..Budgets::default() }, 0).unwrap_err();
+        assert!(e.contains("2 triangles") && e.contains("budget of 1"), "{e}");
+        let e = read(&binary, &Budgets { triangles: 10, ..Budgets::default() }, 10).unwrap_err();
+        assert!(e.starts_with("needs 11 triangles (its 1 faces and the 10 read before)"), "{e}");
     }
 }

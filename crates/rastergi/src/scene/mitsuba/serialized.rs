@@ -16,13 +16,16 @@
 //!
 //! and the file ends with a dictionary: the byte offset of each mesh (u64 in version 4, u32 in
 //! version 3) and the u32 count of meshes; `shape_index` picks a mesh through it. Every count
-//! is checked against what the stream holds before anything is allocated from it.
+//! is checked before anything is allocated from it: against what the compressed stream can
+//! hold (zlib shrinks by 1032:1 at most) and against the budgets (the triangles, the vertices
+//! and the bytes to decompress, [`Budgets`]).
 
 use std::io::Read;
 
 use glam::{Vec2, Vec3};
 
 use super::shapes::Mesh;
+use crate::scene::{Budget, Budgets};
 
 const HEADER: u16 = 0x041C;
 const HAS_NORMALS: u32 = 0x0001;
@@ -30,9 +33,6 @@ const HAS_UVS: u32 = 0x0002;
 const HAS_COLOURS: u32 = 0x0008;
 const FACE_NORMALS: u32 = 0x0010;
 const DOUBLE: u32 = 0x2000;
-/// Most bytes one mesh may decompress to (a guard against zip bombs): 4 GiB, 1 GiB where
-/// addresses are 32 bits (the web).
-const MAX_MESH_BYTES: u64 = if usize::BITS < 64 { 1 << 30 } else { 4 << 30 };
 
 fn u16_at(b: &[u8], at: usize) -> Option<u16> {
     Some(u16::from_le_bytes(b.get(at..at + 2)?.try_into().ok()?))
@@ -85,7 +85,7 @@ impl<R: Read> Stream<R> {
         (&mut self.r)
             .take(n as u64)
             .read_to_end(&mut out)
-            .map_err(|e| format!("its {what} cannot be decompressed ({e})"))?;
+            .map_err(|e| format!("its {what} cannot be decompressed ({})", crate::error::one_line(e)))?;
         if out.len() < n {
             return Err(format!("ends inside its {what} (truncated)"));
         }
@@ -112,9 +112,10 @@ impl<R: Read> Stream<R> {
     }
 }
 
-/// Reads mesh `index` of a `.serialized` file's bytes; errors say what is wrong without
-/// naming the file.
-pub fn read(bytes: &[u8], index: u32) -> Result<Mesh, String> {
+/// Reads mesh `index` of a `.serialized` file's bytes within `budgets`, `used` being the
+/// triangles and the bytes decompressed by the scene's meshes read before; returns the mesh
+/// and the bytes decompressed. Errors say what is wrong without naming the file.
+pub fn read(bytes: &[u8], index: u32, budgets: &Budgets, used: (u64, u64)) -> Result<(Mesh, u64), String> {
     let header = u16_at(bytes, 0).ok_or("is too short to be a .serialized mesh")?;
     if header != HEADER {
         return Err(format!("is not a Mitsuba .serialized mesh (it starts with 0x{header:04X}, not 0x041C)"));
@@ -129,7 +130,8 @@ pub fn read(bytes: &[u8], index: u32) -> Result<Mesh, String> {
         _ => return Err(format!("mesh {index} (at byte {offset}) does not start with the mesh header 0x041C")),
     }
     let compressed = &bytes[offset + 4..];
-    let mut s = Stream { r: flate2::read::ZlibDecoder::new(compressed).take(MAX_MESH_BYTES) };
+    let mut s =
+        Stream { r: flate2::read::ZlibDecoder::new(compressed).take(budgets.decompressed.saturating_sub(used.1)) };
     let flags = s.u32("flags")?;
     if version >= 4 {
         // The name: bytes up to a zero.
@@ -157,14 +159,17 @@ pub fn read(bytes: &[u8], index: u32) -> Result<Mesh, String> {
         .checked_mul(per_vertex * size)
         .and_then(|v| triangles.checked_mul(3 * if wide { 8 } else { 4 }).and_then(|t| v.checked_add(t)));
     // Compressed data shrinks by at most zlib's limit of about 1032:1.
-    match need {
-        Some(n) if n <= MAX_MESH_BYTES && n / 1032 <= compressed.len() as u64 + 64 => {}
+    let need = match need {
+        Some(n) if n / 1032 <= compressed.len() as u64 + 64 => n,
         _ => {
             return Err(format!(
                 "mesh {index} claims {vertices} vertices and {triangles} triangles, more than the file can hold (truncated or not a valid file)"
             ));
         }
-    }
+    };
+    budgets.check_more(Budget::Triangles, used.0, triangles, &format!("mesh {index}"))?;
+    budgets.check(Budget::Vertices, vertices, &format!("mesh {index}"))?;
+    budgets.check_more(Budget::Decompressed, used.1, need, &format!("mesh {index}"))?;
     let (nv, nt) = (vertices as usize, triangles as usize);
     let p = s.floats(3 * nv, double, "positions")?;
     let positions: Vec<Vec3> = p.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect();
@@ -181,22 +186,23 @@ pub fn read(bytes: &[u8], index: u32) -> Result<Mesh, String> {
     if flags & HAS_COLOURS != 0 {
         s.floats(3 * nv, double, "vertex colours")?;
     }
-    let index_bytes = s.bytes(3 * nt * if wide { 8 } else { 4 }, "triangles")?;
-    let indices: Vec<u64> = if wide {
-        index_bytes.chunks_exact(8).map(|c| u64::from_le_bytes(c.try_into().expect("8 bytes"))).collect()
-    } else {
-        index_bytes.chunks_exact(4).map(|c| u32::from_le_bytes(c.try_into().expect("4 bytes")) as u64).collect()
+    let width = if wide { 8 } else { 4 };
+    let index_bytes = s.bytes(3 * nt * width, "triangles")?;
+    let corner = |c: &[u8]| match *c {
+        [a, b, c, d] => u32::from_le_bytes([a, b, c, d]) as u64,
+        _ => u64::from_le_bytes(c.try_into().unwrap_or([0xff; 8])),
     };
-    if let Some(bad) = indices.iter().position(|&i| i >= vertices) {
-        return Err(format!(
-            "triangle {} of mesh {index} names vertex {}, but the mesh has {vertices}",
-            bad / 3,
-            indices[bad]
-        ));
+    let mut faces = Vec::with_capacity(nt);
+    for (t, c) in index_bytes.chunks_exact(3 * width).enumerate() {
+        let face = [corner(&c[..width]), corner(&c[width..2 * width]), corner(&c[2 * width..])];
+        if let Some(&bad) = face.iter().find(|&&i| i >= vertices) {
+            return Err(format!("triangle {t} of mesh {index} names vertex {bad}, but the mesh has {vertices}"));
+        }
+        faces.push(face.map(|i| i as u32));
     }
     if !positions.iter().all(|p| p.is_finite()) {
         return Err(format!("mesh {index} has a non-finite vertex position"));
     }
-    let faces = indices.chunks_exact(3).map(|c| [c[0] as u32, c[1] as u32, c[2] as u32]).collect();
-    Ok(Mesh { positions, normals, uvs, faces, face_normals: flags & FACE_NORMALS != 0 })
+    let mesh = Mesh { positions, normals, uvs, faces, face_normals: flags & FACE_NORMALS != 0 };
+    Ok((mesh, need))
 }

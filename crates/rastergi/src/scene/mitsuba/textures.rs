@@ -28,7 +28,7 @@ impl<'a> Loader<'a> {
         match e.tag.as_str() {
             "texture" | "ref" => {
                 let v = self.texture_value(e, false)?;
-                Ok(if alpha { self.as_opacity(v) } else { v })
+                if alpha { self.as_opacity(v).map_err(|m| self.err(e, m)) } else { Ok(v) }
             }
             _ => {
                 let c = self.v(values::colour(e))?;
@@ -120,24 +120,38 @@ impl<'a> Loader<'a> {
         Ok(UvTransform([[us, 0.0, uo], [0.0, vs, vo]]))
     }
 
-    /// The texture at `path` (read once per path and encoding).
+    /// The texture at `path` (read once per file, however its path is spelled, and encoding),
+    /// its size checked against the texel budget before it is decoded.
     fn load_texture(&mut self, e: &'a Elem, path: PathBuf, linear: bool) -> Res<usize> {
-        if let Some(&t) = self.textures.get(&(path.clone(), linear)) {
+        let canonical = self.files.canonical(&path);
+        if let Some(&t) = self.textures.get(&(canonical.clone(), linear)) {
             return Ok(t);
         }
         if let Some(what) = self.files.missing(&path) {
             return Err(self.err(e, format!("the texture {}: {what}", path.display())));
         }
+        if self.files.is_special(&path) {
+            return Err(self.err(e, format!("the texture {} is not a regular file", path.display())));
+        }
         let bytes = self
             .files
             .read(&path)
             .map_err(|err| self.err(e, format!("the texture {} cannot be read ({err})", path.display())))?;
+        let bad = |l: &Self, m: String| l.err(e, format!("the texture {} {m}", path.display()));
+        let (w, h) = Texture::dimensions(&bytes).map_err(|m| bad(self, m))?;
+        self.charge_texels(w as u64 * h as u64, &format!("{w}x{h}")).map_err(|m| bad(self, m))?;
         let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-        let texture =
-            Texture::decode(&name, &bytes).map_err(|m| self.err(e, format!("the texture {} {m}", path.display())))?;
+        let texture = Texture::decode(&name, &bytes).map_err(|m| bad(self, m))?;
         let t = self.add_texture(e, Texture { linear, ..texture })?;
-        self.textures.insert((path, linear), t);
+        self.textures.insert((canonical, linear), t);
         Ok(t)
+    }
+
+    /// Counts `n` more texels against the texel budget (an error where they exceed it).
+    fn charge_texels(&mut self, n: u64, what: &str) -> Result<(), String> {
+        self.budgets.check_more(crate::scene::Budget::Texels, self.texels, n, what)?;
+        self.texels += n;
+        Ok(())
     }
 
     fn add_texture(&mut self, e: &Elem, t: Texture) -> Res<usize> {
@@ -154,6 +168,9 @@ impl<'a> Loader<'a> {
         if let Some(&t) = self.checkers.get(&key) {
             return t;
         }
+        // A generated texture's few texels are counted but never refused: the budget bounds
+        // what files make the loader decode.
+        self.texels += (CHECKER_SIDE * CHECKER_SIDE) as u64;
         let encode = |c: Vec3| c.to_array().map(|x| (linear_to_srgb(x) * 255.0).round() as u8);
         let (a, b) = (encode(c0), encode(c1));
         let half = CHECKER_SIDE / 2;
@@ -176,9 +193,9 @@ impl<'a> Loader<'a> {
     }
 
     /// `v` with `f` applied to its colour: to a constant, or to every texel of a copy of its
-    /// texture (cached under `key`).
-    pub(super) fn map_value(&mut self, v: Value, key: &str, f: impl Fn(Vec3) -> Vec3) -> Value {
-        match v {
+    /// texture (cached under `key`; the copy's texels count against the texel budget).
+    pub(super) fn map_value(&mut self, v: Value, key: &str, f: impl Fn(Vec3) -> Vec3) -> Result<Value, String> {
+        Ok(match v {
             Value::Constant(c) => Value::Constant(f(c)),
             Value::Texture { texture, factor } => {
                 let linear = self.scene.textures[texture.texture].linear;
@@ -187,7 +204,7 @@ impl<'a> Loader<'a> {
                 let derived = self.derived_texture(texture.texture, format!("{key} {factor}"), key, |t, rgb| {
                     let c = f(factor * rgb);
                     [encode(c.x), encode(c.y), encode(c.z), t[3]]
-                });
+                })?;
                 match derived {
                     Some(t) => Value::Texture {
                         texture: TextureRef { texture: t, transform: texture.transform },
@@ -196,46 +213,52 @@ impl<'a> Loader<'a> {
                     None => Value::Constant(f(factor * 0.5)),
                 }
             }
-        }
+        })
     }
 
     /// A texture as an opacity: its luminance (linear) in the alpha channel of a copy.
-    fn as_opacity(&mut self, v: Value) -> Value {
-        let Value::Texture { texture, factor } = v else { return v };
+    fn as_opacity(&mut self, v: Value) -> Result<Value, String> {
+        let Value::Texture { texture, factor } = v else { return Ok(v) };
         let derived = self.derived_texture(texture.texture, "opacity".to_owned(), "opacity", |t, rgb| {
             [t[0], t[1], t[2], (crate::environment::luminance(rgb).clamp(0.0, 1.0) * 255.0).round() as u8]
-        });
-        match derived {
+        })?;
+        Ok(match derived {
             Some(t) => Value::Texture { texture: TextureRef { texture: t, transform: texture.transform }, factor },
             None => Value::Constant(factor * 0.5),
-        }
+        })
     }
 
     /// A copy of texture `source` whose every texel is `texel(bytes, linear RGB)`, named
     /// "`source` (`label`)" and cached under `cache`; `None` where the scene holds the most
-    /// textures it may.
+    /// textures it may; an error where its texels exceed the texel budget.
     fn derived_texture(
         &mut self,
         source: usize,
         cache: String,
         label: &str,
         texel: impl Fn([u8; 4], Vec3) -> [u8; 4],
-    ) -> Option<usize> {
+    ) -> Result<Option<usize>, String> {
         let key = (source, cache);
         if let Some(&t) = self.derived.get(&key) {
-            return Some(t);
+            return Ok(Some(t));
         }
         if self.scene.textures.len() >= crate::scene::MAX_TEXTURES {
-            return None;
+            return Ok(None);
         }
+        let (name, width, height) = {
+            let src = &self.scene.textures[source];
+            (src.name.clone(), src.width, src.height)
+        };
+        self.charge_texels(width as u64 * height as u64, &format!("a {label} copy of the texture {name}"))
+            .map_err(|m| format!("the scene {m}"))?;
         let src = &self.scene.textures[source];
         let linear = src.linear;
         let decode = |c: u8| if linear { c as f32 / 255.0 } else { srgb_to_linear(c as f32 / 255.0) };
         let texels =
             src.texels.iter().map(|&t| texel(t, Vec3::new(decode(t[0]), decode(t[1]), decode(t[2])))).collect();
-        let derived = Texture { name: format!("{} ({label})", src.name), texels, ..src.clone() };
+        let derived = Texture { name: format!("{name} ({label})"), width, height, texels, linear };
         let t = self.scene.add_texture(derived);
         self.derived.insert(key, t);
-        Some(t)
+        Ok(Some(t))
     }
 }

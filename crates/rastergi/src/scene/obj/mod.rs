@@ -40,7 +40,7 @@ use std::path::{Path, PathBuf};
 
 use glam::{Vec2, Vec3};
 
-use super::{Files, Material, Scene, Texture, TextureRef, UvTransform};
+use super::{Budget, Budgets, Files, Material, Scene, Texture, TextureRef, UvTransform};
 use crate::error::{Error, Result};
 
 mod mtl;
@@ -59,25 +59,36 @@ pub fn load_obj(path: &Path) -> Result<Scene> {
 
 /// Loads the OBJ file at `path` of `files` (its MTL libraries and textures too).
 pub fn load_obj_in(files: Files, path: &Path) -> Result<Scene> {
-    load(files, path, false)
+    load_obj_with(files, path, &Budgets::default())
+}
+
+/// [`load_obj_in`] within `budgets`: the faces' triangles and the vertices are counted in the
+/// text before it is parsed, each texture's size is read before it is decoded.
+pub fn load_obj_with(files: Files, path: &Path, budgets: &Budgets) -> Result<Scene> {
+    load(files, path, false, budgets, 0)
 }
 
 /// The OBJ file's geometry alone, for scene formats that name OBJ meshes (Mitsuba's `obj`
 /// shape): its triangles with their texture coordinates (v flipped as above) and normals
 /// (`vn`, or its smoothing groups'), its MTL libraries not read (every face gets the grey
-/// default material), no camera chosen and the scene not validated.
-pub(crate) fn load_obj_geometry(files: Files, path: &Path) -> Result<Scene> {
-    load(files, path, true)
+/// default material), no camera chosen and the scene not validated; `used`: the triangles of
+/// the scene's shapes read before, which count against the same budget.
+pub(crate) fn load_obj_geometry(files: Files, path: &Path, budgets: &Budgets, used: u64) -> Result<Scene> {
+    load(files, path, true, budgets, used)
 }
 
-fn load(files: Files, path: &Path, geometry_only: bool) -> Result<Scene> {
+fn load(files: Files, path: &Path, geometry_only: bool, budgets: &Budgets, used: u64) -> Result<Scene> {
     if let Some(what) = files.missing(path) {
         return Err(file_error(
             path,
             format!("{what}; give the path of a .obj file or the built-in scene name 'cornell'"),
         ));
     }
+    if files.is_special(path) {
+        return Err(file_error(path, "is not a regular file"));
+    }
     let mut text = text_of(files, path)?;
+    check_counts(&text, budgets, used).map_err(|m| file_error(path, m))?;
     if geometry_only {
         comment_out(&mut text, b"mtllib");
     }
@@ -103,13 +114,16 @@ fn load(files: Files, path: &Path, geometry_only: bool) -> Result<Scene> {
     } else {
         materials.iter().any(|m| TEXTURE_KEYS.iter().any(|&key| map_file(m, key).is_some()))
     };
-    // Normals that faces refer to out of range are not used (the faces shade flat).
-    let mut smooth = has_keyword(&text, b"vn")
-        && check_references(&text, "vn", 2, "normal")
-            .map_err(|message| log::warn!("{}: {message}; its faces shade flat", path.display()))
-            .is_ok();
+    // Normals that faces refer to out of range are not used (the faces shade flat), nor are
+    // smoothing groups then: their normals go before the file's, so a reference out of range
+    // backwards would reach before the first (tobj's index wraps round and overflows).
+    let normals_in_range = check_references(&text, "vn", 2, "normal")
+        .map_err(|message| log::warn!("{}: {message}; its faces shade flat", path.display()))
+        .is_ok();
+    let mut smooth = has_keyword(&text, b"vn") && normals_in_range;
     // Smoothing groups become vertex normals (written into the text tobj reads).
-    if (smooth || !has_keyword(&text, b"vn"))
+    if normals_in_range
+        && (smooth || !has_keyword(&text, b"vn"))
         && let Some(with_normals) = apply_smoothing_groups(&text)
     {
         text = with_normals;
@@ -132,13 +146,16 @@ fn load(files: Files, path: &Path, geometry_only: bool) -> Result<Scene> {
     }
 
     let mut scene = Scene::new(super::Camera { eye: Vec3::Z, target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 45.0 });
-    // Each image once as colour and once as an opacity mask, however many materials use it.
+    // Each image once as colour and once as an opacity mask, however many materials use it
+    // and however its path is spelled.
     let mut texture_of_file: HashMap<(PathBuf, bool), usize> = HashMap::new();
+    let mut texels = 0u64;
     for m in &materials {
         let mut texture = |key: &str, opacity: bool| -> Result<Option<TextureRef>> {
             let Some(file) = map_file(m, key) else { return Ok(None) };
             let transform = map_transform(m, key);
-            let file = PathBuf::from(file);
+            let named = PathBuf::from(file);
+            let file = files.canonical(&named);
             if let Some(&t) = texture_of_file.get(&(file.clone(), opacity)) {
                 return Ok(Some(TextureRef { texture: t, transform }));
             }
@@ -149,8 +166,8 @@ fn load(files: Files, path: &Path, geometry_only: bool) -> Result<Scene> {
             {
                 return Ok(Some(TextureRef { texture: t, transform }));
             }
-            let mut texture = read_texture(files, &file).map_err(|e| {
-                file_error(path, format!("the texture {} ({key} of material '{}') {e}", file.display(), m.name))
+            let mut texture = read_texture(files, &named, budgets, &mut texels).map_err(|e| {
+                file_error(path, format!("the texture {} ({key} of material '{}') {e}", named.display(), m.name))
             })?;
             if opacity && !texture.has_alpha() {
                 // A grey mask: its first channel is the opacity.
@@ -273,13 +290,47 @@ fn load(files: Files, path: &Path, geometry_only: bool) -> Result<Scene> {
 }
 
 /// Reads a `map_Kd` image; a device or a pipe (`map_Kd /dev/zero`) would be read forever.
-fn read_texture(files: Files, file: &Path) -> std::result::Result<Texture, String> {
+/// Its texels and the `texels` of those read before are checked against their budget before
+/// it is decoded.
+fn read_texture(
+    files: Files,
+    file: &Path,
+    budgets: &Budgets,
+    texels: &mut u64,
+) -> std::result::Result<Texture, String> {
     if files.is_special(file) {
         return Err("is not a regular file".into());
     }
     let bytes = files.read(file).map_err(|e| format!("cannot be read ({e})"))?;
     let name = file.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let (w, h) = Texture::dimensions(&bytes)?;
+    let n = w as u64 * h as u64;
+    budgets.check_more(Budget::Texels, *texels, n, &format!("{w}x{h}"))?;
+    *texels += n;
     Texture::decode(&name, &bytes)
+}
+
+/// Checks the vertices (`v` lines) and the triangles the faces (`f` lines, a polygon of n
+/// corners making n − 2) will make against the budgets, before the text is parsed; `used`:
+/// the triangles read before.
+fn check_counts(text: &[u8], budgets: &Budgets, used: u64) -> std::result::Result<(), String> {
+    let (mut vertices, mut triangles) = (0u64, 0u64);
+    for line in text.split(|&b| b == b'\n') {
+        match keyword_of(line) {
+            b"v" => vertices += 1,
+            b"f" => {
+                // The keyword and the corners.
+                let words = match std::str::from_utf8(line) {
+                    Ok(text) => text.split_whitespace().count(),
+                    Err(_) => line.split(u8::is_ascii_whitespace).filter(|w| !w.is_empty()).count(),
+                } as u64;
+                triangles += words.saturating_sub(3);
+            }
+            _ => {}
+        }
+    }
+    budgets.check(Budget::Vertices, vertices, "its v lines")?;
+    budgets.check_more(Budget::Triangles, used, triangles, "its f lines")
 }
 
 /// Parses OBJ text with tobj, loading its MTL libraries relative to `path`.
@@ -307,11 +358,25 @@ fn text_of(files: Files, path: &Path) -> Result<Vec<u8>> {
     files.read(path).map_err(|e| file_error(path, format!("cannot be read: {e}")))
 }
 
-/// The first word of a line.
+/// The first word of a line, split at whitespace as tobj splits it (Unicode's: a line that
+/// a no-break space indents is a `vn` line for tobj too). A line that is not UTF-8 is split at
+/// ASCII whitespace (tobj refuses the file at it).
 fn keyword_of(line: &[u8]) -> &[u8] {
-    let indent = line.iter().take_while(|b| b.is_ascii_whitespace()).count();
+    let indent = indent_of(line);
     let line = &line[indent..];
-    &line[..line.iter().position(u8::is_ascii_whitespace).unwrap_or(line.len())]
+    let end = match std::str::from_utf8(line) {
+        Ok(text) => text.find(char::is_whitespace).unwrap_or(text.len()),
+        Err(_) => line.iter().position(u8::is_ascii_whitespace).unwrap_or(line.len()),
+    };
+    &line[..end]
+}
+
+/// The bytes of whitespace before a line's first word (Unicode's, as [`keyword_of`]).
+fn indent_of(line: &[u8]) -> usize {
+    match std::str::from_utf8(line) {
+        Ok(text) => text.len() - text.trim_start().len(),
+        Err(_) => line.iter().take_while(|b| b.is_ascii_whitespace()).count(),
+    }
 }
 
 /// Whether any line starts with `keyword`.
@@ -324,7 +389,7 @@ fn has_keyword(text: &[u8], keyword: &[u8]) -> bool {
 fn comment_out(text: &mut [u8], keyword: &[u8]) {
     for line in text.split_mut(|&b| b == b'\n') {
         if keyword_of(line) == keyword {
-            let indent = line.iter().take_while(|b| b.is_ascii_whitespace()).count();
+            let indent = indent_of(line);
             line[indent] = b'#';
         }
     }

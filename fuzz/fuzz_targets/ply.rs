@@ -1,0 +1,11 @@
+//! The `ply` reader: see `rastergi::fuzzing`.
+#![no_main]
+
+use libfuzzer_sys::fuzz_target;
+use rastergi::fuzzing::Target;
+
+fuzz_target!(|data: &[u8]| {
+    if let Err(e) = Target::Ply.read(data) {
+        assert!(!e.contains('\n'), "an error of more than one line: {e}");
+    }
+});

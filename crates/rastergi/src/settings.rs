@@ -41,7 +41,8 @@ pub struct RenderSettings {
     /// size ([`crate::photons::passes::fitted_pass_iterations`]).
     pub photon_budget: PhotonBudget,
     /// The sun's and the sky's photons guided to where the map is read, as learned from the
-    /// passes so far ([`crate::photons::guide`]); else only aimed at the photon region.
+    /// passes so far ([`crate::photons::guide`]); else only aimed at the photon region (the
+    /// default: guiding measured no faster to an error on the rooms tried).
     pub photon_guiding: bool,
     /// The traced gather's per-pixel directions drawn from a mixture of the visible point's
     /// scattering and the light its cell's rays found ([`crate::gather::guide`]).
@@ -156,7 +157,7 @@ impl Default for RenderSettings {
             photon_passes: 0,
             pass_iterations: DEFAULT_PASS_ITERATIONS,
             photon_budget: PhotonBudget::default(),
-            photon_guiding: true,
+            photon_guiding: false,
             gather_guiding: false,
             hit_light: HitLight::Map,
             photon_region: PhotonRegionChoice::Camera,

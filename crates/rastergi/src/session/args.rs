@@ -323,8 +323,9 @@ pub struct SceneArgs {
     /// Whether the sun's and the sky's photons are guided to where the photon map is read
     /// (`on`: each pass learns where the photons that landed there started, through a window
     /// or onto the ground the gather sees through it), or only aimed at the region the camera
-    /// reads (`off`)
-    #[arg(long, value_enum, default_value_t = Switch::On)]
+    /// reads (`off`: as fast to an error on the rooms measured, and without the guided
+    /// photons' skew when a pass has few)
+    #[arg(long, value_enum, default_value_t = Switch::Off)]
     pub photon_guiding: Switch,
     /// Whether the traced gather's directions are guided by the light its rays found (`on`:
     /// half of them drawn towards where a visible point's cell found it, the rest as the

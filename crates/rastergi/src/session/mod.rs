@@ -167,7 +167,7 @@ impl Default for Options {
             photon_passes: 0,
             pass_iterations: crate::photons::passes::DEFAULT_PASS_ITERATIONS,
             photon_budget: crate::settings::PhotonBudget::Balanced,
-            photon_guiding: true,
+            photon_guiding: false,
             gather_guiding: false,
             bundle: None,
             gather: GatherMethod::Auto,

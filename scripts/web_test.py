@@ -165,8 +165,10 @@ def main():
     DRIVER = driver
     try:
         url = f"{a.url}/?width={a.size}&height={a.size}&seed={a.seed}&gather={a.gather}&iterations={a.iterations}"
+        began = time.time()
         driver.call("POST", f"{driver.session}/url", {"url": url})
         driver.run("await rastergi.ready;")
+        report["ready_seconds"] = round(time.time() - began, 1)
         error = driver.run("return rastergi.error();")
         if error:
             fail(f"the page could not start: {error}")
@@ -189,6 +191,7 @@ def main():
             wait_for(driver, f"rastergi.samples() >= {a.iterations} && rastergi.idle()", f"{a.iterations} denoised iterations", a.timeout)
             save_png(driver, a.denoised)
             report["denoised"] = driver.run("return rastergi.viewer.describe();")
+            report["denoised_seconds"] = round(time.time() - start, 1)
 
         # A real pointer drag across the canvas orbits the camera: the image restarts.
         canvas = driver.element("#view")
@@ -207,6 +210,7 @@ def main():
         report["drag"] = {"before": before, "after": after}
 
         files = driver.element("#files")
+        start = time.time()
         for group in a.file:
             paths = group.split(",")
             name = os.path.basename(paths[0])
@@ -216,6 +220,7 @@ def main():
             if state["error"]:
                 fail(f"loading {name}: {state['error']}")
             report.setdefault("loaded", []).append(driver.run("return rastergi.viewer.describe();"))
+            report.setdefault("load_seconds", []).append(round(time.time() - start, 1))
         if a.bad_file:
             scene = driver.run("return rastergi.viewer.sceneName();")
             driver.call("POST", f"{driver.session}/element/{files}/value", {"text": os.path.abspath(a.bad_file)})

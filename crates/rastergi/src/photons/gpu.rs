@@ -233,7 +233,7 @@ impl GpuPhotonMap {
             settings.region.as_ref(),
             &gpu.device.limits(),
         )?;
-        // A map of its own: no guided lights, its cells marked where read.
+        // A map of its own: no guided lights, no cells marked.
         let guide = super::guide::PhotonGuide::new(gpu, layout.grid, &[], false, None);
         Self::with_layout(gpu, scene, prepared, settings, layout, &guide)
     }
@@ -346,7 +346,7 @@ impl GpuPhotonMap {
             first_deposit: settings.indirect_only as u32,
             records,
             cell_flags,
-            marks: GridLevels::from(&guide.marks),
+            marks: guide.marked_grid(),
             guide_counters,
             guide_bins: guide.bins(),
             guide_table,
@@ -362,7 +362,7 @@ impl GpuPhotonMap {
             records,
             cell_flags,
             cells: grid.cell_count() as u32,
-            marks: GridLevels::from(&guide.marks),
+            marks: guide.marked_grid(),
         };
         let buffers = [&slots, &keys, &planes, &guide.buffer];
         let (bind_layout, bind_group) = lookup_binding(gpu, &grid_uniforms, buffers);

@@ -284,7 +284,7 @@ pub struct PhotonGuide {
     useful: Vec<f64>,
     emitted: Vec<f64>,
     table: GuideTable,
-    /// Whether emission is guided (else the marks and counts are kept but nothing is learned).
+    /// Whether emission is guided (else no cell is marked, no photon counted, nothing learned).
     pub enabled: bool,
     /// The gather guide's grid, where the gather is guided.
     pub field: Option<crate::gather::guide::GuideField>,
@@ -310,7 +310,10 @@ impl PhotonGuide {
         field: Option<crate::gather::guide::GuideField>,
     ) -> PhotonGuide {
         let mark_words = (marks.cell_count() as u32).div_ceil(32).max(1);
-        let table = GuideTable::unlearned(lights);
+        // Unguided: no light's photons are counted, no cell is marked (the lookups' and the
+        // tracer's atomics on the marks cost nothing then: on SwiftShader they made a
+        // 101 054-triangle scene's iterations minutes long).
+        let table = GuideTable::unlearned(if enabled { lights } else { &[] });
         let bins = table.bins();
         let words = table.words();
         let (_, table_start) = guide_offsets(mark_words, bins);
@@ -327,6 +330,16 @@ impl PhotonGuide {
         let guide = PhotonGuide { buffer, marks, mark_words, useful, emitted, table, enabled, field };
         guide.upload_table(gpu);
         guide
+    }
+
+    /// The grid whose cells the lookups mark, as the shaders read it: none (no cells) where
+    /// emission is not guided, so that `mark_read` and `is_read` touch no memory.
+    pub fn marked_grid(&self) -> super::gpu::GridLevels {
+        let grid = super::gpu::GridLevels::from(&self.marks);
+        match self.enabled {
+            true => grid,
+            false => super::gpu::GridLevels { dims: [0; 3], ..grid },
+        }
     }
 
     /// The cells marked so far (read back: waits for the GPU).

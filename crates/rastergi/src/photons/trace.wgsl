@@ -21,6 +21,9 @@
 
 // Whether the map is read in the cell of p (its mark in the guide's grid).
 fn is_read(p: vec3f) -> bool {
+    if params.marks.dims.x == 0u {
+        return false;
+    }
     let l = lattice_at(params.marks, p);
     let i = lattice_index(l, lattice_cell(l, p));
     return (atomicLoad(&photon_guide[GUIDE_MARKS + i / 32u]) & (1u << (i % 32u))) != 0u;

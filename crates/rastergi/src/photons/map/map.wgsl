@@ -13,6 +13,9 @@
 // Marks the cell of p, in the guide's grid, as one where the map is read (once: a marked
 // cell is only loaded).
 fn mark_read(p: vec3f) {
+    if photon_grid.marks.dims.x == 0u {
+        return; // photons not guided: nothing marks
+    }
     let l = lattice_at(photon_grid.marks, p);
     let i = lattice_index(l, lattice_cell(l, p));
     let bit = 1u << (i % 32u);

@@ -329,16 +329,7 @@ fn guided_photons_deliver(light: impl Fn(&mut Scene), expected: f64) {
     for d in 0..table.lights[0].directions as usize {
         let weights: Vec<f64> =
             (0..n).map(|_| if rng.next_f32() < 0.05 { 0.1 + rng.next_f32() as f64 } else { 0.0 }).collect();
-        let sum: f64 = weights.iter().sum();
-        let mut acc = 0.0;
-        let cdf: Vec<f32> = weights
-            .iter()
-            .map(|w| {
-                acc += w / sum;
-                acc as f32
-            })
-            .collect();
-        table.lights[0].cdfs[d] = (sum as f32, cdf);
+        table.lights[0].cdfs[d] = rastergi::photons::guide::cumulative(&weights);
     }
     guide.set_table(&gpu, table.clone());
     let map = GpuPhotonMap::with_layout(&gpu, &gs, &prepared, &settings, layout.clone(), &guide).unwrap();

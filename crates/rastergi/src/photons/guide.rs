@@ -423,6 +423,24 @@ pub fn guided_lights(lights: &crate::lights::LightTable) -> Vec<(u32, u32)> {
         .collect()
 }
 
+/// A direction's table entry of position-bin `weights` (not all zero): their sum and their
+/// cumulative distribution, its last entry exactly 1.
+pub fn cumulative(weights: &[f64]) -> (f32, Vec<f32>) {
+    let sum: f64 = weights.iter().sum();
+    let mut acc = 0.0;
+    let mut cdf: Vec<f32> = weights
+        .iter()
+        .map(|w| {
+            acc += w / sum;
+            acc as f32
+        })
+        .collect();
+    if let Some(last) = cdf.last_mut() {
+        *last = 1.0;
+    }
+    (sum as f32, cdf)
+}
+
 /// The table learned from the summed counts: per light and direction bin, pmf ∝ the mean
 /// useful deposits per photon started in each position bin, where the direction has
 /// [`MIN_USEFUL`] useful deposits.
@@ -443,19 +461,7 @@ pub fn learn_table(table: &mut GuideTable, useful: &[f64], emitted: &[f64]) {
             let mean: Vec<f64> = (useful[range.clone()].iter().zip(&emitted[range]))
                 .map(|(&u, &e)| ((u + PRIOR_PHOTONS * m) / (e + PRIOR_PHOTONS)).sqrt())
                 .collect();
-            let sum: f64 = mean.iter().sum();
-            let mut acc = 0.0;
-            let mut cdf: Vec<f32> = mean
-                .iter()
-                .map(|m| {
-                    acc += m / sum;
-                    acc as f32
-                })
-                .collect();
-            if let Some(last) = cdf.last_mut() {
-                *last = 1.0;
-            }
-            l.cdfs[d] = (sum as f32, cdf);
+            l.cdfs[d] = cumulative(&mean);
         }
     }
 }
@@ -531,15 +537,7 @@ mod tests {
         let mut rng = crate::sampling::Rng::new(11, 0, 0);
         let weights: Vec<f64> =
             (0..n).map(|_| if rng.next_f32() < 0.05 { rng.next_f32() as f64 * 10.0 } else { 0.0 }).collect();
-        let sum: f64 = weights.iter().sum();
-        let mut acc = 0.0;
-        let cdf: Vec<f32> = weights
-            .iter()
-            .map(|w| {
-                acc += w / sum;
-                acc as f32
-            })
-            .collect();
+        let (_, cdf) = cumulative(&weights);
         let (t, b) = crate::sampling::orthonormal_basis(axis);
         let (towards, rg) = guide_disc(axis, disc, aim);
         // Patches (centre offset in disc coordinates, half size), area in the disc's plane.

@@ -179,6 +179,27 @@ fn screenshots_after_a_scripted_move_match_headless_renders_of_the_same_view() {
 }
 
 #[test]
+fn a_frame_budget_no_iteration_fits_moves_on_previews_and_refines_to_the_renders_image() {
+    // 0.01 ms a frame: while the script moves the camera each frame draws the coarsest
+    // preview; after the stop the previews refine and the window's iterations run a row band
+    // a frame. The screenshot holds the window's own iterations: its direct component is the
+    // render's of the same view bit for bit (it draws the same random numbers), so neither the
+    // previews nor the bands entered the film.
+    const SEED: u32 = 4;
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let script = "show direct\norbit 4,2\norbit 4,2\npan 3,1\nafter 3 iterations: screenshot\nquit\n";
+    let (run, shots) = scripted_view(d, script, &["--seed", &SEED.to_string(), "--frame-budget", "0.01"]);
+    assert_eq!(shots.len(), 1, "{}", run.stdout);
+    assert_eq!(shots[0].iterations, 3);
+    let mut options = shots[0].camera.clone();
+    options.extend(["--show".into(), "direct".into()]);
+    let render = render(d, "direct.exr", SEED, 3, &options);
+    let c = compare(&read_exr(&shots[0].exr).unwrap(), &render, None);
+    assert!(c.relative_rmse < 1e-5, "the viewer's direct component differs from the render's: {c:?}");
+}
+
+#[test]
 fn resizing_and_retracing_rebuild_the_image_at_the_window_size() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();

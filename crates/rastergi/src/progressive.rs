@@ -24,6 +24,41 @@ pub trait Progressive: wgpu::WasmNotSend {
     fn iterate(&mut self) -> Result<()>;
     /// Blocks until the submitted iterations have finished on the GPU.
     fn wait(&self) -> Result<()>;
+    /// Submits the next `rows` rows of the image (at least one) of the iteration under way,
+    /// beginning one where none is; true when that finished it. A renderer that cannot split
+    /// an iteration runs a whole one (the default; the path tracer).
+    fn iterate_rows(&mut self, _rows: u32) -> Result<bool> {
+        self.iterate()?;
+        Ok(true)
+    }
+    /// The rows the iteration under way has added to the film (0: none under way).
+    fn rows_ahead(&self) -> u32 {
+        0
+    }
+    /// [`iterate_rows`](Progressive::iterate_rows) for the preview at 1/`scale` of the
+    /// image's size (a power of two from 2): an image of the same view, of its own iterations,
+    /// that a viewer shows while the camera moves and blends in after it stops
+    /// ([`encode_resolve_preview`](Progressive::encode_resolve_preview)); it never enters the
+    /// film. `None` where the renderer draws no previews (the default; the path tracer).
+    fn iterate_preview_rows(&mut self, _scale: u32, _rows: u32) -> Result<Option<bool>> {
+        Ok(None)
+    }
+    /// The film of the preview at 1/`scale`, once one has been drawn (since the last restart
+    /// it holds that view's iterations only).
+    fn preview_film(&self, _scale: u32) -> Option<&Film> {
+        None
+    }
+    /// Encodes the resolve of `show` blended with the preview at 1/`scale`, its mean weighted
+    /// as `weight` of the film's iterations ([`Film::encode_resolve_preview`]); the plain
+    /// resolve where there is no such preview.
+    fn encode_resolve_preview(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        (show, exposure): (Show, f32),
+        (_scale, _weight): (u32, f32),
+    ) {
+        self.encode_resolve(enc, show, exposure);
+    }
     /// Iterations accumulated since the last restart.
     fn samples(&self) -> u32;
     fn camera(&self) -> Camera;

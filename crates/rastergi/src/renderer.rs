@@ -144,6 +144,21 @@ pub struct Renderer {
     detail_bundle: u32,
     /// The denoiser's guides are accumulated ([`Renderer::enable_denoiser`]).
     denoise: bool,
+    /// The iteration under way in row bands ([`Renderer::iterate_rows`]).
+    band: Option<Band>,
+    /// Smaller images of the same view, made as a viewer asks for them
+    /// ([`Renderer::iterate_preview_rows`]).
+    previews: Vec<Preview>,
+}
+
+/// The view at 1/`scale` of the image's size, with its own passes and film (the scene and the
+/// photon map shared), the preview's iteration under way, and the resolve that blends it into
+/// the film's.
+struct Preview {
+    scale: u32,
+    passes: ImagePasses,
+    band: Option<Band>,
+    resolve: crate::passes::film::PreviewResolve,
 }
 
 impl Renderer {
@@ -227,6 +242,8 @@ impl Renderer {
             passes,
             detail_bundle,
             denoise: false,
+            band: None,
+            previews: Vec::new(),
         })
     }
 
@@ -249,6 +266,7 @@ impl Renderer {
         )?;
         self.budget = new_budget(&self.gpu, &settings, &self.passes.film, self.photons.as_mut(), false);
         self.settings = settings;
+        self.previews.clear();
         if self.denoise {
             self.passes.enable_denoiser(&self.gpu, &self.scene, &self.frame)?;
         }
@@ -300,6 +318,11 @@ impl Renderer {
 
     /// Discards the accumulated iterations.
     pub fn reset(&mut self) {
+        self.band = None;
+        for p in &mut self.previews {
+            p.band = None;
+            p.passes.film.clear(&self.gpu);
+        }
         self.passes.film.clear(&self.gpu);
         if let Some(b) = &mut self.budget {
             b.restart();
@@ -317,9 +340,112 @@ impl Renderer {
         self.iterate_with(&Overrides::default())
     }
 
-    /// One iteration with some random choices fixed (see [`Overrides`]).
+    /// One iteration with some random choices fixed (see [`Overrides`]); an iteration under
+    /// way in row bands ([`Renderer::iterate_rows`]) is finished instead, with its own choices.
     pub fn iterate_with(&mut self, o: &Overrides) -> Result<()> {
-        let (w, h) = (self.settings.width, self.settings.height);
+        if self.band.is_none() {
+            self.begin_iteration(o)?;
+        }
+        while !self.encode_rows(u32::MAX)? {}
+        Ok(())
+    }
+
+    /// Runs the next `rows` rows of the image (at least one) of the iteration under way,
+    /// beginning one where none is; returns whether that finished the iteration (its sample
+    /// then counts in [`samples`](Self::samples)). The viewer splits an iteration so into row
+    /// bands across frames when a whole one would take longer than a frame. A band is the
+    /// whole iteration's work restricted to its rows — the same uniforms, photon map, gather
+    /// directions and per-pixel random sequences — so the film after the last band is bit for
+    /// bit that of [`iterate`](Self::iterate). The G-buffer is rasterized whole with the first
+    /// band. While `Auto` still tries the gathers (it times whole iterations) and where the
+    /// gather is guided (its tables are rebuilt per dispatch), the band is the whole image.
+    pub fn iterate_rows(&mut self, rows: u32) -> Result<bool> {
+        if self.band.is_none() {
+            self.begin_iteration(&Overrides::default())?;
+        }
+        let whole = self.settings.gather_guiding || self.gather_method() == GatherMethod::Auto;
+        self.encode_rows(if whole { u32::MAX } else { rows.max(1) })
+    }
+
+    /// The rows of the image that the iteration under way has added to the film (0 where none
+    /// is under way): the film's sums hold [`samples`](Self::samples) + 1 iterations above
+    /// that row and `samples` below it.
+    pub fn rows_ahead(&self) -> u32 {
+        self.band.map_or(0, |b| b.next_row)
+    }
+
+    /// [`iterate_rows`](Self::iterate_rows) for the preview at 1/`scale` of the image's size
+    /// (made on first use): the same view, its own film and random sequences, the current
+    /// photon map (a preview never begins a photon pass); true when its iteration is done.
+    pub fn iterate_preview_rows(&mut self, scale: u32, rows: u32) -> Result<bool> {
+        let k = match self.previews.iter().position(|p| p.scale == scale) {
+            Some(k) => k,
+            None => {
+                let preview = self.new_preview(scale)?;
+                self.previews.push(preview);
+                self.previews.len() - 1
+            }
+        };
+        let map = self.photons.as_ref().map(PhotonPasses::map);
+        let target = Target { gpu: &self.gpu, scene: &self.scene, frame: &self.frame, map };
+        let p = &mut self.previews[k];
+        if p.band.is_none() {
+            let block = p.passes.film.samples / crate::passes::film::BLOCK_ITERATIONS;
+            let view = (&self.settings, &self.camera);
+            p.band = Some(Band::begin(&target, view, &mut p.passes, &Overrides::default(), block));
+        }
+        let band = p.band.as_mut().expect("a preview iteration under way");
+        let done = band.encode(&target, &mut p.passes, self.settings.directions, rows.max(1))?;
+        p.passes.film.rows_ahead = if done { 0 } else { band.next_row };
+        if done {
+            p.band = None;
+            p.passes.film.samples += 1;
+        }
+        Ok(done)
+    }
+
+    /// The preview at 1/`scale`: the image's passes at ⌈W/scale⌉ × ⌈H/scale⌉ over the same
+    /// scene and photon map, with the gather the full image uses (the traced one while `Auto`
+    /// still tries them: a preview is not timed).
+    fn new_preview(&self, scale: u32) -> Result<Preview> {
+        let gather = match self.gather_method() {
+            GatherMethod::Auto => GatherMethod::Trace,
+            chosen => chosen,
+        };
+        let (w, h) = (self.settings.width.div_ceil(scale), self.settings.height.div_ceil(scale));
+        let settings = RenderSettings { width: w, height: h, gather, ..self.settings.clone() };
+        let map = self.photons.as_ref().map(PhotonPasses::map);
+        let sampler = DirectionSampler::new(settings.seed);
+        let passes =
+            ImagePasses::new(&self.gpu, &self.scene, &self.frame, map, &settings, self.detail_bundle, sampler)?;
+        let resolve = self.passes.film.preview_resolve(&self.gpu, &passes.film);
+        Ok(Preview { scale, passes, band: None, resolve })
+    }
+
+    /// The film of the preview at 1/`scale`, once made.
+    pub fn preview_film(&self, scale: u32) -> Option<&Film> {
+        self.previews.iter().find(|p| p.scale == scale).map(|p| &p.passes.film)
+    }
+
+    /// Encodes the resolve of `show` blended with the preview at 1/`scale` weighted as `weight`
+    /// iterations ([`Film::encode_resolve_preview`]); the plain resolve where there is none.
+    pub fn encode_resolve_preview(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        (show, exposure): (Show, f32),
+        (scale, weight): (u32, f32),
+    ) {
+        match self.previews.iter().find(|p| p.scale == scale) {
+            Some(p) => {
+                let blend = crate::passes::film::PreviewBlend { resolve: &p.resolve, film: &p.passes.film, weight };
+                self.passes.film.encode_resolve_preview(&self.gpu, enc, (show, exposure), blend);
+            }
+            None => self.encode_resolve(enc, show, exposure),
+        }
+    }
+
+    /// Begins an iteration: the photon pass it reads, the film's block, its uniforms.
+    fn begin_iteration(&mut self, o: &Overrides) -> Result<()> {
         // 0. A new photon pass, when the current one has had its iterations (as many as the
         //    photon budget chose from its measurements of the passes so far).
         if let Some(photons) = &mut self.photons {
@@ -337,70 +463,29 @@ impl Renderer {
             Some(p) if p.progressive() => p.pass(),
             _ => iteration / crate::passes::film::BLOCK_ITERATIONS,
         };
-        self.passes.film.begin_iteration(&self.gpu, block);
-        let seed = self.settings.seed;
-        let jitter = o.pixel_jitter.unwrap_or_else(|| pixel_jitter(iteration, seed));
-        let size = (w, h);
-        let mut uniforms =
-            FrameUniforms::new(&self.camera, size, &self.scene, iteration, jitter, seed, self.settings.light_samples);
-        uniforms.eye_chains = self.scene.eye_chains as u32;
-        uniforms.texture_footprint = (self.settings.texture_filter == TextureFilter::Footprint) as u32;
-        let fixed = FixedSample { direction: o.direction, texel_jitter: o.texel_jitter };
         let map = self.photons.as_ref().map(PhotonPasses::map);
-        if let (Some(gather), Some(_)) = (&self.passes.gather, map) {
-            let (count, per_pixel) = gather.strategy(self.settings.directions, &fixed);
-            uniforms.gather_count = count;
-            uniforms.gather_importance = per_pixel as u32;
-            uniforms.gather_guided = (per_pixel && self.settings.gather_guiding) as u32;
-        }
-        self.frame.write(&self.gpu, &uniforms);
-        let ctx = FrameContext {
-            gpu: &self.gpu,
-            scene: &self.scene,
-            frame: &self.frame,
-            map,
-            width: w,
-            height: h,
-            iteration,
-            directions: self.settings.directions,
-            fixed,
-        };
-        let mut enc =
-            self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("iteration") });
-        let p = &mut self.passes;
-        // 1. Eye pass: the visible point of each pixel, at this iteration's jitter (G-buffer);
-        //    through mirrors and glass to the first surface that is not purely specular (eye paths).
-        p.gbuffer.encode(&mut enc, &ctx)?;
-        if let Some(specular) = &mut p.specular {
-            specular.encode(&mut enc, &ctx)?;
-        }
-        // 2. Emission + direct light with soft shadows at the visible points → film (direct).
-        p.direct.encode(&mut enc, &ctx)?;
-        // Debug view: the photon map's radiance at the visible points → film (photon view).
-        if let Some(view) = &mut p.photon_view {
-            view.encode(&mut enc, &ctx)?;
-        }
-        // 3. Caustics: the light that came through mirrors and glass, from the caustic map.
-        if let Some(caustics) = &mut p.caustics {
-            caustics.encode(&mut enc, &ctx)?;
-        }
-        // 4. Final gather along the iteration's directions for every visible point, reading
-        //    the photon map where the directions land → film (indirect).
-        if let Some(gather) = &mut p.gather {
-            gather.encode(&mut enc, &ctx)?;
-        }
-        // 5. Denoiser guides (when enabled): the visible points' albedo, normal, distance and
-        //    the moments of what this iteration added to the film.
-        if let Some(d) = &mut p.denoise {
-            d.guides.encode(&mut enc, &ctx)?;
-        }
-        // 6. Accumulate: every pass above added its estimate to the film's sums.
-        self.gpu.queue.submit([enc.finish()]);
-        self.passes.film.samples += 1;
-        if let Some(p) = self.gpu.profiler.as_ref().filter(|p| p.half_full()) {
-            p.collect(&self.gpu.device, &self.gpu.queue)?;
-        }
+        let target = Target { gpu: &self.gpu, scene: &self.scene, frame: &self.frame, map };
+        let view = (&self.settings, &self.camera);
+        self.band = Some(Band::begin(&target, view, &mut self.passes, o, block));
         Ok(())
+    }
+
+    /// The next `rows` rows of the iteration under way (all that are left at most); true when
+    /// they finish it.
+    fn encode_rows(&mut self, rows: u32) -> Result<bool> {
+        let band = self.band.as_mut().expect("an iteration under way");
+        let map = self.photons.as_ref().map(PhotonPasses::map);
+        let target = Target { gpu: &self.gpu, scene: &self.scene, frame: &self.frame, map };
+        let done = band.encode(&target, &mut self.passes, self.settings.directions, rows)?;
+        self.passes.film.rows_ahead = if done { 0 } else { band.next_row };
+        if done {
+            self.band = None;
+            self.passes.film.samples += 1;
+            if let Some(p) = self.gpu.profiler.as_ref().filter(|p| p.half_full()) {
+                p.collect(&self.gpu.device, &self.gpu.queue)?;
+            }
+        }
+        Ok(done)
     }
 
     /// Blocks until the submitted iterations have finished on the GPU.
@@ -503,6 +588,110 @@ impl Renderer {
     }
 }
 
+/// What every band of an iteration reads besides the image's own passes.
+struct Target<'a> {
+    gpu: &'a Gpu,
+    scene: &'a GpuScene,
+    frame: &'a FrameBinding,
+    map: Option<&'a GpuPhotonMap>,
+}
+
+/// An iteration under way: its uniforms and random choices, fixed when it began, and the next
+/// row to run ([`Renderer::iterate_rows`]).
+#[derive(Clone, Copy)]
+struct Band {
+    uniforms: FrameUniforms,
+    fixed: FixedSample,
+    next_row: u32,
+}
+
+impl Band {
+    /// The iteration of `passes`' film that comes next (its `block` opened), seen by `camera`.
+    fn begin(
+        t: &Target,
+        (settings, camera): (&RenderSettings, &Camera),
+        passes: &mut ImagePasses,
+        o: &Overrides,
+        block: u32,
+    ) -> Band {
+        let (scene, map) = (t.scene, t.map);
+        let film = &mut passes.film;
+        let (iteration, size) = (film.samples, (film.width, film.height));
+        film.begin_iteration(t.gpu, block);
+        let seed = settings.seed;
+        let jitter = o.pixel_jitter.unwrap_or_else(|| pixel_jitter(iteration, seed));
+        let mut uniforms = FrameUniforms::new(camera, size, scene, iteration, jitter, seed, settings.light_samples);
+        uniforms.eye_chains = scene.eye_chains as u32;
+        uniforms.texture_footprint = (settings.texture_filter == TextureFilter::Footprint) as u32;
+        let fixed = FixedSample { direction: o.direction, texel_jitter: o.texel_jitter };
+        if let (Some(gather), Some(_)) = (&passes.gather, map) {
+            let (count, per_pixel) = gather.strategy(settings.directions, &fixed);
+            uniforms.gather_count = count;
+            uniforms.gather_importance = per_pixel as u32;
+            uniforms.gather_guided = (per_pixel && settings.gather_guiding) as u32;
+        }
+        Band { uniforms, fixed, next_row: 0 }
+    }
+
+    /// The iteration's pipeline over the next `rows` rows (all that are left at most), added
+    /// to `passes`' film; true when the iteration is done.
+    fn encode(&mut self, t: &Target, passes: &mut ImagePasses, directions: u32, rows: u32) -> Result<bool> {
+        let [w, h] = self.uniforms.resolution;
+        let y0 = self.next_row;
+        let rows = rows.min(h - y0);
+        (self.uniforms.band_y0, self.uniforms.band_rows) = (y0, rows);
+        t.frame.write(t.gpu, &self.uniforms);
+        let ctx = FrameContext {
+            gpu: t.gpu,
+            scene: t.scene,
+            frame: t.frame,
+            map: t.map,
+            width: w,
+            height: h,
+            y0,
+            rows,
+            iteration: self.uniforms.iteration,
+            directions,
+            fixed: self.fixed,
+        };
+        let mut enc = t.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("iteration") });
+        let p = passes;
+        // 1. Eye pass: the visible point of each pixel, at this iteration's jitter (G-buffer),
+        //    rasterized whole with the first band; through mirrors and glass to the first
+        //    surface that is not purely specular (eye paths).
+        if y0 == 0 {
+            p.gbuffer.encode(&mut enc, &ctx)?;
+        }
+        if let Some(specular) = &mut p.specular {
+            specular.encode(&mut enc, &ctx)?;
+        }
+        // 2. Emission + direct light with soft shadows at the visible points → film (direct).
+        p.direct.encode(&mut enc, &ctx)?;
+        // Debug view: the photon map's radiance at the visible points → film (photon view).
+        if let Some(view) = &mut p.photon_view {
+            view.encode(&mut enc, &ctx)?;
+        }
+        // 3. Caustics: the light that came through mirrors and glass, from the caustic map.
+        if let Some(caustics) = &mut p.caustics {
+            caustics.encode(&mut enc, &ctx)?;
+        }
+        // 4. Final gather along the iteration's directions for every visible point, reading
+        //    the photon map where the directions land → film (indirect).
+        if let Some(gather) = &mut p.gather {
+            gather.encode(&mut enc, &ctx)?;
+        }
+        // 5. Denoiser guides (when enabled): the visible points' albedo, normal, distance and
+        //    the moments of what this iteration added to the film.
+        if let Some(d) = &mut p.denoise {
+            d.guides.encode(&mut enc, &ctx)?;
+        }
+        // 6. Accumulate: every pass above added its estimate to the film's sums.
+        t.gpu.queue.submit([enc.finish()]);
+        self.next_row = y0 + rows;
+        Ok(self.next_row >= h)
+    }
+}
+
 /// The photon budget of a render with these settings ([`RenderSettings::photon_budget`]):
 /// balanced where the passes' length is not given (`pass_iterations` 0) and the map changes
 /// (more than one pass); `fresh` for a new renderer, whose film and first pass are untouched.
@@ -529,6 +718,21 @@ impl Progressive for Renderer {
     }
     fn iterate(&mut self) -> Result<()> {
         Renderer::iterate(self)
+    }
+    fn iterate_rows(&mut self, rows: u32) -> Result<bool> {
+        Renderer::iterate_rows(self, rows)
+    }
+    fn rows_ahead(&self) -> u32 {
+        Renderer::rows_ahead(self)
+    }
+    fn iterate_preview_rows(&mut self, scale: u32, rows: u32) -> Result<Option<bool>> {
+        Renderer::iterate_preview_rows(self, scale, rows).map(Some)
+    }
+    fn preview_film(&self, scale: u32) -> Option<&Film> {
+        Renderer::preview_film(self, scale)
+    }
+    fn encode_resolve_preview(&self, enc: &mut wgpu::CommandEncoder, shown: (Show, f32), preview: (u32, f32)) {
+        Renderer::encode_resolve_preview(self, enc, shown, preview)
     }
     fn wait(&self) -> Result<()> {
         Renderer::wait(self)

@@ -13,6 +13,7 @@ mod denoise;
 mod frames;
 mod gather;
 mod memory;
+mod motion;
 mod photons;
 mod rays;
 
@@ -37,6 +38,11 @@ pub enum BenchCommand {
     /// Frames and iterations per second of the viewer's frame loop at a window size (default
     /// 1920x1080), without a window: batched iterations, resolve, display pass offscreen.
     Frames(frames::FramesArgs),
+    /// The viewer's loop through a scripted camera move (an orbit and a walk): frame times
+    /// during the motion (median, p95), the time to the first full-resolution iteration, and
+    /// the error against the converged view 0.5, 1, 2 and 5 s after the stop — with the frame
+    /// budget off and on, side by side.
+    Motion(motion::MotionArgs),
     /// Scene loading and BVH build times (e.g. `bench bvh spheres:1000000`), with the BVH's shape.
     Bvh(bvh::BvhArgs),
     /// GPU memory of a render (the device allocator's report), by resource.
@@ -54,6 +60,7 @@ pub fn run(command: &BenchCommand) -> Result<()> {
         BenchCommand::Gather(a) => gather::run(a),
         BenchCommand::Converge(a) => converge::run(a),
         BenchCommand::Frames(a) => frames::run(a),
+        BenchCommand::Motion(a) => motion::run(a),
         BenchCommand::Bvh(a) => bvh::run(a),
         BenchCommand::Memory(a) => memory::run(a),
         BenchCommand::Denoise(a) => denoise::run(a),

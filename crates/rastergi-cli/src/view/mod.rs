@@ -3,8 +3,11 @@
 //! kept).
 //!
 //! The loop, per displayed frame: apply held keys and the script's due steps to the camera;
-//! if the camera moved, `Renderer::set_camera` restarts the image; run as many iterations as
-//! fit in [`frames::FRAME_BUDGET`] of GPU time (at least one); resolve the film (or, with the
+//! if the camera moved, `Renderer::set_camera` restarts the image; spend the frame budget
+//! (`--frame-budget`, 50 ms) coarse to fine ([`rastergi::session::refine`]: a preview at a
+//! fraction of the window's size while the camera moves, the previews refined once it stops,
+//! then the window's own iterations, in row bands where one takes longer than the budget);
+//! resolve the film blended with the finest preview (or, with the
 //! denoiser on, its denoised image, filtered again only when due: `app.rs`) and draw it
 //! ([`rastergi::passes::display`]) with the control panel over it; present. Building a renderer
 //! (photon tracing, or opening a scene) runs on a worker thread so the window stays live
@@ -88,6 +91,20 @@ pub struct ViewArgs {
     /// its guides accumulate from the first iteration. Photon map method, full image only.
     #[arg(long)]
     denoise: bool,
+    /// Milliseconds a frame aims at: while the camera moves each frame draws a preview at the
+    /// finest fraction of the window's size that fits (1/2 … 1/32, upscaled); once it stops
+    /// the previews refine, then the window's own iterations accumulate, in row bands where
+    /// one is longer than this. 0: one whole iteration a frame, whatever it takes.
+    #[arg(long, default_value_t = 50.0, value_parser = parse_budget)]
+    frame_budget: f64,
+}
+
+/// A frame budget in milliseconds: finite, 0 or more.
+fn parse_budget(s: &str) -> std::result::Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+        _ => Err(format!("'{s}' is not a number of milliseconds, 0 or more (e.g. 50; 0 turns the budget off)")),
+    }
 }
 
 /// The `after_help` of `rastergi view`: the keys and the script format.
@@ -144,6 +161,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     println!("rastergi view: {}\n{KEYS}", a.scene);
     let mut app = App::new(a, scene, base, steps, Screenshots::new(dir), event_loop.create_proxy());
     app.controls.denoise = args.denoise;
+    app.frame_budget = args.frame_budget / 1000.0;
     event_loop.run_app(&mut app).map_err(|e| anyhow!("the window's event loop failed: {e}"))?;
     app.finish()
 }

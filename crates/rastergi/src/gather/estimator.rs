@@ -169,6 +169,8 @@ pub struct GatherInputs<'a> {
     pub map: &'a GpuPhotonMap,
     pub width: u32,
     pub height: u32,
+    /// The rows of this dispatch ([`crate::passes::FrameContext::rows`]).
+    pub rows: u32,
     /// The iteration's directions, 1 to [`MAX_DIRECTIONS`].
     pub samples: &'a [GatherSample],
     /// Where each pixel draws its own directions instead (then only `samples.len()` counts).

@@ -166,7 +166,7 @@ impl ListGather {
         }
         let mut pass = compute_pass(enc, self.profiler.as_ref(), "gather list project");
         let groups = inputs.groups(&self.project_group);
-        dispatch_pixels(&mut pass, &self.project_pipeline, &groups, inputs.width, inputs.height);
+        dispatch_pixels(&mut pass, &self.project_pipeline, &groups, inputs.width, inputs.rows);
     }
 }
 

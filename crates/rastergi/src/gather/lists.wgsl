@@ -10,7 +10,8 @@
 @group(2) @binding(4) var<storage, read_write> film: array<vec4f>;
 
 @compute @workgroup_size(8, 8)
-fn main(@builtin(global_invocation_id) gid: vec3u) {
+fn main(@builtin(global_invocation_id) id: vec3u) {
+    let gid = band_pixel(id);
     if !begin_pixel(gid.xy) { return; }
     let p = visible_point_at(gid.xy);
     // Both sides of the ray view serve: points below ω gather along −ω, whose nearest surface

@@ -554,6 +554,7 @@ impl IterationPass for GatherPass {
             map,
             width: ctx.width,
             height: ctx.height,
+            rows: ctx.rows,
             samples: &samples,
             pixel_samples,
             first_index: iteration.wrapping_mul(samples.len() as u32),

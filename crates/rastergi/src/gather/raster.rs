@@ -266,11 +266,11 @@ impl RasterGather {
             }
             let mut pass = compute_pass(enc, self.profiler.as_ref(), "gather project");
             let groups = inputs.groups(&self.project_groups[cur]);
-            dispatch_pixels(&mut pass, &self.project_pipeline, &groups, inputs.width, inputs.height);
+            dispatch_pixels(&mut pass, &self.project_pipeline, &groups, inputs.width, inputs.rows);
         }
         let mut pass = compute_pass(enc, self.profiler.as_ref(), "gather resolve behind");
         let groups = inputs.groups(&self.project_groups[0]);
-        dispatch_pixels(&mut pass, &self.resolve_pipeline, &groups, inputs.width, inputs.height);
+        dispatch_pixels(&mut pass, &self.resolve_pipeline, &groups, inputs.width, inputs.rows);
     }
 }
 

@@ -16,7 +16,8 @@
 @group(2) @binding(5) var<storage, read_write> behind: array<vec2u>;
 
 @compute @workgroup_size(8, 8)
-fn main(@builtin(global_invocation_id) gid: vec3u) {
+fn main(@builtin(global_invocation_id) id: vec3u) {
+    let gid = band_pixel(id);
     if !begin_pixel(gid.xy) { return; }
     let pixel = pixel_index(gid.xy);
     if found[pixel] != 0u {
@@ -72,7 +73,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
 // along ω no layer in front of x (an empty texel already counted its escape; where every layer
 // of x's texel lies behind x or is x's own, none was empty).
 @compute @workgroup_size(8, 8)
-fn resolve_behind(@builtin(global_invocation_id) gid: vec3u) {
+fn resolve_behind(@builtin(global_invocation_id) id: vec3u) {
+    let gid = band_pixel(id);
     if !begin_pixel(gid.xy) { return; }
     let pixel = pixel_index(gid.xy);
     let b = behind[pixel];

@@ -58,7 +58,7 @@ impl Gather for TraceGather {
         inputs.write_uniforms(gpu, 0);
         {
             let mut pass = compute_pass(enc, self.profiler.as_ref(), "gather trace");
-            dispatch_pixels(&mut pass, &self.pipeline, &inputs.groups(&self.bind_group), inputs.width, inputs.height);
+            dispatch_pixels(&mut pass, &self.pipeline, &inputs.groups(&self.bind_group), inputs.width, inputs.rows);
         }
         // The guide's tables from what this gather's rays found, for the next iteration's
         // direct pass and gather.

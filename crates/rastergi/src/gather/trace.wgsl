@@ -12,7 +12,8 @@
 @group(2) @binding(2) var<storage, read_write> film: array<vec4f>;
 
 @compute @workgroup_size(8, 8)
-fn main(@builtin(global_invocation_id) gid: vec3u) {
+fn main(@builtin(global_invocation_id) id: vec3u) {
+    let gid = band_pixel(id);
     if !begin_pixel(gid.xy) { return; }
     let p = visible_point_at(gid.xy);
     let pixel = pixel_index(gid.xy);

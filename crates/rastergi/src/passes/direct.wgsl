@@ -4,7 +4,8 @@
 // Bind group 2: gbuffer_film.wgsl.
 
 @compute @workgroup_size(8, 8)
-fn main(@builtin(global_invocation_id) gid: vec3u) {
+fn main(@builtin(global_invocation_id) id: vec3u) {
+    let gid = band_pixel(id);
     if !begin_pixel(gid.xy) { return; }
     let p = visible_point_at(gid.xy);
     var radiance = emitted_radiance(p, gid.xy);

@@ -88,7 +88,16 @@ gpu_struct! {
         pub(crate) show: u32,
         /// 2^exposure.
         pub(crate) scale: f32,
-        pub(crate) _pad: [u32; 3],
+        /// Rows from the top whose sums hold one iteration more than `samples` (an iteration
+        /// under way in row bands).
+        pub(crate) rows_ahead: u32,
+        /// The preview blended in ([`PreviewResolve`]): its size (0 × 0: none), complete
+        /// iterations, rows ahead, and the weight of its mean in iterations of the film's.
+        pub(crate) preview_size: [u32; 2],
+        pub(crate) preview_samples: u32,
+        pub(crate) preview_rows_ahead: u32,
+        pub(crate) preview_weight: f32,
+        pub(crate) _pad: u32,
     }
 }
 
@@ -102,6 +111,9 @@ pub struct Film {
     pub height: u32,
     /// Iterations accumulated so far.
     pub samples: u32,
+    /// Rows from the top that hold one iteration more than `samples`: an iteration under way
+    /// in row bands ([`crate::renderer::Renderer::iterate_rows`]); every resolve counts them.
+    pub rows_ahead: u32,
     /// `COMPONENTS × width × height` vec4 sums: component c of pixel p at `c·W·H + p`.
     pub accumulation: wgpu::Buffer,
     /// The sums of the iterations of odd blocks, laid out as `accumulation`; while an odd
@@ -144,15 +156,33 @@ pub fn resolve_group() -> Group {
             Slot::read::<[f32; 4]>(1, "film"),
             Slot::write::<[f32; 4]>(2, "linear_out"),
             Slot::write::<u32>(3, "display_out"),
+            Slot::read::<[f32; 4]>(4, "preview"),
         ],
     )
 }
 
-/// The resolve's bind group of `uniforms` over `source` into `linear` and `display`.
+/// The resolve of a film blended with a smaller preview image of the same view
+/// ([`Film::preview_resolve`], [`Film::encode_resolve_preview`]).
+pub struct PreviewResolve {
+    uniforms: wgpu::Buffer,
+    bind_group: wgpu::BindGroup,
+}
+
+/// A preview to blend into the film's resolve: its film (of the same view, smaller) and the
+/// weight of its mean in iterations of the film's.
+#[derive(Clone, Copy)]
+pub struct PreviewBlend<'a> {
+    pub resolve: &'a PreviewResolve,
+    pub film: &'a Film,
+    pub weight: f32,
+}
+
+/// The resolve's bind group of `uniforms` over `source` (and the sums of `preview`, or
+/// `source` again where none is blended) into `linear` and `display`.
 fn bind_resolve(
     gpu: &Gpu,
     layout: &wgpu::BindGroupLayout,
-    (uniforms, source): (&wgpu::Buffer, &wgpu::Buffer),
+    (uniforms, source, preview): (&wgpu::Buffer, &wgpu::Buffer, Option<&wgpu::Buffer>),
     (linear, display): (&wgpu::Buffer, &wgpu::Buffer),
 ) -> wgpu::BindGroup {
     resolve_group().bind(
@@ -163,6 +193,7 @@ fn bind_resolve(
             ("film", source.as_entire_binding()),
             ("linear_out", linear.as_entire_binding()),
             ("display_out", display.as_entire_binding()),
+            ("preview", preview.unwrap_or(source).as_entire_binding()),
         ],
     )
 }
@@ -187,7 +218,7 @@ impl Film {
         );
         let device = &gpu.device;
         let layout = resolve_group().layout(device);
-        let bind_group = bind_resolve(gpu, &layout, (&uniforms, &accumulation), (&linear, &display));
+        let bind_group = bind_resolve(gpu, &layout, (&uniforms, &accumulation, None), (&linear, &display));
         let module = shader::module(device, "resolve", &resolve_source());
         let pipeline = compute_pipeline(device, "resolve", &module, "main", &[&layout], &[]);
         let image_pipeline = compute_pipeline(device, "resolve image", &module, "resolve_image", &[&layout], &[]);
@@ -203,6 +234,7 @@ impl Film {
             width,
             height,
             samples: 0,
+            rows_ahead: 0,
             accumulation,
             half,
             half_open: false,
@@ -307,6 +339,7 @@ impl Film {
         enc.clear_buffer(&self.half, 0, None);
         gpu.queue.submit([enc.finish()]);
         self.samples = 0;
+        self.rows_ahead = 0;
         self.half_open = false;
         self.half_samples = 0;
         self.block = None;
@@ -315,7 +348,65 @@ impl Film {
     /// Encodes the resolve of the current mean into the linear and display buffers.
     pub fn encode_resolve(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, show: Show, exposure: f32) {
         let resolve = (&self.pipeline, &self.bind_group, &self.uniforms);
-        self.dispatch_resolve(gpu, enc, "resolve", resolve, (self.samples, show, exposure));
+        let u = self.resolve_uniforms(self.samples, show, exposure);
+        self.dispatch_resolve(gpu, enc, "resolve", resolve, &u);
+    }
+
+    /// The resolve into this film's buffers of its mean blended with `preview`'s (made by
+    /// [`preview_resolve`](Self::preview_resolve) for that film).
+    pub fn preview_resolve(&self, gpu: &Gpu, preview: &Film) -> PreviewResolve {
+        let uniforms = gpu.zeroed_buffer(
+            "resolve preview uniforms",
+            std::mem::size_of::<ResolveUniforms>() as u64,
+            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        );
+        let sources = (&uniforms, &self.accumulation, Some(&preview.accumulation));
+        let bind_group = bind_resolve(gpu, &self.layout, sources, (&self.linear, &self.display));
+        PreviewResolve { uniforms, bind_group }
+    }
+
+    /// Encodes the resolve of the film's mean blended with a preview's: at each pixel, with
+    /// n = S + [y < rows ahead] the film's iterations there,
+    ///
+    ///     n · mean_film + w' · mean_preview
+    ///     ─────────────────────────────────,   w' = w / (1 + n)²,
+    ///              n + w'
+    ///
+    /// `mean_preview` the preview's mean bilinearly interpolated at the pixel's centre (from
+    /// its pixels that hold an iteration), `w` the blend's weight (0 where no tap holds one).
+    /// The preview alone before the film has an iteration, then fading fast: its blur is a
+    /// bias, which must not outlast the film's noise. The film's sums are not touched: the
+    /// blend is what the window shows, and it converges to the film's mean.
+    pub fn encode_resolve_preview(
+        &self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        (show, exposure): (Show, f32),
+        preview: PreviewBlend,
+    ) {
+        let resolve = (&self.pipeline, &preview.resolve.bind_group, &preview.resolve.uniforms);
+        let mut u = self.resolve_uniforms(self.samples, show, exposure);
+        u.preview_size = [preview.film.width, preview.film.height];
+        u.preview_samples = preview.film.samples;
+        u.preview_rows_ahead = preview.film.rows_ahead;
+        u.preview_weight = preview.weight;
+        self.dispatch_resolve(gpu, enc, "resolve preview", resolve, &u);
+    }
+
+    /// The resolve's uniforms of the film's sums as they stand, without a preview.
+    fn resolve_uniforms(&self, samples: u32, show: Show, exposure: f32) -> ResolveUniforms {
+        ResolveUniforms {
+            resolution: [self.width, self.height],
+            samples,
+            show: show.code(),
+            scale: exposure.exp2(),
+            rows_ahead: self.rows_ahead,
+            preview_size: [0, 0],
+            preview_samples: 0,
+            preview_rows_ahead: 0,
+            preview_weight: 0.0,
+            _pad: 0,
+        }
     }
 
     /// One resolve dispatch over the image: `pipeline` with `bind_group`, whose `uniforms` get
@@ -326,16 +417,9 @@ impl Film {
         enc: &mut wgpu::CommandEncoder,
         label: &'static str,
         (pipeline, bind_group, uniforms): (&wgpu::ComputePipeline, &wgpu::BindGroup, &wgpu::Buffer),
-        (samples, show, exposure): (u32, Show, f32),
+        u: &ResolveUniforms,
     ) {
-        let u = ResolveUniforms {
-            resolution: [self.width, self.height],
-            samples,
-            show: show.code(),
-            scale: exposure.exp2(),
-            _pad: [0; 3],
-        };
-        gpu.queue.write_buffer(uniforms, 0, bytemuck::bytes_of(&u));
+        gpu.queue.write_buffer(uniforms, 0, bytemuck::bytes_of(u));
         let mut pass = crate::gpu::profile::compute_pass(enc, gpu.profiler.as_ref(), label);
         pass.set_pipeline(pipeline);
         pass.set_bind_group(0, bind_group, &[]);
@@ -350,7 +434,7 @@ impl Film {
             std::mem::size_of::<ResolveUniforms>() as u64,
             wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         );
-        let bind_group = bind_resolve(gpu, &self.layout, (&uniforms, image), (&self.linear, &self.display));
+        let bind_group = bind_resolve(gpu, &self.layout, (&uniforms, image, None), (&self.linear, &self.display));
         ImageResolve { uniforms, bind_group }
     }
 
@@ -358,7 +442,8 @@ impl Film {
     /// `exposure` into the linear and display buffers, in place of the film's mean.
     pub fn encode_resolve_image(&self, gpu: &Gpu, enc: &mut wgpu::CommandEncoder, image: &ImageResolve, exposure: f32) {
         let resolve = (&self.image_pipeline, &image.bind_group, &image.uniforms);
-        self.dispatch_resolve(gpu, enc, "resolve image", resolve, (1, Show::Full, exposure));
+        let u = ResolveUniforms { rows_ahead: 0, ..self.resolve_uniforms(1, Show::Full, exposure) };
+        self.dispatch_resolve(gpu, enc, "resolve image", resolve, &u);
     }
 
     /// The display buffer as the last submitted resolve left it.
@@ -385,6 +470,12 @@ impl Film {
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         self.encode_resolve(gpu, &mut enc, show, 0.0);
         gpu.queue.submit([enc.finish()]);
+        self.read_linear_buffer(gpu)
+    }
+
+    /// The linear image as the last submitted resolve left it (what a window shows, before
+    /// its exposure and display encoding: a preview's blend included).
+    pub fn read_linear_buffer(&self, gpu: &Gpu) -> Result<LinearImage> {
         let bytes = gpu.read_buffer(&self.linear, self.linear.size())?;
         let texels: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
         let n = (self.width * self.height) as usize;

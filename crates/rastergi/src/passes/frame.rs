@@ -41,7 +41,12 @@ gpu_struct! {
         /// ([`crate::gather::guide`]): the direct pass weighs its environment samples against the
         /// guided density.
         pub gather_guided: u32,
-        pub _pad: [u32; 2],
+        /// The rows of this dispatch: an iteration may run as row bands, one dispatch of
+        /// `band_rows × width` pixels from row `band_y0` each
+        /// ([`crate::renderer::Renderer::iterate_rows`]; `band_pixel`, `begin_pixel` in
+        /// `frame.wgsl`); 0 and the height for a whole iteration.
+        pub band_y0: u32,
+        pub band_rows: u32,
     }
 }
 
@@ -84,7 +89,8 @@ impl FrameUniforms {
             gather_guided: 0,
             eye_chains: 0,
             texture_footprint: 1,
-            _pad: [0; 2],
+            band_y0: 0,
+            band_rows: h,
         }
     }
 }

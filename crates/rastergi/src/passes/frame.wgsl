@@ -12,10 +12,17 @@ fn start_alpha_stream() {
     alpha_seed = pcg_hash(frame.seed ^ pcg_hash(frame.iteration));
 }
 
+// The pixel of invocation `id` of a per-pixel dispatch: the dispatch covers the rows from
+// frame.band_y0 on (an iteration run as row bands; 0 for a whole iteration).
+fn band_pixel(id: vec3u) -> vec3u {
+    return vec3u(id.x, id.y + frame.band_y0, id.z);
+}
+
 // Begins the invocation of pixel `xy` in a pass of 8×8 workgroups: false where the workgroups
-// overhang the image (the invocation returns at once); inside, starts the alpha stream.
+// overhang the image or the dispatch's rows (the invocation returns at once); inside, starts
+// the alpha stream.
 fn begin_pixel(xy: vec2u) -> bool {
-    if any(xy >= frame.resolution) {
+    if any(xy >= frame.resolution) || xy.y >= frame.band_y0 + frame.band_rows {
         return false;
     }
     start_alpha_stream();

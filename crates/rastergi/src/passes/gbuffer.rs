@@ -176,7 +176,7 @@ impl IterationPass for PixelPass {
         let mut pass = compute_pass(enc, self.profiler.as_ref(), self.label);
         let groups: Vec<&wgpu::BindGroup> =
             [&ctx.scene.bind_group, &ctx.frame.bind_group, &self.bind_group].into_iter().chain(third).collect();
-        dispatch_pixels(&mut pass, &self.pipeline, &groups, ctx.width, ctx.height);
+        dispatch_pixels(&mut pass, &self.pipeline, &groups, ctx.width, ctx.rows);
         Ok(())
     }
 }

@@ -58,6 +58,11 @@ pub struct FrameContext<'a> {
     pub map: Option<&'a GpuPhotonMap>,
     pub width: u32,
     pub height: u32,
+    /// The rows of this dispatch, from row `y0` on (the frame's `band_y0`): `height` from 0
+    /// for a whole iteration, fewer for one of its row bands
+    /// ([`crate::renderer::Renderer::iterate_rows`]).
+    pub y0: u32,
+    pub rows: u32,
     /// The iteration's index since the film was last cleared.
     pub iteration: u32,
     /// The gather's directions per pixel and iteration (1 to [`crate::gpu::consts::MAX_DIRECTIONS`]).

@@ -4,7 +4,8 @@
 // Bind group 2: gbuffer_film.wgsl.
 
 @compute @workgroup_size(8, 8)
-fn main(@builtin(global_invocation_id) gid: vec3u) {
+fn main(@builtin(global_invocation_id) id: vec3u) {
+    let gid = band_pixel(id);
     if !begin_pixel(gid.xy) { return; }
     let p = visible_point_at(gid.xy);
     var radiance = vec3f(0.0);
@@ -19,7 +20,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
 // and smooth glass alone, read directly from the caustic map (the gather would blur it, and
 // its rays through specular surfaces leave that light out) → film, indirect component.
 @compute @workgroup_size(8, 8)
-fn caustics(@builtin(global_invocation_id) gid: vec3u) {
+fn caustics(@builtin(global_invocation_id) id: vec3u) {
+    let gid = band_pixel(id);
     if !begin_pixel(gid.xy) { return; }
     let p = visible_point_at(gid.xy);
     if !p.ok {

@@ -1,4 +1,5 @@
-// Resolve (film.rs): mean of the accumulated sums → linear RGB and display RGBA8 (`main`);
+// Resolve (film.rs): mean of the accumulated sums, blended with a preview's where one is
+// given → linear RGB and display RGBA8 (`main`);
 // or a linear image that is already a mean, such as the denoiser's, → the same two
 // (`resolve_image`, with `film` bound to that image: one vec4 per pixel).
 
@@ -6,6 +7,9 @@
 @group(0) @binding(1) var<storage, read> film: array<vec4f>;
 @group(0) @binding(2) var<storage, read_write> linear_out: array<vec4f>;
 @group(0) @binding(3) var<storage, read_write> display_out: array<u32>;
+// A preview's sums (a smaller image of the same view, the film's layout), blended in where
+// params.preview_size is not 0 × 0; the film's own sums otherwise, unread.
+@group(0) @binding(4) var<storage, read> preview: array<vec4f>;
 
 // The film's layout, without the frame: `film_add` is not used here.
 fn film_slot(component: u32, pixel: u32, n_pixels: u32) -> u32 {
@@ -25,6 +29,57 @@ fn display_encode(mean: vec3f) -> u32 {
     return pack4x8unorm(vec4f(display, 1.0));
 }
 
+// The sum of the shown component in `sums` (the film's layout, `n` pixels).
+fn shown_film(pixel: u32, n: u32) -> vec3f {
+    let direct = film[film_slot(FILM_DIRECT, pixel, n)].rgb;
+    let indirect = film[film_slot(FILM_INDIRECT, pixel, n)].rgb;
+    switch params.show {
+        case 1u: { return direct; }
+        case 2u: { return indirect; }
+        case 3u: { return film[film_slot(FILM_PHOTON_VIEW, pixel, n)].rgb; }
+        default: { return direct + indirect; }
+    }
+}
+
+// The same of the preview's sums.
+fn shown_preview(pixel: u32, n: u32) -> vec3f {
+    let direct = preview[film_slot(FILM_DIRECT, pixel, n)].rgb;
+    let indirect = preview[film_slot(FILM_INDIRECT, pixel, n)].rgb;
+    switch params.show {
+        case 1u: { return direct; }
+        case 2u: { return indirect; }
+        case 3u: { return preview[film_slot(FILM_PHOTON_VIEW, pixel, n)].rgb; }
+        default: { return direct + indirect; }
+    }
+}
+
+// The preview's mean at the centre of film pixel `xy`, bilinear over its pixels that hold an
+// iteration (rgb), and the share of the four taps' weight that did (a).
+fn preview_mean(xy: vec2u) -> vec4f {
+    let size = params.preview_size;
+    let n = size.x * size.y;
+    // The film pixel's centre in the preview's pixels, less ½: the taps' corner.
+    let p = (vec2f(xy) + 0.5) * vec2f(size) / vec2f(params.resolution) - 0.5;
+    let base = floor(p);
+    let f = p - base;
+    var sum = vec3f(0.0);
+    var weight = 0.0;
+    for (var k = 0u; k < 4u; k++) {
+        let o = vec2f(f32(k & 1u), f32(k >> 1u));
+        let q = vec2u(clamp(base + o, vec2f(0.0), vec2f(size) - 1.0));
+        let w = select(1.0 - f.x, f.x, o.x > 0.0) * select(1.0 - f.y, f.y, o.y > 0.0);
+        let samples = params.preview_samples + select(0u, 1u, q.y < params.preview_rows_ahead);
+        if samples > 0u && w > 0.0 {
+            sum += w * shown_preview(q.y * size.x + q.x, n) / f32(samples);
+            weight += w;
+        }
+    }
+    if weight == 0.0 {
+        return vec4f(0.0);
+    }
+    return vec4f(sum / weight, weight);
+}
+
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3u) {
     if any(gid.xy >= params.resolution) {
@@ -32,17 +87,20 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     }
     let pixel = gid.y * params.resolution.x + gid.x;
     let n = params.resolution.x * params.resolution.y;
-    let direct = film[film_slot(FILM_DIRECT, pixel, n)].rgb;
-    let indirect = film[film_slot(FILM_INDIRECT, pixel, n)].rgb;
-    var sum = direct + indirect;
-    if params.show == 1u {
-        sum = direct;
-    } else if params.show == 2u {
-        sum = indirect;
-    } else if params.show == 3u {
-        sum = film[film_slot(FILM_PHOTON_VIEW, pixel, n)].rgb;
+    // The film's iterations at this pixel: one more in the rows an iteration under way in
+    // bands has reached.
+    var total = shown_film(pixel, n);
+    var weight = f32(params.samples + select(0u, 1u, gid.y < params.rows_ahead));
+    if params.preview_size.x > 0u && params.preview_weight > 0.0 {
+        // The preview's weight fades as (1 + S)⁻² with the film's S iterations here: all of
+        // the image before the film has one, a quarter of its weight at the first, then
+        // gone before its blur (a bias) could outlast the film's noise (which falls as 1/S).
+        let p = preview_mean(gid.xy);
+        let w = params.preview_weight * p.a / ((1.0 + weight) * (1.0 + weight));
+        total += w * p.rgb;
+        weight += w;
     }
-    let mean = sum / f32(max(params.samples, 1u));
+    let mean = select(total / weight, vec3f(0.0), weight == 0.0);
     linear_out[pixel] = vec4f(mean, 1.0);
     display_out[pixel] = display_encode(mean);
 }

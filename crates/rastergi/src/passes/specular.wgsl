@@ -15,7 +15,8 @@
 const MAX_CHAIN: u32 = 16u;
 
 @compute @workgroup_size(8, 8)
-fn main(@builtin(global_invocation_id) gid: vec3u) {
+fn main(@builtin(global_invocation_id) id: vec3u) {
+    let gid = band_pixel(id);
     if !begin_pixel(gid.xy) { return; }
     let pixel = pixel_index(gid.xy);
     let base = 3u * pixel;

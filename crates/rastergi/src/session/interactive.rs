@@ -1,6 +1,8 @@
 //! The interactive loop that a window and a web page share: a progressive render being looked
-//! at. A camera move restarts the image; the shown component, the exposure and the denoiser
-//! are the viewer's choices; the denoised image is filtered again on a [`Schedule`] (more
+//! at. A camera move restarts the image; each frame's work is chosen within a frame budget,
+//! coarse to fine ([`super::refine`]: previews while the camera moves, row bands where an
+//! iteration is longer than a frame); the shown component, the exposure and the denoiser are
+//! the viewer's choices; the denoised image is filtered again on a [`Schedule`] (more
 //! iterations, or time) and resolved for display in between.
 
 use crate::error::Result;
@@ -8,6 +10,7 @@ use crate::passes::denoise::{DenoiseParams, Schedule};
 use crate::passes::film::Show;
 use crate::progressive::{Denoising, Progressive};
 use crate::scene::Camera;
+use crate::session::refine::{Refine, Work};
 
 /// A progressive render as a viewer shows it.
 pub struct Interactive {
@@ -20,11 +23,69 @@ pub struct Interactive {
     denoise: bool,
     /// When the denoiser last ran for the display.
     denoised: Schedule,
+    /// What each frame draws, coarse to fine, within the frame budget.
+    refine: Refine,
 }
 
 impl Interactive {
     pub fn new(renderer: Box<dyn Progressive>, show: Show, exposure: f32) -> Interactive {
-        Interactive { renderer, show, exposure, denoise: false, denoised: Schedule::default() }
+        let refine = Refine::new(super::refine::DEFAULT_FRAME_BUDGET);
+        Interactive { renderer, show, exposure, denoise: false, denoised: Schedule::default(), refine }
+    }
+
+    /// The frame budget in seconds (0: one whole iteration a frame).
+    pub fn frame_budget(&self) -> f64 {
+        self.refine.budget()
+    }
+
+    pub fn set_frame_budget(&mut self, seconds: f64) {
+        self.refine.set_budget(seconds);
+    }
+
+    /// The schedule of the frames' work (what is refined, what is blended in).
+    pub fn refine(&self) -> &Refine {
+        &self.refine
+    }
+
+    /// One frame's work, waited for: units of work ([`Refine::step`]) until the frame budget is
+    /// spent — one preview iteration while the camera moves, the previews' refinement after it
+    /// stops, then the window's own iterations, in row bands where one is longer than the
+    /// budget — with at most `limit` of the window's iterations finished. Returns the
+    /// window's iterations it finished.
+    pub fn frame(&mut self, limit: u32) -> Result<u32> {
+        let start = web_time::Instant::now();
+        let budget = self.refine.budget();
+        let mut finished = 0;
+        loop {
+            let left = budget - start.elapsed().as_secs_f64();
+            let began = web_time::Instant::now();
+            let Some(work) = self.refine.step(self.renderer.as_mut(), left.max(0.0), limit - finished)? else { break };
+            self.renderer.wait()?;
+            self.refine.finished(&work, began.elapsed().as_secs_f64());
+            finished += u32::from(work.scale == 1 && work.finished);
+            if self.refine.frame_done(&work) || start.elapsed().as_secs_f64() >= budget || finished >= limit {
+                break;
+            }
+        }
+        self.refine.end_frame();
+        Ok(finished)
+    }
+
+    /// One unit of a frame's work without waiting for it (a web page, which cannot block):
+    /// give its time to [`Interactive::finished`] once the GPU has done it, and call
+    /// [`Interactive::end_frame`] after the frame's last.
+    pub fn step(&mut self, left: f64, limit: u32) -> Result<Option<Work>> {
+        self.refine.step(self.renderer.as_mut(), left, limit)
+    }
+
+    /// `work` took `seconds` on the GPU.
+    pub fn finished(&mut self, work: &Work, seconds: f64) {
+        self.refine.finished(work, seconds);
+    }
+
+    /// The frame is over ([`Interactive::step`]).
+    pub fn end_frame(&mut self) {
+        self.refine.end_frame();
     }
 
     pub fn renderer(&self) -> &dyn Progressive {
@@ -48,6 +109,7 @@ impl Interactive {
         }
         self.renderer = renderer;
         self.denoised.clear();
+        self.refine.restart();
         Ok(())
     }
 
@@ -57,6 +119,7 @@ impl Interactive {
         let resized = self.renderer.resize(width, height)?;
         if resized {
             self.denoised.clear();
+            self.refine.restart();
         }
         Ok(resized)
     }
@@ -71,6 +134,7 @@ impl Interactive {
     pub fn set_camera(&mut self, camera: Camera) -> Result<()> {
         self.renderer.set_camera(camera)?;
         self.denoised.clear();
+        self.refine.moved();
         Ok(())
     }
 
@@ -84,6 +148,9 @@ impl Interactive {
         }
         self.denoise = on;
         self.denoised.clear();
+        if self.renderer.samples() == 0 {
+            self.refine.restart();
+        }
         Ok(())
     }
 
@@ -101,6 +168,10 @@ impl Interactive {
     /// that filters at once): the next denoised image is filtered at once.
     pub fn invalidate(&mut self) {
         self.denoised.clear();
+        if self.renderer.samples() == 0 && self.renderer.rows_ahead() == 0 {
+            // A restart: the previews of the view before are gone.
+            self.refine.restart();
+        }
     }
 
     /// Encodes the resolve of what is shown into the film's display buffer: the raw image of
@@ -108,8 +179,10 @@ impl Interactive {
     /// says so at `now` (seconds from any fixed origin).
     pub fn encode_resolve(&mut self, enc: &mut wgpu::CommandEncoder, now: f64) -> Result<()> {
         let samples = self.renderer.samples();
-        let due = self.denoised.due(samples, now);
-        if let Some(r) = self.denoising() {
+        // The denoiser filters whole iterations (not one under way in bands), from the first.
+        let whole = self.renderer.rows_ahead() == 0;
+        let due = whole && samples > 0 && self.denoised.due(samples, now);
+        if let Some(r) = self.denoising().filter(|_| samples > 0) {
             if due {
                 r.encode_denoise(enc, &DenoiseParams::default())?;
             }
@@ -119,7 +192,10 @@ impl Interactive {
             }
         } else {
             let show = if self.renderer.has(self.show) { self.show } else { Show::Full };
-            self.renderer.encode_resolve(enc, show, self.exposure);
+            match self.refine.blend() {
+                Some(preview) => self.renderer.encode_resolve_preview(enc, (show, self.exposure), preview),
+                None => self.renderer.encode_resolve(enc, show, self.exposure),
+            }
             self.denoised.clear();
         }
         Ok(())

@@ -16,6 +16,7 @@
 #[cfg(feature = "clap")]
 pub mod args;
 pub mod interactive;
+pub mod refine;
 pub mod run;
 #[cfg(test)]
 mod tests;

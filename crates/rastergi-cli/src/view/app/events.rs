@@ -64,7 +64,9 @@ impl ApplicationHandler<UserEvent> for App {
                 }
                 self.measured = Measured::default();
                 // The denoiser (enabled by the build where asked) is taken up by sync_denoiser.
-                self.renderer = Some((Interactive::new(active, self.controls.show, self.controls.exposure), build));
+                let mut view = Interactive::new(active, self.controls.show, self.controls.exposure);
+                view.set_frame_budget(self.frame_budget);
+                self.renderer = Some((view, build));
                 if let Some(run) = &mut self.script {
                     run.last = Instant::now();
                 }

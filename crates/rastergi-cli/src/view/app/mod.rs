@@ -26,7 +26,7 @@ use winit::window::{Window, WindowId};
 
 use super::build::{Build, Opened, env_scale, prepare, same_but_size};
 use super::controls::{Controls, Response, SunAngles, camera_options, show_name};
-use super::frames::{Rate, iterate_frame};
+use super::frames::Rate;
 use super::keys::key_of;
 use super::panel::{self, Figures, Panel, PanelPainter, PanelState};
 use super::screenshots::Screenshots;
@@ -92,7 +92,8 @@ pub struct App {
     dragging: (bool, bool),
     cursor: Option<(f64, f64)>,
     last_frame: Instant,
-    batch: u32,
+    /// Seconds a frame aims at (`--frame-budget`; 0: one whole iteration a frame).
+    pub frame_budget: f64,
     rate: Rate,
     measured: Measured,
     /// The origin of the denoiser schedule's times.
@@ -144,7 +145,7 @@ impl App {
             dragging: (false, false),
             cursor: None,
             last_frame: Instant::now(),
-            batch: 1,
+            frame_budget: rastergi::session::refine::DEFAULT_FRAME_BUDGET,
             rate: Rate { since: Instant::now(), count: 0, per_second: 0.0 },
             measured: Measured::default(),
             clock: Instant::now(),
@@ -464,14 +465,15 @@ impl App {
         }
     }
 
-    /// Runs this frame's iterations: as many as fit in [`FRAME_BUDGET`] by the last frame's
-    /// time per iteration, at least one, stopping where the script waits for a count. Only a
-    /// renderer that fits the window and is not about to be replaced iterates.
+    /// Runs this frame's work within the frame budget ([`Interactive::frame`]: previews while
+    /// the camera moves and just after, then the window's iterations, banded where one is
+    /// longer than the budget), stopping where the script waits for a count. Only a renderer
+    /// that fits the window and is not about to be replaced iterates.
     fn iterate_batch(&mut self) -> Result<()> {
         let current = self.settled();
-        let limit = self.batch.min(self.iteration_limit());
+        let limit = self.iteration_limit();
         let Some((view, _)) = self.renderer.as_mut().filter(|_| current) else { return Ok(()) };
-        let done = iterate_frame(view.renderer_mut(), limit, &mut self.batch)?;
+        let done = view.frame(limit)?;
         if done > 0 {
             self.rate.add(done);
         }
@@ -487,6 +489,11 @@ impl App {
         self.measured.at = Some(Instant::now());
         let Some((view, _)) = &self.renderer else { return Ok(()) };
         let r = view.renderer();
+        if r.rows_ahead() > 0 {
+            // An iteration under way in bands: its sums are not yet an image's; next time.
+            self.measured.at = None;
+            return Ok(());
+        }
         let samples = r.samples();
         let history = &mut self.measured.history;
         if history.last().is_some_and(|&(n, _)| n > samples) {

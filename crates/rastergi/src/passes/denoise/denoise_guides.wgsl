@@ -12,7 +12,8 @@
 @group(3) @binding(1) var<storage, read_write> previous: array<vec4f>;
 
 @compute @workgroup_size(8, 8)
-fn accumulate_guides(@builtin(global_invocation_id) gid: vec3u) {
+fn accumulate_guides(@builtin(global_invocation_id) id: vec3u) {
+    let gid = band_pixel(id);
     let xy = gid.xy;
     if !begin_pixel(xy) {
         return;

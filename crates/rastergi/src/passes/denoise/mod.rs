@@ -269,7 +269,10 @@ impl IterationPass for Guides {
     /// Reads: the visible points, the film. Writes: the guides. After the iteration's passes.
     fn encode(&mut self, enc: &mut wgpu::CommandEncoder, ctx: &FrameContext) -> Result<()> {
         self.pass.encode(enc, ctx)?;
-        self.samples += 1;
+        // An iteration counts once its last row band is in.
+        if ctx.y0 + ctx.rows >= ctx.height {
+            self.samples += 1;
+        }
         Ok(())
     }
 }

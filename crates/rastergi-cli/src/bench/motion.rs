@@ -1,0 +1,264 @@
+//! `rastergi bench motion`: the viewer's loop through a scripted camera move, without a window.
+//!
+//! Each variant (the frame budget off — one whole iteration a frame, the viewer before issue
+//! 58 — and on) runs the same script on its own renderer: the view held still for
+//! `--still` seconds (the loop measures its costs, as a viewer does while one looks), then an
+//! orbit of `--orbit` degrees about the target and a walk forward of a tenth of the scene's
+//! diagonal, each over half of `--motion` seconds, the camera placed each frame where the
+//! script is at that time (a slow frame makes a long step, as it does under a hand), then still
+//! again. A frame is the viewer's: [`Interactive::frame`], the resolve and the display pass
+//! into an offscreen texture of the window's size.
+//!
+//! Printed per variant: the frame times during the motion (median, and the 95th percentile on
+//! a line with `p95 … ms`), the time from the last move to the first frame whose film holds a
+//! whole iteration of the window, and the relative RMSE of what is shown (the linear image the
+//! resolve wrote, previews blended in) against the converged view — a fresh render of the final
+//! camera with another seed, `--reference-iterations` iterations (kept in `--reference`, an EXR,
+//! to reuse) — 0.5, 1, 2 and 5 s after the camera stops. The read-backs of those images are not
+//! counted in the times.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{Result, ensure};
+use clap::Args;
+use rastergi::camera_control::CameraControl;
+use rastergi::fit;
+use rastergi::gpu::Gpu;
+use rastergi::image_io::LinearImage;
+use rastergi::passes::display::DisplayTarget;
+use rastergi::passes::film::Show;
+use rastergi::renderer::Renderer;
+use rastergi::scene::{Camera, Scene};
+use rastergi::session::interactive::Interactive;
+use rastergi::session::refine::DEFAULT_FRAME_BUDGET;
+use rastergi::settings::RenderSettings;
+
+use super::window_scene_and_gpu;
+use crate::args::{GatherArg, GpuArgs};
+
+/// Seconds after the camera stops at which the shown image is compared with the converged view.
+const MARKS: [f64; 4] = [0.5, 1.0, 2.0, 5.0];
+
+#[derive(Args, Debug)]
+pub struct MotionArgs {
+    #[command(flatten)]
+    window: super::WindowArgs,
+    /// The frame budget of the second variant, in milliseconds (the first has none).
+    #[arg(long, default_value_t = 1e3 * DEFAULT_FRAME_BUDGET)]
+    frame_budget: f64,
+    /// Seconds the view is held still before the move.
+    #[arg(long, default_value_t = 2.0)]
+    still: f64,
+    /// Seconds the move lasts: an orbit, then a walk, half each.
+    #[arg(long, default_value_t = 4.0)]
+    motion: f64,
+    /// Degrees of the orbit about the target.
+    #[arg(long, default_value_t = 30.0)]
+    orbit: f32,
+    /// Iterations of the converged view (rendered with another seed).
+    #[arg(long, default_value_t = 64)]
+    reference_iterations: u32,
+    /// An EXR holding the converged view: read where it exists (of the window's size), written
+    /// otherwise.
+    #[arg(long)]
+    reference: Option<PathBuf>,
+    /// A directory to write the shown images at the marks to (`budget-B-at-T.exr`).
+    #[arg(long)]
+    images: Option<PathBuf>,
+    /// Photons traced (default: fitted to the scene, as `view` does).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    photons: Option<u32>,
+    /// The gather implementation (as `view --gather`).
+    #[arg(long, value_enum, default_value_t = GatherArg::Auto)]
+    gather: GatherArg,
+    #[command(flatten)]
+    gpu: GpuArgs,
+}
+
+/// What one variant measured.
+struct Measured {
+    /// Frame times during the motion, seconds.
+    frames: Vec<f64>,
+    /// Seconds from the last move to the first frame whose film holds a whole iteration.
+    to_full: Option<f64>,
+    /// The relative RMSE at each of [`MARKS`].
+    errors: Vec<Option<f64>>,
+}
+
+/// The camera `t` seconds into the move of `a` from `start`.
+fn camera_at(a: &MotionArgs, start: &CameraControl, diagonal: f32, t: f64) -> Camera {
+    let half = 0.5 * a.motion.max(1e-3);
+    let orbit = (t / half).clamp(0.0, 1.0) as f32;
+    let walk = ((t - half) / half).clamp(0.0, 1.0) as f32;
+    let mut c = start.clone();
+    c.orbit(orbit * a.orbit.to_radians(), 0.0);
+    c.translate(0.0, 0.0, walk * 0.1 * diagonal);
+    c.camera()
+}
+
+/// One variant: the script with a frame budget of `budget` seconds (0: off).
+fn run_variant(
+    a: &MotionArgs,
+    gpu: &Gpu,
+    scene: &Scene,
+    settings: &RenderSettings,
+    budget: f64,
+    reference: &LinearImage,
+) -> Result<Measured> {
+    let renderer = Renderer::new(gpu, scene, settings.clone())?;
+    renderer.wait()?;
+    let mut view = Interactive::new(Box::new(renderer), Show::Full, 0.0);
+    view.set_frame_budget(budget);
+    let mut target = DisplayTarget::offscreen(gpu, settings.width, settings.height)?;
+    let mut frame = |view: &mut Interactive| -> Result<()> {
+        view.frame(u32::MAX)?;
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        view.encode_resolve(&mut enc, 0.0)?;
+        target.present(gpu, enc, Some(view.renderer().film()), &[])?;
+        gpu.wait()?;
+        Ok(())
+    };
+    let start = Instant::now();
+    while start.elapsed().as_secs_f64() < a.still {
+        frame(&mut view)?;
+    }
+    let control = CameraControl::new(&scene.camera, &scene.bounds());
+    let diagonal = (scene.bounds().max - scene.bounds().min).length();
+    let mut frames = Vec::new();
+    let moving = Instant::now();
+    loop {
+        let t = moving.elapsed().as_secs_f64();
+        let began = Instant::now();
+        view.set_camera(camera_at(a, &control, diagonal, t))?;
+        frame(&mut view)?;
+        frames.push(began.elapsed().as_secs_f64());
+        if t >= a.motion {
+            break;
+        }
+    }
+    // Still at the final camera: the clock runs but for the read-backs.
+    let (mut clock, mut to_full, mut errors) = (0.0, None, Vec::new());
+    while errors.len() < MARKS.len() {
+        let began = Instant::now();
+        frame(&mut view)?;
+        clock += began.elapsed().as_secs_f64();
+        if to_full.is_none() && view.renderer().samples() > 0 {
+            to_full = Some(clock);
+        }
+        while errors.len() < MARKS.len() && clock >= MARKS[errors.len()] {
+            let shown = view.renderer().film().read_linear_buffer(gpu)?;
+            if let Some(dir) = &a.images {
+                let name = format!("budget-{:.0}-at-{}.exr", 1e3 * budget, MARKS[errors.len()]);
+                rastergi::image_io::write_exr(&dir.join(name), &shown)?;
+            }
+            let compared = rastergi::metrics::compare(&shown, reference, None);
+            errors.push(Some(compared.relative_rmse));
+        }
+    }
+    Ok(Measured { frames, to_full, errors })
+}
+
+/// The 100·q-th percentile of `v` (nearest rank).
+fn percentile(v: &[f64], q: f64) -> f64 {
+    let mut v = v.to_vec();
+    v.sort_by(f64::total_cmp);
+    v[((q * v.len() as f64).ceil() as usize).clamp(1, v.len()) - 1]
+}
+
+pub fn run(a: &MotionArgs) -> Result<()> {
+    ensure!(
+        a.frame_budget.is_finite() && a.frame_budget > 0.0,
+        "--frame-budget must be positive milliseconds, got {}",
+        a.frame_budget
+    );
+    ensure!(a.motion.is_finite() && a.motion > 0.0, "--motion must be positive seconds, got {}", a.motion);
+    ensure!(a.still.is_finite() && a.still >= 0.0, "--still must be 0 or more seconds, got {}", a.still);
+    let (scene, gpu) = window_scene_and_gpu(&a.window, &a.gpu)?;
+    let (w, h) = (a.window.width, a.window.height);
+    let grid = fit::grid_resolution(&scene.bounds());
+    let photons = a.photons.unwrap_or_else(|| fit::photon_count(&scene, grid));
+    let settings = RenderSettings {
+        width: w,
+        height: h,
+        photons,
+        grid_resolution: grid,
+        gather: a.gather.method(),
+        ..Default::default()
+    };
+    println!(
+        "bench motion: {} at {w}x{h} on {} ({:?}), {photons} photons, grid {grid}; still {} s, then an orbit of {} degrees and a walk, {} s in all, then still",
+        a.window.scene, gpu.info.name, gpu.info.backend, a.still, a.orbit, a.motion
+    );
+    // The converged view of the final camera, another seed.
+    let control = CameraControl::new(&scene.camera, &scene.bounds());
+    let last = camera_at(a, &control, (scene.bounds().max - scene.bounds().min).length(), a.motion);
+    let reference = match &a.reference {
+        Some(path) if path.exists() => {
+            let image = rastergi::image_io::read_exr(path)?;
+            ensure!(
+                (image.width, image.height) == (w, h),
+                "{}: the reference is {}x{}, not {w}x{h}; delete it to render it again",
+                path.display(),
+                image.width,
+                image.height
+            );
+            println!("  converged view: {}", path.display());
+            image
+        }
+        _ => {
+            let began = Instant::now();
+            let mut r =
+                Renderer::new(&gpu, &scene, RenderSettings { seed: settings.seed ^ 0x5eed, ..settings.clone() })?;
+            r.set_camera(last)?;
+            for _ in 0..a.reference_iterations {
+                r.iterate()?;
+            }
+            let image = r.read_linear(Show::Full)?;
+            println!(
+                "  converged view: {} iterations of the final camera, another seed, in {:.1} s",
+                a.reference_iterations,
+                began.elapsed().as_secs_f64()
+            );
+            if let Some(path) = &a.reference {
+                rastergi::image_io::write_exr(path, &image)?;
+            }
+            image
+        }
+    };
+    let variants = [("budget off: whole iterations", 0.0), ("frame budget", 1e-3 * a.frame_budget)];
+    let mut results = Vec::new();
+    for (name, budget) in variants {
+        let m = run_variant(a, &gpu, &scene, &settings, budget, &reference)?;
+        let label = if budget > 0.0 { format!("{name} {:.0} ms", 1e3 * budget) } else { name.to_owned() };
+        println!("  {label}:");
+        println!(
+            "    during motion: {} frames, median {:.1} ms, p95 {:.1} ms, longest {:.1} ms",
+            m.frames.len(),
+            1e3 * percentile(&m.frames, 0.5),
+            1e3 * percentile(&m.frames, 0.95),
+            1e3 * percentile(&m.frames, 1.0)
+        );
+        let to_full = m.to_full.map_or("not within 5 s".to_owned(), |t| format!("{t:.2} s"));
+        println!("    from the last move to the first full-resolution iteration: {to_full}");
+        let errors: Vec<String> = MARKS
+            .iter()
+            .zip(&m.errors)
+            .map(|(t, e)| format!("{t} s {}", e.map_or("-".to_owned(), |e| format!("{:.1} %", 100.0 * e))))
+            .collect();
+        println!("    relRMSE against the converged view after the stop: {}", errors.join(", "));
+        results.push(m);
+    }
+    let (before, after) = (&results[0], &results[1]);
+    let ratio = |k: usize| match (before.errors[k], after.errors[k]) {
+        (Some(b), Some(a)) if b > 0.0 => format!("{:.2}", a / b),
+        _ => "-".to_owned(),
+    };
+    println!(
+        "  budget on / off: p95 frame {:.2}x; relRMSE at 1 s {}x, at 5 s {}x",
+        percentile(&after.frames, 0.95) / percentile(&before.frames, 0.95),
+        ratio(1),
+        ratio(3)
+    );
+    Ok(())
+}

@@ -1,0 +1,248 @@
+//! Coarse to fine within a frame budget: how a viewer spends each frame so that it answers
+//! within the budget on any device and any scene.
+//!
+//! - **While the camera moves** each frame draws one iteration of a *preview* — the same view
+//!   at 1/s of the window's size, s = 2, 4 … [`COARSEST`] (its own film, the photon map
+//!   shared: [`Progressive::iterate_preview_rows`]) — at the finest s whose iteration fits the
+//!   budget by the measured cost per pixel, shown upscaled (bilinear). Where a whole iteration
+//!   of the window fits, the window's own iterations run instead.
+//! - **When it stops** the previews refine from there: [`LEVEL_ITERATIONS`] iterations at each
+//!   level, then the next finer one, then the window's own iterations, which accumulate in its
+//!   film as they always have. The display blends the finest preview that holds at least
+//!   half the iterations of the coarser one shown before into the film's mean, weighted as the
+//!   preview's iterations against the film's
+//!   ([`Progressive::encode_resolve_preview`]): the coarse image stays on screen until the fine
+//!   one has more iterations, and its weight w/(S + w) vanishes as the film's S grow, so the
+//!   image converges to exactly the film's, which no preview ever enters.
+//! - **No frame longer than the budget at full size either**: an iteration that would take
+//!   longer runs as row bands across frames ([`Progressive::iterate_rows`]; input is handled
+//!   between them), each band as many rows as fit in what is left of the frame's budget.
+//!
+//! The cost model is one figure per level, seconds per pixel of an iteration, the median of
+//! its recent units of work and how long each took ([`Refine::finished`]); a level not yet
+//! measured borrows the nearest measured one's. A budget of 0 turns it off: one whole
+//! iteration per frame, the loop the viewer had before.
+
+use crate::error::Result;
+use crate::progressive::Progressive;
+
+/// The frame budget a viewer aims at by default, in seconds.
+pub const DEFAULT_FRAME_BUDGET: f64 = 0.05;
+/// The coarsest preview: 1/32 of the window's size (a 1280 × 720 window: 40 × 23 pixels).
+pub const COARSEST: u32 = 32;
+/// Levels: the window (0) and the previews at 1/2^k, k = 1 … log2(COARSEST).
+const LEVELS: usize = COARSEST.trailing_zeros() as usize + 1;
+/// Iterations of each preview level after the camera stops, before the next finer level: a
+/// level costs a quarter of the next, so the ladder from the coarsest level to the window
+/// costs about 4/3 of the finest preview's own iterations.
+pub const LEVEL_ITERATIONS: u32 = 4;
+
+/// Units of work whose cost per pixel each level keeps.
+const COSTS_KEPT: usize = 8;
+
+/// The scale (1 = the window) of level `k`.
+fn scale(level: usize) -> u32 {
+    1 << level
+}
+
+/// One unit of work a frame submitted: rows of one level, so many pixels.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Work {
+    /// 1: the window's own iteration; s: the preview at 1/s.
+    pub scale: u32,
+    /// Pixels computed (rows × the level's width).
+    pub pixels: u64,
+    /// Whether it finished an iteration of its level.
+    pub finished: bool,
+}
+
+/// The coarse-to-fine schedule of an interactive view (see the module's notes).
+#[derive(Clone, Debug)]
+pub struct Refine {
+    /// Seconds per frame aimed at; 0: whole iterations, one per frame.
+    budget: f64,
+    /// Measured seconds per pixel of each level: the last [`COSTS_KEPT`] units'.
+    cost: [Vec<f64>; LEVELS],
+    /// The level being refined: 0 once the window's own iterations run.
+    level: usize,
+    /// Iterations finished at `level` since it began.
+    level_iterations: u32,
+    /// The camera moved since the last frame.
+    moving: bool,
+    /// The finest preview that holds a finished iteration of this view (its scale), and the
+    /// iterations it holds: what the display blends in.
+    shown: Option<(u32, u32)>,
+    /// Whether the renderer draws previews (the path tracer does not).
+    previews: bool,
+}
+
+impl Refine {
+    /// A schedule of `budget` seconds a frame (0: off).
+    pub fn new(budget: f64) -> Refine {
+        Refine {
+            budget: budget.max(0.0),
+            cost: Default::default(),
+            level: LEVELS - 1,
+            level_iterations: 0,
+            moving: true,
+            shown: None,
+            previews: true,
+        }
+    }
+
+    /// The budget in seconds (0: off).
+    pub fn budget(&self) -> f64 {
+        self.budget
+    }
+
+    /// Sets the budget (0: off); the measured costs stay.
+    pub fn set_budget(&mut self, budget: f64) {
+        self.budget = budget.max(0.0);
+        self.restart();
+    }
+
+    /// The camera moved (the renderer's image restarted): the previews start again at the
+    /// level that fits a frame.
+    pub fn moved(&mut self) {
+        self.moving = true;
+        self.restart();
+    }
+
+    /// The image restarted for another reason (a new renderer, a setting): as a move.
+    pub fn restart(&mut self) {
+        self.level = LEVELS - 1;
+        self.level_iterations = 0;
+        self.shown = None;
+        self.previews = true;
+    }
+
+    /// The preview the display blends in: its scale and its weight in iterations, where one is.
+    pub fn blend(&self) -> Option<(u32, f32)> {
+        self.shown.map(|(scale, iterations)| (scale, iterations as f32))
+    }
+
+    /// Whether the window's own iterations are under way (the previews are done).
+    pub fn refined(&self) -> bool {
+        self.level == 0
+    }
+
+    /// The measured seconds per pixel at `level` (the median of its recent units: a unit that
+    /// began a photon pass is an outlier), or the nearest measured level's.
+    fn cost_at(&self, level: usize) -> Option<f64> {
+        let k = (0..LEVELS)
+            .flat_map(|d| [level.checked_sub(d), Some(level + d)])
+            .flatten()
+            .find(|&k| k < LEVELS && !self.cost[k].is_empty())?;
+        let mut c = self.cost[k].clone();
+        c.sort_by(f64::total_cmp);
+        Some(c[c.len() / 2])
+    }
+
+    /// The finest level whose whole iteration of `pixels` (the window's) fits the budget; the
+    /// coarsest while nothing is measured.
+    fn fitting_level(&self, pixels: u64) -> usize {
+        (0..LEVELS)
+            .find(|&k| {
+                let p = pixels as f64 / f64::from(scale(k) * scale(k));
+                self.cost_at(k).is_some_and(|c| c * p <= self.budget)
+            })
+            .unwrap_or(LEVELS - 1)
+    }
+
+    /// Submits the next unit of this frame's work with `left` seconds of the budget left, at
+    /// most one whole iteration of the window's where `limit` is 0 (a script waits for a
+    /// count), and returns it; `None` when there is nothing to do. Call
+    /// [`finished`](Self::finished) with its time once it has run.
+    pub fn step(&mut self, r: &mut dyn Progressive, left: f64, limit: u32) -> Result<Option<Work>> {
+        let (w, h) = (r.settings().width, r.settings().height);
+        if self.budget <= 0.0 {
+            // Off: a whole iteration of the window per step.
+            if limit == 0 {
+                return Ok(None);
+            }
+            r.iterate()?;
+            return Ok(Some(Work { scale: 1, pixels: w as u64 * h as u64, finished: true }));
+        }
+        if self.moving {
+            // While moving: the finest level whose iteration fits (the window's own where it
+            // does).
+            self.level = self.fitting_level(w as u64 * h as u64);
+            self.level_iterations = 0;
+        }
+        if !self.previews {
+            self.level = 0;
+        }
+        let k = self.level;
+        let s = scale(k);
+        let (lw, lh) = (w.div_ceil(s), h.div_ceil(s));
+        // The rows that fit in what is left (all of them while nothing is measured at a
+        // preview level; a tenth of the window's).
+        let rows = match self.cost_at(k) {
+            Some(c) => ((left / (c * lw as f64)).floor() as u32).clamp(1, lh),
+            None if k > 0 => lh,
+            None => lh.div_ceil(10),
+        };
+        let work = if k == 0 {
+            if limit == 0 {
+                return Ok(None);
+            }
+            let before = r.rows_ahead();
+            let finished = r.iterate_rows(rows)?;
+            let after = if finished { lh } else { r.rows_ahead() };
+            Work { scale: 1, pixels: (after - before) as u64 * lw as u64, finished }
+        } else {
+            let before = r.preview_film(s).map_or(0, |f| f.rows_ahead);
+            match r.iterate_preview_rows(s, rows)? {
+                None => {
+                    // No previews here: the window's own iterations, banded.
+                    self.previews = false;
+                    self.level = 0;
+                    return self.step(r, left, limit);
+                }
+                Some(finished) => {
+                    let after = if finished { lh } else { r.preview_film(s).map_or(0, |f| f.rows_ahead) };
+                    if finished {
+                        let n = r.preview_film(s).map_or(0, |f| f.samples);
+                        // The display takes a finer preview once it holds half as many
+                        // iterations as the one shown (its noise is then no more than twice
+                        // that one's, its blur less than half).
+                        let finer = |&(shown, m): &(u32, u32)| s == shown || (s < shown && 2 * n >= m);
+                        if self.shown.is_none_or(|ref shown| finer(shown)) {
+                            self.shown = Some((s, n));
+                        }
+                        self.level_iterations += 1;
+                        if !self.moving && self.level_iterations >= LEVEL_ITERATIONS {
+                            self.level -= 1;
+                            self.level_iterations = 0;
+                        }
+                    }
+                    Work { scale: s, pixels: (after - before) as u64 * lw as u64, finished }
+                }
+            }
+        };
+        Ok(Some(work))
+    }
+
+    /// `work` took `seconds`: the cost of its level, a running mean over the recent units.
+    pub fn finished(&mut self, work: &Work, seconds: f64) {
+        if work.pixels == 0 || self.budget <= 0.0 {
+            return;
+        }
+        let kept = &mut self.cost[work.scale.trailing_zeros() as usize];
+        if kept.len() == COSTS_KEPT {
+            kept.remove(0);
+        }
+        kept.push(seconds / work.pixels as f64);
+    }
+
+    /// The frame is over: from the next one on, the camera is still unless it moves again.
+    pub fn end_frame(&mut self) {
+        self.moving = false;
+    }
+
+    /// Whether this frame's work is done: a moving camera gets one preview iteration a frame
+    /// (the next frame's view replaces it).
+    pub fn frame_done(&self, work: &Work) -> bool {
+        self.moving && work.scale > 1 && work.finished
+    }
+}

@@ -1,0 +1,214 @@
+//! The viewer's frame budget (`session::refine`): an iteration run in row bands is the whole
+//! iteration bit for bit; the image shown in the middle of one, and a preview blended in, are
+//! what the film's sums and the preview's say (computed here on the CPU); and after a camera
+//! move, previews and bands leave the film exactly what a fresh render of the new view gives.
+
+mod common;
+
+use rastergi::gather::GatherMethod;
+use rastergi::gpu::Gpu;
+use rastergi::gpu::consts::{FILM_DIRECT, FILM_INDIRECT};
+use rastergi::passes::film::{FilmState, Show};
+use rastergi::progressive::{Denoising, Progressive};
+use rastergi::renderer::Renderer;
+use rastergi::scene::{Scene, cornell_box};
+use rastergi::session::interactive::Interactive;
+use rastergi::settings::RenderSettings;
+
+/// An image size whose height is no multiple of the bands' rows nor of the 8-row workgroups.
+const SIZE: (u32, u32) = (40, 27);
+
+fn settings(gather: GatherMethod) -> RenderSettings {
+    RenderSettings {
+        width: SIZE.0,
+        height: SIZE.1,
+        photons: 1 << 13,
+        grid_resolution: 10,
+        gather,
+        pass_iterations: 2,
+        seed: 5,
+        ..Default::default()
+    }
+}
+
+/// The mean of the full image at pixel `p` of `s`, from its sums, with `n` iterations there.
+fn mean(s: &FilmState, p: usize, n: u32) -> [f32; 3] {
+    let pixels = (s.width * s.height) as usize;
+    let at = |c: u32, ch: usize| s.sums[(c as usize * pixels + p) * 4 + ch];
+    [0, 1, 2].map(|ch| if n == 0 { 0.0 } else { (at(FILM_DIRECT, ch) + at(FILM_INDIRECT, ch)) / n as f32 })
+}
+
+#[test]
+fn an_iteration_in_row_bands_is_the_whole_iteration_bit_for_bit() {
+    let gpu = common::gpu();
+    let scene = cornell_box();
+    for gather in [GatherMethod::Trace, GatherMethod::Raster] {
+        let mut whole = Renderer::new(&gpu, &scene, settings(gather)).unwrap();
+        let mut banded = Renderer::new(&gpu, &scene, settings(gather)).unwrap();
+        whole.enable_denoiser().unwrap();
+        banded.enable_denoiser().unwrap();
+        // Five iterations, photon passes of two: bands of 5 rows (the last of 2), then 1, 13.
+        for (i, rows) in [5, 5, 1, 13, 5].into_iter().enumerate() {
+            whole.iterate().unwrap();
+            let mut bands = 0;
+            while !banded.iterate_rows(rows).unwrap() {
+                bands += 1;
+                assert_eq!(banded.rows_ahead(), (bands * rows).min(SIZE.1));
+                assert_eq!(banded.samples(), i as u32, "an iteration counts once its last band is in");
+            }
+            assert_eq!(bands, SIZE.1.div_ceil(rows) - 1);
+            assert_eq!(banded.rows_ahead(), 0);
+        }
+        let (a, b) = (whole.film_state().unwrap(), banded.film_state().unwrap());
+        assert!(a.sums == b.sums && a.half == b.half, "{gather:?}: the banded film differs from the whole one");
+        assert_eq!((a.samples, a.half_samples), (b.samples, b.half_samples));
+        assert!(
+            whole.read_guides().unwrap() == banded.read_guides().unwrap(),
+            "{gather:?}: the denoiser's guides differ"
+        );
+    }
+}
+
+#[test]
+fn the_image_in_the_middle_of_a_banded_iteration_counts_its_rows_once_more() {
+    let gpu = common::gpu();
+    let mut r = Renderer::new(&gpu, &cornell_box(), settings(GatherMethod::Trace)).unwrap();
+    for _ in 0..2 {
+        r.iterate().unwrap();
+    }
+    assert!(!r.iterate_rows(11).unwrap());
+    let state = r.film_state().unwrap();
+    let shown = r.read_linear(Show::Full).unwrap();
+    for (p, got) in shown.pixels.iter().enumerate() {
+        let n = if (p as u32) / SIZE.0 < 11 { 3 } else { 2 };
+        let want = mean(&state, p, n);
+        for c in 0..3 {
+            assert!((got[c] - want[c]).abs() <= 1e-6 * want[c].abs().max(1.0), "pixel {p}: {got:?} against {want:?}");
+        }
+    }
+}
+
+/// The blend of `film` (with `rows_ahead`) and the preview `pre` weighted `w`, as
+/// `Film::encode_resolve_preview` documents it, at every pixel.
+fn blend(film: &FilmState, rows_ahead: u32, pre: &FilmState, pre_rows_ahead: u32, w: f32) -> Vec<[f32; 3]> {
+    let (fw, fh, pw, ph) = (film.width, film.height, pre.width, pre.height);
+    let mut out = Vec::new();
+    for y in 0..fh {
+        for x in 0..fw {
+            let n = film.samples + u32::from(y < rows_ahead);
+            let p = (y * fw + x) as usize;
+            let pixels = (fw * fh) as usize;
+            let sum = [0, 1, 2].map(|ch| {
+                film.sums[(FILM_DIRECT as usize * pixels + p) * 4 + ch]
+                    + film.sums[(FILM_INDIRECT as usize * pixels + p) * 4 + ch]
+            });
+            let px = (x as f32 + 0.5) * pw as f32 / fw as f32 - 0.5;
+            let py = (y as f32 + 0.5) * ph as f32 / fh as f32 - 0.5;
+            let (bx, by) = (px.floor(), py.floor());
+            let (fx, fy) = (px - bx, py - by);
+            let (mut taps, mut tw) = ([0.0f32; 3], 0.0f32);
+            for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                let qx = (bx + dx as f32).clamp(0.0, pw as f32 - 1.0) as u32;
+                let qy = (by + dy as f32).clamp(0.0, ph as f32 - 1.0) as u32;
+                let wt = if dx == 1 { fx } else { 1.0 - fx } * if dy == 1 { fy } else { 1.0 - fy };
+                let m = pre.samples + u32::from(qy < pre_rows_ahead);
+                if m > 0 && wt > 0.0 {
+                    let v = mean(pre, (qy * pw + qx) as usize, m);
+                    (0..3).for_each(|c| taps[c] += wt * v[c]);
+                    tw += wt;
+                }
+            }
+            let weight = n as f32;
+            let wp = if tw > 0.0 { w * tw / ((1.0 + weight) * (1.0 + weight)) } else { 0.0 };
+            let preview = taps.map(|t| if tw > 0.0 { t / tw } else { 0.0 });
+            let total = [0, 1, 2].map(|c| sum[c] + wp * preview[c]);
+            let all = weight + wp;
+            out.push(total.map(|t| if all == 0.0 { 0.0 } else { t / all }));
+        }
+    }
+    out
+}
+
+#[test]
+fn a_preview_is_blended_in_as_its_weight_and_the_films_iterations_say() {
+    let gpu = common::gpu();
+    let mut r = Renderer::new(&gpu, &cornell_box(), settings(GatherMethod::Trace)).unwrap();
+    for scale in [4, 2] {
+        for _ in 0..3 {
+            while !r.iterate_preview_rows(scale, 3).unwrap() {}
+        }
+    }
+    // The ½ preview one band into its fourth iteration; the film none, then one and a band.
+    assert!(!r.iterate_preview_rows(2, 4).unwrap());
+    let pre = r.preview_film(2).unwrap();
+    assert_eq!((pre.samples, pre.rows_ahead, pre.width, pre.height), (3, 4, 20, 14));
+    let pre_state = pre.read_state(&gpu).unwrap();
+    let check = |r: &Renderer, w: f32| {
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        r.encode_resolve_preview(&mut enc, (Show::Full, 0.0), (2, w));
+        gpu.queue.submit([enc.finish()]);
+        let shown = r.film().read_linear_buffer(&gpu).unwrap();
+        let want = blend(&r.film_state().unwrap(), r.rows_ahead(), &pre_state, 4, w);
+        for (p, (got, want)) in shown.pixels.iter().zip(&want).enumerate() {
+            for c in 0..3 {
+                assert!(
+                    (got[c] - want[c]).abs() <= 1e-5 * want[c].abs().max(1.0),
+                    "pixel {p}: {got:?} against {want:?}"
+                );
+            }
+        }
+    };
+    check(&r, 3.0);
+    r.iterate().unwrap();
+    assert!(!r.iterate_rows(9).unwrap());
+    check(&r, 3.0);
+    check(&r, 0.5);
+}
+
+/// A scene's renderer for the interactive tests: one fixed photon map, so that a fresh
+/// renderer's film and one continued after a move can agree bit for bit.
+fn fixed_map(gpu: &Gpu, scene: &Scene) -> Renderer {
+    let s = RenderSettings { photon_passes: 1, ..settings(GatherMethod::Trace) };
+    Renderer::new(gpu, scene, s).unwrap()
+}
+
+#[test]
+fn after_a_move_previews_and_bands_leave_the_film_of_a_fresh_render() {
+    const N: u32 = 4;
+    let gpu = common::gpu();
+    let scene = cornell_box();
+    let mut view = Interactive::new(Box::new(fixed_map(&gpu, &scene)), Show::Full, 0.0);
+    // A budget no iteration fits: the coarsest preview while moving, bands of a row or so.
+    view.set_frame_budget(1e-6);
+    let mut camera = scene.camera;
+    for step in 0..3 {
+        camera.eye += glam::Vec3::new(0.05, 0.02 * step as f32, 0.0);
+        view.set_camera(camera).unwrap();
+        assert_eq!(view.frame(u32::MAX).unwrap(), 0, "a moving camera gets a preview, not the window's iterations");
+        assert_eq!(view.renderer().samples(), 0);
+        let (scale, weight) = view.refine().blend().expect("a preview is shown while moving");
+        assert!(scale >= 2 && weight == 1.0, "{scale} {weight}");
+    }
+    // Still: the previews refine, then the window's iterations accumulate in bands.
+    let mut frames = 0;
+    while view.renderer().samples() < N {
+        view.frame(N - view.renderer().samples()).unwrap();
+        frames += 1;
+        assert!(frames < 10_000, "the view never converged");
+    }
+    assert!(view.refine().refined());
+    assert!(frames > (N * SIZE.1) as usize / 4, "{frames} frames: the window's iterations ran in bands");
+    // As many restarts as the view had (each turns the gather's directions on), to the same
+    // cameras.
+    let mut fresh = fixed_map(&gpu, &scene);
+    let mut c = scene.camera;
+    for step in 0..3 {
+        c.eye += glam::Vec3::new(0.05, 0.02 * step as f32, 0.0);
+        fresh.set_camera(c).unwrap();
+    }
+    for _ in 0..N {
+        fresh.iterate().unwrap();
+    }
+    let (a, b) = (view.renderer().film_state().unwrap(), fresh.film_state().unwrap());
+    assert!(a.sums == b.sums, "the film after the move differs from a fresh render of the view");
+}

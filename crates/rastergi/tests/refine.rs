@@ -9,7 +9,7 @@ use rastergi::gather::GatherMethod;
 use rastergi::gpu::Gpu;
 use rastergi::gpu::consts::{FILM_DIRECT, FILM_INDIRECT};
 use rastergi::passes::film::{FilmState, Show};
-use rastergi::progressive::{Denoising, Progressive};
+use rastergi::progressive::Denoising;
 use rastergi::renderer::Renderer;
 use rastergi::scene::{Scene, cornell_box};
 use rastergi::session::interactive::Interactive;

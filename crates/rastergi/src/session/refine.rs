@@ -6,9 +6,10 @@
 //!   shared: [`Progressive::iterate_preview_rows`]) — at the finest s whose iteration fits the
 //!   budget by the measured cost per pixel, shown upscaled (bilinear). Where a whole iteration
 //!   of the window fits, the window's own iterations run instead.
-//! - **When it stops** the previews refine from there: [`LEVEL_ITERATIONS`] iterations at each
-//!   level, then the next finer one, then the window's own iterations, which accumulate in its
-//!   film as they always have. The display blends the finest preview that holds at least
+//! - **When it stops** the previews refine from there where a whole iteration of the window
+//!   takes longer than [`REFINE_ABOVE`]: [`LEVEL_ITERATIONS`] iterations at each level, then the
+//!   next finer one; then (at once, where it takes less) the window's own iterations, which
+//!   accumulate in its film as they always have. The display blends the finest preview that holds at least
 //!   half the iterations of the coarser one shown before into the film's mean, weighted as the
 //!   preview's iterations against the film's
 //!   ([`Progressive::encode_resolve_preview`]): the coarse image stays on screen until the fine
@@ -36,6 +37,10 @@ const LEVELS: usize = COARSEST.trailing_zeros() as usize + 1;
 /// level costs a quarter of the next, so the ladder from the coarsest level to the window
 /// costs about 4/3 of the finest preview's own iterations.
 pub const LEVEL_ITERATIONS: u32 = 4;
+
+/// Seconds of one iteration of the window above which the previews refine after a stop
+/// (below, the window's own iterations start at once).
+pub const REFINE_ABOVE: f64 = 1.0;
 
 /// Units of work whose cost per pixel each level keeps.
 const COSTS_KEPT: usize = 8;
@@ -169,7 +174,10 @@ impl Refine {
             self.level = self.fitting_level(w as u64 * h as u64);
             self.level_iterations = 0;
         }
-        if !self.previews {
+        // Still: the previews refine only where the window's own iteration would keep the
+        // image from changing for longer than REFINE_ABOVE (else they cost more than they show).
+        let whole = self.cost_at(0).map(|c| c * (w as u64 * h as u64) as f64);
+        if !self.previews || (!self.moving && whole.is_some_and(|t| t <= REFINE_ABOVE)) {
             self.level = 0;
         }
         let k = self.level;

@@ -49,15 +49,22 @@ pub trait Progressive: wgpu::WasmNotSend {
         None
     }
     /// Encodes the resolve of `show` blended with the preview at 1/`scale`, its mean weighted
-    /// as `weight` of the film's iterations ([`Film::encode_resolve_preview`]); the plain
-    /// resolve where there is no such preview.
-    fn encode_resolve_preview(
-        &self,
+    /// as `weight` of the film's iterations, and with what the view before the last camera
+    /// move held, re-projected ([`Progressive::reproject`]; [`Film::encode_resolve_blend`]);
+    /// the plain resolve where there is neither (the default).
+    fn encode_resolve_blend(
+        &mut self,
         enc: &mut wgpu::CommandEncoder,
         (show, exposure): (Show, f32),
-        (_scale, _weight): (u32, f32),
+        _preview: Option<(u32, f32)>,
     ) {
         self.encode_resolve(enc, show, exposure);
+    }
+    /// Re-projects what the film held before the last camera move onto the current view, for
+    /// the display ([`crate::passes::history`]); false where there is nothing to do (the
+    /// default: the path tracer keeps nothing).
+    fn reproject(&mut self) -> Result<bool> {
+        Ok(false)
     }
     /// Iterations accumulated since the last restart.
     fn samples(&self) -> u32;

@@ -10,9 +10,10 @@ use crate::gpu::Gpu;
 use crate::gpu_scene::GpuScene;
 use crate::image_io::{DisplayImage, LinearImage};
 use crate::passes::denoise::{DenoiseParams, Denoiser, GuideState, Guides};
-use crate::passes::film::{Film, FilmState, ImageResolve, Show};
+use crate::passes::film::{Blend, BlendResolve, Film, FilmState, ImageResolve, Show};
 use crate::passes::frame::{FrameBinding, FrameUniforms, pixel_jitter};
 use crate::passes::gbuffer::{GBufferPass, PixelPass};
+use crate::passes::history::History;
 use crate::passes::photon_view::PhotonView;
 use crate::passes::{FixedSample, FrameContext, IterationPass};
 use crate::photons::PhotonSettings;
@@ -39,6 +40,10 @@ pub struct Overrides {
 }
 
 pub use crate::fit::default_bundle;
+
+/// The most iterations the re-projected history of the view before a move counts for in the
+/// display ([`crate::passes::history`]): more would let a glossy surface's old view linger.
+pub const HISTORY_WEIGHT: u32 = 32;
 
 /// The passes whose resources depend on the image size.
 struct ImagePasses {
@@ -149,6 +154,12 @@ pub struct Renderer {
     /// Smaller images of the same view, made as a viewer asks for them
     /// ([`Renderer::iterate_preview_rows`]).
     previews: Vec<Preview>,
+    /// What the film held before the last camera move ([`crate::passes::history`]), made at
+    /// the first move, and whether it is re-projected onto the current view.
+    history: Option<History>,
+    reprojected: bool,
+    /// The resolves that blend previews (by scale; 0: none) and the history in.
+    blends: Vec<(u32, BlendResolve)>,
 }
 
 /// The view at 1/`scale` of the image's size, with its own passes and film (the scene and the
@@ -158,7 +169,6 @@ struct Preview {
     scale: u32,
     passes: ImagePasses,
     band: Option<Band>,
-    resolve: crate::passes::film::PreviewResolve,
 }
 
 impl Renderer {
@@ -244,6 +254,9 @@ impl Renderer {
             denoise: false,
             band: None,
             previews: Vec::new(),
+            history: None,
+            reprojected: false,
+            blends: Vec::new(),
         })
     }
 
@@ -267,6 +280,8 @@ impl Renderer {
         self.budget = new_budget(&self.gpu, &settings, &self.passes.film, self.photons.as_mut(), false);
         self.settings = settings;
         self.previews.clear();
+        (self.history, self.reprojected) = (None, false);
+        self.blends.clear();
         if self.denoise {
             self.passes.enable_denoiser(&self.gpu, &self.scene, &self.frame)?;
         }
@@ -308,12 +323,95 @@ impl Renderer {
         self.passes.film.samples
     }
 
-    /// Moves the camera; the image starts converging again.
+    /// Moves the camera; the image starts converging again. What the film held is kept for
+    /// the display ([`crate::passes::history`]) where it has iterations (at least as many as
+    /// the history kept before, up to 8: a view passed through quickly does not replace a
+    /// converged one).
     pub fn set_camera(&mut self, camera: Camera) -> Result<()> {
         camera.validate()?;
+        let kept = self.history.as_ref().map_or(0, |h| h.samples);
+        if self.passes.film.samples >= kept.clamp(1, 8) {
+            self.snapshot()?;
+        }
         self.camera = camera;
+        self.reprojected = false;
         self.reset();
         Ok(())
+    }
+
+    /// The frame of the current camera without jitter, for the whole image, and its
+    /// view-projection.
+    fn still_frame(&self) -> (FrameUniforms, glam::Mat4) {
+        let (w, h) = (self.settings.width, self.settings.height);
+        let (seed, samples) = (self.settings.seed, self.settings.light_samples);
+        let mut u = FrameUniforms::new(&self.camera, (w, h), &self.scene, 0, Vec2::ZERO, seed, samples);
+        u.texture_footprint = (self.settings.texture_filter == TextureFilter::Footprint) as u32;
+        let near = crate::passes::frame::near_plane(&self.scene.bounds);
+        (u, crate::passes::frame::view_projection(&self.camera, w, h, near, Vec2::ZERO))
+    }
+
+    /// Keeps the film's mean and what its pixels see, before a move.
+    fn snapshot(&mut self) -> Result<()> {
+        if self.history.is_none() {
+            let (scene, frame) = (&self.scene, &self.frame);
+            self.history = Some(History::new(&self.gpu, (scene, frame), (&self.passes.gbuffer, &self.passes.film)));
+            self.blends.clear();
+        }
+        let (u, view_proj) = self.still_frame();
+        self.frame.write(&self.gpu, &u);
+        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
+        {
+            let ctx = FrameContext {
+                gpu: &self.gpu,
+                scene: &self.scene,
+                frame: &self.frame,
+                map: self.photons.as_ref().map(PhotonPasses::map),
+                width: self.settings.width,
+                height: self.settings.height,
+                y0: 0,
+                rows: self.settings.height,
+                iteration: 0,
+                directions: self.settings.directions,
+                fixed: FixedSample::default(),
+            };
+            let history = self.history.as_mut().expect("made above");
+            history.encode_snapshot(&mut enc, &ctx, &self.passes.film, (Show::Full, view_proj))?;
+        }
+        self.gpu.queue.submit([enc.finish()]);
+        Ok(())
+    }
+
+    /// Re-projects the history onto the current view for the display: the window's G-buffer
+    /// of this camera (without jitter), then each pixel's kept mean where the old view saw the
+    /// same triangle. Nothing where there is no history, it is re-projected already, or an
+    /// iteration is under way in bands (it reads the G-buffer); returns whether it ran.
+    pub fn reproject(&mut self) -> Result<bool> {
+        if self.reprojected || self.band.is_some() || self.history.as_ref().is_none_or(|h| h.samples == 0) {
+            return Ok(false);
+        }
+        let (u, _) = self.still_frame();
+        self.frame.write(&self.gpu, &u);
+        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
+        {
+            let ctx = FrameContext {
+                gpu: &self.gpu,
+                scene: &self.scene,
+                frame: &self.frame,
+                map: self.photons.as_ref().map(PhotonPasses::map),
+                width: self.settings.width,
+                height: self.settings.height,
+                y0: 0,
+                rows: self.settings.height,
+                iteration: 0,
+                directions: self.settings.directions,
+                fixed: FixedSample::default(),
+            };
+            self.passes.gbuffer.encode(&mut enc, &ctx)?;
+            self.history.as_mut().expect("checked above").encode_reproject(&mut enc, &ctx)?;
+        }
+        self.gpu.queue.submit([enc.finish()]);
+        self.reprojected = true;
+        Ok(true)
     }
 
     /// Discards the accumulated iterations.
@@ -418,8 +516,7 @@ impl Renderer {
         let sampler = DirectionSampler::new(settings.seed);
         let passes =
             ImagePasses::new(&self.gpu, &self.scene, &self.frame, map, &settings, self.detail_bundle, sampler)?;
-        let resolve = self.passes.film.preview_resolve(&self.gpu, &passes.film);
-        Ok(Preview { scale, passes, band: None, resolve })
+        Ok(Preview { scale, passes, band: None })
     }
 
     /// The film of the preview at 1/`scale`, once made.
@@ -428,20 +525,35 @@ impl Renderer {
     }
 
     /// Encodes the resolve of `show` blended with the preview at 1/`scale` weighted as `weight`
-    /// iterations ([`Film::encode_resolve_preview`]); the plain resolve where there is none.
-    pub fn encode_resolve_preview(
-        &self,
+    /// iterations, and with the history re-projected onto this view where it is and shows
+    /// `show` (weighed as its iterations, at most [`HISTORY_WEIGHT`]; [`Film::encode_resolve_blend`]);
+    /// the plain resolve where there is neither.
+    pub fn encode_resolve_blend(
+        &mut self,
         enc: &mut wgpu::CommandEncoder,
         (show, exposure): (Show, f32),
-        (scale, weight): (u32, f32),
+        preview: Option<(u32, f32)>,
     ) {
-        match self.previews.iter().find(|p| p.scale == scale) {
-            Some(p) => {
-                let blend = crate::passes::film::PreviewBlend { resolve: &p.resolve, film: &p.passes.film, weight };
-                self.passes.film.encode_resolve_preview(&self.gpu, enc, (show, exposure), blend);
-            }
-            None => self.encode_resolve(enc, show, exposure),
+        let preview =
+            preview.and_then(|(scale, w)| self.previews.iter().position(|p| p.scale == scale).map(|k| (k, w)));
+        let history = self.history.as_ref().filter(|h| self.reprojected && h.samples > 0 && h.show == show);
+        if preview.is_none() && history.is_none() {
+            return self.encode_resolve(enc, show, exposure);
         }
+        let key = preview.map_or(0, |(k, _)| self.previews[k].scale);
+        let film = &self.passes.film;
+        if !self.blends.iter().any(|(s, _)| *s == key) {
+            let pre = preview.map(|(k, _)| &self.previews[k].passes.film);
+            let resolve = film.blend_resolve(&self.gpu, pre, self.history.as_ref().map(|h| &h.reprojected));
+            self.blends.push((key, resolve));
+        }
+        let resolve = &self.blends.iter().find(|(s, _)| *s == key).expect("made above").1;
+        let blend = Blend {
+            resolve,
+            preview: preview.map(|(k, w)| (&self.previews[k].passes.film, w)),
+            history_weight: history.map_or(0.0, |h| h.samples.min(HISTORY_WEIGHT) as f32),
+        };
+        film.encode_resolve_blend(&self.gpu, enc, (show, exposure), blend);
     }
 
     /// Begins an iteration: the photon pass it reads, the film's block, its uniforms.
@@ -731,8 +843,16 @@ impl Progressive for Renderer {
     fn preview_film(&self, scale: u32) -> Option<&Film> {
         Renderer::preview_film(self, scale)
     }
-    fn encode_resolve_preview(&self, enc: &mut wgpu::CommandEncoder, shown: (Show, f32), preview: (u32, f32)) {
-        Renderer::encode_resolve_preview(self, enc, shown, preview)
+    fn encode_resolve_blend(
+        &mut self,
+        enc: &mut wgpu::CommandEncoder,
+        shown: (Show, f32),
+        preview: Option<(u32, f32)>,
+    ) {
+        Renderer::encode_resolve_blend(self, enc, shown, preview)
+    }
+    fn reproject(&mut self) -> Result<bool> {
+        Renderer::reproject(self)
     }
     fn wait(&self) -> Result<()> {
         Renderer::wait(self)

@@ -82,8 +82,9 @@ struct Measured {
     frames: Vec<f64>,
     /// Seconds from the last move to the first frame whose film holds a whole iteration.
     to_full: Option<f64>,
-    /// The relative RMSE at each of [`MARKS`].
+    /// The relative RMSE at each of [`MARKS`], and the window's iterations then.
     errors: Vec<Option<f64>>,
+    iterations: Vec<u32>,
 }
 
 /// The camera `t` seconds into the move of `a` from `start`.
@@ -138,7 +139,7 @@ fn run_variant(
         }
     }
     // Still at the final camera: the clock runs but for the read-backs.
-    let (mut clock, mut to_full, mut errors) = (0.0, None, Vec::new());
+    let (mut clock, mut to_full, mut errors, mut iterations) = (0.0, None, Vec::new(), Vec::new());
     while errors.len() < MARKS.len() {
         let began = Instant::now();
         frame(&mut view)?;
@@ -154,9 +155,10 @@ fn run_variant(
             }
             let compared = rastergi::metrics::compare(&shown, reference, None);
             errors.push(Some(compared.relative_rmse));
+            iterations.push(view.renderer().samples());
         }
     }
-    Ok(Measured { frames, to_full, errors })
+    Ok(Measured { frames, to_full, errors, iterations })
 }
 
 /// The 100·q-th percentile of `v` (nearest rank).
@@ -243,8 +245,10 @@ pub fn run(a: &MotionArgs) -> Result<()> {
         println!("    from the last move to the first full-resolution iteration: {to_full}");
         let errors: Vec<String> = MARKS
             .iter()
-            .zip(&m.errors)
-            .map(|(t, e)| format!("{t} s {}", e.map_or("-".to_owned(), |e| format!("{:.1} %", 100.0 * e))))
+            .zip(m.errors.iter().zip(&m.iterations))
+            .map(|(t, (e, n))| {
+                format!("{t} s {} ({n} it.)", e.map_or("-".to_owned(), |e| format!("{:.1} %", 100.0 * e)))
+            })
             .collect();
         println!("    relRMSE against the converged view after the stop: {}", errors.join(", "));
         results.push(m);

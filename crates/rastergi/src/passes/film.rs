@@ -69,7 +69,7 @@ pub enum Show {
 }
 
 impl Show {
-    fn code(self) -> u32 {
+    pub(crate) fn code(self) -> u32 {
         match self {
             Show::Full => 0,
             Show::Direct => 1,
@@ -97,7 +97,9 @@ gpu_struct! {
         pub(crate) preview_samples: u32,
         pub(crate) preview_rows_ahead: u32,
         pub(crate) preview_weight: f32,
-        pub(crate) _pad: u32,
+        /// The weight of the re-projected history ([`crate::passes::history`]) in iterations,
+        /// before it fades; 0: none.
+        pub(crate) history_weight: f32,
     }
 }
 
@@ -157,32 +159,35 @@ pub fn resolve_group() -> Group {
             Slot::write::<[f32; 4]>(2, "linear_out"),
             Slot::write::<u32>(3, "display_out"),
             Slot::read::<[f32; 4]>(4, "preview"),
+            Slot::read::<[f32; 4]>(5, "history"),
         ],
     )
 }
 
-/// The resolve of a film blended with a smaller preview image of the same view
-/// ([`Film::preview_resolve`], [`Film::encode_resolve_preview`]).
-pub struct PreviewResolve {
+/// The resolve of a film blended with a smaller preview image of the same view and with the
+/// re-projected history of the view before a move ([`Film::blend_resolve`],
+/// [`Film::encode_resolve_blend`]).
+pub struct BlendResolve {
     uniforms: wgpu::Buffer,
     bind_group: wgpu::BindGroup,
 }
 
-/// A preview to blend into the film's resolve: its film (of the same view, smaller) and the
-/// weight of its mean in iterations of the film's.
+/// What to blend into the film's resolve: a preview's film (of the same view, smaller) and the
+/// weight of its mean in iterations of the film's; the history's weight.
 #[derive(Clone, Copy)]
-pub struct PreviewBlend<'a> {
-    pub resolve: &'a PreviewResolve,
-    pub film: &'a Film,
-    pub weight: f32,
+pub struct Blend<'a> {
+    pub resolve: &'a BlendResolve,
+    pub preview: Option<(&'a Film, f32)>,
+    pub history_weight: f32,
 }
 
-/// The resolve's bind group of `uniforms` over `source` (and the sums of `preview`, or
-/// `source` again where none is blended) into `linear` and `display`.
+/// The resolve's bind group of `uniforms` over `source` (and the sums of `preview` and the
+/// re-projected `history`, or `source` again where none is blended) into `linear` and
+/// `display`.
 fn bind_resolve(
     gpu: &Gpu,
     layout: &wgpu::BindGroupLayout,
-    (uniforms, source, preview): (&wgpu::Buffer, &wgpu::Buffer, Option<&wgpu::Buffer>),
+    (uniforms, source, preview, history): (&wgpu::Buffer, &wgpu::Buffer, Option<&wgpu::Buffer>, Option<&wgpu::Buffer>),
     (linear, display): (&wgpu::Buffer, &wgpu::Buffer),
 ) -> wgpu::BindGroup {
     resolve_group().bind(
@@ -194,6 +199,7 @@ fn bind_resolve(
             ("linear_out", linear.as_entire_binding()),
             ("display_out", display.as_entire_binding()),
             ("preview", preview.unwrap_or(source).as_entire_binding()),
+            ("history", history.unwrap_or(source).as_entire_binding()),
         ],
     )
 }
@@ -218,7 +224,7 @@ impl Film {
         );
         let device = &gpu.device;
         let layout = resolve_group().layout(device);
-        let bind_group = bind_resolve(gpu, &layout, (&uniforms, &accumulation, None), (&linear, &display));
+        let bind_group = bind_resolve(gpu, &layout, (&uniforms, &accumulation, None, None), (&linear, &display));
         let module = shader::module(device, "resolve", &resolve_source());
         let pipeline = compute_pipeline(device, "resolve", &module, "main", &[&layout], &[]);
         let image_pipeline = compute_pipeline(device, "resolve image", &module, "resolve_image", &[&layout], &[]);
@@ -352,45 +358,55 @@ impl Film {
         self.dispatch_resolve(gpu, enc, "resolve", resolve, &u);
     }
 
-    /// The resolve into this film's buffers of its mean blended with `preview`'s (made by
-    /// [`preview_resolve`](Self::preview_resolve) for that film).
-    pub fn preview_resolve(&self, gpu: &Gpu, preview: &Film) -> PreviewResolve {
+    /// The resolve into this film's buffers of its mean blended with `preview`'s and with the
+    /// re-projected `history` (where given).
+    pub fn blend_resolve(&self, gpu: &Gpu, preview: Option<&Film>, history: Option<&wgpu::Buffer>) -> BlendResolve {
         let uniforms = gpu.zeroed_buffer(
             "resolve preview uniforms",
             std::mem::size_of::<ResolveUniforms>() as u64,
             wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         );
-        let sources = (&uniforms, &self.accumulation, Some(&preview.accumulation));
+        let sources = (&uniforms, &self.accumulation, preview.map(|p| &p.accumulation), history);
         let bind_group = bind_resolve(gpu, &self.layout, sources, (&self.linear, &self.display));
-        PreviewResolve { uniforms, bind_group }
+        BlendResolve { uniforms, bind_group }
     }
 
-    /// Encodes the resolve of the film's mean blended with a preview's: at each pixel, with
-    /// n = S + [y < rows ahead] the film's iterations there,
+    /// Encodes the resolve of the film's mean blended with the history and a preview: at each
+    /// pixel, with n = S + [y < rows ahead] the film's iterations there,
     ///
-    ///     n · mean_film + w' · mean_preview
-    ///     ─────────────────────────────────,   w' = w / (1 + n)²,
-    ///              n + w'
+    /// ```text
+    /// n · mean_film + h' · history + w' · mean_preview
+    /// ────────────────────────────────────────────────,
+    ///                 n + h' + w'
     ///
+    /// h' = h / (1 + n/h)   where the history is valid here (0 elsewhere),
+    /// w' = w / (1 + n + h')²,
+    /// ```
+    ///
+    /// `history` the re-projected mean of the view before the move ([`crate::passes::history`],
+    /// weighed as h of the film's iterations, fading as 1/n once the film has as many),
     /// `mean_preview` the preview's mean bilinearly interpolated at the pixel's centre (from
-    /// its pixels that hold an iteration), `w` the blend's weight (0 where no tap holds one).
-    /// The preview alone before the film has an iteration, then fading fast: its blur is a
-    /// bias, which must not outlast the film's noise. The film's sums are not touched: the
-    /// blend is what the window shows, and it converges to the film's mean.
-    pub fn encode_resolve_preview(
+    /// its pixels that hold an iteration), w its weight (0 where no tap holds one): the
+    /// preview where nothing better is known, then fading fast, since its blur is a bias that
+    /// must not outlast the film's noise. The film's sums are not touched: the blend is what
+    /// the window shows, and it converges to the film's mean.
+    pub fn encode_resolve_blend(
         &self,
         gpu: &Gpu,
         enc: &mut wgpu::CommandEncoder,
         (show, exposure): (Show, f32),
-        preview: PreviewBlend,
+        blend: Blend,
     ) {
-        let resolve = (&self.pipeline, &preview.resolve.bind_group, &preview.resolve.uniforms);
+        let resolve = (&self.pipeline, &blend.resolve.bind_group, &blend.resolve.uniforms);
         let mut u = self.resolve_uniforms(self.samples, show, exposure);
-        u.preview_size = [preview.film.width, preview.film.height];
-        u.preview_samples = preview.film.samples;
-        u.preview_rows_ahead = preview.film.rows_ahead;
-        u.preview_weight = preview.weight;
-        self.dispatch_resolve(gpu, enc, "resolve preview", resolve, &u);
+        if let Some((film, weight)) = blend.preview {
+            u.preview_size = [film.width, film.height];
+            u.preview_samples = film.samples;
+            u.preview_rows_ahead = film.rows_ahead;
+            u.preview_weight = weight;
+        }
+        u.history_weight = blend.history_weight;
+        self.dispatch_resolve(gpu, enc, "resolve blend", resolve, &u);
     }
 
     /// The resolve's uniforms of the film's sums as they stand, without a preview.
@@ -405,7 +421,7 @@ impl Film {
             preview_samples: 0,
             preview_rows_ahead: 0,
             preview_weight: 0.0,
-            _pad: 0,
+            history_weight: 0.0,
         }
     }
 
@@ -434,7 +450,7 @@ impl Film {
             std::mem::size_of::<ResolveUniforms>() as u64,
             wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         );
-        let bind_group = bind_resolve(gpu, &self.layout, (&uniforms, image, None), (&self.linear, &self.display));
+        let bind_group = bind_resolve(gpu, &self.layout, (&uniforms, image, None, None), (&self.linear, &self.display));
         ImageResolve { uniforms, bind_group }
     }
 

@@ -16,6 +16,7 @@ pub mod display;
 pub mod film;
 pub mod frame;
 pub mod gbuffer;
+pub mod history;
 pub mod photon_view;
 pub mod specular;
 

@@ -10,6 +10,9 @@
 // A preview's sums (a smaller image of the same view, the film's layout), blended in where
 // params.preview_size is not 0 × 0; the film's own sums otherwise, unread.
 @group(0) @binding(4) var<storage, read> preview: array<vec4f>;
+// The history of the view before a camera move, re-projected (history.wgsl: rgb, w = 1 where
+// valid), blended in where params.history_weight > 0.
+@group(0) @binding(5) var<storage, read> history: array<vec4f>;
 
 // The film's layout, without the frame: `film_add` is not used here.
 fn film_slot(component: u32, pixel: u32, n_pixels: u32) -> u32 {
@@ -90,11 +93,19 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     // The film's iterations at this pixel: one more in the rows an iteration under way in
     // bands has reached.
     var total = shown_film(pixel, n);
-    var weight = f32(params.samples + select(0u, 1u, gid.y < params.rows_ahead));
+    let iterations = f32(params.samples + select(0u, 1u, gid.y < params.rows_ahead));
+    var weight = iterations;
+    if params.history_weight > 0.0 {
+        // The history's weight h fades as 1/(1 + n/h) with the film's n iterations here.
+        let h = history[pixel];
+        let w = params.history_weight * h.w / (1.0 + iterations / params.history_weight);
+        total += w * h.rgb;
+        weight += w;
+    }
     if params.preview_size.x > 0u && params.preview_weight > 0.0 {
-        // The preview's weight fades as (1 + S)⁻² with the film's S iterations here: all of
-        // the image before the film has one, a quarter of its weight at the first, then
-        // gone before its blur (a bias) could outlast the film's noise (which falls as 1/S).
+        // The preview's weight fades as (1 + n + h')⁻²: all of the image where nothing else
+        // is known, a quarter of its weight at the first iteration, then gone before its blur
+        // (a bias) could outlast the film's noise (which falls as 1/n).
         let p = preview_mean(gid.xy);
         let w = params.preview_weight * p.a / ((1.0 + weight) * (1.0 + weight));
         total += w * p.rgb;

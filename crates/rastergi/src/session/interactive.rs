@@ -55,6 +55,12 @@ impl Interactive {
     pub fn frame(&mut self, limit: u32) -> Result<u32> {
         let start = web_time::Instant::now();
         let budget = self.refine.budget();
+        // What the view before a move held, re-projected onto this one (once per view; while
+        // moving, where it takes at most half the budget).
+        if budget > 0.0 && self.refine.reprojection_fits() && self.renderer.reproject()? {
+            self.renderer.wait()?;
+            self.refine.reprojected(start.elapsed().as_secs_f64());
+        }
         let mut finished = 0;
         loop {
             let left = budget - start.elapsed().as_secs_f64();
@@ -69,6 +75,13 @@ impl Interactive {
         }
         self.refine.end_frame();
         Ok(finished)
+    }
+
+    /// Re-projects what the view before the last move held onto this one for the display,
+    /// without waiting (a web page's frame, before its [`Interactive::step`]s); false where
+    /// there was nothing to do.
+    pub fn reproject(&mut self) -> Result<bool> {
+        self.renderer.reproject()
     }
 
     /// One unit of a frame's work without waiting for it (a web page, which cannot block):
@@ -192,10 +205,7 @@ impl Interactive {
             }
         } else {
             let show = if self.renderer.has(self.show) { self.show } else { Show::Full };
-            match self.refine.blend() {
-                Some(preview) => self.renderer.encode_resolve_preview(enc, (show, self.exposure), preview),
-                None => self.renderer.encode_resolve(enc, show, self.exposure),
-            }
+            self.renderer.encode_resolve_blend(enc, (show, self.exposure), self.refine.blend());
             self.denoised.clear();
         }
         Ok(())

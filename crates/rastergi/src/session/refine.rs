@@ -79,6 +79,8 @@ pub struct Refine {
     shown: Option<(u32, u32)>,
     /// Whether the renderer draws previews (the path tracer does not).
     previews: bool,
+    /// Seconds the last re-projection of the history took ([`Progressive::reproject`]).
+    reprojection: Option<f64>,
 }
 
 impl Refine {
@@ -92,7 +94,19 @@ impl Refine {
             moving: true,
             shown: None,
             previews: true,
+            reprojection: None,
         }
+    }
+
+    /// Whether this frame re-projects the history: always while still, while moving where the
+    /// last one took at most half the budget.
+    pub fn reprojection_fits(&self) -> bool {
+        !self.moving || self.reprojection.is_none_or(|t| t <= 0.5 * self.budget)
+    }
+
+    /// A re-projection took `seconds`.
+    pub fn reprojected(&mut self, seconds: f64) {
+        self.reprojection = Some(seconds);
     }
 
     /// The budget in seconds (0: off).

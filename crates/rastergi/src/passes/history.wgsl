@@ -1,0 +1,81 @@
+// History (history.rs): what the film held before a camera move, kept and re-projected onto
+// the new view for the display. Prelude: the per-pixel passes' (scene, frame, visible points,
+// film); bind group 3 below.
+
+@group(3) @binding(0) var<uniform> history_params: HistoryParams;
+// Per pixel of the view before the move: the film's mean of the shown component (rgb) and what
+// it saw (w, bitcast `seen_key`).
+@group(3) @binding(1) var<storage, read_write> history: array<vec4f>;
+// Per pixel of the new view: the history's mean where the same triangle is seen through the
+// old view (rgb, w = 1), else 0.
+@group(3) @binding(2) var<storage, read_write> reprojected: array<vec4f>;
+
+// The film's mean of the shown component at pixel `p` of the view before the move.
+fn film_mean(p: u32, y: u32) -> vec3f {
+    let n = frame.resolution.x * frame.resolution.y;
+    let direct = film[film_slot(FILM_DIRECT, p, n)].rgb;
+    let indirect = film[film_slot(FILM_INDIRECT, p, n)].rgb;
+    var sum = direct + indirect;
+    switch history_params.show {
+        case 1u: { sum = direct; }
+        case 2u: { sum = indirect; }
+        case 3u: { sum = film[film_slot(FILM_PHOTON_VIEW, p, n)].rgb; }
+        default: {}
+    }
+    let samples = history_params.samples + select(0u, 1u, y < history_params.rows_ahead);
+    return sum / f32(max(samples, 1u));
+}
+
+// What G-buffer texel `g` sees from the frame's eye: 0 the sky, else the triangle + 1 and, in
+// the top bit, whether it is its back (a wall seen from outside is not its inside).
+fn seen_key(g: vec4u) -> u32 {
+    if g.x == 0u {
+        return 0u;
+    }
+    let s = surface_at(g.x - 1u, bitcast<f32>(g.y), bitcast<f32>(g.z), bitcast<f32>(g.w));
+    let back = dot(s.normal, frame.eye - s.pos) < 0.0;
+    return g.x | select(0u, 0x80000000u, back);
+}
+
+// Before the move (the frame still the old view's): keeps the film's mean and what each pixel
+// sees.
+@compute @workgroup_size(8, 8)
+fn snapshot(@builtin(global_invocation_id) id: vec3u) {
+    let gid = band_pixel(id);
+    if !begin_pixel(gid.xy) { return; }
+    let p = pixel_index(gid.xy);
+    let g = textureLoad(gbuffer, gid.xy, 0);
+    history[p] = vec4f(film_mean(p, gid.y), bitcast<f32>(seen_key(g)));
+}
+
+// After it (the frame and the G-buffer the new view's, without jitter): the old view's pixel
+// that saw this pixel's point (the sky: its direction), if it saw the same side of the same
+// triangle there.
+@compute @workgroup_size(8, 8)
+fn reproject(@builtin(global_invocation_id) id: vec3u) {
+    let gid = band_pixel(id);
+    if !begin_pixel(gid.xy) { return; }
+    let p = pixel_index(gid.xy);
+    reprojected[p] = vec4f(0.0);
+    let g = textureLoad(gbuffer, gid.xy, 0);
+    var clip: vec4f;
+    if g.x == 0u {
+        clip = history_params.view_proj * vec4f(camera_ray(vec2f(gid.xy) + 0.5), 0.0);
+    } else {
+        let s = surface_at(g.x - 1u, bitcast<f32>(g.y), bitcast<f32>(g.z), bitcast<f32>(g.w));
+        clip = history_params.view_proj * vec4f(s.pos, 1.0);
+    }
+    if clip.w <= 0.0 {
+        return;
+    }
+    let ndc = clip.xy / clip.w;
+    let res = vec2f(frame.resolution);
+    let q = floor(vec2f(0.5 * (ndc.x + 1.0), 0.5 * (1.0 - ndc.y)) * res);
+    if any(q < vec2f(0.0)) || any(q >= res) {
+        return;
+    }
+    let h = history[u32(q.y) * frame.resolution.x + u32(q.x)];
+    if bitcast<u32>(h.w) == seen_key(g) {
+        reprojected[p] = vec4f(h.rgb, 1.0);
+    }
+}

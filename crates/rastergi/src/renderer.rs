@@ -44,6 +44,12 @@ pub use crate::fit::default_bundle;
 /// The most iterations the re-projected history of the view before a move counts for in the
 /// display ([`crate::passes::history`]): more would let a glossy surface's old view linger.
 pub const HISTORY_WEIGHT: u32 = 32;
+/// The film's iterations from which a preview is no longer blended in (its weight
+/// w/(1 + n)² is then below 0.4 % of the film's for w ≤ 4).
+pub const PREVIEW_FADED: u32 = 32;
+/// The film's iterations, in multiples of the history's weight h, from which the history is no
+/// longer blended in (its share h'/(n + h') is then below 1/HISTORY_FADED).
+pub const HISTORY_FADED: u32 = 64;
 
 /// The passes whose resources depend on the image size.
 struct ImagePasses {
@@ -534,9 +540,17 @@ impl Renderer {
         (show, exposure): (Show, f32),
         preview: Option<(u32, f32)>,
     ) {
-        let preview =
-            preview.and_then(|(scale, w)| self.previews.iter().position(|p| p.scale == scale).map(|k| (k, w)));
-        let history = self.history.as_ref().filter(|h| self.reprojected && h.samples > 0 && h.show == show);
+        // Each is dropped once its weight has faded below a few parts in a thousand of the
+        // film's: the preview's w/(1 + n)² from n = PREVIEW_FADED, the history's share
+        // h'/(n + h') ≤ h/n from n = HISTORY_FADED · h.
+        let n = self.passes.film.samples;
+        let preview = preview
+            .filter(|_| n < PREVIEW_FADED)
+            .and_then(|(scale, w)| self.previews.iter().position(|p| p.scale == scale).map(|k| (k, w)));
+        let history = self.history.as_ref().filter(|h| {
+            let h_weight = h.samples.min(HISTORY_WEIGHT);
+            self.reprojected && h.samples > 0 && h.show == show && n < HISTORY_FADED * h_weight
+        });
         if preview.is_none() && history.is_none() {
             return self.encode_resolve(enc, show, exposure);
         }

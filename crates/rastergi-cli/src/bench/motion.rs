@@ -85,6 +85,8 @@ struct Measured {
     /// The relative RMSE at each of [`MARKS`], and the window's iterations then.
     errors: Vec<Option<f64>>,
     iterations: Vec<u32>,
+    /// The share of the frames' time after the stop spent on the resolve and display pass.
+    drawing: f64,
 }
 
 /// The camera `t` seconds into the move of `a` from `start`.
@@ -112,13 +114,19 @@ fn run_variant(
     let mut view = Interactive::new(Box::new(renderer), Show::Full, 0.0);
     view.set_frame_budget(budget);
     let mut target = DisplayTarget::offscreen(gpu, settings.width, settings.height)?;
-    let mut frame = |view: &mut Interactive| -> Result<()> {
+    // A frame: its work, then the resolve and the display pass; returns the seconds of each.
+    let mut frame = |view: &mut Interactive| -> Result<(f64, f64)> {
+        let began = Instant::now();
         view.frame(u32::MAX)?;
+        let work = began.elapsed().as_secs_f64();
+        // As the viewer: the resolve when due, the display pass every frame.
         let mut enc = gpu.device.create_command_encoder(&Default::default());
-        view.encode_resolve(&mut enc, 0.0)?;
+        if view.display_due() {
+            view.encode_resolve(&mut enc, 0.0)?;
+        }
         target.present(gpu, enc, Some(view.renderer().film()), &[])?;
         gpu.wait()?;
-        Ok(())
+        Ok((work, began.elapsed().as_secs_f64() - work))
     };
     let start = Instant::now();
     while start.elapsed().as_secs_f64() < a.still {
@@ -138,27 +146,29 @@ fn run_variant(
             break;
         }
     }
-    // Still at the final camera: the clock runs but for the read-backs.
+    // Still at the final camera: the clock runs but for the read-backs. The image on screen at a
+    // mark is the last frame's that ended before it.
     let (mut clock, mut to_full, mut errors, mut iterations) = (0.0, None, Vec::new(), Vec::new());
+    let mut shown = (view.renderer().film().read_linear_buffer(gpu)?, view.renderer().samples());
+    let (mut work, mut drawing) = (0.0, 0.0);
     while errors.len() < MARKS.len() {
-        let began = Instant::now();
-        frame(&mut view)?;
-        clock += began.elapsed().as_secs_f64();
+        let (w, d) = frame(&mut view)?;
+        (work, drawing) = (work + w, drawing + d);
+        clock += w + d;
         if to_full.is_none() && view.renderer().samples() > 0 {
             to_full = Some(clock);
         }
-        while errors.len() < MARKS.len() && clock >= MARKS[errors.len()] {
-            let shown = view.renderer().film().read_linear_buffer(gpu)?;
+        while errors.len() < MARKS.len() && clock > MARKS[errors.len()] {
             if let Some(dir) = &a.images {
                 let name = format!("budget-{:.0}-at-{}.exr", 1e3 * budget, MARKS[errors.len()]);
-                rastergi::image_io::write_exr(&dir.join(name), &shown)?;
+                rastergi::image_io::write_exr(&dir.join(name), &shown.0)?;
             }
-            let compared = rastergi::metrics::compare(&shown, reference, None);
-            errors.push(Some(compared.relative_rmse));
-            iterations.push(view.renderer().samples());
+            errors.push(Some(rastergi::metrics::compare(&shown.0, reference, None).relative_rmse));
+            iterations.push(shown.1);
         }
+        shown = (view.renderer().film().read_linear_buffer(gpu)?, view.renderer().samples());
     }
-    Ok(Measured { frames, to_full, errors, iterations })
+    Ok(Measured { frames, to_full, errors, iterations, drawing: drawing / (work + drawing) })
 }
 
 /// The 100·q-th percentile of `v` (nearest rank).
@@ -251,6 +261,10 @@ pub fn run(a: &MotionArgs) -> Result<()> {
             })
             .collect();
         println!("    relRMSE against the converged view after the stop: {}", errors.join(", "));
+        println!(
+            "    after the stop: {:.0} % of the frames' time drawing (the resolve and the display pass)",
+            100.0 * m.drawing
+        );
         results.push(m);
     }
     let (before, after) = (&results[0], &results[1]);

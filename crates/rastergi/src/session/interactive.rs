@@ -25,12 +25,36 @@ pub struct Interactive {
     denoised: Schedule,
     /// What each frame draws, coarse to fine, within the frame budget.
     refine: Refine,
+    /// When the last frame's work ended, and the seconds the rest of a frame took since
+    /// (the front end's resolve, display and input; a running mean): the work gets the budget
+    /// less that.
+    work_ended: Option<web_time::Instant>,
+    rest: f64,
+    /// When the image was last resolved for display, and whether the camera has moved since.
+    displayed: Option<web_time::Instant>,
+    moved_since_display: bool,
 }
+
+/// While the camera is still, the image is resolved for display at most this often (seconds):
+/// a frame's band changes a few rows, and on a slow device the resolve costs a good part of a
+/// frame.
+pub const DISPLAY_INTERVAL: f64 = 0.2;
 
 impl Interactive {
     pub fn new(renderer: Box<dyn Progressive>, show: Show, exposure: f32) -> Interactive {
         let refine = Refine::new(super::refine::DEFAULT_FRAME_BUDGET);
-        Interactive { renderer, show, exposure, denoise: false, denoised: Schedule::default(), refine }
+        Interactive {
+            renderer,
+            show,
+            exposure,
+            denoise: false,
+            denoised: Schedule::default(),
+            refine,
+            work_ended: None,
+            rest: 0.0,
+            displayed: None,
+            moved_since_display: true,
+        }
     }
 
     /// The frame budget in seconds (0: one whole iteration a frame).
@@ -50,11 +74,22 @@ impl Interactive {
     /// One frame's work, waited for: units of work ([`Refine::step`]) until the frame budget is
     /// spent — one preview iteration while the camera moves, the previews' refinement after it
     /// stops, then the window's own iterations, in row bands where one is longer than the
-    /// budget — with at most `limit` of the window's iterations finished. Returns the
-    /// window's iterations it finished.
+    /// budget — with at most `limit` of the window's iterations finished. The budget is the
+    /// whole frame's: the work gets it less what the rest of the recent frames took (their
+    /// resolve, display and input, measured from the end of one frame's work to the start of
+    /// the next's). Returns the window's iterations it finished.
     pub fn frame(&mut self, limit: u32) -> Result<u32> {
         let start = web_time::Instant::now();
-        let budget = self.refine.budget();
+        if let Some(ended) = self.work_ended {
+            // A stall (a dragged window, a build) is not a frame's rest.
+            let rest = start.duration_since(ended).as_secs_f64().min(self.refine.budget());
+            self.rest = if self.rest == 0.0 { rest } else { 0.75 * self.rest + 0.25 * rest };
+        }
+        let budget = if self.refine.budget() > 0.0 {
+            (self.refine.budget() - self.rest).max(0.25 * self.refine.budget())
+        } else {
+            0.0
+        };
         // What the view before a move held, re-projected onto this one (once per view; while
         // moving, where it takes at most half the budget).
         if budget > 0.0 && self.refine.reprojection_fits() && self.renderer.reproject()? {
@@ -74,6 +109,7 @@ impl Interactive {
             }
         }
         self.refine.end_frame();
+        self.work_ended = Some(web_time::Instant::now());
         Ok(finished)
     }
 
@@ -123,6 +159,7 @@ impl Interactive {
         self.renderer = renderer;
         self.denoised.clear();
         self.refine.restart();
+        self.moved_since_display = true;
         Ok(())
     }
 
@@ -133,6 +170,7 @@ impl Interactive {
         if resized {
             self.denoised.clear();
             self.refine.restart();
+            self.moved_since_display = true;
         }
         Ok(resized)
     }
@@ -148,6 +186,7 @@ impl Interactive {
         self.renderer.set_camera(camera)?;
         self.denoised.clear();
         self.refine.moved();
+        self.moved_since_display = true;
         Ok(())
     }
 
@@ -161,6 +200,7 @@ impl Interactive {
         }
         self.denoise = on;
         self.denoised.clear();
+        self.moved_since_display = true;
         if self.renderer.samples() == 0 {
             self.refine.restart();
         }
@@ -181,16 +221,33 @@ impl Interactive {
     /// that filters at once): the next denoised image is filtered at once.
     pub fn invalidate(&mut self) {
         self.denoised.clear();
+        self.moved_since_display = true;
         if self.renderer.samples() == 0 && self.renderer.rows_ahead() == 0 {
             // A restart: the previews of the view before are gone.
             self.refine.restart();
         }
     }
 
+    /// The display buffer was overwritten (a screenshot's read): resolve it again next frame.
+    pub fn redisplay(&mut self) {
+        self.moved_since_display = true;
+    }
+
+    /// Whether the image should be resolved for display this frame: always with the budget off,
+    /// after a camera move or any change but iterations ([`Interactive::invalidate`]), and at
+    /// most every [`DISPLAY_INTERVAL`] while the camera is still (the front end presents its
+    /// last image meanwhile, with its panel).
+    pub fn display_due(&self) -> bool {
+        self.refine.budget() <= 0.0
+            || self.moved_since_display
+            || self.displayed.is_none_or(|t| t.elapsed().as_secs_f64() >= DISPLAY_INTERVAL)
+    }
+
     /// Encodes the resolve of what is shown into the film's display buffer: the raw image of
     /// the shown component, or the denoised full image, filtered again first when the schedule
     /// says so at `now` (seconds from any fixed origin).
     pub fn encode_resolve(&mut self, enc: &mut wgpu::CommandEncoder, now: f64) -> Result<()> {
+        (self.displayed, self.moved_since_display) = (Some(web_time::Instant::now()), false);
         let samples = self.renderer.samples();
         // The denoiser filters whole iterations (not one under way in bands), from the first.
         let whole = self.renderer.rows_ahead() == 0;

@@ -157,13 +157,13 @@ impl Refine {
         Some(c[c.len() / 2])
     }
 
-    /// The finest level whose whole iteration of `pixels` (the window's) fits the budget; the
-    /// coarsest while nothing is measured.
-    fn fitting_level(&self, pixels: u64) -> usize {
+    /// The finest level whose whole iteration of `pixels` (the window's) fits in `seconds`;
+    /// the coarsest while nothing is measured.
+    fn fitting_level(&self, pixels: u64, seconds: f64) -> usize {
         (0..LEVELS)
             .find(|&k| {
                 let p = pixels as f64 / f64::from(scale(k) * scale(k));
-                self.cost_at(k).is_some_and(|c| c * p <= self.budget)
+                self.cost_at(k).is_some_and(|c| c * p <= seconds)
             })
             .unwrap_or(LEVELS - 1)
     }
@@ -185,7 +185,7 @@ impl Refine {
         if self.moving {
             // While moving: the finest level whose iteration fits (the window's own where it
             // does).
-            self.level = self.fitting_level(w as u64 * h as u64);
+            self.level = self.fitting_level(w as u64 * h as u64, left);
             self.level_iterations = 0;
         }
         // Still: the previews refine only where the window's own iteration would keep the

@@ -366,8 +366,15 @@ impl App {
     fn encode_resolve(&mut self, enc: &mut egui_wgpu::wgpu::CommandEncoder, show: Show) -> Result<()> {
         let now = self.clock.elapsed().as_secs_f64();
         if let Some((view, _)) = &mut self.renderer {
-            (view.show, view.exposure) = (show, self.controls.exposure);
-            view.encode_resolve(enc, now)?;
+            if (view.show, view.exposure) != (show, self.controls.exposure) {
+                (view.show, view.exposure) = (show, self.controls.exposure);
+                view.invalidate();
+            }
+            // While the camera is still the image is resolved a few times a second (the last
+            // one stays on screen); the panel is drawn every frame.
+            if view.display_due() {
+                view.encode_resolve(enc, now)?;
+            }
         }
         Ok(())
     }
@@ -394,9 +401,13 @@ impl App {
                     exposure,
                     camera_options(&renderer.camera())
                 );
-                // The denoiser's image now holds the current iterations' filter.
-                if denoised && let Some((view, _)) = &mut self.renderer {
-                    view.filtered(self.clock.elapsed().as_secs_f64());
+                // The denoiser's image now holds the current iterations' filter; the display
+                // buffer the saved image.
+                if let Some((view, _)) = &mut self.renderer {
+                    if denoised {
+                        view.filtered(self.clock.elapsed().as_secs_f64());
+                    }
+                    view.redisplay();
                 }
                 self.status = format!("saved {}", png.display());
             }

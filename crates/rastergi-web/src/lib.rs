@@ -2,9 +2,12 @@
 //! JavaScript (`web/main.js`) through [`Viewer`].
 //!
 //! The page owns the loop: on each animation frame it calls [`Viewer::frame`], which submits
-//! one iteration (while fewer than [`FRAMES_IN_FLIGHT`] are still on the GPU, so the queue
-//! does not grow faster than the GPU empties it) and draws the film's resolved image onto the
-//! canvas. Nothing here waits for the GPU: the read-backs (the error estimate, "save PNG")
+//! one unit of the library's interactive loop within its frame budget
+//! ([`rastergi::session::refine`]: a preview while the camera moves, row bands of an iteration
+//! longer than the budget, the view before a move re-projected), while fewer than
+//! [`FRAMES_IN_FLIGHT`] are still on the GPU (so the queue does not grow faster than the GPU
+//! empties it), and draws the image onto the canvas. The units' times come back from the
+//! GPU's completion callbacks, which the loop's cost model learns from. Nothing here waits for the GPU: the read-backs (the error estimate, "save PNG")
 //! return promises that the browser resolves once the GPU has answered
 //! (`rastergi::gpu::Gpu::read_buffer_async`).
 //!
@@ -18,8 +21,8 @@
 #![cfg(target_arch = "wasm32")]
 
 use std::path::Path;
-use std::sync::Arc;
 use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::{Arc, Mutex};
 
 use rastergi::camera_control::{CameraControl, DRAG_RADIANS_PER_PIXEL, MoveKeys};
 use rastergi::gather::GatherMethod;
@@ -30,6 +33,7 @@ use rastergi::progressive::Progressive;
 
 use rastergi::scene::{Files, GltfOptions, MemoryFiles, Scene, SunAngles};
 use rastergi::session::interactive::Interactive;
+use rastergi::session::refine::Work;
 use rastergi::session::{Method, Session};
 use wasm_bindgen::prelude::*;
 
@@ -66,6 +70,9 @@ pub struct Viewer {
     control: CameraControl,
     options: Options,
     in_flight: Arc<AtomicU32>,
+    /// Units of work the GPU has finished since the last frame, with their seconds from
+    /// submission.
+    done: Arc<Mutex<Vec<(Work, f64)>>>,
 }
 
 /// Opens the browser's WebGPU adapter for `canvas` and shows the Cornell box at
@@ -124,6 +131,7 @@ pub async fn create_viewer(
         control,
         options,
         in_flight: Arc::new(AtomicU32::new(0)),
+        done: Arc::new(Mutex::new(Vec::new())),
     })
 }
 
@@ -304,21 +312,32 @@ impl Viewer {
         Ok(())
     }
 
-    /// One animation frame: an iteration (unless `limit` > 0 iterations are done, or the GPU
-    /// is [`FRAMES_IN_FLIGHT`] behind), then the image drawn onto the canvas. Returns the
-    /// iterations accumulated.
+    /// One animation frame: a unit of the interactive loop's work within its frame budget
+    /// (unless `limit` > 0 iterations are done, or the GPU is [`FRAMES_IN_FLIGHT`] behind),
+    /// then the image drawn onto the canvas. Returns the iterations accumulated.
     pub fn frame(&mut self, limit: u32) -> Result<u32, JsError> {
-        let done = limit > 0 && self.view.renderer().samples() >= limit;
-        if !done && self.in_flight.load(Ordering::Acquire) < FRAMES_IN_FLIGHT {
-            self.view.renderer_mut().iterate().map_err(error)?;
-            self.in_flight.fetch_add(1, Ordering::AcqRel);
-            let in_flight = self.in_flight.clone();
-            self.gpu.queue.on_submitted_work_done(move || {
-                in_flight.fetch_sub(1, Ordering::AcqRel);
-            });
+        let finished: Vec<(Work, f64)> = std::mem::take(&mut *self.done.lock().unwrap_or_else(|e| e.into_inner()));
+        for (work, seconds) in finished {
+            self.view.finished(&work, seconds);
+        }
+        let samples = self.view.renderer().samples();
+        let left = if limit > 0 { limit.saturating_sub(samples) } else { u32::MAX };
+        if left > 0 && self.in_flight.load(Ordering::Acquire) < FRAMES_IN_FLIGHT {
+            self.view.reproject().map_err(error)?;
+            if let Some(work) = self.view.step(self.view.frame_budget(), left).map_err(error)? {
+                self.in_flight.fetch_add(1, Ordering::AcqRel);
+                let (in_flight, done, submitted) = (self.in_flight.clone(), self.done.clone(), now());
+                self.gpu.queue.on_submitted_work_done(move || {
+                    done.lock().unwrap_or_else(|e| e.into_inner()).push((work, now() - submitted));
+                    in_flight.fetch_sub(1, Ordering::AcqRel);
+                });
+            }
+            self.view.end_frame();
         }
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
-        self.view.encode_resolve(&mut enc, now()).map_err(error)?;
+        if self.view.display_due() {
+            self.view.encode_resolve(&mut enc, now()).map_err(error)?;
+        }
         self.surface.present(&self.gpu, enc, Some(self.view.renderer().film()), &[]).map_err(error)?;
         self.gpu.check().map_err(error)?;
         Ok(self.view.renderer().samples())
@@ -450,7 +469,7 @@ impl Viewer {
     pub fn save_png(&mut self) -> js_sys::Promise {
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
         self.view.invalidate();
-        if let Err(e) = self.view.encode_resolve(&mut enc, now()) {
+        if let Err(e) = self.view.encode_resolve_unblended(&mut enc, now()) {
             return js_sys::Promise::reject(&JsValue::from(error(e)));
         }
         self.gpu.queue.submit([enc.finish()]);

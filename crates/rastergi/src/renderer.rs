@@ -43,13 +43,13 @@ pub use crate::fit::default_bundle;
 
 /// The most iterations the re-projected history of the view before a move counts for in the
 /// display ([`crate::passes::history`]): more would let a glossy surface's old view linger.
-pub const HISTORY_WEIGHT: u32 = 32;
+pub const HISTORY_WEIGHT: u32 = 16;
 /// The film's iterations from which a preview is no longer blended in (its weight
 /// w/(1 + n)² is then below 0.4 % of the film's for w ≤ 4).
 pub const PREVIEW_FADED: u32 = 32;
 /// The film's iterations, in multiples of the history's weight h, from which the history is no
 /// longer blended in (its share h'/(n + h') is then below 1/HISTORY_FADED).
-pub const HISTORY_FADED: u32 = 64;
+pub const HISTORY_FADED: u32 = 16;
 
 /// The passes whose resources depend on the image size.
 struct ImagePasses {

@@ -10,7 +10,7 @@
 //! same triangle (the outside of a wall is not its lit inside). For a
 //! Lambertian surface the radiance towards the eye does not depend on the view: the kept mean
 //! is that of the same surface a fraction of a pixel away; for a glossy one it is the old
-//! view's. The display weighs it as min(m, 32) iterations (m the old film's) fading as the new
+//! view's. The display weighs it as min(m, 16) iterations (m the old film's) fading as the new
 //! view's n iterations grow ([`crate::passes::film::Film::encode_resolve_blend`]): the film
 //! itself never holds it, so the image converges to exactly what it did.
 

@@ -248,6 +248,17 @@ impl Interactive {
     /// says so at `now` (seconds from any fixed origin).
     pub fn encode_resolve(&mut self, enc: &mut wgpu::CommandEncoder, now: f64) -> Result<()> {
         (self.displayed, self.moved_since_display) = (Some(web_time::Instant::now()), false);
+        self.encode_shown(enc, now, true)
+    }
+
+    /// [`Interactive::encode_resolve`] without the previews and the history blended in: the
+    /// render's own image, as a screenshot saves it (the next frame's display resolves again).
+    pub fn encode_resolve_unblended(&mut self, enc: &mut wgpu::CommandEncoder, now: f64) -> Result<()> {
+        self.moved_since_display = true;
+        self.encode_shown(enc, now, false)
+    }
+
+    fn encode_shown(&mut self, enc: &mut wgpu::CommandEncoder, now: f64, blend: bool) -> Result<()> {
         let samples = self.renderer.samples();
         // The denoiser filters whole iterations (not one under way in bands), from the first.
         let whole = self.renderer.rows_ahead() == 0;
@@ -262,7 +273,11 @@ impl Interactive {
             }
         } else {
             let show = if self.renderer.has(self.show) { self.show } else { Show::Full };
-            self.renderer.encode_resolve_blend(enc, (show, self.exposure), self.refine.blend());
+            if blend {
+                self.renderer.encode_resolve_blend(enc, (show, self.exposure), self.refine.blend());
+            } else {
+                self.renderer.encode_resolve(enc, show, self.exposure);
+            }
             self.denoised.clear();
         }
         Ok(())

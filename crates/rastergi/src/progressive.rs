@@ -66,6 +66,18 @@ pub trait Progressive: wgpu::WasmNotSend {
     fn reproject(&mut self) -> Result<bool> {
         Ok(false)
     }
+    /// Traces each new photon pass in steps beside the current one
+    /// ([`Progressive::photon_step`]) rather than at once (where the renderer has passes).
+    fn set_photon_steps(&mut self, _on: bool) {}
+    /// The next photon pass's photons traced and in all, while it is traced in steps.
+    fn photons_pending(&self) -> Option<(u32, u32)> {
+        None
+    }
+    /// Traces up to `photons` more of the pass under way in steps; true once it is the map
+    /// the iterations read.
+    fn photon_step(&mut self, _photons: u32) -> Result<bool> {
+        Ok(false)
+    }
     /// Iterations accumulated since the last restart.
     fn samples(&self) -> u32;
     fn camera(&self) -> Camera;

@@ -166,6 +166,8 @@ pub struct Renderer {
     reprojected: bool,
     /// The resolves that blend previews (by scale; 0: none) and the history in.
     blends: Vec<(u32, BlendResolve)>,
+    /// Seconds spent tracing the photon pass under way in steps ([`Renderer::photon_step`]).
+    stepped_seconds: f64,
 }
 
 /// The view at 1/`scale` of the image's size, with its own passes and film (the scene and the
@@ -263,6 +265,7 @@ impl Renderer {
             history: None,
             reprojected: false,
             blends: Vec::new(),
+            stepped_seconds: 0.0,
         })
     }
 
@@ -570,6 +573,40 @@ impl Renderer {
         film.encode_resolve_blend(&self.gpu, enc, (show, exposure), blend);
     }
 
+    /// Traces each new photon pass in steps ([`Renderer::photon_step`]) beside the current one,
+    /// which the iterations go on reading until it is done (an interactive view: no frame
+    /// waits for a whole pass), or at once before the iteration that needs it (`false`: the
+    /// default, and `render`'s). Not where the photons are guided.
+    pub fn set_photon_steps(&mut self, on: bool) {
+        if let Some(p) = &mut self.photons {
+            p.set_stepped(on);
+        }
+    }
+
+    /// The next photon pass's photons traced and in all, while it is traced in steps.
+    pub fn photons_pending(&self) -> Option<(u32, u32)> {
+        self.photons.as_ref().and_then(PhotonPasses::pending)
+    }
+
+    /// Traces up to `photons` more of the photon pass under way in steps, between iterations
+    /// (nothing while one is under way in bands); once it is all traced it becomes the map
+    /// that the next iteration reads, and the photon budget measures the pass that ends.
+    /// Returns whether that happened.
+    pub fn photon_step(&mut self, photons: u32) -> Result<bool> {
+        let Some(p) = self.photons.as_mut().filter(|_| self.band.is_none()) else { return Ok(false) };
+        let done = p.iterations_in_pass();
+        let began = web_time::Instant::now();
+        let swapped = p.trace_step(&self.gpu, &self.scene, photons);
+        if let Some(budget) = &mut self.budget {
+            self.gpu.wait()?;
+            self.stepped_seconds += began.elapsed().as_secs_f64();
+            if swapped {
+                budget.pass_traced(&self.gpu, p, done, std::mem::take(&mut self.stepped_seconds))?;
+            }
+        }
+        Ok(swapped)
+    }
+
     /// Begins an iteration: the photon pass it reads, the film's block, its uniforms.
     fn begin_iteration(&mut self, o: &Overrides) -> Result<()> {
         // 0. A new photon pass, when the current one has had its iterations (as many as the
@@ -867,6 +904,15 @@ impl Progressive for Renderer {
     }
     fn reproject(&mut self) -> Result<bool> {
         Renderer::reproject(self)
+    }
+    fn set_photon_steps(&mut self, on: bool) {
+        Renderer::set_photon_steps(self, on)
+    }
+    fn photons_pending(&self) -> Option<(u32, u32)> {
+        Renderer::photons_pending(self)
+    }
+    fn photon_step(&mut self, photons: u32) -> Result<bool> {
+        Renderer::photon_step(self, photons)
     }
     fn wait(&self) -> Result<()> {
         Renderer::wait(self)

@@ -53,6 +53,71 @@ fn each_pass_traces_fresh_photons_on_the_schedule_with_the_same_energy() {
 }
 
 #[test]
+fn a_pass_traced_in_steps_is_the_pass_traced_at_once() {
+    // The viewer traces each new pass in steps between its iterations (`set_photon_steps`):
+    // the iterations go on with the current pass until the next is all traced, and then that
+    // map holds exactly the photons the pass traced at once holds (photon i's random numbers
+    // depend on (seed, i, pass) only, the counters are integer sums). Passes 1 to 4 take in
+    // new layouts and the same one again.
+    let gpu = common::gpu();
+    let scene = rooms(true);
+    let mut at_once = Renderer::new(&gpu, &scene, settings(0)).unwrap();
+    let mut stepped = Renderer::new(&gpu, &scene, settings(0)).unwrap();
+    stepped.set_photon_steps(true);
+    for _ in 0..2 {
+        at_once.iterate().unwrap();
+        stepped.iterate().unwrap();
+    }
+    for pass in 1..=4u32 {
+        at_once.iterate().unwrap();
+        assert_eq!(at_once.photon_pass(), pass);
+        stepped.iterate().unwrap();
+        assert_eq!(stepped.photon_pass(), pass - 1, "the iteration reads the current pass's map");
+        assert_eq!(stepped.photons_pending(), Some((0, 1 << 16)));
+        let mut steps = 0;
+        while !stepped.photon_step(5_000 + 1_000 * pass).unwrap() {
+            steps += 1;
+            assert_eq!(stepped.photon_pass(), pass - 1);
+        }
+        assert_eq!(steps, (1u32 << 16).div_ceil(5_000 + 1_000 * pass) - 1);
+        assert_eq!((stepped.photon_pass(), stepped.photons_pending()), (pass, None));
+        let (a, b) =
+            (at_once.photon_map().unwrap().read(&gpu).unwrap(), stepped.photon_map().unwrap().read(&gpu).unwrap());
+        assert_eq!(a.grid(), b.grid(), "pass {pass}: the schedule's cells");
+        assert!(a.flux == b.flux, "pass {pass}: the map traced in steps differs from the map traced at once");
+        at_once.iterate().unwrap();
+        for _ in 0..2 {
+            stepped.iterate().unwrap();
+        }
+    }
+}
+
+#[test]
+fn the_balanced_budget_goes_on_with_passes_traced_in_steps() {
+    // As the viewer runs it: the balanced budget chooses each pass's length from the passes
+    // it measured, and a pass traced in steps ends when its successor is all traced.
+    let gpu = common::gpu();
+    let scene = rooms(true);
+    let s =
+        RenderSettings { pass_iterations: 0, photon_budget: rastergi::settings::PhotonBudget::Balanced, ..settings(0) };
+    let mut r = Renderer::new(&gpu, &scene, s).unwrap();
+    r.set_photon_steps(true);
+    let (mut passes, mut iterations) = (0, 0);
+    while passes < 3 {
+        r.iterate().unwrap();
+        iterations += 1;
+        if r.photons_pending().is_some() {
+            while !r.photon_step(20_000).unwrap() {}
+            passes += 1;
+            assert_eq!(r.photon_pass(), passes);
+        }
+        assert!(iterations < 1000, "no pass ended in {iterations} iterations");
+    }
+    let image = r.read_linear(Show::Full).unwrap();
+    assert!(image.pixels.iter().flatten().all(|v| v.is_finite()));
+}
+
+#[test]
 fn the_sealed_room_stays_exactly_black_with_a_fixed_map_and_with_passes() {
     // The closed rooms: the camera's room receives no light at all (Mitsuba: 0 at every
     // pixel). The map's slots keep the two rooms apart (the wall's faces separate the floor,

@@ -85,8 +85,10 @@ struct Measured {
     /// The relative RMSE at each of [`MARKS`], and the window's iterations then.
     errors: Vec<Option<f64>>,
     iterations: Vec<u32>,
-    /// The share of the frames' time after the stop spent on the resolve and display pass.
+    /// The share of the frames' time after the stop spent on the resolve and display pass, and
+    /// the longest frame after the stop (seconds).
     drawing: f64,
+    longest_still: f64,
 }
 
 /// The camera `t` seconds into the move of `a` from `start`.
@@ -150,10 +152,10 @@ fn run_variant(
     // mark is the last frame's that ended before it.
     let (mut clock, mut to_full, mut errors, mut iterations) = (0.0, None, Vec::new(), Vec::new());
     let mut shown = (view.renderer().film().read_linear_buffer(gpu)?, view.renderer().samples());
-    let (mut work, mut drawing) = (0.0, 0.0);
+    let (mut work, mut drawing, mut longest_still) = (0.0, 0.0, 0.0f64);
     while errors.len() < MARKS.len() {
         let (w, d) = frame(&mut view)?;
-        (work, drawing) = (work + w, drawing + d);
+        (work, drawing, longest_still) = (work + w, drawing + d, longest_still.max(w + d));
         clock += w + d;
         if to_full.is_none() && view.renderer().samples() > 0 {
             to_full = Some(clock);
@@ -168,7 +170,7 @@ fn run_variant(
         }
         shown = (view.renderer().film().read_linear_buffer(gpu)?, view.renderer().samples());
     }
-    Ok(Measured { frames, to_full, errors, iterations, drawing: drawing / (work + drawing) })
+    Ok(Measured { frames, to_full, errors, iterations, drawing: drawing / (work + drawing), longest_still })
 }
 
 /// The 100·q-th percentile of `v` (nearest rank).
@@ -262,7 +264,8 @@ pub fn run(a: &MotionArgs) -> Result<()> {
             .collect();
         println!("    relRMSE against the converged view after the stop: {}", errors.join(", "));
         println!(
-            "    after the stop: {:.0} % of the frames' time drawing (the resolve and the display pass)",
+            "    after the stop: the longest frame {:.1} ms; {:.0} % of the frames' time drawing (the resolve and the display pass)",
+            1e3 * m.longest_still,
             100.0 * m.drawing
         );
         results.push(m);

@@ -313,7 +313,8 @@ impl Budget {
     /// is measured first and the next pass lasts as long as the measurements say.
     pub fn advance(&mut self, gpu: &Gpu, scene: &GpuScene, photons: &mut PhotonPasses) -> Result<()> {
         let done = photons.iterations_in_pass();
-        if !photons.pass_ends() {
+        // Traced in steps, the next pass begins in `pass_traced`, once it is all traced.
+        if !photons.pass_ends() || photons.stepped() {
             if done == 0 {
                 self.current.started = web_time::Instant::now();
             }
@@ -336,6 +337,25 @@ impl Budget {
             measured: true,
             started: web_time::Instant::now(),
             pass_seconds: Some(pass_seconds),
+        };
+        Ok(())
+    }
+
+    /// A pass traced in steps ([`PhotonPasses::trace_step`]) in `seconds` in all has become the
+    /// current one after `done` iterations of the one before: as [`advance`](Self::advance)
+    /// does at a pass's end, the end is measured and the new pass's length chosen.
+    pub fn pass_traced(&mut self, gpu: &Gpu, photons: &mut PhotonPasses, done: u32, seconds: f64) -> Result<()> {
+        self.end_pass(gpu, done)?;
+        photons.set_pass_iterations(self.next_iterations());
+        if self.previous.is_none() {
+            self.gpu.start(gpu);
+        }
+        self.passes += 1;
+        self.current = Pass {
+            photons: photons.pass_photons(),
+            measured: true,
+            started: web_time::Instant::now(),
+            pass_seconds: Some(seconds),
         };
         Ok(())
     }

@@ -404,47 +404,89 @@ impl GpuPhotonMap {
     /// photons than the settings' carry more flux each than the fixed point's Φ_max: k times
     /// fewer make deposits of up to k·2²⁴ units, which the 64-bit counters hold as well.
     pub fn trace_photons(&self, gpu: &Gpu, scene: &GpuScene, pass: u32, count: u32) {
-        let device = &gpu.device;
-        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("photon clear") });
+        self.begin_trace(gpu);
+        self.trace_batch(gpu, scene, (pass, count), 0, count);
+        self.resolve(gpu, scene, (pass, count));
+    }
+
+    /// The first step of a pass traced in steps ([`trace_photons`](Self::trace_photons) is
+    /// the three at once): clears the counters. The lookup values stay those of the last
+    /// resolve until the pass's [`resolve`](Self::resolve), so the map can be read meanwhile.
+    pub fn begin_trace(&self, gpu: &Gpu) {
+        let mut enc =
+            gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("photon clear") });
         let build = self.build.as_ref().expect("trace() after release_build_buffers()");
         enc.clear_buffer(&build.tally, 0, None);
         gpu.queue.submit([enc.finish()]);
-        let inv_photon_count = 1.0 / count.max(1) as f32;
-        let mut params = PhotonParams { pass_index: pass, inv_photon_count, ..self.params };
-        let dispatch = |params: &mut PhotonParams,
-                        items: u32,
-                        (pipeline, group): (&wgpu::ComputePipeline, &wgpu::BindGroup),
-                        label: &'static str| {
-            let groups = items.div_ceil(WORKGROUP);
-            let (gx, gy) = (groups.min(65535), groups.div_ceil(65535));
-            params.groups_x = gx;
-            gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(params));
-            let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
-            {
-                let mut pass = compute_pass(&mut enc, gpu.profiler.as_ref(), label);
-                pass.set_pipeline(pipeline);
-                pass.set_bind_group(0, &scene.bind_group, &[]);
-                pass.set_bind_group(1, group, &[]);
-                pass.dispatch_workgroups(gx, gy, 1);
-            }
-            gpu.queue.submit([enc.finish()]);
-        };
-        if self.has_lights {
-            let mut first = 0u32;
-            while first < count {
-                let batch = BATCH.min(count - first);
-                params.first_photon = first;
-                params.batch_size = batch;
-                dispatch(&mut params, batch, (&self.trace_pipeline, &build.trace_group), "photon trace");
-                first += batch;
-            }
+    }
+
+    /// Traces photons `first .. first + n` of pass `pass` of `count` photons into the counters
+    /// (in dispatches of at most `BATCH`). Photon i's random numbers depend on (seed, i, pass)
+    /// only and the counters are integer sums, so a pass traced in any steps is bit for bit
+    /// the pass traced at once.
+    pub fn trace_batch(&self, gpu: &Gpu, scene: &GpuScene, (pass, count): (u32, u32), first: u32, n: u32) {
+        if !self.has_lights {
+            return;
         }
-        dispatch(
+        let build = self.build.as_ref().expect("trace() after release_build_buffers()");
+        let mut params = self.pass_params(pass, count);
+        let end = first.saturating_add(n).min(count);
+        let mut first = first;
+        while first < end {
+            let batch = BATCH.min(end - first);
+            params.first_photon = first;
+            params.batch_size = batch;
+            self.dispatch(gpu, scene, &mut params, batch, (&self.trace_pipeline, &build.trace_group), "photon trace");
+            first += batch;
+        }
+    }
+
+    /// The last step: resolves the counters into the lookup values the passes read.
+    pub fn resolve(&self, gpu: &Gpu, scene: &GpuScene, (pass, count): (u32, u32)) {
+        let build = self.build.as_ref().expect("trace() after release_build_buffers()");
+        let mut params = self.pass_params(pass, count);
+        let items = self.layout.table.capacity() as u32;
+        self.dispatch(
+            gpu,
+            scene,
             &mut params,
-            self.layout.table.capacity() as u32,
+            items,
             (&self.resolve_pipeline, &build.resolve_group),
             "photon map resolve",
         );
+    }
+
+    /// The trace's and the resolve's parameters of pass `pass` with `count` photons, each
+    /// carrying 1/count of the emitted power. Fewer photons than the settings' carry more flux
+    /// each than the fixed point's Φ_max: k times fewer make deposits of up to k·2²⁴ units,
+    /// which the 64-bit counters hold as well.
+    fn pass_params(&self, pass: u32, count: u32) -> PhotonParams {
+        PhotonParams { pass_index: pass, inv_photon_count: 1.0 / count.max(1) as f32, ..self.params }
+    }
+
+    /// One dispatch of `items` invocations of `pipeline` with `group`, submitted.
+    fn dispatch(
+        &self,
+        gpu: &Gpu,
+        scene: &GpuScene,
+        params: &mut PhotonParams,
+        items: u32,
+        (pipeline, group): (&wgpu::ComputePipeline, &wgpu::BindGroup),
+        label: &'static str,
+    ) {
+        let groups = items.div_ceil(WORKGROUP);
+        let (gx, gy) = (groups.min(65535), groups.div_ceil(65535));
+        params.groups_x = gx;
+        gpu.queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(params));
+        let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+        {
+            let mut pass = compute_pass(&mut enc, gpu.profiler.as_ref(), label);
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, &scene.bind_group, &[]);
+            pass.set_bind_group(1, group, &[]);
+            pass.dispatch_workgroups(gx, gy, 1);
+        }
+        gpu.queue.submit([enc.finish()]);
     }
 
     /// Reads the map back: from the counters (exact fixed-point sums) while they exist, else

@@ -78,6 +78,21 @@ pub struct PhotonPasses {
     map: GpuPhotonMap,
     /// Where the map is read, and where the sun's and the sky's photons start to land there.
     guide: PhotonGuide,
+    /// Whether a new pass is traced in steps beside the current one ([`Self::set_stepped`]).
+    stepped: bool,
+    /// The next pass, while it is traced in steps.
+    pending: Option<Pending>,
+}
+
+/// The next pass traced a step at a time ([`PhotonPasses::trace_step`]) while the iterations
+/// go on reading the current map.
+struct Pending {
+    /// Its map where the schedule asks for finer cells; `None`: the current map's counters
+    /// (its lookup values stay the current pass's until the pass resolves).
+    map: Option<GpuPhotonMap>,
+    /// Photons of the pass, and those traced so far.
+    count: u32,
+    traced: u32,
 }
 
 impl PhotonPasses {
@@ -120,6 +135,8 @@ impl PhotonPasses {
             finest: None,
             map,
             guide,
+            stepped: false,
+            pending: None,
         })
     }
 
@@ -167,6 +184,7 @@ impl PhotonPasses {
         }
         self.pass = pass;
         self.iterations_in_pass = iterations_in_pass;
+        self.pending = None;
         Ok(())
     }
 
@@ -209,19 +227,78 @@ impl PhotonPasses {
         more && self.iterations_in_pass >= self.pass_iterations
     }
 
+    /// Traces each new pass in steps beside the current one (an interactive view, whose frames
+    /// must stay short: [`trace_step`](Self::trace_step)) or at once (`false`, the default).
+    /// Not where the photons are guided (what the guide learns of a pass is tied to its map).
+    pub fn set_stepped(&mut self, on: bool) {
+        self.stepped = on && self.progressive() && !self.settings.guided;
+    }
+
+    /// Whether the passes are traced in steps.
+    pub fn stepped(&self) -> bool {
+        self.stepped
+    }
+
+    /// The next pass's photons traced so far and in all, while it is traced in steps.
+    pub fn pending(&self) -> Option<(u32, u32)> {
+        self.pending.as_ref().map(|p| (p.traced, p.count))
+    }
+
     /// Called before each iteration: once the current pass has had its iterations, traces the
-    /// next one (a new layout where the schedule asks for finer cells). Returns whether the map
+    /// next one (a new layout where the schedule asks for finer cells) — or, traced in steps,
+    /// begins it and goes on with the current one until it is done. Returns whether the map
     /// changed.
     pub fn advance(&mut self, gpu: &Gpu, scene: &GpuScene) -> Result<bool> {
-        if !self.pass_ends() {
+        if !self.pass_ends() || self.pending.is_some() {
+            self.iterations_in_pass += 1;
+            return Ok(false);
+        }
+        if self.stepped {
+            let map = self.next_map(gpu, scene, self.pass + 1)?;
+            let target = map.as_ref().unwrap_or(&self.map);
+            target.begin_trace(gpu);
+            self.pending = Some(Pending { map, count: self.settings.count, traced: 0 });
             self.iterations_in_pass += 1;
             return Ok(false);
         }
         self.pass += 1;
         self.iterations_in_pass = 1;
-        let wanted = pass_resolution(self.settings.grid_resolution, self.pass);
+        if let Some(map) = self.next_map(gpu, scene, self.pass)? {
+            self.map = map;
+        }
+        self.map.trace_pass(gpu, scene, self.pass);
+        Ok(true)
+    }
+
+    /// Traces up to `photons` more of the pass under way in steps; once all are, resolves it
+    /// and makes it the current pass (its first iteration is the next). Returns whether it
+    /// did; nothing where no pass is under way in steps.
+    pub fn trace_step(&mut self, gpu: &Gpu, scene: &GpuScene, photons: u32) -> bool {
+        let Some(p) = &mut self.pending else { return false };
+        let pass = self.pass + 1;
+        let target = p.map.as_ref().unwrap_or(&self.map);
+        let n = photons.max(1).min(p.count - p.traced);
+        target.trace_batch(gpu, scene, (pass, p.count), p.traced, n);
+        p.traced += n;
+        if p.traced < p.count {
+            return false;
+        }
+        target.resolve(gpu, scene, (pass, p.count));
+        if let Some(map) = self.pending.take().and_then(|p| p.map) {
+            self.map = map;
+        }
+        self.pass = pass;
+        self.iterations_in_pass = 0;
+        true
+    }
+
+    /// The map of pass `pass` where its cells differ from the current map's (allocated, not
+    /// traced), after learning what the last pass's photons found where the guide asks.
+    fn next_map(&mut self, gpu: &Gpu, scene: &GpuScene, pass: u32) -> Result<Option<GpuPhotonMap>> {
+        let wanted = pass_resolution(self.settings.grid_resolution, pass);
         let wanted = self.finest.map_or(wanted, |f| wanted.min(f));
         let current = self.map.grid().dims.max_element();
+        let mut next = None;
         if wanted > current {
             let layout = self.layout(gpu, wanted)?;
             let got = layout.grid.dims.max_element();
@@ -230,8 +307,8 @@ impl PhotonPasses {
             }
             if got > current {
                 let settings = PhotonSettings { grid_resolution: got, ..self.settings };
-                self.map = GpuPhotonMap::with_layout(gpu, scene, &self.prepared, &settings, layout, &self.guide)?;
-                log::info!("photon pass {}: {} cells along the longest axis", self.pass, got);
+                next = Some(GpuPhotonMap::with_layout(gpu, scene, &self.prepared, &settings, layout, &self.guide)?);
+                log::info!("photon pass {pass}: {got} cells along the longest axis");
             }
         }
         // What the last pass's photons found, learned before this pass's start.
@@ -242,8 +319,7 @@ impl PhotonPasses {
                 useful as f64 / photons as f64
             );
         }
-        self.map.trace_pass(gpu, scene, self.pass);
-        Ok(true)
+        Ok(next)
     }
 
     /// The photon guide (where the map is read, what the passes learned).

@@ -43,6 +43,8 @@ pub const DISPLAY_INTERVAL: f64 = 0.2;
 impl Interactive {
     pub fn new(renderer: Box<dyn Progressive>, show: Show, exposure: f32) -> Interactive {
         let refine = Refine::new(super::refine::DEFAULT_FRAME_BUDGET);
+        let mut renderer = renderer;
+        renderer.set_photon_steps(refine.budget() > 0.0);
         Interactive {
             renderer,
             show,
@@ -62,8 +64,10 @@ impl Interactive {
         self.refine.budget()
     }
 
+    /// Sets the frame budget (0: off); with one, new photon passes are traced in steps.
     pub fn set_frame_budget(&mut self, seconds: f64) {
         self.refine.set_budget(seconds);
+        self.renderer.set_photon_steps(self.refine.budget() > 0.0);
     }
 
     /// The schedule of the frames' work (what is refined, what is blended in).
@@ -156,6 +160,7 @@ impl Interactive {
         if self.denoise {
             enable(renderer.as_mut())?;
         }
+        renderer.set_photon_steps(self.refine.budget() > 0.0);
         self.renderer = renderer;
         self.denoised.clear();
         self.refine.restart();

@@ -42,6 +42,13 @@ pub const LEVEL_ITERATIONS: u32 = 4;
 /// (below, the window's own iterations start at once).
 pub const REFINE_ABOVE: f64 = 1.0;
 
+/// The median of `v`, `None` where it is empty.
+fn median(v: &[f64]) -> Option<f64> {
+    let mut v = v.to_vec();
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied()
+}
+
 /// Units of work whose cost per pixel each level keeps.
 const COSTS_KEPT: usize = 8;
 
@@ -50,14 +57,15 @@ fn scale(level: usize) -> u32 {
     1 << level
 }
 
-/// One unit of work a frame submitted: rows of one level, so many pixels.
+/// One unit of work a frame submitted: rows of one level, so many pixels; or photons of the
+/// next photon pass.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Work {
-    /// 1: the window's own iteration; s: the preview at 1/s.
+    /// 1: the window's own iteration; s: the preview at 1/s; 0: photons.
     pub scale: u32,
-    /// Pixels computed (rows × the level's width).
+    /// Pixels computed (rows × the level's width), or photons traced.
     pub pixels: u64,
-    /// Whether it finished an iteration of its level.
+    /// Whether it finished an iteration of its level (the photon pass).
     pub finished: bool,
 }
 
@@ -81,6 +89,8 @@ pub struct Refine {
     previews: bool,
     /// Seconds the last re-projection of the history took ([`Progressive::reproject`]).
     reprojection: Option<f64>,
+    /// Measured seconds per photon of the photon passes traced in steps (the last units').
+    photon_cost: Vec<f64>,
 }
 
 impl Refine {
@@ -95,6 +105,7 @@ impl Refine {
             shown: None,
             previews: true,
             reprojection: None,
+            photon_cost: Vec::new(),
         }
     }
 
@@ -152,9 +163,7 @@ impl Refine {
             .flat_map(|d| [level.checked_sub(d), Some(level + d)])
             .flatten()
             .find(|&k| k < LEVELS && !self.cost[k].is_empty())?;
-        let mut c = self.cost[k].clone();
-        c.sort_by(f64::total_cmp);
-        Some(c[c.len() / 2])
+        median(&self.cost[k])
     }
 
     /// The finest level whose whole iteration of `pixels` (the window's) fits in `seconds`;
@@ -193,6 +202,19 @@ impl Refine {
         let whole = self.cost_at(0).map(|c| c * (w as u64 * h as u64) as f64);
         if !self.previews || (!self.moving && whole.is_some_and(|t| t <= REFINE_ABOVE)) {
             self.level = 0;
+        }
+        // The next photon pass, traced in steps between the window's iterations: first.
+        if self.level == 0
+            && r.rows_ahead() == 0
+            && let Some((traced, count)) = r.photons_pending()
+        {
+            let n = match median(&self.photon_cost) {
+                Some(c) => (left / c) as u32,
+                None => count / 64,
+            };
+            let n = n.clamp(1024, count - traced);
+            let finished = r.photon_step(n)?;
+            return Ok(Some(Work { scale: 0, pixels: u64::from(n), finished }));
         }
         let k = self.level;
         let s = scale(k);
@@ -250,7 +272,10 @@ impl Refine {
         if work.pixels == 0 || self.budget <= 0.0 {
             return;
         }
-        let kept = &mut self.cost[work.scale.trailing_zeros() as usize];
+        let kept = match work.scale {
+            0 => &mut self.photon_cost,
+            s => &mut self.cost[s.trailing_zeros() as usize],
+        };
         if kept.len() == COSTS_KEPT {
             kept.remove(0);
         }

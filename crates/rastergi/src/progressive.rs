@@ -73,6 +73,11 @@ pub trait Progressive: wgpu::WasmNotSend {
     fn photons_pending(&self) -> Option<(u32, u32)> {
         None
     }
+    /// Fits the photon region to the current view and begins a pass over it where it moved
+    /// (passes in steps, the region following the camera); false where nothing began.
+    fn refit_photon_region(&mut self) -> Result<bool> {
+        Ok(false)
+    }
     /// Traces up to `photons` more of the pass under way in steps; true once it is the map
     /// the iterations read.
     fn photon_step(&mut self, _photons: u32) -> Result<bool> {

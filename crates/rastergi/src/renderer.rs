@@ -583,6 +583,25 @@ impl Renderer {
         }
     }
 
+    /// Where the photon region follows the camera (`PhotonRegionChoice::Camera`) and the passes
+    /// are traced in steps: fits the region to the current view and, where it has moved
+    /// ([`crate::photons::passes::region_moved`]), begins the next pass at once over it (it
+    /// replaces the map when it is all traced, [`Renderer::photon_step`]). Returns whether it
+    /// began. A viewer calls it when the camera stops.
+    pub fn refit_photon_region(&mut self) -> Result<bool> {
+        let Some(p) = self.photons.as_mut().filter(|p| p.stepped()) else { return Ok(false) };
+        if self.settings.photon_region != PhotonRegionChoice::Camera {
+            return Ok(false);
+        }
+        let aspect = self.settings.width as f32 / self.settings.height as f32;
+        let region = crate::fit::photon_region(p.prepared(), &self.camera, aspect, self.settings.grid_resolution);
+        let began = p.refit(&self.gpu, &self.scene, region)?;
+        if began && let Some(r) = p.region() {
+            log::info!("photon region refitted to the view: {r}");
+        }
+        Ok(began)
+    }
+
     /// The next photon pass's photons traced and in all, while it is traced in steps.
     pub fn photons_pending(&self) -> Option<(u32, u32)> {
         self.photons.as_ref().and_then(PhotonPasses::pending)
@@ -910,6 +929,9 @@ impl Progressive for Renderer {
     }
     fn photons_pending(&self) -> Option<(u32, u32)> {
         Renderer::photons_pending(self)
+    }
+    fn refit_photon_region(&mut self) -> Result<bool> {
+        Renderer::refit_photon_region(self)
     }
     fn photon_step(&mut self, photons: u32) -> Result<bool> {
         Renderer::photon_step(self, photons)

@@ -118,6 +118,58 @@ fn the_balanced_budget_goes_on_with_passes_traced_in_steps() {
 }
 
 #[test]
+fn the_photon_region_follows_the_camera_when_it_stops_elsewhere() {
+    // The sunroom beside its wide ground: the region is fitted to the room the camera sees.
+    // The camera out on the ground: the view reads the coarse cells there, so the next pass
+    // is begun at once over the region fitted to the new view, and
+    // replaces the map when it is traced. A small step keeps the map.
+    let gpu = common::gpu();
+    let scene = rastergi::scene::generate::sunroom();
+    let s = RenderSettings { photon_region: rastergi::settings::PhotonRegionChoice::Camera, ..settings(0) };
+    let mut r = Renderer::new(&gpu, &scene, s.clone()).unwrap();
+    r.set_photon_steps(true);
+    r.iterate().unwrap();
+    let aspect = s.width as f32 / s.height as f32;
+    let prepared = rastergi::surface::PreparedScene::new(&scene);
+    let fitted =
+        |camera: &rastergi::scene::Camera| rastergi::fit::photon_region(&prepared, camera, aspect, s.grid_resolution);
+    let refined = |r: &Renderer| r.photon_map().unwrap().layout.grid.refine;
+    let before = refined(&r);
+    assert!(before.factor > 1, "the sunroom's region is refined");
+
+    let mut step = scene.camera;
+    step.eye += 0.01 * (step.target - step.eye);
+    r.set_camera(step).unwrap();
+    assert!(!r.refit_photon_region().unwrap(), "a small step keeps the region");
+
+    // Out on the ground, thirty metres away, looking down at it.
+    let out = rastergi::scene::Camera {
+        eye: glam::Vec3::new(30.0, 4.0, 30.0),
+        target: glam::Vec3::new(30.0, 0.0, 28.0),
+        up: glam::Vec3::Y,
+        fov_y_deg: 60.0,
+    };
+    let region = fitted(&out);
+    assert!(rastergi::photons::passes::region_moved(fitted(&scene.camera).as_ref(), region.as_ref()));
+    r.set_camera(out).unwrap();
+    let pass = r.photon_pass();
+    assert!(r.refit_photon_region().unwrap());
+    assert_eq!(r.photon_pass(), pass, "the current map serves until the new one is traced");
+    while !r.photon_step(50_000).unwrap() {}
+    assert_eq!(r.photon_pass(), pass + 1);
+    let grid = r.photon_map().unwrap().layout.grid;
+    assert_ne!(grid.refine, before);
+    // The refined cells now hold the centre of the region fitted to the new view.
+    let (lo, hi) =
+        (grid.origin + grid.refine.lo.as_vec3() * grid.cell, grid.origin + grid.refine.hi.as_vec3() * grid.cell);
+    let centre = region.expect("a region out there").bounds.center();
+    assert!(centre.cmpge(lo).all() && centre.cmple(hi).all(), "{centre} outside the refined cells {lo} .. {hi}");
+    r.iterate().unwrap();
+    let image = r.read_linear(Show::Full).unwrap();
+    assert!(image.pixels.iter().flatten().all(|v| v.is_finite()));
+}
+
+#[test]
 fn the_sealed_room_stays_exactly_black_with_a_fixed_map_and_with_passes() {
     // The closed rooms: the camera's room receives no light at all (Mitsuba: 0 at every
     // pixel). The map's slots keep the two rooms apart (the wall's faces separate the floor,

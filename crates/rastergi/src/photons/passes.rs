@@ -25,10 +25,12 @@ use super::PhotonSettings;
 use super::gpu::GpuPhotonMap;
 use super::guide::PhotonGuide;
 use super::map::MapLayout;
+use super::map::PhotonRegion;
 use crate::error::Result;
 use crate::gpu::Gpu;
 use crate::gpu_scene::GpuScene;
 use crate::surface::PreparedScene;
+use glam::Vec3;
 
 /// The schedule's α: cell area ∝ pass^−(1−α).
 pub const ALPHA: f64 = 2.0 / 3.0;
@@ -63,6 +65,26 @@ pub fn pass_resolution(first: u32, pass: u32) -> u32 {
     let step = (growth * RESOLUTION_STEPS_PER_DOUBLING + 1e-9).floor() / RESOLUTION_STEPS_PER_DOUBLING;
     ((first as f64) * 2f64.powf(step)).round() as u32
 }
+
+/// Whether the camera's region `new` asks for another map than one refined over `old`: less
+/// than [`REGION_KEPT`] of its volume lies in `old`, or it is a quarter of `old`'s or less
+/// (cells four times as fine and more would fit it); a region where there was none or none
+/// where there was one.
+pub fn region_moved(old: Option<&PhotonRegion>, new: Option<&PhotonRegion>) -> bool {
+    let volume = |a: Vec3| f64::from(a.x.max(0.0)) * f64::from(a.y.max(0.0)) * f64::from(a.z.max(0.0));
+    match (old, new) {
+        (None, None) => false,
+        (Some(o), Some(n)) => {
+            let inside = volume(n.bounds.max.min(o.bounds.max) - n.bounds.min.max(o.bounds.min));
+            let (vn, vo) = (volume(n.bounds.extent()), volume(o.bounds.extent()));
+            inside < REGION_KEPT * vn || 4.0 * vn <= vo
+        }
+        _ => true,
+    }
+}
+
+/// The share of the camera's new region that must lie in the refined one for the map to stay.
+pub const REGION_KEPT: f64 = 0.75;
 
 /// The photon map of the current pass and what the next pass needs.
 pub struct PhotonPasses {
@@ -267,6 +289,35 @@ impl PhotonPasses {
             self.map = map;
         }
         self.map.trace_pass(gpu, scene, self.pass);
+        Ok(true)
+    }
+
+    /// The scene as the passes trace it.
+    pub fn prepared(&self) -> &PreparedScene {
+        &self.prepared
+    }
+
+    /// The region whose cells are refined ([`PhotonSettings::region`]).
+    pub fn region(&self) -> Option<&PhotonRegion> {
+        self.settings.region.as_ref()
+    }
+
+    /// Moves the refined region to `region` (the camera went where the map is coarse): where
+    /// the passes are traced in steps and none is under way, the next pass begins at once,
+    /// over a layout with the new region, and replaces the current map when it is all traced
+    /// ([`trace_step`](Self::trace_step)); the passes after it keep the region. Returns
+    /// whether it began.
+    pub fn refit(&mut self, gpu: &Gpu, scene: &GpuScene, region: Option<PhotonRegion>) -> Result<bool> {
+        if !self.stepped || self.pending.is_some() || !region_moved(self.settings.region.as_ref(), region.as_ref()) {
+            return Ok(false);
+        }
+        self.settings.region = region;
+        let resolution = self.map.grid().dims.max_element().max(self.settings.grid_resolution);
+        let layout = self.layout(gpu, resolution)?;
+        let settings = PhotonSettings { grid_resolution: layout.grid.dims.max_element(), ..self.settings };
+        let map = GpuPhotonMap::with_layout(gpu, scene, &self.prepared, &settings, layout, &self.guide)?;
+        map.begin_trace(gpu);
+        self.pending = Some(Pending { map: Some(map), count: self.settings.count, traced: 0 });
         Ok(true)
     }
 

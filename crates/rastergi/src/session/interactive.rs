@@ -33,6 +33,8 @@ pub struct Interactive {
     /// When the image was last resolved for display, and whether the camera has moved since.
     displayed: Option<web_time::Instant>,
     moved_since_display: bool,
+    /// The camera moved since the photon region was last fitted to the view.
+    refit_due: bool,
 }
 
 /// While the camera is still, the image is resolved for display at most this often (seconds):
@@ -56,6 +58,7 @@ impl Interactive {
             rest: 0.0,
             displayed: None,
             moved_since_display: true,
+            refit_due: false,
         }
     }
 
@@ -95,10 +98,13 @@ impl Interactive {
             0.0
         };
         // What the view before a move held, re-projected onto this one (once per view; while
-        // moving, where it takes at most half the budget).
-        if budget > 0.0 && self.refine.reprojection_fits() && self.renderer.reproject()? {
-            self.renderer.wait()?;
-            self.refine.reprojected(start.elapsed().as_secs_f64());
+        // moving, where it takes at most half the budget); once still, the photon region.
+        if budget > 0.0 {
+            self.refit_region()?;
+            if self.refine.reprojection_fits() && self.renderer.reproject()? {
+                self.renderer.wait()?;
+                self.refine.reprojected(start.elapsed().as_secs_f64());
+            }
         }
         let mut finished = 0;
         loop {
@@ -121,7 +127,18 @@ impl Interactive {
     /// without waiting (a web page's frame, before its [`Interactive::step`]s); false where
     /// there was nothing to do.
     pub fn reproject(&mut self) -> Result<bool> {
+        self.refit_region()?;
         self.renderer.reproject()
+    }
+
+    /// Once the camera is still after a move: the photon region fitted to the view, a pass
+    /// over it begun where it moved ([`Progressive::refit_photon_region`]).
+    fn refit_region(&mut self) -> Result<()> {
+        if self.refit_due && !self.refine.moving() {
+            self.refit_due = false;
+            self.renderer.refit_photon_region()?;
+        }
+        Ok(())
     }
 
     /// One unit of a frame's work without waiting for it (a web page, which cannot block):
@@ -192,6 +209,7 @@ impl Interactive {
         self.denoised.clear();
         self.refine.moved();
         self.moved_since_display = true;
+        self.refit_due = true;
         Ok(())
     }
 

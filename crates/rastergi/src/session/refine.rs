@@ -109,6 +109,11 @@ impl Refine {
         }
     }
 
+    /// Whether the camera moved in this frame (or the last, before [`Refine::end_frame`]).
+    pub fn moving(&self) -> bool {
+        self.moving
+    }
+
     /// Whether this frame re-projects the history: always while still, while moving where the
     /// last one took at most half the budget.
     pub fn reprojection_fits(&self) -> bool {

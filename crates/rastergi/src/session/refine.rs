@@ -217,7 +217,8 @@ impl Refine {
                 Some(c) => (left / c) as u32,
                 None => count / 64,
             };
-            let n = n.clamp(1024, count - traced);
+            // At least a few thousand photons a unit (a dispatch's worth), at most the rest.
+            let n = n.max(1024).min(count - traced);
             let finished = r.photon_step(n)?;
             return Ok(Some(Work { scale: 0, pixels: u64::from(n), finished }));
         }

@@ -370,19 +370,9 @@ impl Renderer {
         self.frame.write(&self.gpu, &u);
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
         {
-            let ctx = FrameContext {
-                gpu: &self.gpu,
-                scene: &self.scene,
-                frame: &self.frame,
-                map: self.photons.as_ref().map(PhotonPasses::map),
-                width: self.settings.width,
-                height: self.settings.height,
-                y0: 0,
-                rows: self.settings.height,
-                iteration: 0,
-                directions: self.settings.directions,
-                fixed: FixedSample::default(),
-            };
+            let map = self.photons.as_ref().map(PhotonPasses::map);
+            let target = Target { gpu: &self.gpu, scene: &self.scene, frame: &self.frame, map };
+            let ctx = target.whole_image(&self.settings);
             let history = self.history.as_mut().expect("made above");
             history.encode_snapshot(&mut enc, &ctx, &self.passes.film, (Show::Full, view_proj))?;
         }
@@ -402,19 +392,9 @@ impl Renderer {
         self.frame.write(&self.gpu, &u);
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
         {
-            let ctx = FrameContext {
-                gpu: &self.gpu,
-                scene: &self.scene,
-                frame: &self.frame,
-                map: self.photons.as_ref().map(PhotonPasses::map),
-                width: self.settings.width,
-                height: self.settings.height,
-                y0: 0,
-                rows: self.settings.height,
-                iteration: 0,
-                directions: self.settings.directions,
-                fixed: FixedSample::default(),
-            };
+            let map = self.photons.as_ref().map(PhotonPasses::map);
+            let target = Target { gpu: &self.gpu, scene: &self.scene, frame: &self.frame, map };
+            let ctx = target.whole_image(&self.settings);
             self.passes.gbuffer.encode(&mut enc, &ctx)?;
             self.history.as_mut().expect("checked above").encode_reproject(&mut enc, &ctx)?;
         }
@@ -501,14 +481,7 @@ impl Renderer {
             let view = (&self.settings, &self.camera);
             p.band = Some(Band::begin(&target, view, &mut p.passes, &Overrides::default(), block));
         }
-        let band = p.band.as_mut().expect("a preview iteration under way");
-        let done = band.encode(&target, &mut p.passes, self.settings.directions, rows.max(1))?;
-        p.passes.film.rows_ahead = if done { 0 } else { band.next_row };
-        if done {
-            p.band = None;
-            p.passes.film.samples += 1;
-        }
-        Ok(done)
+        run_band(&mut p.band, &target, &mut p.passes, self.settings.directions, rows.max(1))
     }
 
     /// The preview at 1/`scale`: the image's passes at ⌈W/scale⌉ × ⌈H/scale⌉ over the same
@@ -655,17 +628,11 @@ impl Renderer {
     /// The next `rows` rows of the iteration under way (all that are left at most); true when
     /// they finish it.
     fn encode_rows(&mut self, rows: u32) -> Result<bool> {
-        let band = self.band.as_mut().expect("an iteration under way");
         let map = self.photons.as_ref().map(PhotonPasses::map);
         let target = Target { gpu: &self.gpu, scene: &self.scene, frame: &self.frame, map };
-        let done = band.encode(&target, &mut self.passes, self.settings.directions, rows)?;
-        self.passes.film.rows_ahead = if done { 0 } else { band.next_row };
-        if done {
-            self.band = None;
-            self.passes.film.samples += 1;
-            if let Some(p) = self.gpu.profiler.as_ref().filter(|p| p.half_full()) {
-                p.collect(&self.gpu.device, &self.gpu.queue)?;
-            }
+        let done = run_band(&mut self.band, &target, &mut self.passes, self.settings.directions, rows)?;
+        if done && let Some(p) = self.gpu.profiler.as_ref().filter(|p| p.half_full()) {
+            p.collect(&self.gpu.device, &self.gpu.queue)?;
         }
         Ok(done)
     }
@@ -776,6 +743,40 @@ struct Target<'a> {
     scene: &'a GpuScene,
     frame: &'a FrameBinding,
     map: Option<&'a GpuPhotonMap>,
+}
+
+impl Target<'_> {
+    /// The frame context of a pass over the whole image of `settings`' size outside an
+    /// iteration (the history's: no jitter, iteration 0).
+    fn whole_image(&self, settings: &RenderSettings) -> FrameContext<'_> {
+        FrameContext {
+            gpu: self.gpu,
+            scene: self.scene,
+            frame: self.frame,
+            map: self.map,
+            width: settings.width,
+            height: settings.height,
+            y0: 0,
+            rows: settings.height,
+            iteration: 0,
+            directions: settings.directions,
+            fixed: FixedSample::default(),
+        }
+    }
+}
+
+/// Runs the next `rows` rows of the iteration under way in `slot` into `passes`' film, which
+/// counts the rows ahead meanwhile and the iteration once it is done (the slot then empty);
+/// true when it is.
+fn run_band(slot: &mut Option<Band>, t: &Target, passes: &mut ImagePasses, directions: u32, rows: u32) -> Result<bool> {
+    let band = slot.as_mut().expect("an iteration under way");
+    let done = band.encode(t, passes, directions, rows)?;
+    passes.film.rows_ahead = if done { 0 } else { band.next_row };
+    if done {
+        *slot = None;
+        passes.film.samples += 1;
+    }
+    Ok(done)
 }
 
 /// An iteration under way: its uniforms and random choices, fixed when it began, and the next

@@ -1,8 +1,9 @@
 //! `rastergi bench frames`: frames per second of the viewer's frame loop, without a window.
 //!
-//! A frame does the viewer's per-frame work: its batch of iterations
-//! ([`crate::view::iterate_frame`]: as many as fit in [`FRAME_BUDGET`] at the last frame's
-//! time per iteration, 1 to [`MAX_BATCH`]), the resolve of the display image, the display
+//! A frame does a viewer's per-frame work with whole iterations: its batch of iterations
+//! ([`iterate_frame`]: as many as fit in [`FRAME_BUDGET`] at the last frame's time per
+//! iteration, 1 to [`MAX_BATCH`]; the viewer's loop before its frame budget, whose frames
+//! `rastergi bench motion` times), the resolve of the display image, the display
 //! pass and the control panel (its egui pass, tessellation and egui-wgpu drawing), into a
 //! texture of the window's size instead of a swapchain image ([`DisplayTarget::offscreen`]): nothing
 //! is presented, so there is no vsync and the figure is what the GPU sustains. The renderer
@@ -13,7 +14,7 @@
 //! viewer's batched loop with the panel, the same without it (H), then one iteration per
 //! frame (a viewer that shows every iteration) with the panel.
 
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use anyhow::Result;
 use clap::Args;
@@ -23,6 +24,7 @@ use rastergi::gather::GatherMethod;
 use rastergi::gpu::Gpu;
 use rastergi::passes::display::DisplayTarget;
 use rastergi::passes::film::Show;
+use rastergi::progressive::Progressive;
 use rastergi::renderer::Renderer;
 use rastergi::settings::RenderSettings;
 
@@ -30,7 +32,6 @@ use super::window_scene_and_gpu;
 use crate::args::{GatherArg, GpuArgs};
 use crate::view::controls::Controls;
 use crate::view::panel::{self, Figures, PanelPainter, PanelState};
-use crate::view::{FRAME_BUDGET, MAX_BATCH, iterate_frame};
 
 #[derive(Args, Debug)]
 pub struct FramesArgs {
@@ -198,4 +199,31 @@ pub fn run(a: &FramesArgs) -> Result<()> {
         rates[0].1 / rates[1].1
     );
     Ok(())
+}
+
+/// GPU time aimed at per displayed frame: iterations are batched up to this.
+pub const FRAME_BUDGET: Duration = Duration::from_millis(30);
+/// Most iterations in one frame (keeps a frame short when iterations are very cheap).
+pub const MAX_BATCH: u32 = 64;
+
+/// One frame's iterations: up to `limit`, stopping once [`FRAME_BUDGET`] has passed (so at
+/// least one where `limit` > 0), then waits for them and sets `batch` (the next frame's
+/// limit) to as many as fit in the budget at this frame's time per iteration, 1 to
+/// [`MAX_BATCH`]. Returns how many ran.
+pub fn iterate_frame(renderer: &mut dyn Progressive, limit: u32, batch: &mut u32) -> Result<u32> {
+    let start = Instant::now();
+    let mut done = 0;
+    while done < limit {
+        renderer.iterate()?;
+        done += 1;
+        if start.elapsed() >= FRAME_BUDGET {
+            break;
+        }
+    }
+    if done > 0 {
+        renderer.wait()?;
+        let per_iteration = start.elapsed().as_secs_f64() / done as f64;
+        *batch = ((FRAME_BUDGET.as_secs_f64() / per_iteration.max(1e-6)) as u32).clamp(1, MAX_BATCH);
+    }
+    Ok(done)
 }

@@ -47,7 +47,6 @@ use winit::event_loop::EventLoop;
 
 use crate::args::SceneArgs;
 use app::{App, UserEvent};
-pub use frames::{FRAME_BUDGET, MAX_BATCH, iterate_frame};
 use screenshots::Screenshots;
 
 /// The keys and mouse bindings (a macro so that `--help` can join it to the script text).

@@ -32,28 +32,27 @@ fn display_encode(mean: vec3f) -> u32 {
     return pack4x8unorm(vec4f(display, 1.0));
 }
 
-// The sum of the shown component in `sums` (the film's layout, `n` pixels).
-fn shown_film(pixel: u32, n: u32) -> vec3f {
-    let direct = film[film_slot(FILM_DIRECT, pixel, n)].rgb;
-    let indirect = film[film_slot(FILM_INDIRECT, pixel, n)].rgb;
+// The shown component of a pixel's sums of the direct light, the indirect light and the
+// photon-map view.
+fn shown(direct: vec3f, indirect: vec3f, photon_view: vec3f) -> vec3f {
     switch params.show {
         case 1u: { return direct; }
         case 2u: { return indirect; }
-        case 3u: { return film[film_slot(FILM_PHOTON_VIEW, pixel, n)].rgb; }
+        case 3u: { return photon_view; }
         default: { return direct + indirect; }
     }
 }
 
+// The sum of the shown component at `pixel` of the film (its layout, `n` pixels).
+fn shown_film(pixel: u32, n: u32) -> vec3f {
+    let c = vec3u(film_slot(FILM_DIRECT, pixel, n), film_slot(FILM_INDIRECT, pixel, n), film_slot(FILM_PHOTON_VIEW, pixel, n));
+    return shown(film[c.x].rgb, film[c.y].rgb, film[c.z].rgb);
+}
+
 // The same of the preview's sums.
 fn shown_preview(pixel: u32, n: u32) -> vec3f {
-    let direct = preview[film_slot(FILM_DIRECT, pixel, n)].rgb;
-    let indirect = preview[film_slot(FILM_INDIRECT, pixel, n)].rgb;
-    switch params.show {
-        case 1u: { return direct; }
-        case 2u: { return indirect; }
-        case 3u: { return preview[film_slot(FILM_PHOTON_VIEW, pixel, n)].rgb; }
-        default: { return direct + indirect; }
-    }
+    let c = vec3u(film_slot(FILM_DIRECT, pixel, n), film_slot(FILM_INDIRECT, pixel, n), film_slot(FILM_PHOTON_VIEW, pixel, n));
+    return shown(preview[c.x].rgb, preview[c.y].rgb, preview[c.z].rgb);
 }
 
 // The preview's mean at the centre of film pixel `xy`, bilinear over its pixels that hold an

@@ -327,26 +327,12 @@ impl Budget {
         let began = web_time::Instant::now();
         photons.advance(gpu, scene)?;
         gpu.wait()?;
-        let pass_seconds = began.elapsed().as_secs_f64();
-        if self.previous.is_none() {
-            self.gpu.start(gpu);
-        }
-        self.passes += 1;
-        self.current = Pass {
-            photons: photons.pass_photons(),
-            measured: true,
-            started: web_time::Instant::now(),
-            pass_seconds: Some(pass_seconds),
-        };
+        self.begin_pass(gpu, photons, began.elapsed().as_secs_f64());
         Ok(())
     }
 
-    /// A pass traced in steps ([`PhotonPasses::trace_step`]) in `seconds` in all has become the
-    /// current one after `done` iterations of the one before: as [`advance`](Self::advance)
-    /// does at a pass's end, the end is measured and the new pass's length chosen.
-    pub fn pass_traced(&mut self, gpu: &Gpu, photons: &mut PhotonPasses, done: u32, seconds: f64) -> Result<()> {
-        self.end_pass(gpu, done)?;
-        photons.set_pass_iterations(self.next_iterations());
+    /// The pass `photons` is now in began, traced in `seconds`: measured from here.
+    fn begin_pass(&mut self, gpu: &Gpu, photons: &PhotonPasses, seconds: f64) {
         if self.previous.is_none() {
             self.gpu.start(gpu);
         }
@@ -357,6 +343,15 @@ impl Budget {
             started: web_time::Instant::now(),
             pass_seconds: Some(seconds),
         };
+    }
+
+    /// A pass traced in steps ([`PhotonPasses::trace_step`]) in `seconds` in all has become the
+    /// current one after `done` iterations of the one before: as [`advance`](Self::advance)
+    /// does at a pass's end, the end is measured and the new pass's length chosen.
+    pub fn pass_traced(&mut self, gpu: &Gpu, photons: &mut PhotonPasses, done: u32, seconds: f64) -> Result<()> {
+        self.end_pass(gpu, done)?;
+        photons.set_pass_iterations(self.next_iterations());
+        self.begin_pass(gpu, photons, seconds);
         Ok(())
     }
 

@@ -139,7 +139,7 @@ def render(scene: Union[str, "os.PathLike[str]"], width: int = 256, height: int 
     ``eye``, ``target``, ``up``, ``fov``, ``camera``, ``sun``, ``sun_size``, ``sky``, ``point``, ``spot``,
     ``env``, ``env_scale``, ``light_samples``, ``photon_passes``, ``pass_iterations``,
     ``photon_budget`` (``"balanced"``, which follows timings, or ``"fitted"``, which repeats bit
-    for bit), ``photon_guiding`` and ``gather_guiding`` (``"on"`` or ``"off"``),
+    for bit), ``photon_guiding``, ``gather_guiding`` and ``sky_guiding`` (``"on"`` or ``"off"``),
     ``bundle``, ``backend``, ``rays`` (``"auto"``, ``"hardware"``, ``"compute"``: hardware ray
     queries or the compute-shader BVH), ``method`` (``"gather"`` or ``"path"``, the reference path
     tracer) and ``denoise`` (``True``: the image denoised as ``rastergi render --denoise``

@@ -270,7 +270,7 @@ impl Environment {
     }
 
     /// The cell (column, row) holding direction `d`.
-    fn cell_of(&self, d: Vec3) -> (usize, usize) {
+    pub(crate) fn cell_of(&self, d: Vec3) -> (usize, usize) {
         let (w, h) = (self.width as usize, self.height as usize);
         let uv = direction_to_uv(d);
         let x = (uv.x - 0.5 / w as f32).rem_euclid(1.0) * w as f32;
@@ -302,7 +302,7 @@ impl Environment {
 
     /// The direction at fractions (a, b) ∈ [0, 1)² across cell (i, j): φ uniform over the
     /// cell's columns, cos θ uniform over its rows.
-    fn cell_direction(&self, i: u32, j: u32, a: f32, b: f32) -> Vec3 {
+    pub(crate) fn cell_direction(&self, i: u32, j: u32, a: f32, b: f32) -> Vec3 {
         let u = (i as f32 + 0.5 + a) / self.width as f32;
         let (c0, c1) = row_cosines(self.height, j);
         let cos_t = c0 - b * (c0 - c1);

@@ -59,6 +59,9 @@ struct ImagePasses {
     photon_view: Option<PixelPass>,
     caustics: Option<PixelPass>,
     gather: Option<GatherPass>,
+    /// The pass that makes the guides' tables (the sky's, the gather's) from what the passes
+    /// learned, at the start of each iteration, where the photon map's guide has cells.
+    guide_build: Option<crate::gather::guide::GuideBuild>,
     film: Film,
     /// The denoiser's guides and filter, once enabled ([`Renderer::enable_denoiser`]).
     denoise: Option<DenoisePasses>,
@@ -86,8 +89,9 @@ impl ImagePasses {
         let film = Film::new(gpu, width, height)?;
         let gbuffer = GBufferPass::new(gpu, scene, frame, width, height);
         let specular = scene.eye_chains.then(|| crate::passes::specular::pass(gpu, scene, frame, &gbuffer, &film));
-        // The guided gather's density weighs the direct pass's environment samples.
-        let guided = map.filter(|m| m.guide_cells > 0 && settings.gather_guiding);
+        // The guides' tables: the guided sky's for the direct pass's environment samples, and
+        // the guided gather's density that weighs them.
+        let guided = map.filter(|m| m.guide_cells > 0);
         let direct = crate::passes::direct::pass(gpu, scene, frame, (&gbuffer, &film), guided);
         let photon_view = match map {
             Some(map) if settings.show_photon_map => {
@@ -117,7 +121,10 @@ impl ImagePasses {
             }
             None => None,
         };
-        Ok(ImagePasses { gbuffer, specular, direct, photon_view, caustics, gather, film, denoise: None })
+        let guide_build = map
+            .filter(|m| m.guide_cells > 0)
+            .map(|m| crate::gather::guide::GuideBuild::new(gpu, &m.guide, m.guide_cells));
+        Ok(ImagePasses { gbuffer, specular, direct, photon_view, caustics, gather, guide_build, film, denoise: None })
     }
 
     fn enable_denoiser(&mut self, gpu: &Gpu, scene: &GpuScene, frame: &FrameBinding) -> Result<()> {
@@ -234,12 +241,17 @@ impl Renderer {
                     k => k,
                 };
                 let n = settings.photon_passes;
-                // The gather guide's cells over the photon region (or the scene).
-                let field = settings.gather_guiding.then(|| {
+                // The guides' cells over the photon region (or the scene): the gather's tables
+                // and the sky's, where each is on.
+                let sky = prepared.scene.environment.as_deref().filter(|e| settings.sky_guiding && !e.is_dark());
+                let field = (settings.gather_guiding || sky.is_some()).then(|| {
                     let bounds = region.as_ref().map_or(prepared.bounds, |r| r.bounds);
                     let area: f64 =
                         prepared.scene.triangles.iter().map(|t| crate::scene::triangle_area(t) as f64).sum();
-                    crate::gather::guide::GuideField::new(&bounds, prepared.lights.power, area)
+                    let mut field = crate::gather::guide::GuideField::new(&bounds, prepared.lights.power, area);
+                    field.gather = settings.gather_guiding;
+                    field.sky = sky.map(crate::passes::sky_guide::SkyBlocks::new);
+                    field
                 });
                 PhotonPasses::new(gpu, &gpu_scene, prepared, photon_settings, n, k, field)
             })
@@ -444,13 +456,13 @@ impl Renderer {
     /// whole iteration's work restricted to its rows — the same uniforms, photon map, gather
     /// directions and per-pixel random sequences — so the film after the last band is bit for
     /// bit that of [`iterate`](Self::iterate). The G-buffer is rasterized whole with the first
-    /// band. While `Auto` still tries the gathers (it times whole iterations) and where the
-    /// gather is guided (its tables are rebuilt per dispatch), the band is the whole image.
+    /// band. While `Auto` still tries the gathers (it times whole iterations), the band is the
+    /// whole image.
     pub fn iterate_rows(&mut self, rows: u32) -> Result<bool> {
         if self.band.is_none() {
             self.begin_iteration(&Overrides::default())?;
         }
-        let whole = self.settings.gather_guiding || self.gather_method() == GatherMethod::Auto;
+        let whole = self.gather_method() == GatherMethod::Auto;
         self.encode_rows(if whole { u32::MAX } else { rows.max(1) })
     }
 
@@ -841,8 +853,15 @@ impl Band {
         let p = passes;
         // 1. Eye pass: the visible point of each pixel, at this iteration's jitter (G-buffer),
         //    rasterized whole with the first band; through mirrors and glass to the first
-        //    surface that is not purely specular (eye paths).
+        //    surface that is not purely specular (eye paths). The guides' tables are made
+        //    then from what the iterations before learned, at iterations 1, 2, 4, 8 …: every
+        //    band of an iteration (its direct light and its gather alike) reads the same
+        //    tables, and each aligned run of 2^m iterations one table, so that the pixels'
+        //    Sobol' points stay stratified through the guided warps ([`crate::passes::sky_guide`]).
         if y0 == 0 {
+            if let Some(build) = p.guide_build.as_ref().filter(|_| self.uniforms.iteration.is_power_of_two()) {
+                build.encode(&mut enc, t.gpu.profiler.as_ref());
+            }
             p.gbuffer.encode(&mut enc, &ctx)?;
         }
         if let Some(specular) = &mut p.specular {

@@ -47,6 +47,10 @@ pub struct RenderSettings {
     /// The traced gather's per-pixel directions drawn from a mixture of the visible point's
     /// scattering and the light its cell's rays found ([`crate::gather::guide`]).
     pub gather_guiding: bool,
+    /// The direct pass's environment samples drawn towards the parts of the sky that are open
+    /// from each visible point, as its cell learned them ([`crate::passes::sky_guide`]); off
+    /// by default (measured no better in the rooms tried).
+    pub sky_guiding: bool,
     /// Gather directions per iteration, 1 to [`crate::gather::MAX_DIRECTIONS`]: they share the iteration's
     /// G-buffer and direct light.
     pub directions: u32,
@@ -159,6 +163,7 @@ impl Default for RenderSettings {
             photon_budget: PhotonBudget::default(),
             photon_guiding: false,
             gather_guiding: false,
+            sky_guiding: false,
             hit_light: HitLight::Map,
             photon_region: PhotonRegionChoice::Camera,
             texture_filter: TextureFilter::Footprint,

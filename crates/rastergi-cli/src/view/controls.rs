@@ -85,6 +85,7 @@ pub struct Controls {
     pub photon_budget: rastergi::settings::PhotonBudget,
     pub photon_guiding: bool,
     pub gather_guiding: bool,
+    pub sky_guiding: bool,
     /// The scene's sun (its last distant light), if it has one.
     pub sun: Option<SunAngles>,
     /// The environment map's radiance scale, if the scene has one that can be scaled.
@@ -116,6 +117,7 @@ impl Controls {
             photon_budget: settings.photon_budget,
             photon_guiding: settings.photon_guiding,
             gather_guiding: settings.gather_guiding,
+            sky_guiding: settings.sky_guiding,
             sun: None,
             env_scale: None,
             panel: true,
@@ -158,6 +160,7 @@ impl Controls {
             photon_budget: self.photon_budget,
             photon_guiding: self.photon_guiding,
             gather_guiding: self.gather_guiding,
+            sky_guiding: self.sky_guiding,
             ..base.clone()
         }
     }
@@ -303,6 +306,7 @@ impl Controls {
             Action::PhotonBudget(b) => r.retrace = std::mem::replace(&mut self.photon_budget, b) != b,
             Action::PhotonGuiding(on) => r.retrace = std::mem::replace(&mut self.photon_guiding, on) != on,
             Action::GatherGuiding(on) => r.retrace = std::mem::replace(&mut self.gather_guiding, on) != on,
+            Action::SkyGuiding(on) => r.retrace = std::mem::replace(&mut self.sky_guiding, on) != on,
             Action::Speed(s) => self.camera.speed = s.max(1e-6),
             Action::Home => r.camera_moved = self.home(),
             Action::Open(ref name) => r.open = Some(name.clone()),

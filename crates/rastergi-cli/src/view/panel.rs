@@ -313,6 +313,14 @@ fn renderer(ui: &mut Ui, c: &Controls, out: &mut Vec<Action>) {
     {
         out.push(Action::GatherGuiding(guided));
     }
+    let mut sky = c.sky_guiding;
+    if ui
+        .checkbox(&mut sky, "guided sky")
+        .on_hover_text("half of the environment's light samples drawn towards the parts of the sky open from there")
+        .changed()
+    {
+        out.push(Action::SkyGuiding(sky));
+    }
 }
 
 fn photon_map(ui: &mut Ui, c: &Controls, out: &mut Vec<Action>) {

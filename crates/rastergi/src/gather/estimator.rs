@@ -97,6 +97,7 @@ pub fn estimate_source(pieces: &[&str]) -> String {
         include_str!("estimator.wgsl"),
         super::guide::WGSL,
         super::guide::DENSITY_WGSL,
+        crate::passes::sky_guide::WGSL,
     ];
     all.extend_from_slice(pieces);
     crate::passes::per_pixel(&all)

@@ -235,7 +235,7 @@ fn escape_estimate_weighted(p: VisiblePoint, weight: vec3f, w: vec3f) -> vec3f {
     if !has_environment() {
         return vec3f(0.0);
     }
-    return weight * env_radiance(w) * env_gather_weight(gather_density(p, w), w);
+    return weight * env_radiance(w) * env_gather_weight(gather_density(p, w), environment.pmf * env_light_density(p, w));
 }
 
 // escape_estimate_weighted for shared directions (pdf 1/2π): f·cos θ_x·2π.

@@ -49,12 +49,14 @@ pub const GRID: u32 = 32;
 /// Cells the guide holds at most (a power of two): a table per cell and side the camera
 /// sees; more are not guided.
 pub const CAPACITY: u32 = 4096;
-/// Words per cell: its key, its bins' sums, counts and cumulative weights.
-pub const ENTRY_WORDS: u32 = 1 + 3 * BINS;
+/// Words of one guide's table in a cell: its bins' sums, counts and cumulative weights.
+pub const TABLE_WORDS: u32 = 3 * BINS;
+/// A guide that is off has its table at this offset (`GUIDE_NO_TABLE` in `guide.wgsl`).
+pub const NO_TABLE: u32 = u32::MAX;
 
 /// Where the guide's cells lie and what its fixed point counts: written into the guide
 /// buffer's header ([`crate::photons::guide::PhotonGuide`]).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct GuideField {
     pub origin: Vec3,
     pub cell: f32,
@@ -62,6 +64,11 @@ pub struct GuideField {
     pub capacity: u32,
     /// Fixed-point units per unit of luminance: 256 per the scene's typical radiance.
     pub scale: f32,
+    /// Whether the cells hold the gather guide's tables.
+    pub gather: bool,
+    /// The guided sky's blocks of the environment, where its cells hold the sky's tables
+    /// ([`crate::passes::sky_guide`]).
+    pub sky: Option<crate::passes::sky_guide::SkyBlocks>,
 }
 
 impl GuideField {
@@ -74,12 +81,28 @@ impl GuideField {
         let dims = (extent / cell).ceil().as_uvec3().max(glam::UVec3::ONE).min(glam::UVec3::splat(GRID));
         let typical = ((power.x + power.y + power.z) as f64 / 3.0 / (std::f64::consts::PI * area.max(1e-12))) as f32;
         let scale = if typical > 0.0 && typical.is_finite() { 256.0 / typical } else { 256.0 };
-        GuideField { origin: bounds.min, cell, dims: dims.into(), capacity: CAPACITY, scale }
+        GuideField { origin: bounds.min, cell, dims: dims.into(), capacity: CAPACITY, scale, gather: true, sky: None }
     }
 
-    /// Its words in the guide buffer's header (`guide.wgsl`: `guide_header_*`), with its
-    /// cells from word `base`.
-    pub fn header(&self, base: u32) -> [u32; 10] {
+    /// The offsets in a cell's entry of the gather guide's table and the sky's ([`NO_TABLE`]
+    /// where off), and the words of an entry (its key and its tables).
+    pub fn tables(&self) -> (u32, u32, u32) {
+        let gather = if self.gather { 1 } else { NO_TABLE };
+        let sky = match (&self.sky, self.gather) {
+            (None, _) => NO_TABLE,
+            (Some(_), true) => 1 + TABLE_WORDS,
+            (Some(_), false) => 1,
+        };
+        let words = 1 + TABLE_WORDS * (self.gather as u32 + self.sky.is_some() as u32);
+        (gather, sky, words)
+    }
+
+    /// Its words in the guide buffer's header (`guide.wgsl`: `guide_header_*`) where its part
+    /// of the buffer begins at word `start`: the sky's block masses there, then the cells.
+    pub fn header(&self, start: u32) -> [u32; 16] {
+        let (gather, sky, entry) = self.tables();
+        let (columns, rows) = self.sky.as_ref().map_or((0, 0), |b| (b.columns, b.rows));
+        let lead = self.leading_words().len() as u32;
         [
             self.origin.x.to_bits(),
             self.origin.y.to_bits(),
@@ -89,14 +112,25 @@ impl GuideField {
             self.dims[1],
             self.dims[2],
             self.capacity,
-            base,
+            start + lead,
             self.scale.to_bits(),
+            entry,
+            gather,
+            sky,
+            columns,
+            rows,
+            start,
         ]
     }
 
-    /// The words its cells take.
+    /// The words that follow the header: the sky's block tables (none without it).
+    pub fn leading_words(&self) -> Vec<u32> {
+        self.sky.as_ref().map_or(Vec::new(), |b| b.words().iter().map(|m| m.to_bits()).collect())
+    }
+
+    /// The words its part of the buffer takes: the block masses and the cells.
     pub fn words(&self) -> u64 {
-        self.capacity as u64 * ENTRY_WORDS as u64
+        self.leading_words().len() as u64 + self.capacity as u64 * self.tables().2 as u64
     }
 }
 

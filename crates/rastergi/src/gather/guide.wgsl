@@ -1,14 +1,17 @@
-// The gather's guide (gather/guide.rs): per cell of a grid over the part of the scene the
-// camera reads, and per side (the dominant axis of a visible point's shading normal), the
-// radiance the gather's rays found, in GATHER_GUIDE_BINS directions of equal solid angle; the
-// traced gather draws its directions from a mixture of the visible point's scattering and
-// this table, and the direct pass weighs its environment samples against that mixture. It
-// lives in the guide buffer `photon_guide` (bound by the including shader): a header at word
-// GUIDE_HEADER, then its cells, GATHER_GUIDE_ENTRY words each: the cell's key (0: free),
-// the bins' radiance sums (fixed point), their sample counts, their cumulative weights (f32).
+// The guides' tables (gather/guide.rs): per cell of a grid over the part of the scene the
+// camera reads, and per side (the dominant axis of a visible point's shading normal), a table
+// of direction bins per guide: the gather's (the radiance its rays found, in
+// GATHER_GUIDE_BINS directions of equal solid angle; the traced gather draws its directions
+// from a mixture of the visible point's scattering and this table, and the direct pass weighs
+// its environment samples against that mixture) and the guided sky's (passes/sky_guide.rs:
+// how open each block of the environment is from there). They live in the guide buffer
+// `photon_guide` (bound by the including shader): a header at word GUIDE_HEADER, then the
+// cells, `guide_entry_words()` words each: the cell's key (0: free), then each guide's table
+// at its offset in the entry (GUIDE_NO_TABLE where that guide is off): the bins' sums (fixed
+// point), their sample counts, their cumulative weights (f32), GATHER_GUIDE_BINS words each.
 
-const GATHER_GUIDE_ENTRY: u32 = 1u + 3u * GATHER_GUIDE_BINS;
 const NO_GUIDE: u32 = 0xffffffffu;
+const GUIDE_NO_TABLE: u32 = 0xffffffffu;
 
 fn guide_header_u32(k: u32) -> u32 {
     return atomicLoad(&photon_guide[GUIDE_HEADER + k]);
@@ -37,9 +40,24 @@ fn gather_guide_key(x: vec3f, n: vec3f) -> u32 {
     return 1u + ((c.z * dims.y + c.y) * dims.x + c.x) * 6u + side;
 }
 
+// Words per cell entry: its key and its guides' tables.
+fn guide_entry_words() -> u32 {
+    return guide_header_u32(10u);
+}
+
+// The offset in an entry of the gather guide's table, and of the guided sky's
+// (GUIDE_NO_TABLE: that guide is off).
+fn gather_guide_table() -> u32 {
+    return guide_header_u32(11u);
+}
+
+fn sky_guide_table() -> u32 {
+    return guide_header_u32(12u);
+}
+
 // The word k of guide entry e.
 fn guide_entry_word(e: u32, k: u32) -> u32 {
-    return guide_header_u32(8u) + e * GATHER_GUIDE_ENTRY + k;
+    return guide_header_u32(8u) + e * guide_entry_words() + k;
 }
 
 // The entry of cell `key`, NO_GUIDE where it has none; with `insert`, a free entry is taken
@@ -95,38 +113,44 @@ fn gather_guide_direction(b: u32, u: vec2f) -> vec3f {
     return vec3f(sin(phi) * s, y, -cos(phi) * s);
 }
 
-// Entry e's cumulative weight up to bin b, inclusive.
-fn gather_guide_cdf(e: u32, b: u32) -> f32 {
-    return bitcast<f32>(atomicLoad(&photon_guide[guide_entry_word(e, 1u + 2u * GATHER_GUIDE_BINS + b)]));
+// The cumulative weight up to bin b, inclusive, of the table at offset t of entry e.
+fn guide_cdf(e: u32, t: u32, b: u32) -> f32 {
+    return bitcast<f32>(atomicLoad(&photon_guide[guide_entry_word(e, t + 2u * GATHER_GUIDE_BINS + b)]));
 }
 
-// Entry e's total weight (0: nothing learned; NO_GUIDE: none).
-fn gather_guide_total(e: u32) -> f32 {
-    if e == NO_GUIDE {
-        return 0.0;
-    }
-    return gather_guide_cdf(e, GATHER_GUIDE_BINS - 1u);
-}
-
-// The table's density (per steradian) of direction w in entry e of total weight `total` > 0.
-fn gather_guide_pdf(e: u32, total: f32, w: vec3f) -> f32 {
-    let b = gather_guide_bin(w);
+// Bin b's own weight in the table at offset t of entry e.
+fn guide_weight(e: u32, t: u32, b: u32) -> f32 {
     var below = 0.0;
     if b > 0u {
-        below = gather_guide_cdf(e, b - 1u);
+        below = guide_cdf(e, t, b - 1u);
     }
-    return (gather_guide_cdf(e, b) - below) / total * f32(GATHER_GUIDE_BINS) / (4.0 * PI);
+    return guide_cdf(e, t, b) - below;
 }
 
-// A direction from entry e (total weight `total` > 0): a bin by its weight (u.x, remapped
-// within the bin's interval), then uniform in it.
-fn gather_guide_sample(e: u32, total: f32, u: vec2f) -> vec3f {
-    let goal = u.x * total;
+// The total weight of the table at offset t of entry e (0: nothing learned, or no entry, or
+// no table).
+fn guide_total(e: u32, t: u32) -> f32 {
+    if e == NO_GUIDE || t == GUIDE_NO_TABLE {
+        return 0.0;
+    }
+    return guide_cdf(e, t, GATHER_GUIDE_BINS - 1u);
+}
+
+// A bin picked from a table by its weight, and the uniform's position in its cdf interval.
+struct GuidePick {
+    bin: u32,
+    u: f32,
+}
+
+// The bin of the table at offset t of entry e (total weight `total` > 0) whose cdf interval
+// holds u·total, and u's position in that interval, in [0, 1).
+fn guide_pick(e: u32, t: u32, total: f32, u: f32) -> GuidePick {
+    let goal = u * total;
     var lo = 0u;
     var hi = GATHER_GUIDE_BINS - 1u;
     while lo < hi {
         let mid = (lo + hi) / 2u;
-        if gather_guide_cdf(e, mid) <= goal {
+        if guide_cdf(e, t, mid) <= goal {
             lo = mid + 1u;
         } else {
             hi = mid;
@@ -134,22 +158,44 @@ fn gather_guide_sample(e: u32, total: f32, u: vec2f) -> vec3f {
     }
     var below = 0.0;
     if lo > 0u {
-        below = gather_guide_cdf(e, lo - 1u);
+        below = guide_cdf(e, t, lo - 1u);
     }
-    let s = clamp((goal - below) / max(gather_guide_cdf(e, lo) - below, 1e-30), 0.0, 0.9999999);
-    return gather_guide_direction(lo, vec2f(s, u.y));
+    let s = clamp((goal - below) / max(guide_cdf(e, t, lo) - below, 1e-30), 0.0, 0.9999999);
+    return GuidePick(lo, s);
+}
+
+// Adds one sample of value q (fixed point) to bin b of the table at offset t of entry e.
+fn guide_add(e: u32, t: u32, b: u32, q: u32) {
+    if e == NO_GUIDE || t == GUIDE_NO_TABLE {
+        return;
+    }
+    if q > 0u {
+        atomicAdd(&photon_guide[guide_entry_word(e, t + b)], q);
+    }
+    atomicAdd(&photon_guide[guide_entry_word(e, t + GATHER_GUIDE_BINS + b)], 1u);
+}
+
+// Entry e's total weight in the gather guide's table.
+fn gather_guide_total(e: u32) -> f32 {
+    return guide_total(e, gather_guide_table());
+}
+
+// The table's density (per steradian) of direction w in entry e of total weight `total` > 0.
+fn gather_guide_pdf(e: u32, total: f32, w: vec3f) -> f32 {
+    let b = gather_guide_bin(w);
+    return guide_weight(e, gather_guide_table(), b) / total * f32(GATHER_GUIDE_BINS) / (4.0 * PI);
+}
+
+// A direction from entry e (total weight `total` > 0): a bin by its weight (u.x, remapped
+// within the bin's interval), then uniform in it.
+fn gather_guide_sample(e: u32, total: f32, u: vec2f) -> vec3f {
+    let pick = guide_pick(e, gather_guide_table(), total, u.x);
+    return gather_guide_direction(pick.bin, vec2f(pick.u, u.y));
 }
 
 // Adds a gather ray's finding to entry e: radiance of luminance y along w (clamped, for the
 // table only: the estimates stay unbiased whatever it holds).
 fn gather_guide_learn(e: u32, w: vec3f, y: f32) {
-    if e == NO_GUIDE {
-        return;
-    }
-    let b = gather_guide_bin(w);
     let q = u32(clamp(y * guide_header_f32(9u), 0.0, 65535.0));
-    if q > 0u {
-        atomicAdd(&photon_guide[guide_entry_word(e, 1u + b)], q);
-    }
-    atomicAdd(&photon_guide[guide_entry_word(e, 1u + GATHER_GUIDE_BINS + b)], 1u);
+    guide_add(e, gather_guide_table(), gather_guide_bin(w), q);
 }

@@ -1,26 +1,35 @@
-// The gather guide's tables made from what the gather learned (gather/guide.rs): per cell in
-// use, each direction bin's weight is its mean radiance (its sum over its count), and the
-// cumulative weights are what gather_guide_sample draws from. A cell whose bins counted
-// GATHER_GUIDE_DECAY samples or more has its sums and counts halved first, so the counters
-// never overflow and the table follows what recent iterations found.
+// The guides' tables made from what the passes learned (gather/guide.rs): per cell in use and
+// per guide, each direction bin's weight from its sum over its count — the gather guide's the
+// bin's mean radiance, the guided sky's (passes/sky_guide.rs) the block's environment mass
+// times its mean openness — and the cumulative weights are what the guides draw from. A table
+// whose bins counted GATHER_GUIDE_DECAY samples or more has its sums and counts halved first,
+// so the counters never overflow and the table follows what recent iterations found.
 
 @group(0) @binding(0) var<storage, read_write> photon_guide: array<atomic<u32>>;
 
-@compute @workgroup_size(64)
-fn build_guide(@builtin(global_invocation_id) gid: vec3u, @builtin(num_workgroups) groups: vec3u) {
-    let e = gid.x + gid.y * groups.x * 64u;
-    if e >= guide_header_u32(7u) || atomicLoad(&photon_guide[guide_entry_word(e, 0u)]) == 0u {
-        return;
+// The environment's probability of the guided sky's block b (its cells' pmfs summed; the
+// buffer holds them cumulated).
+fn build_sky_block_mass(b: u32) -> f32 {
+    let at = guide_header_u32(15u) + b;
+    var below = 0.0;
+    if b > 0u {
+        below = bitcast<f32>(atomicLoad(&photon_guide[at - 1u]));
     }
+    return bitcast<f32>(atomicLoad(&photon_guide[at])) - below;
+}
+
+// Makes the table at offset t of entry e; `sky`: the guided sky's (weights × block masses).
+fn build_table(e: u32, t: u32, sky: bool) {
     var most = 0u;
     for (var b = 0u; b < GATHER_GUIDE_BINS; b++) {
-        most = max(most, atomicLoad(&photon_guide[guide_entry_word(e, 1u + GATHER_GUIDE_BINS + b)]));
+        most = max(most, atomicLoad(&photon_guide[guide_entry_word(e, t + GATHER_GUIDE_BINS + b)]));
     }
     let halve = most >= GATHER_GUIDE_DECAY;
+    let blocks = guide_header_u32(13u) * guide_header_u32(14u);
     var acc = 0.0;
     for (var b = 0u; b < GATHER_GUIDE_BINS; b++) {
-        let s = guide_entry_word(e, 1u + b);
-        let c = guide_entry_word(e, 1u + GATHER_GUIDE_BINS + b);
+        let s = guide_entry_word(e, t + b);
+        let c = guide_entry_word(e, t + GATHER_GUIDE_BINS + b);
         var sum = atomicLoad(&photon_guide[s]);
         var count = atomicLoad(&photon_guide[c]);
         if halve {
@@ -30,8 +39,26 @@ fn build_guide(@builtin(global_invocation_id) gid: vec3u, @builtin(num_workgroup
             atomicStore(&photon_guide[c], count);
         }
         if count > 0u {
-            acc += f32(sum) / f32(count);
+            var weight = f32(sum) / f32(count);
+            if sky {
+                weight = select(0.0, weight * build_sky_block_mass(b), b < blocks);
+            }
+            acc += weight;
         }
-        atomicStore(&photon_guide[guide_entry_word(e, 1u + 2u * GATHER_GUIDE_BINS + b)], bitcast<u32>(acc));
+        atomicStore(&photon_guide[guide_entry_word(e, t + 2u * GATHER_GUIDE_BINS + b)], bitcast<u32>(acc));
+    }
+}
+
+@compute @workgroup_size(64)
+fn build_guide(@builtin(global_invocation_id) gid: vec3u, @builtin(num_workgroups) groups: vec3u) {
+    let e = gid.x + gid.y * groups.x * 64u;
+    if e >= guide_header_u32(7u) || atomicLoad(&photon_guide[guide_entry_word(e, 0u)]) == 0u {
+        return;
+    }
+    if gather_guide_table() != GUIDE_NO_TABLE {
+        build_table(e, gather_guide_table(), false);
+    }
+    if sky_guide_table() != GUIDE_NO_TABLE {
+        build_table(e, sky_guide_table(), true);
     }
 }

@@ -24,9 +24,6 @@ pub struct TraceGather {
     pipeline: wgpu::ComputePipeline,
     bind_group: wgpu::BindGroup,
     profiler: Option<Profiler>,
-    /// The guide's tables made after each gather, where the map's guide has cells
-    /// ([`super::guide`]).
-    guide: Option<super::guide::GuideBuild>,
 }
 
 /// The traced gather's bind group 2: the G-buffer read, the film written.
@@ -46,9 +43,7 @@ impl TraceGather {
             .concat(),
         );
         let pipeline = setup.estimate_pipeline(device, "gather trace", &[include_str!("trace.wgsl")], &layout);
-        let guide = (setup.map.guide_cells > 0)
-            .then(|| super::guide::GuideBuild::new(gpu, &setup.map.guide, setup.map.guide_cells));
-        TraceGather { pipeline, bind_group, profiler: gpu.profiler.clone(), guide }
+        TraceGather { pipeline, bind_group, profiler: gpu.profiler.clone() }
     }
 }
 
@@ -59,11 +54,6 @@ impl Gather for TraceGather {
         {
             let mut pass = compute_pass(enc, self.profiler.as_ref(), "gather trace");
             dispatch_pixels(&mut pass, &self.pipeline, &inputs.groups(&self.bind_group), inputs.width, inputs.rows);
-        }
-        // The guide's tables from what this gather's rays found, for the next iteration's
-        // direct pass and gather.
-        if let Some(guide) = &self.guide {
-            guide.encode(enc, self.profiler.as_ref());
         }
         Ok(())
     }

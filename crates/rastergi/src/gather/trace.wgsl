@@ -30,6 +30,14 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
         entry = gather_guide_entry(gather_guide_key(p.x.pos, p.ns), true);
         total = gather_guide_total(entry);
     }
+    // The guided sky's cell (sky_guide.wgsl): the escaping rays are weighed against the
+    // direct pass's environment density there.
+    var sky_entry = NO_GUIDE;
+    var sky_total = 0.0;
+    if p.ok {
+        sky_entry = sky_guide_entry(p, false);
+        sky_total = sky_guide_total(sky_entry);
+    }
     for (var k = 0u; k < gather.count && p.ok; k++) {
         let j = gather.first_index + k;
         // The direction, the estimator's factor f cos θ_x / pdf, and the pdf the sky's two
@@ -84,7 +92,8 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
             // The light of surfaces this ray found, for the guide (its luminance).
             gather_guide_learn(entry, w, (found.r + found.g + found.b) / 3.0);
         } else if has_environment() {
-            sky += weight * env_radiance(w) * env_gather_weight(density, w);
+            let p_light = environment.pmf * sky_density(sky_entry, sky_total, w);
+            sky += weight * env_radiance(w) * env_gather_weight(density, p_light);
         }
     }
     film_add(FILM_INDIRECT, gid.xy, p.weight * (sum / f32(gather.count)));

@@ -89,6 +89,11 @@ pub const GATHER_GUIDE_FRACTION: f32 = 0.5;
 pub const GATHER_GUIDE_PROBES: u32 = 32;
 /// A gather guide cell whose bins counted this many samples has its sums and counts halved.
 pub const GATHER_GUIDE_DECAY: u32 = 1 << 15;
+/// The share of the direct pass's environment samples drawn from the guided sky's table where
+/// a visible point's cell has learned one ([`crate::passes::sky_guide`]).
+pub const SKY_GUIDE_FRACTION: f32 = 0.5;
+/// Fixed-point units of the guided sky's learned openness (visibility × cosine, in [0, 1]).
+pub const SKY_GUIDE_SCALE: f32 = 1024.0;
 /// The first word of the guide buffer's header, and of its marks (after the header).
 pub const GUIDE_HEADER: u32 = 0;
 pub const GUIDE_MARKS: u32 = 16;

@@ -140,6 +140,8 @@ pub fn constants() -> String {
         ("NEAR_FACE", crate::gpu::consts::NEAR_FACE),
         ("GUIDED_FRACTION", crate::gpu::consts::GUIDED_FRACTION),
         ("GATHER_GUIDE_FRACTION", crate::gpu::consts::GATHER_GUIDE_FRACTION),
+        ("SKY_GUIDE_FRACTION", crate::gpu::consts::SKY_GUIDE_FRACTION),
+        ("SKY_GUIDE_SCALE", crate::gpu::consts::SKY_GUIDE_SCALE),
         ("GLASS_ALBEDO_ETA_MAX", crate::gpu::consts::GLASS_ETA_MAX),
     ];
     let mut s = String::from("// Generated from the Rust constants (shader.rs).\n");

@@ -70,18 +70,25 @@ pub fn light_sample_uniforms(seed: u32, x: u32, y: u32, j: u32, lights: &LightTa
 
 /// The pass's composed shader.
 pub fn source() -> String {
-    crate::passes::per_pixel(&[GBUFFER_FILM_WGSL, DENSITY_UNGUIDED, include_str!("direct.wgsl")])
+    crate::passes::per_pixel(&[
+        GBUFFER_FILM_WGSL,
+        DENSITY_UNGUIDED,
+        crate::passes::sky_guide::UNGUIDED_WGSL,
+        include_str!("direct.wgsl"),
+    ])
 }
 
-/// The direct pass's shader where a photon map exists: with the map's group (3), whose guide
-/// buffer holds the gather guide's tables, so its environment samples are weighed against the
-/// guided gather's density ([`crate::gather::guide`]).
+/// The direct pass's shader where the photon map's guide buffer holds guides' tables: with
+/// the map's group (3), so its environment samples are drawn from the guided sky
+/// ([`crate::passes::sky_guide`]) and weighed against the guided gather's density
+/// ([`crate::gather::guide`]).
 pub fn source_with_map() -> String {
     crate::passes::per_pixel(&[
         GBUFFER_FILM_WGSL,
         &crate::photons::gpu::lookup_wgsl(),
         crate::gather::guide::WGSL,
         crate::gather::guide::DENSITY_WGSL,
+        crate::passes::sky_guide::WGSL,
         DENSITY_GUIDED,
         include_str!("direct.wgsl"),
     ])

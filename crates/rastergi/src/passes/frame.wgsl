@@ -57,15 +57,15 @@ fn power_heuristic(pa: f32, pb: f32) -> f32 {
 }
 
 // The environment's light along w at a visible point is estimated twice: by the direct
-// pass's light samples (frame.light_samples of them, density pmf·pdf(w)) and by the final
-// gather's rays that escape (frame.gather_count of them, density p_gather = gather_density).
-// Each estimate is weighted by the power heuristic over both (Veach's multi-sample model), so
-// the weights sum to one for every direction. This is the gather's weight; the direct pass's
-// is 1 − it.
-fn env_gather_weight(p_gather: f32, w: vec3f) -> f32 {
+// pass's light samples (frame.light_samples of them, density p_light = pmf·p(w), p the
+// environment's pdf or the guided sky's mixture, env_light_density) and by the final gather's
+// rays that escape (frame.gather_count of them, density p_gather = gather_density). Each
+// estimate is weighted by the power heuristic over both (Veach's multi-sample model), so the
+// weights sum to one for every direction. This is the gather's weight; the direct pass's is
+// 1 − it.
+fn env_gather_weight(p_gather: f32, p_light: f32) -> f32 {
     if p_gather <= 0.0 {
         return 0.0;
     }
-    let p_light = environment.pmf * env_pdf(w);
     return power_heuristic(f32(frame.gather_count) * p_gather, f32(frame.light_samples) * p_light);
 }

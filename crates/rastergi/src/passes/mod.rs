@@ -18,6 +18,7 @@ pub mod frame;
 pub mod gbuffer;
 pub mod history;
 pub mod photon_view;
+pub mod sky_guide;
 pub mod specular;
 
 use glam::{Vec2, Vec3};

@@ -380,7 +380,7 @@ impl GpuPhotonMap {
             resolve_pipeline,
             has_lights: scene.light_count > 0,
             guide: guide.buffer.clone(),
-            guide_cells: guide.field.map_or(0, |f| f.capacity),
+            guide_cells: guide.field.as_ref().map_or(0, |f| f.capacity),
         })
     }
 

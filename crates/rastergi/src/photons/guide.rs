@@ -318,14 +318,20 @@ impl PhotonGuide {
         let words = table.words();
         let (_, table_start) = guide_offsets(mark_words, bins);
         let field_start = table_start as u64 + words.len() as u64;
-        let size = (field_start + field.map_or(0, |f| f.words())) * 4;
+        let size = (field_start + field.as_ref().map_or(0, |f| f.words())) * 4;
         let buffer = gpu.zeroed_buffer(
             "guide",
             size,
             wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
         );
-        let header = field.map_or([0u32; 10], |f| f.header(field_start as u32));
+        let header = field.as_ref().map_or([0u32; 16], |f| f.header(field_start as u32));
         gpu.queue.write_buffer(&buffer, crate::gpu::consts::GUIDE_HEADER as u64 * 4, bytemuck::cast_slice(&header));
+        if let Some(f) = &field {
+            let lead = f.leading_words();
+            if !lead.is_empty() {
+                gpu.queue.write_buffer(&buffer, field_start * 4, bytemuck::cast_slice(&lead));
+            }
+        }
         let (useful, emitted) = (vec![0.0; bins as usize], vec![0.0; bins as usize]);
         let guide = PhotonGuide { buffer, marks, mark_words, useful, emitted, table, enabled, field };
         guide.upload_table(gpu);

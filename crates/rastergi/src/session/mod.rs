@@ -123,6 +123,9 @@ pub struct Options {
     pub photon_guiding: bool,
     /// The traced gather's directions guided by the light its rays found.
     pub gather_guiding: bool,
+    /// The direct pass's environment samples guided to the parts of the sky open from each
+    /// visible point.
+    pub sky_guiding: bool,
     /// The gather's ray-view resolution (`None`: fitted).
     pub bundle: Option<u32>,
     pub gather: GatherMethod,
@@ -170,6 +173,7 @@ impl Default for Options {
             photon_budget: crate::settings::PhotonBudget::Balanced,
             photon_guiding: false,
             gather_guiding: false,
+            sky_guiding: false,
             bundle: None,
             gather: GatherMethod::Auto,
             gather_directions: GatherDirections::default(),
@@ -331,6 +335,7 @@ impl Options {
             photon_budget,
             photon_guiding,
             gather_guiding: self.gather_guiding,
+            sky_guiding: self.sky_guiding,
             hit_light: self.hit_light,
             photon_region: self.photon_region,
             texture_filter: self.texture_filter,

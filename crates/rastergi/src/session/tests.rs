@@ -33,7 +33,7 @@ fn cornell_with_no_flags_gets_the_fitted_defaults() {
 /// `rastergi render cornell --width 96 --height 40 --seed 7 --photons 5000 --grid 20 --bundle
 /// 300 --gather trace --gather-directions shared --directions 2 --light-samples 3
 /// --photon-passes 4 --pass-iterations 10 --photon-budget fitted --photon-guiding off
-/// --gather-guiding off --hit-light exact --photon-region scene --texture-filter bilinear
+/// --gather-guiding off --sky-guiding off --hit-light exact --photon-region scene --texture-filter bilinear
 /// --show photon-map`.
 #[test]
 fn given_flags_are_the_settings() {
@@ -54,6 +54,7 @@ fn given_flags_are_the_settings() {
         photon_budget: PhotonBudget::Fitted,
         photon_guiding: false,
         gather_guiding: false,
+        sky_guiding: false,
         hit_light: HitLight::Exact,
         photon_region: PhotonRegionChoice::Scene,
         texture_filter: TextureFilter::Bilinear,
@@ -79,6 +80,7 @@ fn given_flags_are_the_settings() {
         photon_budget: PhotonBudget::Fitted,
         photon_guiding: false,
         gather_guiding: false,
+        sky_guiding: false,
         hit_light: HitLight::Exact,
         photon_region: PhotonRegionChoice::Scene,
         texture_filter: TextureFilter::Bilinear,

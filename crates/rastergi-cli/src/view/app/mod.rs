@@ -636,8 +636,8 @@ impl App {
             (b.settings.photons, b.settings.grid_resolution, b.settings.photon_passes);
         (c.gather, c.gather_directions, c.directions) =
             (b.settings.gather, b.settings.gather_directions, b.settings.directions);
-        (c.photon_budget, c.photon_guiding, c.gather_guiding) =
-            (b.settings.photon_budget, b.settings.photon_guiding, b.settings.gather_guiding);
+        (c.photon_budget, c.photon_guiding, c.gather_guiding, c.sky_guiding) =
+            (b.settings.photon_budget, b.settings.photon_guiding, b.settings.gather_guiding, b.settings.sky_guiding);
         (c.method, c.sun, c.env_scale) = (b.method, b.sun, b.env_scale);
     }
 }

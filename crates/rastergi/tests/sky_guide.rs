@@ -1,0 +1,58 @@
+//! The guided sky (`RenderSettings::sky_guiding`, `passes/sky_guide.rs`) against the
+//! environment's own sampling: both unbiased, so the direct light (the light samples and the
+//! gather's escaping rays, weighed against each other with the guided density) agrees in the
+//! mean. The warp's density is checked against its samples by a χ² test on the CPU twin
+//! (`passes::sky_guide::tests`); this checks the GPU's: a warp that drew other directions than
+//! `sky_density` says would bias the guided image.
+
+mod common;
+
+use rastergi::environment::Environment;
+use rastergi::passes::film::Show;
+use rastergi::scene::generate::sunroom;
+use rastergi::settings::RenderSettings;
+
+#[test]
+fn the_guided_sky_agrees_with_the_skys_own_sampling_in_the_mean() {
+    let gpu = common::gpu();
+    let mut scene = sunroom();
+    scene.lights.clear();
+    scene.environment = Some(Environment::load(&common::data("env/sky_64x32.exr"), 1.0).unwrap());
+    let (w, h, iterations) = (64u32, 48u32, 128u32);
+    let settings = |seed: u32, sky_guiding: bool| RenderSettings {
+        width: w,
+        height: h,
+        seed,
+        photons: 1 << 16,
+        gather: rastergi::gather::GatherMethod::Trace,
+        sky_guiding,
+        ..Default::default()
+    };
+    let seed: u32 = std::env::var("RASTERGI_TEST_SEED").ok().and_then(|s| s.parse().ok()).unwrap_or(1);
+    // Per pixel the difference of the guided and the unguided direct light of two seeds each;
+    // the pixels' errors are independent (each its own light samples and gather directions),
+    // so the mean difference's standard error is their spread over √N.
+    let mut d = Vec::new();
+    for s in [seed, seed + 2] {
+        let on = common::render(&gpu, &scene, settings(s, true), iterations, Show::Direct);
+        let off = common::render(&gpu, &scene, settings(s + 1, false), iterations, Show::Direct);
+        for (a, b) in on.pixels.iter().zip(&off.pixels) {
+            let (a, b) = ((a[0] + a[1] + a[2]) as f64 / 3.0, (b[0] + b[1] + b[2]) as f64 / 3.0);
+            assert!(a.is_finite() && b.is_finite());
+            // The sky seen through the windows is the eye's, the same in both: left out.
+            if b < 3.0 {
+                d.push((a - b, b));
+            }
+        }
+    }
+    let n = d.len() as f64;
+    let mean = d.iter().map(|x| x.0).sum::<f64>() / n;
+    let level = d.iter().map(|x| x.1).sum::<f64>() / n;
+    let sd = (d.iter().map(|x| (x.0 - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+    let se = sd / n.sqrt();
+    println!("guided − unguided {mean:.6} (of {level:.5}), standard error {se:.6}");
+    assert!(
+        mean.abs() < 3.0 * se,
+        "guided − unguided direct light {mean:.5} (of {level:.4}) against a standard error of {se:.5}"
+    );
+}

@@ -56,3 +56,32 @@ fn the_guided_sky_agrees_with_the_skys_own_sampling_in_the_mean() {
         "guided − unguided direct light {mean:.5} (of {level:.4}) against a standard error of {se:.5}"
     );
 }
+
+/// The GPU's guided warp against its CPU twin (`SkyBlocks::sample`, whose density a χ² test
+/// checks): the same direction and density from the same uniforms, for a sky with a sun and a
+/// table that opens a window's blocks.
+#[test]
+fn the_gpus_guided_warp_is_its_cpu_twins() {
+    use rastergi::passes::sky_guide::{SkyBlocks, guided_sky_on_gpu};
+    let gpu = common::gpu();
+    let env = Environment::load(&common::data("env/sky_64x32.exr"), 1.0).unwrap();
+    let blocks = SkyBlocks::new(&env);
+    let mut openness = vec![0.0f32; blocks.masses.len()];
+    for (b, v) in [(5 * 16, 0.43), (5 * 16 + 1, 0.06), (5 * 16 + 15, 0.14), (6 * 16, 0.1), (2 * 16 + 2, 0.5)] {
+        openness[b] = v;
+    }
+    let weights: Vec<f32> = openness.iter().zip(&blocks.masses).map(|(v, m)| v * m).collect();
+    let mut rng = rastergi::sampling::Rng::new(11, 0, 0);
+    let queries: Vec<[f32; 2]> = (0..4096).map(|_| [rng.next_f32(), rng.next_f32()]).collect();
+    let gpu_samples = guided_sky_on_gpu(&gpu, &env, &blocks, &weights, &queries).unwrap();
+    let mut far = 0;
+    for (q, g) in queries.iter().zip(&gpu_samples) {
+        let (d, pdf) = blocks.sample(&env, &weights, q[0], q[1]);
+        let gd = glam::Vec3::new(g[0], g[1], g[2]);
+        // Rounding may move a sample on a cell's edge to the next cell.
+        if (gd - d).length() > 1e-3 || (g[3] - pdf).abs() > 1e-3 * pdf {
+            far += 1;
+            assert!(far <= 4, "({}, {}): GPU {gd} {} against CPU {d} {pdf}", q[0], q[1], g[3]);
+        }
+    }
+}

@@ -18,14 +18,23 @@ fn build_sky_block_mass(b: u32) -> f32 {
     return bitcast<f32>(atomicLoad(&photon_guide[at])) - below;
 }
 
-// Makes the table at offset t of entry e; `sky`: the guided sky's (weights × block masses).
+// Makes the table at offset t of entry e; `sky`: the guided sky's — each block's mean
+// openness smoothed towards the cell's mean by SKY_GUIDE_PRIOR pseudo-samples, times the
+// block's mass; no weights (no guiding) before the cell counted SKY_GUIDE_MIN_SAMPLES.
 fn build_table(e: u32, t: u32, sky: bool) {
     var most = 0u;
+    var all_sums = 0.0;
+    var all_counts = 0u;
     for (var b = 0u; b < GATHER_GUIDE_BINS; b++) {
-        most = max(most, atomicLoad(&photon_guide[guide_entry_word(e, t + GATHER_GUIDE_BINS + b)]));
+        let count = atomicLoad(&photon_guide[guide_entry_word(e, t + GATHER_GUIDE_BINS + b)]);
+        most = max(most, count);
+        all_counts += count;
+        all_sums += f32(atomicLoad(&photon_guide[guide_entry_word(e, t + b)]));
     }
     let halve = most >= GATHER_GUIDE_DECAY;
     let blocks = guide_header_u32(13u) * guide_header_u32(14u);
+    let learned = all_counts >= SKY_GUIDE_MIN_SAMPLES;
+    let mean = all_sums / f32(max(all_counts, 1u));
     var acc = 0.0;
     for (var b = 0u; b < GATHER_GUIDE_BINS; b++) {
         let s = guide_entry_word(e, t + b);
@@ -38,12 +47,13 @@ fn build_table(e: u32, t: u32, sky: bool) {
             atomicStore(&photon_guide[s], sum);
             atomicStore(&photon_guide[c], count);
         }
-        if count > 0u {
-            var weight = f32(sum) / f32(count);
-            if sky {
-                weight = select(0.0, weight * build_sky_block_mass(b), b < blocks);
+        if sky {
+            if learned && b < blocks {
+                let open = (f32(sum) + SKY_GUIDE_PRIOR * mean) / (f32(count) + SKY_GUIDE_PRIOR);
+                acc += open * build_sky_block_mass(b);
             }
-            acc += weight;
+        } else if count > 0u {
+            acc += f32(sum) / f32(count);
         }
         atomicStore(&photon_guide[guide_entry_word(e, t + 2u * GATHER_GUIDE_BINS + b)], bitcast<u32>(acc));
     }

@@ -94,6 +94,13 @@ pub const GATHER_GUIDE_DECAY: u32 = 1 << 15;
 pub const SKY_GUIDE_FRACTION: f32 = 0.5;
 /// Fixed-point units of the guided sky's learned openness (visibility × cosine, in [0, 1]).
 pub const SKY_GUIDE_SCALE: f32 = 1024.0;
+/// The samples a cell's sky table must have learned before it guides (fewer give a table of
+/// noise: the ground seen far through a window, a few samples a cell, measured 2–3× the
+/// variance).
+pub const SKY_GUIDE_MIN_SAMPLES: u32 = 256;
+/// Pseudo-samples of the cell's mean openness added to each block's (a block seen by few
+/// samples keeps near the cell's mean instead of 0 or 1).
+pub const SKY_GUIDE_PRIOR: f32 = 4.0;
 /// The first word of the guide buffer's header, and of its marks (after the header).
 pub const GUIDE_HEADER: u32 = 0;
 pub const GUIDE_MARKS: u32 = 16;

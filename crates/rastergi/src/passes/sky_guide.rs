@@ -188,6 +188,100 @@ impl SkyBlocks {
     }
 }
 
+/// The guided warp of `sky_guide.wgsl` (`sky_guided_light`) run on the GPU for `env`, its
+/// `blocks` and one cell whose table has block weights `weights`, at each (u1, u2) of
+/// `queries`: the direction and its density (per steradian) — the GPU side of the CPU twin's
+/// test ([`SkyBlocks::sample`]).
+pub fn guided_sky_on_gpu(
+    gpu: &crate::gpu::Gpu,
+    env: &Environment,
+    blocks: &SkyBlocks,
+    weights: &[f32],
+    queries: &[[f32; 2]],
+) -> crate::error::Result<Vec<[f32; 4]>> {
+    use crate::gpu::binding::{Group, Slot};
+    use crate::gpu::shader;
+    use crate::gpu::structs::GpuStruct;
+    let uniform = crate::environment::GpuEnvironment::new(Some(env), Vec3::ZERO, 1.0, 1.0);
+    let storage = wgpu::BufferUsages::empty();
+    let uniform = gpu.storage_buffer("sky check environment", bytemuck::bytes_of(&uniform), storage);
+    let data = gpu.storage_buffer("sky check data", bytemuck::cast_slice(&env.gpu_data()), storage);
+    // The guide buffer: the header, the blocks' tables, one cell (key, then the sky's table:
+    // sums and counts unused, the cumulative weights).
+    let bins = crate::gpu::consts::GATHER_GUIDE_BINS as usize;
+    let lead = blocks.words();
+    let start = crate::gpu::consts::GUIDE_MARKS;
+    let base = start + lead.len() as u32;
+    let mut words = vec![0u32; base as usize + 1 + 3 * bins];
+    let header =
+        [0, 0, 0, 0, 1, 1, 1, 1, base, 0, 1 + 3 * bins as u32, u32::MAX, 1, blocks.columns, blocks.rows, start];
+    words[..16].copy_from_slice(&header);
+    for (k, w) in lead.iter().enumerate() {
+        words[start as usize + k] = w.to_bits();
+    }
+    words[base as usize] = 1;
+    let mut acc = 0.0f32;
+    for b in 0..bins {
+        acc += weights.get(b).copied().unwrap_or(0.0);
+        words[base as usize + 1 + 2 * bins + b] = acc.to_bits();
+    }
+    let guide = gpu.storage_buffer("sky check guide", bytemuck::cast_slice(&words), storage);
+    let input = gpu.storage_buffer("sky check queries", bytemuck::cast_slice(queries), storage);
+    let environment = include_str!("../environment.wgsl")
+        .replace("@group(0) @binding(9) var<uniform> environment: Environment;", "")
+        .replace("scene_f32(scene_offset(DATA_ENVIRONMENT) + k)", "env_words[k]");
+    let main = "
+        @group(0) @binding(0) var<storage, read> environment: Environment;
+        @group(0) @binding(1) var<storage, read> env_words: array<f32>;
+        @group(0) @binding(2) var<storage, read_write> photon_guide: array<atomic<u32>>;
+        @group(0) @binding(3) var<storage, read> queries: array<vec2f>;
+        @group(0) @binding(4) var<storage, read_write> samples: array<vec4f>;
+        struct Surface { pos: vec3f }
+        struct VisiblePoint { x: Surface, ns: vec3f }
+        struct LightRay { dir: vec3f, dist: f32, e: vec3f, tri: u32, pdf: f32 }
+        @compute @workgroup_size(64)
+        fn main(@builtin(global_invocation_id) gid: vec3u) {
+            if gid.x >= arrayLength(&queries) {
+                return;
+            }
+            var l: LightRay;
+            l.pdf = 1.0;
+            let r = sky_guided_light(l, queries[gid.x], 0u, guide_total(0u, sky_guide_table()));
+            samples[gid.x] = vec4f(r.dir, r.pdf);
+        }";
+    let source = shader::compose(&[
+        shader::SAMPLING,
+        &crate::environment::GpuEnvironment::wgsl(),
+        &environment,
+        crate::gather::guide::WGSL,
+        WGSL,
+        main,
+    ]);
+    let module = shader::module(&gpu.device, "sky check", &source);
+    gpu.run_once_read(
+        "sky check",
+        &module,
+        &Group::compute(
+            "sky check",
+            &[
+                Slot::read::<crate::environment::GpuEnvironment>(0, "environment"),
+                Slot::read::<f32>(1, "env_words"),
+                Slot::write::<u32>(2, "photon_guide"),
+                Slot::read::<[f32; 2]>(3, "queries"),
+                Slot::write::<[f32; 4]>(4, "samples"),
+            ],
+        ),
+        &[
+            ("environment", uniform.as_entire_binding()),
+            ("env_words", data.as_entire_binding()),
+            ("photon_guide", guide.as_entire_binding()),
+            ("queries", input.as_entire_binding()),
+        ],
+        "samples",
+        queries.len(),
+    )
+}
+
 /// The guided sky's WGSL (`sky_guide.wgsl`): for a shader that binds the guide buffer and
 /// knows the environment and the visible point.
 pub const WGSL: &str = include_str!("sky_guide.wgsl");

@@ -39,7 +39,10 @@
 //! wall-clock times on this GPU: C from a pass's tracing's start to its end (the GPU waited
 //! for), c per iteration between a pass's start and its end. M* is rounded to a power of two in
 //! [[`MIN_ITERATIONS`], [`MAX_ITERATIONS`]], so that noise in the timings seldom changes it (the
-//! ceiling keeps the cells shrinking: the map's blur, a bias, goes with passes). The
+//! ceiling keeps the cells shrinking: the map's blur, a bias, goes with passes); where tracing
+//! a pass costs more than [`TRACE_SHARE`] of 64 iterations the ceiling rises until it does not
+//! ([`longest_pass`]: a scene whose map's variance is small would otherwise spend a third of
+//! its time tracing, the staircase measured 1.8× slower than the fitted cadence at 16 s). The
 //! iterations' samples are consecutive points of per-pixel Sobol' sequences, whose blocks are
 //! slightly anti-correlated: W comes out a little high (as the film's error estimate does).
 //!
@@ -55,9 +58,17 @@ use crate::gpu_scene::GpuScene;
 /// Iterations of each of the first three passes, before the measurements choose (the third
 /// lasts twice as long).
 pub const FIRST_ITERATIONS: u32 = 16;
-/// The fewest and most iterations a balanced pass lasts.
+/// The fewest and most iterations a balanced pass lasts (the most where tracing a pass costs
+/// no more than [`TRACE_SHARE`] of the pass: see [`longest_pass`]).
 pub const MIN_ITERATIONS: u32 = 2;
 pub const MAX_ITERATIONS: u32 = 64;
+/// Where the map's variance is too small to call for short passes, the share of a pass's time
+/// that tracing its photons may take: the ceiling rises above [`MAX_ITERATIONS`] until
+/// tracing is at most this share (the staircase at 160 × 90: a pass of 2²¹ photons took
+/// 2.5 s against 89 ms an iteration, a third of the time at 64 iterations a pass).
+pub const TRACE_SHARE: f64 = 1.0 / 8.0;
+/// The most iterations a pass lasts however costly its tracing.
+pub const LONGEST_PASS: u32 = 1024;
 /// Pairs of passes the fit uses.
 pub const HISTORY: usize = 8;
 /// Every EXPLORE-th pass after the first three lasts twice (or half) the chosen length.
@@ -139,22 +150,34 @@ pub fn fit(pairs: &[PassPair]) -> Option<Variances> {
 /// The iterations per pass of least variance per unit of time for a pass whose map adds
 /// `map_variance` and whose iterations each `iteration_variance`, costing `pass_seconds` and
 /// `iteration_seconds`: √(W·C / (V_map·c)) as a power of two (the nearest in log scale) within
-/// [MIN_ITERATIONS, MAX_ITERATIONS].
+/// [MIN_ITERATIONS, [`longest_pass`]].
 pub fn balanced_iterations(
     map_variance: f64,
     iteration_variance: f64,
     pass_seconds: f64,
     iteration_seconds: f64,
 ) -> u32 {
+    let longest = longest_pass(pass_seconds, iteration_seconds);
     let m = (iteration_variance * pass_seconds / (map_variance * iteration_seconds)).sqrt();
     if m.is_nan() || m <= 0.0 {
         return MIN_ITERATIONS;
     }
     if m.is_infinite() {
-        return MAX_ITERATIONS;
+        return longest;
     }
     let m = 2f64.powi(m.log2().round() as i32);
-    (m.clamp(MIN_ITERATIONS as f64, MAX_ITERATIONS as f64)) as u32
+    (m.clamp(MIN_ITERATIONS as f64, longest as f64)) as u32
+}
+
+/// The ceiling of a balanced pass's iterations: [`MAX_ITERATIONS`] (the cells keep shrinking:
+/// the map's blur, a bias, goes with passes), raised to the power of two at which tracing
+/// (`pass_seconds`) takes at most [`TRACE_SHARE`] of the pass, at most [`LONGEST_PASS`].
+pub fn longest_pass(pass_seconds: f64, iteration_seconds: f64) -> u32 {
+    let m = pass_seconds * (1.0 - TRACE_SHARE) / (TRACE_SHARE * iteration_seconds);
+    if !(m.is_finite() && m > MAX_ITERATIONS as f64) {
+        return MAX_ITERATIONS;
+    }
+    (m.ceil() as u32).next_power_of_two().min(LONGEST_PASS)
 }
 
 /// The GPU side: snapshots of the film where a pass starts and the sums of its end
@@ -424,7 +447,11 @@ impl Budget {
             );
         }
         if k.is_multiple_of(EXPLORE) {
-            if self.chosen < MAX_ITERATIONS { 2 * self.chosen } else { self.chosen / 2 }
+            let longest = match (mean(&self.pass_seconds), mean(&self.iteration_seconds)) {
+                (Some(cost), Some(c)) => longest_pass(cost, c),
+                _ => MAX_ITERATIONS,
+            };
+            if self.chosen < longest { 2 * self.chosen } else { self.chosen / 2 }
         } else {
             self.chosen
         }
@@ -463,6 +490,22 @@ mod tests {
         }
         assert_eq!(balanced_iterations(0.0, 1.0, 1.0, 1.0), MAX_ITERATIONS);
         assert_eq!(balanced_iterations(1.0, 0.0, 1.0, 1.0), MIN_ITERATIONS);
+    }
+
+    /// Where the map's variance calls for long passes, the ceiling keeps tracing to at most
+    /// an eighth of a pass: 64 iterations where tracing is cheap, more where it is dear (the
+    /// staircase: 2.5 s a pass, 89 ms an iteration), never over 1024.
+    #[test]
+    fn costly_tracing_raises_the_ceiling_to_keep_its_share() {
+        assert_eq!(longest_pass(0.1, 0.02), MAX_ITERATIONS);
+        let m = longest_pass(2.532, 0.0888);
+        assert_eq!(m, 256);
+        assert!(2.532 / (2.532 + m as f64 * 0.0888) <= TRACE_SHARE);
+        assert!(2.532 / (2.532 + (m / 2) as f64 * 0.0888) > TRACE_SHARE);
+        assert_eq!(balanced_iterations(0.0, 1.0, 2.532, 0.0888), 256);
+        assert_eq!(balanced_iterations(1e-9, 1.0, 2.532, 0.0888), 256);
+        assert_eq!(longest_pass(100.0, 0.001), LONGEST_PASS);
+        assert_eq!(longest_pass(f64::NAN, 0.0), MAX_ITERATIONS);
     }
 
     /// Pairs made from known a and W (with noise of 5 % on each squared difference) give them

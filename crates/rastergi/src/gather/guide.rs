@@ -17,8 +17,11 @@
 //! adds the luminance of what it brought back — the photon map's light at its hit, the sky
 //! where it escaped, zero where it found nothing — to its direction's bin, and counts itself
 //! there (fixed point: the sums do not depend on the order the rays add them, so a seed still
-//! gives one image). After each gather a pass ([`build`]) makes each cell's table: a bin's
-//! weight is its mean radiance; cells whose counts reach [`DECAY`] are halved first.
+//! gives one image). At the start of iterations 1, 2, 4, 8 … a pass ([`build_source`],
+//! [`GuideBuild`]) makes each cell's table — a bin's weight is its mean radiance; cells whose
+//! counts reach [`DECAY`] are halved first — so every row band of an iteration reads one table
+//! and each aligned run of 2^m iterations one warp. The same pass makes the guided sky's tables
+//! ([`crate::passes::sky_guide`]), which share the cells.
 //!
 //! **How it samples.** The traced gather's per-pixel direction is drawn from the one-sample
 //! mixture
@@ -167,8 +170,8 @@ pub fn build_source() -> String {
     shader::compose(&[shader::SAMPLING, WGSL, include_str!("guide_build.wgsl")])
 }
 
-/// The pass that makes the cells' tables from what the gather learned (`guide_build.wgsl`),
-/// after each traced gather.
+/// The pass that makes the cells' tables from what the passes learned (`guide_build.wgsl`):
+/// the gather guide's and the guided sky's, at the start of iterations 1, 2, 4, 8 …
 pub struct GuideBuild {
     pipeline: wgpu::ComputePipeline,
     bind_group: wgpu::BindGroup,

@@ -175,6 +175,20 @@ fn guide_add(e: u32, t: u32, b: u32, q: u32) {
     atomicAdd(&photon_guide[guide_entry_word(e, t + GATHER_GUIDE_BINS + b)], 1u);
 }
 
+// The guided sky's blocks (passes/sky_guide.rs), from the header's word 15: the environment's
+// probability of blocks 0 to b together, and of block b (its cells' pmfs summed).
+fn sky_blocks_cdf(b: u32) -> f32 {
+    return bitcast<f32>(atomicLoad(&photon_guide[guide_header_u32(15u) + b]));
+}
+
+fn sky_block_mass(b: u32) -> f32 {
+    var below = 0.0;
+    if b > 0u {
+        below = sky_blocks_cdf(b - 1u);
+    }
+    return sky_blocks_cdf(b) - below;
+}
+
 // Entry e's total weight in the gather guide's table.
 fn gather_guide_total(e: u32) -> f32 {
     return guide_total(e, gather_guide_table());

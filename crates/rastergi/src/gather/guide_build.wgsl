@@ -7,17 +7,6 @@
 
 @group(0) @binding(0) var<storage, read_write> photon_guide: array<atomic<u32>>;
 
-// The environment's probability of the guided sky's block b (its cells' pmfs summed; the
-// buffer holds them cumulated).
-fn build_sky_block_mass(b: u32) -> f32 {
-    let at = guide_header_u32(15u) + b;
-    var below = 0.0;
-    if b > 0u {
-        below = bitcast<f32>(atomicLoad(&photon_guide[at - 1u]));
-    }
-    return bitcast<f32>(atomicLoad(&photon_guide[at])) - below;
-}
-
 // Makes the table at offset t of entry e; `sky`: the guided sky's — each block's mean
 // openness smoothed towards the cell's mean by SKY_GUIDE_PRIOR pseudo-samples, times the
 // block's mass; no weights (no guiding) before the cell counted SKY_GUIDE_MIN_SAMPLES.
@@ -50,7 +39,7 @@ fn build_table(e: u32, t: u32, sky: bool) {
         if sky {
             if learned && b < blocks {
                 let open = (f32(sum) + SKY_GUIDE_PRIOR * mean) / (f32(count) + SKY_GUIDE_PRIOR);
-                acc += open * build_sky_block_mass(b);
+                acc += open * sky_block_mass(b);
             }
         } else if count > 0u {
             acc += f32(sum) / f32(count);

@@ -10,20 +10,6 @@ fn sky_guided() -> bool {
     return sky_guide_table() != GUIDE_NO_TABLE && has_environment();
 }
 
-// The environment's probability of blocks 0 to b together, and of block b (its cells' pmfs
-// summed).
-fn sky_blocks_cdf(b: u32) -> f32 {
-    return bitcast<f32>(atomicLoad(&photon_guide[guide_header_u32(15u) + b]));
-}
-
-fn sky_block_mass(b: u32) -> f32 {
-    var below = 0.0;
-    if b > 0u {
-        below = sky_blocks_cdf(b - 1u);
-    }
-    return sky_blocks_cdf(b) - below;
-}
-
 // The block of unit direction d: block (k, l) holds cells (i, j) with ⌊i·columns/W⌋ = k and
 // ⌊j·rows/(H − 1)⌋ = l (SkyBlocks::block_of).
 fn sky_block_of(d: vec3f) -> u32 {
@@ -57,19 +43,13 @@ fn sky_guide_total(e: u32) -> f32 {
 }
 
 // The guided environment density of direction w (per steradian) for entry e of total weight
-// `total`: p_env·((1 − g) + g·W_b/(P_b·ΣW)), or p_env where nothing is learned.
+// `total`: p_env·F_b (sky_factor), or p_env where nothing is learned.
 fn sky_density(e: u32, total: f32, w: vec3f) -> f32 {
     let p = env_pdf(w);
     if total <= 0.0 {
         return p;
     }
-    let b = sky_block_of(w);
-    let m = sky_block_mass(b);
-    var share = 0.0;
-    if m > 0.0 {
-        share = guide_weight(e, sky_guide_table(), b) / (m * total);
-    }
-    return p * ((1.0 - SKY_GUIDE_FRACTION) + SKY_GUIDE_FRACTION * share);
+    return p * sky_factor(e, total, sky_block_of(w));
 }
 
 // The density of the direct pass's environment samples along w at visible point p (what the

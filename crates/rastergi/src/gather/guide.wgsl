@@ -1,14 +1,15 @@
 // The guides' tables (gather/guide.rs): per cell of a grid over the part of the scene the
 // camera reads, and per side (the dominant axis of a visible point's shading normal), a table
 // of direction bins per guide: the gather's (the radiance its rays found, in
-// GATHER_GUIDE_BINS directions of equal solid angle; the traced gather draws its directions
-// from a mixture of the visible point's scattering and this table, and the direct pass weighs
-// its environment samples against that mixture) and the guided sky's (passes/sky_guide.rs:
-// how open each block of the environment is from there). They live in the guide buffer
-// `photon_guide` (bound by the including shader): a header at word GUIDE_HEADER, then the
-// cells, `guide_entry_words()` words each: the cell's key (0: free), then each guide's table
-// at its offset in the entry (GUIDE_NO_TABLE where that guide is off): the bins' sums (fixed
-// point), their sample counts, their cumulative weights (f32), GATHER_GUIDE_BINS words each.
+// GATHER_GUIDE_BINS bins of the cosine warp's square in the side's frame; the traced gather
+// draws its directions on a Lambertian surface by one warp of the mixture of the cosine and
+// this table, and the direct pass weighs its environment samples against that mixture) and
+// the guided sky's (passes/sky_guide.rs: how open each block of the environment is from
+// there). They live in the guide buffer `photon_guide` (bound by the including shader): a
+// header at word GUIDE_HEADER, then the cells, `guide_entry_words()` words each: the cell's
+// key (0: free), then each guide's table at its offset in the entry (GUIDE_NO_TABLE where that
+// guide is off): the bins' sums (fixed point), their sample counts, their cumulative weights
+// (f32), GATHER_GUIDE_BINS words each.
 
 const NO_GUIDE: u32 = 0xffffffffu;
 const GUIDE_NO_TABLE: u32 = 0xffffffffu;
@@ -94,23 +95,38 @@ fn gather_guide_entry(key: u32, insert: bool) -> u32 {
     return NO_GUIDE;
 }
 
-// The direction bin of unit direction w: GATHER_GUIDE_BANDS bands of equal solid angle in
-// w.y, as many sectors of φ = atan2(w.x, −w.z) (gather/guide.rs: direction_bin).
-fn gather_guide_bin(w: vec3f) -> u32 {
-    let n = GATHER_GUIDE_BANDS;
-    let band = min(u32((w.y + 1.0) * 0.5 * f32(n)), n - 1u);
-    let u = atan2(w.x, -w.z) / (2.0 * PI);
-    let sector = min(u32((u - floor(u)) * f32(n)), n - 1u);
-    return band * n + sector;
+// The guide's frame at a surface of shading normal n: the tangent t from a world axis across
+// the side's dominant axis (z where x dominates, else x), b = n × t — the same for every
+// point of a cell's side whose normals agree, and continuous in n within the side
+// (gather/guide.rs: frame).
+fn gather_guide_frame(n: vec3f) -> mat3x3f {
+    let a = abs(n);
+    let r = select(vec3f(1.0, 0.0, 0.0), vec3f(0.0, 0.0, 1.0), a.x > max(a.y, a.z));
+    let t = normalize(r - n * dot(n, r));
+    return mat3x3f(t, cross(n, t), n);
 }
 
-// A direction uniform in bin b from two uniforms (gather/guide.rs: bin_direction).
-fn gather_guide_direction(b: u32, u: vec2f) -> vec3f {
-    let n = GATHER_GUIDE_BANDS;
-    let y = -1.0 + (f32(b / n) + u.x) * 2.0 / f32(n);
-    let phi = (f32(b % n) + u.y) * 2.0 * PI / f32(n);
-    let s = sqrt(max(1.0 - y * y, 0.0));
-    return vec3f(sin(phi) * s, y, -cos(phi) * s);
+// The cosine warp in the guide's frame about n: v = (sin²θ, φ/2π) ↦ w, pdf cos θ/π for v
+// uniform (gather/guide.rs: warp).
+fn gather_guide_warp(n: vec3f, v: vec2f) -> vec3f {
+    let f = gather_guide_frame(n);
+    let r = sqrt(v.x);
+    let phi = 2.0 * PI * v.y;
+    return normalize(f[0] * (r * cos(phi)) + f[1] * (r * sin(phi)) + n * sqrt(max(1.0 - v.x, 0.0)));
+}
+
+// The direction bin of w about n: the cell of the cosine warp's square [0, 1)² holding the
+// point that warps to w, GATHER_GUIDE_BANDS rows of sin²θ by as many columns of φ — bins of
+// equal projected solid angle (gather/guide.rs: direction_bin).
+fn gather_guide_bin(n: vec3f, w: vec3f) -> u32 {
+    let f = gather_guide_frame(n);
+    let x = dot(w, f[0]);
+    let y = dot(w, f[1]);
+    let k = f32(GATHER_GUIDE_BANDS);
+    let row = min(u32(clamp(x * x + y * y, 0.0, 1.0) * k), GATHER_GUIDE_BANDS - 1u);
+    let a = atan2(y, x) / (2.0 * PI);
+    let column = min(u32((a - floor(a)) * k), GATHER_GUIDE_BANDS - 1u);
+    return row * GATHER_GUIDE_BANDS + column;
 }
 
 // The cumulative weight up to bin b, inclusive, of the table at offset t of entry e.
@@ -134,34 +150,6 @@ fn guide_total(e: u32, t: u32) -> f32 {
         return 0.0;
     }
     return guide_cdf(e, t, GATHER_GUIDE_BINS - 1u);
-}
-
-// A bin picked from a table by its weight, and the uniform's position in its cdf interval.
-struct GuidePick {
-    bin: u32,
-    u: f32,
-}
-
-// The bin of the table at offset t of entry e (total weight `total` > 0) whose cdf interval
-// holds u·total, and u's position in that interval, in [0, 1).
-fn guide_pick(e: u32, t: u32, total: f32, u: f32) -> GuidePick {
-    let goal = u * total;
-    var lo = 0u;
-    var hi = GATHER_GUIDE_BINS - 1u;
-    while lo < hi {
-        let mid = (lo + hi) / 2u;
-        if guide_cdf(e, t, mid) <= goal {
-            lo = mid + 1u;
-        } else {
-            hi = mid;
-        }
-    }
-    var below = 0.0;
-    if lo > 0u {
-        below = guide_cdf(e, t, lo - 1u);
-    }
-    let s = clamp((goal - below) / max(guide_cdf(e, t, lo) - below, 1e-30), 0.0, 0.9999999);
-    return GuidePick(lo, s);
 }
 
 // Adds one sample of value q (fixed point) to bin b of the table at offset t of entry e.
@@ -194,22 +182,67 @@ fn gather_guide_total(e: u32) -> f32 {
     return guide_total(e, gather_guide_table());
 }
 
-// The table's density (per steradian) of direction w in entry e of total weight `total` > 0.
-fn gather_guide_pdf(e: u32, total: f32, w: vec3f) -> f32 {
-    let b = gather_guide_bin(w);
-    return guide_weight(e, gather_guide_table(), b) / total * f32(GATHER_GUIDE_BINS) / (4.0 * PI);
+// The guided mixture's factor F_b = p/p_cos of bin b of entry e (total weight `total` > 0):
+// (1 − g) + g·BINS·weight_b/total — the cosine warp's square drawn with probability F_b/BINS
+// per bin (gather/guide.rs: factor).
+fn gather_guide_factor(e: u32, total: f32, b: u32) -> f32 {
+    let q = guide_weight(e, gather_guide_table(), b) / total;
+    return (1.0 - GATHER_GUIDE_FRACTION) + GATHER_GUIDE_FRACTION * f32(GATHER_GUIDE_BINS) * q;
 }
 
-// A direction from entry e (total weight `total` > 0): a bin by its weight (u.x, remapped
-// within the bin's interval), then uniform in it.
-fn gather_guide_sample(e: u32, total: f32, u: vec2f) -> vec3f {
-    let pick = guide_pick(e, gather_guide_table(), total, u.x);
-    return gather_guide_direction(pick.bin, vec2f(pick.u, u.y));
+// The mixture's probability of bins 0 to b together: (1 − g)(b + 1)/BINS + g·cdf_b/total.
+fn gather_guide_mixture_cdf(e: u32, total: f32, b: u32) -> f32 {
+    return (1.0 - GATHER_GUIDE_FRACTION) * f32(b + 1u) / f32(GATHER_GUIDE_BINS)
+        + GATHER_GUIDE_FRACTION * guide_cdf(e, gather_guide_table(), b) / total;
 }
 
-// Adds a gather ray's finding to entry e: radiance of luminance y along w (clamped, for the
-// table only: the estimates stay unbiased whatever it holds).
-fn gather_guide_learn(e: u32, w: vec3f, y: f32) {
+// A direction about n from entry e (total weight `total` > 0), by one warp of the two
+// uniforms u: u.x picks the row of the cosine warp's square by the mixture's row masses, u.y
+// the bin along that row by the mixture's masses, each remainder the point in the bin; that
+// point is warped by the cosine (gather_guide_warp). Monotone in each uniform, so a pixel's
+// Sobol' points stay stratified; with a uniform table it is the cosine warp itself. Density
+// F_b·cos θ/π (gather/guide.rs: sample).
+fn gather_guide_sample(e: u32, total: f32, n: vec3f, u: vec2f) -> vec3f {
+    let k = GATHER_GUIDE_BANDS;
+    var lo = 0u;
+    var hi = k - 1u;
+    while lo < hi {
+        let mid = (lo + hi) / 2u;
+        if gather_guide_mixture_cdf(e, total, mid * k + k - 1u) <= u.x {
+            lo = mid + 1u;
+        } else {
+            hi = mid;
+        }
+    }
+    let row = lo;
+    var below = 0.0;
+    if row > 0u {
+        below = gather_guide_mixture_cdf(e, total, row * k - 1u);
+    }
+    let row_mass = max(gather_guide_mixture_cdf(e, total, row * k + k - 1u) - below, 1e-30);
+    let v1 = clamp((u.x - below) / row_mass, 0.0, 0.99999994);
+    let goal = below + u.y * row_mass;
+    lo = row * k;
+    hi = row * k + k - 1u;
+    while lo < hi {
+        let mid = (lo + hi) / 2u;
+        if gather_guide_mixture_cdf(e, total, mid) <= goal {
+            lo = mid + 1u;
+        } else {
+            hi = mid;
+        }
+    }
+    var before = below;
+    if lo > row * k {
+        before = gather_guide_mixture_cdf(e, total, lo - 1u);
+    }
+    let v2 = clamp((goal - before) / max(gather_guide_mixture_cdf(e, total, lo) - before, 1e-30), 0.0, 0.99999994);
+    return gather_guide_warp(n, vec2f((f32(row) + v1) / f32(k), (f32(lo - row * k) + v2) / f32(k)));
+}
+
+// Adds a gather ray's finding to entry e: radiance of luminance y along w about the shading
+// normal n (clamped, for the table only: the estimates stay unbiased whatever it holds).
+fn gather_guide_learn(e: u32, n: vec3f, w: vec3f, y: f32) {
     let q = u32(clamp(y * guide_header_f32(9u), 0.0, 65535.0));
-    guide_add(e, gather_guide_table(), gather_guide_bin(w), q);
+    guide_add(e, gather_guide_table(), gather_guide_bin(n, w), q);
 }

@@ -1,15 +1,19 @@
 // The guides' tables made from what the passes learned (gather/guide.rs): per cell in use and
-// per guide, each direction bin's weight from its sum over its count — the gather guide's the
-// bin's mean radiance, the guided sky's (passes/sky_guide.rs) the block's environment mass
-// times its mean openness — and the cumulative weights are what the guides draw from. A table
+// per guide, each direction bin's weight from its sum over its count, smoothed towards the
+// cell's mean by a few pseudo-samples — the gather guide's the bin's mean radiance, the guided
+// sky's (passes/sky_guide.rs) the block's environment mass times its mean openness — and the
+// cumulative weights are what the guides draw from; none (no guiding) before the cell has
+// counted enough samples. A table
 // whose bins counted GATHER_GUIDE_DECAY samples or more has its sums and counts halved first,
 // so the counters never overflow and the table follows what recent iterations found.
 
 @group(0) @binding(0) var<storage, read_write> photon_guide: array<atomic<u32>>;
 
-// Makes the table at offset t of entry e; `sky`: the guided sky's — each block's mean
-// openness smoothed towards the cell's mean by SKY_GUIDE_PRIOR pseudo-samples, times the
-// block's mass; no weights (no guiding) before the cell counted SKY_GUIDE_MIN_SAMPLES.
+// Makes the table at offset t of entry e: the gather's — each bin's mean radiance smoothed
+// towards the cell's mean by GATHER_GUIDE_PRIOR pseudo-samples, no weights before the cell
+// counted GATHER_GUIDE_MIN_SAMPLES; `sky`: the guided sky's — each block's mean openness
+// smoothed by SKY_GUIDE_PRIOR pseudo-samples, times the block's mass, no weights before
+// SKY_GUIDE_MIN_SAMPLES.
 fn build_table(e: u32, t: u32, sky: bool) {
     var most = 0u;
     var all_sums = 0.0;
@@ -22,7 +26,7 @@ fn build_table(e: u32, t: u32, sky: bool) {
     }
     let halve = most >= GATHER_GUIDE_DECAY;
     let blocks = guide_header_u32(13u) * guide_header_u32(14u);
-    let learned = all_counts >= SKY_GUIDE_MIN_SAMPLES;
+    let learned = all_counts >= select(GATHER_GUIDE_MIN_SAMPLES, SKY_GUIDE_MIN_SAMPLES, sky);
     let mean = all_sums / f32(max(all_counts, 1u));
     var acc = 0.0;
     for (var b = 0u; b < GATHER_GUIDE_BINS; b++) {
@@ -41,8 +45,8 @@ fn build_table(e: u32, t: u32, sky: bool) {
                 let open = (f32(sum) + SKY_GUIDE_PRIOR * mean) / (f32(count) + SKY_GUIDE_PRIOR);
                 acc += open * sky_block_mass(b);
             }
-        } else if count > 0u {
-            acc += f32(sum) / f32(count);
+        } else if learned {
+            acc += (f32(sum) + GATHER_GUIDE_PRIOR * mean) / (f32(count) + GATHER_GUIDE_PRIOR);
         }
         atomicStore(&photon_guide[guide_entry_word(e, t + 2u * GATHER_GUIDE_BINS + b)], bitcast<u32>(acc));
     }

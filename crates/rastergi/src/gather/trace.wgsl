@@ -5,7 +5,9 @@
 // lies above x's surface (gather_side), pdf 1/2π. Per-pixel directions: drawn from x's own
 // scattering (gather_direction: cosine-distributed on a Lambertian surface, by the BSDF
 // elsewhere) with the Owen-scrambled Sobol' point of index first_index + k and this pixel's
-// scramble seed, the lobe by a hash of (pixel, index).
+// scramble seed, the lobe by a hash of (pixel, index); with the gather guide, on a Lambertian
+// surface whose cell has learned, by one warp of the same point from the mixture of the cosine
+// and the cell's table (guide.wgsl), and every ray's finding added to that table.
 
 @group(2) @binding(0) var<uniform> gather: Gather;
 @group(2) @binding(1) var gbuffer: texture_2d<u32>;
@@ -46,28 +48,20 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
         var weight = vec3f(0.0);
         var density = 0.0;
         if per_pixel {
-            var lobe = rng_new(frame.seed ^ STREAM_GATHER_LOBE, pixel, j);
-            let lobe_u = rng_f32(&lobe);
-            if total > 0.0 {
-                // Half the directions from the point's scattering, half from the guide's table
-                // (alternating, each strategy its own Sobol' points, which keep stratifying it):
-                // the deterministic mixture, weighed with the mixture's density.
-                let half = gather.first_index / 2u + k / 2u;
-                if (k & 1u) == 1u {
-                    let u = sobol_owen_2d(half, pcg_hash(seed ^ STREAM_GATHER_LOBE));
-                    w = gather_guide_sample(entry, total, vec2f(unit_f32(u.x), unit_f32(u.y)));
-                } else {
-                    let u = sobol_owen_2d(half, seed);
-                    w = gather_direction(p, vec2f(unit_f32(u.x), unit_f32(u.y)), lobe_u).w;
-                }
+            let s = sobol_owen_2d(j, seed);
+            let u = vec2f(unit_f32(s.x), unit_f32(s.y));
+            if gather_guided_at(p, total) {
+                // One warp of the mixture of the cosine and the guide's table (guide.wgsl):
+                // the pixel's own Sobol' points, still stratified.
+                w = gather_guide_sample(entry, total, p.ns, u);
                 density = guided_gather_density(p, entry, total, w);
                 let cos_x = gather_cosine(p, w);
                 if density > 0.0 && cos_x > 0.0 {
                     weight = visible_f(p, w) * (cos_x / density);
                 }
             } else {
-                let u = sobol_owen_2d(j, seed);
-                let d = gather_direction(p, vec2f(unit_f32(u.x), unit_f32(u.y)), lobe_u);
+                var lobe = rng_new(frame.seed ^ STREAM_GATHER_LOBE, pixel, j);
+                let d = gather_direction(p, u, rng_f32(&lobe));
                 w = d.w;
                 weight = d.weight;
                 density = gather_density(p, w);
@@ -90,8 +84,12 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
             let found = gather_radiance(p.x.pos, w, h.tri, p.x.pos + w * h.t, vec2f(h.b1, h.b2), pixel, j);
             sum += weight * found;
             // The light of surfaces this ray found, for the guide (its luminance).
-            gather_guide_learn(entry, w, (found.r + found.g + found.b) / 3.0);
-        } else if has_environment() {
+            gather_guide_learn(entry, p.ns, w, (found.r + found.g + found.b) / 3.0);
+        } else {
+            // An escaping ray brings no light from surfaces: the guide learns a zero there.
+            gather_guide_learn(entry, p.ns, w, 0.0);
+        }
+        if h.tri == NO_TRIANGLE && has_environment() {
             let p_light = environment.pmf * sky_density(sky_entry, sky_total, w);
             sky += weight * env_radiance(w) * env_gather_weight(density, p_light);
         }

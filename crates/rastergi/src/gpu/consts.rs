@@ -79,12 +79,16 @@ pub const GUIDED_FRACTION: f32 = 0.75;
 pub const MAX_GUIDED_LIGHTS: u32 = 4;
 /// Words of a guided light's header in the guide's table.
 pub const GUIDE_HEADER_WORDS: u32 = 4;
-/// Direction bins of the gather's guide ([`crate::gather::guide`]): bands of equal solid angle
-/// in w_y, and as many sectors of φ; their product.
+/// Direction bins of the gather's guide ([`crate::gather::guide`]): rows of the cosine warp's
+/// square (sin²θ), and as many columns (φ); their product (also the guided sky's most blocks).
 pub const GATHER_GUIDE_BANDS: u32 = 16;
 pub const GATHER_GUIDE_BINS: u32 = GATHER_GUIDE_BANDS * GATHER_GUIDE_BANDS;
-/// The share of the guided gather's directions drawn from the guide's table.
+/// The guide table's share g of the guided gather's mixture density.
 pub const GATHER_GUIDE_FRACTION: f32 = 0.5;
+/// Samples a cell's gather table counts before it guides.
+pub const GATHER_GUIDE_MIN_SAMPLES: u32 = 2 * GATHER_GUIDE_BINS;
+/// Pseudo-samples of the cell's mean radiance in each bin of its gather table.
+pub const GATHER_GUIDE_PRIOR: f32 = 4.0;
 /// Entries a search of the gather guide's cells probes at most.
 pub const GATHER_GUIDE_PROBES: u32 = 32;
 /// A gather guide cell whose bins counted this many samples has its sums and counts halved.

@@ -105,6 +105,7 @@ pub fn constants() -> String {
         ("GATHER_GUIDE_PROBES", crate::gpu::consts::GATHER_GUIDE_PROBES),
         ("GATHER_GUIDE_DECAY", crate::gpu::consts::GATHER_GUIDE_DECAY),
         ("SKY_GUIDE_MIN_SAMPLES", crate::gpu::consts::SKY_GUIDE_MIN_SAMPLES),
+        ("GATHER_GUIDE_MIN_SAMPLES", crate::gpu::consts::GATHER_GUIDE_MIN_SAMPLES),
         ("GUIDE_HEADER", crate::gpu::consts::GUIDE_HEADER),
         ("GUIDE_MARKS", crate::gpu::consts::GUIDE_MARKS),
         ("LIGHT_POINT", LIGHT_POINT),
@@ -144,6 +145,7 @@ pub fn constants() -> String {
         ("SKY_GUIDE_FRACTION", crate::gpu::consts::SKY_GUIDE_FRACTION),
         ("SKY_GUIDE_SCALE", crate::gpu::consts::SKY_GUIDE_SCALE),
         ("SKY_GUIDE_PRIOR", crate::gpu::consts::SKY_GUIDE_PRIOR),
+        ("GATHER_GUIDE_PRIOR", crate::gpu::consts::GATHER_GUIDE_PRIOR),
         ("GLASS_ALBEDO_ETA_MAX", crate::gpu::consts::GLASS_ETA_MAX),
     ];
     let mut s = String::from("// Generated from the Rust constants (shader.rs).\n");

@@ -68,6 +68,9 @@ pub const AIM_FRACTION: f32 = 0.5;
 pub const NEAR_FRACTION: f32 = 0.25;
 /// The surroundings' disc radius over the aim's.
 pub const NEAR_SCALE: f32 = 4.0;
+/// The fraction of Lambertian bounces outside the aim's sphere drawn towards it
+/// ([`crate::photons::lambertian_bounce`]): half.
+pub const BOUNCE_AIM_FRACTION: f32 = 0.5;
 /// Position bins per side of a guided light's disc ([`crate::photons::guide`]).
 pub const GUIDE_POSITIONS: u32 = 64;
 /// Bands (of equal solid angle, in cos θ about +Y) and sectors of φ of the sky's direction bins

@@ -139,6 +139,7 @@ pub fn constants() -> String {
         ("AIM_FRACTION", crate::gpu::consts::AIM_FRACTION),
         ("NEAR_FRACTION", crate::gpu::consts::NEAR_FRACTION),
         ("NEAR_SCALE", crate::gpu::consts::NEAR_SCALE),
+        ("BOUNCE_AIM_FRACTION", crate::gpu::consts::BOUNCE_AIM_FRACTION),
         ("NEAR_FACE", crate::gpu::consts::NEAR_FACE),
         ("GUIDED_FRACTION", crate::gpu::consts::GUIDED_FRACTION),
         ("GATHER_GUIDE_FRACTION", crate::gpu::consts::GATHER_GUIDE_FRACTION),

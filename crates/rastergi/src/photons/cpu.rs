@@ -5,7 +5,7 @@ use super::{MAX_BOUNCES, PhotonSettings, STREAM_PHOTON};
 use crate::bsdf::{Frame, Transport};
 use crate::par::prelude::*;
 use crate::photons::map::{GridSpec, MapLayout, PhotonMap};
-use crate::sampling::{Rng, bend_towards, cosine_hemisphere, pcg_hash};
+use crate::sampling::{Rng, bend_towards, pcg_hash};
 use crate::scene::triangle_normal;
 use crate::surface::{PreparedScene, alpha_uniform};
 
@@ -105,6 +105,9 @@ fn trace_photon(
     let first_deposit = settings.indirect_only as u32;
     // Every scattering so far was a specular (delta) one, and there was one.
     let mut caustic = false;
+    // Whether the photon's one aimed bounce (super::lambertian_bounce) is still to come.
+    let mut aim_bounce = true;
+    let aim = settings.aim();
     for bounce in 0..MAX_BOUNCES {
         let solid = |h: &crate::bvh::Hit| {
             let u = alpha_uniform(h.triangle, h.b1, h.b2, alpha_seed);
@@ -167,12 +170,16 @@ fn trace_photon(
             }
             flux *= albedo / survive;
             let (u1, u2) = (rng.next_f32(), rng.next_f32());
-            dir = cosine_hemisphere(ns, u1, u2);
+            let outside =
+                aim.as_ref().is_some_and(|a| a.radius > 0.0 && (a.centre - p).length_squared() > a.radius * a.radius);
+            let (d, factor) = super::lambertian_bounce(p, ns, aim.as_ref().filter(|_| aim_bounce && outside), u1, u2);
+            aim_bounce &= !outside;
+            dir = d;
             let (cos_s, cos_g) = (dir.dot(ns), dir.dot(n));
-            if cos_g <= 0.0 || cos_s <= 0.0 {
+            if cos_g <= 0.0 || cos_s <= 0.0 || factor <= 0.0 {
                 break;
             }
-            flux *= arrive * (cos_g / cos_s);
+            flux *= arrive * (cos_g / cos_s) * factor;
             caustic = false;
         } else {
             // trace.wgsl: a direction from the BSDF, then roulette by its weight.

@@ -124,6 +124,40 @@ fn deposit(p: vec3f, tri: u32, back: bool, flux: vec3f, twin: u32) {
     add64(2u, s, q.z);
 }
 
+// A Lambertian bounce at x about the shading normal ns from two uniforms: the direction and
+// the factor (cos θ/π)/p by which its weight differs from the cosine's (photons/mod.rs:
+// lambertian_bounce). Cosine-distributed (factor 1) unless `aimed` and x lies outside the
+// aim's sphere (aim = centre, radius > 0): then from the mixture (1 − β)·cos θ/π + β·U_cone, U_cone
+// uniform in the cone the sphere subtends, v1 choosing the strategy and then reused.
+struct Bounce {
+    dir: vec3f,
+    factor: f32,
+}
+
+fn lambertian_bounce(x: vec3f, ns: vec3f, aimed: bool, aim: vec4f, v1: f32, v2: f32) -> Bounce {
+    let to = aim.xyz - x;
+    let d2 = dot(to, to);
+    if !aimed || aim.w <= 0.0 || d2 <= aim.w * aim.w {
+        return Bounce(cosine_hemisphere(ns, v1, v2), 1.0);
+    }
+    let beta = BOUNCE_AIM_FRACTION;
+    let axis = to / sqrt(d2);
+    let s2 = aim.w * aim.w / d2;
+    let one_minus_cos = s2 / (1.0 + sqrt(max(1.0 - s2, 0.0)));
+    var w: vec3f;
+    if v1 < beta {
+        w = uniform_cone(axis, one_minus_cos, v1 / beta, v2);
+    } else {
+        w = cosine_hemisphere(ns, (v1 - beta) / (1.0 - beta), v2);
+    }
+    let c = cross(to, w);
+    let in_cone = dot(to, w) > 0.0 && dot(c, c) <= aim.w * aim.w;
+    let cosine = max(dot(w, ns), 0.0) / PI;
+    let cone = select(0.0, 1.0 / (2.0 * PI * one_minus_cos), in_cone);
+    let p = (1.0 - beta) * cosine + beta * cone;
+    return Bounce(w, select(0.0, cosine / p, p > 0.0));
+}
+
 @compute @workgroup_size(64)
 fn trace_photons(@builtin(global_invocation_id) gid: vec3u) {
     let local = gid.x + gid.y * params.groups_x * 64u;
@@ -148,6 +182,8 @@ fn trace_photons(@builtin(global_invocation_id) gid: vec3u) {
     var caustic = false;
     // Deposits where the map is read (counted for a guided photon's start).
     var useful = 0u;
+    // Whether the photon's one aimed bounce (lambertian_bounce) is still to come.
+    var aim_bounce = true;
     for (var bounce = 0u; bounce < params.max_bounces; bounce++) {
         let hit = trace(origin, dir, params.ray_epsilon, 3.0e38, skip, NO_TRIANGLE, false);
         if hit.tri == NO_TRIANGLE {
@@ -188,14 +224,19 @@ fn trace_photons(@builtin(global_invocation_id) gid: vec3u) {
             flux *= s.albedo / survive;
             let v1 = rng_f32(&rng);
             let v2 = rng_f32(&rng);
-            dir = cosine_hemisphere(ns, v1, v2);
+            // Cosine-distributed, or once outside the aim's sphere towards it (photons/mod.rs).
+            let to_aim = params.aim.xyz - s.pos;
+            let outside = params.aim.w > 0.0 && dot(to_aim, to_aim) > params.aim.w * params.aim.w;
+            let bounce = lambertian_bounce(s.pos, ns, aim_bounce && outside, params.aim, v1, v2);
+            aim_bounce = aim_bounce && !outside;
+            dir = bounce.dir;
             let cos_s = dot(dir, ns);
             let cos_g = dot(dir, n);
             // No way into the surface.
-            if cos_g <= 0.0 || cos_s <= 0.0 {
+            if cos_g <= 0.0 || cos_s <= 0.0 || bounce.factor <= 0.0 {
                 break;
             }
-            flux *= arrive * (cos_g / cos_s);
+            flux *= arrive * (cos_g / cos_s) * bounce.factor;
             caustic = false;
         } else {
             // A direction from the BSDF (importance: no 1/η² on refraction), then Russian

@@ -67,6 +67,17 @@ pub fn cosine_hemisphere(n: Vec3, u1: f32, u2: f32) -> Vec3 {
     (t * (r * phi.cos()) + b * (r * phi.sin()) + n * (1.0 - u1).max(0.0).sqrt()).normalize()
 }
 
+/// A direction uniform in the cone about the unit `axis` whose half-angle θ_max has
+/// 1 − cos θ_max = `one_minus_cos` (pdf 1/(2π·one_minus_cos); passed so, it stays exact for
+/// narrow cones). Mirrors `uniform_cone` in `sampling.wgsl`.
+pub fn uniform_cone(axis: Vec3, one_minus_cos: f32, u1: f32, u2: f32) -> Vec3 {
+    let a = u1 * one_minus_cos;
+    let sin_t = (a * (2.0 - a)).max(0.0).sqrt();
+    let phi = 2.0 * std::f32::consts::PI * u2;
+    let (t, b) = orthonormal_basis(axis);
+    (t * (sin_t * phi.cos()) + b * (sin_t * phi.sin()) + axis * (1.0 - a)).normalize()
+}
+
 /// A point uniformly distributed on the triangle (pdf 1/area).
 pub fn uniform_triangle(t: &[Vec3; 3], u1: f32, u2: f32) -> Vec3 {
     let su = u1.sqrt();

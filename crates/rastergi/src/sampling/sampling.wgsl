@@ -52,6 +52,16 @@ fn cosine_hemisphere(n: vec3f, u1: f32, u2: f32) -> vec3f {
     return normalize(tb[0] * (r * cos(phi)) + tb[1] * (r * sin(phi)) + n * sqrt(max(1.0 - u1, 0.0)));
 }
 
+// A direction uniform in the cone about `axis` with 1 − cos θ_max = one_minus_cos (pdf
+// 1/(2π·one_minus_cos)); mirrors uniform_cone.
+fn uniform_cone(axis: vec3f, one_minus_cos: f32, u1: f32, u2: f32) -> vec3f {
+    let a = u1 * one_minus_cos;
+    let sin_t = sqrt(max(a * (2.0 - a), 0.0));
+    let phi = 2.0 * PI * u2;
+    let tb = orthonormal_basis(axis);
+    return normalize(tb[0] * (sin_t * cos(phi)) + tb[1] * (sin_t * sin(phi)) + axis * (1.0 - a));
+}
+
 // Barycentrics (b0, b1, b2) of a uniform point on a triangle (pdf 1/area).
 fn uniform_triangle_bary(u1: f32, u2: f32) -> vec3f {
     let su = sqrt(u1);

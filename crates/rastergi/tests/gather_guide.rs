@@ -45,11 +45,7 @@ fn the_guided_gather_agrees_with_the_cosines_sampling_in_the_mean() {
             d.push((a - b, b));
         }
     }
-    let n = d.len() as f64;
-    let mean = d.iter().map(|x| x.0).sum::<f64>() / n;
-    let level = d.iter().map(|x| x.1).sum::<f64>() / n;
-    let sd = (d.iter().map(|x| (x.0 - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
-    let se = sd / n.sqrt();
+    let (mean, level, se) = common::mean_difference(&d);
     println!("guided − unguided {mean:.6} (of {level:.5}), standard error {se:.6}");
     assert!(
         mean.abs() < 3.0 * se,

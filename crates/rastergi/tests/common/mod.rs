@@ -326,3 +326,14 @@ pub fn with_unit_triangle(mut doc: Value, attributes: &[(&str, &[f32])]) -> Valu
     doc["accessors"] = json!(accessors);
     doc
 }
+
+/// Per-pixel pairs (difference of two estimators, the level of one): the mean difference, the
+/// mean level, and the mean difference's standard error (the differences' spread over √N, for
+/// pixels whose errors are independent).
+pub fn mean_difference(d: &[(f64, f64)]) -> (f64, f64, f64) {
+    let n = d.len() as f64;
+    let mean = d.iter().map(|x| x.0).sum::<f64>() / n;
+    let level = d.iter().map(|x| x.1).sum::<f64>() / n;
+    let sd = (d.iter().map(|x| (x.0 - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+    (mean, level, sd / n.sqrt())
+}

@@ -14,6 +14,7 @@ use crate::passes::film::{Blend, BlendResolve, Film, FilmState, ImageResolve, Sh
 use crate::passes::frame::{FrameBinding, FrameUniforms, pixel_jitter};
 use crate::passes::gbuffer::{GBufferPass, PixelPass};
 use crate::passes::history::History;
+use crate::passes::light_budget::LightBudget;
 use crate::passes::photon_view::PhotonView;
 use crate::passes::{FixedSample, FrameContext, IterationPass};
 use crate::photons::PhotonSettings;
@@ -175,6 +176,11 @@ pub struct Renderer {
     blends: Vec<(u32, BlendResolve)>,
     /// Seconds spent tracing the photon pass under way in steps ([`Renderer::photon_step`]).
     stepped_seconds: f64,
+    /// The light samples per iteration, measured ([`crate::passes::light_budget`]); `None`
+    /// where the count is fixed.
+    light_budget: Option<LightBudget>,
+    /// When the iteration under way began, where the light budget times it.
+    timing: Option<web_time::Instant>,
 }
 
 /// The view at 1/`scale` of the image's size, with its own passes and film (the scene and the
@@ -261,6 +267,7 @@ impl Renderer {
         let sampler = DirectionSampler::new(settings.seed);
         let passes = ImagePasses::new(gpu, &gpu_scene, &frame, map, &settings, detail_bundle, sampler)?;
         let budget = new_budget(gpu, &settings, &passes.film, photons.as_mut(), true);
+        let settings_light_budget = settings.light_balance.then(LightBudget::new);
         Ok(Renderer {
             gpu: gpu.clone(),
             settings,
@@ -278,6 +285,8 @@ impl Renderer {
             reprojected: false,
             blends: Vec::new(),
             stepped_seconds: 0.0,
+            light_budget: settings_light_budget,
+            timing: None,
         })
     }
 
@@ -337,6 +346,12 @@ impl Renderer {
 
     pub fn camera(&self) -> Camera {
         self.camera
+    }
+
+    /// Light samples per pixel of the iterations now: the fixed count, or the light budget's
+    /// choice so far ([`crate::passes::light_budget`]; its first iterations time others).
+    pub fn light_samples(&self) -> u32 {
+        self.light_budget.as_ref().map_or(self.settings.light_samples, LightBudget::chosen)
     }
 
     /// Iterations accumulated since the last reset.
@@ -426,6 +441,10 @@ impl Renderer {
         if let Some(b) = &mut self.budget {
             b.restart();
         }
+        if let Some(b) = &mut self.light_budget {
+            b.restart();
+        }
+        self.timing = None;
         if let Some(d) = &mut self.passes.denoise {
             d.guides.clear(&self.gpu);
         }
@@ -491,7 +510,9 @@ impl Renderer {
         if p.band.is_none() {
             let block = p.passes.film.samples / crate::passes::film::BLOCK_ITERATIONS;
             let view = (&self.settings, &self.camera);
-            p.band = Some(Band::begin(&target, view, &mut p.passes, &Overrides::default(), block));
+            let light = self.light_budget.as_ref().map_or(self.settings.light_samples, LightBudget::chosen);
+            let first = p.passes.film.samples.wrapping_mul(light);
+            p.band = Some(Band::begin(&target, view, &mut p.passes, (&Overrides::default(), (light, first)), block));
         }
         run_band(&mut p.band, &target, &mut p.passes, self.settings.directions, rows.max(1))
     }
@@ -611,8 +632,15 @@ impl Renderer {
         Ok(swapped)
     }
 
-    /// Begins an iteration: the photon pass it reads, the film's block, its uniforms.
+    /// Begins an iteration: the photon pass it reads, the film's block, its light samples, its
+    /// uniforms.
     fn begin_iteration(&mut self, o: &Overrides) -> Result<()> {
+        let iteration = self.passes.film.samples;
+        // The light budget reads the film where it chooses again, before the photon budget
+        // times the pass that begins (the read waits for the iterations under way).
+        if let Some(b) = self.light_budget.as_mut().filter(|b| b.decides_before(iteration)) {
+            b.decide(&self.passes.film.read_state(&self.gpu)?);
+        }
         // 0. A new photon pass, when the current one has had its iterations (as many as the
         //    photon budget chose from its measurements of the passes so far).
         if let Some(photons) = &mut self.photons {
@@ -623,17 +651,33 @@ impl Renderer {
                 }
             }
         }
-        let iteration = self.passes.film.samples;
         // The film's blocks for its error estimate: the photon passes (each its own photons),
         // or runs of BLOCK_ITERATIONS iterations where the map is fixed.
         let block = match &self.photons {
             Some(p) if p.progressive() => p.pass(),
             _ => iteration / crate::passes::film::BLOCK_ITERATIONS,
         };
+        // The light samples: a fixed count, or as the light budget chose from its
+        // measurements (some early iterations timed).
+        let light = match &mut self.light_budget {
+            Some(b) => {
+                let (k, first, timed) = b.begin(iteration);
+                if timed {
+                    // Timed from here (the photon pass begun before) to the iteration's end.
+                    self.gpu.wait()?;
+                    self.timing = Some(web_time::Instant::now());
+                }
+                if let Some(photons) = &mut self.budget {
+                    photons.set_light_samples(k, b.costs().map(|c| c.sample));
+                }
+                (k, first)
+            }
+            None => (self.settings.light_samples, iteration.wrapping_mul(self.settings.light_samples)),
+        };
         let map = self.photons.as_ref().map(PhotonPasses::map);
         let target = Target { gpu: &self.gpu, scene: &self.scene, frame: &self.frame, map };
         let view = (&self.settings, &self.camera);
-        self.band = Some(Band::begin(&target, view, &mut self.passes, o, block));
+        self.band = Some(Band::begin(&target, view, &mut self.passes, (o, light), block));
         Ok(())
     }
 
@@ -642,9 +686,17 @@ impl Renderer {
     fn encode_rows(&mut self, rows: u32) -> Result<bool> {
         let map = self.photons.as_ref().map(PhotonPasses::map);
         let target = Target { gpu: &self.gpu, scene: &self.scene, frame: &self.frame, map };
+        let k = self.band.as_ref().map_or(1, |b| b.uniforms.light_samples);
         let done = run_band(&mut self.band, &target, &mut self.passes, self.settings.directions, rows)?;
         if done && let Some(p) = self.gpu.profiler.as_ref().filter(|p| p.half_full()) {
             p.collect(&self.gpu.device, &self.gpu.queue)?;
+        }
+        // A timed iteration counts where it ran in one go (a viewer's bands wait for frames).
+        if let Some(began) = self.timing.take().filter(|_| done && rows >= self.settings.height)
+            && let Some(b) = &mut self.light_budget
+        {
+            self.gpu.wait()?;
+            b.timed(k, began.elapsed().as_secs_f64());
         }
         Ok(done)
     }
@@ -689,6 +741,9 @@ impl Renderer {
         self.passes.film.restore(&self.gpu, film)?;
         if let Some(b) = &mut self.budget {
             b.restart();
+        }
+        if let Some(b) = &mut self.light_budget {
+            b.resume(film.samples, self.settings.light_samples);
         }
         if let Some(d) = &mut self.passes.denoise {
             d.guides.restart_from(&self.gpu, &self.passes.film);
@@ -806,7 +861,7 @@ impl Band {
         t: &Target,
         (settings, camera): (&RenderSettings, &Camera),
         passes: &mut ImagePasses,
-        o: &Overrides,
+        (o, (light_samples, light_base)): (&Overrides, (u32, u32)),
         block: u32,
     ) -> Band {
         let (scene, map) = (t.scene, t.map);
@@ -815,7 +870,8 @@ impl Band {
         film.begin_iteration(t.gpu, block);
         let seed = settings.seed;
         let jitter = o.pixel_jitter.unwrap_or_else(|| pixel_jitter(iteration, seed));
-        let mut uniforms = FrameUniforms::new(camera, size, scene, iteration, jitter, seed, settings.light_samples);
+        let mut uniforms = FrameUniforms::new(camera, size, scene, iteration, jitter, seed, light_samples);
+        uniforms.light_base = light_base;
         uniforms.eye_chains = scene.eye_chains as u32;
         uniforms.texture_footprint = (settings.texture_filter == TextureFilter::Footprint) as u32;
         let fixed = FixedSample { direction: o.direction, texel_jitter: o.texel_jitter };

@@ -11,8 +11,14 @@ pub struct RenderSettings {
     pub width: u32,
     pub height: u32,
     pub seed: u32,
-    /// Light samples per pixel per iteration in the direct pass.
+    /// Light samples per pixel per iteration in the direct pass (where `light_balance`, the
+    /// count the render starts from).
     pub light_samples: u32,
+    /// The light samples per iteration chosen by measurement as the render goes on: the direct
+    /// light's variance against the rest's, and what each costs on this GPU
+    /// ([`crate::passes::light_budget`]). The library's settings default to a fixed count (a
+    /// seed gives one image), the front ends ([`crate::session::Options`]) to balanced.
+    pub light_balance: bool,
     /// Photons traced into the photon map (0: no photon map, no indirect light).
     pub photons: u32,
     /// Photon grid cells along the scene's longest axis.
@@ -117,7 +123,7 @@ impl RenderSettings {
         let s = self;
         [
             ("size", format!("{}x{}", s.width, s.height)),
-            ("light-samples", s.light_samples.to_string()),
+            ("light-samples", if s.light_balance { "balanced".into() } else { s.light_samples.to_string() }),
             ("photons", s.photons.to_string()),
             ("grid", s.grid_resolution.to_string()),
             ("photon-view", s.show_photon_map.to_string()),
@@ -150,6 +156,7 @@ impl Default for RenderSettings {
             height: 256,
             seed: 0,
             light_samples: 1,
+            light_balance: false,
             photons: p.count,
             grid_resolution: p.grid_resolution,
             show_photon_map: false,

@@ -86,6 +86,8 @@ pub struct Controls {
     pub photon_guiding: bool,
     pub gather_guiding: bool,
     pub sky_guiding: bool,
+    /// The light samples per iteration balanced by measurement (else the fixed count).
+    pub light_balance: bool,
     /// The scene's sun (its last distant light), if it has one.
     pub sun: Option<SunAngles>,
     /// The environment map's radiance scale, if the scene has one that can be scaled.
@@ -118,6 +120,7 @@ impl Controls {
             photon_guiding: settings.photon_guiding,
             gather_guiding: settings.gather_guiding,
             sky_guiding: settings.sky_guiding,
+            light_balance: settings.light_balance,
             sun: None,
             env_scale: None,
             panel: true,
@@ -161,6 +164,7 @@ impl Controls {
             photon_guiding: self.photon_guiding,
             gather_guiding: self.gather_guiding,
             sky_guiding: self.sky_guiding,
+            light_balance: self.light_balance,
             ..base.clone()
         }
     }
@@ -307,6 +311,7 @@ impl Controls {
             Action::PhotonGuiding(on) => r.retrace = std::mem::replace(&mut self.photon_guiding, on) != on,
             Action::GatherGuiding(on) => r.retrace = std::mem::replace(&mut self.gather_guiding, on) != on,
             Action::SkyGuiding(on) => r.retrace = std::mem::replace(&mut self.sky_guiding, on) != on,
+            Action::LightBalance(on) => r.retrace = std::mem::replace(&mut self.light_balance, on) != on,
             Action::Speed(s) => self.camera.speed = s.max(1e-6),
             Action::Home => r.camera_moved = self.home(),
             Action::Open(ref name) => r.open = Some(name.clone()),

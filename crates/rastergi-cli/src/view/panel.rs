@@ -321,6 +321,16 @@ fn renderer(ui: &mut Ui, c: &Controls, out: &mut Vec<Action>) {
     {
         out.push(Action::SkyGuiding(sky));
     }
+    let mut balanced = c.light_balance;
+    if ui
+        .checkbox(&mut balanced, "balanced light samples")
+        .on_hover_text(
+            "light samples per iteration chosen from the direct light's variance against the rest's and their costs",
+        )
+        .changed()
+    {
+        out.push(Action::LightBalance(balanced));
+    }
 }
 
 fn photon_map(ui: &mut Ui, c: &Controls, out: &mut Vec<Action>) {

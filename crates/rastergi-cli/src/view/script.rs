@@ -128,6 +128,7 @@ pub enum Action {
     /// The traced gather guided by what its rays found (on) or not.
     GatherGuiding(bool),
     SkyGuiding(bool),
+    LightBalance(bool),
     /// Camera speed in scene units per second.
     Speed(f32),
     Home,
@@ -262,6 +263,7 @@ fn parse_action(action: &str) -> Result<Action> {
         "photon-guiding" => Action::PhotonGuiding(on_off(name, args)?),
         "gather-guiding" => Action::GatherGuiding(on_off(name, args)?),
         "sky-guiding" => Action::SkyGuiding(on_off(name, args)?),
+        "light-balance" => Action::LightBalance(on_off(name, args)?),
         "speed" => match numbers::<1>(args, "SPEED")?[0] {
             s if s > 0.0 => Action::Speed(s),
             _ => bail!("'speed' takes a positive number of scene units per second"),

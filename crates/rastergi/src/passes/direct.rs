@@ -13,7 +13,8 @@
 //! The light samples are quasi-random ([`light_sample_uniforms`]): pixel (x, y) has its own
 //! Owen-scrambled Sobol' sequence (Burley 2020, [`sobol_owen_2d`]) with scramble seed
 //! [`pixel_seed`]`(`[`light_sample_key`]`(seed), x, y)`, and sample k of iteration i is its
-//! point of index i·L + k (L light samples per iteration). Every aligned block of 2^m
+//! point of index b_i + k, b_i the light samples of the iterations before (i·L for L light samples
+//! per iteration; [`crate::passes::light_budget`] chooses L as the render goes on). Every aligned block of 2^m
 //! consecutive indices — the first 2^m samples of a pixel, in particular — is a (0, m, 2)-net,
 //! so the pixel's samples stay stratified over the emitters as the image converges, instead of
 //! clumping like independent ones. The seed does not depend on the restart: the light samples

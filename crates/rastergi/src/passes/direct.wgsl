@@ -49,11 +49,15 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
     if !begin_pixel(gid.xy) { return; }
     let p = visible_point_at(gid.xy);
     var radiance = emitted_radiance(p, gid.xy);
+    // Σ over the light samples of their estimates and of their squares (sample variance).
+    var sum = vec3f(0.0);
+    var squares = vec3f(0.0);
     let glass = p.seen && p.x.transmission > 0.0;
     if has_lights() && (p.ok || glass) {
         // The scattering model in the shading frame on the eye's side.
         let v = visible_bsdf(p);
-        // Sample k of iteration i has index i·L + k in the pixel's own sequence, whose seed
+        // Sample k of iteration i has index b_i + k in the pixel's own sequence (b_i the light
+        // samples of the iterations before: i·L for a fixed count L), whose seed
         // depends on (seed, pixel) only: a restart replays the same light samples.
         let seed = pixel_seed(pcg_hash(frame.seed ^ STREAM_DIRECT), gid.x, gid.y);
         // The guided sky's cell of this point (sky_guide.wgsl; NO_GUIDE where it is off): its
@@ -62,9 +66,8 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
         let sky = sky_guide_entry(p, true);
         let sky_total = sky_guide_total(sky);
         let origin = p.x.pos + p.n * frame.ray_epsilon;
-        var sum = vec3f(0.0);
         for (var k = 0u; k < frame.light_samples; k++) {
-            let index = frame.iteration * frame.light_samples + k;
+            let index = frame.light_base + k;
             let c = light_sample_uniforms(index, seed);
             var l = sample_light_at(origin, c);
             let env = l.pdf > 0.0 && sky != NO_GUIDE;
@@ -73,6 +76,7 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
             }
             let estimate = light_estimate(p, v, l);
             sum += estimate.xyz;
+            squares += estimate.xyz * estimate.xyz;
             if env {
                 sky_guide_learn(sky, l.dir, estimate.w);
             }
@@ -80,4 +84,12 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
         radiance += sum / f32(frame.light_samples);
     }
     film_add_seen(FILM_DIRECT, gid.xy, p.weight * (radiance), select(0.0, 1.0, sees_light(p)));
+    // One light sample's variance at this visible point, estimated from this iteration's k:
+    // s² = (Σe² − (Σe)²/k)/(k − 1) per channel, times the path's weight², summed over the
+    // channels (the light budget's D, passes/light_budget.rs).
+    let k = f32(frame.light_samples);
+    if frame.light_samples > 1u {
+        let s2 = max(squares - sum * sum / k, vec3f(0.0)) / (k - 1.0);
+        film_add_light_variance(gid.xy, dot(p.weight * p.weight, s2));
+    }
 }

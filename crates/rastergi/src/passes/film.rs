@@ -579,6 +579,27 @@ impl FilmState {
     /// noise-free, neither fills the mean nor hides the room's noise; all pixels where every
     /// one did); `None` until both halves hold iterations or where the image is black.
     pub fn error_estimate(&self) -> Option<f64> {
+        let (var, mean, count) = self.variance_of_mean(Show::Full)?;
+        (mean > 0.0).then(|| (var / count).sqrt() / (mean / count))
+    }
+
+    /// The direct pass's estimates of one light sample's variance (summed over the channels
+    /// and the iterations that drew two or more: the fourth channel of [`FILM_INDIRECT`],
+    /// `film_add_light_variance` in film.wgsl), summed over the pixels that
+    /// [`variance_of_mean`](Self::variance_of_mean) takes.
+    pub fn light_sample_variance(&self) -> f64 {
+        let all_light = (0..self.pixels()).all(|p| self.sees_light(p));
+        (0..self.pixels())
+            .filter(|&p| all_light || !self.sees_light(p))
+            .map(|p| self.sums[4 * (FILM_INDIRECT as usize * self.pixels() + p) + 3] as f64)
+            .sum()
+    }
+
+    /// The variance of `show`'s mean estimated from the two halves (see the module's notes),
+    /// summed over the channels of the pixels that never saw light itself (all pixels where
+    /// every one did), with the sum of the mean over them and their count (channels):
+    /// (Σ var, Σ mean, count); `None` until both halves hold iterations.
+    pub fn variance_of_mean(&self, show: Show) -> Option<(f64, f64, f64)> {
         let n = self.samples as f64;
         let nb = self.half_samples as f64;
         let na = n - nb;
@@ -592,15 +613,15 @@ impl FilmState {
                 continue;
             }
             count += 3.0;
-            let s = self.show_sum(&self.sums, Show::Full, p);
-            let b = self.show_sum(&self.half, Show::Full, p);
+            let s = self.show_sum(&self.sums, show, p);
+            let b = self.show_sum(&self.half, show, p);
             for c in 0..3 {
                 let d = (s[c] as f64 - b[c] as f64) / na - b[c] as f64 / nb;
                 var += d * d * na * nb / (n * n);
                 mean += s[c] as f64 / n;
             }
         }
-        (mean > 0.0).then(|| (var / count).sqrt() / (mean / count))
+        Some((var, mean, count))
     }
 
     /// Adds `other`'s iterations (another seed's render of the same image): the sums and the

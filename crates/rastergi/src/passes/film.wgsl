@@ -13,8 +13,16 @@ fn film_add(component: u32, texel: vec2u, v: vec3f) {
 // film_add, and `seen` to the component's fourth channel: the direct pass and the path tracer
 // add 1 to FILM_DIRECT's where this iteration's sample of the pixel sees an emitter or the
 // sky, directly or through smooth glass and mirrors (FilmState::error_estimate leaves such
-// pixels out); nothing else writes the fourth channels.
+// pixels out); FILM_INDIRECT's is film_add_light_variance's; nothing else writes them.
 fn film_add_seen(component: u32, texel: vec2u, v: vec3f, seen: f32) {
     let pixel = texel.y * frame.resolution.x + texel.x;
     film[film_slot(component, pixel, frame.resolution.x * frame.resolution.y)] += vec4f(v, seen);
+}
+
+// Adds v to FILM_INDIRECT's fourth channel: the direct pass's estimate of one light sample's
+// variance at the pixel's visible point, summed over the iterations that drew two or more
+// (FilmState::light_sample_variance, the light budget's).
+fn film_add_light_variance(texel: vec2u, v: f32) {
+    let pixel = texel.y * frame.resolution.x + texel.x;
+    film[film_slot(FILM_INDIRECT, pixel, frame.resolution.x * frame.resolution.y)].w += v;
 }

@@ -47,6 +47,12 @@ gpu_struct! {
         /// `frame.wgsl`); 0 and the height for a whole iteration.
         pub band_y0: u32,
         pub band_rows: u32,
+        /// The index of this iteration's first light sample in each pixel's sequence: the light
+        /// samples of the film's iterations before it (`iteration · light_samples` for a fixed
+        /// count; [`crate::passes::light_budget`] where the count changes), so that a pixel's
+        /// samples are always a prefix of its sequence.
+        pub light_base: u32,
+        pub _pad: [u32; 3],
     }
 }
 
@@ -91,6 +97,8 @@ impl FrameUniforms {
             texture_footprint: 1,
             band_y0: 0,
             band_rows: h,
+            light_base: iteration.wrapping_mul(light_samples.max(1)),
+            _pad: [0; 3],
         }
     }
 }

@@ -17,6 +17,7 @@ pub mod film;
 pub mod frame;
 pub mod gbuffer;
 pub mod history;
+pub mod light_budget;
 pub mod photon_view;
 pub mod sky_guide;
 pub mod specular;

@@ -273,6 +273,8 @@ struct Pass {
     /// When its iterations began, and its tracing's cost.
     started: web_time::Instant,
     pass_seconds: Option<f64>,
+    /// Σ of its iterations' light samples, and their count.
+    light: (f64, u32),
 }
 
 /// The balanced budget of a render: the GPU's measurements and what they said so far.
@@ -284,7 +286,11 @@ pub struct Budget {
     pairs: Vec<PassPair>,
     /// Recent costs: seconds per pass's tracing, per iteration.
     pass_seconds: Vec<f64>,
-    iteration_seconds: Vec<f64>,
+    /// With the mean light samples its iterations drew.
+    iteration_seconds: Vec<(f64, f64)>,
+    /// The light samples of the iterations now and a light sample's cost, where the light
+    /// budget measured it ([`crate::passes::light_budget`] changes the count as it goes).
+    light_samples: Option<(u32, f64)>,
     /// Passes begun since the budget was made (the exploration's count).
     passes: u32,
     /// The length chosen for the passes that do not explore.
@@ -305,14 +311,28 @@ impl Budget {
                 measured: fresh && photons.iterations_in_pass() == 0,
                 started: web_time::Instant::now(),
                 pass_seconds: None,
+                light: (0.0, 0),
             },
             previous: None,
             pairs: Vec::new(),
             pass_seconds: Vec::new(),
             iteration_seconds: Vec::new(),
+            light_samples: None,
             passes: 1,
             chosen: FIRST_ITERATIONS,
         }
+    }
+
+    /// The iteration that begins draws `k` light samples, each costing `sample_seconds` where
+    /// that is measured ([`crate::passes::light_budget`]).
+    pub fn set_light_samples(&mut self, k: u32, sample_seconds: Option<f64>) {
+        self.light_samples = Some((k, sample_seconds.unwrap_or(0.0)));
+        self.current.light = (self.current.light.0 + k as f64, self.current.light.1 + 1);
+    }
+
+    /// Recent seconds per iteration ([`iteration_costs`]).
+    fn iteration_costs(&self) -> Vec<f64> {
+        iteration_costs(&self.iteration_seconds, self.light_samples)
     }
 
     /// The film was cleared (a camera move): the pass under way is not measured.
@@ -365,6 +385,7 @@ impl Budget {
             measured: true,
             started: web_time::Instant::now(),
             pass_seconds: Some(seconds),
+            light: (0.0, 0),
         };
     }
 
@@ -389,7 +410,7 @@ impl Budget {
         }
         let [e2, sum_x, pixels] = self.gpu.end(gpu, done, self.previous.is_some())?;
         let seconds = c.started.elapsed().as_secs_f64() / done as f64;
-        keep_recent(&mut self.iteration_seconds, seconds);
+        keep_recent(&mut self.iteration_seconds, (seconds, c.light.0 / c.light.1.max(1) as f64));
         if let Some(s) = c.pass_seconds {
             keep_recent(&mut self.pass_seconds, s);
         }
@@ -435,7 +456,7 @@ impl Budget {
         }
         let mean = |v: &[f64]| (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64);
         if let (Some(v), Some(cost), Some(c)) =
-            (fit(&self.pairs), mean(&self.pass_seconds), mean(&self.iteration_seconds))
+            (fit(&self.pairs), mean(&self.pass_seconds), mean(&self.iteration_costs()))
         {
             let photons = self.current.photons.max(1) as f64;
             self.chosen = balanced_iterations(v.map_times_photons / photons, v.iteration, cost, c);
@@ -447,7 +468,7 @@ impl Budget {
             );
         }
         if k.is_multiple_of(EXPLORE) {
-            let longest = match (mean(&self.pass_seconds), mean(&self.iteration_seconds)) {
+            let longest = match (mean(&self.pass_seconds), mean(&self.iteration_costs())) {
                 (Some(cost), Some(c)) => longest_pass(cost, c),
                 _ => MAX_ITERATIONS,
             };
@@ -459,7 +480,16 @@ impl Budget {
 }
 
 /// Appends `v`, keeping the last [`HISTORY`].
-fn keep_recent(values: &mut Vec<f64>, v: f64) {
+/// The passes' seconds per iteration `(t, k̄)` (k̄ their iterations' mean light samples), each
+/// as if its iterations had drawn the light samples `now` = (k, c), c a sample's cost:
+/// t − (k̄ − k)·c, at least a tenth of t. The light budget's first iterations draw more, and
+/// its choices change the count; the passes' costs would otherwise follow them.
+fn iteration_costs(seconds: &[(f64, f64)], now: Option<(u32, f64)>) -> Vec<f64> {
+    let extra = |mean: f64| now.map_or(0.0, |(k, c)| (mean - k as f64) * c);
+    seconds.iter().map(|&(t, mean)| (t - extra(mean)).max(0.1 * t)).collect()
+}
+
+fn keep_recent<T>(values: &mut Vec<T>, v: T) {
     values.push(v);
     if values.len() > HISTORY {
         values.remove(0);
@@ -473,6 +503,18 @@ mod tests {
     /// The rounded choice is the power of two of least (V_map + W/M)(C + M·c) among all of them
     /// in range, or within 7 % of it where the optimum lies between two; the unrounded one is
     /// the continuous optimum (brute force).
+    #[test]
+    fn an_iterations_cost_is_taken_at_the_light_samples_drawn_now() {
+        // Passes of 8, 2 and a mix averaging 5.5 light samples at 0.5 ms each over a 9 ms rest.
+        let passes = [(13e-3, 8.0), (10e-3, 2.0), (11.75e-3, 5.5)];
+        for c in iteration_costs(&passes, Some((2, 0.5e-3))) {
+            assert!((c - 10e-3).abs() < 1e-12, "{c}");
+        }
+        assert_eq!(iteration_costs(&passes, None), vec![13e-3, 10e-3, 11.75e-3]);
+        // A light budget that has not timed a sample yet (cost 0) leaves them as measured.
+        assert_eq!(iteration_costs(&passes, Some((1, 0.0))), vec![13e-3, 10e-3, 11.75e-3]);
+    }
+
     #[test]
     fn the_balanced_iterations_minimise_the_variance_per_unit_of_time() {
         let cases = [(1.0, 1.0, 1.0, 1.0), (0.01, 5.0, 0.2, 0.01), (3.0, 0.1, 0.05, 0.02), (1e-2, 10.0, 0.5, 1e-2)];

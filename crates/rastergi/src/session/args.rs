@@ -105,6 +105,33 @@ impl Switch {
     }
 }
 
+/// `--light-samples`: a count, or balanced by measurement.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum LightSamplesArg {
+    Balanced,
+    Fixed(u32),
+}
+
+impl LightSamplesArg {
+    /// The count of the first iterations.
+    pub fn first(self) -> u32 {
+        match self {
+            LightSamplesArg::Balanced => 1,
+            LightSamplesArg::Fixed(n) => n,
+        }
+    }
+}
+
+fn parse_light_samples(s: &str) -> std::result::Result<LightSamplesArg, String> {
+    if s == "balanced" {
+        return Ok(LightSamplesArg::Balanced);
+    }
+    match s.parse::<u32>() {
+        Ok(n @ 1..=64) => Ok(LightSamplesArg::Fixed(n)),
+        _ => Err(format!("`{s}` is neither `balanced` nor a count from 1 to 64")),
+    }
+}
+
 /// How long each photon pass lasts where `--pass-iterations` is not given.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
 pub enum PhotonBudgetArg {
@@ -295,9 +322,11 @@ pub struct SceneArgs {
     /// Mitsuba 3's `roughconductor`, for comparisons with it.
     #[arg(long)]
     pub single_scattering: bool,
-    /// Light samples per pixel per iteration.
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=64))]
-    pub light_samples: u32,
+    /// Light samples per pixel per iteration: `balanced` chooses them as the render goes on, from
+    /// the direct light's variance against the rest's and what each costs on this GPU (depends
+    /// on timings: give a number, 1 to 64, for images that repeat bit for bit)
+    #[arg(long, default_value = "balanced", value_parser = parse_light_samples)]
+    pub light_samples: LightSamplesArg,
     /// Photons traced into the photon map (default: fitted to the scene: about 40 per
     /// cell-sized patch of surface, a power of two from 2^18 to 2^24; 2^20 for cornell).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
@@ -409,7 +438,8 @@ impl SceneArgs {
             env: self.env.clone(),
             env_scale: self.env_scale,
             single_scattering: self.single_scattering,
-            light_samples: self.light_samples,
+            light_samples: self.light_samples.first(),
+            light_balance: self.light_samples == LightSamplesArg::Balanced,
             photons: self.photons,
             grid: self.grid,
             photon_passes: self.photon_passes,

@@ -111,7 +111,10 @@ pub struct Options {
     pub env_scale: f32,
     /// Rough metals and glass without their multiple-scattering compensation.
     pub single_scattering: bool,
+    /// Light samples per pixel per iteration, the first count where `light_balance`.
     pub light_samples: u32,
+    /// The light samples chosen by measurement ([`crate::passes::light_budget`]).
+    pub light_balance: bool,
     /// Photons per pass and photon grid cells along the longest axis (`None`: fitted).
     pub photons: Option<u32>,
     pub grid: Option<u32>,
@@ -166,6 +169,7 @@ impl Default for Options {
             env_scale: 1.0,
             single_scattering: false,
             light_samples: 1,
+            light_balance: true,
             photons: None,
             grid: None,
             photon_passes: 0,
@@ -322,6 +326,8 @@ impl Options {
             height,
             seed: self.seed,
             light_samples: self.light_samples,
+            // A web page cannot wait for the film's read-back either.
+            light_balance: self.light_balance && crate::gpu::READ_BACK_BLOCKS,
             photons,
             grid_resolution: grid,
             show_photon_map,

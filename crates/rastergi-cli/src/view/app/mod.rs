@@ -639,5 +639,6 @@ impl App {
         (c.photon_budget, c.photon_guiding, c.gather_guiding, c.sky_guiding) =
             (b.settings.photon_budget, b.settings.photon_guiding, b.settings.gather_guiding, b.settings.sky_guiding);
         (c.method, c.sun, c.env_scale) = (b.method, b.sun, b.env_scale);
+        c.light_balance = b.settings.light_balance;
     }
 }

@@ -53,16 +53,18 @@ use crate::passes::film::{FilmState, Show};
 /// Iterations before the timings (the first ones build pipelines and tables).
 pub const WARM_UP: u32 = 4;
 /// Iterations timed with [`LOW`] light samples, then with [`PROBE`].
-pub const TIMED: u32 = 6;
+pub const TIMED: u32 = 4;
 /// Light samples of the two timed sets.
 pub const LOW: u32 = 2;
-pub const PROBE: u32 = 16;
+pub const PROBE: u32 = 8;
 /// Light samples of the iterations before the first decision that are not timed. The film's
 /// mean weighs every iteration alike, so where many samples are best, early iterations of one
 /// sample stay in the image's noise for long (in the sky-lit room 22 of them, of 236 in 6 s,
 /// made the error at 6 s 30 % larger than 16 samples throughout), while where one is best,
-/// 8 for a few iterations cost a few tenths of a second.
-pub const BEFORE: u32 = 8;
+/// each extra sample of these iterations is time lost before the image reaches a first
+/// error (the sunlit room reaches 5 % within 2 s; four here and [`PROBE`] 8, [`TIMED`] 4, were
+/// as good as or better than 8, 16 and 6 under both the sun and the sky at 1–3 s).
+pub const BEFORE: u32 = 4;
 /// The most light samples an iteration draws (the model counts the jitter's variance as the
 /// light's: where the rest is nearly noise-free it would otherwise ask for ever more).
 pub const MOST: u32 = 16;

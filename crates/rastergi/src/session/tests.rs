@@ -17,13 +17,14 @@ use crate::settings::PhotonBudget;
 fn cornell_with_no_flags_gets_the_fitted_defaults() {
     let options = Options { scene: "cornell".into(), ..Options::default() };
     let session = Session::load(&options).unwrap();
-    // The renderer's own defaults (256², seed 0, one light sample, the traced-or-rasterized
-    // `auto` gather with four per-pixel directions, …) but for the fitted photon map and the
-    // front ends' balanced photon budget.
+    // The renderer's own defaults (256², seed 0, the traced-or-rasterized `auto` gather with
+    // four per-pixel directions, …) but for the fitted photon map and the front ends' balanced
+    // photon budget and light samples (from one).
     let defaults = RenderSettings {
         photons: 1 << 20,
         grid_resolution: 64,
         photon_budget: crate::settings::PhotonBudget::Balanced,
+        light_balance: true,
         ..RenderSettings::default()
     };
     assert_eq!(session.settings, defaults);

@@ -137,7 +137,8 @@ def render(scene: Union[str, "os.PathLike[str]"], width: int = 256, height: int 
     another for images that repeat bit for bit), ``gather_directions``, ``directions``,
     ``hit_light``, ``show`` (``"full"``, ``"direct"``, ``"indirect"``, ``"photon-map"``),
     ``eye``, ``target``, ``up``, ``fov``, ``camera``, ``sun``, ``sun_size``, ``sky``, ``point``, ``spot``,
-    ``env``, ``env_scale``, ``light_samples``, ``photon_passes``, ``pass_iterations``,
+    ``env``, ``env_scale``, ``light_samples`` (a count, or ``"balanced"``, the default, which
+    follows timings), ``photon_passes``, ``pass_iterations``,
     ``photon_budget`` (``"balanced"``, which follows timings, or ``"fitted"``, which repeats bit
     for bit), ``photon_guiding``, ``gather_guiding`` and ``sky_guiding`` (``"on"`` or ``"off"``),
     ``bundle``, ``backend``, ``rays`` (``"auto"``, ``"hardware"``, ``"compute"``: hardware ray

@@ -24,10 +24,23 @@ fn script() -> PathBuf {
 }
 
 /// The render options of every shard here: the Cornell box at 32², traced gather, few photons,
-/// the fitted photon budget (the balanced budget times its passes by the clock, so a shard
-/// resumed from its checkpoint repeats the uninterrupted render bit for bit only with this one).
-const RENDER: [&str; 10] =
-    ["--width", "32", "--height", "32", "--gather", "trace", "--photons", "20000", "--photon-budget", "fitted"];
+/// the fitted photon budget and one light sample an iteration (the balanced budget and light
+/// samples follow the clock, so a shard resumed from its checkpoint repeats the uninterrupted
+/// render bit for bit only with these).
+const RENDER: [&str; 12] = [
+    "--width",
+    "32",
+    "--height",
+    "32",
+    "--gather",
+    "trace",
+    "--photons",
+    "20000",
+    "--photon-budget",
+    "fitted",
+    "--light-samples",
+    "1",
+];
 
 /// The runner's arguments: the Cornell box with `options`, this build's rastergi, and the
 /// render options of every shard here.

@@ -19,6 +19,10 @@ const TIMEOUT: Duration = Duration::from_secs(180);
 /// Small and quick: the comparisons need no more.
 const SIZE: &[&str] = &["--width", "64", "--height", "64"];
 const PHOTONS: &[&str] = &["--photons", "65536", "--grid", "32"];
+/// One light sample an iteration in the viewer and the renders alike: the balanced count is
+/// chosen from timings, and a viewer's iterations in row bands are not timed (they draw one),
+/// so the two draw the same light samples only at a fixed count.
+const LIGHT: &[&str] = &["--light-samples", "1"];
 
 impl Run {
     fn check_success(&self, what: &str) {
@@ -86,6 +90,7 @@ fn scripted_view(d: &Path, script: &str, options: &[&str]) -> (Run, Vec<Shot>) {
     args.extend_from_slice(options);
     args.extend_from_slice(SIZE);
     args.extend_from_slice(PHOTONS);
+    args.extend_from_slice(LIGHT);
     let run = view(d, &args);
     run.check_success(&format!("view {}", options.join(" ")));
     let shots = screenshots(d, &run.stdout);
@@ -103,6 +108,7 @@ fn render_scene(dir: &Path, scene: &str, out: &str, seed: u32, iterations: u32, 
     let mut args = vec!["render", scene, "--seed", &seed, "--iterations", &iterations, "--out", out];
     args.extend_from_slice(SIZE);
     args.extend_from_slice(PHOTONS);
+    args.extend_from_slice(LIGHT);
     args.extend(extra.iter().map(String::as_str));
     rastergi(dir, &args).check_success("render");
     read_exr(&dir.join(out)).unwrap()

@@ -267,7 +267,7 @@ impl Renderer {
         let sampler = DirectionSampler::new(settings.seed);
         let passes = ImagePasses::new(gpu, &gpu_scene, &frame, map, &settings, detail_bundle, sampler)?;
         let budget = new_budget(gpu, &settings, &passes.film, photons.as_mut(), true);
-        let settings_light_budget = settings.light_balance.then(LightBudget::new);
+        let light_budget = settings.light_balance.then(LightBudget::new);
         Ok(Renderer {
             gpu: gpu.clone(),
             settings,
@@ -285,7 +285,7 @@ impl Renderer {
             reprojected: false,
             blends: Vec::new(),
             stepped_seconds: 0.0,
-            light_budget: settings_light_budget,
+            light_budget,
             timing: None,
         })
     }
@@ -462,7 +462,7 @@ impl Renderer {
     /// way in row bands ([`Renderer::iterate_rows`]) is finished instead, with its own choices.
     pub fn iterate_with(&mut self, o: &Overrides) -> Result<()> {
         if self.band.is_none() {
-            self.begin_iteration(o)?;
+            self.begin_iteration(o, true)?;
         }
         while !self.encode_rows(u32::MAX)? {}
         Ok(())
@@ -478,10 +478,10 @@ impl Renderer {
     /// band. While `Auto` still tries the gathers (it times whole iterations), the band is the
     /// whole image.
     pub fn iterate_rows(&mut self, rows: u32) -> Result<bool> {
-        if self.band.is_none() {
-            self.begin_iteration(&Overrides::default())?;
-        }
         let whole = self.gather_method() == GatherMethod::Auto;
+        if self.band.is_none() {
+            self.begin_iteration(&Overrides::default(), whole || rows >= self.settings.height)?;
+        }
         self.encode_rows(if whole { u32::MAX } else { rows.max(1) })
     }
 
@@ -632,9 +632,9 @@ impl Renderer {
         Ok(swapped)
     }
 
-    /// Begins an iteration: the photon pass it reads, the film's block, its light samples, its
-    /// uniforms.
-    fn begin_iteration(&mut self, o: &Overrides) -> Result<()> {
+    /// Begins an iteration (`whole`: run at once, not in bands): the photon pass it reads, the
+    /// film's block, its light samples, its uniforms.
+    fn begin_iteration(&mut self, o: &Overrides, whole: bool) -> Result<()> {
         let iteration = self.passes.film.samples;
         // The light budget reads the film where it chooses again, before the photon budget
         // times the pass that begins (the read waits for the iterations under way).
@@ -661,7 +661,7 @@ impl Renderer {
         // measurements (some early iterations timed).
         let light = match &mut self.light_budget {
             Some(b) => {
-                let (k, first, timed) = b.begin(iteration);
+                let (k, first, timed) = b.begin(iteration, whole);
                 if timed {
                     // Timed from here (the photon pass begun before) to the iteration's end.
                     self.gpu.wait()?;

@@ -126,6 +126,9 @@ pub fn variances(film: &FilmState, varied: u32, inverse: f64) -> Option<(f64, f6
 pub struct LightBudget {
     /// Light samples of the iterations that are not timed.
     chosen: u32,
+    /// A count was chosen, and a restart since: no more choices.
+    decided: bool,
+    settled: bool,
     /// Σ k and Σ 1/k over the film's iterations begun, and how many of them drew two or more.
     drawn: u32,
     inverse: f64,
@@ -146,6 +149,8 @@ impl LightBudget {
     pub fn new() -> LightBudget {
         LightBudget {
             chosen: BEFORE,
+            decided: false,
+            settled: false,
             drawn: 0,
             inverse: 0.0,
             varied: 0,
@@ -166,9 +171,12 @@ impl LightBudget {
     }
 
     /// The film was cleared: its light samples start again from the sequence's first point (a
-    /// restart replays them, as with a fixed count); what was timed and chosen is kept.
+    /// restart replays them, as with a fixed count); what was timed and chosen is kept, and
+    /// once chosen the count is not chosen again (a viewer's camera moves would read the film
+    /// back at every view's 32nd, 128th … iteration: a frame's stall each).
     pub fn restart(&mut self) {
         (self.drawn, self.inverse, self.varied) = (0, 0.0, 0);
+        self.settled |= self.decided;
     }
 
     /// The film was restored with `samples` iterations of `k` light samples each (a checkpoint
@@ -179,14 +187,23 @@ impl LightBudget {
         self.varied = if k > 1 { samples } else { 0 };
     }
 
-    /// The light samples of the film's `iteration`, which begins now: (k, the index of its
-    /// first sample in each pixel's sequence, whether to time it).
-    pub fn begin(&mut self, iteration: u32) -> (u32, u32, bool) {
-        let (k, timed) = match (self.costs, iteration.checked_sub(WARM_UP)) {
-            (None, Some(i)) if i < TIMED => (LOW, true),
-            (None, Some(i)) if i < 2 * TIMED => (PROBE, true),
-            (None, _) => (BEFORE, false),
-            _ => (self.chosen, false),
+    /// The light samples of the film's `iteration`, which begins now and runs `whole` (at once,
+    /// not in a viewer's row bands, which wait for frames and cannot be timed): (k, the index
+    /// of its first sample in each pixel's sequence, whether to time it). Until a count is
+    /// chosen, every film draws [`BEFORE`], [`LOW`] and [`PROBE`] at the same iterations (a
+    /// restart replays the light samples of a fresh render, as with a fixed count), timed
+    /// until the costs are known; an iteration in bands draws one sample until then (a viewer
+    /// whose iterations never fit a frame keeps the count it had before the budget).
+    pub fn begin(&mut self, iteration: u32, whole: bool) -> (u32, u32, bool) {
+        // Until a count is chosen every film begins alike (a restart replays a fresh render's
+        // light samples), timed while the costs are not known.
+        let untimed = self.costs.is_none();
+        let (k, timed) = match iteration.checked_sub(WARM_UP) {
+            _ if self.decided => (self.chosen, false),
+            _ if untimed && !whole => (1, false),
+            Some(i) if i < TIMED => (LOW, untimed),
+            Some(i) if i < 2 * TIMED => (PROBE, untimed),
+            _ => (BEFORE, false),
         };
         let first = self.drawn;
         self.drawn = self.drawn.wrapping_add(k);
@@ -210,7 +227,7 @@ impl LightBudget {
 
     /// Whether the count is chosen again before the film's `iteration` (the film is read).
     pub fn decides_before(&self, iteration: u32) -> bool {
-        self.costs.is_some() && DECISIONS.contains(&iteration)
+        self.costs.is_some() && !self.settled && DECISIONS.contains(&iteration)
     }
 
     /// Chooses the count from the film ([`variances`]) and the costs; returns it.
@@ -225,7 +242,7 @@ impl LightBudget {
             1e3 * costs.sample,
             1e3 * costs.rest,
         );
-        self.chosen = k;
+        (self.chosen, self.decided) = (k, true);
         k
     }
 }
@@ -285,7 +302,7 @@ mod tests {
         let mut b = LightBudget::new();
         let mut next = 0;
         for i in 0..WARM_UP + 2 * TIMED + 4 {
-            let (k, first, timed) = b.begin(i);
+            let (k, first, timed) = b.begin(i, true);
             assert_eq!(first, next, "iteration {i}");
             next += k;
             let probing = (WARM_UP + TIMED..WARM_UP + 2 * TIMED).contains(&i);
@@ -311,14 +328,45 @@ mod tests {
         let inverse = TIMED as f64 / LOW as f64 + TIMED as f64 / PROBE as f64 + (WARM_UP + 4) as f64 / BEFORE as f64;
         assert!((b.inverse - inverse).abs() < 1e-9, "{} against {inverse}", b.inverse);
         assert!(b.decides_before(32) && !b.decides_before(33));
-        // A restart replays the sequence from its first point and times nothing again.
+        // One pixel whose halves differ in the direct light only, by hand: per channel the
+        // halves' means differ by 24/16 − 16/16 = ½, so n²·Var(direct mean) = 3·¼·16·16 = 192;
+        // D = 96/16 = 6 (16 iterations drew two or more), Σ1/k = 4/2 + 4/8 + 8/4 = 4.5, so
+        // J = (192 − 6·4.5)/32 = 5.16 is the rest (no indirect variance) and
+        // k* = √(6·0.01/(5.16·0.001)) = 3.4: four.
+        let comp = |d: f32, light: f32| [d, d, d, 0.0, 0.0, 0.0, 0.0, light, 0.0, 0.0, 0.0, 0.0];
+        let film = FilmState {
+            width: 1,
+            height: 1,
+            samples: 32,
+            half_samples: 16,
+            sums: comp(40.0, 32.0 * 3.0).to_vec(),
+            half: comp(16.0, 16.0 * 3.0).to_vec(),
+        };
+        assert_eq!(b.decide(&film), 4);
+        // A restart after a choice begins its sequence from the first point with the count
+        // chosen, and chooses no more.
         b.restart();
-        assert_eq!(b.begin(0), (BEFORE, 0, false));
-        assert_eq!(b.begin(WARM_UP), (BEFORE, BEFORE, false));
-        // Until the costs are known, a restart begins with BEFORE again and times as before.
+        assert!(!b.decides_before(32));
+        assert_eq!(b.begin(0, true), (4, 0, false));
+        assert_eq!(b.begin(WARM_UP + TIMED, true), (4, 4, false));
+        // Before a choice a restart replays a fresh render's counts, untimed once timed.
         let mut b = LightBudget::new();
-        assert_eq!(b.begin(0), (BEFORE, 0, false));
+        for i in 0..WARM_UP + 2 * TIMED {
+            let (k, _, timed) = b.begin(i, true);
+            if timed {
+                b.timed(k, 0.01 + 0.001 * k as f64);
+            }
+        }
+        assert!(b.costs().is_some());
         b.restart();
-        assert_eq!(b.begin(WARM_UP), (LOW, 0, true));
+        let counts: Vec<_> = (0..WARM_UP + 2 * TIMED + 1).map(|i| b.begin(i, true)).collect();
+        let mut fresh = LightBudget::new();
+        let fresh: Vec<_> =
+            (0..WARM_UP + 2 * TIMED + 1).map(|i| fresh.begin(i, true)).map(|(k, f, _)| (k, f, false)).collect();
+        assert_eq!(counts, fresh);
+        // Iterations in bands are not timed: until some are, one sample, as before the budget.
+        let mut b = LightBudget::new();
+        assert_eq!(b.begin(WARM_UP, false), (1, 0, false));
+        assert_eq!(b.begin(WARM_UP + 1, true), (LOW, 1, true));
     }
 }

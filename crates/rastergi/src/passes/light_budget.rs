@@ -126,6 +126,9 @@ pub fn variances(film: &FilmState, varied: u32, inverse: f64) -> Option<(f64, f6
 pub struct LightBudget {
     /// Light samples of the iterations that are not timed.
     chosen: u32,
+    /// The film's iteration where this budget's schedule starts: 0, or where a resumed render
+    /// picked up (its timings come after that).
+    origin: u32,
     /// A count was chosen, and a restart since: no more choices.
     decided: bool,
     settled: bool,
@@ -149,6 +152,7 @@ impl LightBudget {
     pub fn new() -> LightBudget {
         LightBudget {
             chosen: BEFORE,
+            origin: 0,
             decided: false,
             settled: false,
             drawn: 0,
@@ -175,14 +179,16 @@ impl LightBudget {
     /// once chosen the count is not chosen again (a viewer's camera moves would read the film
     /// back at every view's 32nd, 128th … iteration: a frame's stall each).
     pub fn restart(&mut self) {
-        (self.drawn, self.inverse, self.varied) = (0, 0.0, 0);
+        (self.drawn, self.inverse, self.varied, self.origin) = (0, 0.0, 0, 0);
         self.settled |= self.decided;
     }
 
     /// The film was restored with `samples` iterations of `k` light samples each (a checkpoint
-    /// does not record them: `k` is the count the resumed render starts from).
+    /// does not record them: `k` is the count the resumed render starts from); the schedule
+    /// (timings, then choices) starts from there.
     pub fn resume(&mut self, samples: u32, k: u32) {
         let k = k.max(1);
+        self.origin = samples;
         (self.drawn, self.inverse) = (samples.saturating_mul(k), samples as f64 / k as f64);
         self.varied = if k > 1 { samples } else { 0 };
     }
@@ -198,7 +204,7 @@ impl LightBudget {
         // Until a count is chosen every film begins alike (a restart replays a fresh render's
         // light samples), timed while the costs are not known.
         let untimed = self.costs.is_none();
-        let (k, timed) = match iteration.checked_sub(WARM_UP) {
+        let (k, timed) = match iteration.saturating_sub(self.origin).checked_sub(WARM_UP) {
             _ if self.decided => (self.chosen, false),
             _ if untimed && !whole => (1, false),
             Some(i) if i < TIMED => (LOW, untimed),
@@ -364,6 +370,10 @@ mod tests {
         let fresh: Vec<_> =
             (0..WARM_UP + 2 * TIMED + 1).map(|i| fresh.begin(i, true)).map(|(k, f, _)| (k, f, false)).collect();
         assert_eq!(counts, fresh);
+        // A resumed render times its own iterations after the restored ones.
+        let mut b = LightBudget::new();
+        b.resume(100, 1);
+        assert_eq!(b.begin(100 + WARM_UP, true), (LOW, 100, true));
         // Iterations in bands are not timed: until some are, one sample, as before the budget.
         let mut b = LightBudget::new();
         assert_eq!(b.begin(WARM_UP, false), (1, 0, false));

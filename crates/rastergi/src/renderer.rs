@@ -504,13 +504,13 @@ impl Renderer {
                 self.previews.len() - 1
             }
         };
+        let light = self.light_samples();
         let map = self.photons.as_ref().map(PhotonPasses::map);
         let target = Target { gpu: &self.gpu, scene: &self.scene, frame: &self.frame, map };
         let p = &mut self.previews[k];
         if p.band.is_none() {
             let block = p.passes.film.samples / crate::passes::film::BLOCK_ITERATIONS;
             let view = (&self.settings, &self.camera);
-            let light = self.light_budget.as_ref().map_or(self.settings.light_samples, LightBudget::chosen);
             let first = p.passes.film.samples.wrapping_mul(light);
             p.band = Some(Band::begin(&target, view, &mut p.passes, (&Overrides::default(), (light, first)), block));
         }
@@ -691,8 +691,8 @@ impl Renderer {
         if done && let Some(p) = self.gpu.profiler.as_ref().filter(|p| p.half_full()) {
             p.collect(&self.gpu.device, &self.gpu.queue)?;
         }
-        // A timed iteration counts where it ran in one go (a viewer's bands wait for frames).
-        if let Some(began) = self.timing.take().filter(|_| done && rows >= self.settings.height)
+        // A timed iteration began whole ([`LightBudget::begin`]), so one call finishes it.
+        if let Some(began) = self.timing.take().filter(|_| done)
             && let Some(b) = &mut self.light_budget
         {
             self.gpu.wait()?;

@@ -588,11 +588,14 @@ impl FilmState {
     /// `film_add_light_variance` in film.wgsl), summed over the pixels that
     /// [`variance_of_mean`](Self::variance_of_mean) takes.
     pub fn light_sample_variance(&self) -> f64 {
+        self.counted_pixels().map(|p| self.sums[4 * (FILM_INDIRECT as usize * self.pixels() + p) + 3] as f64).sum()
+    }
+
+    /// The pixels the error estimates take: those that never saw light itself, or all where
+    /// every one did.
+    fn counted_pixels(&self) -> impl Iterator<Item = usize> + '_ {
         let all_light = (0..self.pixels()).all(|p| self.sees_light(p));
-        (0..self.pixels())
-            .filter(|&p| all_light || !self.sees_light(p))
-            .map(|p| self.sums[4 * (FILM_INDIRECT as usize * self.pixels() + p) + 3] as f64)
-            .sum()
+        (0..self.pixels()).filter(move |&p| all_light || !self.sees_light(p))
     }
 
     /// The variance of `show`'s mean estimated from the two halves (see the module's notes),
@@ -606,12 +609,8 @@ impl FilmState {
         if na < 1.0 || nb < 1.0 {
             return None;
         }
-        let all_light = (0..self.pixels()).all(|p| self.sees_light(p));
         let (mut var, mut mean, mut count) = (0.0f64, 0.0f64, 0.0f64);
-        for p in 0..self.pixels() {
-            if self.sees_light(p) && !all_light {
-                continue;
-            }
+        for p in self.counted_pixels() {
             count += 3.0;
             let s = self.show_sum(&self.sums, show, p);
             let b = self.show_sum(&self.half, show, p);

@@ -138,7 +138,8 @@ def render(scene: Union[str, "os.PathLike[str]"], width: int = 256, height: int 
     ``hit_light``, ``show`` (``"full"``, ``"direct"``, ``"indirect"``, ``"photon-map"``),
     ``eye``, ``target``, ``up``, ``fov``, ``camera``, ``sun``, ``sun_size``, ``sky``, ``point``, ``spot``,
     ``env``, ``env_scale``, ``light_samples`` (a count, or ``"balanced"``, the default, which
-    follows timings), ``photon_passes``, ``pass_iterations``,
+    follows timings), ``emitter_edges`` (sub-pixel rays per axis for the emission at emitters'
+    edges, 0 to 16; 0: off), ``photon_passes``, ``pass_iterations``,
     ``photon_budget`` (``"balanced"``, which follows timings, or ``"fitted"``, which repeats bit
     for bit), ``photon_guiding``, ``gather_guiding`` and ``sky_guiding`` (``"on"`` or ``"off"``),
     ``bundle``, ``backend``, ``rays`` (``"auto"``, ``"hardware"``, ``"compute"``: hardware ray

@@ -10,6 +10,7 @@ use crate::gpu::Gpu;
 use crate::gpu_scene::GpuScene;
 use crate::image_io::{DisplayImage, LinearImage};
 use crate::passes::denoise::{DenoiseParams, Denoiser, GuideState, Guides};
+use crate::passes::emitter_edges::EmitterEdges;
 use crate::passes::film::{Blend, BlendResolve, Film, FilmState, ImageResolve, Show};
 use crate::passes::frame::{FrameBinding, FrameUniforms, pixel_jitter};
 use crate::passes::gbuffer::{GBufferPass, PixelPass};
@@ -56,6 +57,9 @@ pub const HISTORY_FADED: u32 = 16;
 struct ImagePasses {
     gbuffer: GBufferPass,
     specular: Option<PixelPass>,
+    /// The keys of what the pixels' centres see as light, where the emission at emitters'
+    /// edges is supersampled (`RenderSettings::emitter_edges` > 0).
+    emitter_edges: Option<crate::passes::emitter_edges::EmitterEdges>,
     direct: PixelPass,
     photon_view: Option<PixelPass>,
     caustics: Option<PixelPass>,
@@ -90,6 +94,7 @@ impl ImagePasses {
         let film = Film::new(gpu, width, height)?;
         let gbuffer = GBufferPass::new(gpu, scene, frame, width, height);
         let specular = scene.eye_chains.then(|| crate::passes::specular::pass(gpu, scene, frame, &gbuffer, &film));
+        let emitter_edges = (settings.emitter_edges > 0).then(|| EmitterEdges::new(gpu, scene, frame, &gbuffer, &film));
         // The guides' tables: the guided sky's for the direct pass's environment samples, and
         // the guided gather's density that weighs them.
         let guided = map.filter(|m| m.guide_cells > 0);
@@ -125,7 +130,18 @@ impl ImagePasses {
         let guide_build = map
             .filter(|m| m.guide_cells > 0)
             .map(|m| crate::gather::guide::GuideBuild::new(gpu, &m.guide, m.guide_cells));
-        Ok(ImagePasses { gbuffer, specular, direct, photon_view, caustics, gather, guide_build, film, denoise: None })
+        Ok(ImagePasses {
+            gbuffer,
+            specular,
+            emitter_edges,
+            direct,
+            photon_view,
+            caustics,
+            gather,
+            guide_build,
+            film,
+            denoise: None,
+        })
     }
 
     fn enable_denoiser(&mut self, gpu: &Gpu, scene: &GpuScene, frame: &FrameBinding) -> Result<()> {
@@ -433,6 +449,7 @@ impl Renderer {
     /// Discards the accumulated iterations.
     pub fn reset(&mut self) {
         self.band = None;
+        self.frame.edge_keys.take();
         for p in &mut self.previews {
             p.band = None;
             p.passes.film.clear(&self.gpu);
@@ -872,6 +889,7 @@ impl Band {
         let jitter = o.pixel_jitter.unwrap_or_else(|| pixel_jitter(iteration, seed));
         let mut uniforms = FrameUniforms::new(camera, size, scene, iteration, jitter, seed, light_samples);
         uniforms.light_base = light_base;
+        uniforms.emitter_edges = settings.emitter_edges;
         uniforms.eye_chains = scene.eye_chains as u32;
         uniforms.texture_footprint = (settings.texture_filter == TextureFilter::Footprint) as u32;
         let fixed = FixedSample { direction: o.direction, texel_jitter: o.texel_jitter };
@@ -923,7 +941,14 @@ impl Band {
         if let Some(specular) = &mut p.specular {
             specular.encode(&mut enc, &ctx)?;
         }
-        // 2. Emission + direct light with soft shadows at the visible points → film (direct).
+        // 2. Emission + direct light with soft shadows at the visible points → film (direct);
+        //    first, once per view, which pixels straddle an emitter's edge: their emission is
+        //    supersampled.
+        if let Some(edges) = &mut p.emitter_edges {
+            let mut keys = t.frame.edge_keys.get();
+            edges.encode(&mut enc, &ctx, &mut keys)?;
+            t.frame.edge_keys.set(keys);
+        }
         p.direct.encode(&mut enc, &ctx)?;
         // Debug view: the photon map's radiance at the visible points → film (photon view).
         if let Some(view) = &mut p.photon_view {

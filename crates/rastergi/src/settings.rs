@@ -19,6 +19,11 @@ pub struct RenderSettings {
     /// ([`crate::passes::light_budget`]). The library's settings default to a fixed count (a
     /// seed gives one image), the front ends ([`crate::session::Options`]) to balanced.
     pub light_balance: bool,
+    /// n: the emission seen at pixels on the edge of an emitter or of the sky is estimated by
+    /// n × n stratified sub-pixel rays per iteration ([`crate::passes::emitter_edges`]); 0: by
+    /// the iteration's one jittered sample, as every other pixel. The same image in the mean,
+    /// so not in the [fingerprint](Self::fingerprint): renders with different values may be merged.
+    pub emitter_edges: u32,
     /// Photons traced into the photon map (0: no photon map, no indirect light).
     pub photons: u32,
     /// Photon grid cells along the scene's longest axis.
@@ -157,6 +162,7 @@ impl Default for RenderSettings {
             seed: 0,
             light_samples: 1,
             light_balance: false,
+            emitter_edges: crate::passes::emitter_edges::DEFAULT_EMITTER_EDGES,
             photons: p.count,
             grid_resolution: p.grid_resolution,
             show_photon_map: false,

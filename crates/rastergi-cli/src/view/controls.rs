@@ -88,6 +88,8 @@ pub struct Controls {
     pub sky_guiding: bool,
     /// The light samples per iteration balanced by measurement (else the fixed count).
     pub light_balance: bool,
+    /// Sub-pixel rays per axis for the emission at emitters' edges (0: off).
+    pub emitter_edges: u32,
     /// The scene's sun (its last distant light), if it has one.
     pub sun: Option<SunAngles>,
     /// The environment map's radiance scale, if the scene has one that can be scaled.
@@ -121,6 +123,7 @@ impl Controls {
             gather_guiding: settings.gather_guiding,
             sky_guiding: settings.sky_guiding,
             light_balance: settings.light_balance,
+            emitter_edges: settings.emitter_edges,
             sun: None,
             env_scale: None,
             panel: true,
@@ -165,6 +168,7 @@ impl Controls {
             gather_guiding: self.gather_guiding,
             sky_guiding: self.sky_guiding,
             light_balance: self.light_balance,
+            emitter_edges: self.emitter_edges,
             ..base.clone()
         }
     }
@@ -312,6 +316,10 @@ impl Controls {
             Action::GatherGuiding(on) => r.retrace = std::mem::replace(&mut self.gather_guiding, on) != on,
             Action::SkyGuiding(on) => r.retrace = std::mem::replace(&mut self.sky_guiding, on) != on,
             Action::LightBalance(on) => r.retrace = std::mem::replace(&mut self.light_balance, on) != on,
+            Action::EmitterEdges(on) => {
+                let n = if on { rastergi::passes::emitter_edges::DEFAULT_EMITTER_EDGES } else { 0 };
+                r.retrace = std::mem::replace(&mut self.emitter_edges, n) != n;
+            }
             Action::Speed(s) => self.camera.speed = s.max(1e-6),
             Action::Home => r.camera_moved = self.home(),
             Action::Open(ref name) => r.open = Some(name.clone()),

@@ -331,6 +331,14 @@ fn renderer(ui: &mut Ui, c: &Controls, out: &mut Vec<Action>) {
     {
         out.push(Action::LightBalance(balanced));
     }
+    let mut edges = c.emitter_edges > 0;
+    if ui
+        .checkbox(&mut edges, "supersampled emitter edges")
+        .on_hover_text("the emission seen at pixels on an emitter's or the sky's edge from 16 sub-pixel rays")
+        .changed()
+    {
+        out.push(Action::EmitterEdges(edges));
+    }
 }
 
 fn photon_map(ui: &mut Ui, c: &Controls, out: &mut Vec<Action>) {

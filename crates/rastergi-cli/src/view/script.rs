@@ -129,6 +129,8 @@ pub enum Action {
     GatherGuiding(bool),
     SkyGuiding(bool),
     LightBalance(bool),
+    /// The emission at emitters' edges supersampled (on: the default rays) or not.
+    EmitterEdges(bool),
     /// Camera speed in scene units per second.
     Speed(f32),
     Home,
@@ -264,6 +266,7 @@ fn parse_action(action: &str) -> Result<Action> {
         "gather-guiding" => Action::GatherGuiding(on_off(name, args)?),
         "sky-guiding" => Action::SkyGuiding(on_off(name, args)?),
         "light-balance" => Action::LightBalance(on_off(name, args)?),
+        "emitter-edges" => Action::EmitterEdges(on_off(name, args)?),
         "speed" => match numbers::<1>(args, "SPEED")?[0] {
             s if s > 0.0 => Action::Speed(s),
             _ => bail!("'speed' takes a positive number of scene units per second"),

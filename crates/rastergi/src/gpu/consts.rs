@@ -148,6 +148,8 @@ pub mod stream {
     pub const GATHER_LOBE: u32 = 0x510e527f;
     /// The ray view's sub-texel offset, keyed (direction index, restart).
     pub const TEXEL_JITTER: u32 = 0x7e1a5;
+    /// The sub-pixel rays of the emission seen at an emitter's edge, keyed (pixel, iteration).
+    pub const EMITTER_EDGE: u32 = 0x9b05688c;
     /// The scramble seed of the pixel jitter's Owen-scrambled Sobol' sequence (hashed, not a
     /// stream).
     pub const PIXEL_JITTER: u32 = 0x6a09e667;

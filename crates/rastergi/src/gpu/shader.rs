@@ -93,6 +93,7 @@ pub fn constants() -> String {
         ("STREAM_EYE_CHAIN", stream::EYE_CHAIN),
         ("STREAM_GATHER_CHAIN", stream::GATHER_CHAIN),
         ("STREAM_GATHER_LOBE", stream::GATHER_LOBE),
+        ("STREAM_EMITTER_EDGE", stream::EMITTER_EDGE),
         ("PUNCTUAL_LIGHT", PUNCTUAL_LIGHT),
         ("ENVIRONMENT_LIGHT", ENVIRONMENT_LIGHT),
         ("CAUSTIC_CELL", CAUSTIC_CELL),

@@ -48,7 +48,8 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
     let gid = band_pixel(id);
     if !begin_pixel(gid.xy) { return; }
     let p = visible_point_at(gid.xy);
-    var radiance = emitted_radiance(p, gid.xy);
+    // The light reflected towards the eye, before the eye chain's weight.
+    var reflected = vec3f(0.0);
     // Σ over the light samples of their estimates and of their squares (sample variance).
     var sum = vec3f(0.0);
     var squares = vec3f(0.0);
@@ -81,9 +82,9 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
                 sky_guide_learn(sky, l.dir, estimate.w);
             }
         }
-        radiance += sum / f32(frame.light_samples);
+        reflected += sum / f32(frame.light_samples);
     }
-    film_add_seen(FILM_DIRECT, gid.xy, p.weight * (radiance), select(0.0, 1.0, sees_light(p)));
+    film_add_seen(FILM_DIRECT, gid.xy, seen_emission(p, gid.xy) + p.weight * reflected, select(0.0, 1.0, sees_light(p)));
     // One light sample's variance at this visible point, estimated from this iteration's k:
     // s² = (Σe² − (Σe)²/k)/(k − 1) per channel, times the path's weight², summed over the
     // channels (the light budget's D, passes/light_budget.rs).

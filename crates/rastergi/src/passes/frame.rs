@@ -52,7 +52,13 @@ gpu_struct! {
         /// count; [`crate::passes::light_budget`] where the count changes), so that a pixel's
         /// samples are always a prefix of its sequence.
         pub light_base: u32,
-        pub _pad: [u32; 3],
+        /// n where the emission the eye sees is supersampled by n × n sub-pixel rays at the
+        /// pixels on an emitter's edge (`seen_emission` in `visible_point.wgsl`,
+        /// [`crate::passes::emitter_edges`]); 0: off.
+        pub emitter_edges: u32,
+        /// This iteration's sub-pixel offset ([`pixel_jitter`]): the G-buffer's sample of pixel
+        /// (x, y) lies at (x + ½, y + ½) + jitter on the image plane.
+        pub jitter: [f32; 2],
     }
 }
 
@@ -98,7 +104,8 @@ impl FrameUniforms {
             band_y0: 0,
             band_rows: h,
             light_base: iteration.wrapping_mul(light_samples.max(1)),
-            _pad: [0; 3],
+            emitter_edges: 0,
+            jitter: jitter.into(),
         }
     }
 }
@@ -140,6 +147,8 @@ pub fn view_projection(camera: &Camera, width: u32, height: u32, near: f32, jitt
 pub struct FrameBinding {
     pub buffer: wgpu::Buffer,
     pub eye_paths: wgpu::Buffer,
+    /// Whose emitter-edge keys the eye paths hold ([`crate::passes::emitter_edges`]).
+    pub edge_keys: std::cell::Cell<crate::passes::emitter_edges::EdgeKeys>,
     pub layout: wgpu::BindGroupLayout,
     pub bind_group: wgpu::BindGroup,
 }
@@ -184,7 +193,7 @@ impl FrameBinding {
         let group = group();
         let layout = group.layout(&gpu.device);
         let bind_group = bind(gpu, &layout, &buffer, &eye_paths);
-        Self { buffer, eye_paths, layout, bind_group }
+        Self { buffer, eye_paths, edge_keys: Default::default(), layout, bind_group }
     }
 
     /// Makes room for the eye paths of `pixels` pixels.
@@ -194,6 +203,7 @@ impl FrameBinding {
             return;
         }
         self.eye_paths = gpu.zeroed_buffer("eye paths", size, wgpu::BufferUsages::STORAGE);
+        self.edge_keys.take();
         self.bind_group = bind(gpu, &self.layout, &self.buffer, &self.eye_paths);
     }
 

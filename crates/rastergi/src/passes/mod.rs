@@ -1,6 +1,6 @@
 //! The per-iteration passes over the image, in the order [`crate::renderer::Renderer::iterate`]
 //! runs them: [`frame`] (the iteration's camera and uniforms) → [`gbuffer`] → [`specular`] chains
-//! → [`direct`] → the final gather ([`crate::gather`]) and [`photon_view`] → [`film`]
+//! → [`emitter_edges`] (keys) → [`direct`] → the final gather ([`crate::gather`]) and [`photon_view`] → [`film`]
 //! (accumulate, resolve) → [`denoise`] → [`display`].
 //!
 //! What the passes of an iteration share: one [`FrameContext`] that each reads, and one
@@ -13,6 +13,7 @@
 pub mod denoise;
 pub mod direct;
 pub mod display;
+pub mod emitter_edges;
 pub mod film;
 pub mod frame;
 pub mod gbuffer;
@@ -51,6 +52,7 @@ pub fn per_pixel(pieces: &[&str]) -> String {
 }
 
 /// What every pass of one iteration reads besides its own resources.
+#[derive(Clone)]
 pub struct FrameContext<'a> {
     pub gpu: &'a Gpu,
     /// Bind group 0 of every pass.

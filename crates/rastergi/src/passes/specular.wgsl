@@ -21,8 +21,10 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
     let pixel = pixel_index(gid.xy);
     let base = 3u * pixel;
     let g = textureLoad(gbuffer, gid.xy, 0);
+    // The second slot's w is the emitter-edges pass's (kept from one iteration to the next).
+    let edge = eye_paths[base + 1u].w;
     eye_paths[base] = vec4f(frame.eye, 0.0);
-    eye_paths[base + 1u] = vec4f(1.0, 1.0, 1.0, 0.0);
+    eye_paths[base + 1u] = vec4f(1.0, 1.0, 1.0, edge);
     eye_paths[base + 2u] = bitcast<vec4f>(g);
     if g.x == 0u {
         return;
@@ -42,7 +44,7 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
                 // The visible point: here (the G-buffer's own where k = 0 and no delta lobe).
                 if k > 0u || choice.pd > 0.0 {
                     eye_paths[base] = vec4f(o, 1.0);
-                    eye_paths[base + 1u] = vec4f(throughput / (1.0 - choice.pd), 0.0);
+                    eye_paths[base + 1u] = vec4f(throughput / (1.0 - choice.pd), edge);
                     eye_paths[base + 2u] = bitcast<vec4f>(hit_g);
                 }
                 return;
@@ -67,6 +69,6 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
     }
     // Escaped, absorbed or too long: nothing more reaches the pixel along this chain.
     eye_paths[base] = vec4f(o, 1.0);
-    eye_paths[base + 1u] = vec4f(0.0);
+    eye_paths[base + 1u] = vec4f(0.0, 0.0, 0.0, edge);
     eye_paths[base + 2u] = vec4f(0.0);
 }

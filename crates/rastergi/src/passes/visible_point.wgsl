@@ -120,6 +120,81 @@ fn emitted_radiance(p: VisiblePoint, xy: vec2u) -> vec3f {
     return radiance;
 }
 
+// Emitter edges (passes/emitter_edges.rs). The emission the eye sees is a pixel's integral of a
+// discontinuous function: one jittered sample an iteration gets an emitter's edge pixel all or
+// nothing, an error of the order of the emitter's radiance that dominates an image's first
+// iterations wherever an emitter or a bright sky is in view. Where the camera rays through the
+// centres of a pixel's 3 × 3 neighbourhood (not jittered: a choice that does not depend on this
+// iteration's random numbers) do not all see the same light, the pixel's own emission — what
+// its first surface emits towards the eye, or the environment where the ray escapes — is
+// estimated by frame.emitter_edges² stratified sub-pixel rays instead,
+//
+//   E ≈ (1/n²) Σ_ij Le(first hit of the ray through (x + (i + ξ_i)/n, y + (j + η_j)/n)),
+//
+// an unbiased estimate of the same box-filtered integral as the jittered sample's; every other
+// pixel keeps the sample. Behind a mirror or glass the chain's emission is reflected light and
+// stays with the sample.
+
+// What the camera ray through image point q (pixels from the top-left corner, not jittered)
+// first meets, as light: key 0 where nothing emits towards the eye, 1 the environment, 2 + m
+// an emitter's front face of material m; and the radiance.
+struct SeenLight {
+    key: u32,
+    radiance: vec3f,
+}
+
+fn light_seen_through(q: vec2f) -> SeenLight {
+    // camera_ray(q') meets the image plane at q' + jitter.
+    let d = camera_ray(q - frame.jitter);
+    let hit = trace(frame.eye, d, 0.0, 3.0e38, NO_TRIANGLE, NO_TRIANGLE, false);
+    if hit.tri == NO_TRIANGLE {
+        let e = env_radiance(d);
+        return SeenLight(select(0u, 1u, any(e > vec3f(0.0))), e);
+    }
+    let s = surface_at(hit.tri, hit.b1, hit.b2, 0.0);
+    if dot(s.normal, frame.eye - s.pos) > 0.0 && any(s.emission > vec3f(0.0)) {
+        return SeenLight(min(2u + triangles[hit.tri].material, EDGE_FLAG - 1u), s.emission);
+    }
+    return SeenLight(0u, vec3f(0.0));
+}
+
+// Added to a pixel's key where it lies on an emitter's edge (its 3 × 3 neighbourhood's keys
+// differ), by the emitter-edges passes, which keep both in the w of the pixel's second eye-path
+// slot as a float (exact below 2²⁴: keys stay below EDGE_FLAG).
+const EDGE_FLAG: u32 = 0x800000u;
+
+// The key of pixel xy's centre.
+fn edge_key(xy: vec2u) -> u32 {
+    return u32(eye_paths[3u * pixel_index(xy) + 1u].w) & (EDGE_FLAG - 1u);
+}
+
+// Whether pixel xy lies on an emitter's edge.
+fn on_emitter_edge(xy: vec2u) -> bool {
+    return u32(eye_paths[3u * pixel_index(xy) + 1u].w) >= EDGE_FLAG;
+}
+
+// What pixel xy adds before any light is reflected: the emission its visible point p sends
+// to the eye, times the eye chain's throughput (emitted_radiance), its own part estimated by
+// sub-pixel rays on an emitter's edge (above). The direct pass adds it to the film; the
+// denoiser's guides sum the same (the same random numbers).
+fn seen_emission(p: VisiblePoint, xy: vec2u) -> vec3f {
+    let point = p.weight * emitted_radiance(p, xy);
+    let n = frame.emitter_edges;
+    if n == 0u || !on_emitter_edge(xy) {
+        return point;
+    }
+    // Behind a specular chain the point's emission is reflected light: it stays.
+    var e = select(vec3f(0.0), point, any(p.eye != frame.eye));
+    var state = rng_new(frame.seed ^ STREAM_EMITTER_EDGE, pixel_index(xy), frame.iteration);
+    var sum = vec3f(0.0);
+    for (var i = 0u; i < n * n; i++) {
+        let cell = vec2f(f32(i % n), f32(i / n));
+        let u = (cell + vec2f(rng_f32(&state), rng_f32(&state))) / f32(n);
+        sum += light_seen_through(vec2f(xy) + u).radiance;
+    }
+    return e + sum / f32(n * n);
+}
+
 // Whether the visible point is light itself, as emitted_radiance sees it: the sky where the
 // camera ray (or the eye's specular chain) escapes, or an emitter's front face.
 fn sees_light(p: VisiblePoint) -> bool {

@@ -327,6 +327,11 @@ pub struct SceneArgs {
     /// on timings: give a number, 1 to 64, for images that repeat bit for bit)
     #[arg(long, default_value = "balanced", value_parser = parse_light_samples)]
     pub light_samples: LightSamplesArg,
+    /// Sub-pixel rays per axis (n: n × n rays) for the emission seen at the pixels on the edge
+    /// of an emitter or of the sky, per iteration; 0: one jittered sample, as elsewhere (the
+    /// same image in the mean)
+    #[arg(long, default_value_t = crate::passes::emitter_edges::DEFAULT_EMITTER_EDGES, value_parser = clap::value_parser!(u32).range(0..=16))]
+    pub emitter_edges: u32,
     /// Photons traced into the photon map (default: fitted to the scene: about 40 per
     /// cell-sized patch of surface, a power of two from 2^18 to 2^24; 2^20 for cornell).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
@@ -440,6 +445,7 @@ impl SceneArgs {
             single_scattering: self.single_scattering,
             light_samples: self.light_samples.first(),
             light_balance: self.light_samples == LightSamplesArg::Balanced,
+            emitter_edges: self.emitter_edges,
             photons: self.photons,
             grid: self.grid,
             photon_passes: self.photon_passes,

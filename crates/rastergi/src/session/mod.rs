@@ -115,6 +115,9 @@ pub struct Options {
     pub light_samples: u32,
     /// The light samples chosen by measurement ([`crate::passes::light_budget`]).
     pub light_balance: bool,
+    /// Sub-pixel rays per axis for the emission at emitters' edges (0: off;
+    /// [`crate::passes::emitter_edges`]).
+    pub emitter_edges: u32,
     /// Photons per pass and photon grid cells along the longest axis (`None`: fitted).
     pub photons: Option<u32>,
     pub grid: Option<u32>,
@@ -170,6 +173,7 @@ impl Default for Options {
             single_scattering: false,
             light_samples: 1,
             light_balance: true,
+            emitter_edges: crate::passes::emitter_edges::DEFAULT_EMITTER_EDGES,
             photons: None,
             grid: None,
             photon_passes: 0,
@@ -328,6 +332,7 @@ impl Options {
             light_samples: self.light_samples,
             // A web page cannot wait for the film's read-back either.
             light_balance: self.light_balance && crate::gpu::READ_BACK_BLOCKS,
+            emitter_edges: self.emitter_edges,
             photons,
             grid_resolution: grid,
             show_photon_map,

@@ -7,7 +7,7 @@
 // it saw (w, bitcast `seen_key`).
 @group(3) @binding(1) var<storage, read_write> history: array<vec4f>;
 // Per pixel of the new view: the history's mean where the same triangle is seen through the
-// old view (rgb, w = 1), else 0.
+// old view (rgb; w = 1, or 2 where either pixel straddles an edge of light), else 0.
 @group(3) @binding(2) var<storage, read_write> reprojected: array<vec4f>;
 
 // The film's mean of the shown component at pixel `p` of the view before the move.
@@ -37,15 +37,79 @@ fn seen_key(g: vec4u) -> u32 {
     return g.x | select(0u, 0x80000000u, back);
 }
 
+// Marks a kept pixel at an edge of light (seen_key's bit 30; triangle + 1 stays below it).
+const MIXED: u32 = 0x40000000u;
+
+// The share of the old film's iterations at pixel xy whose sample saw light itself (the direct
+// component's fourth channel counts them).
+fn light_share(xy: vec2u) -> f32 {
+    let n = history_params.samples + select(0u, 1u, xy.y < history_params.rows_ahead);
+    let seen = film[film_slot(FILM_DIRECT, pixel_index(xy), frame.resolution.x * frame.resolution.y)].w;
+    return seen / f32(max(n, 1u));
+}
+
+// Whether the old film's samples show an edge of an emitter or of the sky at pixel xy (the
+// shares of its 3 × 3 neighbourhood differ): such a pixel's mean is a mix of both sides in
+// proportions that a pixel of the new view, straddling the edge elsewhere, does not share —
+// better than nothing, worse than any sample of the new view's own.
+fn light_edge(xy: vec2u) -> bool {
+    let s = light_share(xy);
+    let lo = max(vec2i(xy) - 1, vec2i(0));
+    let hi = min(vec2i(xy) + 1, vec2i(frame.resolution) - 1);
+    for (var y = lo.y; y <= hi.y; y++) {
+        for (var x = lo.x; x <= hi.x; x++) {
+            if light_share(vec2u(vec2i(x, y))) != s {
+                return true;
+            }
+        }
+    }
+    return false;
+}
+
+// What G-buffer texel g sees as light (light_seen_through's keys, textures aside): 1 the sky,
+// 2 + m an emitter's front face of material m, 0 anything else.
+fn texel_light_key(g: vec4u) -> u32 {
+    if g.x == 0u {
+        return 1u;
+    }
+    let t = triangles[g.x - 1u];
+    let b = vec2f(bitcast<f32>(g.y), bitcast<f32>(g.z));
+    let pos = t.v0 * (1.0 - b.x - b.y) + t.v1 * b.x + t.v2 * b.y;
+    let front = dot(triangle_normal(t), frame.eye - pos) > 0.0;
+    if front && any(materials[t.material].material.emission > vec3f(0.0)) {
+        return 2u + t.material;
+    }
+    return 0u;
+}
+
+// Whether the G-buffer's texels show an edge of light at pixel xy: the keys of its 3 × 3
+// neighbourhood differ.
+fn texels_light_edge(xy: vec2u) -> bool {
+    let k = texel_light_key(textureLoad(gbuffer, xy, 0));
+    let lo = max(vec2i(xy) - 1, vec2i(0));
+    let hi = min(vec2i(xy) + 1, vec2i(frame.resolution) - 1);
+    for (var y = lo.y; y <= hi.y; y++) {
+        for (var x = lo.x; x <= hi.x; x++) {
+            if texel_light_key(textureLoad(gbuffer, vec2i(x, y), 0)) != k {
+                return true;
+            }
+        }
+    }
+    return false;
+}
+
 // Before the move (the frame still the old view's): keeps the film's mean and what each pixel
-// sees.
+// sees, marked MIXED at an edge of light: where the film's samples show one, or the G-buffer's
+// texels (the film's mean there may be the supersampled coverage, emitter_edges.rs, though its
+// samples all saw the light).
 @compute @workgroup_size(8, 8)
 fn snapshot(@builtin(global_invocation_id) id: vec3u) {
     let gid = band_pixel(id);
     if !begin_pixel(gid.xy) { return; }
     let p = pixel_index(gid.xy);
     let g = textureLoad(gbuffer, gid.xy, 0);
-    history[p] = vec4f(film_mean(p, gid.y), bitcast<f32>(seen_key(g)));
+    let key = seen_key(g) | select(0u, MIXED, light_edge(gid.xy) || texels_light_edge(gid.xy));
+    history[p] = vec4f(film_mean(p, gid.y), bitcast<f32>(key));
 }
 
 // After it (the frame and the G-buffer the new view's, without jitter): the old view's pixel
@@ -75,7 +139,10 @@ fn reproject(@builtin(global_invocation_id) id: vec3u) {
         return;
     }
     let h = history[u32(q.y) * frame.resolution.x + u32(q.x)];
-    if bitcast<u32>(h.w) == seen_key(g) {
-        reprojected[p] = vec4f(h.rgb, 1.0);
+    let key = bitcast<u32>(h.w);
+    if (key & ~MIXED) == seen_key(g) {
+        // Only until the film has an iteration where either view's pixel straddles an edge.
+        let mixed = (key & MIXED) != 0u || texels_light_edge(gid.xy);
+        reprojected[p] = vec4f(h.rgb, select(1.0, 2.0, mixed));
     }
 }

@@ -11,7 +11,8 @@
 // params.preview_size is not 0 × 0; the film's own sums otherwise, unread.
 @group(0) @binding(4) var<storage, read> preview: array<vec4f>;
 // The history of the view before a camera move, re-projected (history.wgsl: rgb, w = 1 where
-// valid), blended in where params.history_weight > 0.
+// valid, 2 where valid until the film has an iteration), blended in where
+// params.history_weight > 0.
 @group(0) @binding(5) var<storage, read> history: array<vec4f>;
 
 // The film's layout, without the frame: `film_add` is not used here.
@@ -82,6 +83,31 @@ fn preview_mean(xy: vec2u) -> vec4f {
     return vec4f(sum / weight, weight);
 }
 
+// The share of the film's iterations at pixel xy whose sample saw light itself (an emitter's
+// front face, the sky: the direct component's fourth channel counts them), and the iterations.
+fn light_share(xy: vec2u) -> vec2f {
+    let n = params.samples + select(0u, 1u, xy.y < params.rows_ahead);
+    let seen = film[film_slot(FILM_DIRECT, xy.y * params.resolution.x + xy.x, params.resolution.x * params.resolution.y)].w;
+    return vec2f(seen / f32(max(n, 1u)), f32(n));
+}
+
+// Whether the film's samples show an edge of light at pixel xy: the shares of its 3 × 3
+// neighbourhood's pixels that hold an iteration differ.
+fn film_light_edge(xy: vec2u) -> bool {
+    let s = light_share(xy).x;
+    let lo = max(vec2i(xy) - 1, vec2i(0));
+    let hi = min(vec2i(xy) + 1, vec2i(params.resolution) - 1);
+    for (var y = lo.y; y <= hi.y; y++) {
+        for (var x = lo.x; x <= hi.x; x++) {
+            let q = light_share(vec2u(vec2i(x, y)));
+            if q.y > 0.0 && q.x != s {
+                return true;
+            }
+        }
+    }
+    return false;
+}
+
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3u) {
     if any(gid.xy >= params.resolution) {
@@ -94,14 +120,22 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     var total = shown_film(pixel, n);
     let iterations = f32(params.samples + select(0u, 1u, gid.y < params.rows_ahead));
     var weight = iterations;
-    if params.history_weight > 0.0 {
-        // The history's weight h fades as 1/(1 + n/h) with the film's n iterations here.
+    // Where the film's samples show an edge of an emitter or of the sky, its own estimate —
+    // the emission supersampled there (emitter_edges.rs) — beats what is re-projected or
+    // upscaled from another image, whose pixels straddle the edge elsewhere: once the film
+    // has an iteration there, neither is blended in.
+    let blending = params.history_weight > 0.0 || (params.preview_size.x > 0u && params.preview_weight > 0.0);
+    let edge = blending && iterations > 0.0 && film_light_edge(gid.xy);
+    if params.history_weight > 0.0 && !edge {
+        // The history's weight h fades as 1/(1 + n/h) with the film's n iterations here; a
+        // pixel the old view saw at an edge of light (w = 2) only until the film has one.
         let h = history[pixel];
-        let w = params.history_weight * h.w / (1.0 + iterations / params.history_weight);
+        let valid = h.w == 1.0 || (h.w == 2.0 && iterations == 0.0);
+        let w = select(0.0, params.history_weight, valid) / (1.0 + iterations / params.history_weight);
         total += w * h.rgb;
         weight += w;
     }
-    if params.preview_size.x > 0u && params.preview_weight > 0.0 {
+    if params.preview_size.x > 0u && params.preview_weight > 0.0 && !edge {
         // The preview's weight fades as (1 + n + h')⁻²: all of the image where nothing else
         // is known, a quarter of its weight at the first iteration, then gone before its blur
         // (a bias) could outlast the film's noise (which falls as 1/n).

@@ -208,9 +208,12 @@ impl Refine {
         if !self.previews || (!self.moving && whole.is_some_and(|t| t <= REFINE_ABOVE)) {
             self.level = 0;
         }
-        // The next photon pass, traced in steps between the window's iterations: first.
+        // The next photon pass, traced in steps between the window's iterations, once the
+        // window holds one (the iterations read the current pass until the next is done: the
+        // first iteration after a stop is what the screen waits for, the pass is not).
         if self.level == 0
             && r.rows_ahead() == 0
+            && r.samples() > 0
             && let Some((traced, count)) = r.photons_pending()
         {
             let n = match median(&self.photon_cost) {

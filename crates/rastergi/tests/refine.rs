@@ -89,15 +89,29 @@ fn the_image_in_the_middle_of_a_banded_iteration_counts_its_rows_once_more() {
 }
 
 /// The blend of `film` (with `rows_ahead`) and the preview `pre` weighted `w`, as
-/// `Film::encode_resolve_preview` documents it, at every pixel.
+/// `Film::encode_resolve_preview` documents it, at every pixel: none where the film has an
+/// iteration and its samples show an edge of light (the shares of the samples that saw light,
+/// the direct component's fourth channel, differ in the pixel's 3 × 3 neighbourhood) or the
+/// preview's four taps do.
 fn blend(film: &FilmState, rows_ahead: u32, pre: &FilmState, pre_rows_ahead: u32, w: f32) -> Vec<[f32; 3]> {
     let (fw, fh, pw, ph) = (film.width, film.height, pre.width, pre.height);
+    let pixels = (fw * fh) as usize;
+    // (share of the samples that saw light, the iterations) at (x, y).
+    let share = |x: u32, y: u32| {
+        let n = film.samples + u32::from(y < rows_ahead);
+        let seen = film.sums[(FILM_DIRECT as usize * pixels + (y * fw + x) as usize) * 4 + 3];
+        (seen / n.max(1) as f32, n)
+    };
+    let edge = |x: u32, y: u32| {
+        let (s, n) = share(x, y);
+        let near = |a: u32, len: u32| a.saturating_sub(1)..=(a + 1).min(len - 1);
+        n > 0 && near(y, fh).any(|qy| near(x, fw).any(|qx| matches!(share(qx, qy), (t, m) if m > 0 && t != s)))
+    };
     let mut out = Vec::new();
     for y in 0..fh {
         for x in 0..fw {
             let n = film.samples + u32::from(y < rows_ahead);
             let p = (y * fw + x) as usize;
-            let pixels = (fw * fh) as usize;
             let sum = [0, 1, 2].map(|ch| {
                 film.sums[(FILM_DIRECT as usize * pixels + p) * 4 + ch]
                     + film.sums[(FILM_INDIRECT as usize * pixels + p) * 4 + ch]
@@ -106,20 +120,25 @@ fn blend(film: &FilmState, rows_ahead: u32, pre: &FilmState, pre_rows_ahead: u32
             let py = (y as f32 + 0.5) * ph as f32 / fh as f32 - 0.5;
             let (bx, by) = (px.floor(), py.floor());
             let (fx, fy) = (px - bx, py - by);
-            let (mut taps, mut tw) = ([0.0f32; 3], 0.0f32);
+            let (mut taps, mut tw, mut light) = ([0.0f32; 3], 0.0f32, (1.0f32, 0.0f32));
             for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
                 let qx = (bx + dx as f32).clamp(0.0, pw as f32 - 1.0) as u32;
                 let qy = (by + dy as f32).clamp(0.0, ph as f32 - 1.0) as u32;
                 let wt = if dx == 1 { fx } else { 1.0 - fx } * if dy == 1 { fy } else { 1.0 - fy };
                 let m = pre.samples + u32::from(qy < pre_rows_ahead);
                 if m > 0 && wt > 0.0 {
-                    let v = mean(pre, (qy * pw + qx) as usize, m);
+                    let q = (qy * pw + qx) as usize;
+                    let v = mean(pre, q, m);
                     (0..3).for_each(|c| taps[c] += wt * v[c]);
                     tw += wt;
+                    let seen = pre.sums[(FILM_DIRECT as usize * (pw * ph) as usize + q) * 4 + 3] / m as f32;
+                    light = (light.0.min(seen), light.1.max(seen));
                 }
             }
             let weight = n as f32;
-            let wp = if tw > 0.0 { w * tw / ((1.0 + weight) * (1.0 + weight)) } else { 0.0 };
+            let taps_edge = light.0 != light.1 && n > 0;
+            let wp =
+                if tw > 0.0 && !edge(x, y) && !taps_edge { w * tw / ((1.0 + weight) * (1.0 + weight)) } else { 0.0 };
             let preview = taps.map(|t| if tw > 0.0 { t / tw } else { 0.0 });
             let total = [0, 1, 2].map(|c| sum[c] + wp * preview[c]);
             let all = weight + wp;

@@ -56,9 +56,16 @@ fn shown_preview(pixel: u32, n: u32) -> vec3f {
     return shown(preview[c.x].rgb, preview[c.y].rgb, preview[c.z].rgb);
 }
 
-// The preview's mean at the centre of film pixel `xy`, bilinear over its pixels that hold an
-// iteration (rgb), and the share of the four taps' weight that did (a).
-fn preview_mean(xy: vec2u) -> vec4f {
+// The preview at the centre of film pixel `xy`: its mean, bilinear over its pixels that hold
+// an iteration; the share of the four taps' weight that did; and whether those taps straddle
+// an edge of light (the shares of their samples that saw light differ).
+struct PreviewTaps {
+    mean: vec3f,
+    weight: f32,
+    edge: bool,
+}
+
+fn preview_mean(xy: vec2u) -> PreviewTaps {
     let size = params.preview_size;
     let n = size.x * size.y;
     // The film pixel's centre in the preview's pixels, less ½: the taps' corner.
@@ -67,20 +74,24 @@ fn preview_mean(xy: vec2u) -> vec4f {
     let f = p - base;
     var sum = vec3f(0.0);
     var weight = 0.0;
+    var light = vec2f(1.0, 0.0);
     for (var k = 0u; k < 4u; k++) {
         let o = vec2f(f32(k & 1u), f32(k >> 1u));
         let q = vec2u(clamp(base + o, vec2f(0.0), vec2f(size) - 1.0));
         let w = select(1.0 - f.x, f.x, o.x > 0.0) * select(1.0 - f.y, f.y, o.y > 0.0);
         let samples = params.preview_samples + select(0u, 1u, q.y < params.preview_rows_ahead);
         if samples > 0u && w > 0.0 {
-            sum += w * shown_preview(q.y * size.x + q.x, n) / f32(samples);
+            let pixel = q.y * size.x + q.x;
+            sum += w * shown_preview(pixel, n) / f32(samples);
             weight += w;
+            let share = preview[film_slot(FILM_DIRECT, pixel, n)].w / f32(samples);
+            light = vec2f(min(light.x, share), max(light.y, share));
         }
     }
     if weight == 0.0 {
-        return vec4f(0.0);
+        return PreviewTaps(vec3f(0.0), 0.0, false);
     }
-    return vec4f(sum / weight, weight);
+    return PreviewTaps(sum / weight, weight, light.x != light.y);
 }
 
 // The share of the film's iterations at pixel xy whose sample saw light itself (an emitter's
@@ -138,11 +149,14 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if params.preview_size.x > 0u && params.preview_weight > 0.0 && !edge {
         // The preview's weight fades as (1 + n + h')⁻²: all of the image where nothing else
         // is known, a quarter of its weight at the first iteration, then gone before its blur
-        // (a bias) could outlast the film's noise (which falls as 1/n).
+        // (a bias) could outlast the film's noise (which falls as 1/n); where its taps
+        // straddle an edge of light, only until the film has an iteration.
         let p = preview_mean(gid.xy);
-        let w = params.preview_weight * p.a / ((1.0 + weight) * (1.0 + weight));
-        total += w * p.rgb;
-        weight += w;
+        if !(p.edge && iterations > 0.0) {
+            let w = params.preview_weight * p.weight / ((1.0 + weight) * (1.0 + weight));
+            total += w * p.mean;
+            weight += w;
+        }
     }
     let mean = select(total / weight, vec3f(0.0), weight == 0.0);
     linear_out[pixel] = vec4f(mean, 1.0);

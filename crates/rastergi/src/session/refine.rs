@@ -19,10 +19,14 @@
 //!   longer runs as row bands across frames ([`Progressive::iterate_rows`]; input is handled
 //!   between them), each band as many rows as fit in what is left of the frame's budget.
 //!
-//! The cost model is one figure per level, seconds per pixel of an iteration, the median of
-//! its recent units of work and how long each took ([`Refine::finished`]); a level not yet
-//! measured borrows the nearest measured one's. A budget of 0 turns it off: one whole
-//! iteration per frame, the loop the viewer had before.
+//! The cost model is one line per level, a unit's seconds = a + b · its pixels, fitted robustly
+//! (Theil–Sen: the median of the pairwise slopes, then the median intercept) to its recent
+//! units of work and how long each took ([`Refine::finished`]): a unit's fixed cost a — its
+//! submission and the wait for it, about 5 ms on lavapipe — is paid once per unit, so a frame
+//! does not begin one in the little time it has left. While the units all had one size, b is
+//! their median cost per pixel and a is 0. A level not yet measured borrows the nearest
+//! measured one's. A budget of 0 turns it off: one whole iteration per frame, the loop the
+//! viewer had before.
 
 use crate::error::Result;
 use crate::progressive::Progressive;
@@ -49,8 +53,42 @@ fn median(v: &[f64]) -> Option<f64> {
     v.get(v.len() / 2).copied()
 }
 
-/// Units of work whose cost per pixel each level keeps.
+/// Units of work whose cost each level keeps.
 const COSTS_KEPT: usize = 8;
+
+/// A level's cost model: a unit of p pixels takes `fixed` + `per_pixel` · p seconds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Cost {
+    fixed: f64,
+    per_pixel: f64,
+}
+
+impl Cost {
+    /// The line through the units (pixels, seconds): Theil–Sen (robust to the odd unit that
+    /// began a photon pass or waited for a re-projection), kept where it has a positive slope
+    /// and a non-negative intercept; else the median seconds per pixel alone.
+    fn fit(units: &[(f64, f64)]) -> Option<Cost> {
+        let per_pixel = median(&units.iter().map(|&(p, t)| t / p).collect::<Vec<_>>())?;
+        let slopes: Vec<f64> = units
+            .iter()
+            .enumerate()
+            .flat_map(|(i, a)| units[i + 1..].iter().map(move |b| (a, b)))
+            .filter(|(a, b)| (b.0 - a.0).abs() > 0.0)
+            .map(|(a, b)| (b.1 - a.1) / (b.0 - a.0))
+            .collect();
+        if let Some(b) = median(&slopes).filter(|&b| b > 0.0)
+            && let Some(a) = median(&units.iter().map(|&(p, t)| t - b * p).collect::<Vec<_>>()).filter(|&a| a >= 0.0)
+        {
+            return Some(Cost { fixed: a, per_pixel: b });
+        }
+        Some(Cost { fixed: 0.0, per_pixel })
+    }
+
+    /// Seconds for a unit of `pixels`.
+    fn time(&self, pixels: f64) -> f64 {
+        self.fixed + self.per_pixel * pixels
+    }
+}
 
 /// The scale (1 = the window) of level `k`.
 fn scale(level: usize) -> u32 {
@@ -74,8 +112,8 @@ pub struct Work {
 pub struct Refine {
     /// Seconds per frame aimed at; 0: whole iterations, one per frame.
     budget: f64,
-    /// Measured seconds per pixel of each level: the last [`COSTS_KEPT`] units'.
-    cost: [Vec<f64>; LEVELS],
+    /// The last [`COSTS_KEPT`] units of each level: (pixels, seconds).
+    cost: [Vec<(f64, f64)>; LEVELS],
     /// The level being refined: 0 once the window's own iterations run.
     level: usize,
     /// Iterations finished at `level` since it began.
@@ -89,8 +127,8 @@ pub struct Refine {
     previews: bool,
     /// Seconds the last re-projection of the history took ([`Progressive::reproject`]).
     reprojection: Option<f64>,
-    /// Measured seconds per photon of the photon passes traced in steps (the last units').
-    photon_cost: Vec<f64>,
+    /// The photon passes' last units traced in steps: (photons, seconds).
+    photon_cost: Vec<(f64, f64)>,
 }
 
 impl Refine {
@@ -161,14 +199,13 @@ impl Refine {
         self.level == 0
     }
 
-    /// The measured seconds per pixel at `level` (the median of its recent units: a unit that
-    /// began a photon pass is an outlier), or the nearest measured level's.
-    fn cost_at(&self, level: usize) -> Option<f64> {
+    /// The cost model at `level` from its recent units, or the nearest measured level's.
+    fn cost_at(&self, level: usize) -> Option<Cost> {
         let k = (0..LEVELS)
             .flat_map(|d| [level.checked_sub(d), Some(level + d)])
             .flatten()
             .find(|&k| k < LEVELS && !self.cost[k].is_empty())?;
-        median(&self.cost[k])
+        Cost::fit(&self.cost[k])
     }
 
     /// The finest level whose whole iteration of `pixels` (the window's) fits in `seconds`;
@@ -177,7 +214,7 @@ impl Refine {
         (0..LEVELS)
             .find(|&k| {
                 let p = pixels as f64 / f64::from(scale(k) * scale(k));
-                self.cost_at(k).is_some_and(|c| c * p <= seconds)
+                self.cost_at(k).is_some_and(|c| c.time(p) <= seconds)
             })
             .unwrap_or(LEVELS - 1)
     }
@@ -204,7 +241,7 @@ impl Refine {
         }
         // Still: the previews refine only where the window's own iteration would keep the
         // image from changing for longer than REFINE_ABOVE (else they cost more than they show).
-        let whole = self.cost_at(0).map(|c| c * (w as u64 * h as u64) as f64);
+        let whole = self.cost_at(0).map(|c| c.time((w as u64 * h as u64) as f64));
         if !self.previews || (!self.moving && whole.is_some_and(|t| t <= REFINE_ABOVE)) {
             self.level = 0;
         }
@@ -216,8 +253,14 @@ impl Refine {
             && r.samples() > 0
             && let Some((traced, count)) = r.photons_pending()
         {
-            let n = match median(&self.photon_cost) {
-                Some(c) => (left / c) as u32,
+            let n = match Cost::fit(&self.photon_cost) {
+                Some(c) => {
+                    let fit = ((left - c.fixed).max(0.0) / c.per_pixel) as u32;
+                    if fit < 1024 && left < 0.5 * self.budget {
+                        return Ok(None);
+                    }
+                    fit
+                }
                 None => count / 64,
             };
             // At least a few thousand photons a unit (a dispatch's worth), at most the rest.
@@ -229,9 +272,16 @@ impl Refine {
         let s = scale(k);
         let (lw, lh) = (w.div_ceil(s), h.div_ceil(s));
         // The rows that fit in what is left (all of them while nothing is measured at a
-        // preview level; a tenth of the window's).
+        // preview level; a tenth of the window's). Not one in what is left of a frame that has
+        // had most of its budget: the frame is done (a unit's fixed cost would overrun it).
         let rows = match self.cost_at(k) {
-            Some(c) => ((left / (c * lw as f64)).floor() as u32).clamp(1, lh),
+            Some(c) => {
+                let fit = ((left - c.fixed) / (c.per_pixel * lw as f64)).floor().max(0.0) as u32;
+                if fit == 0 && left < 0.5 * self.budget {
+                    return Ok(None);
+                }
+                fit.clamp(1, lh)
+            }
             None if k > 0 => lh,
             None => lh.div_ceil(10),
         };
@@ -276,7 +326,7 @@ impl Refine {
         Ok(Some(work))
     }
 
-    /// `work` took `seconds`: the cost of its level, a running mean over the recent units.
+    /// `work` took `seconds`: a unit of its level's cost model.
     pub fn finished(&mut self, work: &Work, seconds: f64) {
         if work.pixels == 0 || self.budget <= 0.0 {
             return;
@@ -288,7 +338,7 @@ impl Refine {
         if kept.len() == COSTS_KEPT {
             kept.remove(0);
         }
-        kept.push(seconds / work.pixels as f64);
+        kept.push((work.pixels as f64, seconds));
     }
 
     /// The frame is over: from the next one on, the camera is still unless it moves again.
@@ -300,5 +350,29 @@ impl Refine {
     /// (the next frame's view replaces it).
     pub fn frame_done(&self, work: &Work) -> bool {
         self.moving && work.scale > 1 && work.finished
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The cost model recovers a unit's fixed cost and its cost per pixel from units of
+    /// several sizes on a line (t = 5 ms + 0.5 µs · p), one of them an outlier (a unit that
+    /// waited for something else), which least squares would follow; units of one size give
+    /// the median per pixel.
+    #[test]
+    fn the_cost_model_is_a_robust_line_through_the_units() {
+        let line = |p: f64| 5e-3 + 0.5e-6 * p;
+        let mut units: Vec<(f64, f64)> =
+            [2560.0, 14080.0, 37120.0, 42240.0, 10240.0, 1280.0, 51200.0].iter().map(|&p| (p, line(p))).collect();
+        units.push((20000.0, 0.4));
+        let c = Cost::fit(&units).unwrap();
+        assert!((c.fixed - 5e-3).abs() < 1e-6 && (c.per_pixel - 0.5e-6).abs() < 1e-10, "{c:?}");
+        // The rows that fit in 20 ms of a 1280-pixel-wide level: (20 − 5) ms / (0.64 ms a row).
+        assert_eq!(((20e-3 - c.fixed) / (c.per_pixel * 1280.0)).floor(), 23.0);
+        let same = Cost::fit(&[(1000.0, 2e-3), (1000.0, 3e-3), (1000.0, 2.5e-3)]).unwrap();
+        assert_eq!(same, Cost { fixed: 0.0, per_pixel: 2.5e-6 });
+        assert_eq!(Cost::fit(&[]), None);
     }
 }

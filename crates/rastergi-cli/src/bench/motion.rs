@@ -30,6 +30,7 @@ use rastergi::passes::display::DisplayTarget;
 use rastergi::passes::film::Show;
 use rastergi::renderer::Renderer;
 use rastergi::scene::{Camera, Scene};
+use rastergi::session::args::LightSamplesArg;
 use rastergi::session::interactive::Interactive;
 use rastergi::session::refine::DEFAULT_FRAME_BUDGET;
 use rastergi::settings::RenderSettings;
@@ -72,6 +73,10 @@ pub struct MotionArgs {
     /// The gather implementation (as `view --gather`).
     #[arg(long, value_enum, default_value_t = GatherArg::Auto)]
     gather: GatherArg,
+    /// Light samples per pixel per iteration (as `view --light-samples`: `balanced`, the
+    /// viewer's default, or a count)
+    #[arg(long, default_value = "balanced", value_parser = rastergi::session::args::parse_light_samples)]
+    light_samples: LightSamplesArg,
     #[command(flatten)]
     gpu: GpuArgs,
 }
@@ -198,6 +203,8 @@ pub fn run(a: &MotionArgs) -> Result<()> {
         photons,
         grid_resolution: grid,
         gather: a.gather.method(),
+        light_samples: a.light_samples.first(),
+        light_balance: a.light_samples == LightSamplesArg::Balanced,
         ..Default::default()
     };
     println!(

@@ -122,7 +122,7 @@ impl LightSamplesArg {
     }
 }
 
-fn parse_light_samples(s: &str) -> std::result::Result<LightSamplesArg, String> {
+pub fn parse_light_samples(s: &str) -> std::result::Result<LightSamplesArg, String> {
     if s == "balanced" {
         return Ok(LightSamplesArg::Balanced);
     }

@@ -129,6 +129,8 @@ pub struct Refine {
     reprojection: Option<f64>,
     /// The photon passes' last units traced in steps: (photons, seconds).
     photon_cost: Vec<(f64, f64)>,
+    /// Units of work submitted in this frame.
+    units: u32,
 }
 
 impl Refine {
@@ -144,6 +146,7 @@ impl Refine {
             previews: true,
             reprojection: None,
             photon_cost: Vec::new(),
+            units: 0,
         }
     }
 
@@ -256,7 +259,7 @@ impl Refine {
             let n = match Cost::fit(&self.photon_cost) {
                 Some(c) => {
                     let fit = ((left - c.fixed).max(0.0) / c.per_pixel) as u32;
-                    if fit < 1024 && left < 0.5 * self.budget {
+                    if fit < 1024 && self.units > 0 {
                         return Ok(None);
                     }
                     fit
@@ -266,18 +269,19 @@ impl Refine {
             // At least a few thousand photons a unit (a dispatch's worth), at most the rest.
             let n = n.max(1024).min(count - traced);
             let finished = r.photon_step(n)?;
+            self.units += 1;
             return Ok(Some(Work { scale: 0, pixels: u64::from(n), finished }));
         }
         let k = self.level;
         let s = scale(k);
         let (lw, lh) = (w.div_ceil(s), h.div_ceil(s));
         // The rows that fit in what is left (all of them while nothing is measured at a
-        // preview level; a tenth of the window's). Not one in what is left of a frame that has
-        // had most of its budget: the frame is done (a unit's fixed cost would overrun it).
+        // preview level; a tenth of the window's); after the frame's first unit, none where
+        // not one fits: the frame is done (a unit's fixed cost would overrun it).
         let rows = match self.cost_at(k) {
             Some(c) => {
                 let fit = ((left - c.fixed) / (c.per_pixel * lw as f64)).floor().max(0.0) as u32;
-                if fit == 0 && left < 0.5 * self.budget {
+                if fit == 0 && self.units > 0 {
                     return Ok(None);
                 }
                 fit.clamp(1, lh)
@@ -323,6 +327,7 @@ impl Refine {
                 }
             }
         };
+        self.units += 1;
         Ok(Some(work))
     }
 
@@ -344,6 +349,7 @@ impl Refine {
     /// The frame is over: from the next one on, the camera is still unless it moves again.
     pub fn end_frame(&mut self) {
         self.moving = false;
+        self.units = 0;
     }
 
     /// Whether this frame's work is done: a moving camera gets one preview iteration a frame

@@ -559,3 +559,20 @@ fn denoise_writes_the_denoised_image_to_out_and_the_raw_one_beside_it() {
     assert!(show.error_line().contains("--show"), "{}", show.stderr);
     assert_eq!(files_in(dir.path()).len(), 5);
 }
+
+/// A command that runs past its timeout is stopped with everything it started (as `xvfb-run`
+/// starts Xvfb and a viewer): a shell that starts a background `sleep` and waits; after the
+/// timeout's panic the `sleep` must not be running (gone, or a zombie waiting to be reaped).
+#[test]
+fn a_command_past_its_timeout_is_stopped_with_what_it_started() {
+    let dir = tempfile::tempdir().unwrap();
+    let started = std::panic::catch_unwind(|| {
+        common::run(dir.path(), "sh", &["-c", "sleep 60 & echo $! > pid; wait"], &[], Duration::from_secs(1))
+    });
+    assert!(started.is_err(), "the shell should have run past its timeout");
+    let pid = std::fs::read_to_string(dir.path().join("pid")).unwrap();
+    let stat = std::fs::read_to_string(format!("/proc/{}/stat", pid.trim())).unwrap_or_default();
+    // The state is the field after the command's name in parentheses.
+    let state = stat.rsplit_once(')').map_or("", |(_, rest)| rest.trim_start()).chars().next();
+    assert!(matches!(state, None | Some('Z') | Some('X')), "the background sleep still runs: {stat}");
+}

@@ -53,6 +53,10 @@ pub fn run(dir: &Path, program: &str, args: &[&str], env: &[(&str, Option<&str>)
             None => command.env_remove(key),
         };
     }
+    // Its own process group, so that a timeout stops what it started too (`xvfb-run` starts
+    // Xvfb and the viewer: killing the script alone left them running, a viewer at 80 % of a
+    // core slowing every test after it).
+    std::os::unix::process::CommandExt::process_group(&mut command, 0);
     let mut child = match command.spawn() {
         Ok(child) => child,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound && program == "xvfb-run" => panic!(
@@ -66,6 +70,7 @@ pub fn run(dir: &Path, program: &str, args: &[&str], env: &[(&str, Option<&str>)
             break status;
         }
         if start.elapsed() > timeout {
+            let _ = Command::new("kill").args(["-KILL", "--", &format!("-{}", child.id())]).status();
             let _ = child.kill();
             let _ = child.wait();
             panic!("{program} {args:?} ran longer than {timeout:?}");

@@ -184,7 +184,7 @@ fn seen_emission(p: VisiblePoint, xy: vec2u) -> vec3f {
         return point;
     }
     // Behind a specular chain the point's emission is reflected light: it stays.
-    var e = select(vec3f(0.0), point, any(p.eye != frame.eye));
+    let e = select(vec3f(0.0), point, any(p.eye != frame.eye));
     var state = rng_new(frame.seed ^ STREAM_EMITTER_EDGE, pixel_index(xy), frame.iteration);
     var sum = vec3f(0.0);
     for (var i = 0u; i < n * n; i++) {

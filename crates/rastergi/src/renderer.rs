@@ -18,11 +18,11 @@ use crate::passes::history::History;
 use crate::passes::light_budget::LightBudget;
 use crate::passes::photon_view::PhotonView;
 use crate::passes::{FixedSample, FrameContext, IterationPass};
-use crate::photons::PhotonSettings;
 use crate::photons::budget::Budget;
 use crate::photons::gpu::GpuPhotonMap;
 use crate::photons::map::GridSpec;
 use crate::photons::passes::{PhotonPasses, fitted_pass_iterations};
+use crate::photons::{PhotonSettings, SampledDirect};
 use crate::progressive::{Denoising, Progressive};
 use crate::scene::{Camera, Scene};
 use crate::settings::{PhotonBudget, PhotonRegionChoice, RenderSettings, TextureFilter};
@@ -251,7 +251,11 @@ impl Renderer {
             count: settings.photons,
             seed: settings.seed,
             grid_resolution: settings.grid_resolution,
-            indirect_only: settings.hit_light == HitLight::Exact,
+            sampled_direct: match settings.hit_light {
+                HitLight::Map => SampledDirect::None,
+                HitLight::Exact => SampledDirect::All,
+                HitLight::Punctual => SampledDirect::Punctual,
+            },
             region,
             guided: settings.photon_guiding && crate::gpu::READ_BACK_BLOCKS,
         };

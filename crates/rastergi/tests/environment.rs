@@ -223,8 +223,14 @@ fn photons_carry_the_skys_flux_to_the_floor() {
         let mut scene = floor(env);
         scene.materials[0].albedo = Vec3::ZERO;
         let n = 1 << 16;
-        let settings =
-            PhotonSettings { count: n, seed: 5, grid_resolution: 8, indirect_only: false, region: None, guided: false };
+        let settings = PhotonSettings {
+            count: n,
+            seed: 5,
+            grid_resolution: 8,
+            sampled_direct: Default::default(),
+            region: None,
+            guided: false,
+        };
         let prepared = PreparedScene::new(&scene);
         let gpu = common::gpu();
         let gs = rastergi::gpu_scene::GpuScene::new(&gpu, &prepared).unwrap();

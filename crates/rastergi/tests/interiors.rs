@@ -94,6 +94,37 @@ fn a_sunlit_room_on_a_large_ground_plane_matches_mitsuba_in_the_skys_light() {
     common::assert_agreement(&c, bias, MAX_BIAS, MAX_BLOCK, MAX_RATIO);
 }
 
+/// The room under its sun and the sky at once, the sun's direct light at the gather's hits
+/// taken from a sample of it with a shadow ray and the rest from the map
+/// (`HitLight::Punctual`): the sun's photons skip their first surface, the sky's do not.
+/// Light adds, so the reference is the sum of the two pairs' means, its noise their noises'
+/// root sum of squares; the bounds are the sun's. Seeds 1–2, 3–4, 5–6: bias beyond the noise
+/// 2.2, 2.0, 2.8 %, block-mean error 0.21–0.34 %, channel means within 0.31 %; with the sun's
+/// first deposits kept as well (its light counted twice) the means were 6.9 % high, without the
+/// punctual lights' share of the table in the sample's weight 23 % high.
+#[test]
+fn a_room_under_sun_and_sky_matches_mitsuba_with_the_suns_light_sampled_at_gather_hits() {
+    let gpu = common::gpu();
+    let mut scene = room(true);
+    scene.environment = room(false).environment;
+    let seed: u32 = std::env::var("RASTERGI_TEST_SEED").ok().and_then(|s| s.parse().ok()).unwrap_or(1);
+    let settings = |seed| RenderSettings {
+        hit_light: rastergi::gather::HitLight::Punctual,
+        ..settings(&scene, seed, PhotonRegionChoice::Camera)
+    };
+    let a = common::render(&gpu, &scene, settings(seed), ITERATIONS, Show::Full);
+    let b = common::render(&gpu, &scene, settings(seed + 1), ITERATIONS, Show::Full);
+    let (sun, sun_noise) = common::reference_pair("sunroom_sun_path_96", None);
+    let (sky, sky_noise) = common::reference_pair("sunroom_sky_path_96", None);
+    let reference = rastergi::image_io::LinearImage {
+        pixels: sun.pixels.iter().zip(&sky.pixels).map(|(p, q)| [0, 1, 2].map(|c| p[c] + q[c])).collect(),
+        ..sun
+    };
+    let (c, noise, bias) = common::against_reference(&a, &b, &reference, sun_noise.hypot(sky_noise), None);
+    common::print_agreement("sunroom, sun and sky, the sun sampled at gather hits", &c, noise, bias);
+    common::assert_agreement(&c, bias, MAX_BIAS, MAX_BLOCK, MAX_RATIO);
+}
+
 const ITERATIONS: u32 = 128;
 /// Iterations per photon pass: 8 passes in the test's iterations, so the map's noise averages
 /// as it does in a long render (the fitted cadence, 4·photons/pixels, would keep this small

@@ -157,7 +157,7 @@ fn first_hit_flux(light: Light, photons: u32) -> (Vec3, Vec3, Vec3) {
         count: photons,
         seed: 5,
         grid_resolution: 8,
-        indirect_only: false,
+        sampled_direct: Default::default(),
         region: None,
         guided: false,
     };

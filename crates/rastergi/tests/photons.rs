@@ -8,7 +8,7 @@ use rastergi::gpu_scene::GpuScene;
 use rastergi::metrics::emitter_mask;
 use rastergi::passes::film::Show;
 use rastergi::photons::map::{GridSpec, PhotonMap};
-use rastergi::photons::{PhotonSettings, cpu, gpu::GpuPhotonMap};
+use rastergi::photons::{PhotonSettings, SampledDirect, cpu, gpu::GpuPhotonMap};
 use rastergi::scene::{Camera, Material, Scene, cornell_box};
 use rastergi::settings::RenderSettings;
 use rastergi::surface::PreparedScene;
@@ -69,7 +69,8 @@ fn closed_box_maps(
     seed: u32,
     indirect_only: bool,
 ) -> (glam::DVec3, [(&'static str, PhotonMap); 2]) {
-    let settings = PhotonSettings { count, seed, grid_resolution: 16, indirect_only, region: None, guided: false };
+    let sampled_direct = if indirect_only { SampledDirect::All } else { SampledDirect::None };
+    let settings = PhotonSettings { count, seed, grid_resolution: 16, sampled_direct, region: None, guided: false };
     let gpu = common::gpu();
     let scene = closed_box(a as f32);
     let grid = GridSpec::new(&scene.bounds(), settings.grid_resolution);
@@ -238,6 +239,56 @@ fn an_indirect_only_map_holds_the_albedo_times_the_full_maps_energy() {
         let flux = map.total_flux();
         for c in 0..3 {
             assert_within_four_sigma(name, c, "indirect flux", flux[c], power[c] * a / (1.0 - a), sigma);
+        }
+    }
+}
+
+/// The punctual lights' photons alone skip their first surface (`SampledDirect::Punctual`,
+/// `--hit-light punctual`): in the closed box of albedo a lit by its area emitter (Φ_A) and a
+/// point light at its centre (Φ_P = 4π·I), a photon of the emitter deposits K times and one of
+/// the point light K − 1, E[K] = 1/(1−a): the map holds Φ_A/(1−a) + Φ_P·a/(1−a), on the GPU
+/// and in the CPU twin. Per photon, X = f_l·D with f_l = Φ_l/p_l for the light picked with
+/// probability p_l, E[K²] = (1+a)/(1−a)², E[(K−1)²] = a(1+a)/(1−a)²: the relative standard
+/// error is √((E[X²] − E[X]²)/N)/E[X]. (Counting the point light's first deposit would add
+/// Φ_P, a third of the total here; skipping the emitter's would remove Φ_A, two thirds.)
+#[test]
+fn only_the_punctual_lights_photons_skip_their_first_surface() {
+    let a = 0.5f64;
+    let n = 1u32 << 20;
+    let mut scene = closed_box(a as f32);
+    let intensity = 0.08f32;
+    scene.lights.push(rastergi::scene::Light::Point { position: Vec3::ZERO, intensity: Vec3::splat(intensity) });
+    let area_power = scene.emitted_power().as_dvec3();
+    let point_power = 4.0 * std::f64::consts::PI * intensity as f64;
+    let table = rastergi::lights::LightTable::new(&scene);
+    let p_point: f64 = table
+        .entries
+        .iter()
+        .filter(|e| e.triangle & rastergi::gpu::consts::PUNCTUAL_LIGHT != 0)
+        .map(|e| e.pmf as f64)
+        .sum();
+    let settings = PhotonSettings {
+        count: n,
+        seed: 7,
+        grid_resolution: 16,
+        sampled_direct: SampledDirect::Punctual,
+        region: None,
+        guided: false,
+    };
+    let gpu = common::gpu();
+    let grid = GridSpec::new(&scene.bounds(), settings.grid_resolution);
+    let cpu_map = cpu::trace(&PreparedScene::new(&scene), &grid, &settings);
+    let maps = [("gpu", gpu_map(&gpu, &scene, &settings)), ("cpu", cpu_map)];
+    let (k1, k2) = (1.0 / (1.0 - a), (1.0 + a) / (1.0 - a).powi(2));
+    for (name, map) in maps {
+        let flux = map.total_flux();
+        for c in 0..3 {
+            let (fa, fp) = (area_power[c] / (1.0 - p_point), point_power / p_point);
+            let mean = (1.0 - p_point) * fa * k1 + p_point * fp * a * k1;
+            let square = (1.0 - p_point) * fa * fa * k2 + p_point * fp * fp * a * k2;
+            let sigma = ((square - mean * mean) / n as f64).sqrt() / mean;
+            let expected = area_power[c] * k1 + point_power * a * k1;
+            assert_within_four_sigma(name, c, "flux", flux[c], expected, sigma);
         }
     }
 }

@@ -65,18 +65,34 @@ fn gather_radiance(x: vec3f, w0: vec3f, tri0: u32, hit0: vec3f, b0: vec2f, pixel
             }
             let lambertian = surface_is_lambertian(s);
             var e = photon_irradiance(hit, tri, !front);
+            // The punctual lights' direct irradiance where the map leaves it to a sample of them
+            // (SampledDirect::Punctual): one of them by their cdf, with a shadow ray.
+            if photon_grid.sampled_direct == 2u && photon_grid.punctual_count > 0u {
+                var u = vec2f(rng_f32(&rng), rng_f32(&rng));
+                if first_stop {
+                    u = hit_light_uniforms(pixel, j);
+                }
+                let c = punctual_choice(u);
+                let l = sample_light_at(hit + a.n * frame.ray_epsilon, c.choice);
+                let cos_l = dot(a.frame[2], l.dir);
+                if dot(a.n, l.dir) > 0.0 && cos_l > 0.0 && any(l.e > vec3f(0.0)) {
+                    if !occluded(hit + a.n * frame.ray_epsilon, l.dir, frame.ray_epsilon, l.dist * (1.0 - 1e-4), tri, l.tri) {
+                        e += l.e * (cos_l * c.mass);
+                    }
+                }
+            }
             // The light sample: for the Lambertian part where the map holds indirect light
             // only, and for f_R where it is a punctual or distant light.
-            if has_lights() && (photon_grid.indirect_only != 0u || !lambertian) {
+            if has_lights() && (photon_grid.sampled_direct == 1u || !lambertian) {
                 var c: LightChoice;
-                if first_stop {
+                if first_stop && photon_grid.sampled_direct != 2u {
                     c = hit_light_choice(pixel, j);
                 } else {
                     c = light_choice(rng_f32(&rng), rng_f32(&rng), rng_f32(&rng));
                 }
                 let l = sample_light_at(hit + a.n * frame.ray_epsilon, c);
                 let cos_l = dot(a.frame[2], l.dir);
-                let lit = photon_grid.indirect_only != 0u && dot(a.n, l.dir) > 0.0 && cos_l > 0.0;
+                let lit = photon_grid.sampled_direct == 1u && dot(a.n, l.dir) > 0.0 && cos_l > 0.0;
                 if (lit || !lambertian) && any(l.e > vec3f(0.0)) {
                     let side = select(-a.n, a.n, dot(a.n, l.dir) >= 0.0);
                     if !occluded(hit + side * frame.ray_epsilon, l.dir, frame.ray_epsilon, l.dist * (1.0 - 1e-4), tri, l.tri) {
@@ -253,4 +269,40 @@ fn hit_light_choice(pixel: u32, j: u32) -> LightChoice {
     let xy = vec2u(pixel % frame.resolution.x, pixel / frame.resolution.x);
     let seed = pixel_seed(pcg_hash(frame.seed ^ STREAM_HIT_LIGHT), xy.x, xy.y);
     return light_sample_uniforms(j, seed);
+}
+
+// The same point j of the pixel's sequence as two uniforms (for punctual_choice).
+fn hit_light_uniforms(pixel: u32, j: u32) -> vec2f {
+    let xy = vec2u(pixel % frame.resolution.x, pixel / frame.resolution.x);
+    let seed = pixel_seed(pcg_hash(frame.seed ^ STREAM_HIT_LIGHT), xy.x, xy.y);
+    let p = sobol_owen_2d(j, seed);
+    return vec2f(unit_f32(p.x), unit_f32(p.y));
+}
+
+// A light sample among the punctual lights alone (the light table's entries
+// [punctual_first, punctual_first + punctual_count), one run), by their share of the table's
+// cdf: u.x is placed in their interval [lo, hi) and picks there, its position in the picked
+// entry's interval is u1, u.y is u2. sample_light_at weighs by 1/pmf of the whole table, and
+// this choice has probability pmf/(hi − lo): its estimate is scaled by `mass` = hi − lo.
+struct PunctualChoice {
+    choice: LightChoice,
+    mass: f32,
+}
+
+fn punctual_choice(u: vec2f) -> PunctualChoice {
+    let first = photon_grid.punctual_first;
+    let last = first + photon_grid.punctual_count - 1u;
+    var lo = 0.0;
+    if first > 0u {
+        lo = light_entry(first - 1u).cdf;
+    }
+    let hi = light_entry(last).cdf;
+    let x = lo + u.x * (hi - lo);
+    let e = clamp(light_pick(x), first, last);
+    var below = 0.0;
+    if e > 0u {
+        below = light_entry(e - 1u).cdf;
+    }
+    let u1 = clamp((x - below) / max(light_entry(e).pmf, 1e-30), 0.0, 0.99999994);
+    return PunctualChoice(LightChoice(e, u1, u.y), hi - lo);
 }

@@ -101,6 +101,13 @@ pub enum HitLight {
     /// which then holds indirect light only (photons deposit from their second surface on):
     /// the map's cell-sized blur then touches only light that has bounced twice.
     Exact,
+    /// E(h) = the direct irradiance of the punctual lights (points, spots and distant lights
+    /// such as the sun) from one sample of them with a shadow ray, plus the map's, which holds
+    /// the rest (the emitters' and the sky's direct light, and all that has bounced): a sun's
+    /// sharp patches through windows are then exact at the hit instead of counted in cells,
+    /// while the sky and area lights, which one light sample at a hit finds mostly blocked,
+    /// stay the map's.
+    Punctual,
 }
 
 /// One way of finding the nearest surface along an iteration's gather directions and adding

@@ -102,7 +102,7 @@ fn trace_photon(
         prepared.lights.emit_photon_guided(scene, emitted, u, eps, settings.aim(), guide);
     let mut flux = flux / settings.count as f32;
     let mut skip = emitter.unwrap_or(u32::MAX);
-    let first_deposit = settings.indirect_only as u32;
+    let first_deposit = settings.sampled_direct.skips_first(prepared.lights.pick(u[0]).triangle) as u32;
     // Every scattering so far was a specular (delta) one, and there was one.
     let mut caustic = false;
     // Whether the photon's one aimed bounce (super::lambertian_bounce) is still to come.

@@ -5,14 +5,16 @@
 // The including shader binds `photon_guide` and `params` (trace.wgsl).
 
 // A photon leaving the lights: origin, direction, flux × the photon count, the emitter
-// triangle to skip (NO_TRIANGLE for the other lights), and its guide counter bin (NO_BIN for a
-// light that is not guided).
+// triangle to skip (NO_TRIANGLE for the other lights), its guide counter bin (NO_BIN for a
+// light that is not guided), and whether its light is punctual (a point, spot or distant
+// light: SampledDirect::skips_first).
 struct PhotonStart {
     origin: vec3f,
     skip: u32,
     dir: vec3f,
     bin: u32,
     flux: vec3f,
+    punctual: bool,
 }
 
 const NO_BIN: u32 = 0xffffffffu;
@@ -301,6 +303,7 @@ fn emit_photon(u0: f32, u1: f32, u2: f32, u3: f32, u4: f32, eps: f32, aim: vec4f
     }
     let p = punctual_light(entry.triangle & ~PUNCTUAL_LIGHT);
     s.skip = NO_TRIANGLE;
+    s.punctual = true;
     if p.kind == LIGHT_POINT {
         s.origin = p.position;
         s.dir = uniform_sphere(u3, u4);

@@ -17,7 +17,7 @@
 use glam::UVec3;
 
 use super::map::{GridSpec, MapLayout, PhotonMap, TrianglePlane};
-use super::{MAX_BOUNCES, PhotonSettings};
+use super::{MAX_BOUNCES, PhotonSettings, SampledDirect};
 use crate::error::Result;
 use crate::gpu::binding::{Group, Slot};
 use crate::gpu::profile::compute_pass;
@@ -90,7 +90,8 @@ gpu_struct! {
         /// The separators' table: capacity − 1 and the longest probe.
         pub(crate) sep_mask: u32,
         pub(crate) sep_max_probe: u32,
-        /// The first bounce that deposits: 0, or 1 for a map of indirect light only.
+        /// Whose photons deposit from their second surface on ([`super::SampledDirect`]'s code:
+        /// 0 none, 1 all, 2 the punctual lights').
         pub(crate) first_deposit: u32,
         /// Where the separators' records and the cells' separator flags start in `slot_keys`
         /// ([`table_entries`]).
@@ -116,8 +117,9 @@ gpu_struct! {
         pub max_probe: u32,
         pub sep_mask: u32,
         pub sep_max_probe: u32,
-        /// 1 where the map holds indirect irradiance only (deposits from the second surface on).
-        pub indirect_only: u32,
+        /// Whose direct light the readers take from a light sample, the map holding the rest
+        /// ([`super::SampledDirect`]'s code: 0 none, 1 every light's, 2 the punctual lights').
+        pub sampled_direct: u32,
         /// Where the separators' records and the cells' separator flags start in `slot_keys`
         /// ([`table_entries`]).
         pub records: u32,
@@ -126,6 +128,12 @@ gpu_struct! {
         pub cells: u32,
         /// The photon guide's grid, whose cells a lookup marks ([`super::guide`]).
         pub marks: GridLevels,
+        /// The punctual lights' entries in the light table, `punctual_count` from
+        /// `punctual_first` (the light samples of [`super::SampledDirect::Punctual`]).
+        pub punctual_first: u32,
+        pub punctual_count: u32,
+        pub _pad0: u32,
+        pub _pad1: u32,
     }
 }
 
@@ -343,7 +351,7 @@ impl GpuPhotonMap {
             pass_index: 0,
             sep_mask,
             sep_max_probe,
-            first_deposit: settings.indirect_only as u32,
+            first_deposit: settings.sampled_direct as u32,
             records,
             cell_flags,
             marks: guide.marked_grid(),
@@ -352,17 +360,26 @@ impl GpuPhotonMap {
             guide_table,
             _pad: 0,
         };
+        // The punctual lights' entries, one run in the table (emitters, punctual, environment).
+        let punctual = |e: &crate::lights::LightEntry| SampledDirect::Punctual.skips_first(e.triangle);
+        let entries = &prepared.lights.entries;
+        let punctual_first = entries.iter().position(punctual).unwrap_or(0) as u32;
+        let punctual_count = entries.iter().filter(|e| punctual(e)).count() as u32;
         let grid_uniforms = PhotonGridUniforms {
             grid: GridLevels::from(&grid),
             mask,
             max_probe,
             sep_mask,
             sep_max_probe,
-            indirect_only: settings.indirect_only as u32,
+            sampled_direct: settings.sampled_direct as u32,
             records,
             cell_flags,
             cells: grid.cell_count() as u32,
             marks: guide.marked_grid(),
+            punctual_first,
+            punctual_count,
+            _pad0: 0,
+            _pad1: 0,
         };
         let buffers = [&slots, &keys, &planes, &guide.buffer];
         let (bind_layout, bind_group) = lookup_binding(gpu, &grid_uniforms, buffers);

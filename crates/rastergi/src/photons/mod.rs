@@ -71,9 +71,9 @@ pub struct PhotonSettings {
     pub seed: u32,
     /// Grid cells along the scene's longest axis.
     pub grid_resolution: u32,
-    /// Deposit from a photon's second surface on: the map then holds indirect irradiance only,
-    /// and its readers add the direct part exactly ([`crate::gather::HitLight::Exact`]).
-    pub indirect_only: bool,
+    /// Whose photons deposit from their second surface on, their direct light being taken by
+    /// the map's readers from a light sample ([`SampledDirect`]).
+    pub sampled_direct: SampledDirect,
     /// Where the camera reads the map, in cells `factor` times finer than the rest's
     /// ([`crate::fit::photon_region`]); `None`: one level of cells over the whole scene.
     pub region: Option<map::PhotonRegion>,
@@ -84,7 +84,44 @@ pub struct PhotonSettings {
 
 impl Default for PhotonSettings {
     fn default() -> Self {
-        Self { count: 1 << 20, seed: 0, grid_resolution: 64, indirect_only: false, region: None, guided: false }
+        Self {
+            count: 1 << 20,
+            seed: 0,
+            grid_resolution: 64,
+            sampled_direct: SampledDirect::None,
+            region: None,
+            guided: false,
+        }
+    }
+}
+
+/// Which lights' direct light the map leaves to its readers, who take it at each hit from a
+/// light sample with a shadow ray ([`crate::gather::HitLight`]): those lights' photons deposit
+/// from their second surface on. The codes are the shaders' (`params.first_deposit` in
+/// `trace.wgsl`, `photon_grid.sampled_direct` in the gather).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum SampledDirect {
+    /// None: the map holds all the light (`HitLight::Map`).
+    #[default]
+    None = 0,
+    /// Every light's: the map holds indirect light only (`HitLight::Exact`).
+    All = 1,
+    /// The punctual lights' (points, spots and distant lights such as the sun): the map holds
+    /// the rest (`HitLight::Punctual`).
+    Punctual = 2,
+}
+
+impl SampledDirect {
+    /// Whether a photon of `light` (a light table entry's `triangle` word) skips its first
+    /// surface's deposit.
+    pub fn skips_first(self, light: u32) -> bool {
+        match self {
+            SampledDirect::None => false,
+            SampledDirect::All => true,
+            SampledDirect::Punctual => {
+                light != crate::gpu::consts::ENVIRONMENT_LIGHT && light & crate::gpu::consts::PUNCTUAL_LIGHT != 0
+            }
+        }
     }
 }
 

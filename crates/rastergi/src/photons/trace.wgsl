@@ -184,6 +184,9 @@ fn trace_photons(@builtin(global_invocation_id) gid: vec3u) {
     var useful = 0u;
     // Whether the photon's one aimed bounce (lambertian_bounce) is still to come.
     var aim_bounce = true;
+    // The first surface deposits unless the map's readers take this light's direct part from
+    // a light sample (SampledDirect: 1 every light's, 2 the punctual lights').
+    let first_deposit = select(0u, 1u, params.first_deposit == 1u || (params.first_deposit == 2u && start.punctual));
     for (var bounce = 0u; bounce < params.max_bounces; bounce++) {
         let hit = trace(origin, dir, params.ray_epsilon, 3.0e38, skip, NO_TRIANGLE, false);
         if hit.tri == NO_TRIANGLE {
@@ -204,7 +207,7 @@ fn trace_photons(@builtin(global_invocation_id) gid: vec3u) {
         // f·|ω_i·n_s|/pdf · (|ω_o·n_s|/|ω_o·n_g|)·(|ω_i·n_g|/|ω_i·n_s|).
         let ns = bend_towards(select(-s.shading, s.shading, front), -dir);
         let arrive = dot(-dir, ns) / dot(-dir, n);
-        if bounce >= params.first_deposit {
+        if bounce >= first_deposit {
             deposit(s.pos, hit.tri, !front, flux * arrive, 0u);
             if start.bin != NO_BIN && is_read(s.pos) {
                 useful += 1u;

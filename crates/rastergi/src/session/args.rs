@@ -90,6 +90,9 @@ pub enum HitLightArg {
     /// The direct part from one light sample with a shadow ray, the rest from a photon map
     /// of indirect light only.
     Exact,
+    /// The punctual lights' (points, spots, the sun) direct part from one sample of them with a
+    /// shadow ray, the rest (emitters, the sky, light that bounced) from the photon map.
+    Punctual,
 }
 
 /// A strategy on or off.
@@ -195,6 +198,7 @@ impl HitLightArg {
         match self {
             HitLightArg::Map => HitLight::Map,
             HitLightArg::Exact => HitLight::Exact,
+            HitLightArg::Punctual => HitLight::Punctual,
         }
     }
 }

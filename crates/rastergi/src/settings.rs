@@ -177,7 +177,7 @@ impl Default for RenderSettings {
             photon_guiding: false,
             gather_guiding: false,
             sky_guiding: false,
-            hit_light: HitLight::Map,
+            hit_light: HitLight::Punctual,
             photon_region: PhotonRegionChoice::Camera,
             texture_filter: TextureFilter::Footprint,
         }

@@ -66,8 +66,11 @@ fn gather_radiance(x: vec3f, w0: vec3f, tri0: u32, hit0: vec3f, b0: vec2f, pixel
             let lambertian = surface_is_lambertian(s);
             var e = photon_irradiance(hit, tri, !front);
             // The punctual lights' direct irradiance where the map leaves it to a sample of them
-            // (SampledDirect::Punctual): one of them by their cdf, with a shadow ray.
-            if photon_grid.sampled_direct == 2u && photon_grid.punctual_count > 0u {
+            // (SampledDirect::Punctual): one of them by their cdf, with a shadow ray. It takes
+            // the pixel's point of the sequence at the first stop, and f_R's sample below the
+            // chain's random numbers.
+            let punctual = photon_grid.sampled_direct == 2u && photon_grid.punctual_count > 0u;
+            if punctual {
                 var u = vec2f(rng_f32(&rng), rng_f32(&rng));
                 if first_stop {
                     u = hit_light_uniforms(pixel, j);
@@ -85,7 +88,7 @@ fn gather_radiance(x: vec3f, w0: vec3f, tri0: u32, hit0: vec3f, b0: vec2f, pixel
             // only, and for f_R where it is a punctual or distant light.
             if has_lights() && (photon_grid.sampled_direct == 1u || !lambertian) {
                 var c: LightChoice;
-                if first_stop && photon_grid.sampled_direct != 2u {
+                if first_stop && !punctual {
                     c = hit_light_choice(pixel, j);
                 } else {
                     c = light_choice(rng_f32(&rng), rng_f32(&rng), rng_f32(&rng));

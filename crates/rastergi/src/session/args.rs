@@ -394,9 +394,12 @@ pub struct SceneArgs {
     /// light, so the noisier indirect light gets more samples per second.
     #[arg(long, default_value_t = crate::settings::DEFAULT_DIRECTIONS, value_parser = clap::value_parser!(u32).range(1..=16))]
     pub directions: u32,
-    /// Where the light at a gather ray's hit comes from: the photon map (`map`), or direct
-    /// light by a shadow ray plus a map of indirect light only (`exact`).
-    #[arg(long, value_enum, default_value_t = HitLightArg::Map)]
+    /// Where the light at a gather ray's hit comes from: the punctual lights' (points, spots, the
+    /// sun) direct light by a shadow ray and the rest from the photon map (`punctual`: sharp sun
+    /// patches through windows exact, no extra ray in a scene without punctual lights), all from
+    /// the map (`map`), or every light's direct light by a shadow ray plus a map of indirect
+    /// light only (`exact`).
+    #[arg(long, value_enum, default_value_t = HitLightArg::Punctual)]
     pub hit_light: HitLightArg,
     /// Where the photon grid's cells are finer: around what the camera and its gather rays
     /// reach (`camera`; a room beside a large ground plane gets cells sized to the room), or

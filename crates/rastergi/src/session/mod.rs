@@ -186,7 +186,7 @@ impl Default for Options {
             gather: GatherMethod::Auto,
             gather_directions: GatherDirections::default(),
             directions: crate::settings::DEFAULT_DIRECTIONS,
-            hit_light: HitLight::Map,
+            hit_light: HitLight::Punctual,
             photon_region: PhotonRegionChoice::Camera,
             texture_filter: TextureFilter::Footprint,
             show: Show::Full,

@@ -253,7 +253,7 @@ fn the_cornell_box_with_a_point_light_and_the_sun_through_its_open_front_matches
     common::matches_mitsuba(
         "cornell + point + sun",
         &scene,
-        rastergi::gather::HitLight::Map,
+        rastergi::gather::HitLight::Punctual,
         256,
         "cornell_lights_path_128",
         true,
@@ -276,7 +276,7 @@ fn the_cornell_box_with_a_hard_edged_spot_matches_mitsuba() {
     common::matches_mitsuba(
         "cornell + spot",
         &scene,
-        rastergi::gather::HitLight::Map,
+        rastergi::gather::HitLight::Punctual,
         256,
         "cornell_spot_path_128",
         true,

@@ -52,8 +52,8 @@ pub struct ConvergeArgs {
     #[arg(long, value_enum, value_delimiter = ',', default_values_t = [crate::args::GatherDirectionsArg::default_value()])]
     gather_directions: Vec<crate::args::GatherDirectionsArg>,
     /// Where the light at gather hits comes from (see `render --hit-light`); several
-    /// comma-separated values are measured side by side, e.g. map,exact.
-    #[arg(long, value_enum, value_delimiter = ',', default_value = "map")]
+    /// comma-separated values are measured side by side, e.g. punctual,map,exact.
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "punctual")]
     hit_light: Vec<crate::args::HitLightArg>,
     /// Also measure Mitsuba 3 (built-in cornell only; needs python3 with mitsuba).
     #[arg(long)]

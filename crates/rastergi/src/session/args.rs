@@ -53,7 +53,9 @@ pub enum ShowArg {
     Direct,
     /// Indirect light only.
     Indirect,
-    /// The photon map's radiance ρ/π·E at the visible points.
+    /// The photon map's radiance ρ/π·E at the visible points (without the direct light of the
+    /// lights `--hit-light` samples at the gather's hits: by default the sun's and other
+    /// punctual lights').
     PhotonMap,
 }
 

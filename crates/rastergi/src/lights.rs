@@ -35,6 +35,12 @@ gpu_struct! {
     }
 }
 
+/// Whether a light table entry's `triangle` word names a punctual light (a point, spot or
+/// distant light), not an emitter triangle or the environment.
+pub fn is_punctual(triangle: u32) -> bool {
+    triangle != ENVIRONMENT_LIGHT && triangle & PUNCTUAL_LIGHT != 0
+}
+
 gpu_struct! {
     /// A point, spot or distant light as stored on the GPU (`PunctualLight` in WGSL).
     #[derive(PartialEq)]
@@ -194,6 +200,14 @@ impl LightTable {
 
     pub fn is_empty(&self) -> bool {
         self.entries.is_empty()
+    }
+
+    /// The punctual lights' entries, one run in the table (emitters, punctual lights, the
+    /// environment): (first, count); (0, 0) without any.
+    pub fn punctual_run(&self) -> (u32, u32) {
+        let first = self.entries.iter().position(|e| is_punctual(e.triangle)).unwrap_or(0);
+        let count = self.entries.iter().filter(|e| is_punctual(e.triangle)).count();
+        (first as u32, count as u32)
     }
 
     /// The entry whose cdf interval holds u ∈ [0,1): the first with `u < cdf`.

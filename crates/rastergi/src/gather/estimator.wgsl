@@ -269,17 +269,19 @@ fn escape_estimate(p: VisiblePoint, cos_x: f32, w: vec3f) -> vec3f {
 // stratifying it; the index shuffle of sobol_owen_2d keeps it independent of the per-pixel
 // directions, which use the same indices with other seeds.
 fn hit_light_choice(pixel: u32, j: u32) -> LightChoice {
-    let xy = vec2u(pixel % frame.resolution.x, pixel / frame.resolution.x);
-    let seed = pixel_seed(pcg_hash(frame.seed ^ STREAM_HIT_LIGHT), xy.x, xy.y);
-    return light_sample_uniforms(j, seed);
+    return light_sample_uniforms(j, hit_light_seed(pixel));
 }
 
 // The same point j of the pixel's sequence as two uniforms (for punctual_choice).
 fn hit_light_uniforms(pixel: u32, j: u32) -> vec2f {
-    let xy = vec2u(pixel % frame.resolution.x, pixel / frame.resolution.x);
-    let seed = pixel_seed(pcg_hash(frame.seed ^ STREAM_HIT_LIGHT), xy.x, xy.y);
-    let p = sobol_owen_2d(j, seed);
+    let p = sobol_owen_2d(j, hit_light_seed(pixel));
     return vec2f(unit_f32(p.x), unit_f32(p.y));
+}
+
+// The scramble seed of the pixel's hit-light sequence: (seed, stream::HIT_LIGHT, pixel).
+fn hit_light_seed(pixel: u32) -> u32 {
+    let xy = vec2u(pixel % frame.resolution.x, pixel / frame.resolution.x);
+    return pixel_seed(pcg_hash(frame.seed ^ STREAM_HIT_LIGHT), xy.x, xy.y);
 }
 
 // A light sample among the punctual lights alone (the light table's entries

@@ -17,7 +17,7 @@
 use glam::UVec3;
 
 use super::map::{GridSpec, MapLayout, PhotonMap, TrianglePlane};
-use super::{MAX_BOUNCES, PhotonSettings, SampledDirect};
+use super::{MAX_BOUNCES, PhotonSettings};
 use crate::error::Result;
 use crate::gpu::binding::{Group, Slot};
 use crate::gpu::profile::compute_pass;
@@ -360,11 +360,7 @@ impl GpuPhotonMap {
             guide_table,
             _pad: 0,
         };
-        // The punctual lights' entries, one run in the table (emitters, punctual, environment).
-        let punctual = |e: &crate::lights::LightEntry| SampledDirect::Punctual.skips_first(e.triangle);
-        let entries = &prepared.lights.entries;
-        let punctual_first = entries.iter().position(punctual).unwrap_or(0) as u32;
-        let punctual_count = entries.iter().filter(|e| punctual(e)).count() as u32;
+        let (punctual_first, punctual_count) = prepared.lights.punctual_run();
         let grid_uniforms = PhotonGridUniforms {
             grid: GridLevels::from(&grid),
             mask,

@@ -118,9 +118,7 @@ impl SampledDirect {
         match self {
             SampledDirect::None => false,
             SampledDirect::All => true,
-            SampledDirect::Punctual => {
-                light != crate::gpu::consts::ENVIRONMENT_LIGHT && light & crate::gpu::consts::PUNCTUAL_LIGHT != 0
-            }
+            SampledDirect::Punctual => crate::lights::is_punctual(light),
         }
     }
 }

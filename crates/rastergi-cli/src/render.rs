@@ -30,7 +30,7 @@ pub use rastergi::session::Method;
 use rastergi::session::new_renderer;
 use rastergi::session::run::{Limits, Observer, Stop};
 
-use crate::args::{SceneArgs, ShowArg, gpu_profiled, print_profile};
+use crate::args::{SceneArgs, ShowArg, print_profile};
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
@@ -70,6 +70,11 @@ pub struct RenderArgs {
     /// Print the GPU time of every pass (timestamp queries): the set-up's and the iterations'.
     #[arg(long)]
     profile: bool,
+    /// Count the rays every pass traces (photons, the eye's chains, shadow rays, the gather's
+    /// rays) and print them per pixel: what a GPU's ray throughput projects a render's time
+    /// from. One atomic add per ray, so the render is a little slower; the image is the same.
+    #[arg(long)]
+    count_rays: bool,
     /// Denoise the accumulated image (a weighted regression on distance and normal guided by an
     /// edge-avoiding à-trous filter, docs/denoiser.md): --out gets the denoised image and NAME.raw.EXT beside it the
     /// raw one (what --out holds without --denoise). Gather method, full image only.
@@ -179,6 +184,19 @@ impl Observer for Watch<'_> {
     }
 }
 
+/// The rays counted (`--count-rays`): `setup` before the first iteration (the first photon
+/// pass), `total` at the end, over `iterations` iterations of `pixels` pixels.
+fn print_rays(setup: u64, total: u64, iterations: u32, pixels: u64) {
+    let per_pixel = |n: u64| n as f64 / pixels as f64;
+    println!(
+        "rays traced: {total} ({:.1} per pixel): set-up {setup} ({:.1} per pixel), {iterations} iterations {} ({:.1} per pixel per iteration, photon passes included)",
+        per_pixel(total),
+        per_pixel(setup),
+        total - setup,
+        per_pixel(total - setup) / f64::from(iterations.max(1)),
+    );
+}
+
 pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     let format = ImageFormat::from_path(&args.out)?;
     check_output_path(&args.out, "--out")?;
@@ -208,7 +226,11 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     let a = &args.scene;
     let mut options = a.options(args.method, guides_wanted);
     // The GPU first: the scene's triangle budget follows what it binds.
-    let gpu = gpu_profiled(&a.gpu, args.profile)?;
+    let gpu = rastergi::gpu::Gpu::new(&rastergi::gpu::GpuOptions {
+        profile: args.profile,
+        count_rays: args.count_rays,
+        ..a.gpu.options()
+    })?;
     options.budgets = options.budgets.fit_device(&gpu.device.limits());
     let start = Instant::now();
     let scene = options.load_scene()?;
@@ -251,6 +273,7 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     renderer.wait()?;
     log::info!("set-up (BVH, upload, photon map) in {:.2} s", start.elapsed().as_secs_f64());
     print_profile(&gpu, args.profile, "set-up", 1, "set-up")?;
+    let setup_rays = renderer.rays_traced()?;
     if let Some((bundle, directions, method)) = gather_info {
         // Auto without trials (a CPU adapter) has chosen already.
         if method == GatherMethod::Auto {
@@ -313,6 +336,9 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
         );
     }
     print_profile(&gpu, args.profile, "iterations", rendered.max(1) as u64, "iteration")?;
+    if let (Some(before), Some(after)) = (setup_rays, renderer.rays_traced()?) {
+        print_rays(before, after, rendered, width as u64 * height as u64);
+    }
 
     let show = a.show.show();
     let linear = renderer.read_linear(show)?;

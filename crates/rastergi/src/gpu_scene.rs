@@ -140,7 +140,7 @@ pub use crate::gpu::consts::GpuSceneOffsets;
 /// the count at which lavapipe (Mesa 22.3) silently loses fragment writes (11 storage buffers
 /// in a fragment stage, though it reports 32: the fragment lists' gather lost 10 % of its
 /// estimates, tests/gather.rs).
-pub fn group(tlas: bool) -> Group {
+pub fn group(tlas: bool, count_rays: bool) -> Group {
     let compute = wgpu::ShaderStages::COMPUTE;
     let mut g = Group::new(
         "scene",
@@ -159,8 +159,16 @@ pub fn group(tlas: bool) -> Group {
     if tlas {
         g.slots.push(Slot::tlas(crate::gpu::accel::TLAS_BINDING, "scene_tlas").only(compute));
     }
+    if count_rays {
+        g.slots.push(Slot::write::<u32>(RAY_COUNT_BINDING, "ray_count").only(compute));
+    }
     g
 }
+
+/// The ray count's binding in the scene's group where rays are counted
+/// ([`crate::gpu::GpuOptions::count_rays`]; `gpu/ray_count.wgsl`): two words, the low and the
+/// high half of the rays traced.
+pub const RAY_COUNT_BINDING: u32 = 16;
 
 /// The GGX albedo tables as gpu_scene.wgsl reads them: the cells and means, N × (N + 1)
 /// RGBA32F, and the rough glass's, N × (cells / N) R32F. Computed and filled only where some
@@ -313,9 +321,22 @@ pub struct GpuScene {
     /// The acceleration structures, bound at `accel::TLAS_BINDING`, where the device has ray
     /// queries and the compute path was not asked for.
     pub accel: Option<SceneAccel>,
+    /// The rays traced so far, where they are counted ([`RAY_COUNT_BINDING`]).
+    pub ray_count: Option<wgpu::Buffer>,
 }
 
 impl GpuScene {
+    /// The rays this scene's passes have traced since it was uploaded, where the device counts
+    /// them ([`crate::gpu::GpuOptions::count_rays`]): every query of `trace` (a shadow ray, a
+    /// gather ray, a photon's flight, an eye ray past a mirror …), whichever traversal answers
+    /// it. Waits for the GPU.
+    pub fn rays_traced(&self, gpu: &Gpu) -> Result<Option<u64>> {
+        let Some(buffer) = &self.ray_count else { return Ok(None) };
+        let words = gpu.read_buffer(buffer, 8)?;
+        let w: &[u32] = bytemuck::cast_slice(&words);
+        Ok(Some(u64::from(w[0]) | u64::from(w[1]) << 32))
+    }
+
     /// The values of the scene's pipeline-overridable constants (`gpu_scene.wgsl`), for every
     /// pipeline whose shader reads the scene: a scene without glossy or specular materials,
     /// or without surfaces that pass rays, gets kernels without the branches that serve them
@@ -353,7 +374,8 @@ impl GpuScene {
 
     /// [`Self::module`] on ray path `path` (the hardware one needs [`Self::accel`]).
     pub fn module_for(&self, device: &wgpu::Device, label: &str, source: &str, path: RayPath) -> wgpu::ShaderModule {
-        crate::gpu::shader::module(device, label, &crate::gpu::shader::for_rays(source, path))
+        let count = self.ray_count.is_some();
+        crate::gpu::shader::module(device, label, &crate::gpu::shader::for_rays(source, path, count))
     }
 
     /// Uploads `prepared`, after checking that its buffers fit the device (see [`crate::gpu::limits`]),
@@ -490,7 +512,11 @@ impl GpuScene {
         } else {
             None
         };
-        let group = group(accel.is_some());
+        let ray_count = gpu.count_rays.then(|| {
+            let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
+            gpu.zeroed_buffer("scene ray count", 8, usage)
+        });
+        let group = group(accel.is_some(), ray_count.is_some());
         let layout = group.layout(&gpu.device);
         let (ggx_cells, glass) = albedo_textures(gpu, has_bsdfs, s.materials.iter().any(Material::needs_glass_table));
         let mut resources = vec![
@@ -505,6 +531,9 @@ impl GpuScene {
         ];
         if let Some(a) = &accel {
             resources.push(("scene_tlas", wgpu::BindingResource::AccelerationStructure(&a.tlas)));
+        }
+        if let Some(b) = &ray_count {
+            resources.push(("ray_count", b.as_entire_binding()));
         }
         let bind_group = group.bind(&gpu.device, &layout, &resources);
         let (rays, rays_why) = match (gpu.rays, &accel) {
@@ -539,6 +568,7 @@ impl GpuScene {
             rays,
             rays_why,
             accel,
+            ray_count,
         };
         Ok(scene)
     }

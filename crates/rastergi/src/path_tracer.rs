@@ -275,6 +275,9 @@ impl Progressive for PathTracer {
         self.gpu.wait()
     }
     /// Iterations (paths per pixel) accumulated since the last reset.
+    fn rays_traced(&self) -> Result<Option<u64>> {
+        self.scene.rays_traced(&self.gpu)
+    }
     fn samples(&self) -> u32 {
         self.film.samples
     }

@@ -1044,6 +1044,9 @@ impl Progressive for Renderer {
     fn wait(&self) -> Result<()> {
         Renderer::wait(self)
     }
+    fn rays_traced(&self) -> Result<Option<u64>> {
+        self.scene.rays_traced(&self.gpu)
+    }
     fn samples(&self) -> u32 {
         Renderer::samples(self)
     }

@@ -293,6 +293,35 @@ fn only_the_punctual_lights_photons_skip_their_first_surface() {
     }
 }
 
+/// The photon pass's rays, counted (`--count-rays`), are its photons' flights: in the closed
+/// box of albedo a every flight ends on a wall, and a photon flies again with probability a,
+/// so N photons fly K₁ + … + K_N times, K geometric: E[K] = 1/(1−a), Var[K] = a/(1−a)². The
+/// GPU's count lies within four standard deviations of N/(1−a) (a pass that traced one more
+/// ray per photon, or counted a photon's flight twice, would be hundreds of them away).
+#[test]
+fn the_photon_pass_traces_one_ray_per_flight() {
+    let a = 0.5f64;
+    let n = 1u32 << 18;
+    let gpu = rastergi::gpu::Gpu::new(&rastergi::gpu::GpuOptions { count_rays: true, ..Default::default() }).unwrap();
+    let scene = closed_box(a as f32);
+    let prepared = PreparedScene::new(&scene);
+    let gs = GpuScene::new(&gpu, &prepared).unwrap();
+    let settings = PhotonSettings {
+        count: n,
+        seed: 3,
+        grid_resolution: 16,
+        sampled_direct: SampledDirect::None,
+        region: None,
+        guided: false,
+    };
+    GpuPhotonMap::build(&gpu, &gs, &prepared, &settings).unwrap();
+    let rays = gs.rays_traced(&gpu).unwrap().expect("counted") as f64;
+    let expected = n as f64 / (1.0 - a);
+    let sigma = (n as f64 * a).sqrt() / (1.0 - a);
+    println!("{n} photons: {rays} rays, expected {expected} ± {sigma:.0}");
+    assert!((rays - expected).abs() < 4.0 * sigma, "{rays} rays, expected {expected} ± {sigma:.0}");
+}
+
 /// The sky's photons guided by any table carry the sky's light (`photons::guide`): a constant
 /// sky of radiance L over a 20 m floor, aimed at a region of it, with a table per direction
 /// bin that sends three quarters of its photons to a few random bins of the guide disc. The

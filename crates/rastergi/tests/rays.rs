@@ -171,3 +171,57 @@ fn every_tracing_pass_renders_the_same_image_on_both_paths() {
         assert_eq!(differ, 0, "{name}");
     }
 }
+
+/// `--count-rays` counts every query of `trace` once, on each ray path the device offers: the
+/// ray kernel traces each of its rays once per run (a warm-up and two timed runs here), every
+/// kind of ray, so the count grows by exactly three times the rays of each batch. And counting
+/// changes nothing that is traced: a render's images are the same to the bit with and without
+/// it.
+#[test]
+fn the_ray_count_is_every_query_of_trace_and_changes_no_image() {
+    use rastergi::passes::film::Show;
+    use rastergi::progressive::Progressive;
+    use rastergi::renderer::Renderer;
+    let scene = cornell_with_glass();
+    let prepared = PreparedScene::new(&scene);
+    let counting = |rays| Gpu::new(&GpuOptions { rays: Some(rays), count_rays: true, ..GpuOptions::default() });
+    let mut paths = vec![(RayPath::Compute, counting(Rays::Compute).unwrap())];
+    match counting(Rays::Hardware) {
+        Ok(gpu) => paths.push((RayPath::Hardware, gpu)),
+        Err(e) => println!("hardware path not offered: {e}"),
+    }
+    for (path, gpu) in &paths {
+        let gs = GpuScene::new(gpu, &prepared).unwrap();
+        assert_eq!(gs.rays_traced(gpu).unwrap(), Some(0), "{path:?}: a new scene has traced nothing");
+        let caster = RayCaster::on(gpu, &gs, *path);
+        let mut expected = 0u64;
+        for kind in RayKind::ALL {
+            let rays = make_rays(&prepared, &scene.camera, (48, 40), kind, 9);
+            caster.trace(gpu, &gs, &rays, 2).unwrap();
+            expected += 3 * rays.len() as u64;
+            assert_eq!(gs.rays_traced(gpu).unwrap(), Some(expected), "{path:?} {kind:?}");
+        }
+    }
+    // Budgets fixed, not timed: the same choices with and without the count's atomic adds.
+    let settings = rastergi::settings::RenderSettings {
+        photon_budget: rastergi::settings::PhotonBudget::Fitted,
+        pass_iterations: 2,
+        ..common::fitted_settings(&scene, 32, 5)
+    };
+    let images = |gpu: &Gpu| {
+        let mut r = Renderer::new(gpu, &scene, settings.clone()).unwrap();
+        for _ in 0..3 {
+            r.iterate().unwrap();
+        }
+        let shows = [Show::Direct, Show::Indirect, Show::Full].map(|show| r.read_linear(show).unwrap().pixels);
+        (shows, r.rays_traced().unwrap())
+    };
+    let (plain, none) = images(&common::gpu());
+    assert_eq!(none, None, "a device that does not count rays counts none");
+    let (counted, rays) = images(&paths[0].1);
+    let rays = rays.expect("counted");
+    println!("3 iterations at 32², set-up included: {rays} rays");
+    // The photon pass alone traces more than a ray per photon.
+    assert!(rays > u64::from(settings.photons), "{rays} rays");
+    assert!(plain == counted, "counting the rays changed the image");
+}

@@ -17,7 +17,7 @@ use rastergi::renderer::Renderer;
 use rastergi::settings::RenderSettings;
 
 use super::load_valid_scene;
-use crate::args::{GpuArgs, gpu};
+use crate::args::GpuArgs;
 
 #[derive(Args, Debug)]
 pub struct ConvergeArgs {
@@ -62,7 +62,12 @@ pub struct ConvergeArgs {
     /// where usable).
     #[arg(long, value_name = "VARIANT", requires = "mitsuba")]
     mitsuba_variant: Option<String>,
-    /// CSV output: method, seconds, samples, relative RMSE.
+    /// Count the rays each renderer traces (see `render --count-rays`) and print them per
+    /// pixel at each target: one atomic add per ray, so its times are a little longer.
+    #[arg(long)]
+    count_rays: bool,
+    /// CSV output: method, seconds, samples, relative RMSE (and rays per pixel with
+    /// --count-rays).
     #[arg(long, default_value = "converge.csv")]
     csv: PathBuf,
     /// Plot of relative RMSE against time (log-log), PNG.
@@ -79,7 +84,7 @@ pub fn run(a: &ConvergeArgs) -> Result<()> {
         a.plot.display()
     );
     let scene = load_valid_scene(&a.scene)?;
-    let gpu = gpu(&a.gpu)?;
+    let gpu = rastergi::gpu::Gpu::new(&rastergi::gpu::GpuOptions { count_rays: a.count_rays, ..a.gpu.options() })?;
     let reference = Reference::load(&a.reference)?;
     let (w, h) = reference.size();
     println!(
@@ -142,11 +147,12 @@ pub fn run(a: &ConvergeArgs) -> Result<()> {
         curves.push((name, points));
     }
     print_equal_time(&curves);
-    let mut csv = String::from("method,seconds,samples,relative_rmse\n");
+    let mut csv = String::from("method,seconds,samples,relative_rmse,rays_per_pixel\n");
     for (name, points) in &curves {
         for p in points {
             // Quoted: the names hold commas.
-            csv += &format!("\"{name}\",{:.4},{},{:.6}\n", p.seconds, p.samples, p.error);
+            let rays = p.rays_per_pixel.map_or(String::new(), |r| format!("{r:.2}"));
+            csv += &format!("\"{name}\",{:.4},{},{:.6},{rays}\n", p.seconds, p.samples, p.error);
         }
     }
     write_file(&a.csv, csv.as_bytes())?;
@@ -170,6 +176,8 @@ pub struct Point {
     seconds: f64,
     samples: u32,
     error: f64,
+    /// Rays traced per pixel so far, set-up included, where they are counted (`--count-rays`).
+    rays_per_pixel: Option<f64>,
 }
 
 /// A converged reference, the mean of one or more renders, and its emitter pixels (left out
@@ -233,7 +241,9 @@ fn curve(m: &mut dyn Progressive, reference: &Reference, max_seconds: f64, stop_
         m.wait()?;
         rendering += t.elapsed();
         let error = reference.error(&m.read_linear(Show::Full)?);
-        points.push(Point { seconds: rendering.as_secs_f64(), samples: m.samples(), error });
+        let (w, h) = reference.size();
+        let rays_per_pixel = m.rays_traced()?.map(|r| r as f64 / (f64::from(w) * f64::from(h)));
+        points.push(Point { seconds: rendering.as_secs_f64(), samples: m.samples(), error, rays_per_pixel });
         if error <= stop_at {
             break;
         }
@@ -282,10 +292,11 @@ pub fn print_targets(name: &str, points: &[Point], targets: &[f64], setup: f64, 
     for &target in targets {
         match first_below(points, target) {
             Some(p) => println!(
-                "  {name:<36} {:>4.1} %: {:>8.2} s ({} {unit}, error {:.2} %; set-up {setup:.2} s)",
+                "  {name:<36} {:>4.1} %: {:>8.2} s ({} {unit}{}, error {:.2} %; set-up {setup:.2} s)",
                 100.0 * target,
                 p.seconds,
                 p.samples,
+                p.rays_per_pixel.map_or(String::new(), |r| format!(", {r:.0} rays per pixel")),
                 100.0 * p.error
             ),
             None => println!(
@@ -377,7 +388,7 @@ pub fn mitsuba_curve(
     loop {
         let seconds = (run(spp)? - startup).max(0.0);
         let error = reference.error(&read_exr(&out)?);
-        points.push(Point { seconds, samples: spp, error });
+        points.push(Point { seconds, samples: spp, error, rays_per_pixel: None });
         if error <= stop_at || seconds > max_seconds {
             break;
         }

@@ -40,6 +40,7 @@ fn intersect_triangle(t: Triangle, o: vec3f, d: vec3f) -> vec3f {
 // a hit on a hole continues the ray from there, and an any-hit query that meets a hole walks
 // the ray hit by hit from its start instead (an any hit is not the nearest).
 fn trace(o: vec3f, d: vec3f, t_min: f32, t_max: f32, skip_a: u32, skip_b: u32, any_hit: bool) -> RayHit {
+    count_ray();
     var lo = t_min;
     var passed = NO_TRIANGLE;
     var first = any_hit;
@@ -59,6 +60,10 @@ fn trace(o: vec3f, d: vec3f, t_min: f32, t_max: f32, skip_a: u32, skip_b: u32, a
     // More holes in a row than MAX_HOLE_CROSSINGS: the ray counts as stopped there.
     return traverse(o, d, lo, t_max, skip_a, skip_b, passed, false);
 }
+
+// Counts one query of `trace` where rays are counted (`--count-rays`): shader::for_rays then
+// puts the counting one (gpu/ray_count.wgsl) in place of this empty body.
+fn count_ray() {}
 
 fn occluded(o: vec3f, d: vec3f, t_min: f32, t_max: f32, skip_a: u32, skip_b: u32) -> bool {
     return trace(o, d, t_min, t_max, skip_a, skip_b, true).tri != NO_TRIANGLE;

@@ -200,7 +200,7 @@ fn every_tracing_shader_composes_and_validates_for_hardware_ray_queries() {
     use crate::gpu::accel::{RayPath, TLAS_BINDING};
     let mut traced = Vec::new();
     for (label, source) in shaders() {
-        let hardware = crate::gpu::shader::for_rays(&source, RayPath::Hardware);
+        let hardware = crate::gpu::shader::for_rays(&source, RayPath::Hardware, false);
         if hardware == source {
             continue;
         }
@@ -213,6 +213,16 @@ fn every_tracing_shader_composes_and_validates_for_hardware_ray_queries() {
         naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
             .validate(&module)
             .unwrap_or_else(|e| panic!("{label} (hardware): {}", e.emit_to_string(&hardware)));
+        // And with its rays counted (`--count-rays`): the counter at its binding, `trace`
+        // adding to it.
+        let counted = crate::gpu::shader::for_rays(&source, RayPath::Hardware, true);
+        let module = naga::front::wgsl::parse_str(&counted)
+            .unwrap_or_else(|e| panic!("{label} (counted): {}", e.emit_to_string(&counted)));
+        let count = naga::ResourceBinding { group: 0, binding: crate::gpu_scene::RAY_COUNT_BINDING };
+        assert!(module.global_variables.iter().any(|(_, g)| g.binding == Some(count)), "{label}: no ray count");
+        naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
+            .validate(&module)
+            .unwrap_or_else(|e| panic!("{label} (counted): {}", e.emit_to_string(&counted)));
     }
     // Every pass that casts rays (the G-buffer's raster shader holds the prelude too).
     let expected = [
@@ -294,7 +304,7 @@ fn the_design_page_names_every_wgsl_entry_point_and_each_exists() {
 fn declared_groups(label: &str) -> Vec<Vec<Group>> {
     use crate::passes::{denoise, film, frame, gbuffer};
     use crate::{gather, gpu_scene, photons};
-    let scene = || vec![gpu_scene::group(false)];
+    let scene = || vec![gpu_scene::group(false, false)];
     let per_pixel = || vec![scene(), vec![frame::group()], vec![gbuffer::pixel_group()]];
     let lookup = || vec![photons::gpu::lookup_group()];
     let estimate = |own: Group| vec![scene(), vec![frame::group()], vec![own], lookup()];
@@ -361,18 +371,25 @@ fn wgsl_kind(module: &naga::Module, layouter: &naga::proc::Layouter, var: &naga:
 fn every_declared_bind_group_matches_the_bindings_of_its_shaders() {
     let mut failures = Vec::new();
     // Each shader as composed for the compute ray path, and where it traces, for the hardware
-    // one, whose scene group also binds the TLAS.
-    let hardware = shaders().into_iter().filter_map(|(label, source)| {
-        let hw = crate::gpu::shader::for_rays(&source, crate::gpu::accel::RayPath::Hardware);
-        (hw != source).then(|| (label, hw.into_owned(), true))
-    });
-    for (label, source, tlas) in shaders().into_iter().map(|(l, s)| (l, s, false)).chain(hardware) {
+    // one, whose scene group also binds the TLAS, and with its rays counted, whose scene group
+    // also binds the count.
+    let composed = |path, count| {
+        shaders().into_iter().filter_map(move |(label, source)| {
+            let s = crate::gpu::shader::for_rays(&source, path, count);
+            (s != source).then(|| (label, s.into_owned(), (path == crate::gpu::accel::RayPath::Hardware, count)))
+        })
+    };
+    let plain = shaders().into_iter().map(|(l, s)| (l, s, (false, false)));
+    let variants = plain
+        .chain(composed(crate::gpu::accel::RayPath::Hardware, false))
+        .chain(composed(crate::gpu::accel::RayPath::Compute, true));
+    for (label, source, (tlas, count)) in variants {
         let module = naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| panic!("{label}: {e}"));
         let mut layouter = naga::proc::Layouter::default();
         layouter.update(module.to_ctx()).expect("layouts of a parsed module");
         let mut groups = declared_groups(label);
-        if tlas {
-            groups[0] = vec![crate::gpu_scene::group(true)];
+        if tlas || count {
+            groups[0] = vec![crate::gpu_scene::group(tlas, count)];
         }
         let mut bound = BTreeSet::new();
         for (_, var) in module.global_variables.iter() {

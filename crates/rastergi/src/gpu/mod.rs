@@ -38,6 +38,11 @@ pub struct GpuOptions {
     /// if set, else the compute BVH (so that a library caller or a test gets the hardware path
     /// only where it asks: `--rays` of the front ends defaults to `auto`).
     pub rays: Option<Rays>,
+    /// Count the rays every pass traces (`--count-rays`): each scene uploaded on this device
+    /// then binds a counter that its shaders' `trace` adds to ([`crate::gpu_scene`]), read by
+    /// [`crate::progressive::Progressive::rays_traced`]. Off by default: the counter is one
+    /// atomic add per ray.
+    pub count_rays: bool,
 }
 
 /// The most storage buffers per shader stage that browsers' WebGPU grants (Chrome's adapters
@@ -73,6 +78,8 @@ pub struct Gpu {
     /// The ray path asked for ([`GpuOptions::rays`] resolved); the device has
     /// `EXPERIMENTAL_RAY_QUERY` where this is not `Compute` and the adapter offers it.
     pub rays: Rays,
+    /// Rays are counted ([`GpuOptions::count_rays`]).
+    pub count_rays: bool,
     /// The first error the device reported outside a call that returns one (a lost device, a
     /// GPU timeout, an allocation that failed): [`Gpu::wait`] and every readback return it.
     fault: std::sync::Arc<std::sync::Mutex<Fault>>,
@@ -205,7 +212,7 @@ impl Gpu {
             });
         }
         let _compiled = std::sync::Arc::new(crate::gpu::compiled::register(&device));
-        Ok(Gpu { adapter, device, queue, info, profiler, rays, fault, _compiled })
+        Ok(Gpu { adapter, device, queue, info, profiler, rays, count_rays: options.count_rays, fault, _compiled })
     }
 
     /// Whether the adapter offers hardware ray queries (wgpu's `EXPERIMENTAL_RAY_QUERY`:

@@ -63,6 +63,11 @@ pub const BVH: &str = concat!(include_str!("../bvh/bvh.wgsl"), "\n", include_str
 pub const TRAVERSE_COMPUTE: &str = include_str!("../bvh/bvh_compute.wgsl");
 /// The hardware path's `traverse`: a ray query over the scene's TLAS (`accel.rs`).
 pub const TRAVERSE_HARDWARE: &str = include_str!("bvh_hardware.wgsl");
+/// `count_ray` as [`BVH`] holds it: counts nothing.
+pub const NO_RAY_COUNT: &str = "fn count_ray() {}";
+/// `count_ray` where rays are counted: one more in the scene's ray count
+/// ([`crate::gpu_scene::RAY_COUNT_BINDING`]).
+pub const RAY_COUNT: &str = include_str!("ray_count.wgsl");
 
 /// WGSL declarations of the constants Rust and WGSL share, from their Rust values.
 pub fn constants() -> String {
@@ -168,15 +173,22 @@ pub fn compose(pieces: &[&str]) -> String {
 
 /// `source` (a composed shader) for ray path `path`: unchanged for the compute path; for the
 /// hardware path its compute `traverse` replaced by the ray query's and `enable wgpu_ray_query;`
-/// put first. A shader without [`BVH`] casts no rays and is returned as it is.
-pub fn for_rays(source: &str, path: crate::gpu::accel::RayPath) -> std::borrow::Cow<'_, str> {
-    match path {
-        crate::gpu::accel::RayPath::Hardware if source.contains(TRAVERSE_COMPUTE) => std::borrow::Cow::Owned(format!(
-            "enable wgpu_ray_query;\n{}",
-            source.replacen(TRAVERSE_COMPUTE, TRAVERSE_HARDWARE, 1)
-        )),
-        _ => std::borrow::Cow::Borrowed(source),
+/// put first. With `count`, its empty `count_ray` replaced by [`RAY_COUNT`]'s, which counts
+/// every ray the shader traces (`--count-rays`). A shader without [`BVH`] casts no rays and is
+/// returned as it is.
+pub fn for_rays(source: &str, path: crate::gpu::accel::RayPath, count: bool) -> std::borrow::Cow<'_, str> {
+    use std::borrow::Cow;
+    if !source.contains(TRAVERSE_COMPUTE) {
+        return Cow::Borrowed(source);
     }
+    let mut s = Cow::Borrowed(source);
+    if path == crate::gpu::accel::RayPath::Hardware {
+        s = Cow::Owned(format!("enable wgpu_ray_query;\n{}", s.replacen(TRAVERSE_COMPUTE, TRAVERSE_HARDWARE, 1)));
+    }
+    if count {
+        s = Cow::Owned(s.replacen(NO_RAY_COUNT, RAY_COUNT, 1));
+    }
+    s
 }
 
 /// The shader module of `source`: the device's one of it ([`crate::gpu::compiled`]).

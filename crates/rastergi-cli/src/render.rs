@@ -31,6 +31,7 @@ use rastergi::session::new_renderer;
 use rastergi::session::run::{Limits, Observer, Stop};
 
 use crate::args::{SceneArgs, ShowArg, print_profile};
+use rastergi::gpu_scene::RaysTraced;
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
@@ -185,15 +186,22 @@ impl Observer for Watch<'_> {
 }
 
 /// The rays counted (`--count-rays`): `setup` before the first iteration (the first photon
-/// pass), `total` at the end, over `iterations` iterations of `pixels` pixels.
-fn print_rays(setup: u64, total: u64, iterations: u32, pixels: u64) {
+/// pass), `total` at the end, over `iterations` iterations of `pixels` pixels, by use.
+fn print_rays(setup: RaysTraced, total: RaysTraced, iterations: u32, pixels: u64) {
     let per_pixel = |n: u64| n as f64 / pixels as f64;
+    let run = total.since(&setup);
+    let per_iteration = |n: u64| per_pixel(n) / f64::from(iterations.max(1));
     println!(
-        "rays traced: {total} ({:.1} per pixel): set-up {setup} ({:.1} per pixel), {iterations} iterations {} ({:.1} per pixel per iteration, photon passes included)",
-        per_pixel(total),
-        per_pixel(setup),
-        total - setup,
-        per_pixel(total - setup) / f64::from(iterations.max(1)),
+        "rays traced: {} ({:.1} per pixel): set-up {} ({:.1} per pixel, photons), {iterations} iterations {} ({:.1} per pixel per iteration: eye and direct light {:.2}, gather {:.2}, photon passes {:.2})",
+        total.total(),
+        per_pixel(total.total()),
+        setup.total(),
+        per_pixel(setup.total()),
+        run.total(),
+        per_iteration(run.total()),
+        per_iteration(run.eye),
+        per_iteration(run.gather),
+        per_iteration(run.photons),
     );
 }
 

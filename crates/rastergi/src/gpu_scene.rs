@@ -165,10 +165,49 @@ pub fn group(tlas: bool, count_rays: bool) -> Group {
     g
 }
 
-/// The ray count's binding in the scene's group where rays are counted
-/// ([`crate::gpu::GpuOptions::count_rays`]; `gpu/ray_count.wgsl`): two words, the low and the
-/// high half of the rays traced.
+/// The ray counts' binding in the scene's group where rays are counted
+/// ([`crate::gpu::GpuOptions::count_rays`]; `gpu/ray_count.wgsl`): for each [`RayUse`], two
+/// words, the low and the high half of its rays traced.
 pub const RAY_COUNT_BINDING: u32 = 16;
+
+/// The ray counts' size: two words for each [`RayUse`].
+const RAY_COUNT_BYTES: u64 = 3 * 8;
+
+/// What a shader's rays are counted as (`--count-rays`): each pass says so where it composes
+/// its shader ([`GpuScene::module`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RayUse {
+    /// The eye's: camera rays past mirrors and glass, the direct light's shadow rays, the
+    /// emitters' edges; the path tracer's every ray; the ray kernel's.
+    Eye = 0,
+    /// The final gather's rays and the shadow rays at their hits.
+    Gather = 1,
+    /// The photons' flights.
+    Photons = 2,
+}
+
+/// The rays a scene's passes have traced, by use ([`GpuScene::rays_traced`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RaysTraced {
+    pub eye: u64,
+    pub gather: u64,
+    pub photons: u64,
+}
+
+impl RaysTraced {
+    pub fn total(&self) -> u64 {
+        self.eye + self.gather + self.photons
+    }
+
+    /// The rays traced since `before`.
+    pub fn since(&self, before: &RaysTraced) -> RaysTraced {
+        RaysTraced {
+            eye: self.eye - before.eye,
+            gather: self.gather - before.gather,
+            photons: self.photons - before.photons,
+        }
+    }
+}
 
 /// The GGX albedo tables as gpu_scene.wgsl reads them: the cells and means, N × (N + 1)
 /// RGBA32F, and the rough glass's, N × (cells / N) R32F. Computed and filled only where some
@@ -321,7 +360,7 @@ pub struct GpuScene {
     /// The acceleration structures, bound at `accel::TLAS_BINDING`, where the device has ray
     /// queries and the compute path was not asked for.
     pub accel: Option<SceneAccel>,
-    /// The rays traced so far, where they are counted ([`RAY_COUNT_BINDING`]).
+    /// The rays traced so far by use, where they are counted ([`RAY_COUNT_BINDING`]).
     pub ray_count: Option<wgpu::Buffer>,
 }
 
@@ -329,12 +368,13 @@ impl GpuScene {
     /// The rays this scene's passes have traced since it was uploaded, where the device counts
     /// them ([`crate::gpu::GpuOptions::count_rays`]): every query of `trace` (a shadow ray, a
     /// gather ray, a photon's flight, an eye ray past a mirror …), whichever traversal answers
-    /// it. Waits for the GPU.
-    pub fn rays_traced(&self, gpu: &Gpu) -> Result<Option<u64>> {
+    /// it), by use. Waits for the GPU.
+    pub fn rays_traced(&self, gpu: &Gpu) -> Result<Option<RaysTraced>> {
         let Some(buffer) = &self.ray_count else { return Ok(None) };
-        let words = gpu.read_buffer(buffer, 8)?;
+        let words = gpu.read_buffer(buffer, RAY_COUNT_BYTES)?;
         let w: &[u32] = bytemuck::cast_slice(&words);
-        Ok(Some(u64::from(w[0]) | u64::from(w[1]) << 32))
+        let count = |u: RayUse| u64::from(w[2 * u as usize]) | u64::from(w[2 * u as usize + 1]) << 32;
+        Ok(Some(RaysTraced { eye: count(RayUse::Eye), gather: count(RayUse::Gather), photons: count(RayUse::Photons) }))
     }
 
     /// The values of the scene's pipeline-overridable constants (`gpu_scene.wgsl`), for every
@@ -367,14 +407,22 @@ impl GpuScene {
     }
 
     /// A shader module of `source` (a composed shader that reads this scene) on this scene's
-    /// ray path ([`crate::gpu::shader::for_rays`]).
-    pub fn module(&self, device: &wgpu::Device, label: &str, source: &str) -> wgpu::ShaderModule {
-        self.module_for(device, label, source, self.rays)
+    /// ray path ([`crate::gpu::shader::for_rays`]), its rays counted as `used` where they are
+    /// counted.
+    pub fn module(&self, device: &wgpu::Device, label: &str, source: &str, used: RayUse) -> wgpu::ShaderModule {
+        self.module_for(device, label, source, self.rays, used)
     }
 
     /// [`Self::module`] on ray path `path` (the hardware one needs [`Self::accel`]).
-    pub fn module_for(&self, device: &wgpu::Device, label: &str, source: &str, path: RayPath) -> wgpu::ShaderModule {
-        let count = self.ray_count.is_some();
+    pub fn module_for(
+        &self,
+        device: &wgpu::Device,
+        label: &str,
+        source: &str,
+        path: RayPath,
+        used: RayUse,
+    ) -> wgpu::ShaderModule {
+        let count = self.ray_count.as_ref().map(|_| used);
         crate::gpu::shader::module(device, label, &crate::gpu::shader::for_rays(source, path, count))
     }
 
@@ -514,7 +562,7 @@ impl GpuScene {
         };
         let ray_count = gpu.count_rays.then(|| {
             let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
-            gpu.zeroed_buffer("scene ray count", 8, usage)
+            gpu.zeroed_buffer("scene ray count", RAY_COUNT_BYTES, usage)
         });
         let group = group(accel.is_some(), ray_count.is_some());
         let layout = group.layout(&gpu.device);

@@ -152,7 +152,7 @@ impl PathTracer {
         // `main` does not write the visibility buffer; a placeholder fills its binding.
         let placeholder = gpu.zeroed_buffer("path tracer visibility placeholder", 16, wgpu::BufferUsages::STORAGE);
         let bind_group = bind(gpu, &layout, &film.accumulation, &params, &placeholder);
-        let module = gpu_scene.module(device, "path tracer", &source());
+        let module = gpu_scene.module(device, "path tracer", &source(), crate::gpu_scene::RayUse::Eye);
         let layouts = [&gpu_scene.layout, &frame.layout, &layout];
         let trace = gpu_scene.compute_pipeline(device, "path tracer", &module, "main", &layouts);
         let primary = gpu_scene.compute_pipeline(device, "path tracer primary hits", &module, "primary_hits", &layouts);
@@ -275,7 +275,7 @@ impl Progressive for PathTracer {
         self.gpu.wait()
     }
     /// Iterations (paths per pixel) accumulated since the last reset.
-    fn rays_traced(&self) -> Result<Option<u64>> {
+    fn rays_traced(&self) -> Result<Option<crate::gpu_scene::RaysTraced>> {
         self.scene.rays_traced(&self.gpu)
     }
     fn samples(&self) -> u32 {

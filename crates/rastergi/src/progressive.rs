@@ -86,7 +86,7 @@ pub trait Progressive: wgpu::WasmNotSend {
     /// The rays the renderer has traced since it was made (every pass: photons, the eye's
     /// chains, shadow rays, the gather's rays), where the device counts them
     /// ([`crate::gpu::GpuOptions::count_rays`]); `None` where it does not. Waits for the GPU.
-    fn rays_traced(&self) -> Result<Option<u64>>;
+    fn rays_traced(&self) -> Result<Option<crate::gpu_scene::RaysTraced>>;
     /// Iterations accumulated since the last restart.
     fn samples(&self) -> u32;
     fn camera(&self) -> Camera;

@@ -1044,7 +1044,7 @@ impl Progressive for Renderer {
     fn wait(&self) -> Result<()> {
         Renderer::wait(self)
     }
-    fn rays_traced(&self) -> Result<Option<u64>> {
+    fn rays_traced(&self) -> Result<Option<crate::gpu_scene::RaysTraced>> {
         self.scene.rays_traced(&self.gpu)
     }
     fn samples(&self) -> u32 {

@@ -315,7 +315,9 @@ fn the_photon_pass_traces_one_ray_per_flight() {
         guided: false,
     };
     GpuPhotonMap::build(&gpu, &gs, &prepared, &settings).unwrap();
-    let rays = gs.rays_traced(&gpu).unwrap().expect("counted") as f64;
+    let counted = gs.rays_traced(&gpu).unwrap().expect("counted");
+    assert_eq!((counted.eye, counted.gather), (0, 0), "the photon pass's rays are the photons'");
+    let rays = counted.photons as f64;
     let expected = n as f64 / (1.0 - a);
     let sigma = (n as f64 * a).sqrt() / (1.0 - a);
     println!("{n} photons: {rays} rays, expected {expected} ± {sigma:.0}");

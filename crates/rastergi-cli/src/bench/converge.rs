@@ -242,7 +242,7 @@ fn curve(m: &mut dyn Progressive, reference: &Reference, max_seconds: f64, stop_
         rendering += t.elapsed();
         let error = reference.error(&m.read_linear(Show::Full)?);
         let (w, h) = reference.size();
-        let rays_per_pixel = m.rays_traced()?.map(|r| r as f64 / (f64::from(w) * f64::from(h)));
+        let rays_per_pixel = m.rays_traced()?.map(|r| r.total() as f64 / (f64::from(w) * f64::from(h)));
         points.push(Point { seconds: rendering.as_secs_f64(), samples: m.samples(), error, rays_per_pixel });
         if error <= stop_at {
             break;

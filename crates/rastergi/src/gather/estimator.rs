@@ -155,7 +155,7 @@ impl GatherSetup<'_> {
         own: &wgpu::BindGroupLayout,
         entries: [&str; N],
     ) -> [wgpu::ComputePipeline; N] {
-        let module = self.scene.module(device, label, &estimate_source(pieces));
+        let module = self.scene.module(device, label, &estimate_source(pieces), crate::gpu_scene::RayUse::Gather);
         let layouts = [&self.scene.layout, &self.frame.layout, own, &self.map.bind_layout];
         entries.map(|entry| self.scene.compute_pipeline(device, label, &module, entry, &layouts))
     }

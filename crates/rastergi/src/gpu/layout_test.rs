@@ -200,7 +200,7 @@ fn every_tracing_shader_composes_and_validates_for_hardware_ray_queries() {
     use crate::gpu::accel::{RayPath, TLAS_BINDING};
     let mut traced = Vec::new();
     for (label, source) in shaders() {
-        let hardware = crate::gpu::shader::for_rays(&source, RayPath::Hardware, false);
+        let hardware = crate::gpu::shader::for_rays(&source, RayPath::Hardware, None);
         if hardware == source {
             continue;
         }
@@ -215,7 +215,7 @@ fn every_tracing_shader_composes_and_validates_for_hardware_ray_queries() {
             .unwrap_or_else(|e| panic!("{label} (hardware): {}", e.emit_to_string(&hardware)));
         // And with its rays counted (`--count-rays`): the counter at its binding, `trace`
         // adding to it.
-        let counted = crate::gpu::shader::for_rays(&source, RayPath::Hardware, true);
+        let counted = crate::gpu::shader::for_rays(&source, RayPath::Hardware, Some(crate::gpu_scene::RayUse::Photons));
         let module = naga::front::wgsl::parse_str(&counted)
             .unwrap_or_else(|e| panic!("{label} (counted): {}", e.emit_to_string(&counted)));
         let count = naga::ResourceBinding { group: 0, binding: crate::gpu_scene::RAY_COUNT_BINDING };
@@ -373,9 +373,10 @@ fn every_declared_bind_group_matches_the_bindings_of_its_shaders() {
     // Each shader as composed for the compute ray path, and where it traces, for the hardware
     // one, whose scene group also binds the TLAS, and with its rays counted, whose scene group
     // also binds the count.
-    let composed = |path, count| {
+    let composed = |path: crate::gpu::accel::RayPath, count: bool| {
         shaders().into_iter().filter_map(move |(label, source)| {
-            let s = crate::gpu::shader::for_rays(&source, path, count);
+            let used = count.then_some(crate::gpu_scene::RayUse::Gather);
+            let s = crate::gpu::shader::for_rays(&source, path, used);
             (s != source).then(|| (label, s.into_owned(), (path == crate::gpu::accel::RayPath::Hardware, count)))
         })
     };

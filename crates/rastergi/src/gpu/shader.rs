@@ -174,9 +174,13 @@ pub fn compose(pieces: &[&str]) -> String {
 /// `source` (a composed shader) for ray path `path`: unchanged for the compute path; for the
 /// hardware path its compute `traverse` replaced by the ray query's and `enable wgpu_ray_query;`
 /// put first. With `count`, its empty `count_ray` replaced by [`RAY_COUNT`]'s, which counts
-/// every ray the shader traces (`--count-rays`). A shader without [`BVH`] casts no rays and is
-/// returned as it is.
-pub fn for_rays(source: &str, path: crate::gpu::accel::RayPath, count: bool) -> std::borrow::Cow<'_, str> {
+/// every ray the shader traces in the count of that use (`--count-rays`). A shader without
+/// [`BVH`] casts no rays and is returned as it is.
+pub fn for_rays(
+    source: &str,
+    path: crate::gpu::accel::RayPath,
+    count: Option<crate::gpu_scene::RayUse>,
+) -> std::borrow::Cow<'_, str> {
     use std::borrow::Cow;
     if !source.contains(TRAVERSE_COMPUTE) {
         return Cow::Borrowed(source);
@@ -185,8 +189,9 @@ pub fn for_rays(source: &str, path: crate::gpu::accel::RayPath, count: bool) -> 
     if path == crate::gpu::accel::RayPath::Hardware {
         s = Cow::Owned(format!("enable wgpu_ray_query;\n{}", s.replacen(TRAVERSE_COMPUTE, TRAVERSE_HARDWARE, 1)));
     }
-    if count {
-        s = Cow::Owned(s.replacen(NO_RAY_COUNT, RAY_COUNT, 1));
+    if let Some(u) = count {
+        let counting = format!("const RAY_COUNT_WORD: u32 = {}u;\n{RAY_COUNT}", 2 * u as u32);
+        s = Cow::Owned(s.replacen(NO_RAY_COUNT, &counting, 1));
     }
     s
 }

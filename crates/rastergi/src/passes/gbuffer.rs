@@ -145,7 +145,7 @@ impl PixelPass {
     ) -> PixelPass {
         let device = &gpu.device;
         let label = shader.label;
-        let module = scene.module(device, label, shader.source);
+        let module = scene.module(device, label, shader.source, crate::gpu_scene::RayUse::Eye);
         let resources = [
             ("gbuffer", wgpu::BindingResource::TextureView(&gbuffer.view)),
             ("film", film.accumulation.as_entire_binding()),

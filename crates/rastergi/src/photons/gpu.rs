@@ -322,7 +322,7 @@ impl GpuPhotonMap {
         let (trace_layout, trace_group) = trace_group().layout_and_bind(device, &trace_resources);
         let resolve_resources: Vec<_> = counters.into_iter().chain(resolve_only).collect();
         let (resolve_layout, resolve_group) = resolve_group().layout_and_bind(device, &resolve_resources);
-        let module = scene.module(device, "photon trace", &trace_source());
+        let module = scene.module(device, "photon trace", &trace_source(), crate::gpu_scene::RayUse::Photons);
         let trace_pipeline =
             scene.compute_pipeline(device, "trace photons", &module, "trace_photons", &[&scene.layout, &trace_layout]);
         let resolve_pipeline = scene.compute_pipeline(

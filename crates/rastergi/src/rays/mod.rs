@@ -309,7 +309,7 @@ impl RayCaster {
     pub fn on(gpu: &Gpu, scene: &GpuScene, path: RayPath) -> RayCaster {
         let device = &gpu.device;
         let layout = group().layout(device);
-        let module = scene.module_for(device, "rays", &source(), path);
+        let module = scene.module_for(device, "rays", &source(), path, crate::gpu_scene::RayUse::Eye);
         let pipeline =
             compute_pipeline(device, "rays", &module, "main", &[&scene.layout, &layout], &scene.pipeline_constants());
         RayCaster { pipeline, layout }

@@ -32,7 +32,7 @@ impl GpuScene {
         log::info!("rays: {} ({})", scene.rays.name(), scene.rays_why);
         // The probe's rays are not the render's.
         if let Some(count) = &scene.ray_count {
-            gpu.queue.write_buffer(count, 0, &[0; 8]);
+            gpu.queue.write_buffer(count, 0, &[0; 24]);
         }
         Ok(scene)
     }

@@ -245,19 +245,21 @@ if [ "$ref_ok" = 1 ]; then
         report "against it near or below that are reference noise (they add in quadrature)." ""
     fi
     step "convergence" "$B_CONVERGE" "$binary" bench converge --reference "$ref_a,$ref_b" \
-        --seconds "$CONVERGE_SECONDS" --csv "$stem-converge.csv" --plot "$stem-converge.png" || true
+        --seconds "$CONVERGE_SECONDS" --count-rays --csv "$stem-converge.csv" --plot "$stem-converge.png" || true
     if [ -f "$stem-converge.csv" ]; then
         report "Last point of each curve ($(basename "$stem")-converge.csv holds them all):" ""
         # With the reference's noise n known: sqrt(e² - n²) estimates the error against the
         # converged image.
         awk -F, -v n="${noise:-}" '
             NR > 1 {
-                # The method is quoted and may hold commas: the figures are the last three fields.
+                # The method is quoted and may hold commas: the figures are the last four fields
+                # (seconds, samples, relative RMSE, rays per pixel: empty for Mitsuba).
                 name = $0
-                sub(/,[^,]*,[^,]*,[^,]*$/, "", name)
+                sub(/,[^,]*,[^,]*,[^,]*,[^,]*$/, "", name)
                 gsub(/"/, "", name)
-                e = 100 * $NF
-                s = sprintf("- %s: %.2f %% after %.2f s of rendering (%d samples per pixel)", name, e, $(NF - 2), $(NF - 1))
+                e = 100 * $(NF - 1)
+                s = sprintf("- %s: %.2f %% after %.2f s of rendering (%d samples per pixel", name, e, $(NF - 3), $(NF - 2))
+                s = s ($NF != "" ? sprintf(", %.0f rays per pixel traced", $NF) : "") ")"
                 if (n != "") s = s sprintf("; %.2f %% once the reference noise is taken out", sqrt(e * e > n * n ? e * e - n * n : 0))
                 last[name] = s
                 if (!(name in seen)) { seen[name] = 1; order[++k] = name }

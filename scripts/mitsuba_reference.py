@@ -1108,7 +1108,8 @@ def xml_for_mitsuba3(text, width, height, spp, max_depth):
             # Mitsuba 3 has no phong: its diffuse part, as rastergi reads it (with a warning).
             parent.set("type", "diffuse")
             for child in list(parent):
-                if child.get("name") == "diffuseReflectance":
+                # 0.6's name, or 3's (a file written in Mitsuba 3's names).
+                if child.get("name") in ("diffuseReflectance", "diffuse_reflectance"):
                     child.set("name", "reflectance")
                 else:
                     parent.remove(child)

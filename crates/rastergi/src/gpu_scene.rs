@@ -367,7 +367,7 @@ pub struct GpuScene {
 impl GpuScene {
     /// The rays this scene's passes have traced since it was uploaded, where the device counts
     /// them ([`crate::gpu::GpuOptions::count_rays`]): every query of `trace` (a shadow ray, a
-    /// gather ray, a photon's flight, an eye ray past a mirror …), whichever traversal answers
+    /// gather ray, a photon's flight, an eye ray past a mirror …, whichever traversal answers
     /// it), by use. Waits for the GPU.
     pub fn rays_traced(&self, gpu: &Gpu) -> Result<Option<RaysTraced>> {
         let Some(buffer) = &self.ray_count else { return Ok(None) };

@@ -9,6 +9,7 @@ pub mod bench;
 pub mod compare;
 pub mod export;
 pub mod merge;
+pub mod noise;
 pub mod render;
 pub mod serve;
 pub mod view;

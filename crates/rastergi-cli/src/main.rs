@@ -4,7 +4,7 @@
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use rastergi_cli::{args, bench, compare, export, merge, render, serve, view};
+use rastergi_cli::{args, bench, compare, export, merge, noise, render, serve, view};
 
 #[derive(Parser)]
 #[command(
@@ -34,6 +34,9 @@ enum Command {
     Bench(bench::BenchCommand),
     /// Compare an image with a reference: relative RMSE, block-mean error, PSNR, mean ratios.
     Compare(compare::CompareArgs),
+    /// The noise of one render from renders of different seeds, no reference needed: its
+    /// relative RMSE, its body and the share of its worst 1 % of pixels.
+    Noise(noise::NoiseArgs),
     /// Write a scene (built in, e.g. `atrium` or `spheres:1000000`, or a file) as Wavefront OBJ + MTL.
     Export(export::ExportArgs),
     /// Open a window that shows the image converging; fly or orbit through the scene.
@@ -81,6 +84,7 @@ fn main() -> ExitCode {
         Command::Merge(args) => ok(merge::run(&args)),
         Command::Bench(command) => ok(bench::run(&command)),
         Command::Compare(args) => ok(compare::run(&args)),
+        Command::Noise(args) => ok(noise::run(&args)),
         Command::Export(args) => ok(export::run(&args)),
         Command::View(args) => ok(view::run(&args)),
         Command::Serve(args) => ok(serve::run(&args)),

@@ -1,6 +1,7 @@
 //! `rastergi compare` on image pairs whose differences are known in closed form (identical,
 //! a constant offset, Gaussian noise of a known level, PNG values), and on the inputs it must
-//! refuse with one clear error line: missing, corrupt, mismatched, non-finite.
+//! refuse with one clear error line: missing, corrupt, mismatched, non-finite; `rastergi noise`
+//! on renders of a known noise level, and on what it must refuse.
 
 mod common;
 
@@ -297,4 +298,51 @@ fn black_reference_makes_relative_errors_undefined() {
     let run = compare(dir.path(), ("a.exr", &ramp(4, 4)), ("black.exr", &black), &[]);
     let line = run.error_line();
     assert!(line.contains("black.exr") && line.contains("undefined"), "{line}");
+}
+
+/// Renders of a ramp with independent normal noise of a known level, as EXR files in `dir`.
+fn noisy_renders(dir: &Path, k: usize, sigma: f64) -> Vec<String> {
+    let reference = ramp(64, 64);
+    let mut normal = rastergi::sampling::gaussian_deviates(99);
+    (0..k)
+        .map(|i| {
+            let name = format!("seed{i}.exr");
+            write(dir, &name, &map(&reference, |p| p.map(|v| v + (sigma * normal()) as f32)));
+            name
+        })
+        .collect()
+}
+
+#[test]
+fn noise_of_renders_of_known_gaussian_noise_is_its_level_within_sampling_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let (sigma, k) = (0.05, 4);
+    let names = noisy_renders(dir.path(), k, sigma);
+    let args: Vec<&str> = std::iter::once("noise").chain(names.iter().map(String::as_str)).collect();
+    let run = rastergi(dir.path(), &args);
+    run.assert_success();
+    let mean = ramp_channel_means(64, 64).iter().sum::<f64>() / 3.0;
+    // mean s²/σ² over n = 3·64² values of k − 1 degrees of freedom: sd √(2/(n(k − 1))), half
+    // that in the root.
+    let n = 3.0 * 64.0 * 64.0;
+    let sd = sigma / mean * (2.0 / (n * (k - 1) as f64)).sqrt() / 2.0;
+    let noise = run.number("noise");
+    assert!((noise - sigma / mean).abs() < 4.0 * sd, "{noise} against {} ± {sd}\n{}", sigma / mean, run.stdout);
+    assert!((run.number("noise of mean") - noise / 2.0).abs() < 2e-6, "{}", run.stdout);
+    assert_eq!(run.numbers("pairs").len(), 2, "{}", run.stdout);
+    assert!(run.stdout.contains("renders:          4 of 64 x 64"), "{}", run.stdout);
+}
+
+#[test]
+fn noise_refuses_one_render_and_renders_of_different_sizes() {
+    let dir = tempfile::tempdir().unwrap();
+    let names = noisy_renders(dir.path(), 1, 0.05);
+    let run = rastergi(dir.path(), &["noise", &names[0]]);
+    assert!(run.error_line().contains("at least two"), "{}", run.stderr);
+    write(dir.path(), "small.exr", &ramp(8, 8));
+    let run = rastergi(dir.path(), &["noise", &names[0], "small.exr"]);
+    let line = run.error_line();
+    assert!(line.contains("differ in size") && line.contains("small.exr"), "{line}");
+    let run = rastergi(dir.path(), &["noise", &names[0], "missing.exr"]);
+    assert!(run.error_line().contains("missing.exr"), "{}", run.stderr);
 }

@@ -1,7 +1,8 @@
 //! Image error metrics of DESIGN.md ("Validation"): relative RMSE over pixels and channels,
 //! and the error of 16×16 block means, where Monte Carlo noise averages out and bias remains;
 //! and a false-colour picture of where two images differ; [`metrics`] is `rastergi compare`'s
-//! whole comparison, with its refusals.
+//! whole comparison, with its refusals; [`seed_noise`] is `rastergi noise`'s: one render's noise
+//! from renders of independent seeds, without a reference.
 
 use crate::error::{Error, Result};
 use crate::image_io::{DisplayImage, LinearImage};
@@ -174,6 +175,92 @@ pub fn difference_image(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// k renders of `base` plus independent normal noise of standard deviation σ_p per pixel
+    /// (every channel), from `seed`.
+    fn noisy_renders(base: &LinearImage, sigma: impl Fn(usize) -> f64, k: usize, seed: u64) -> Vec<LinearImage> {
+        let mut normal = crate::sampling::gaussian_deviates(seed);
+        (0..k)
+            .map(|_| LinearImage {
+                width: base.width,
+                height: base.height,
+                pixels: base
+                    .pixels
+                    .iter()
+                    .enumerate()
+                    .map(|(p, v)| v.map(|v| v + (sigma(p) * normal()) as f32))
+                    .collect(),
+            })
+            .collect()
+    }
+
+    fn names(k: usize) -> Vec<String> {
+        (0..k).map(|i| format!("r{i}.exr")).collect()
+    }
+
+    #[test]
+    fn seed_noise_of_known_gaussian_noise_is_its_level_within_sampling_error() {
+        let (w, h, sigma, k) = (64u32, 64u32, 0.05, 4);
+        let base = LinearImage {
+            width: w,
+            height: h,
+            pixels: (0..w * h).map(|i| [0.5 + 0.5 * (i % 7) as f32 / 7.0; 3]).collect(),
+        };
+        let mean = masked_mean(&base, None);
+        let n = f64::from(3 * w * h);
+        let s = seed_noise(&noisy_renders(&base, |_| sigma, k, 7), &names(k), None).unwrap();
+        // mean s²/σ² is a mean of n·(k − 1) squared deviates: sd √(2/(n(k − 1))), half that
+        // in its root.
+        let sd = sigma / mean * (2.0 / (n * (k - 1) as f64)).sqrt() / 2.0;
+        assert!((s.relative - sigma / mean).abs() < 4.0 * sd, "{} against {} ± {sd}", s.relative, sigma / mean);
+        // Each pair alone: n deviates, sd √(2/n)/2 relative.
+        let pair_sd = sigma / mean * (2.0 / n).sqrt() / 2.0;
+        assert_eq!(s.pairs.len(), 2);
+        for p in &s.pairs {
+            assert!((p - sigma / mean).abs() < 4.0 * pair_sd, "pair {p} against {}", sigma / mean);
+        }
+        assert!((s.mean - mean).abs() < 1e-3 * mean);
+        assert_eq!((s.renders, s.compared_pixels, s.total_pixels), (k, (w * h) as usize, (w * h) as usize));
+        // Homoscedastic: the worst 1 % hold little more than 1 %.
+        assert!(s.tail_share > 0.01 && s.tail_share < 0.05, "tail {}", s.tail_share);
+    }
+
+    #[test]
+    fn seed_noise_finds_the_tail_and_the_body() {
+        // 41 of 4096 pixels ten times as noisy: they hold 41·100 / (41·100 + 4055) = 50.3 % of
+        // the variance; the body is the rest's σ.
+        let (w, h, sigma, k) = (64u32, 64u32, 0.02, 4);
+        let base = LinearImage { width: w, height: h, pixels: vec![[1.0; 3]; (w * h) as usize] };
+        let loud = |p: usize| p.is_multiple_of(100);
+        let renders = noisy_renders(&base, |p| if loud(p) { 10.0 * sigma } else { sigma }, k, 11);
+        let s = seed_noise(&renders, &names(k), None).unwrap();
+        let want = 41.0 * 100.0 / (41.0 * 100.0 + 4055.0);
+        // The worst 40 by their estimates are 40 of the 41 loud pixels (s² of 9 degrees of
+        // freedom: their sum's sd is 7 % of it, the share's about 2 points).
+        assert!((s.tail_share - want).abs() < 0.06, "tail {} against {want}", s.tail_share);
+        assert!((s.body - sigma).abs() < 0.05 * sigma, "body {} against {sigma}", s.body);
+        let all = ((41.0 * 100.0 + 4055.0) / 4096.0f64).sqrt() * sigma;
+        assert!((s.relative - all).abs() < 0.05 * all, "{} against {all}", s.relative);
+    }
+
+    #[test]
+    fn seed_noise_leaves_out_emitters_and_refuses_what_it_cannot_measure() {
+        let (w, h) = (32u32, 32u32);
+        let mut base = LinearImage { width: w, height: h, pixels: vec![[0.5; 3]; (w * h) as usize] };
+        base.pixels[(10 * w + 10) as usize] = [100.0; 3];
+        let renders = noisy_renders(&base, |_| 0.01, 3, 5);
+        let s = seed_noise(&renders, &names(3), Some(3.0)).unwrap();
+        assert_eq!((s.compared_pixels, s.total_pixels), ((w * h - 9) as usize, (w * h) as usize));
+        assert_eq!(s.pairs.len(), 1);
+        let e = |r: Result<SeedNoise>| r.expect_err("refused").to_string();
+        assert!(e(seed_noise(&renders[..1], &names(1), None)).contains("at least two"));
+        let small = LinearImage { width: 8, height: 8, pixels: vec![[0.5; 3]; 64] };
+        let msg = e(seed_noise(&[renders[0].clone(), small], &names(2), None));
+        assert!(msg.contains("differ in size") && msg.contains("r1.exr"), "{msg}");
+        let black = vec![LinearImage { width: 4, height: 4, pixels: vec![[0.0; 3]; 16] }; 2];
+        assert!(e(seed_noise(&black, &names(2), None)).contains("black"));
+        assert!(e(seed_noise(&renders, &names(3), Some(0.1))).contains("leaves no pixel"));
+    }
 
     fn constant(w: u32, h: u32, v: f32) -> LinearImage {
         LinearImage { width: w, height: h, pixels: vec![[v; 3]; (w * h) as usize] }
@@ -403,5 +490,129 @@ pub fn metrics(
         compared_pixels: kept,
         total_pixels: total,
         mask,
+    })
+}
+
+/// The noise of one render, measured from renders of the same settings with independent seeds
+/// (`rastergi noise`): for k renders x_1 … x_k, per pixel and channel the unbiased sample
+/// variance s² = Σ_i (x_i − x̄)² / (k − 1), whose expectation is one render's variance σ²
+/// whatever the image's expectation is. Over the kept pixels, with m the renders' mean:
+///
+/// ```text
+///   relative = √(mean s²) / m      (one render's relative RMSE against its expectation)
+/// ```
+///
+/// what `rastergi compare` would give against a noise-free reference, less the bias. Where
+/// the noise has a heavy tail, a few pixels hold most of Σ s² and two renders tell little (the
+/// shared classroom: 17.5 % from one pair of seeds, 23.1 % from the next, docs/measurements.md):
+/// the pairs' own estimates are reported beside it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SeedNoise {
+    /// √(mean s²) / m over the kept pixels and channels.
+    pub relative: f64,
+    /// The same over the best 99 % of the kept pixels (by s² averaged over the channels): the
+    /// body of the noise.
+    pub body: f64,
+    /// The share of Σ s² in the worst 1 % of the kept pixels (at least one): the tail.
+    pub tail_share: f64,
+    /// `relative` from each disjoint pair of renders alone, (1, 2), (3, 4) …:
+    /// √(mean (a − b)²/2) / m.
+    pub pairs: Vec<f64>,
+    /// The renders' mean over the kept pixels and channels.
+    pub mean: f64,
+    pub renders: usize,
+    pub compared_pixels: usize,
+    pub total_pixels: usize,
+}
+
+/// [`SeedNoise`] of `images` (at least two, one size; `names` for the messages) over the pixels
+/// that the emitter mask of their mean leaves (`mask_emitters`, as `rastergi compare`'s of its
+/// reference), refusing fewer than two images, images of different sizes, a mask that leaves
+/// nothing and a black mean.
+pub fn seed_noise(images: &[LinearImage], names: &[String], mask_emitters: Option<f32>) -> Result<SeedNoise> {
+    check_mask_threshold(mask_emitters)?;
+    if images.len() < 2 {
+        return Err(Error::Invalid(
+            "noise needs at least two renders of the same settings with different seeds; give two or more images"
+                .into(),
+        ));
+    }
+    let first = &images[0];
+    for (image, name) in images.iter().zip(names).skip(1) {
+        if (image.width, image.height) != (first.width, first.height) {
+            return Err(Error::Invalid(format!(
+                "the images differ in size: {} is {} x {} but {name} is {} x {}; noise needs renders of the same size",
+                names[0], first.width, first.height, image.width, image.height
+            )));
+        }
+    }
+    let k = images.len() as f64;
+    let pixels = first.pixels.len();
+    let mean_image = LinearImage {
+        width: first.width,
+        height: first.height,
+        pixels: (0..pixels)
+            .map(|p| [0, 1, 2].map(|c| (images.iter().map(|i| f64::from(i.pixels[p][c])).sum::<f64>() / k) as f32))
+            .collect(),
+    };
+    let mask = mask_emitters.map(|t| emitter_mask(&mean_image, t));
+    let keep = |p: usize| mask.as_ref().is_none_or(|m| m[p]);
+    let kept: Vec<usize> = (0..pixels).filter(|&p| keep(p)).collect();
+    if kept.is_empty() {
+        return Err(Error::Invalid("--mask-emitters leaves no pixel to measure; raise its threshold".into()));
+    }
+    let mean = kept
+        .iter()
+        .map(|&p| images.iter().map(|i| i.pixels[p].iter().map(|&v| f64::from(v)).sum::<f64>()).sum::<f64>())
+        .sum::<f64>()
+        / (3.0 * k * kept.len() as f64);
+    if mean <= 0.0 {
+        return Err(Error::Invalid(format!(
+            "the renders are black over the measured pixels (mean {mean}), so relative noise is undefined"
+        )));
+    }
+    // s² per kept pixel, averaged over its channels.
+    let mut variance: Vec<f64> = kept
+        .iter()
+        .map(|&p| {
+            (0..3)
+                .map(|c| {
+                    let m = images.iter().map(|i| f64::from(i.pixels[p][c])).sum::<f64>() / k;
+                    images.iter().map(|i| (f64::from(i.pixels[p][c]) - m).powi(2)).sum::<f64>() / (k - 1.0)
+                })
+                .sum::<f64>()
+                / 3.0
+        })
+        .collect();
+    let total: f64 = variance.iter().sum();
+    variance.sort_by(|a, b| b.total_cmp(a));
+    let worst = (kept.len() / 100).max(1);
+    let tail: f64 = variance[..worst].iter().sum();
+    let n = kept.len() as f64;
+    let relative = (total / n).sqrt() / mean;
+    let body = if kept.len() > worst { ((total - tail) / (n - worst as f64)).sqrt() / mean } else { 0.0 };
+    let pairs = images
+        .chunks_exact(2)
+        .map(|pair| {
+            let s: f64 = kept
+                .iter()
+                .map(|&p| {
+                    (0..3)
+                        .map(|c| (f64::from(pair[0].pixels[p][c]) - f64::from(pair[1].pixels[p][c])).powi(2) / 2.0)
+                        .sum::<f64>()
+                })
+                .sum();
+            (s / (3.0 * n)).sqrt() / mean
+        })
+        .collect();
+    Ok(SeedNoise {
+        relative,
+        body,
+        tail_share: if total > 0.0 { tail / total } else { 0.0 },
+        pairs,
+        mean,
+        renders: images.len(),
+        compared_pixels: kept.len(),
+        total_pixels: pixels,
     })
 }

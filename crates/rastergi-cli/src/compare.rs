@@ -10,7 +10,7 @@ use rastergi::metrics::{BLOCK, difference_image};
 pub use rastergi::metrics::{Metrics, check_finite, check_mask_threshold, metrics};
 
 /// Reference values above which `--mask-emitters` without a value treats a pixel as an emitter.
-const DEFAULT_EMITTER_THRESHOLD: &str = "3";
+pub(crate) const DEFAULT_EMITTER_THRESHOLD: &str = "3";
 
 #[derive(Args, Debug)]
 pub struct CompareArgs {

@@ -8,7 +8,7 @@ use anyhow::Result;
 use clap::Args;
 use rastergi::metrics::seed_noise;
 
-use crate::compare::read;
+use crate::compare::{DEFAULT_EMITTER_THRESHOLD, read};
 
 #[derive(Args, Debug)]
 pub struct NoiseArgs {
@@ -18,7 +18,7 @@ pub struct NoiseArgs {
     images: Vec<PathBuf>,
     /// Leave emitters out: pixels above THRESHOLD in any channel of the renders' mean (default
     /// 3), and their 8 neighbours. Give it after the file names or with a value.
-    #[arg(long, value_name = "THRESHOLD", num_args = 0..=1, default_missing_value = "3")]
+    #[arg(long, value_name = "THRESHOLD", num_args = 0..=1, default_missing_value = DEFAULT_EMITTER_THRESHOLD)]
     mask_emitters: Option<f32>,
 }
 

@@ -548,24 +548,19 @@ pub fn seed_noise(images: &[LinearImage], names: &[String], mask_emitters: Optio
     }
     let k = images.len() as f64;
     let pixels = first.pixels.len();
-    let mean_image = LinearImage {
-        width: first.width,
-        height: first.height,
-        pixels: (0..pixels)
-            .map(|p| [0, 1, 2].map(|c| (images.iter().map(|i| f64::from(i.pixels[p][c])).sum::<f64>() / k) as f32))
-            .collect(),
-    };
-    let mask = mask_emitters.map(|t| emitter_mask(&mean_image, t));
-    let keep = |p: usize| mask.as_ref().is_none_or(|m| m[p]);
-    let kept: Vec<usize> = (0..pixels).filter(|&p| keep(p)).collect();
+    // x̄ per pixel and channel, once: for the emitter mask, the mean and the variances.
+    let means: Vec<[f64; 3]> = (0..pixels)
+        .map(|p| [0, 1, 2].map(|c| images.iter().map(|i| f64::from(i.pixels[p][c])).sum::<f64>() / k))
+        .collect();
+    let mask = mask_emitters.map(|t| {
+        let pixels = means.iter().map(|m| m.map(|v| v as f32)).collect();
+        emitter_mask(&LinearImage { width: first.width, height: first.height, pixels }, t)
+    });
+    let kept: Vec<usize> = (0..pixels).filter(|&p| mask.as_ref().is_none_or(|m| m[p])).collect();
     if kept.is_empty() {
         return Err(Error::Invalid("--mask-emitters leaves no pixel to measure; raise its threshold".into()));
     }
-    let mean = kept
-        .iter()
-        .map(|&p| images.iter().map(|i| i.pixels[p].iter().map(|&v| f64::from(v)).sum::<f64>()).sum::<f64>())
-        .sum::<f64>()
-        / (3.0 * k * kept.len() as f64);
+    let mean = kept.iter().map(|&p| means[p].iter().sum::<f64>()).sum::<f64>() / (3.0 * kept.len() as f64);
     if mean <= 0.0 {
         return Err(Error::Invalid(format!(
             "the renders are black over the measured pixels (mean {mean}), so relative noise is undefined"
@@ -576,12 +571,9 @@ pub fn seed_noise(images: &[LinearImage], names: &[String], mask_emitters: Optio
         .iter()
         .map(|&p| {
             (0..3)
-                .map(|c| {
-                    let m = images.iter().map(|i| f64::from(i.pixels[p][c])).sum::<f64>() / k;
-                    images.iter().map(|i| (f64::from(i.pixels[p][c]) - m).powi(2)).sum::<f64>() / (k - 1.0)
-                })
+                .map(|c| images.iter().map(|i| (f64::from(i.pixels[p][c]) - means[p][c]).powi(2)).sum::<f64>())
                 .sum::<f64>()
-                / 3.0
+                / (3.0 * (k - 1.0))
         })
         .collect();
     let total: f64 = variance.iter().sum();

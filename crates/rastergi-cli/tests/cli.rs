@@ -324,6 +324,27 @@ fn bench_rays_refuses_a_batch_beyond_the_gpus_buffers_before_making_it() {
     assert!(!run.status.success() && run.stderr.contains("--size"), "{}", run.stderr);
 }
 
+#[test]
+fn bench_motion_refuses_where_its_images_cannot_go_before_rendering() {
+    let dir = tempfile::tempdir().unwrap();
+    // A file where the directory for the images should be, and a reference in a directory
+    // that does not exist: each refused in one line before the converged view is rendered
+    // (which takes minutes on a real scene), nothing written.
+    std::fs::write(dir.path().join("taken"), "a file").unwrap();
+    let run =
+        rastergi(dir.path(), &["bench", "motion", "cornell", "--width", "32", "--height", "32", "--images", "taken"]);
+    assert!(!run.status.success());
+    assert!(run.stderr.contains("--images") && run.stderr.contains("taken"), "{}", run.stderr);
+    assert!(!run.stdout.contains("converged view"), "{}", run.stdout);
+    let run = rastergi(
+        dir.path(),
+        &["bench", "motion", "cornell", "--width", "32", "--height", "32", "--reference", "nowhere/ref.exr"],
+    );
+    assert!(!run.status.success());
+    assert!(run.stderr.contains("--reference") && run.stderr.contains("does not exist"), "{}", run.stderr);
+    assert!(!run.stderr.contains("panicked") && !dir.path().join("nowhere").exists(), "{}", run.stderr);
+}
+
 /// A view straight down at [`floor_obj`]'s floor from 3 m, 16 × 16 pixels.
 const FLOOR_VIEW: [&str; 10] =
     ["--eye", "0,3,0.01", "--target", "0,0,0", "--fov", "40", "--width", "16", "--height", "16"];

@@ -20,7 +20,7 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use anyhow::{Result, ensure};
+use anyhow::{Context, Result, ensure};
 use clap::Args;
 use rastergi::camera_control::CameraControl;
 use rastergi::fit;
@@ -193,6 +193,22 @@ pub fn run(a: &MotionArgs) -> Result<()> {
     );
     ensure!(a.motion.is_finite() && a.motion > 0.0, "--motion must be positive seconds, got {}", a.motion);
     ensure!(a.still.is_finite() && a.still >= 0.0, "--still must be 0 or more seconds, got {}", a.still);
+    // Where the images and the converged view go is checked before minutes of rendering.
+    if let Some(dir) = &a.images {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("--images {}: cannot make the directory", dir.display()))?;
+    }
+    if let Some(path) = &a.reference
+        && !path.exists()
+        && let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty())
+    {
+        ensure!(
+            parent.is_dir(),
+            "--reference {}: the directory {} does not exist; make it or name another",
+            path.display(),
+            parent.display()
+        );
+    }
     let (scene, gpu) = window_scene_and_gpu(&a.window, &a.gpu)?;
     let (w, h) = (a.window.width, a.window.height);
     let grid = fit::grid_resolution(&scene.bounds());

@@ -389,4 +389,25 @@ mod tests {
         view.encode_resolve(&mut enc, 0.0).unwrap();
         gpu.queue.submit([enc.finish()]);
     }
+
+    /// While the camera moves, every frame shows a preview iteration of its own view, however
+    /// short the budget: a frame whose budget is smaller than the coarsest preview's iteration
+    /// still finishes one (the next frame's camera would restart a part of one, and the move
+    /// would show nothing).
+    #[test]
+    fn every_frame_of_a_move_shows_a_preview_of_its_view() {
+        let gpu = Gpu::new(&GpuOptions::default()).expect("tests need a GPU adapter (lavapipe on CI)");
+        let scene = crate::scene::cornell_box();
+        // 128 × 64: the coarsest preview is 4 × 2 pixels, two rows.
+        let s = RenderSettings { width: 128, height: 64, ..settings() };
+        let mut view = Interactive::new(Box::new(Renderer::new(&gpu, &scene, s).unwrap()), Show::Full, 0.0);
+        view.set_frame_budget(1e-6);
+        let mut camera = view.renderer().camera();
+        for frame in 0..4 {
+            camera.eye += glam::Vec3::new(0.02, 0.0, 0.0);
+            view.set_camera(camera).unwrap();
+            view.frame(u32::MAX).unwrap();
+            assert!(view.refine().blend().is_some(), "frame {frame} of the move finished no preview iteration");
+        }
+    }
 }

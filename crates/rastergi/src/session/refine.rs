@@ -279,6 +279,12 @@ impl Refine {
         // preview level; a tenth of the window's); after the frame's first unit, none where
         // not one fits: the frame is done (a unit's fixed cost would overrun it).
         let rows = match self.cost_at(k) {
+            // While moving, a preview's iteration is drawn whole, even past the budget where
+            // the coarsest level does not fit: the next frame's camera restarts it, so a part
+            // of one would show nothing (the staircase at 1280 × 720 on a slow lavapipe: the
+            // 1/32 preview's iteration took longer than a frame's work, and every frame of the
+            // move was thrown away).
+            _ if self.moving && k > 0 => lh,
             Some(c) => {
                 let fit = ((left - c.fixed) / (c.per_pixel * lw as f64)).floor().max(0.0) as u32;
                 if fit == 0 && self.units > 0 {

@@ -4,8 +4,10 @@
 //! - **While the camera moves** each frame draws one iteration of a *preview* — the same view
 //!   at 1/s of the window's size, s = 2, 4 … [`COARSEST`] (its own film, the photon map
 //!   shared: [`Progressive::iterate_preview_rows`]) — at the finest s whose iteration fits the
-//!   budget by the measured cost per pixel, shown upscaled (bilinear). Where a whole iteration
-//!   of the window fits, the window's own iterations run instead.
+//!   budget by the measured cost per pixel (the coarsest where none fits, drawn whole even
+//!   past the budget: the next frame's camera would restart a part of one), shown upscaled
+//!   (bilinear). Where a whole iteration of the window fits, the window's own iterations run
+//!   instead.
 //! - **When it stops** the previews refine from there where a whole iteration of the window
 //!   takes longer than [`REFINE_ABOVE`]: [`LEVEL_ITERATIONS`] iterations at each level, then the
 //!   next finer one; then (at once, where it takes less) the window's own iterations, which

@@ -366,9 +366,11 @@ impl Budget {
         }
         self.end_pass(gpu, done)?;
         let iterations = self.next_iterations();
-        photons.set_pass_iterations(iterations);
         let began = web_time::Instant::now();
+        // The pass under way ends (it has had its iterations), then the new one gets its
+        // length: set before, a longer length would extend the pass under way instead.
         photons.advance(gpu, scene)?;
+        photons.set_pass_iterations(iterations);
         gpu.wait()?;
         self.begin_pass(gpu, photons, began.elapsed().as_secs_f64());
         Ok(())

@@ -783,6 +783,11 @@ impl Renderer {
         self.photons.as_ref().map(PhotonPasses::guide)
     }
 
+    /// The balanced photon budget, where this render has one.
+    pub fn photon_budget(&self) -> Option<&crate::photons::budget::Budget> {
+        self.budget.as_ref()
+    }
+
     /// The current photon pass (0-based; 0 without a photon map).
     pub fn photon_pass(&self) -> u32 {
         self.photons.as_ref().map_or(0, PhotonPasses::pass)

@@ -94,28 +94,34 @@ fn a_pass_traced_in_steps_is_the_pass_traced_at_once() {
 
 #[test]
 fn the_balanced_budgets_passes_last_as_long_as_it_chose() {
-    // The balanced budget's first three passes last 16, 16 and 32 iterations
-    // (photons::budget: FIRST_ITERATIONS, then twice as many), so new maps begin at iterations
-    // 16, 32 and 64, and each later pass lasts the length the budget logs. A pass chosen longer
-    // than the one under way once extended the one under way instead (the second pass lasted
-    // 32 iterations, the third began at 48), and the measurement of the pair divided 16
-    // iterations' sums by 32: the fit then followed a difference of the passes' means of
-    // 130 % that was 6 %.
+    // The balanced budget's first three passes last 16·s, 16·s and 32·s iterations
+    // (photons::budget: FIRST_ITERATIONS times the start-up's scale s, chosen once the first
+    // pass has had 16, then twice as many), so new maps begin at iterations 16·s, 32·s and
+    // 64·s. A pass chosen longer than the one under way once extended the one under way
+    // instead (the second pass lasted 32 iterations, the third began at 48), and the
+    // measurement of the pair divided 16 iterations' sums by 32: the fit then followed a
+    // difference of the passes' means of 130 % that was 6 %.
     let gpu = common::gpu();
     let scene = rooms(true);
     let s =
         RenderSettings { pass_iterations: 0, photon_budget: rastergi::settings::PhotonBudget::Balanced, ..settings(0) };
     let mut r = Renderer::new(&gpu, &scene, s).unwrap();
     let mut begun = Vec::new();
-    for i in 0..66u32 {
+    let mut i = 0u32;
+    let scale = loop {
+        if let Some(s) = r.photon_budget().unwrap().startup().filter(|_| i >= 64 * 64 || begun.len() == 3) {
+            break s;
+        }
         let pass = r.photon_pass();
         r.iterate().unwrap();
         if r.photon_pass() != pass {
             assert_eq!(r.photon_pass(), pass + 1);
             begun.push(i);
         }
-    }
-    assert_eq!(begun, [16, 32, 64], "the iterations at which new photon passes began");
+        i += 1;
+    };
+    let first = 16 * scale;
+    assert_eq!(begun, [first, 2 * first, 4 * first], "the iterations at which new photon passes began (scale {scale})");
 }
 
 #[test]

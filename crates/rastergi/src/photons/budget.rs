@@ -33,9 +33,16 @@
 //! ```
 //!
 //! linear in the unknowns a and W: they are fitted by least squares to the last [`HISTORY`]
-//! pairs of passes ([`fit`]). For both to be known the passes must differ: the first three
-//! last [`FIRST_ITERATIONS`] (the first with a quarter of the photons), then twice as many, and
-//! after that every [`EXPLORE`]-th pass lasts twice (or half) the chosen length. The costs are
+//! pairs of passes ([`fit`]). For both to be known the passes must differ: the first two
+//! last [`FIRST_ITERATIONS`]·s (the first with a quarter of the photons), the third twice as
+//! many, and after that every [`EXPLORE`]-th pass lasts twice (or half) the chosen length.
+//! The start-up's scale s ([`startup_scale`]) makes each of these passes' iterations cost
+//! about as much as tracing a pass of all the photons (estimated from the first pass's
+//! tracing, timed, and its first [`FIRST_ITERATIONS`] iterations): knowing nothing yet of a
+//! and W, passes whose tracing and iterations cost the same have at most twice the least
+//! variance × time that any length could give ((a/N + W/M)(C + M·c) with M = C/c is
+//! 2(a·C/N + W·c) ≤ 2(√(a·C/N) + √(W·c))²), where passes of a fixed 16 iterations, in a room
+//! whose tracing costs 80 iterations, spend 5/6 of the start-up tracing. The costs are
 //! wall-clock times on this GPU: C from a pass's tracing's start to its end (the GPU waited
 //! for), c per iteration between a pass's start and its end. M* is rounded to a power of two in
 //! [[`MIN_ITERATIONS`], [`MAX_ITERATIONS`]], so that noise in the timings seldom changes it (the
@@ -69,6 +76,8 @@ pub const MAX_ITERATIONS: u32 = 64;
 pub const TRACE_SHARE: f64 = 1.0 / 8.0;
 /// The most iterations a pass lasts however costly its tracing.
 pub const LONGEST_PASS: u32 = 1024;
+/// The largest start-up scale: the third pass lasts at most [`LONGEST_PASS`] iterations.
+pub const MAX_STARTUP_SCALE: u32 = LONGEST_PASS / (2 * FIRST_ITERATIONS);
 /// Pairs of passes the fit uses.
 pub const HISTORY: usize = 8;
 /// Every EXPLORE-th pass after the first three lasts twice (or half) the chosen length.
@@ -167,6 +176,17 @@ pub fn balanced_iterations(
     }
     let m = 2f64.powi(m.log2().round() as i32);
     (m.clamp(MIN_ITERATIONS as f64, longest as f64)) as u32
+}
+
+/// The start-up's scale s: the power of two (nearest in log scale, in [1,
+/// [`MAX_STARTUP_SCALE`]]) at which [`FIRST_ITERATIONS`]·s iterations of `iteration_seconds`
+/// cost as much as tracing a pass, `pass_seconds`.
+pub fn startup_scale(pass_seconds: f64, iteration_seconds: f64) -> u32 {
+    let s = pass_seconds / (FIRST_ITERATIONS as f64 * iteration_seconds);
+    if !(s.is_finite() && s > 1.0) {
+        return 1;
+    }
+    (2f64.powi(s.log2().round() as i32) as u32).clamp(1, MAX_STARTUP_SCALE)
 }
 
 /// The ceiling of a balanced pass's iterations: [`MAX_ITERATIONS`] (the cells keep shrinking:
@@ -295,6 +315,9 @@ pub struct Budget {
     passes: u32,
     /// The length chosen for the passes that do not explore.
     chosen: u32,
+    /// The start-up's scale ([`startup_scale`]), once the first pass has had
+    /// [`FIRST_ITERATIONS`] (1 until then, and where the first pass was not timed).
+    scale: Option<u32>,
 }
 
 impl Budget {
@@ -320,6 +343,7 @@ impl Budget {
             light_samples: None,
             passes: 1,
             chosen: FIRST_ITERATIONS,
+            scale: None,
         }
     }
 
@@ -346,6 +370,12 @@ impl Budget {
         &self.pairs
     }
 
+    /// The start-up's scale ([`startup_scale`]), once the first pass has had
+    /// [`FIRST_ITERATIONS`] iterations.
+    pub fn startup(&self) -> Option<u32> {
+        self.scale
+    }
+
     /// The iterations of the passes that do not explore, as chosen so far.
     pub fn chosen(&self) -> u32 {
         self.chosen
@@ -356,6 +386,9 @@ impl Budget {
     /// is measured first and the next pass lasts as long as the measurements say.
     pub fn advance(&mut self, gpu: &Gpu, scene: &GpuScene, photons: &mut PhotonPasses) -> Result<()> {
         let done = photons.iterations_in_pass();
+        if photons.pass_ends() && self.scale.is_none() {
+            self.scale_startup(gpu, photons, done)?;
+        }
         // Traced in steps, the next pass begins in `pass_traced`, once it is all traced.
         if !photons.pass_ends() || photons.stepped() {
             if done == 0 {
@@ -373,6 +406,33 @@ impl Budget {
         photons.set_pass_iterations(iterations);
         gpu.wait()?;
         self.begin_pass(gpu, photons, began.elapsed().as_secs_f64());
+        Ok(())
+    }
+
+    /// The first pass has had its [`FIRST_ITERATIONS`]: the start-up's scale s from their cost
+    /// and the first pass's tracing, the first pass lengthened to `FIRST_ITERATIONS`·s (the
+    /// next two follow in [`next_iterations`](Self::next_iterations)). Where the first pass was
+    /// not measured from its start (a resumed render, a camera move) or not timed, s = 1.
+    fn scale_startup(&mut self, gpu: &Gpu, photons: &mut PhotonPasses, done: u32) -> Result<()> {
+        let mut scale = 1;
+        if let (true, 0, Some(first)) =
+            (self.current.measured && done > 0, photons.pass(), photons.first_pass_seconds())
+        {
+            gpu.wait()?;
+            let iteration = self.current.started.elapsed().as_secs_f64() / done as f64;
+            let pass = first * photons.next_pass_photons() as f64 / photons.pass_photons().max(1) as f64;
+            scale = startup_scale(pass, iteration);
+            log::info!(
+                "photon budget: start-up passes of {} iterations (a pass's tracing estimated at {:.0} ms, an iteration {:.1} ms)",
+                FIRST_ITERATIONS * scale,
+                pass * 1e3,
+                iteration * 1e3
+            );
+        }
+        self.scale = Some(scale);
+        if scale > 1 {
+            photons.set_pass_iterations(FIRST_ITERATIONS * scale);
+        }
         Ok(())
     }
 
@@ -450,11 +510,12 @@ impl Budget {
     /// length, twice or half of it every [`EXPLORE`]-th pass.
     fn next_iterations(&mut self) -> u32 {
         let k = self.passes;
+        let first = FIRST_ITERATIONS * self.scale.unwrap_or(1);
         if k < 2 {
-            return FIRST_ITERATIONS;
+            return first;
         }
         if k == 2 {
-            return 2 * FIRST_ITERATIONS;
+            return 2 * first;
         }
         let mean = |v: &[f64]| (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64);
         if let (Some(v), Some(cost), Some(c)) =
@@ -534,6 +595,31 @@ mod tests {
         }
         assert_eq!(balanced_iterations(0.0, 1.0, 1.0, 1.0), MAX_ITERATIONS);
         assert_eq!(balanced_iterations(1.0, 0.0, 1.0, 1.0), MIN_ITERATIONS);
+    }
+
+    /// The start-up's length: tracing a pass and its iterations cost alike, which is never
+    /// worse than twice the least variance × time of any length, for any split of the variance
+    /// between the map and the iterations; rounded to a power of two (within √2 of it), never
+    /// worse than 1 + √2 times (brute force). Where tracing costs less than 16 iterations, the
+    /// start-up's 16 stay (as before the scale).
+    #[test]
+    fn the_startups_passes_cost_their_tracing_and_are_never_far_from_the_best() {
+        assert_eq!(startup_scale(2.37, 0.03), 4); // `rooms`: 79 iterations' worth, 4.9 × 16
+        assert_eq!(startup_scale(0.05, 0.01), 1);
+        assert_eq!(startup_scale(0.24, 0.01), 2); // 1.5 × 16: log-nearest is 2 (√2 the boundary)
+        assert_eq!(startup_scale(f64::NAN, 0.01), 1);
+        assert_eq!(startup_scale(1.0, 0.0), 1);
+        assert_eq!(startup_scale(1e3, 1e-3), MAX_STARTUP_SCALE);
+        for (c_pass, c_it) in [(2.37, 0.03), (0.24, 0.01), (0.6, 0.002), (0.7, 0.03)] {
+            let m = (FIRST_ITERATIONS * startup_scale(c_pass, c_it)) as f64;
+            for (v_map, w) in [(1.0, 0.0), (0.0, 1.0), (1.0, 1.0), (1e-3, 1.0), (1.0, 1e-3), (0.2, 30.0)] {
+                let cost = |m: f64| (v_map + w / m) * (c_pass + m * c_it);
+                let best = (1..=200_000).map(|i| cost(i as f64 * 0.01)).fold(f64::INFINITY, f64::min);
+                let at = |m: f64| format!("{c_pass} s, {c_it} s, V {v_map}, W {w}: {m} iterations");
+                assert!(cost(c_pass / c_it) <= 2.0 * best * (1.0 + 1e-9), "{}", at(c_pass / c_it));
+                assert!(cost(m) <= (1.0 + std::f64::consts::SQRT_2) * best, "{}", at(m));
+            }
+        }
     }
 
     /// Where the map's variance calls for long passes, the ceiling keeps tracing to at most

@@ -104,6 +104,9 @@ pub struct PhotonPasses {
     stepped: bool,
     /// The next pass, while it is traced in steps.
     pending: Option<Pending>,
+    /// Seconds the first pass's tracing took (the GPU waited for), where it was timed: of
+    /// several passes, where the GPU can be waited for ([`crate::gpu::READ_BACK_BLOCKS`]).
+    first_seconds: Option<f64>,
 }
 
 /// The next pass traced a step at a time ([`PhotonPasses::trace_step`]) while the iterations
@@ -142,7 +145,19 @@ impl PhotonPasses {
         let lights = super::guide::guided_lights(&prepared.lights);
         let guide = PhotonGuide::new(gpu, layout.grid, &lights, settings.guided && passes != 1, field);
         let mut map = GpuPhotonMap::with_layout(gpu, scene, &prepared, &settings, layout, &guide)?;
+        // Timed for the photon budget's start-up ([`super::budget::startup_scale`]).
+        let timed = passes != 1 && crate::gpu::READ_BACK_BLOCKS;
+        if timed {
+            gpu.wait()?;
+        }
+        let began = web_time::Instant::now();
         map.trace_photons(gpu, scene, 0, first);
+        let first_seconds = if timed {
+            gpu.wait()?;
+            Some(began.elapsed().as_secs_f64())
+        } else {
+            None
+        };
         if passes == 1 {
             // One fixed map: rendering reads the lookup values alone.
             map.release_build_buffers();
@@ -159,6 +174,7 @@ impl PhotonPasses {
             guide,
             stepped: false,
             pending: None,
+            first_seconds,
         })
     }
 
@@ -236,6 +252,11 @@ impl PhotonPasses {
     /// The photons of the current pass (the first of several has a quarter of them).
     pub fn pass_photons(&self) -> u32 {
         if self.pass == 0 && self.passes != 1 { first_pass_photons(self.settings.count) } else { self.settings.count }
+    }
+
+    /// Seconds the first pass's tracing took, where it was timed.
+    pub fn first_pass_seconds(&self) -> Option<f64> {
+        self.first_seconds
     }
 
     /// The photons of the pass after the current one.

@@ -81,6 +81,7 @@ pub fn source() -> String {
         shader::BVH,
         &crate::passes::frame::wgsl(),
         crate::passes::FILM,
+        crate::passes::EYE_RAY,
         include_str!("path_tracer.wgsl"),
     ])
 }

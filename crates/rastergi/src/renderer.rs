@@ -25,7 +25,7 @@ use crate::photons::passes::{PhotonPasses, fitted_pass_iterations};
 use crate::photons::{PhotonSettings, SampledDirect};
 use crate::progressive::{Denoising, Progressive};
 use crate::scene::{Camera, Scene};
-use crate::settings::{PhotonBudget, PhotonRegionChoice, RenderSettings, TextureFilter};
+use crate::settings::{EyeMethod, PhotonBudget, PhotonRegionChoice, RenderSettings, TextureFilter};
 use crate::surface::PreparedScene;
 
 /// Fixed values for one iteration's random choices, so tests can compare the passes with
@@ -87,12 +87,18 @@ impl ImagePasses {
         frame: &FrameBinding,
         map: Option<&GpuPhotonMap>,
         settings: &RenderSettings,
-        detail_bundle: u32,
+        (detail_bundle, preview): (u32, bool),
         sampler: DirectionSampler,
     ) -> Result<ImagePasses> {
         let (width, height) = (settings.width, settings.height);
         let film = Film::new(gpu, width, height)?;
-        let gbuffer = GBufferPass::new(gpu, scene, frame, width, height);
+        // The window's image rasterizes where the way is not given: its many pixels make the
+        // triangles' cost a small part (a preview times both ways: `new_preview`).
+        let eye = match settings.eye_pass {
+            EyeMethod::Auto if !preview => EyeMethod::Raster,
+            m => m,
+        };
+        let gbuffer = GBufferPass::new(gpu, scene, frame, (width, height), eye);
         let specular = scene.eye_chains.then(|| crate::passes::specular::pass(gpu, scene, frame, &gbuffer, &film));
         let emitter_edges = (settings.emitter_edges > 0).then(|| EmitterEdges::new(gpu, scene, frame, &gbuffer, &film));
         // The guides' tables: the guided sky's for the direct pass's environment samples, and
@@ -285,7 +291,7 @@ impl Renderer {
         let mut photons = photons;
         let map = photons.as_ref().map(PhotonPasses::map);
         let sampler = DirectionSampler::new(settings.seed);
-        let passes = ImagePasses::new(gpu, &gpu_scene, &frame, map, &settings, detail_bundle, sampler)?;
+        let passes = ImagePasses::new(gpu, &gpu_scene, &frame, map, &settings, (detail_bundle, false), sampler)?;
         let budget = new_budget(gpu, &settings, &passes.film, photons.as_mut(), true);
         let light_budget = settings.light_balance.then(LightBudget::new);
         Ok(Renderer {
@@ -324,7 +330,7 @@ impl Renderer {
             &self.frame,
             self.photons.as_ref().map(PhotonPasses::map),
             &settings,
-            self.detail_bundle,
+            (self.detail_bundle, false),
             sampler,
         )?;
         self.budget = new_budget(&self.gpu, &settings, &self.passes.film, self.photons.as_mut(), false);
@@ -551,7 +557,7 @@ impl Renderer {
         let map = self.photons.as_ref().map(PhotonPasses::map);
         let sampler = DirectionSampler::new(settings.seed);
         let passes =
-            ImagePasses::new(&self.gpu, &self.scene, &self.frame, map, &settings, self.detail_bundle, sampler)?;
+            ImagePasses::new(&self.gpu, &self.scene, &self.frame, map, &settings, (self.detail_bundle, true), sampler)?;
         Ok(Preview { scale, passes, band: None })
     }
 
@@ -945,7 +951,9 @@ impl Band {
             if let Some(build) = p.guide_build.as_ref().filter(|_| self.uniforms.iteration.is_power_of_two()) {
                 build.encode(&mut enc, t.gpu.profiler.as_ref());
             }
-            p.gbuffer.encode(&mut enc, &ctx)?;
+            if !p.gbuffer.timed(&ctx)? {
+                p.gbuffer.encode(&mut enc, &ctx)?;
+            }
         }
         if let Some(specular) = &mut p.specular {
             specular.encode(&mut enc, &ctx)?;

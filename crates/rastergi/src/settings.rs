@@ -72,6 +72,22 @@ pub struct RenderSettings {
     /// How the eye's visible points read textures: filtered over the pixel's footprint, or
     /// level 0 bilinearly as reference renderers do.
     pub texture_filter: TextureFilter,
+    /// How the eye pass finds the visible points: rasterized, ray-cast, or (`Auto`) rasterized
+    /// for the image and measured both ways for each of a viewer's coarse previews.
+    pub eye_pass: EyeMethod,
+}
+
+/// How the eye pass finds each pixel's visible point (the G-buffer, `passes::gbuffer`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum EyeMethod {
+    /// The image rasterized; each coarse preview of a viewer ([`crate::session::refine`])
+    /// times a G-buffer each way (where the GPU can be waited for) and keeps the faster.
+    #[default]
+    Auto,
+    /// Every triangle drawn: its cost is mostly the triangles', whatever the pixels.
+    Raster,
+    /// A camera ray per pixel through the BVH: its cost is the pixels'.
+    Trace,
 }
 
 /// How the eye's visible points (the G-buffer's, and the path tracer's first hits) read
@@ -141,6 +157,7 @@ impl RenderSettings {
             ("hit-light", format!("{:?}", s.hit_light)),
             ("photon-region", format!("{:?}", s.photon_region)),
             ("texture-filter", format!("{:?}", s.texture_filter)),
+            ("eye-pass", format!("{:?}", s.eye_pass)),
         ]
         .into_iter()
         .map(|(k, v)| (k.to_owned(), v))
@@ -180,6 +197,7 @@ impl Default for RenderSettings {
             hit_light: HitLight::Punctual,
             photon_region: PhotonRegionChoice::Camera,
             texture_filter: TextureFilter::Footprint,
+            eye_pass: EyeMethod::Auto,
         }
     }
 }

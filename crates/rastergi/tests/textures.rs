@@ -99,11 +99,16 @@ fn gbuffer_level_of_detail_is_a_pixels_footprint_in_texels() {
     // coordinates change by repeats/2 per world unit, and a coordinate spans 64 texels, so a
     // pixel covers ρ = 64 · repeats/2 · 2·d·tan(fov/2)/H texels: λ = log2 ρ. The square faces
     // the camera, so ρ is the same at every pixel.
+    // The same with the eye pass ray-cast (`EyeMethod::Trace`), whose λ comes from ray
+    // differentials instead of the rasterizer's screen-space derivatives.
     let gpu = common::gpu();
     let size = 64;
-    for (repeats, distance) in [(8.0f32, 3.0f32), (8.0, 1.5), (1.0, 3.0), (64.0, 3.0)] {
+    let eyes = [rastergi::settings::EyeMethod::Raster, rastergi::settings::EyeMethod::Trace];
+    for ((repeats, distance), eye_pass) in
+        [(8.0f32, 3.0f32), (8.0, 1.5), (1.0, 3.0), (64.0, 3.0)].into_iter().flat_map(|c| eyes.map(|e| (c, e)))
+    {
         let scene = frontal_square(repeats, distance);
-        let settings = RenderSettings { width: size, height: size, photons: 0, ..Default::default() };
+        let settings = RenderSettings { width: size, height: size, photons: 0, eye_pass, ..Default::default() };
         let mut r = Renderer::new(&gpu, &scene, settings).unwrap();
         r.iterate().unwrap();
         let rho = 64.0 * repeats / 2.0 * 2.0 * distance * 20f32.to_radians().tan() / size as f32;
@@ -112,7 +117,7 @@ fn gbuffer_level_of_detail_is_a_pixels_footprint_in_texels() {
             r.read_gbuffer().unwrap().iter().filter(|g| g[0] != 0).map(|g| f32::from_bits(g[3])).collect();
         assert!(lods.len() > 1000, "the square covers too few pixels");
         let worst = lods.iter().map(|l| (l - expected).abs()).fold(0.0, f32::max);
-        println!("repeats {repeats}, distance {distance}: expected λ {expected:.3}, largest error {worst:.2e}");
+        println!("{eye_pass:?}: repeats {repeats}, distance {distance}: expected λ {expected:.3}, largest error {worst:.2e}");
         assert!(worst < 0.01, "λ differs from log2 of the footprint {expected} by {worst}");
     }
 }

@@ -21,6 +21,8 @@ pub enum Kind {
     UintTexture,
     /// `texture_2d<f32>` read texel by texel with `textureLoad` (tables, the texture atlas).
     FloatTexture,
+    /// `texture_storage_2d<rgba32uint, write>` (the ray-cast G-buffer).
+    UintStorageTexture,
     /// `acceleration_structure` (hardware ray queries).
     Tlas,
 }
@@ -66,6 +68,11 @@ impl Slot {
         Slot::new(binding, name, Kind::FloatTexture)
     }
 
+    /// A 2D `rgba32uint` texture that the pass writes (`textureStore`).
+    pub const fn uint_storage_texture(binding: u32, name: &'static str) -> Slot {
+        Slot::new(binding, name, Kind::UintStorageTexture)
+    }
+
     /// A top-level acceleration structure.
     pub const fn tlas(binding: u32, name: &'static str) -> Slot {
         Slot::new(binding, name, Kind::Tlas)
@@ -78,7 +85,7 @@ impl Slot {
 
     /// Whether the pass writes it.
     pub fn writes(&self) -> bool {
-        matches!(self.kind, Kind::Storage { write: true, .. })
+        matches!(self.kind, Kind::Storage { write: true, .. } | Kind::UintStorageTexture)
     }
 
     fn entry(&self, stages: ShaderStages) -> wgpu::BindGroupLayoutEntry {
@@ -99,6 +106,11 @@ impl Slot {
             Kind::Storage { write, size } => buffer(wgpu::BufferBindingType::Storage { read_only: !write }, size),
             Kind::UintTexture => texture(wgpu::TextureSampleType::Uint),
             Kind::FloatTexture => texture(wgpu::TextureSampleType::Float { filterable: false }),
+            Kind::UintStorageTexture => wgpu::BindingType::StorageTexture {
+                access: wgpu::StorageTextureAccess::WriteOnly,
+                format: wgpu::TextureFormat::Rgba32Uint,
+                view_dimension: wgpu::TextureViewDimension::D2,
+            },
             Kind::Tlas => wgpu::BindingType::AccelerationStructure { vertex_return: false },
         };
         wgpu::BindGroupLayoutEntry { binding: self.binding, visibility: self.stages.unwrap_or(stages), ty, count: None }

@@ -89,6 +89,7 @@ fn shaders() -> Vec<(&'static str, String)> {
     use crate::gather::estimator::{RAY_VIEW_LOOKUP, estimate_source};
     vec![
         ("gbuffer", crate::passes::gbuffer::source()),
+        ("gbuffer trace", crate::passes::gbuffer::trace_source()),
         ("direct", crate::passes::direct::source()),
         ("direct with photon map", crate::passes::direct::source_with_map()),
         ("gather guide build", crate::gather::guide::build_source()),
@@ -227,6 +228,7 @@ fn every_tracing_shader_composes_and_validates_for_hardware_ray_queries() {
     // Every pass that casts rays (the G-buffer's raster shader holds the prelude too).
     let expected = [
         "gbuffer",
+        "gbuffer trace",
         "direct",
         "direct with photon map",
         "specular chains",
@@ -310,6 +312,7 @@ fn declared_groups(label: &str) -> Vec<Vec<Group>> {
     let estimate = |own: Group| vec![scene(), vec![frame::group()], vec![own], lookup()];
     match label {
         "gbuffer" => vec![scene(), vec![frame::group()]],
+        "gbuffer trace" => vec![scene(), vec![frame::group()], vec![gbuffer::trace_group()]],
         "direct" | "specular chains" => per_pixel(),
         "photon view" | "direct with photon map" => [per_pixel(), vec![lookup()]].concat(),
         "gather guide build" => vec![vec![gather::guide::build_group()]],
@@ -358,6 +361,14 @@ fn wgsl_kind(module: &naga::Module, layouter: &naga::proc::Layouter, var: &naga:
             ScalarKind::Float => Some(Kind::FloatTexture),
             _ => None,
         },
+        (
+            AddressSpace::Handle,
+            TypeInner::Image {
+                dim: ImageDimension::D2,
+                arrayed: false,
+                class: ImageClass::Storage { format: naga::StorageFormat::Rgba32Uint, access },
+            },
+        ) if *access == naga::StorageAccess::STORE => Some(Kind::UintStorageTexture),
         (AddressSpace::Handle, TypeInner::AccelerationStructure { .. }) => Some(Kind::Tlas),
         _ => None,
     }

@@ -36,6 +36,8 @@ use crate::photons::gpu::GpuPhotonMap;
 pub const VISIBLE_POINT: &str = include_str!("visible_point.wgsl");
 /// Film writes by component (`film_add`), for passes that bind `film`.
 pub const FILM: &str = include_str!("film.wgsl");
+/// The camera ray's texture footprint (ray differentials) where the visible point is traced.
+pub const EYE_RAY: &str = include_str!("eye_ray.wgsl");
 
 /// The common prelude of every pass that reads the scene (its bind group 0) and the frame
 /// (bind group 1, [`frame::wgsl`]), then `pass`.

@@ -186,6 +186,27 @@ impl TextureFilterArg {
     }
 }
 
+/// How the eye pass finds the visible points.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
+pub enum EyeArg {
+    /// The image rasterized; the viewer's previews timed both ways, the faster kept.
+    Auto,
+    /// Every triangle drawn.
+    Raster,
+    /// A camera ray per pixel.
+    Trace,
+}
+
+impl EyeArg {
+    pub fn method(self) -> crate::settings::EyeMethod {
+        match self {
+            EyeArg::Auto => crate::settings::EyeMethod::Auto,
+            EyeArg::Raster => crate::settings::EyeMethod::Raster,
+            EyeArg::Trace => crate::settings::EyeMethod::Trace,
+        }
+    }
+}
+
 impl PhotonRegionArg {
     pub fn choice(self) -> PhotonRegionChoice {
         match self {
@@ -413,6 +434,12 @@ pub struct SceneArgs {
     /// do: for comparisons with them).
     #[arg(long, value_enum, default_value_t = TextureFilterArg::Footprint)]
     pub texture_filter: TextureFilterArg,
+    /// How the eye pass finds each pixel's visible point: `raster` draws every triangle,
+    /// `trace` casts a camera ray per pixel into the BVH (cheaper where the pixels are few and
+    /// the triangles many), `auto` rasterizes the image and times both ways for each of the
+    /// viewer's coarse previews.
+    #[arg(long, value_enum, default_value_t = EyeArg::Auto)]
+    pub eye_pass: EyeArg,
     /// What the image shows.
     #[arg(long, value_enum, default_value_t = ShowArg::Full)]
     pub show: ShowArg,
@@ -470,6 +497,7 @@ impl SceneArgs {
             hit_light: self.hit_light.hit_light(),
             photon_region: self.photon_region.choice(),
             texture_filter: self.texture_filter.filter(),
+            eye_pass: self.eye_pass.method(),
             show: self.show.show(),
             method,
             denoiser,

@@ -140,6 +140,8 @@ pub struct Options {
     pub hit_light: HitLight,
     pub photon_region: PhotonRegionChoice,
     pub texture_filter: TextureFilter,
+    /// How the eye pass finds the visible points ([`crate::settings::EyeMethod`]).
+    pub eye_pass: crate::settings::EyeMethod,
     /// What the image shows ([`Show::PhotonMap`] keeps the photon map's view).
     pub show: Show,
     pub method: Method,
@@ -189,6 +191,7 @@ impl Default for Options {
             hit_light: HitLight::Punctual,
             photon_region: PhotonRegionChoice::Camera,
             texture_filter: TextureFilter::Footprint,
+            eye_pass: crate::settings::EyeMethod::Auto,
             show: Show::Full,
             method: Method::Gather,
             denoiser: false,
@@ -350,6 +353,7 @@ impl Options {
             hit_light: self.hit_light,
             photon_region: self.photon_region,
             texture_filter: self.texture_filter,
+            eye_pass: self.eye_pass,
         }
     }
 }

@@ -61,6 +61,7 @@ fn given_flags_are_the_settings() {
         hit_light: HitLight::Exact,
         photon_region: PhotonRegionChoice::Scene,
         texture_filter: TextureFilter::Bilinear,
+        eye_pass: crate::settings::EyeMethod::Trace,
         show: Show::PhotonMap,
         ..Options::default()
     };
@@ -89,6 +90,7 @@ fn given_flags_are_the_settings() {
         hit_light: HitLight::Exact,
         photon_region: PhotonRegionChoice::Scene,
         texture_filter: TextureFilter::Bilinear,
+        eye_pass: crate::settings::EyeMethod::Trace,
     };
     assert_eq!(session.settings, expected);
     assert_eq!(

@@ -117,7 +117,9 @@ fn gbuffer_level_of_detail_is_a_pixels_footprint_in_texels() {
             r.read_gbuffer().unwrap().iter().filter(|g| g[0] != 0).map(|g| f32::from_bits(g[3])).collect();
         assert!(lods.len() > 1000, "the square covers too few pixels");
         let worst = lods.iter().map(|l| (l - expected).abs()).fold(0.0, f32::max);
-        println!("{eye_pass:?}: repeats {repeats}, distance {distance}: expected λ {expected:.3}, largest error {worst:.2e}");
+        println!(
+            "{eye_pass:?}: repeats {repeats}, distance {distance}: expected λ {expected:.3}, largest error {worst:.2e}"
+        );
         assert!(worst < 0.01, "λ differs from log2 of the footprint {expected} by {worst}");
     }
 }

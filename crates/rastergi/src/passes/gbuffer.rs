@@ -118,8 +118,13 @@ impl GBufferPass {
             let module = scene.module(device, "gbuffer trace", &trace_source(), crate::gpu_scene::RayUse::Eye);
             let (layout, bind_group) =
                 trace_group().layout_and_bind(device, &[("visibility", wgpu::BindingResource::TextureView(&view))]);
-            let pipeline =
-                scene.compute_pipeline(device, "gbuffer trace", &module, "main", &[&scene.layout, &frame.layout, &layout]);
+            let pipeline = scene.compute_pipeline(
+                device,
+                "gbuffer trace",
+                &module,
+                "main",
+                &[&scene.layout, &frame.layout, &layout],
+            );
             TracedEye { pipeline, bind_group }
         });
         Self { pipeline, texture, view, depth_view, profiler: gpu.profiler.clone(), traced, choice }
@@ -143,7 +148,8 @@ impl GBufferPass {
         let gpu = ctx.gpu;
         gpu.wait()?;
         let began = web_time::Instant::now();
-        let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("gbuffer timed") });
+        let mut enc =
+            gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("gbuffer timed") });
         self.encode_as(&mut enc, ctx, if k == 0 { EyeMethod::Raster } else { EyeMethod::Trace });
         gpu.queue.submit([enc.finish()]);
         gpu.wait()?;

@@ -147,8 +147,17 @@ fn run_variant(
         let t = moving.elapsed().as_secs_f64();
         let began = Instant::now();
         view.set_camera(camera_at(a, &control, diagonal, t))?;
-        frame(&mut view)?;
+        let camera = began.elapsed().as_secs_f64();
+        let (work, drawing) = frame(&mut view)?;
         frames.push(began.elapsed().as_secs_f64());
+        log::debug!(
+            "moving frame {}: {:.1} ms (camera {:.1}, work {:.1}, drawing {:.1})",
+            frames.len(),
+            1e3 * frames.last().unwrap(),
+            1e3 * camera,
+            1e3 * work,
+            1e3 * drawing
+        );
         if t >= a.motion {
             break;
         }

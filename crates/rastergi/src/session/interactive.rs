@@ -104,20 +104,27 @@ impl Interactive {
         };
         // What the view before a move held, re-projected onto this one (once per view; while
         // moving, where it takes at most half the budget); once still, the photon region.
+        let mut reprojected = None;
         if budget > 0.0 {
             self.refit_region()?;
             if self.refine.reprojection_fits() && self.renderer.reproject()? {
                 self.renderer.wait()?;
-                self.refine.reprojected(start.elapsed().as_secs_f64());
+                let seconds = start.elapsed().as_secs_f64();
+                self.refine.reprojected(seconds);
+                reprojected = Some(seconds);
             }
         }
         let mut finished = 0;
+        // (scale, rows or whole, milliseconds) of each unit, for the debug log.
+        let mut units = Vec::new();
         loop {
             let left = budget - start.elapsed().as_secs_f64();
             let began = web_time::Instant::now();
             let Some(work) = self.refine.step(self.renderer.as_mut(), left.max(0.0), limit - finished)? else { break };
             self.renderer.wait()?;
-            self.refine.finished(&work, began.elapsed().as_secs_f64());
+            let seconds = began.elapsed().as_secs_f64();
+            self.refine.finished(&work, seconds);
+            units.push((work.scale, work.finished, (seconds * 1e4).round() / 10.0));
             finished += u32::from(work.scale == 1 && work.finished);
             if self.refine.frame_done(&work) || start.elapsed().as_secs_f64() >= budget || finished >= limit {
                 break;
@@ -125,6 +132,13 @@ impl Interactive {
         }
         self.refine.end_frame();
         self.work_ended = Some(web_time::Instant::now());
+        log::debug!(
+            "frame: work {:.1} ms of {:.1} (rest {:.1}); re-projection {:?} ms; units (scale, finished, ms) {units:?}",
+            start.elapsed().as_secs_f64() * 1e3,
+            budget * 1e3,
+            self.rest * 1e3,
+            reprojected.map(|s| (s * 1e4).round() / 10.0)
+        );
         Ok(finished)
     }
 

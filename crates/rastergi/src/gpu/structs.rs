@@ -83,7 +83,7 @@ pub trait GpuStruct: bytemuck::Pod {
 /// `Clone, Copy, Debug, Pod, Zeroable` (and what its own attributes add), and its
 /// [`GpuStruct`] and [`WgslType`] impls.
 ///
-/// ```ignore
+/// ```text
 /// gpu_struct! {
 ///     /// `Resolve` in `resolve.wgsl`.
 ///     pub(crate) struct ResolveUniforms as "Resolve" {

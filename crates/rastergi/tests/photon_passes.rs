@@ -92,6 +92,11 @@ fn a_pass_traced_in_steps_is_the_pass_traced_at_once() {
     }
 }
 
+/// Unlimited passes whose lengths the balanced photon budget chooses.
+fn balanced() -> RenderSettings {
+    RenderSettings { pass_iterations: 0, photon_budget: rastergi::settings::PhotonBudget::Balanced, ..settings(0) }
+}
+
 #[test]
 fn the_balanced_budgets_passes_last_as_long_as_it_chose() {
     // The balanced budget's first three passes last 16·s, 16·s and 32·s iterations
@@ -103,9 +108,7 @@ fn the_balanced_budgets_passes_last_as_long_as_it_chose() {
     // difference of the passes' means of 130 % that was 6 %.
     let gpu = common::gpu();
     let scene = rooms(true);
-    let s =
-        RenderSettings { pass_iterations: 0, photon_budget: rastergi::settings::PhotonBudget::Balanced, ..settings(0) };
-    let mut r = Renderer::new(&gpu, &scene, s).unwrap();
+    let mut r = Renderer::new(&gpu, &scene, balanced()).unwrap();
     let mut begun = Vec::new();
     let mut i = 0u32;
     let scale = loop {
@@ -130,9 +133,7 @@ fn the_balanced_budget_goes_on_with_passes_traced_in_steps() {
     // it measured, and a pass traced in steps ends when its successor is all traced.
     let gpu = common::gpu();
     let scene = rooms(true);
-    let s =
-        RenderSettings { pass_iterations: 0, photon_budget: rastergi::settings::PhotonBudget::Balanced, ..settings(0) };
-    let mut r = Renderer::new(&gpu, &scene, s).unwrap();
+    let mut r = Renderer::new(&gpu, &scene, balanced()).unwrap();
     r.set_photon_steps(true);
     let (mut passes, mut iterations) = (0, 0);
     while passes < 3 {

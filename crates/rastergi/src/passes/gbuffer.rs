@@ -1,15 +1,17 @@
 //! Eye pass: rasterizes the scene from the camera (jittered per iteration) into a visibility
-//! G-buffer — or casts a camera ray per pixel into the BVH for the same texels
-//! (`gbuffer_trace.wgsl`, [`EyeMethod::Trace`]), which is cheaper where the pixels are few and
-//! the triangles many: drawing the staircase's 262 k triangles took 31.6 ms of lavapipe's time
-//! for a 40 × 23 preview, 70 % of its iteration, where 920 rays take about 1 ms. A viewer's
-//! previews measure both ([`EyeMethod::Auto`]: two G-buffers each way, each alone on the GPU,
-//! the faster kept by the least of its times). Each pixel stores `(triangle + 1, b1, b2, λ)` — 0 where nothing is seen — from
+//! G-buffer. Each pixel stores `(triangle + 1, b1, b2, λ)` — 0 where nothing is seen — from
 //! which later passes reconstruct the visible point exactly (`surface_at` in WGSL): position
 //! by barycentric interpolation, geometric normal, material. λ is the albedo texture's level
 //! of detail over the pixel's footprint, log2 of the texture coordinates' screen-space change
 //! in texels (`texture_lod`), so that the passes read the texture filtered like a fragment
 //! shader would.
+//!
+//! The same texels can be found by casting a camera ray per pixel into the BVH instead
+//! (`gbuffer_trace.wgsl`, [`EyeMethod::Trace`]; λ by ray differentials), which is cheaper where
+//! the pixels are few and the triangles many: drawing the staircase's 262 k triangles took
+//! 31.6 ms of lavapipe's time for a 40 × 23 preview, 70 % of its iteration, where 920 rays take
+//! about 1 ms. A viewer's previews measure both ([`EyeMethod::Auto`]: [`EYE_TRIALS`]
+//! G-buffers each way, each alone on the GPU, the faster kept by the least of its times).
 
 use crate::error::Result;
 use crate::gpu::binding::{Group, Slot};
@@ -78,6 +80,13 @@ impl GBufferPass {
         method: EyeMethod,
     ) -> Self {
         let device = &gpu.device;
+        let choice = match method {
+            EyeMethod::Auto if crate::gpu::READ_BACK_BLOCKS => EyeChoice::Timing([Vec::new(), Vec::new()]),
+            EyeMethod::Auto | EyeMethod::Raster => EyeChoice::Fixed(EyeMethod::Raster),
+            EyeMethod::Trace => EyeChoice::Fixed(EyeMethod::Trace),
+        };
+        // The ray-cast pass and the texture's storage use, only where it may trace.
+        let traces = choice != EyeChoice::Fixed(EyeMethod::Raster);
         let module = shader::module(device, "gbuffer", &source());
         let layouts = [&scene.layout, &frame.layout];
         // Reversed Z: the nearest surface has the largest depth.
@@ -93,8 +102,8 @@ impl GBufferPass {
             format: FORMAT,
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT
                 | wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::STORAGE_BINDING
-                | wgpu::TextureUsages::COPY_SRC,
+                | wgpu::TextureUsages::COPY_SRC
+                | if traces { wgpu::TextureUsages::STORAGE_BINDING } else { wgpu::TextureUsages::empty() },
             view_formats: &[],
         });
         let depth = device.create_texture(&wgpu::TextureDescriptor {
@@ -109,12 +118,7 @@ impl GBufferPass {
         });
         let view = texture.create_view(&Default::default());
         let depth_view = depth.create_view(&Default::default());
-        let choice = match method {
-            EyeMethod::Auto if crate::gpu::READ_BACK_BLOCKS => EyeChoice::Timing([Vec::new(), Vec::new()]),
-            EyeMethod::Auto | EyeMethod::Raster => EyeChoice::Fixed(EyeMethod::Raster),
-            EyeMethod::Trace => EyeChoice::Fixed(EyeMethod::Trace),
-        };
-        let traced = (choice != EyeChoice::Fixed(EyeMethod::Raster)).then(|| {
+        let traced = traces.then(|| {
             let module = scene.module(device, "gbuffer trace", &trace_source(), crate::gpu_scene::RayUse::Eye);
             let (layout, bind_group) =
                 trace_group().layout_and_bind(device, &[("visibility", wgpu::BindingResource::TextureView(&view))]);
@@ -203,8 +207,8 @@ impl GBufferPass {
 }
 
 impl IterationPass for GBufferPass {
-    /// Reads: scene, frame. Writes: the G-buffer.
-    /// Rasterized (or traced, where that was chosen) whole, whatever the band's rows.
+    /// Reads: scene, frame. Writes: the G-buffer, whole whatever the band's rows: rasterized,
+    /// or traced where that was chosen.
     fn encode(&mut self, enc: &mut wgpu::CommandEncoder, ctx: &FrameContext) -> Result<()> {
         self.encode_as(enc, ctx, self.method());
         Ok(())

@@ -73,6 +73,9 @@ pub struct Viewer {
     /// Units of work the GPU has finished since the last frame, with their seconds from
     /// submission.
     done: Arc<Mutex<Vec<(Work, f64)>>>,
+    /// The seconds from the submission of a frame that ran the denoiser's filter to its end on
+    /// the GPU (with whatever was queued before it: an over-estimate that spaces filters more).
+    filter_took: Arc<Mutex<Option<f64>>>,
 }
 
 /// Opens the browser's WebGPU adapter for `canvas` and shows the Cornell box at
@@ -132,6 +135,7 @@ pub async fn create_viewer(
         options,
         in_flight: Arc::new(AtomicU32::new(0)),
         done: Arc::new(Mutex::new(Vec::new())),
+        filter_took: Arc::new(Mutex::new(None)),
     })
 }
 
@@ -320,6 +324,9 @@ impl Viewer {
         for (work, seconds) in finished {
             self.view.finished(&work, seconds);
         }
+        if let Some(seconds) = self.filter_took.lock().unwrap_or_else(|e| e.into_inner()).take() {
+            self.view.filter_took(seconds);
+        }
         let samples = self.view.renderer().samples();
         let left = if limit > 0 { limit.saturating_sub(samples) } else { u32::MAX };
         if left > 0 && self.in_flight.load(Ordering::Acquire) < FRAMES_IN_FLIGHT {
@@ -338,7 +345,15 @@ impl Viewer {
         if self.view.display_due() {
             self.view.encode_resolve(&mut enc, now()).map_err(error)?;
         }
+        let (filtered, submitted) = (self.view.filter_encoded(), now());
         self.surface.present(&self.gpu, enc, Some(self.view.renderer().film()), &[]).map_err(error)?;
+        if filtered {
+            // The denoiser's schedule spaces filters by what this one takes.
+            let took = self.filter_took.clone();
+            self.gpu.queue.on_submitted_work_done(move || {
+                *took.lock().unwrap_or_else(|e| e.into_inner()) = Some(now() - submitted);
+            });
+        }
         self.gpu.check().map_err(error)?;
         Ok(self.view.renderer().samples())
     }

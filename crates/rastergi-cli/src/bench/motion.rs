@@ -77,6 +77,10 @@ pub struct MotionArgs {
     /// viewer's default, or a count)
     #[arg(long, default_value = "balanced", value_parser = rastergi::session::args::parse_light_samples)]
     light_samples: LightSamplesArg,
+    /// Show the denoised image (as `view --denoise`): its filter runs on the viewer's schedule,
+    /// and its time counts as drawing.
+    #[arg(long)]
+    denoise: bool,
     #[command(flatten)]
     gpu: GpuArgs,
 }
@@ -120,8 +124,12 @@ fn run_variant(
     renderer.wait()?;
     let mut view = Interactive::new(Box::new(renderer), Show::Full, 0.0);
     view.set_frame_budget(budget);
+    if a.denoise {
+        view.set_denoise(true)?;
+    }
     let mut target = DisplayTarget::offscreen(gpu, settings.width, settings.height)?;
     // A frame: its work, then the resolve and the display pass; returns the seconds of each.
+    let clock = Instant::now();
     let mut frame = |view: &mut Interactive| -> Result<(f64, f64)> {
         let began = Instant::now();
         view.frame(u32::MAX)?;
@@ -129,7 +137,7 @@ fn run_variant(
         // As the viewer: the resolve when due, the display pass every frame.
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         if view.display_due() {
-            view.encode_resolve(&mut enc, 0.0)?;
+            view.encode_resolve(&mut enc, clock.elapsed().as_secs_f64())?;
         }
         target.present(gpu, enc, Some(view.renderer().film()), &[])?;
         gpu.wait()?;
@@ -233,8 +241,14 @@ pub fn run(a: &MotionArgs) -> Result<()> {
         ..Default::default()
     };
     println!(
-        "bench motion: {} at {w}x{h} on {} ({:?}), {photons} photons, grid {grid}; still {} s, then an orbit of {} degrees and a walk, {} s in all, then still",
-        a.window.scene, gpu.info.name, gpu.info.backend, a.still, a.orbit, a.motion
+        "bench motion: {} at {w}x{h} on {} ({:?}), {photons} photons, grid {grid}; still {} s, then an orbit of {} degrees and a walk, {} s in all, then still{}",
+        a.window.scene,
+        gpu.info.name,
+        gpu.info.backend,
+        a.still,
+        a.orbit,
+        a.motion,
+        if a.denoise { "; the denoised image shown" } else { "" }
     );
     // The converged view of the final camera, another seed.
     let control = CameraControl::new(&scene.camera, &scene.bounds());

@@ -123,20 +123,30 @@ pub const EXTRA_SLOTS: u64 = 3;
 /// When a window that shows the denoised image filters it again ([`Schedule`]): once the image
 /// holds this factor more iterations than at the last filter...
 pub const SCHEDULE_GROWTH: u32 = 2;
-/// ...or this many seconds after it, if the image has new iterations since.
+/// ...or this many seconds after it, if the image has new iterations since...
 pub const SCHEDULE_INTERVAL: f64 = 1.0;
+/// ...but the latter never before the last filter's measured time over this share has passed
+/// since it began: between doublings the filter takes at most this share of the window's time.
+pub const SCHEDULE_SHARE: f64 = 0.25;
 
 /// When an interactive window (`rastergi view`, the web page) runs the filter again while it
 /// shows the denoised image. The filter costs far more than an iteration where the GPU is slow
 /// (0.9 s at 256² on lavapipe), so not every frame: at once where nothing is denoised yet or
 /// the image restarted (fewer iterations than at the last filter), then when the iterations
 /// have grown by [`SCHEDULE_GROWTH`] (log₂ n filters in all) or [`SCHEDULE_INTERVAL`] has
-/// passed. Between filters the window resolves the last denoised image (an exposure change
-/// needs no filter). Times are seconds from any fixed origin.
+/// passed — the latter, where the window measured what the last filter took
+/// ([`Schedule::took`]), not before that time over [`SCHEDULE_SHARE`] has passed since it
+/// began: at 1280 × 720 on lavapipe a filter takes 1.5 s, which a one-second interval repeated
+/// after every iteration (57 % of the window's time), for an image one iteration better.
+/// Doublings, log₂ n of them, stay due at once. Between filters the window resolves the
+/// last denoised image (an exposure change needs no filter). Times are seconds from any fixed
+/// origin.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Schedule {
     /// The iterations and the time of the last filter; `None`: none is on the window.
     last: Option<(u32, f64)>,
+    /// The seconds the last measured filter took (0 until one is).
+    cost: f64,
 }
 
 impl Schedule {
@@ -147,14 +157,30 @@ impl Schedule {
             // Fewer iterations: the image restarted since.
             Some((last, _)) if samples < last => true,
             Some((last, at)) => {
-                samples != last && (samples >= last.saturating_mul(SCHEDULE_GROWTH) || now - at >= SCHEDULE_INTERVAL)
+                let since = now - at;
+                samples != last
+                    && (samples >= last.saturating_mul(SCHEDULE_GROWTH)
+                        || since >= SCHEDULE_INTERVAL.max(self.cost / SCHEDULE_SHARE))
             }
         }
+    }
+
+    /// The last filter took `seconds` (on the GPU, or the frame's time beside its work): the
+    /// next waits for it over [`SCHEDULE_SHARE`]. Kept across [`Schedule::clear`] (the device
+    /// and the image size make it), replaced at every measurement.
+    pub fn took(&mut self, seconds: f64) {
+        self.cost = seconds.max(0.0);
     }
 
     /// The filter ran on the image at `samples` iterations at time `now`.
     pub fn ran(&mut self, samples: u32, now: f64) {
         self.last = Some((samples, now));
+    }
+
+    /// Whether a filter ran since the last [`Schedule::clear`]: the denoised image is of the
+    /// current view.
+    pub fn filtered(&self) -> bool {
+        self.last.is_some()
     }
 
     /// The window no longer shows a denoised image: the next is filtered at once.
@@ -580,5 +606,44 @@ mod tests {
         assert!(s.due(3, t), "restarted: fewer iterations");
         s.clear();
         assert!(s.due(8, t), "cleared: filtered at once");
+    }
+
+    /// A filter measured at 1.5 s (1280 × 720 on lavapipe) is not run again before 6 s have
+    /// passed since it began unless the iterations doubled: between doublings, at most a
+    /// quarter of the window's time.
+    #[test]
+    fn the_schedule_gives_the_filter_at_most_its_share_of_the_time() {
+        let (t, cost) = (100.0, 1.5);
+        let mut s = Schedule::default();
+        s.ran(8, t);
+        s.took(cost);
+        let wait = cost / SCHEDULE_SHARE;
+        assert!(s.due(16, t + SCHEDULE_INTERVAL), "doubled");
+        assert!(!s.due(15, t + SCHEDULE_INTERVAL), "a second passed, but within the filter's share");
+        assert!(!s.due(9, t + wait - 0.01));
+        assert!(s.due(9, t + wait), "a second passed, and the filter's share");
+        assert!(s.due(16, t + wait));
+        assert!(!s.due(8, t + 10.0 * wait), "no new iterations, no new filter");
+        assert!(s.due(3, t), "restarted: filtered at once");
+        s.clear();
+        assert!(s.due(8, t), "cleared: filtered at once");
+        s.ran(8, t);
+        assert!(!s.due(9, t + SCHEDULE_INTERVAL), "the cost is kept across a clear");
+        // Over a run of iterations (0.5 s each), each filter but a doubling begins at least
+        // cost / share after the last began.
+        let (mut s, mut now, mut samples, mut starts) = (Schedule::default(), 0.0, 1u32, Vec::new());
+        while now < 100.0 {
+            if s.due(samples, now) {
+                s.ran(samples, now);
+                s.took(cost);
+                starts.push((now, samples));
+                now += cost;
+            }
+            now += 0.5;
+            samples += 1;
+        }
+        assert!(starts.len() > 10);
+        let spaced = |w: &[(f64, u32)]| w[1].1 >= 2 * w[0].1 || w[1].0 - w[0].0 >= wait;
+        assert!(starts.windows(2).all(spaced), "filters (seconds, iterations) {starts:?}");
     }
 }

@@ -149,6 +149,12 @@ pub trait Denoising {
     fn read_guides(&self) -> Result<GuideState>;
     /// Encodes the filter without reading it back (timing).
     fn encode_denoise(&self, enc: &mut wgpu::CommandEncoder, params: &DenoiseParams) -> Result<()>;
+    /// The filter's dispatches ([`Denoising::encode_denoise_rows`]).
+    fn denoise_stages(&self, params: &DenoiseParams) -> Result<usize>;
+    /// Submits the rows `rows` of dispatch `stage` of the filter, alone: a filter run in steps,
+    /// every row of a stage before the next, the image unchanged meanwhile
+    /// ([`crate::passes::denoise::Denoiser::encode_rows`]).
+    fn submit_denoise_rows(&self, params: &DenoiseParams, step: (usize, std::ops::Range<u32>)) -> Result<()>;
     /// Encodes the resolve of the denoiser's output image (as the last
     /// [`encode_denoise`](Denoising::encode_denoise) before it in submission order filtered it)
     /// at `exposure` into the film's linear and display buffers, with the display encoding of

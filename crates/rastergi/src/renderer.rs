@@ -1142,6 +1142,18 @@ impl Denoising for Renderer {
         d.denoiser.encode(&self.gpu, enc, (self.passes.film.samples, d.guides.samples), angle, params);
         Ok(())
     }
+    fn denoise_stages(&self, params: &DenoiseParams) -> Result<usize> {
+        Ok(self.denoiser()?.denoiser.stages(params))
+    }
+    fn submit_denoise_rows(&self, params: &DenoiseParams, step: (usize, std::ops::Range<u32>)) -> Result<()> {
+        let d = self.denoiser()?;
+        let angle = crate::passes::denoise::pixel_angle(&self.camera, self.settings.height);
+        let mut enc =
+            self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("denoise step") });
+        d.denoiser.encode_rows(&self.gpu, &mut enc, (self.passes.film.samples, d.guides.samples), angle, params, step);
+        self.gpu.queue.submit([enc.finish()]);
+        Ok(())
+    }
     fn encode_resolve_denoised(&self, enc: &mut wgpu::CommandEncoder, exposure: f32) -> Result<()> {
         let d = self.denoiser()?;
         self.passes.film.encode_resolve_image(&self.gpu, enc, &d.resolve, exposure);

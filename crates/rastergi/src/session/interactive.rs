@@ -29,6 +29,12 @@ pub struct Interactive {
     /// The front end's clock (the `now` of the schedule) at its last resolve, and the instant
     /// then: the schedule's time between resolves.
     clock: Option<(f64, web_time::Instant)>,
+    /// Whether the filter runs in steps across frames ([`Interactive::frame`] with a frame
+    /// budget) rather than whole in the resolve (the page, or no budget); the run under way,
+    /// and the seconds per row each of its stages last took (the steps' sizes).
+    stepped_filter: bool,
+    filter_run: Option<FilterRun>,
+    filter_row_seconds: Vec<f64>,
     /// What each frame draws, coarse to fine, within the frame budget.
     refine: Refine,
     /// When the last frame's work ended, and the seconds the rest of a frame took since
@@ -43,6 +49,21 @@ pub struct Interactive {
     /// The camera moved since the photon region was last fitted to the view.
     refit_due: bool,
 }
+
+/// A filter of the denoised image run in steps across frames: the next stage and row, and the
+/// film's iterations, the schedule's time and the GPU seconds it has taken.
+#[derive(Clone, Copy, Debug)]
+struct FilterRun {
+    stage: usize,
+    row: u32,
+    stages: usize,
+    samples: u32,
+    began: f64,
+    seconds: f64,
+}
+
+/// The rows of a filter step before its stage's cost per row is measured.
+const FILTER_FIRST_ROWS: u32 = 16;
 
 /// While the camera is still, the image is resolved for display at most this often (seconds)
 /// while the previews refine: a frame's preview iteration changes the whole picture, but on a
@@ -66,6 +87,9 @@ impl Interactive {
             denoised: Schedule::default(),
             filter_untimed: false,
             clock: None,
+            stepped_filter: false,
+            filter_run: None,
+            filter_row_seconds: Vec::new(),
             refine,
             work_ended: None,
             rest: 0.0,
@@ -132,11 +156,23 @@ impl Interactive {
             }
         }
         let mut finished = 0;
-        // (scale, rows or whole, milliseconds) of each unit, for the debug log.
+        // (scale, rows or whole, milliseconds) of each unit, for the debug log (scale 0: a step
+        // of the denoiser's filter, and whether it finished it).
         let mut units = Vec::new();
+        self.stepped_filter = budget > 0.0;
         loop {
             let left = budget - start.elapsed().as_secs_f64();
             let began = web_time::Instant::now();
+            if self.filter_run.is_some() {
+                // A filter under way takes the frame's time until it is done (the window's
+                // iterations wait: they would change what it filters).
+                let done = self.filter_step(left.max(0.0))?;
+                units.push((0, done, (began.elapsed().as_secs_f64() * 1e4).round() / 10.0));
+                if start.elapsed().as_secs_f64() >= budget {
+                    break;
+                }
+                continue;
+            }
             let Some(work) = self.refine.step(self.renderer.as_mut(), left.max(0.0), limit - finished)? else { break };
             self.renderer.wait()?;
             let seconds = began.elapsed().as_secs_f64();
@@ -145,12 +181,15 @@ impl Interactive {
             let iterated = work.scale == 1 && work.finished;
             finished += u32::from(iterated);
             // The denoiser filters whole iterations: where the denoised image is due a filter,
-            // the frame's work ends with the iteration, not in the next one's first band.
-            if self.refine.frame_done(&work)
-                || start.elapsed().as_secs_f64() >= budget
-                || finished >= limit
-                || (iterated && self.filter_due())
-            {
+            // it begins with the iteration's end, not in the next one's first band.
+            if iterated && self.filter_due() {
+                self.begin_filter()?;
+                if start.elapsed().as_secs_f64() >= budget {
+                    break;
+                }
+                continue;
+            }
+            if self.refine.frame_done(&work) || start.elapsed().as_secs_f64() >= budget || finished >= limit {
                 break;
             }
         }
@@ -171,9 +210,66 @@ impl Interactive {
         self.clock.map_or(0.0, |(now, at)| now + at.elapsed().as_secs_f64())
     }
 
+    /// The denoised image is no longer the view's: the next is filtered at once, and a filter
+    /// under way is dropped.
+    fn clear_filter(&mut self) {
+        self.denoised.clear();
+        self.filter_run = None;
+    }
+
     /// Whether the denoised image is shown and due a filter.
     fn filter_due(&self) -> bool {
         self.denoising().is_some() && self.denoised.due(self.renderer.samples(), self.now())
+    }
+
+    /// Begins the filter of the window's image: in steps across frames where the loop has a
+    /// budget (the image shown until it is done is the last filter's, or the raw one); else
+    /// the next resolve filters it whole.
+    fn begin_filter(&mut self) -> Result<()> {
+        if !self.stepped_filter {
+            return Ok(());
+        }
+        let params = DenoiseParams::default();
+        let Some(r) = self.renderer.denoising() else { return Ok(()) };
+        let stages = r.denoise_stages(&params)?;
+        self.filter_row_seconds.resize(stages, 0.0);
+        let samples = self.renderer.samples();
+        self.filter_run = Some(FilterRun { stage: 0, row: 0, stages, samples, began: self.now(), seconds: 0.0 });
+        Ok(())
+    }
+
+    /// One step of the filter under way: as many rows of its stage as fit in `left` seconds at
+    /// the stage's last measured cost per row (at least 8), submitted alone and waited for.
+    /// Returns whether the filter is done; an image that changed under it (another iteration,
+    /// a restart) ends it undone.
+    fn filter_step(&mut self, left: f64) -> Result<bool> {
+        let Some(mut run) = self.filter_run.take() else { return Ok(false) };
+        let height = self.renderer.settings().height;
+        if self.renderer.samples() != run.samples || self.renderer.rows_ahead() != 0 {
+            return Ok(false);
+        }
+        let Some(r) = self.renderer.denoising() else { return Ok(false) };
+        let per_row = self.filter_row_seconds[run.stage];
+        let fit = if per_row > 0.0 { (left / per_row) as u32 } else { FILTER_FIRST_ROWS };
+        let rows = fit.max(8).min(height - run.row);
+        let began = web_time::Instant::now();
+        r.submit_denoise_rows(&DenoiseParams::default(), (run.stage, run.row..run.row + rows))?;
+        self.renderer.wait()?;
+        let seconds = began.elapsed().as_secs_f64();
+        self.filter_row_seconds[run.stage] = seconds / rows as f64;
+        run.seconds += seconds;
+        run.row += rows;
+        if run.row >= height {
+            (run.stage, run.row) = (run.stage + 1, 0);
+        }
+        if run.stage < run.stages {
+            self.filter_run = Some(run);
+            return Ok(false);
+        }
+        self.denoised.ran(run.samples, run.began);
+        self.denoised.took(run.seconds);
+        self.moved_since_display = true;
+        Ok(true)
     }
 
     /// Whether the last resolve encoded the denoiser's filter since this was last asked: a front
@@ -246,7 +342,7 @@ impl Interactive {
         }
         renderer.set_photon_steps(self.refine.budget() > 0.0);
         self.renderer = renderer;
-        self.denoised.clear();
+        self.clear_filter();
         self.refine.restart();
         self.moved_since_display = true;
         Ok(())
@@ -257,7 +353,7 @@ impl Interactive {
     pub fn resize(&mut self, width: u32, height: u32) -> Result<bool> {
         let resized = self.renderer.resize(width, height)?;
         if resized {
-            self.denoised.clear();
+            self.clear_filter();
             self.refine.restart();
             self.moved_since_display = true;
         }
@@ -268,13 +364,15 @@ impl Interactive {
     /// filtered it to save it): the display need not filter it again until it is due.
     pub fn filtered(&mut self, now: f64) {
         self.clock = Some((now, web_time::Instant::now()));
+        // The screenshot's filter was of the same iterations: one under way has nothing to add.
+        self.filter_run = None;
         self.denoised.ran(self.renderer.samples(), now);
     }
 
     /// Moves the camera: the image restarts.
     pub fn set_camera(&mut self, camera: Camera) -> Result<()> {
         self.renderer.set_camera(camera)?;
-        self.denoised.clear();
+        self.clear_filter();
         self.refine.moved();
         self.moved_since_display = true;
         self.refit_due = true;
@@ -290,7 +388,7 @@ impl Interactive {
             enable(self.renderer.as_mut())?;
         }
         self.denoise = on;
-        self.denoised.clear();
+        self.clear_filter();
         self.moved_since_display = true;
         if self.renderer.samples() == 0 {
             self.refine.restart();
@@ -311,7 +409,7 @@ impl Interactive {
     /// The shown image changed other than by iterations (a new renderer, a restart, a save
     /// that filters at once): the next denoised image is filtered at once.
     pub fn invalidate(&mut self) {
-        self.denoised.clear();
+        self.clear_filter();
         self.moved_since_display = true;
         if self.renderer.samples() == 0 && self.renderer.rows_ahead() == 0 {
             // A restart: the previews of the view before are gone.
@@ -333,6 +431,11 @@ impl Interactive {
     pub fn display_due(&self) -> bool {
         let Some((at, samples)) = self.displayed else { return true };
         let interval = if self.refine.refined() { BAND_DISPLAY_INTERVAL } else { DISPLAY_INTERVAL };
+        if self.filter_run.is_some() {
+            // A filter under way: nothing new until it is done (its last stage writes the
+            // denoised image in bands).
+            return self.moved_since_display;
+        }
         self.refine.budget() <= 0.0
             || self.moved_since_display
             || self.renderer.samples() != samples
@@ -359,9 +462,11 @@ impl Interactive {
         let samples = self.renderer.samples();
         // The denoiser filters whole iterations (not one under way in bands), from the first;
         // until it has filtered this view's image the raw one is shown (with what is blended
-        // into it), not the last filter's of another view or none.
+        // into it), not the last filter's of another view or none. Where the loop runs the
+        // filter in steps (`frame` with a budget) only an unblended resolve (a screenshot's)
+        // filters here.
         let whole = self.renderer.rows_ahead() == 0;
-        let due = whole && samples > 0 && self.denoised.due(samples, now);
+        let due = !(self.stepped_filter && blend) && whole && samples > 0 && self.denoised.due(samples, now);
         let filtered = due || self.denoised.filtered();
         if let Some(r) = self.denoising().filter(|_| samples > 0 && filtered) {
             if due {
@@ -371,6 +476,8 @@ impl Interactive {
             if due {
                 self.denoised.ran(samples, now);
                 self.filter_untimed = true;
+                // Of the same iterations as a filter under way (a screenshot's).
+                self.filter_run = None;
             }
         } else {
             let show = if self.renderer.has(self.show) { self.show } else { Show::Full };
@@ -379,7 +486,9 @@ impl Interactive {
             } else {
                 self.renderer.encode_resolve(enc, show, self.exposure);
             }
-            self.denoised.clear();
+            if self.denoising().is_none() {
+                self.clear_filter();
+            }
         }
         Ok(())
     }
@@ -489,6 +598,43 @@ mod tests {
         let denoised = view.denoising().unwrap().read_display_denoised(&params, 0.0).unwrap();
         assert!(displayed.rgba == denoised.rgba, "a whole iteration must be filtered and shown denoised");
         assert!(displayed.rgba != raw.rgba);
+    }
+
+    /// With a frame budget the filter runs in steps across frames (here each stage's 20 rows as
+    /// 16, unmeasured, then 4: bands across the 8-row workgroups), the window's iterations
+    /// waiting: once done, the shown image is bit for bit the filter run whole on the same
+    /// iterations.
+    #[test]
+    fn a_filter_in_steps_is_the_whole_filter() {
+        let gpu = Gpu::new(&GpuOptions::default()).expect("tests need a GPU adapter (lavapipe on CI)");
+        let scene = crate::scene::cornell_box();
+        let s = RenderSettings { width: 24, height: 20, ..settings() };
+        let mut view = Interactive::new(Box::new(Renderer::new(&gpu, &scene, s).unwrap()), Show::Full, 0.0);
+        view.set_denoise(true).unwrap();
+        view.set_frame_budget(1e-6);
+        let (mut frames, mut steps) = (0, 0);
+        while !view.denoised.filtered() {
+            assert!(frames < 2000, "no filter in {frames} frames");
+            let samples = view.renderer().samples();
+            view.frame(u32::MAX).unwrap();
+            if view.filter_run.is_some() || view.denoised.filtered() {
+                steps += 1;
+                assert!(view.renderer().samples() <= samples.max(1), "an iteration ran during the filter");
+            }
+            frames += 1;
+        }
+        // One frame begins it; 7 stages of 2 steps each.
+        assert_eq!(steps, 1 + 7 * 2, "steps of the filter");
+        assert_eq!(view.renderer().rows_ahead(), 0);
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        view.encode_resolve(&mut enc, 0.0).unwrap();
+        gpu.queue.submit([enc.finish()]);
+        let shown = view.renderer().film().read_display_buffer(&gpu).unwrap();
+        let params = crate::passes::denoise::DenoiseParams::default();
+        let whole = view.denoising().unwrap().read_display_denoised(&params, 0.0).unwrap();
+        assert!(shown.rgba == whole.rgba, "the filter in steps differs from the whole filter");
+        let raw = view.renderer().read_display(Show::Full, 0.0).unwrap();
+        assert!(shown.rgba != raw.rgba, "the shown image is not the denoised one");
     }
 
     /// While the camera moves, every frame shows a preview iteration of its own view, however

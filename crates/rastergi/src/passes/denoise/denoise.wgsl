@@ -19,6 +19,12 @@
 // What prepare wrote: the unfiltered light and its variance, for the regression.
 @group(0) @binding(8) var<storage, read_write> light: array<vec4f>;
 
+// A dispatch covers the rows [row0, row_end) of its pass (the whole image, or one band of a
+// filter run across frames): invocation `id` is the pixel `id` + (0, row0).
+fn band_pixel(id: vec3u) -> vec3u {
+    return vec3u(id.x, id.y + params.row0, 0u);
+}
+
 fn pixel_count() -> u32 {
     return params.resolution.x * params.resolution.y;
 }
@@ -43,8 +49,9 @@ fn variance_of_mean(m1: f32, m2: f32, n: f32) -> f32 {
 }
 
 @compute @workgroup_size(8, 8)
-fn prepare(@builtin(global_invocation_id) gid: vec3u) {
-    if any(gid.xy >= params.resolution) {
+fn prepare(@builtin(global_invocation_id) id: vec3u) {
+    let gid = band_pixel(id);
+    if gid.x >= params.resolution.x || gid.y >= params.row_end {
         return;
     }
     let n = pixel_count();
@@ -128,8 +135,9 @@ fn blur3(xy: vec2i, what: u32) -> vec2f {
 // The luminance guide of the level: the luminances of `src` blurred by the 3×3 binomial
 // kernel, so that the edge-stopping compares local means, not single noisy values.
 @compute @workgroup_size(8, 8)
-fn blur_luminance(@builtin(global_invocation_id) gid: vec3u) {
-    if any(gid.xy >= params.resolution) {
+fn blur_luminance(@builtin(global_invocation_id) id: vec3u) {
+    let gid = band_pixel(id);
+    if gid.x >= params.resolution.x || gid.y >= params.row_end {
         return;
     }
     lum[gid.y * params.resolution.x + gid.x] = blur3(vec2i(gid.xy), BLUR_LUMINANCE);
@@ -138,8 +146,9 @@ fn blur_luminance(@builtin(global_invocation_id) gid: vec3u) {
 const B3 = array<f32, 5>(0.0625, 0.25, 0.375, 0.25, 0.0625);
 
 @compute @workgroup_size(8, 8)
-fn atrous(@builtin(global_invocation_id) gid: vec3u) {
-    if any(gid.xy >= params.resolution) {
+fn atrous(@builtin(global_invocation_id) id: vec3u) {
+    let gid = band_pixel(id);
+    if gid.x >= params.resolution.x || gid.y >= params.row_end {
         return;
     }
     let n = pixel_count();
@@ -308,8 +317,9 @@ fn fit(xy: vec2i, c: u32) -> vec3f {
 // the unfiltered light; writes the fits to `dst`. A pixel where nothing is seen (no distance)
 // keeps its light (0: its emission is added at compose); such neighbours are left out.
 @compute @workgroup_size(8, 8)
-fn regress(@builtin(global_invocation_id) gid: vec3u) {
-    if any(gid.xy >= params.resolution) {
+fn regress(@builtin(global_invocation_id) id: vec3u) {
+    let gid = band_pixel(id);
+    if gid.x >= params.resolution.x || gid.y >= params.row_end {
         return;
     }
     let n = pixel_count();
@@ -324,8 +334,9 @@ fn regress(@builtin(global_invocation_id) gid: vec3u) {
 }
 
 @compute @workgroup_size(8, 8)
-fn compose(@builtin(global_invocation_id) gid: vec3u) {
-    if any(gid.xy >= params.resolution) {
+fn compose(@builtin(global_invocation_id) id: vec3u) {
+    let gid = band_pixel(id);
+    if gid.x >= params.resolution.x || gid.y >= params.row_end {
         return;
     }
     let n = pixel_count();

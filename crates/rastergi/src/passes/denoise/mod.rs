@@ -248,7 +248,10 @@ gpu_struct! {
         pub(crate) sigma_g: f32,
         /// The regression's ridge: a fraction of each regressor's own weighted square.
         pub(crate) ridge: f32,
-        pub(crate) _pad: [u32; 3],
+        /// The rows the dispatch covers: [row0, row_end) (a band of a filter run in steps).
+        pub(crate) row0: u32,
+        pub(crate) row_end: u32,
+        pub(crate) _pad: u32,
     }
 }
 
@@ -496,6 +499,12 @@ impl Denoiser {
         Denoiser { width, height, uniforms, groups, pipelines, image, levels }
     }
 
+    /// The filter's dispatches for `params`, in order ([`Denoiser::encode_rows`]): prepare,
+    /// the luminance blur and the à-trous pass of each level, the regression, compose.
+    pub fn stages(&self, params: &DenoiseParams) -> usize {
+        2 * params.levels.min(self.levels) as usize + 3
+    }
+
     /// Encodes the filter of the sums of `samples` film iterations and `guide_samples` guide
     /// iterations into the denoised image. `params.levels` is capped at the levels the
     /// denoiser was made for.
@@ -503,12 +512,50 @@ impl Denoiser {
         &self,
         gpu: &Gpu,
         enc: &mut wgpu::CommandEncoder,
-        (samples, guide_samples): (u32, u32),
+        samples: (u32, u32),
         pixel_angle: f32,
         params: &DenoiseParams,
     ) {
+        for stage in 0..self.stages(params) {
+            self.encode_rows(gpu, enc, samples, pixel_angle, params, (stage, 0..self.height));
+        }
+    }
+
+    /// Encodes the rows `rows` of dispatch `stage` of the filter ([`Denoiser::encode`]'s
+    /// arguments). A filter run in steps (a window that gives it a frame's time at a time)
+    /// encodes every row of a stage before the next stage, each step in a submission of its
+    /// own (the uniforms of a dispatch are written when it is encoded), with the film and
+    /// the guides unchanged from the first to the last: the denoised image is then bit for
+    /// bit [`Denoiser::encode`]'s (every pixel's value depends on the stage before only).
+    pub fn encode_rows(
+        &self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        (samples, guide_samples): (u32, u32),
+        pixel_angle: f32,
+        params: &DenoiseParams,
+        (stage, rows): (usize, std::ops::Range<u32>),
+    ) {
         let levels = params.levels.min(self.levels) as usize;
-        let uniform = |step: u32| DenoiseUniforms {
+        let rows = rows.start..rows.end.min(self.height);
+        if rows.is_empty() || stage >= self.stages(params) {
+            return;
+        }
+        // Dispatch d runs with group d (src ping[(d + 1) % 2], dst ping[d % 2]) and its own
+        // uniforms: prepare (0) writes ping[0], level i (d = i + 1: its luminance blur, then
+        // its à-trous pass) reads ping[i % 2], the regression (d = levels + 1) reads the last
+        // level's output ping[levels % 2], and compose (d = levels + 2) reads the regression's.
+        let p = &self.pipelines;
+        let (d, pipeline, step) = match stage {
+            0 => (0, &p.prepare, 0),
+            s if s <= 2 * levels => {
+                let i = (s - 1) / 2;
+                (i + 1, if (s - 1) % 2 == 0 { &p.blur_luminance } else { &p.atrous }, 1 << i)
+            }
+            s if s == 2 * levels + 1 => (levels + 1, &p.regress, 0),
+            _ => (levels + 2, &p.compose, 0),
+        };
+        let uniform = DenoiseUniforms {
             resolution: [self.width, self.height],
             samples,
             guide_samples,
@@ -521,29 +568,15 @@ impl Denoiser {
             radius_indirect: params.radius_indirect,
             sigma_g: params.sigma_g,
             ridge: params.ridge,
-            _pad: [0; 3],
+            row0: rows.start,
+            row_end: rows.end,
+            _pad: 0,
         };
-        // Dispatch d runs with group d (src ping[(d + 1) % 2], dst ping[d % 2]) and its own
-        // uniforms: prepare (0) writes ping[0], level i (d = i + 1) reads ping[i % 2], the
-        // regression (d = levels + 1) reads the last level's output ping[levels % 2], and
-        // compose (d = levels + 2) reads the regression's.
-        let mut run = |d: usize, pipeline: &wgpu::ComputePipeline, step: u32, write: bool| {
-            if write {
-                gpu.queue.write_buffer(&self.uniforms[d], 0, bytemuck::bytes_of(&uniform(step)));
-            }
-            let mut pass = crate::gpu::profile::compute_pass(enc, gpu.profiler.as_ref(), "denoise");
-            pass.set_pipeline(pipeline);
-            pass.set_bind_group(0, &self.groups[d], &[]);
-            pass.dispatch_workgroups(groups(self.width, 8), groups(self.height, 8), 1);
-        };
-        let p = &self.pipelines;
-        run(0, &p.prepare, 0, true);
-        for i in 0..levels {
-            run(i + 1, &p.blur_luminance, 1 << i, true);
-            run(i + 1, &p.atrous, 1 << i, false);
-        }
-        run(levels + 1, &p.regress, 0, true);
-        run(levels + 2, &p.compose, 0, true);
+        gpu.queue.write_buffer(&self.uniforms[d], 0, bytemuck::bytes_of(&uniform));
+        let mut pass = crate::gpu::profile::compute_pass(enc, gpu.profiler.as_ref(), "denoise");
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, &self.groups[d], &[]);
+        pass.dispatch_workgroups(groups(self.width, 8), groups(rows.end - rows.start, 8), 1);
     }
 
     /// The denoised image's buffer (`width × height` vec4, linear RGB and 1), as the last

@@ -65,6 +65,18 @@ fn quiet_wayland_probe() {
     }
 }
 
+/// Rust ignores SIGPIPE, so a reader that closes the pipe early (`rastergi compare … | head`)
+/// made the next `println!` panic with a backtrace. As other Unix tools do, the process now
+/// ends quietly there (the signal's default action).
+fn default_sigpipe() {
+    // SAFETY: called at the start of main, before any other thread exists; SIG_DFL is a valid
+    // disposition for SIGPIPE.
+    #[cfg(unix)]
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
 impl Command {
     fn opens_window(&self) -> bool {
         matches!(self, Command::View(_))
@@ -72,6 +84,7 @@ impl Command {
 }
 
 fn main() -> ExitCode {
+    default_sigpipe();
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();
     if !cli.command.opens_window() {

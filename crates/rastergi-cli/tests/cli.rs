@@ -112,6 +112,31 @@ fn an_unknown_ray_path_is_a_usage_error_naming_the_choices() {
     assert!(run.status.success() && run.stdout.contains("rays:     compute (asked for"), "{}", run.stdout);
 }
 
+/// A reader that closed the pipe before rastergi writes to it (`rastergi compare … | head`):
+/// the process ends quietly by SIGPIPE, as other Unix tools do; it panicked in `println!`
+/// with a backtrace ("failed printing to stdout: Broken pipe").
+#[cfg(unix)]
+#[test]
+fn a_closed_output_pipe_ends_the_run_quietly() {
+    use std::os::unix::process::ExitStatusExt;
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../rastergi/tests/data");
+    let (a, b) = (data.join("cornell_path_128_a.exr"), data.join("cornell_path_128_b.exr"));
+    // The read end is closed before the process starts: its first line meets a pipe with no
+    // reader, whatever the timing.
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_rastergi"))
+        .args(["compare", a.to_str().unwrap(), b.to_str().unwrap()])
+        .stdin(std::process::Stdio::null())
+        .stdout(writer)
+        .stderr(std::process::Stdio::piped())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "the run panicked:\n{stderr}");
+    assert_eq!(out.status.signal(), Some(libc::SIGPIPE), "{:?}:\n{stderr}", out.status);
+}
+
 #[test]
 fn unknown_option_is_a_usage_error() {
     let dir = tempfile::tempdir().unwrap();

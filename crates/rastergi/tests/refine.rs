@@ -257,6 +257,83 @@ fn check_reprojection(camera: rastergi::scene::Camera, at_least: usize) {
     assert!(valid >= at_least, "{valid} of {n} pixels see what the old view saw");
 }
 
+/// After a move, where the view before it is kept (re-projected) and a coarse preview's taps
+/// straddle an edge of light (an emitter, the sky), the preview is not blended in: its pixels
+/// spread the light's radiance over their neighbours (a halo ten pixels wide around the Cornell
+/// box's light at 1280 × 720, half a second after a stop), which the kept pixel does not. The
+/// film has no iteration; the shown image there must be the history's alone, bit for bit the
+/// resolve without the preview; elsewhere the preview still counts.
+#[test]
+fn a_coarse_preview_does_not_spread_light_over_the_kept_view() {
+    const M: u32 = 3;
+    let gpu = common::gpu();
+    let scene = cornell_box();
+    let mut r = fixed_map(&gpu, &scene);
+    for _ in 0..M {
+        r.iterate().unwrap();
+    }
+    let mut camera = r.camera();
+    camera.eye += glam::Vec3::new(0.08, 0.03, 0.0);
+    r.set_camera(camera).unwrap();
+    assert!(r.reproject().unwrap());
+    let shown = |r: &mut Renderer, preview: Option<(u32, f32)>| {
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        r.encode_resolve_blend(&mut enc, (Show::Full, 0.0), preview);
+        gpu.queue.submit([enc.finish()]);
+        r.film().read_linear_buffer(&gpu).unwrap()
+    };
+    let kept = shown(&mut r, None);
+    for _ in 0..3 {
+        while !r.iterate_preview_rows(4, 4).unwrap() {}
+    }
+    let blended = shown(&mut r, Some((4, 3.0)));
+    let pre = r.preview_film(4).unwrap();
+    let (pw, ph, m) = (pre.width, pre.height, pre.samples);
+    let pre = pre.read_state(&gpu).unwrap();
+    let (fw, fh) = SIZE;
+    // The preview's taps at each window pixel (as resolve.wgsl's preview_mean): whether the
+    // shares of their samples that saw light differ.
+    let seen =
+        |qx: u32, qy: u32| pre.sums[(FILM_DIRECT as usize * (pw * ph) as usize + (qy * pw + qx) as usize) * 4 + 3];
+    let (mut straddling, mut changed) = (0, 0);
+    for y in 0..fh {
+        for x in 0..fw {
+            let px = (x as f32 + 0.5) * pw as f32 / fw as f32 - 0.5;
+            let py = (y as f32 + 0.5) * ph as f32 / fh as f32 - 0.5;
+            let (bx, by) = (px.floor(), py.floor());
+            let (fx, fy) = (px - bx, py - by);
+            let shares: Vec<f32> = [(0, 0), (1, 0), (0, 1), (1, 1)]
+                .into_iter()
+                .filter(|&(dx, dy)| (if dx == 1 { fx } else { 1.0 - fx }) * (if dy == 1 { fy } else { 1.0 - fy }) > 0.0)
+                .map(|(dx, dy)| {
+                    let qx = (bx + dx as f32).clamp(0.0, pw as f32 - 1.0) as u32;
+                    let qy = (by + dy as f32).clamp(0.0, ph as f32 - 1.0) as u32;
+                    seen(qx, qy) / m as f32
+                })
+                .collect();
+            let edge = shares.iter().any(|&s| s != shares[0]);
+            let p = (y * fw + x) as usize;
+            let (k, b) = (kept.pixels[p], blended.pixels[p]);
+            // A kept pixel: the history's nonzero mean (the box's walls and light).
+            if k.iter().any(|&c| c > 0.0) {
+                if edge {
+                    straddling += 1;
+                    assert!(
+                        (0..3).all(|c| (b[c] - k[c]).abs() <= 1e-5 * k[c].abs().max(1.0)),
+                        "pixel ({x}, {y}): the preview spread its light over the kept {k:?}: {b:?}"
+                    );
+                } else if (0..3).any(|c| (b[c] - k[c]).abs() > 1e-5 * k[c].abs().max(1.0)) {
+                    changed += 1;
+                }
+            }
+        }
+    }
+    // Measured: 239 kept pixels whose taps straddle an edge (the light's, the box's opening
+    // onto the black sky), 343 others that the preview changed.
+    assert!(straddling >= 100, "{straddling} kept pixels whose taps straddle an edge of light");
+    assert!(changed >= 150, "the preview changed only {changed} kept pixels away from edges of light");
+}
+
 /// A scene's renderer for the interactive tests: one fixed photon map, so that a fresh
 /// renderer's film and one continued after a move can agree bit for bit.
 fn fixed_map(gpu: &Gpu, scene: &Scene) -> Renderer {

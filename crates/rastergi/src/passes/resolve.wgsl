@@ -137,6 +137,9 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     // has an iteration there, neither is blended in.
     let blending = params.history_weight > 0.0 || (params.preview_size.x > 0u && params.preview_weight > 0.0);
     let edge = blending && iterations > 0.0 && film_light_edge(gid.xy);
+    // Whether the view before the move is kept here (re-projected: the same side of the same
+    // triangle at a point a fraction of a pixel away).
+    var kept = false;
     if params.history_weight > 0.0 && !edge {
         // The history's weight h fades as 1/(1 + n/h) with the film's n iterations here; a
         // pixel the old view saw at an edge of light (w = 2) only until the film has one.
@@ -145,14 +148,18 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
         let w = select(0.0, params.history_weight, valid) / (1.0 + iterations / params.history_weight);
         total += w * h.rgb;
         weight += w;
+        kept = valid;
     }
     if params.preview_size.x > 0u && params.preview_weight > 0.0 && !edge {
         // The preview's weight fades as (1 + n + h')⁻²: all of the image where nothing else
         // is known, a quarter of its weight at the first iteration, then gone before its blur
         // (a bias) could outlast the film's noise (which falls as 1/n); where its taps
-        // straddle an edge of light, only until the film has an iteration.
+        // straddle an edge of light, only until the film has an iteration, and not where the
+        // view before the move is kept: its coarse pixels spread an emitter's or the sky's
+        // radiance (hundreds of times the image's) over their neighbours, which the kept
+        // pixel, as sharp as the window's, does not.
         let p = preview_mean(gid.xy);
-        if !(p.edge && iterations > 0.0) {
+        if !(p.edge && (iterations > 0.0 || kept)) {
             let w = params.preview_weight * p.weight / ((1.0 + weight) * (1.0 + weight));
             total += w * p.mean;
             weight += w;

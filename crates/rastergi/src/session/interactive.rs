@@ -518,6 +518,20 @@ mod tests {
         RenderSettings { width: 16, height: 16, photons: 1 << 12, grid_resolution: 8, gather, ..Default::default() }
     }
 
+    /// What the view shows now: its resolve for display, submitted and read back.
+    fn shown(gpu: &Gpu, view: &mut Interactive) -> crate::image_io::DisplayImage {
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        view.encode_resolve(&mut enc, 0.0).unwrap();
+        gpu.queue.submit([enc.finish()]);
+        view.renderer().film().read_display_buffer(gpu).unwrap()
+    }
+
+    /// The view's denoised image filtered now, whole, display-encoded.
+    fn denoised_now(view: &Interactive) -> crate::image_io::DisplayImage {
+        let params = crate::passes::denoise::DenoiseParams::default();
+        view.denoising().unwrap().read_display_denoised(&params, 0.0).unwrap()
+    }
+
     /// The loop's promises, checked on the renderers: a camera move and turning the denoiser
     /// on restart the image; the denoised image is shown only where the renderer has a
     /// denoiser, its guides on and the full image shown; a new renderer keeps the view's
@@ -542,13 +556,8 @@ mod tests {
         for _ in 0..3 {
             view.renderer_mut().iterate().unwrap();
         }
-        let mut enc = gpu.device.create_command_encoder(&Default::default());
-        view.encode_resolve(&mut enc, 0.0).unwrap();
-        gpu.queue.submit([enc.finish()]);
-        let shown = view.renderer().film().read_display_buffer(&gpu).unwrap();
-        let params = crate::passes::denoise::DenoiseParams::default();
-        let denoised = view.denoising().unwrap().read_display_denoised(&params, 0.0).unwrap();
-        assert!(shown.rgba == denoised.rgba, "the display does not show the denoised image");
+        let displayed = shown(&gpu, &mut view);
+        assert!(displayed.rgba == denoised_now(&view).rgba, "the display does not show the denoised image");
 
         let mut camera = view.renderer().camera();
         camera.eye += glam::Vec3::new(0.1, 0.0, 0.0);
@@ -582,21 +591,13 @@ mod tests {
         view.renderer_mut().iterate().unwrap();
         assert!(!view.renderer_mut().iterate_rows(4).unwrap(), "four rows of 16 end no iteration");
         assert!(view.renderer().rows_ahead() > 0);
-        let shown = |view: &mut Interactive| {
-            let mut enc = gpu.device.create_command_encoder(&Default::default());
-            view.encode_resolve(&mut enc, 0.0).unwrap();
-            gpu.queue.submit([enc.finish()]);
-            view.renderer().film().read_display_buffer(&gpu).unwrap()
-        };
         let raw = view.renderer().read_display(Show::Full, 0.0).unwrap();
         assert!(raw.rgba.iter().any(|&c| c > 0), "the raw image is not black");
-        assert!(shown(&mut view).rgba == raw.rgba, "before its first filter the view must show the raw image");
+        assert!(shown(&gpu, &mut view).rgba == raw.rgba, "before its first filter the view must show the raw image");
         while !view.renderer_mut().iterate_rows(4).unwrap() {}
         assert_eq!((view.renderer().samples(), view.renderer().rows_ahead()), (2, 0));
-        let displayed = shown(&mut view);
-        let params = crate::passes::denoise::DenoiseParams::default();
-        let denoised = view.denoising().unwrap().read_display_denoised(&params, 0.0).unwrap();
-        assert!(displayed.rgba == denoised.rgba, "a whole iteration must be filtered and shown denoised");
+        let displayed = shown(&gpu, &mut view);
+        assert!(displayed.rgba == denoised_now(&view).rgba, "a whole iteration must be filtered and shown denoised");
         assert!(displayed.rgba != raw.rgba);
     }
 
@@ -626,15 +627,10 @@ mod tests {
         // One frame begins it; 7 stages of 2 steps each.
         assert_eq!(steps, 1 + 7 * 2, "steps of the filter");
         assert_eq!(view.renderer().rows_ahead(), 0);
-        let mut enc = gpu.device.create_command_encoder(&Default::default());
-        view.encode_resolve(&mut enc, 0.0).unwrap();
-        gpu.queue.submit([enc.finish()]);
-        let shown = view.renderer().film().read_display_buffer(&gpu).unwrap();
-        let params = crate::passes::denoise::DenoiseParams::default();
-        let whole = view.denoising().unwrap().read_display_denoised(&params, 0.0).unwrap();
-        assert!(shown.rgba == whole.rgba, "the filter in steps differs from the whole filter");
+        let displayed = shown(&gpu, &mut view);
+        assert!(displayed.rgba == denoised_now(&view).rgba, "the filter in steps differs from the whole filter");
         let raw = view.renderer().read_display(Show::Full, 0.0).unwrap();
-        assert!(shown.rgba != raw.rgba, "the shown image is not the denoised one");
+        assert!(displayed.rgba != raw.rgba, "the shown image is not the denoised one");
     }
 
     /// While the camera moves, every frame shows a preview iteration of its own view, however

@@ -370,6 +370,23 @@ fn bench_motion_refuses_where_its_images_cannot_go_before_rendering() {
     assert!(!run.stderr.contains("panicked") && !dir.path().join("nowhere").exists(), "{}", run.stderr);
 }
 
+#[test]
+fn bench_resolve_times_the_three_states_a_viewer_resolves_in() {
+    let dir = tempfile::tempdir().unwrap();
+    let run =
+        rastergi(dir.path(), &["bench", "resolve", "cornell", "--width", "32", "--height", "24", "--repeats", "2"]);
+    assert!(run.status.success(), "{}", run.stderr);
+    for state in ["the film alone: ", "moving: the 1/4 preview upscaled", "after the stop: "] {
+        let line = run
+            .stdout
+            .lines()
+            .find(|l| l.contains(state))
+            .unwrap_or_else(|| panic!("no '{state}' in:\n{}", run.stdout));
+        let ms: f64 = line.rsplit(": ").next().and_then(|f| f.split(' ').next()).and_then(|f| f.parse().ok()).unwrap();
+        assert!(ms > 0.0, "{line}");
+    }
+}
+
 /// A view straight down at [`floor_obj`]'s floor from 3 m, 16 × 16 pixels.
 const FLOOR_VIEW: [&str; 10] =
     ["--eye", "0,3,0.01", "--target", "0,0,0", "--fov", "40", "--width", "16", "--height", "16"];

@@ -5,7 +5,8 @@
 //! three final-gather implementations, and the time to a target error), [`converge`] (error
 //! against time for the renderer, the path tracer and Mitsuba 3), [`frames`] (the viewer's
 //! frame loop without a window), [`bvh`] (scene loading and BVH build), [`rays`] (rays per
-//! second of each kind, GPU and CPU twin) and [`memory`] (the GPU memory of a render).
+//! second of each kind, GPU and CPU twin), [`memory`] (the GPU memory of a render), [`denoise`]
+//! (one application of the denoiser) and [`resolve`] (one resolve for display, blended or not).
 
 mod bvh;
 mod converge;
@@ -16,6 +17,7 @@ mod memory;
 mod motion;
 mod photons;
 mod rays;
+mod resolve;
 
 use std::time::Duration;
 
@@ -49,6 +51,9 @@ pub enum BenchCommand {
     Memory(memory::MemoryArgs),
     /// Milliseconds per application of the denoiser at the window's size.
     Denoise(denoise::DenoiseArgs),
+    /// Milliseconds per resolve of the film for display at the window's size: the film alone,
+    /// a moving frame's upscaled preview, and the blend just after a stop.
+    Resolve(resolve::ResolveArgs),
     /// Rays per second of each kind the renderer casts (camera, shadow, bounce, gather, photon)
     /// on the GPU kernel and the CPU twin, hit for hit, and the BVH's build time, SAH cost and size.
     Rays(rays::RaysArgs),
@@ -64,6 +69,7 @@ pub fn run(command: &BenchCommand) -> Result<()> {
         BenchCommand::Bvh(a) => bvh::run(a),
         BenchCommand::Memory(a) => memory::run(a),
         BenchCommand::Denoise(a) => denoise::run(a),
+        BenchCommand::Resolve(a) => resolve::run(a),
         BenchCommand::Rays(a) => rays::run(a),
     }
 }

@@ -128,19 +128,36 @@ fn run_variant(
         view.set_denoise(true)?;
     }
     let mut target = DisplayTarget::offscreen(gpu, settings.width, settings.height)?;
-    // A frame: its work, then the resolve and the display pass; returns the seconds of each.
+    // A frame: its work, then the resolve and the display pass; returns the seconds of the
+    // work and of the drawing. The resolve is waited for alone where debug output is on, so
+    // that each frame's line splits the drawing into the resolve's and the display pass's.
     let clock = Instant::now();
+    let split = log::log_enabled!(log::Level::Debug);
     let mut frame = |view: &mut Interactive| -> Result<(f64, f64)> {
         let began = Instant::now();
         view.frame(u32::MAX)?;
         let work = began.elapsed().as_secs_f64();
         // As the viewer: the resolve when due, the display pass every frame.
         let mut enc = gpu.device.create_command_encoder(&Default::default());
+        let mut resolve = None;
         if view.display_due() {
             view.encode_resolve(&mut enc, clock.elapsed().as_secs_f64())?;
+            if split {
+                let at = Instant::now();
+                gpu.queue.submit([
+                    std::mem::replace(&mut enc, gpu.device.create_command_encoder(&Default::default())).finish()
+                ]);
+                gpu.wait()?;
+                resolve = Some(at.elapsed().as_secs_f64());
+            }
         }
+        let at = Instant::now();
         target.present(gpu, enc, Some(view.renderer().film()), &[])?;
         gpu.wait()?;
+        if split {
+            let ms = |t: Option<f64>| t.map_or("-".to_owned(), |t| format!("{:.1}", 1e3 * t));
+            log::debug!("  drawing: resolve {} ms, display {} ms", ms(resolve), ms(Some(at.elapsed().as_secs_f64())));
+        }
         Ok((work, began.elapsed().as_secs_f64() - work))
     };
     let start = Instant::now();

@@ -33,27 +33,28 @@ fn display_encode(mean: vec3f) -> u32 {
     return pack4x8unorm(vec4f(display, 1.0));
 }
 
-// The shown component of a pixel's sums of the direct light, the indirect light and the
-// photon-map view.
-fn shown(direct: vec3f, indirect: vec3f, photon_view: vec3f) -> vec3f {
+// The sum of the shown component (the direct light, the indirect light, the photon-map view,
+// or the first two added) at `pixel` of the film (its layout, `n` pixels). Only the planes
+// shown are read: on a CPU adapter each load costs more than the arithmetic around it.
+fn shown_film(pixel: u32, n: u32) -> vec3f {
     switch params.show {
-        case 1u: { return direct; }
-        case 2u: { return indirect; }
-        case 3u: { return photon_view; }
-        default: { return direct + indirect; }
+        case 1u: { return film[film_slot(FILM_DIRECT, pixel, n)].rgb; }
+        case 2u: { return film[film_slot(FILM_INDIRECT, pixel, n)].rgb; }
+        case 3u: { return film[film_slot(FILM_PHOTON_VIEW, pixel, n)].rgb; }
+        default: { return film[film_slot(FILM_DIRECT, pixel, n)].rgb + film[film_slot(FILM_INDIRECT, pixel, n)].rgb; }
     }
 }
 
-// The sum of the shown component at `pixel` of the film (its layout, `n` pixels).
-fn shown_film(pixel: u32, n: u32) -> vec3f {
-    let c = vec3u(film_slot(FILM_DIRECT, pixel, n), film_slot(FILM_INDIRECT, pixel, n), film_slot(FILM_PHOTON_VIEW, pixel, n));
-    return shown(film[c.x].rgb, film[c.y].rgb, film[c.z].rgb);
-}
-
-// The same of the preview's sums.
-fn shown_preview(pixel: u32, n: u32) -> vec3f {
-    let c = vec3u(film_slot(FILM_DIRECT, pixel, n), film_slot(FILM_INDIRECT, pixel, n), film_slot(FILM_PHOTON_VIEW, pixel, n));
-    return shown(preview[c.x].rgb, preview[c.y].rgb, preview[c.z].rgb);
+// The same of the preview's sums (rgb), with the count of its samples that saw light (w: the
+// direct component's fourth channel).
+fn shown_preview(pixel: u32, n: u32) -> vec4f {
+    let direct = preview[film_slot(FILM_DIRECT, pixel, n)];
+    switch params.show {
+        case 1u: { return direct; }
+        case 2u: { return vec4f(preview[film_slot(FILM_INDIRECT, pixel, n)].rgb, direct.w); }
+        case 3u: { return vec4f(preview[film_slot(FILM_PHOTON_VIEW, pixel, n)].rgb, direct.w); }
+        default: { return vec4f(direct.rgb + preview[film_slot(FILM_INDIRECT, pixel, n)].rgb, direct.w); }
+    }
 }
 
 // The preview at the centre of film pixel `xy`: its mean, bilinear over its pixels that hold
@@ -81,10 +82,10 @@ fn preview_mean(xy: vec2u) -> PreviewTaps {
         let w = select(1.0 - f.x, f.x, o.x > 0.0) * select(1.0 - f.y, f.y, o.y > 0.0);
         let samples = params.preview_samples + select(0u, 1u, q.y < params.preview_rows_ahead);
         if samples > 0u && w > 0.0 {
-            let pixel = q.y * size.x + q.x;
-            sum += w * shown_preview(pixel, n) / f32(samples);
+            let v = shown_preview(q.y * size.x + q.x, n);
+            sum += w * v.rgb / f32(samples);
             weight += w;
-            let share = preview[film_slot(FILM_DIRECT, pixel, n)].w / f32(samples);
+            let share = v.w / f32(samples);
             light = vec2f(min(light.x, share), max(light.y, share));
         }
     }
@@ -94,29 +95,29 @@ fn preview_mean(xy: vec2u) -> PreviewTaps {
     return PreviewTaps(sum / weight, weight, light.x != light.y);
 }
 
-// The share of the film's iterations at pixel xy whose sample saw light itself (an emitter's
-// front face, the sky: the direct component's fourth channel counts them), and the iterations.
-fn light_share(xy: vec2u) -> vec2f {
+// The film's iterations at pixel xy (one more in the rows an iteration under way in bands has
+// reached) and how many of their samples saw light itself — an emitter's front face, the sky:
+// the direct component's fourth channel counts them.
+fn light_count(xy: vec2u) -> vec2f {
     let n = params.samples + select(0u, 1u, xy.y < params.rows_ahead);
     let seen = film[film_slot(FILM_DIRECT, xy.y * params.resolution.x + xy.x, params.resolution.x * params.resolution.y)].w;
-    return vec2f(seen / f32(max(n, 1u)), f32(n));
+    return vec2f(seen, f32(n));
 }
 
 // Whether the film's samples show an edge of light at pixel xy: the shares of its 3 × 3
-// neighbourhood's pixels that hold an iteration differ.
+// neighbourhood's pixels (within the image) that hold an iteration differ from its own
+// (compared as seen·n' ≠ seen'·n: exact, as nothing is blended past 256 iterations). Unrolled, each
+// neighbour clamped to the image (which repeats pixels of the neighbourhood): a loop whose
+// bounds vary by pixel costs a CPU adapter more than its loads.
 fn film_light_edge(xy: vec2u) -> bool {
-    let s = light_share(xy).x;
-    let lo = max(vec2i(xy) - 1, vec2i(0));
-    let hi = min(vec2i(xy) + 1, vec2i(params.resolution) - 1);
-    for (var y = lo.y; y <= hi.y; y++) {
-        for (var x = lo.x; x <= hi.x; x++) {
-            let q = light_share(vec2u(vec2i(x, y)));
-            if q.y > 0.0 && q.x != s {
-                return true;
-            }
-        }
+    let c = light_count(xy);
+    let hi = vec2i(params.resolution) - 1;
+    var edge = false;
+    for (var k = 0u; k < 9u; k++) {
+        let q = light_count(vec2u(clamp(vec2i(xy) + vec2i(i32(k % 3u), i32(k / 3u)) - 1, vec2i(0), hi)));
+        edge = edge || (q.y > 0.0 && q.x * c.y != c.x * q.y);
     }
-    return false;
+    return edge;
 }
 
 @compute @workgroup_size(8, 8)

@@ -338,6 +338,12 @@ impl Film {
         &self.display
     }
 
+    /// The linear image written by the last resolve ([`Film::read_linear_buffer`] reads it):
+    /// one vec4 (rgb, 1) per pixel, row-major.
+    pub fn linear_buffer(&self) -> &wgpu::Buffer {
+        &self.linear
+    }
+
     /// Clears the sums (camera moved, scene changed): submitted before any later work.
     pub fn clear(&mut self, gpu: &Gpu) {
         let mut enc = gpu.device.create_command_encoder(&Default::default());

@@ -95,9 +95,9 @@ struct Measured {
     errors: Vec<Option<f64>>,
     iterations: Vec<u32>,
     /// The share of the frames' time after the stop spent on the resolve and display pass, and
-    /// the longest frame after the stop (seconds).
+    /// the frames after the stop (seconds).
     drawing: f64,
-    longest_still: f64,
+    still: Vec<f64>,
 }
 
 /// The camera `t` seconds into the move of `a` from `start`.
@@ -205,10 +205,11 @@ fn run_variant(
     // replaced (held), or the film's last resolve where it did not resolve.
     let (mut clock, mut to_full, mut errors, mut iterations) = (0.0, None, Vec::new(), Vec::new());
     let mut shown_samples = view.renderer().samples();
-    let (mut work, mut drawing, mut longest_still) = (0.0, 0.0, 0.0f64);
+    let (mut work, mut drawing, mut still) = (0.0, 0.0, Vec::new());
     while errors.len() < MARKS.len() {
         let (w, d, resolved) = frame(&mut view, true)?;
-        (work, drawing, longest_still) = (work + w, drawing + d, longest_still.max(w + d));
+        (work, drawing) = (work + w, drawing + d);
+        still.push(w + d);
         clock += w + d;
         if to_full.is_none() && view.renderer().samples() > 0 {
             to_full = Some(clock);
@@ -231,7 +232,7 @@ fn run_variant(
         }
         shown_samples = view.renderer().samples();
     }
-    Ok(Measured { frames, to_full, errors, iterations, drawing: drawing / (work + drawing), longest_still })
+    Ok(Measured { frames, to_full, errors, iterations, drawing: drawing / (work + drawing), still })
 }
 
 /// The 100·q-th percentile of `v` (nearest rank).
@@ -349,8 +350,10 @@ pub fn run(a: &MotionArgs) -> Result<()> {
             .collect();
         println!("    relRMSE against the converged view after the stop: {}", errors.join(", "));
         println!(
-            "    after the stop: the longest frame {:.1} ms; {:.0} % of the frames' time drawing (the resolve and the display pass)",
-            1e3 * m.longest_still,
+            "    after the stop: frames median {:.1} ms, p95 {:.1} ms, the longest {:.1} ms; {:.0} % of their time drawing (the resolve and the display pass)",
+            1e3 * percentile(&m.still, 0.5),
+            1e3 * percentile(&m.still, 0.95),
+            1e3 * percentile(&m.still, 1.0),
             100.0 * m.drawing
         );
         results.push(m);

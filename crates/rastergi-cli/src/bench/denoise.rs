@@ -43,24 +43,17 @@ pub fn run(a: &DenoiseArgs) -> Result<()> {
         gpu.wait()?;
         Ok(())
     };
-    apply()?;
-    let mut times = vec![];
-    for _ in 0..a.repeats.max(1) {
-        let start = std::time::Instant::now();
-        apply()?;
-        times.push(start.elapsed().as_secs_f64() * 1e3);
-    }
-    times.sort_by(f64::total_cmp);
+    let (median, min, max) = super::milliseconds(a.repeats, apply)?;
     println!(
         "denoise: {} at {w}x{h} on {} ({:?}), {} levels: {:.1} ms per application (median of {}; min {:.1}, max {:.1})",
         a.window.scene,
         gpu.info.name,
         gpu.info.backend,
         params.levels,
-        times[times.len() / 2],
-        times.len(),
-        times[0],
-        times[times.len() - 1]
+        median,
+        a.repeats.max(1),
+        min,
+        max
     );
     Ok(())
 }

@@ -96,7 +96,7 @@ fn load_valid_scene(name: &str) -> Result<Scene> {
     Ok(scene)
 }
 
-/// The set-up of the window benchmarks (`frames`, `memory`, `denoise`): the scene of `window`,
+/// The set-up of the window benchmarks (`frames`, `memory`, `denoise`, `resolve`): the scene of `window`,
 /// validated as [`load_valid_scene`] does, then the GPU `gpu_args` choose.
 fn window_scene_and_gpu(window: &WindowArgs, gpu_args: &GpuArgs) -> Result<(Scene, Gpu)> {
     let scene = load_valid_scene(&window.scene)?;
@@ -107,4 +107,18 @@ fn window_scene_and_gpu(window: &WindowArgs, gpu_args: &GpuArgs) -> Result<(Scen
 fn median(mut v: Vec<Duration>) -> Duration {
     v.sort();
     v[v.len() / 2]
+}
+
+/// Milliseconds of `repeats` (at least one) runs of `run`, after one untimed (shaders
+/// compiled, caches warm): their median, minimum and maximum.
+fn milliseconds(repeats: u32, mut run: impl FnMut() -> Result<()>) -> Result<(f64, f64, f64)> {
+    run()?;
+    let mut times = vec![];
+    for _ in 0..repeats.max(1) {
+        let start = std::time::Instant::now();
+        run()?;
+        times.push(start.elapsed().as_secs_f64() * 1e3);
+    }
+    times.sort_by(f64::total_cmp);
+    Ok((times[times.len() / 2], times[0], times[times.len() - 1]))
 }

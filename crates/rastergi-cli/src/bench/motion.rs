@@ -216,11 +216,7 @@ fn run_variant(
         }
         if clock > MARKS[errors.len()] {
             let film = view.renderer().film();
-            let buffer = if resolved { &held } else { film.linear_buffer() };
-            let texels = gpu.read_buffer(buffer, bytes)?;
-            let texel = |t: &[u8]| std::array::from_fn(|c| f32::from_le_bytes(t[4 * c..4 * c + 4].try_into().unwrap()));
-            let pixels = texels.chunks_exact(16).map(texel).collect();
-            let shown = LinearImage { width: film.width, height: film.height, pixels };
+            let shown = if resolved { film.read_linear_copy(gpu, &held)? } else { film.read_linear_buffer(gpu)? };
             while errors.len() < MARKS.len() && clock > MARKS[errors.len()] {
                 if let Some(dir) = &a.images {
                     let name = format!("budget-{:.0}-at-{}.exr", 1e3 * budget, MARKS[errors.len()]);

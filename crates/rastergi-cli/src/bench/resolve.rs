@@ -37,24 +37,18 @@ pub fn run(a: &ResolveArgs) -> Result<()> {
     }
     r.wait()?;
     let show = (Show::Full, 0.0);
-    // Median milliseconds of `repeats` resolves encoded by `encode` (after one untimed).
-    let time = |r: &mut Renderer, blend: Option<(u32, f32)>| -> Result<(f64, f64, f64)> {
-        let mut times = vec![];
-        for k in 0..=a.repeats.max(1) {
-            let start = std::time::Instant::now();
+    // The resolve of the film alone, or blended with the preview at 1/s weighed as w
+    // iterations (and the history where re-projected), timed.
+    let time = |r: &mut Renderer, blend: Option<(u32, f32)>| {
+        super::milliseconds(a.repeats, || {
             let mut enc = gpu.device.create_command_encoder(&Default::default());
             match blend {
                 None => r.encode_resolve(&mut enc, show.0, show.1),
                 Some(p) => r.encode_resolve_blend(&mut enc, show, Some(p)),
             }
             gpu.queue.submit([enc.finish()]);
-            gpu.wait()?;
-            if k > 0 {
-                times.push(start.elapsed().as_secs_f64() * 1e3);
-            }
-        }
-        times.sort_by(f64::total_cmp);
-        Ok((times[times.len() / 2], times[0], times[times.len() - 1]))
+            Ok(gpu.wait()?)
+        })
     };
     let film = time(&mut r, None)?;
     // A move: the camera turned a little (the view before kept as history), a preview drawn.

@@ -498,7 +498,13 @@ impl Film {
     /// The linear image as the last submitted resolve left it (what a window shows, before
     /// its exposure and display encoding: a preview's blend included).
     pub fn read_linear_buffer(&self, gpu: &Gpu) -> Result<LinearImage> {
-        let bytes = gpu.read_buffer(&self.linear, self.linear.size())?;
+        self.read_linear_copy(gpu, &self.linear)
+    }
+
+    /// The same of `buffer`, a copy of the linear buffer ([`Film::linear_buffer`]) made
+    /// on the GPU: the image a resolve left before a later one overwrote it.
+    pub fn read_linear_copy(&self, gpu: &Gpu, buffer: &wgpu::Buffer) -> Result<LinearImage> {
+        let bytes = gpu.read_buffer(buffer, self.linear.size())?;
         let texels: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
         let n = (self.width * self.height) as usize;
         Ok(LinearImage {

@@ -561,6 +561,12 @@ mod tests {
         RenderSettings { width: 16, height: 16, photons: 1 << 12, grid_resolution: 8, gather, ..Default::default() }
     }
 
+    /// The Cornell box in a view of the full image, rendered with `s`.
+    fn cornell_view(gpu: &Gpu, s: RenderSettings) -> Interactive {
+        let renderer = Renderer::new(gpu, &crate::scene::cornell_box(), s).unwrap();
+        Interactive::new(Box::new(renderer), Show::Full, 0.0)
+    }
+
     /// What the view shows now: its resolve for display, submitted and read back.
     fn shown(gpu: &Gpu, view: &mut Interactive) -> crate::image_io::DisplayImage {
         let mut enc = gpu.device.create_command_encoder(&Default::default());
@@ -584,8 +590,7 @@ mod tests {
     fn the_view_restarts_and_denoises_as_a_viewer_expects() {
         let gpu = Gpu::new(&GpuOptions::default()).expect("tests need a GPU adapter (lavapipe on CI)");
         let scene = crate::scene::cornell_box();
-        let renderer = Box::new(Renderer::new(&gpu, &scene, settings()).unwrap());
-        let mut view = Interactive::new(renderer, Show::Full, 0.0);
+        let mut view = cornell_view(&gpu, settings());
         for _ in 0..2 {
             view.renderer_mut().iterate().unwrap();
         }
@@ -627,9 +632,7 @@ mod tests {
     #[test]
     fn the_denoised_view_waits_for_its_first_filter() {
         let gpu = Gpu::new(&GpuOptions::default()).expect("tests need a GPU adapter (lavapipe on CI)");
-        let scene = crate::scene::cornell_box();
-        let renderer = Box::new(Renderer::new(&gpu, &scene, settings()).unwrap());
-        let mut view = Interactive::new(renderer, Show::Full, 0.0);
+        let mut view = cornell_view(&gpu, settings());
         view.set_denoise(true).unwrap();
         view.renderer_mut().iterate().unwrap();
         assert!(!view.renderer_mut().iterate_rows(4).unwrap(), "four rows of 16 end no iteration");
@@ -651,9 +654,7 @@ mod tests {
     #[test]
     fn a_filter_in_steps_is_the_whole_filter() {
         let gpu = Gpu::new(&GpuOptions::default()).expect("tests need a GPU adapter (lavapipe on CI)");
-        let scene = crate::scene::cornell_box();
-        let s = RenderSettings { width: 24, height: 20, ..settings() };
-        let mut view = Interactive::new(Box::new(Renderer::new(&gpu, &scene, s).unwrap()), Show::Full, 0.0);
+        let mut view = cornell_view(&gpu, RenderSettings { width: 24, height: 20, ..settings() });
         view.set_denoise(true).unwrap();
         view.set_frame_budget(1e-6);
         let (mut frames, mut steps) = (0, 0);
@@ -683,10 +684,8 @@ mod tests {
     #[test]
     fn every_frame_of_a_move_shows_a_preview_of_its_view() {
         let gpu = Gpu::new(&GpuOptions::default()).expect("tests need a GPU adapter (lavapipe on CI)");
-        let scene = crate::scene::cornell_box();
         // 128 × 64: the coarsest preview is 4 × 2 pixels, two rows.
-        let s = RenderSettings { width: 128, height: 64, ..settings() };
-        let mut view = Interactive::new(Box::new(Renderer::new(&gpu, &scene, s).unwrap()), Show::Full, 0.0);
+        let mut view = cornell_view(&gpu, RenderSettings { width: 128, height: 64, ..settings() });
         view.set_frame_budget(1e-6);
         let mut camera = view.renderer().camera();
         for frame in 0..4 {

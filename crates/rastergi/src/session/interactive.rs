@@ -527,7 +527,9 @@ fn work_budget(budget: f64, rest: [f64; 2], resolving: bool) -> f64 {
 fn enable(renderer: &mut dyn Progressive) -> Result<()> {
     let Some(d) = renderer.denoising_mut().filter(|d| !d.denoiser_enabled()) else { return Ok(()) };
     d.enable_denoiser()?;
-    if renderer.samples() > 0 {
+    // The guides hold the iterations from here on: an iteration under way in row bands (the
+    // first one too) would leave its rows above the band without it.
+    if renderer.samples() > 0 || renderer.rows_ahead() > 0 {
         renderer.reset();
     }
     Ok(())
@@ -645,6 +647,34 @@ mod tests {
         let displayed = shown(&gpu, &mut view);
         assert!(displayed.rgba == denoised_now(&view).rgba, "a whole iteration must be filtered and shown denoised");
         assert!(displayed.rgba != raw.rgba);
+    }
+
+    /// The denoiser turned on while the first iteration is under way in row bands (a click in
+    /// the page's first frames): the image restarts with it, so that the guides hold the same
+    /// iterations as the film in every row — those of a view whose denoiser was on from the
+    /// start. (The rows above the band lacked an iteration of albedo: half of it at two.)
+    #[test]
+    fn the_denoiser_turned_on_within_an_iteration_restarts_it() {
+        let gpu = Gpu::new(&GpuOptions::default()).expect("tests need a GPU adapter (lavapipe on CI)");
+        let albedo = |view: &Interactive| view.renderer().denoising().unwrap().read_guides().unwrap().albedo();
+        let mut view = cornell_view(&gpu, settings());
+        assert!(!view.renderer_mut().iterate_rows(4).unwrap(), "four rows of 16 end no iteration");
+        assert_eq!((view.renderer().samples(), view.renderer().rows_ahead() > 0), (0, true));
+        view.set_denoise(true).unwrap();
+        assert_eq!(view.renderer().rows_ahead(), 0, "the iteration under way must be dropped");
+        let mut fresh = cornell_view(&gpu, settings());
+        fresh.set_denoise(true).unwrap();
+        for v in [&mut view, &mut fresh] {
+            for _ in 0..2 {
+                v.renderer_mut().iterate().unwrap();
+            }
+        }
+        let (a, b) = (albedo(&view), albedo(&fresh));
+        for (p, (x, y)) in a.pixels.iter().zip(&b.pixels).enumerate() {
+            for c in 0..3 {
+                assert!((x[c] - y[c]).abs() <= 1e-6, "albedo at pixel {p}: {x:?} against {y:?} from the start");
+            }
+        }
     }
 
     /// With a frame budget the filter runs in steps across frames (here each stage's 20 rows as

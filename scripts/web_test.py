@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """Drives rastergi's web page in Chromium through chromedriver (the W3C WebDriver
-protocol over HTTP, standard library only): renders the Cornell box, saves the image, turns
-the denoiser on with the panel's checkbox and saves the denoised image, moves the camera with
-a real pointer drag, loads files through the page's file input.
+protocol over HTTP, standard library only): turns the denoiser on with the panel's checkbox
+(with --denoised), renders the Cornell box, saves the raw image and the denoised one of the
+same iterations, moves the camera with a real pointer drag, loads files through the page's
+file input.
 
 Usage: web_test.py URL OUT.png [--iterations N] [--size W] [--seed S] [--gather G]
            [--denoised OUT.png] [--file SCENE_FILE]... [--bad-file FILE]
@@ -135,9 +136,10 @@ def wait_for(driver, condition, what, timeout):
     fail(f"timed out after {timeout} s waiting for {what} (page error: {state['error'] or 'none'}, {state['samples']} iterations)")
 
 
-def save_png(driver, path):
-    """Writes the page's "save PNG" image to `path` (whole, or not at all)."""
-    png = base64.b64decode(driver.run("return await rastergi.png();"))
+def save_png(driver, path, raw=False):
+    """Writes the page's "save PNG" image to `path` (whole, or not at all); with `raw`, the
+    film's image unfiltered where the denoised one is shown."""
+    png = base64.b64decode(driver.run(f"return await rastergi.png({'true' if raw else 'false'});"))
     with open(path + ".tmp", "wb") as f:
         f.write(png)
     os.replace(path + ".tmp", path)
@@ -155,7 +157,7 @@ def main():
     p.add_argument("--bad-file", help="a file that is not a scene: the page must refuse it and keep its scene")
     p.add_argument("--timeout", type=int, default=600)
     p.add_argument("--screenshot", help="also save a screenshot of the whole page here, after the render")
-    p.add_argument("--denoised", help="then tick the panel's denoise box, render the same iterations again and save that image here")
+    p.add_argument("--denoised", help="tick the panel's denoise box first and save the denoised image of the same iterations here (OUT.png: the raw one)")
     a = p.parse_args()
     chromium = shutil.which("chromium") or shutil.which("chromium-browser") or fail("chromium is not installed")
     chromedriver = shutil.which("chromedriver") or fail("chromedriver is not installed")
@@ -173,25 +175,24 @@ def main():
         if error:
             fail(f"the page could not start: {error}")
         report["adapter"] = driver.run("return rastergi.viewer.describe();")
-        start = time.time()
-        wait_for(driver, f"rastergi.samples() >= {a.iterations} && rastergi.idle()", f"{a.iterations} iterations", a.timeout)
-        report["seconds"] = round(time.time() - start, 1)
-        save_png(driver, a.out)
-        if a.screenshot:
-            with open(a.screenshot, "wb") as f:
-                f.write(base64.b64decode(driver.call("GET", f"{driver.session}/screenshot")))
-
         if a.denoised:
-            # A real click on the panel's checkbox: the denoiser's guides start, so the image
-            # restarts and runs the same iterations again.
+            # A real click on the panel's checkbox before the iterations: the denoiser's guides
+            # start, so the image restarts; the same iterations then give both images, the
+            # film's raw one and the denoised one.
             driver.call("POST", f"{driver.session}/element/{driver.element('#denoise')}/click", {})
             wait_for(driver, "rastergi.viewer.describe().includes('denoised') || rastergi.error()", "the denoiser to turn on", 60)
             if driver.run("return rastergi.error();"):
                 fail(f"turning the denoiser on: {driver.run('return rastergi.error();')}")
-            wait_for(driver, f"rastergi.samples() >= {a.iterations} && rastergi.idle()", f"{a.iterations} denoised iterations", a.timeout)
-            save_png(driver, a.denoised)
             report["denoised"] = driver.run("return rastergi.viewer.describe();")
-            report["denoised_seconds"] = round(time.time() - start, 1)
+        start = time.time()
+        wait_for(driver, f"rastergi.samples() >= {a.iterations} && rastergi.idle()", f"{a.iterations} iterations", a.timeout)
+        report["seconds"] = round(time.time() - start, 1)
+        save_png(driver, a.out, raw=True)
+        if a.denoised:
+            save_png(driver, a.denoised)
+        if a.screenshot:
+            with open(a.screenshot, "wb") as f:
+                f.write(base64.b64decode(driver.call("GET", f"{driver.session}/screenshot")))
 
         # A real pointer drag across the canvas orbits the camera: the image restarts.
         canvas = driver.element("#view")

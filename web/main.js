@@ -4,8 +4,8 @@
 // URL parameters (all optional): scene (a built-in name), width, height, seed, gather
 // (lists | trace), denoise (1: start with the denoiser on), iterations (stop after this many;
 // the test uses it). The page publishes
-// `window.rastergi` = { ready (a promise), viewer, samples(), error(), png() } for
-// scripts/web-test.sh.
+// `window.rastergi` = { ready (a promise), viewer, samples(), error(), png(raw) } for
+// scripts/web-test.sh (png(true): the film's image unfiltered while the denoised one is shown).
 import init, { createViewer } from './pkg/rastergi_web.js';
 
 const $ = (id) => document.getElementById(id);
@@ -17,8 +17,8 @@ window.rastergi = {
   samples: () => (state.viewer ? state.viewer.samples() : 0),
   error: () => state.error,
   idle: () => (state.viewer ? state.viewer.idle() : false),
-  png: async () => {
-    const bytes = await state.viewer.savePng();
+  png: async (raw = false) => {
+    const bytes = await state.viewer.savePng(raw);
     let text = '';
     for (let i = 0; i < bytes.length; i += 0x8000) text += String.fromCharCode(...bytes.subarray(i, i + 0x8000));
     return btoa(text);
@@ -169,7 +169,7 @@ function wire() {
   });
   $('save').addEventListener('click', async () => {
     try {
-      const bytes = await v().savePng();
+      const bytes = await v().savePng(false);
       const a = document.createElement('a');
       a.href = URL.createObjectURL(new Blob([bytes], { type: 'image/png' }));
       a.download = `rastergi-${v().sceneName().replace(/[^\w.-]+/g, '_')}-${v().samples()}.png`;

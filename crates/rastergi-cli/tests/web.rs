@@ -4,9 +4,10 @@
 //! triangles) and an OBJ (with its MTL and texture) loaded through the page's file input, and a file that is not a scene, which
 //! the page must refuse with one line while keeping its scene. The image is then compared with
 //! `rastergi render` of the same settings: their difference must be within the noise, as
-//! measured by two seeds of the native render. Before the drag the page's denoise checkbox is
-//! ticked and the same iterations run again: that image must agree with `rastergi render
-//! --denoise` in the same way, and be closer to the Mitsuba reference than the raw one.
+//! measured by two seeds of the native render. The page's denoise checkbox is ticked before
+//! the iterations (the image restarts), and the denoised image of the same iterations must
+//! agree with `rastergi render --denoise` in the same way, and be closer to the Mitsuba
+//! reference than the raw one.
 //!
 //! Skipped, with a message, only where Chromium cannot be installed (web-test.sh exits 3).
 

@@ -479,13 +479,22 @@ impl Viewer {
 
     /// The image as shown (the film's display encoding at its own size; the denoised image
     /// filtered at the current iterations where it is shown) as PNG bytes: a promise of a
-    /// `Uint8Array`.
+    /// `Uint8Array`. With `raw` true, the film's own image of the shown component instead of
+    /// the denoised one (the same iterations, unfiltered); the canvas shows its image again at
+    /// the next frame.
     #[wasm_bindgen(js_name = savePng)]
-    pub fn save_png(&mut self) -> js_sys::Promise {
+    pub fn save_png(&mut self, raw: bool) -> js_sys::Promise {
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
-        self.view.invalidate();
-        if let Err(e) = self.view.encode_resolve_unblended(&mut enc, now()) {
-            return js_sys::Promise::reject(&JsValue::from(error(e)));
+        if raw {
+            let renderer = self.view.renderer();
+            let show = if renderer.has(self.view.show) { self.view.show } else { Show::Full };
+            renderer.encode_resolve(&mut enc, show, self.view.exposure);
+            self.view.redisplay();
+        } else {
+            self.view.invalidate();
+            if let Err(e) = self.view.encode_resolve_unblended(&mut enc, now()) {
+                return js_sys::Promise::reject(&JsValue::from(error(e)));
+            }
         }
         self.gpu.queue.submit([enc.finish()]);
         let image = self.view.renderer().film().read_display_buffer_async(&self.gpu);

@@ -33,7 +33,7 @@ use rastergi::progressive::Progressive;
 
 use rastergi::scene::{Files, GltfOptions, MemoryFiles, Scene, SunAngles};
 use rastergi::session::interactive::Interactive;
-use rastergi::session::refine::Work;
+use rastergi::session::interactive::Unit;
 use rastergi::session::{Method, Session};
 use wasm_bindgen::prelude::*;
 
@@ -72,7 +72,7 @@ pub struct Viewer {
     in_flight: Arc<AtomicU32>,
     /// Units of work the GPU has finished since the last frame, with their seconds from
     /// submission.
-    done: Arc<Mutex<Vec<(Work, f64)>>>,
+    done: Arc<Mutex<Vec<(Unit, f64)>>>,
     /// The seconds from the submission of a frame that ran the denoiser's filter to its end on
     /// the GPU (with whatever was queued before it: an over-estimate that spaces filters more).
     filter_took: Arc<Mutex<Option<f64>>>,
@@ -320,22 +320,27 @@ impl Viewer {
     /// (unless `limit` > 0 iterations are done, or the GPU is [`FRAMES_IN_FLIGHT`] behind),
     /// then the image drawn onto the canvas. Returns the iterations accumulated.
     pub fn frame(&mut self, limit: u32) -> Result<u32, JsError> {
-        let finished: Vec<(Work, f64)> = std::mem::take(&mut *self.done.lock().unwrap_or_else(|e| e.into_inner()));
-        for (work, seconds) in finished {
-            self.view.finished(&work, seconds);
+        let finished: Vec<(Unit, f64)> = std::mem::take(&mut *self.done.lock().unwrap_or_else(|e| e.into_inner()));
+        for (unit, seconds) in finished {
+            self.view.finished(&unit, seconds);
         }
         if let Some(seconds) = self.filter_took.lock().unwrap_or_else(|e| e.into_inner()).take() {
             self.view.filter_took(seconds);
         }
         let samples = self.view.renderer().samples();
         let left = if limit > 0 { limit.saturating_sub(samples) } else { u32::MAX };
-        if left > 0 && self.in_flight.load(Ordering::Acquire) < FRAMES_IN_FLIGHT {
+        // A filter of the denoised image under way in steps goes on after the last iteration;
+        // its steps wait for the queue to empty, so that their time is theirs alone (it sizes
+        // the next).
+        let in_flight = self.in_flight.load(Ordering::Acquire);
+        let free = if self.view.filtering() { in_flight == 0 } else { left > 0 && in_flight < FRAMES_IN_FLIGHT };
+        if free {
             self.view.reproject().map_err(error)?;
-            if let Some(work) = self.view.step(self.view.frame_budget(), left).map_err(error)? {
+            if let Some(unit) = self.view.step(self.view.frame_budget(), left).map_err(error)? {
                 self.in_flight.fetch_add(1, Ordering::AcqRel);
                 let (in_flight, done, submitted) = (self.in_flight.clone(), self.done.clone(), now());
                 self.gpu.queue.on_submitted_work_done(move || {
-                    done.lock().unwrap_or_else(|e| e.into_inner()).push((work, now() - submitted));
+                    done.lock().unwrap_or_else(|e| e.into_inner()).push((unit, now() - submitted));
                     in_flight.fetch_sub(1, Ordering::AcqRel);
                 });
             }

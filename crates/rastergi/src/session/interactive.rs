@@ -35,6 +35,8 @@ pub struct Interactive {
     stepped_filter: bool,
     filter_run: Option<FilterRun>,
     filter_row_seconds: Vec<f64>,
+    /// The GPU seconds of the steps timed so far of the filter under way.
+    filter_seconds: f64,
     /// What each frame draws, coarse to fine, within the frame budget.
     refine: Refine,
     /// When the last frame's work ended, and the seconds the rest of a frame took since (the
@@ -53,8 +55,8 @@ pub struct Interactive {
     refit_due: bool,
 }
 
-/// A filter of the denoised image run in steps across frames: the next stage and row, and the
-/// film's iterations, the schedule's time and the GPU seconds it has taken.
+/// A filter of the denoised image run in steps across frames: the next stage and row, the
+/// film's iterations and the schedule's time.
 #[derive(Clone, Copy, Debug)]
 struct FilterRun {
     stage: usize,
@@ -62,7 +64,24 @@ struct FilterRun {
     stages: usize,
     samples: u32,
     began: f64,
-    seconds: f64,
+}
+
+/// One unit of a frame's work that [`Interactive::step`] submitted: the renderer's (a preview's
+/// iteration, rows of the window's, photons) or steps of the denoiser's filter.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Unit {
+    Work(Work),
+    Filter(Vec<FilterStep>),
+}
+
+/// A step of the denoiser's filter submitted: rows of one of its stages, the seconds they were
+/// estimated to take (0: the stage's cost not known yet), and whether it was the filter's last.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FilterStep {
+    stage: usize,
+    rows: u32,
+    estimate: f64,
+    last: bool,
 }
 
 /// The rows of a filter step before its stage's cost per row is measured.
@@ -93,6 +112,7 @@ impl Interactive {
             stepped_filter: false,
             filter_run: None,
             filter_row_seconds: Vec::new(),
+            filter_seconds: 0.0,
             refine,
             work_ended: None,
             rest: [0.0; 2],
@@ -224,6 +244,7 @@ impl Interactive {
     fn clear_filter(&mut self) {
         self.denoised.clear();
         self.filter_run = None;
+        self.filter_seconds = 0.0;
     }
 
     /// Whether the denoised image is shown and due a filter.
@@ -243,42 +264,105 @@ impl Interactive {
         let stages = r.denoise_stages(&params)?;
         self.filter_row_seconds.resize(stages, 0.0);
         let samples = self.renderer.samples();
-        self.filter_run = Some(FilterRun { stage: 0, row: 0, stages, samples, began: self.now(), seconds: 0.0 });
+        self.filter_run = Some(FilterRun { stage: 0, row: 0, stages, samples, began: self.now() });
+        self.filter_seconds = 0.0;
         Ok(())
     }
 
-    /// One step of the filter under way: as many rows of its stage as fit in `left` seconds at
-    /// the stage's last measured cost per row (at least 8), submitted alone and waited for.
-    /// Returns whether the filter is done; an image that changed under it (another iteration,
-    /// a restart) ends it undone.
+    /// One step of the filter under way, waited for and timed ([`Interactive::submit_filter_step`]).
+    /// Returns whether the filter is done.
     fn filter_step(&mut self, left: f64) -> Result<bool> {
-        let Some(mut run) = self.filter_run.take() else { return Ok(false) };
+        let began = web_time::Instant::now();
+        let Some(step) = self.submit_filter_step(left)? else { return Ok(false) };
+        self.renderer.wait()?;
+        self.filter_steps_took(&[step], began.elapsed().as_secs_f64());
+        Ok(step.last)
+    }
+
+    /// The seconds per row of `stage` of the filter: as its last step measured, else the last
+    /// whole filter's time spread evenly over its stages' rows, else 0 (not known).
+    fn filter_row_cost(&self, stage: usize) -> f64 {
+        let measured = self.filter_row_seconds.get(stage).copied().unwrap_or(0.0);
+        if measured > 0.0 {
+            return measured;
+        }
+        let rows = self.filter_row_seconds.len() as f64 * self.renderer.settings().height as f64;
+        if rows > 0.0 { self.denoised.cost() / rows } else { 0.0 }
+    }
+
+    /// Submits one step of the filter under way, without waiting: as many rows of its stage as
+    /// fit in `left` seconds at the stage's cost per row ([`Interactive::filter_row_cost`]; 16
+    /// rows where it is not known; at least 8). Once its last step is submitted the filtered
+    /// image is the view's (the queue runs the display's resolve after it). `None` where no
+    /// filter is under way; an image that changed under it (another iteration, a restart) ends
+    /// it undone. Its time goes to [`Interactive::filter_steps_took`].
+    fn submit_filter_step(&mut self, left: f64) -> Result<Option<FilterStep>> {
+        let Some(mut run) = self.filter_run.take() else { return Ok(None) };
         let height = self.renderer.settings().height;
         if self.renderer.samples() != run.samples || self.renderer.rows_ahead() != 0 {
-            return Ok(false);
+            return Ok(None);
         }
-        let Some(r) = self.renderer.denoising() else { return Ok(false) };
-        let per_row = self.filter_row_seconds[run.stage];
+        let per_row = self.filter_row_cost(run.stage);
+        let Some(r) = self.renderer.denoising() else { return Ok(None) };
         let fit = if per_row > 0.0 { (left / per_row) as u32 } else { FILTER_FIRST_ROWS };
         let rows = fit.max(8).min(height - run.row);
-        let began = web_time::Instant::now();
         r.submit_denoise_rows(&DenoiseParams::default(), (run.stage, run.row..run.row + rows))?;
-        self.renderer.wait()?;
-        let seconds = began.elapsed().as_secs_f64();
-        self.filter_row_seconds[run.stage] = seconds / rows as f64;
-        run.seconds += seconds;
+        let stage = run.stage;
         run.row += rows;
         if run.row >= height {
             (run.stage, run.row) = (run.stage + 1, 0);
         }
-        if run.stage < run.stages {
+        let last = run.stage >= run.stages;
+        if last {
+            self.denoised.ran(run.samples, run.began);
+            self.moved_since_display = true;
+        } else {
             self.filter_run = Some(run);
-            return Ok(false);
         }
-        self.denoised.ran(run.samples, run.began);
-        self.denoised.took(run.seconds);
-        self.moved_since_display = true;
-        Ok(true)
+        Ok(Some(FilterStep { stage, rows, estimate: per_row * rows as f64, last }))
+    }
+
+    /// Submits steps of the filter under way, without waiting, across its stages, until their
+    /// estimated seconds reach `left` (a stage whose cost is not known yet begins a unit of
+    /// its own, so that its time measures it alone). `None` where no filter is under way.
+    fn submit_filter_steps(&mut self, left: f64) -> Result<Option<Vec<FilterStep>>> {
+        let mut steps: Vec<FilterStep> = Vec::new();
+        let mut estimate = 0.0;
+        while let Some(run) = self.filter_run {
+            if !steps.is_empty() && (estimate >= left || self.filter_row_cost(run.stage) <= 0.0) {
+                break;
+            }
+            let Some(step) = self.submit_filter_step((left - estimate).max(0.0))? else { break };
+            estimate += step.estimate;
+            steps.push(step);
+            if step.estimate <= 0.0 {
+                break;
+            }
+        }
+        Ok((!steps.is_empty()).then_some(steps))
+    }
+
+    /// Steps of the filter submitted together took `seconds` on the GPU: each stage's cost per
+    /// row (the next steps' sizes; shared in proportion to the estimates, or evenly over the
+    /// rows where there were none), and after the last step the whole filter's, which spaces
+    /// the filters.
+    fn filter_steps_took(&mut self, steps: &[FilterStep], seconds: f64) {
+        let estimate: f64 = steps.iter().map(|s| s.estimate).sum();
+        let rows: u32 = steps.iter().map(|s| s.rows).sum();
+        for s in steps {
+            let per_row = if estimate > 0.0 {
+                s.estimate / s.rows.max(1) as f64 * seconds / estimate
+            } else {
+                seconds / rows.max(1) as f64
+            };
+            if let Some(cost) = self.filter_row_seconds.get_mut(s.stage) {
+                *cost = per_row;
+            }
+        }
+        self.filter_seconds += seconds;
+        if steps.iter().any(|s| s.last) {
+            self.denoised.took(std::mem::take(&mut self.filter_seconds));
+        }
     }
 
     /// Whether the last resolve encoded the denoiser's filter since this was last asked: a front
@@ -315,14 +399,34 @@ impl Interactive {
 
     /// One unit of a frame's work without waiting for it (a web page, which cannot block):
     /// give its time to [`Interactive::finished`] once the GPU has done it, and call
-    /// [`Interactive::end_frame`] after the frame's last.
-    pub fn step(&mut self, left: f64, limit: u32) -> Result<Option<Work>> {
-        self.refine.step(self.renderer.as_mut(), left, limit)
+    /// [`Interactive::end_frame`] after the frame's last. With a frame budget the denoiser's
+    /// filter runs in steps here as in [`Interactive::frame`]: begun where an iteration ends
+    /// and a filter is due, then as many steps a unit as fit in `left` (the window's
+    /// iterations wait, whatever `limit`).
+    pub fn step(&mut self, left: f64, limit: u32) -> Result<Option<Unit>> {
+        self.stepped_filter = self.refine.budget() > 0.0;
+        if let Some(steps) = self.submit_filter_steps(left.max(0.0))? {
+            return Ok(Some(Unit::Filter(steps)));
+        }
+        let Some(work) = self.refine.step(self.renderer.as_mut(), left, limit)? else { return Ok(None) };
+        if work.scale == 1 && work.finished && self.filter_due() {
+            self.begin_filter()?;
+        }
+        Ok(Some(Unit::Work(work)))
     }
 
-    /// `work` took `seconds` on the GPU.
-    pub fn finished(&mut self, work: &Work, seconds: f64) {
-        self.refine.finished(work, seconds);
+    /// Whether a filter of the denoised image is under way in steps ([`Interactive::step`]
+    /// runs it even where no iteration is left to do).
+    pub fn filtering(&self) -> bool {
+        self.filter_run.is_some()
+    }
+
+    /// `unit` took `seconds` on the GPU.
+    pub fn finished(&mut self, unit: &Unit, seconds: f64) {
+        match unit {
+            Unit::Work(work) => self.refine.finished(work, seconds),
+            Unit::Filter(steps) => self.filter_steps_took(steps, seconds),
+        }
     }
 
     /// The frame is over ([`Interactive::step`]).
@@ -705,6 +809,48 @@ mod tests {
         assert!(displayed.rgba == denoised_now(&view).rgba, "the filter in steps differs from the whole filter");
         let raw = view.renderer().read_display(Show::Full, 0.0).unwrap();
         assert!(displayed.rgba != raw.rgba, "the shown image is not the denoised one");
+    }
+
+    /// The page's loop ([`Interactive::step`], nothing waited for, each unit's time given
+    /// afterwards): the filter runs in steps there too — begun where the iteration ends, the
+    /// window's iterations waiting, and on after the iteration limit is reached — and once done
+    /// the shown image is bit for bit the filter run whole on the same iterations. A unit takes
+    /// as many steps, across stages, as its budget allows at the costs measured: with a budget
+    /// of a microsecond two a stage (16 rows unmeasured, then the 4 left), with one of a second
+    /// the next filter whole in one unit.
+    #[test]
+    fn the_pages_loop_filters_in_steps_too() {
+        let gpu = Gpu::new(&GpuOptions::default()).expect("tests need a GPU adapter (lavapipe on CI)");
+        let mut view = cornell_view(&gpu, RenderSettings { width: 24, height: 20, ..settings() });
+        view.set_denoise(true).unwrap();
+        let filter = |view: &mut Interactive, budget: f64, limit: u32| {
+            view.set_frame_budget(budget);
+            let (mut frames, mut units, mut begun) = (0, 0, false);
+            while !begun || view.filtering() {
+                assert!(frames < 2000, "no filter in {frames} frames");
+                let left = limit - view.renderer().samples().min(limit);
+                assert!(left > 0 || view.filtering(), "the iterations are done and no filter is under way");
+                let samples = view.renderer().samples();
+                if let Some(unit) = view.step(view.frame_budget(), left).unwrap() {
+                    if matches!(unit, Unit::Filter(_)) {
+                        units += 1;
+                        assert_eq!(view.renderer().samples(), samples, "an iteration ran during the filter");
+                    }
+                    view.finished(&unit, 1e-3);
+                }
+                view.end_frame();
+                begun |= view.filtering();
+                frames += 1;
+            }
+            assert_eq!((view.renderer().samples(), view.renderer().rows_ahead()), (limit, 0));
+            let displayed = shown(&gpu, view);
+            assert!(displayed.rgba == denoised_now(view).rgba, "the filter in steps differs from the whole filter");
+            let raw = view.renderer().read_display(Show::Full, 0.0).unwrap();
+            assert!(displayed.rgba != raw.rgba, "the shown image is not the denoised one");
+            units
+        };
+        assert_eq!(filter(&mut view, 1e-6, 1), 7 * 2, "units of the first filter (7 stages)");
+        assert_eq!(filter(&mut view, 1.0, 2), 1, "units of the second filter");
     }
 
     /// While the camera moves, every frame shows a preview iteration of its own view, however

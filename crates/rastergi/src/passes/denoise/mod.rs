@@ -172,6 +172,11 @@ impl Schedule {
         self.cost = seconds.max(0.0);
     }
 
+    /// The seconds the last measured filter took (0 until one is).
+    pub fn cost(&self) -> f64 {
+        self.cost
+    }
+
     /// The filter ran on the image at `samples` iterations at time `now`.
     pub fn ran(&mut self, samples: u32, now: f64) {
         self.last = Some((samples, now));

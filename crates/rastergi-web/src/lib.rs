@@ -317,8 +317,9 @@ impl Viewer {
     }
 
     /// One animation frame: a unit of the interactive loop's work within its frame budget
-    /// (unless `limit` > 0 iterations are done, or the GPU is [`FRAMES_IN_FLIGHT`] behind),
-    /// then the image drawn onto the canvas. Returns the iterations accumulated.
+    /// (unless `limit` > 0 iterations are done and no filter is under way, or the GPU is
+    /// [`FRAMES_IN_FLIGHT`] behind; a filter's steps wait until it has nothing queued), then
+    /// the image drawn onto the canvas. Returns the iterations accumulated.
     pub fn frame(&mut self, limit: u32) -> Result<u32, JsError> {
         let finished: Vec<(Unit, f64)> = std::mem::take(&mut *self.done.lock().unwrap_or_else(|e| e.into_inner()));
         for (unit, seconds) in finished {

@@ -303,14 +303,18 @@ fn pixel_coverage(poly: &[[f64; 2]], i: u32, j: u32) -> f64 {
 
 /// The emission seen at an emitter's edges against the exact box-filtered coverage: a unit
 /// square emitter turned 25° in its plane, facing the camera squarely (its image a turned
-/// square), nothing else in the scene. Each pixel's value is Le × the area of the square's
+/// square) before a black wall. Each pixel's value is Le × the area of the square's
 /// image inside the pixel, computed here by clipping. With the edge pixels supersampled
 /// (`emitter_edges` = 4, 16 stratified rays) one iteration is within a few hundredths of the
 /// coverage, where one jittered sample is off by about ½; after 64 iterations the mean error
 /// over the edge pixels shows no bias (a sub-pixel ray placed by the wrong jitter would blur
 /// the edge by up to a pixel, an error of tenths). Thresholds from seeds 0–8: one iteration
 /// 0.045–0.053 (one sample 0.33–0.46), 64 iterations 0.0054–0.0067, mean error within
-/// ±0.0011, elsewhere at most 0.0054.
+/// ±0.0011, elsewhere at most 0.0054. The share of each pixel that the film records as seeing
+/// light (the direct component's fourth channel, which the viewer's resolve reads to keep a
+/// preview's light off the pixels that do not see it) is the same coverage from the same rays
+/// at the edge pixels, and elsewhere (coverage within 0.01 of 0 or 1) within one of the 16
+/// rays of it: 0 or 1, or a sliver flagged as an edge.
 #[test]
 fn the_emission_at_an_emitters_edges_is_its_pixel_coverage() {
     let gpu = common::gpu();
@@ -321,6 +325,10 @@ fn the_emission_at_an_emitters_edges_is_its_pixel_coverage() {
     let turn = glam::Mat3::from_rotation_z(25f32.to_radians());
     let corners = [[-0.5, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]].map(|[x, y]| turn * Vec3::new(x, y, 0.0));
     scene.add_quad(corners, light);
+    // A black wall behind it, so that the pixels around the square see a surface, not the
+    // (black) sky, which counts as light itself.
+    let wall = scene.add_material(Material::diffuse("wall", Vec3::ZERO));
+    scene.add_quad([[-3.0, -3.0], [3.0, -3.0], [3.0, 3.0], [-3.0, 3.0]].map(|[x, y]| Vec3::new(x, y, -1.0)), wall);
     let (w, h) = (64u32, 48u32);
     // The corners' images, in pixels from the top-left corner.
     let (right, up, forward) = camera.frame();
@@ -353,7 +361,25 @@ fn the_emission_at_an_emitters_edges_is_its_pixel_coverage() {
         (rms, e.iter().sum::<f64>() / e.len() as f64, elsewhere)
     };
     let (point, _, _) = errors(&common::render(&gpu, &scene, settings(0), 1, Show::Direct));
-    let (one, _, _) = errors(&common::render(&gpu, &scene, settings(4), 1, Show::Direct));
+    let mut r = rastergi::renderer::Renderer::new(&gpu, &scene, settings(4)).unwrap();
+    r.iterate().unwrap();
+    let (one, _, _) = errors(&r.read_linear(Show::Direct).unwrap());
+    let film = r.film_state().unwrap();
+    let share =
+        |k: usize| f64::from(film.sums[(rastergi::gpu::consts::FILM_DIRECT as usize * coverage.len() + k) * 4 + 3]);
+    let shares = edge.iter().map(|&k| (share(k) - coverage[k]).powi(2)).sum::<f64>() / edge.len() as f64;
+    let off_edge =
+        (0..coverage.len()).filter(|k| !edge.contains(k)).map(|k| (share(k) - coverage[k]).abs()).fold(0.0, f64::max);
+    println!(
+        "the film's share of light after one iteration: at the edge pixels RMS error {:.4}, elsewhere at most {off_edge:.4}",
+        shares.sqrt()
+    );
+    assert!(
+        shares.sqrt() < 0.06,
+        "the film's share of light at the edge pixels is not their coverage (RMS {:.4})",
+        shares.sqrt()
+    );
+    assert!(off_edge <= 1.0 / 16.0 + 0.01, "the film's share of light off the edges is off by {off_edge:.4}");
     let (many, bias, elsewhere) = errors(&common::render(&gpu, &scene, settings(4), 64, Show::Direct));
     println!(
         "{} edge pixels: RMS error of one iteration {point:.4} (one sample) → {one:.4} (16 rays); of 64 iterations {many:.5}, mean {bias:+.5}; elsewhere at most {elsewhere:.4}",

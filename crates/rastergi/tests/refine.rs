@@ -90,9 +90,10 @@ fn the_image_in_the_middle_of_a_banded_iteration_counts_its_rows_once_more() {
 
 /// The blend of `film` (with `rows_ahead`) and the preview `pre` weighted `w`, as
 /// `Film::encode_resolve_preview` documents it, at every pixel: none where the film has an
-/// iteration and its samples show an edge of light (the shares of the samples that saw light,
-/// the direct component's fourth channel, differ in the pixel's 3 × 3 neighbourhood) or the
-/// preview's four taps do.
+/// iteration and its samples show an edge of light (the shares of the pixel that saw light,
+/// the direct component's fourth channel, differ in the pixel's 3 × 3 neighbourhood); where
+/// the film has an iteration and no edge, only the preview's taps whose share of light is the
+/// film pixel's; all of them where the film has none.
 fn blend(film: &FilmState, rows_ahead: u32, pre: &FilmState, pre_rows_ahead: u32, w: f32) -> Vec<[f32; 3]> {
     let (fw, fh, pw, ph) = (film.width, film.height, pre.width, pre.height);
     let pixels = (fw * fh) as usize;
@@ -120,25 +121,23 @@ fn blend(film: &FilmState, rows_ahead: u32, pre: &FilmState, pre_rows_ahead: u32
             let py = (y as f32 + 0.5) * ph as f32 / fh as f32 - 0.5;
             let (bx, by) = (px.floor(), py.floor());
             let (fx, fy) = (px - bx, py - by);
-            let (mut taps, mut tw, mut light) = ([0.0f32; 3], 0.0f32, (1.0f32, 0.0f32));
+            let own = (n > 0).then(|| share(x, y).0);
+            let (mut taps, mut tw) = ([0.0f32; 3], 0.0f32);
             for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
                 let qx = (bx + dx as f32).clamp(0.0, pw as f32 - 1.0) as u32;
                 let qy = (by + dy as f32).clamp(0.0, ph as f32 - 1.0) as u32;
                 let wt = if dx == 1 { fx } else { 1.0 - fx } * if dy == 1 { fy } else { 1.0 - fy };
                 let m = pre.samples + u32::from(qy < pre_rows_ahead);
-                if m > 0 && wt > 0.0 {
-                    let q = (qy * pw + qx) as usize;
+                let q = (qy * pw + qx) as usize;
+                let seen = pre.sums[(FILM_DIRECT as usize * (pw * ph) as usize + q) * 4 + 3] / m.max(1) as f32;
+                if m > 0 && wt > 0.0 && own.is_none_or(|s| s == seen) {
                     let v = mean(pre, q, m);
                     (0..3).for_each(|c| taps[c] += wt * v[c]);
                     tw += wt;
-                    let seen = pre.sums[(FILM_DIRECT as usize * (pw * ph) as usize + q) * 4 + 3] / m as f32;
-                    light = (light.0.min(seen), light.1.max(seen));
                 }
             }
             let weight = n as f32;
-            let taps_edge = light.0 != light.1 && n > 0;
-            let wp =
-                if tw > 0.0 && !edge(x, y) && !taps_edge { w * tw / ((1.0 + weight) * (1.0 + weight)) } else { 0.0 };
+            let wp = if tw > 0.0 && !edge(x, y) { w * tw / ((1.0 + weight) * (1.0 + weight)) } else { 0.0 };
             let preview = taps.map(|t| if tw > 0.0 { t / tw } else { 0.0 });
             let total = [0, 1, 2].map(|c| sum[c] + wp * preview[c]);
             let all = weight + wp;

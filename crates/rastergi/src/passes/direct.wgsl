@@ -84,7 +84,8 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
         }
         reflected += sum / f32(frame.light_samples);
     }
-    film_add_seen(FILM_DIRECT, gid.xy, seen_emission(p, gid.xy) + p.weight * reflected, select(0.0, 1.0, sees_light(p)));
+    let emitted = seen_emission(p, gid.xy);
+    film_add_seen(FILM_DIRECT, gid.xy, emitted.radiance + p.weight * reflected, emitted.light);
     // One light sample's variance at this visible point, estimated from this iteration's k:
     // s² = (Σe² − (Σe)²/k)/(k − 1) per channel, times the path's weight², summed over the
     // channels (the light budget's D, passes/light_budget.rs).

@@ -11,9 +11,11 @@ fn film_add(component: u32, texel: vec2u, v: vec3f) {
 }
 
 // film_add, and `seen` to the component's fourth channel: the direct pass and the path tracer
-// add 1 to FILM_DIRECT's where this iteration's sample of the pixel sees an emitter or the
-// sky, directly or through smooth glass and mirrors (FilmState::error_estimate leaves such
-// pixels out); FILM_INDIRECT's is film_add_light_variance's; nothing else writes them.
+// add to FILM_DIRECT's the share of the pixel that this iteration sees as an emitter or the
+// sky, directly or through smooth glass and mirrors — 1 or 0 by its sample, or on an emitter's
+// edge the share of the direct pass's sub-pixel rays that meet light (seen_emission)
+// (FilmState::error_estimate leaves pixels with any out); FILM_INDIRECT's is
+// film_add_light_variance's; nothing else writes them.
 fn film_add_seen(component: u32, texel: vec2u, v: vec3f, seen: f32) {
     let pixel = texel.y * frame.resolution.x + texel.x;
     film[film_slot(component, pixel, frame.resolution.x * frame.resolution.y)] += vec4f(v, seen);

@@ -45,8 +45,9 @@ fn shown_film(pixel: u32, n: u32) -> vec3f {
     }
 }
 
-// The same of the preview's sums (rgb), with the count of its samples that saw light (w: the
-// direct component's fourth channel).
+// The same of the preview's sums (rgb), with how much of its samples saw light (w: the direct
+// component's fourth channel: per iteration 0 or 1, or on an emitter's edge the share of the
+// pixel's sub-pixel rays that met light).
 fn shown_preview(pixel: u32, n: u32) -> vec4f {
     let direct = preview[film_slot(FILM_DIRECT, pixel, n)];
     switch params.show {
@@ -58,15 +59,16 @@ fn shown_preview(pixel: u32, n: u32) -> vec4f {
 }
 
 // The preview at the centre of film pixel `xy`: its mean, bilinear over its pixels that hold
-// an iteration; the share of the four taps' weight that did; and whether those taps straddle
-// an edge of light (the shares of their samples that saw light differ).
+// an iteration and, where `own` ≥ 0 (the film pixel's share of light, known), whose share of
+// light is the same; the share of the four taps' weight so taken; and whether the taps that
+// hold an iteration straddle an edge of light (their shares of light differ).
 struct PreviewTaps {
     mean: vec3f,
     weight: f32,
     edge: bool,
 }
 
-fn preview_mean(xy: vec2u) -> PreviewTaps {
+fn preview_mean(xy: vec2u, own: f32) -> PreviewTaps {
     let size = params.preview_size;
     let n = size.x * size.y;
     // The film pixel's centre in the preview's pixels, less ½: the taps' corner.
@@ -83,21 +85,23 @@ fn preview_mean(xy: vec2u) -> PreviewTaps {
         let samples = params.preview_samples + select(0u, 1u, q.y < params.preview_rows_ahead);
         if samples > 0u && w > 0.0 {
             let v = shown_preview(q.y * size.x + q.x, n);
-            sum += w * v.rgb / f32(samples);
-            weight += w;
             let share = v.w / f32(samples);
+            if own < 0.0 || share == own {
+                sum += w * v.rgb / f32(samples);
+                weight += w;
+            }
             light = vec2f(min(light.x, share), max(light.y, share));
         }
     }
     if weight == 0.0 {
-        return PreviewTaps(vec3f(0.0), 0.0, false);
+        return PreviewTaps(vec3f(0.0), 0.0, light.x < light.y);
     }
-    return PreviewTaps(sum / weight, weight, light.x != light.y);
+    return PreviewTaps(sum / weight, weight, light.x < light.y);
 }
 
 // The film's iterations at pixel xy (one more in the rows an iteration under way in bands has
-// reached) and how many of their samples saw light itself — an emitter's front face, the sky:
-// the direct component's fourth channel counts them.
+// reached) and how much of their samples saw light itself — an emitter's front face, the sky:
+// the direct component's fourth channel sums it (shown_preview).
 fn light_count(xy: vec2u) -> vec2f {
     let n = params.samples + select(0u, 1u, xy.y < params.rows_ahead);
     let seen = film[film_slot(FILM_DIRECT, xy.y * params.resolution.x + xy.x, params.resolution.x * params.resolution.y)].w;
@@ -106,11 +110,11 @@ fn light_count(xy: vec2u) -> vec2f {
 
 // Whether the film's samples show an edge of light at pixel xy: the shares of its 3 × 3
 // neighbourhood's pixels (within the image) that hold an iteration differ from its own
-// (compared as seen·n' ≠ seen'·n: exact, as nothing is blended past 256 iterations). Unrolled, each
+// (compared as seen·n' ≠ seen'·n: exact, as the shares are multiples of the sub-pixel rays'
+// 1/n² and nothing is blended past 256 iterations). Unrolled, each
 // neighbour clamped to the image (which repeats pixels of the neighbourhood): a loop whose
 // bounds vary by pixel costs a CPU adapter more than its loads.
-fn film_light_edge(xy: vec2u) -> bool {
-    let c = light_count(xy);
+fn film_light_edge(xy: vec2u, c: vec2f) -> bool {
     let hi = vec2i(params.resolution) - 1;
     var edge = false;
     for (var k = 0u; k < 9u; k++) {
@@ -137,7 +141,8 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     // upscaled from another image, whose pixels straddle the edge elsewhere: once the film
     // has an iteration there, neither is blended in.
     let blending = params.history_weight > 0.0 || (params.preview_size.x > 0u && params.preview_weight > 0.0);
-    let edge = blending && iterations > 0.0 && film_light_edge(gid.xy);
+    let own = light_count(gid.xy);
+    let edge = blending && iterations > 0.0 && film_light_edge(gid.xy, own);
     // Whether the view before the move is kept here (re-projected: the same side of the same
     // triangle at a point a fraction of a pixel away).
     var kept = false;
@@ -154,13 +159,17 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     if params.preview_size.x > 0u && params.preview_weight > 0.0 && !edge {
         // The preview's weight fades as (1 + n + h')⁻²: all of the image where nothing else
         // is known, a quarter of its weight at the first iteration, then gone before its blur
-        // (a bias) could outlast the film's noise (which falls as 1/n); where its taps
-        // straddle an edge of light, only until the film has an iteration, and not where the
-        // view before the move is kept: its coarse pixels spread an emitter's or the sky's
-        // radiance (hundreds of times the image's) over their neighbours, which the kept
-        // pixel, as sharp as the window's, does not.
-        let p = preview_mean(gid.xy);
-        if !(p.edge && (iterations > 0.0 || kept)) {
+        // (a bias) could outlast the film's noise (which falls as 1/n). A preview pixel that
+        // straddles an edge of light holds the emitter's or the sky's radiance (hundreds of
+        // times the image's) over its whole area, which its upsampling spreads over window
+        // pixels that do not see it: where the film's samples here agree with their
+        // neighbours' on how much light they see (no edge), only the taps that see as much are
+        // taken; where the film has no iteration here, taps that straddle an edge are left
+        // out where the view before the move is kept (as sharp as the window's), and are all
+        // there is otherwise.
+        let share = select(-1.0, own.x / own.y, iterations > 0.0);
+        let p = preview_mean(gid.xy, share);
+        if share >= 0.0 || !(p.edge && kept) {
             let w = params.preview_weight * p.weight / ((1.0 + weight) * (1.0 + weight));
             total += w * p.mean;
             weight += w;

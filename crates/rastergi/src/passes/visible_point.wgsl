@@ -137,10 +137,13 @@ fn emitted_radiance(p: VisiblePoint, xy: vec2u) -> vec3f {
 
 // What the camera ray through image point q (pixels from the top-left corner, not jittered)
 // first meets, as light: key 0 where nothing emits towards the eye, 1 the environment, 2 + m
-// an emitter's front face of material m; and the radiance.
+// an emitter's front face of material m; the radiance; and whether it is light itself as
+// sees_light counts it (an emitter's front face, or an escape: the environment even where
+// it is black).
 struct SeenLight {
     key: u32,
     radiance: vec3f,
+    light: bool,
 }
 
 fn light_seen_through(q: vec2f) -> SeenLight {
@@ -149,13 +152,13 @@ fn light_seen_through(q: vec2f) -> SeenLight {
     let hit = trace(frame.eye, d, 0.0, 3.0e38, NO_TRIANGLE, NO_TRIANGLE, false);
     if hit.tri == NO_TRIANGLE {
         let e = env_radiance(d);
-        return SeenLight(select(0u, 1u, any(e > vec3f(0.0))), e);
+        return SeenLight(select(0u, 1u, any(e > vec3f(0.0))), e, true);
     }
     let s = surface_at(hit.tri, hit.b1, hit.b2, 0.0);
     if dot(s.normal, frame.eye - s.pos) > 0.0 && any(s.emission > vec3f(0.0)) {
-        return SeenLight(min(2u + triangles[hit.tri].material, EDGE_FLAG - 1u), s.emission);
+        return SeenLight(min(2u + triangles[hit.tri].material, EDGE_FLAG - 1u), s.emission, true);
     }
-    return SeenLight(0u, vec3f(0.0));
+    return SeenLight(0u, vec3f(0.0), false);
 }
 
 // Added to a pixel's key where it lies on an emitter's edge (its 3 × 3 neighbourhood's keys
@@ -175,24 +178,40 @@ fn on_emitter_edge(xy: vec2u) -> bool {
 
 // What pixel xy adds before any light is reflected: the emission its visible point p sends
 // to the eye, times the eye chain's throughput (emitted_radiance), its own part estimated by
-// sub-pixel rays on an emitter's edge (above). The direct pass adds it to the film; the
-// denoiser's guides sum the same (the same random numbers).
-fn seen_emission(p: VisiblePoint, xy: vec2u) -> vec3f {
+// sub-pixel rays on an emitter's edge (above); and the share of the pixel that sees light
+// itself in this estimate — 0 or 1 from the jittered sample (sees_light), or on an edge the
+// share of the sub-pixel rays that meet light as sees_light counts it (1 where the jittered
+// sample sees it through a specular chain). The direct pass adds both to the film (the share to
+// FILM_DIRECT's fourth channel: a pixel on an edge of light then shows that it straddles one,
+// whatever its jittered sample met); the denoiser's guides sum the same radiance (the same
+// random numbers).
+struct SeenEmission {
+    radiance: vec3f,
+    light: f32,
+}
+
+fn seen_emission(p: VisiblePoint, xy: vec2u) -> SeenEmission {
     let point = p.weight * emitted_radiance(p, xy);
+    let seen = select(0.0, 1.0, sees_light(p));
     let n = frame.emitter_edges;
     if n == 0u || !on_emitter_edge(xy) {
-        return point;
+        return SeenEmission(point, seen);
     }
     // Behind a specular chain the point's emission is reflected light: it stays.
-    let e = select(vec3f(0.0), point, any(p.eye != frame.eye));
+    let chain = any(p.eye != frame.eye);
+    let e = select(vec3f(0.0), point, chain);
     var state = rng_new(frame.seed ^ STREAM_EMITTER_EDGE, pixel_index(xy), frame.iteration);
     var sum = vec3f(0.0);
+    var hits = 0u;
     for (var i = 0u; i < n * n; i++) {
         let cell = vec2f(f32(i % n), f32(i / n));
         let u = (cell + vec2f(rng_f32(&state), rng_f32(&state))) / f32(n);
-        sum += light_seen_through(vec2f(xy) + u).radiance;
+        let s = light_seen_through(vec2f(xy) + u);
+        sum += s.radiance;
+        hits += select(0u, 1u, s.light);
     }
-    return e + sum / f32(n * n);
+    let share = select(f32(hits) / f32(n * n), 1.0, chain && seen > 0.0);
+    return SeenEmission(e + sum / f32(n * n), share);
 }
 
 // Whether the visible point is light itself, as emitted_radiance sees it: the sky where the

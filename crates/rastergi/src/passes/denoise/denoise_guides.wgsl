@@ -26,7 +26,7 @@ fn accumulate_guides(@builtin(global_invocation_id) id: vec3u) {
     var depth = 0.0;
     var seen = 0.0;
     // What the direct pass adds before any light is reflected.
-    let emitted = seen_emission(v, xy);
+    let emitted = seen_emission(v, xy).radiance;
     if v.seen {
         albedo = v.weight * v.x.albedo;
         normal = v.ns;

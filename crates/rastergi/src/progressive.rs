@@ -60,6 +60,18 @@ pub trait Progressive: wgpu::WasmNotSend {
     ) {
         self.encode_resolve(enc, show, exposure);
     }
+    /// Where the film holds nothing of this view yet and nothing of the view before the move
+    /// is blended in (a moving frame), encodes the preview's own resolve at its size, which
+    /// the display then upscales ([`Film::show_upscaled`]), and returns true; else encodes
+    /// nothing and returns false (the default).
+    fn encode_resolve_upscaled(
+        &mut self,
+        _enc: &mut wgpu::CommandEncoder,
+        _shown: (Show, f32),
+        _preview: Option<(u32, f32)>,
+    ) -> bool {
+        false
+    }
     /// Re-projects what the film held before the last camera move onto the current view, for
     /// the display ([`crate::passes::history`]); false where there is nothing to do (the
     /// default: the path tracer keeps nothing).

@@ -1,6 +1,7 @@
 //! The display pass shows exactly the bytes of the display image (the PNG screenshot): on a
 //! plain `*Unorm` target as they are, on an `*Srgb` target through decode + hardware encode;
-//! and its overlay darkens a box and lights glyph texels on top.
+//! a moving frame's preview, upscaled, as bilinear between its pixel centres; and its overlay
+//! darkens a box and lights glyph texels on top.
 
 mod common;
 
@@ -13,6 +14,20 @@ use rastergi::settings::RenderSettings;
 /// Draws the renderer's film (resolved for the full image at `exposure`) with `overlay` onto
 /// a `format` texture of the film's size and reads it back as RGBA8 rows.
 fn draw(gpu: &Gpu, renderer: &Renderer, format: wgpu::TextureFormat, overlay: &[String]) -> Vec<u8> {
+    let mut enc = gpu.device.create_command_encoder(&Default::default());
+    renderer.encode_resolve(&mut enc, rastergi::passes::film::Show::Full, 0.5);
+    draw_resolved(gpu, renderer, enc, format, overlay)
+}
+
+/// Draws the renderer's film as last resolved (after `enc`'s work) onto a `format` texture of
+/// the film's size and reads it back as RGBA8 rows.
+fn draw_resolved(
+    gpu: &Gpu,
+    renderer: &Renderer,
+    mut enc: wgpu::CommandEncoder,
+    format: wgpu::TextureFormat,
+    overlay: &[String],
+) -> Vec<u8> {
     let (w, h) = (renderer.settings().width, renderer.settings().height);
     let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
         label: Some("display target"),
@@ -26,8 +41,6 @@ fn draw(gpu: &Gpu, renderer: &Renderer, format: wgpu::TextureFormat, overlay: &[
     });
     let view = texture.create_view(&Default::default());
     let mut pass = DisplayPass::new(gpu, format);
-    let mut enc = gpu.device.create_command_encoder(&Default::default());
-    renderer.encode_resolve(&mut enc, rastergi::passes::film::Show::Full, 0.5);
     pass.encode(gpu, &mut enc, &view, (w, h), Some(renderer.film()), overlay);
     let row = (w * 4).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
     let buffer = gpu.zeroed_buffer(
@@ -105,4 +118,53 @@ fn overlay_lights_glyphs_over_a_darkened_box_and_leaves_the_rest() {
     // '#' lights a good part of its cell, and not all of it.
     assert!((10..50).contains(&lit), "{lit} glyph texels");
     assert!(dark > 16 * 16 - 64, "{dark}");
+}
+
+/// A moving frame whose film holds nothing yet shows the preview's own resolve, upscaled by the
+/// display pass: each window pixel bilinear between the preview pixels' centres around its own
+/// centre (as the resolve stretches a preview), of the preview's display bytes, computed here
+/// on the CPU from those bytes — within one step of rounding. Once the film has an iteration
+/// nothing is upscaled and the display shows the film's own resolve again.
+#[test]
+fn a_moving_frames_preview_is_upscaled_between_its_pixel_centres() {
+    let gpu = common::gpu();
+    let (w, h) = (64u32, 40u32);
+    let settings = RenderSettings { width: w, height: h, photons: 1 << 14, grid_resolution: 16, ..Default::default() };
+    let mut r = Renderer::new(&gpu, &cornell_box(), settings).unwrap();
+    for _ in 0..2 {
+        while !r.iterate_preview_rows(4, 64).unwrap() {}
+    }
+    let show = (rastergi::passes::film::Show::Full, 0.5);
+    let mut enc = gpu.device.create_command_encoder(&Default::default());
+    assert!(r.encode_resolve_upscaled(&mut enc, show, Some((4, 2.0))), "the film is empty: the preview is upscaled");
+    let shown = draw_resolved(&gpu, &r, enc, wgpu::TextureFormat::Rgba8Unorm, &[]);
+    let pre = r.preview_film(4).unwrap().read_display_buffer(&gpu).unwrap();
+    assert_eq!((pre.width, pre.height), (16, 10));
+    let texel = |x: f32, y: f32, c: usize| {
+        let (x, y) = (x.clamp(0.0, 15.0) as usize, y.clamp(0.0, 9.0) as usize);
+        f32::from(pre.rgba[4 * (y * 16 + x) + c])
+    };
+    let mut worst = 0.0f32;
+    for y in 0..h {
+        for x in 0..w {
+            let (px, py) = ((x as f32 + 0.5) / 4.0 - 0.5, (y as f32 + 0.5) / 4.0 - 0.5);
+            let (bx, by) = (px.floor(), py.floor());
+            let (fx, fy) = (px - bx, py - by);
+            for c in 0..3 {
+                let top = texel(bx, by, c) * (1.0 - fx) + texel(bx + 1.0, by, c) * fx;
+                let bottom = texel(bx, by + 1.0, c) * (1.0 - fx) + texel(bx + 1.0, by + 1.0, c) * fx;
+                let want = top * (1.0 - fy) + bottom * fy;
+                worst = worst.max((f32::from(shown[4 * (y * w + x) as usize + c]) - want).abs());
+            }
+        }
+    }
+    assert!(worst <= 1.0, "the upscaled preview differs from its bilinear by up to {worst} steps");
+    assert!(pre.rgba.chunks(4).any(|p| p[0] > 40 && p[0] < 250), "a lit, unsaturated pixel to compare");
+    // An iteration of the window's own: its resolve, not the preview's.
+    r.iterate().unwrap();
+    let mut enc = gpu.device.create_command_encoder(&Default::default());
+    assert!(!r.encode_resolve_upscaled(&mut enc, show, Some((4, 2.0))));
+    r.encode_resolve(&mut enc, show.0, show.1);
+    let own = draw_resolved(&gpu, &r, enc, wgpu::TextureFormat::Rgba8Unorm, &[]);
+    assert_eq!(own, r.film().read_display_buffer(&gpu).unwrap().rgba, "the film's own resolve is not what is shown");
 }

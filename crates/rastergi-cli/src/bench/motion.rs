@@ -6,8 +6,8 @@
 //! orbit of `--orbit` degrees about the target and a walk forward of a tenth of the scene's
 //! diagonal, each over half of `--motion` seconds, the camera placed each frame where the
 //! script is at that time (a slow frame makes a long step, as it does under a hand), then still
-//! again. A frame is the viewer's: [`Interactive::frame`], the resolve and the display pass
-//! into an offscreen texture of the window's size.
+//! again. A frame is the viewer's: [`Interactive::frame`], the resolve when due and the display
+//! pass into an offscreen texture of the window's size when due ([`Interactive::draw_due`]).
 //!
 //! Printed per variant: the frame times during the motion (median, and the 95th percentile on
 //! a line with `p95 … ms`), the time from the last move to the first frame whose film holds a
@@ -146,7 +146,8 @@ fn run_variant(
         let began = Instant::now();
         view.frame(u32::MAX)?;
         let work = began.elapsed().as_secs_f64();
-        // As the viewer: the resolve when due, the display pass every frame.
+        // As the viewer: the resolve when due, the display pass when the view says it is
+        // (a new image, else now and then).
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         let mut resolve = None;
         let resolved = view.display_due();
@@ -165,11 +166,18 @@ fn run_variant(
             }
         }
         let at = Instant::now();
-        target.present(gpu, enc, Some(view.renderer().film()), &[])?;
+        let drawn = view.draw_due(resolved);
+        if drawn {
+            target.present(gpu, enc, Some(view.renderer().film()), &[])?;
+            view.drawn();
+        } else {
+            gpu.queue.submit([enc.finish()]);
+        }
         gpu.wait()?;
         if split {
             let ms = |t: Option<f64>| t.map_or("-".to_owned(), |t| format!("{:.1}", 1e3 * t));
-            log::debug!("  drawing: resolve {} ms, display {} ms", ms(resolve), ms(Some(at.elapsed().as_secs_f64())));
+            let display = drawn.then(|| at.elapsed().as_secs_f64());
+            log::debug!("  drawing: resolve {} ms, display {} ms", ms(resolve), ms(display));
         }
         Ok((work, began.elapsed().as_secs_f64() - work, resolved))
     };

@@ -43,6 +43,9 @@ gpu_struct! {
         pub(crate) text_cols: u32,
         pub(crate) text_rows: u32,
         pub(crate) text_scale: u32,
+        /// The size of the image in the display buffer: the film's, or a smaller image of the
+        /// same view stretched over the film's frame ([`crate::passes::film::DisplaySource`]).
+        pub(crate) source_size: [u32; 2],
     }
 }
 
@@ -161,9 +164,10 @@ impl DisplayPass {
         self.format
     }
 
-    /// Encodes drawing `film`'s display buffer (as last resolved; the background where there
+    /// Encodes drawing `film`'s display image (as last resolved, [`Film::display_source`]: its
+    /// own, or a smaller image of the same view upscaled bilinearly; the background where there
     /// is no film) scaled to fit a `target_size` target, and the `overlay` lines on top.
-    /// Reads: the film's display buffer. Writes: `target`, whole.
+    /// Reads: that display buffer. Writes: `target`, whole.
     pub fn encode(
         &mut self,
         gpu: &Gpu,
@@ -175,9 +179,11 @@ impl DisplayPass {
     ) {
         let (cols, rows, text) = layout_text(overlay);
         gpu.queue.write_buffer(&self.text, 0, bytemuck::cast_slice(&text));
-        let image_size = film.map_or([0, 0], |f| [f.width, f.height]);
+        let source = film.map(Film::display_source);
+        let image_size = source.as_ref().map_or([0, 0], |s| s.frame);
         let u = DisplayUniforms {
             image_size,
+            source_size: source.as_ref().map_or([0, 0], |s| s.size),
             target_size: [target_size.0, target_size.1],
             decode_srgb: needs_decode(self.format) as u32,
             text_cols: cols,
@@ -185,7 +191,7 @@ impl DisplayPass {
             text_scale: text_scale(target_size.1),
         };
         gpu.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
-        let image = film.map_or(&self.no_image, |f| f.display_buffer()).clone();
+        let image = source.map_or_else(|| self.no_image.clone(), |s| s.buffer);
         if self.bound.as_ref().is_none_or(|(b, _)| *b != image) {
             let bind_group = group().bind(
                 &gpu.device,

@@ -31,7 +31,11 @@ fn srgb_decode(c: vec3f) -> vec3f {
 }
 
 // The film pixel shown at target pixel `p`: the image scaled to fit, centred, nearest
-// neighbour; the identity when the sizes agree. The background colour off the image.
+// neighbour; the identity when the sizes agree. The background colour off the image. Where the
+// display buffer holds a smaller image of the same view (params.source_size, a moving frame's
+// preview), the film pixel's value is that image's, bilinear between its pixel centres as the
+// resolve stretches a preview over the film (resolve.wgsl's preview_mean), of the encoded
+// values.
 fn image_at(p: vec2f) -> vec3f {
     let image_size = vec2f(params.image_size);
     if params.image_size.x == 0u || params.image_size.y == 0u {
@@ -44,8 +48,20 @@ fn image_at(p: vec2f) -> vec3f {
     if any(q < vec2f(0.0)) || any(q >= image_size) {
         return BACKGROUND;
     }
-    let i = u32(q.y) * params.image_size.x + u32(q.x);
-    return unpack4x8unorm(image[i]).rgb;
+    if all(params.source_size == params.image_size) {
+        let i = u32(q.y) * params.image_size.x + u32(q.x);
+        return unpack4x8unorm(image[i]).rgb;
+    }
+    let size = vec2f(params.source_size);
+    let c = (q + 0.5) * size / image_size - 0.5;
+    let base = floor(c);
+    let f = c - base;
+    let lo = vec2u(clamp(base, vec2f(0.0), size - 1.0));
+    let hi = vec2u(clamp(base + 1.0, vec2f(0.0), size - 1.0));
+    let w = params.source_size.x;
+    let top = mix(unpack4x8unorm(image[lo.y * w + lo.x]).rgb, unpack4x8unorm(image[lo.y * w + hi.x]).rgb, f.x);
+    let bottom = mix(unpack4x8unorm(image[hi.y * w + lo.x]).rgb, unpack4x8unorm(image[hi.y * w + hi.x]).rgb, f.x);
+    return mix(top, bottom, f.y);
 }
 
 // Overlay coverage at target pixel `p`: x = 1 on a glyph's lit texel, y = 1 inside the

@@ -136,6 +136,21 @@ pub struct Film {
     /// The resolve's layout and its `resolve_image` entry ([`ImageResolve`]).
     layout: wgpu::BindGroupLayout,
     image_pipeline: wgpu::ComputePipeline,
+    /// Where the last resolve for display was a smaller image's of the same view (a moving
+    /// frame's preview, [`Film::show_upscaled`]): its display buffer and size, which the
+    /// display pass upscales onto this film's frame; `None` where it was this film's own.
+    upscaled: std::sync::Mutex<Option<(wgpu::Buffer, [u32; 2])>>,
+}
+
+/// The image the display pass draws for a film ([`Film::display_source`]): a display buffer
+/// (packed sRGB, row-major), its size in pixels, and the size of the frame it fills — the
+/// film's; where the two differ the buffer is a smaller image of the same view, stretched over
+/// the frame as the resolve stretches a preview (bilinear between pixel centres).
+#[derive(Clone, Debug)]
+pub struct DisplaySource {
+    pub buffer: wgpu::Buffer,
+    pub size: [u32; 2],
+    pub frame: [u32; 2],
 }
 
 /// The resolve of a linear image of the film's size that is already a mean (one vec4 per
@@ -255,6 +270,7 @@ impl Film {
             bind_group,
             layout,
             image_pipeline,
+            upscaled: std::sync::Mutex::new(None),
         })
     }
 
@@ -336,6 +352,29 @@ impl Film {
     /// RGBA8 sRGB pixel (`pack4x8unorm`) per `u32`, row-major, row 0 at the top.
     pub fn display_buffer(&self) -> &wgpu::Buffer {
         &self.display
+    }
+
+    /// What the display pass draws for this film: its own display buffer, or, where the last
+    /// resolve for display was a smaller image's ([`Film::show_upscaled`]), that one's.
+    pub fn display_source(&self) -> DisplaySource {
+        let frame = [self.width, self.height];
+        match &*self.upscaled.lock().unwrap_or_else(|e| e.into_inner()) {
+            Some((buffer, size)) => DisplaySource { buffer: buffer.clone(), size: *size, frame },
+            None => DisplaySource { buffer: self.display.clone(), size: frame, frame },
+        }
+    }
+
+    /// The display shows `smaller`'s display buffer (a film of the same view at a smaller size,
+    /// resolved for display), stretched over this film's frame, until this film's next resolve.
+    /// Its linear buffer and display buffer keep what they held.
+    pub fn show_upscaled(&self, smaller: &Film) {
+        *self.upscaled.lock().unwrap_or_else(|e| e.into_inner()) =
+            Some((smaller.display.clone(), [smaller.width, smaller.height]));
+    }
+
+    /// This film's own resolve is shown again.
+    fn show_own(&self) {
+        *self.upscaled.lock().unwrap_or_else(|e| e.into_inner()) = None;
     }
 
     /// The linear image written by the last resolve ([`Film::read_linear_buffer`] reads it):
@@ -441,6 +480,7 @@ impl Film {
         (pipeline, bind_group, uniforms): (&wgpu::ComputePipeline, &wgpu::BindGroup, &wgpu::Buffer),
         u: &ResolveUniforms,
     ) {
+        self.show_own();
         gpu.queue.write_buffer(uniforms, 0, bytemuck::bytes_of(u));
         let mut pass = crate::gpu::profile::compute_pass(enc, gpu.profiler.as_ref(), label);
         pass.set_pipeline(pipeline);

@@ -96,6 +96,7 @@ impl ApplicationHandler<UserEvent> for App {
         {
             let r = panel.input.on_window_event(window, &event);
             if r.repaint {
+                self.draw_next = true;
                 window.request_redraw();
             }
             to_panel = r.consumed;
@@ -114,11 +115,13 @@ impl ApplicationHandler<UserEvent> for App {
                     self.size = (size.width, size.height);
                     self.resized_at = Some(Instant::now());
                 }
+                self.draw_next = true;
                 self.redraw();
             }
             WindowEvent::Occluded(occluded) => {
                 self.occluded = occluded;
                 if !occluded {
+                    self.draw_next = true;
                     self.redraw();
                 }
             }

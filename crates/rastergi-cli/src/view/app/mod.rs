@@ -88,6 +88,10 @@ pub struct App {
     resized_at: Option<Instant>,
     occluded: bool,
     retry_at: Option<Instant>,
+    /// The next frame draws whatever the view says (input reached the panel, the window was
+    /// resized or uncovered), and when the panel last asked to be drawn again.
+    draw_next: bool,
+    panel_repaint_at: Option<Instant>,
     /// Mouse buttons held (left, right) and the last cursor position.
     dragging: (bool, bool),
     cursor: Option<(f64, f64)>,
@@ -142,6 +146,8 @@ impl App {
             resized_at: None,
             occluded: false,
             retry_at: None,
+            draw_next: true,
+            panel_repaint_at: None,
             dragging: (false, false),
             cursor: None,
             last_frame: Instant::now(),
@@ -360,23 +366,39 @@ impl App {
         }
     }
 
-    /// Encodes the resolve of what the window shows into the film's display buffer: the raw
-    /// image of `show`, or the denoised one, filtered again first when it is due
-    /// ([`denoise::Schedule`]).
-    fn encode_resolve(&mut self, enc: &mut egui_wgpu::wgpu::CommandEncoder, show: Show) -> Result<()> {
+    /// Encodes the resolve of what the window shows into the film's display buffer where one is
+    /// due: the raw image of the component shown ([`App::draw_due`] sets it), or the denoised
+    /// one, filtered again first when it is due ([`denoise::Schedule`]).
+    fn encode_resolve(&mut self, enc: &mut egui_wgpu::wgpu::CommandEncoder) -> Result<()> {
         let now = self.clock.elapsed().as_secs_f64();
         if let Some((view, _)) = &mut self.renderer {
-            if (view.show, view.exposure) != (show, self.controls.exposure) {
-                (view.show, view.exposure) = (show, self.controls.exposure);
-                view.invalidate();
-            }
             // While the camera is still the image is resolved a few times a second (the last
-            // one stays on screen); the panel is drawn every frame.
+            // one stays on screen).
             if view.display_due() {
                 view.encode_resolve(enc, now)?;
             }
         }
         Ok(())
+    }
+
+    /// Whether this frame draws the window (the display pass, the panel, present): where the
+    /// view resolves a new image or says so otherwise ([`Interactive::draw_due`]: an idle view
+    /// every frame, a working one at least every half second), where input reached the panel
+    /// or the window was resized or uncovered, or where the panel asked to be drawn by now.
+    /// Between resolves the image is the same, and on a slow adapter the display pass costs a
+    /// good part of a frame that the iterations would have.
+    fn draw_due(&mut self, show: Show) -> bool {
+        let panel = self.controls.panel && self.panel.is_some();
+        let view = self.renderer.as_mut().map(|(view, _)| {
+            if (view.show, view.exposure) != (show, self.controls.exposure) {
+                (view.show, view.exposure) = (show, self.controls.exposure);
+                view.invalidate();
+            }
+            view.draw_due(view.display_due())
+        });
+        std::mem::take(&mut self.draw_next)
+            || view != Some(false)
+            || (panel && self.panel_repaint_at.is_some_and(|t| Instant::now() >= t))
     }
 
     fn screenshot(&mut self) {
@@ -543,6 +565,10 @@ impl App {
         if let Err(e) = self.iterate_batch() {
             return self.fail(event_loop, e);
         }
+        let show = self.shown();
+        if !self.draw_due(show) {
+            return self.refresh_title();
+        }
         let panel_shown = self.controls.panel && self.panel.is_some();
         if panel_shown && let Err(e) = self.measure() {
             return self.fail(event_loop, e);
@@ -551,10 +577,17 @@ impl App {
             Some((output, actions)) => (Some(output), actions),
             None => (None, Vec::new()),
         };
-        let show = self.shown();
+        // egui's next repaint: at once while it animates, else when it asked (a tooltip's delay).
+        self.panel_repaint_at = panel_output.as_ref().and_then(|o| {
+            let delay = o.viewport_output.values().map(|v| v.repaint_delay).min()?;
+            Instant::now().checked_add(delay)
+        });
         let mut enc = gpu.device.create_command_encoder(&Default::default());
-        if let Err(e) = self.encode_resolve(&mut enc, show) {
+        if let Err(e) = self.encode_resolve(&mut enc) {
             return self.fail(event_loop, e);
+        }
+        if let Some((view, _)) = &mut self.renderer {
+            view.drawn();
         }
         let (Some(surface), Some(window)) = (&mut self.surface, &self.window) else { return };
         let film = self.renderer.as_ref().map(|(r, _)| r.renderer().film());
@@ -579,6 +612,11 @@ impl App {
             let r = self.controls.action(&action, self.size.1 as f32);
             self.apply(event_loop, r);
         }
+        self.refresh_title();
+    }
+
+    /// The window's title (the scene, the iterations and their rate) about twice a second.
+    fn refresh_title(&mut self) {
         if self.title_at.elapsed() >= Duration::from_millis(500) {
             self.title_at = Instant::now();
             if let Some(w) = &self.window {

@@ -348,13 +348,9 @@ impl Film {
         Ok(())
     }
 
-    /// The display encoding written by [`encode_resolve`](Self::encode_resolve): one packed
-    /// RGBA8 sRGB pixel (`pack4x8unorm`) per `u32`, row-major, row 0 at the top.
-    pub fn display_buffer(&self) -> &wgpu::Buffer {
-        &self.display
-    }
-
-    /// What the display pass draws for this film: its own display buffer, or, where the last
+    /// What the display pass draws for this film: its own display buffer (the display encoding
+    /// written by [`encode_resolve`](Self::encode_resolve): one packed RGBA8 sRGB pixel,
+    /// `pack4x8unorm`, per `u32`, row-major, row 0 at the top), or, where the last
     /// resolve for display was a smaller image's ([`Film::show_upscaled`]), that one's.
     pub fn display_source(&self) -> DisplaySource {
         let frame = [self.width, self.height];
